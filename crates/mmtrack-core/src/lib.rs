@@ -1,0 +1,44 @@
+//! # mmtrack-core
+//!
+//! The data model every other mmtrack crate speaks, plus the small math that
+//! belongs with it. It owns:
+//!
+//! - time: `i64` nanoseconds since the UNIX epoch (or since scenario start for
+//!   simulations), always in fields named `t_ns`;
+//! - [`Se2`] rigid transforms (`world_from_vehicle`) with composition and inverse;
+//! - [`PolarScan`]: a spinning-radar sweep with per-azimuth time, angle and validity;
+//! - [`CirSnapshot`]: one channel impulse response with its tap spacing and its
+//!   position in the sounder's set/snapshot structure;
+//! - [`GnssFix`], [`MpcDetection`] and [`MpcTrack`].
+//!
+//! It must not do I/O, print, or depend on any other mmtrack crate: it sits at
+//! the bottom of the data flow (`ingest -> recording -> process -> tables ->
+//! analyze`) and everything else depends on it.
+//!
+//! Units are SI and named in identifiers (`range_m`, `delay_s`, `azimuth_rad`);
+//! geodetic latitude/longitude are the one exception and are named `_deg`.
+
+mod cir;
+mod error;
+mod gnss;
+mod mpc;
+mod pose;
+mod radar;
+
+pub use cir::CirSnapshot;
+pub use error::CoreError;
+pub use gnss::{GnssFix, GnssFixQuality};
+pub use mpc::{MpcDetection, MpcTrack};
+pub use num_complex::Complex64;
+pub use pose::{Se2, StampedPose, path_length_m, wrap_angle_rad};
+pub use radar::{AzimuthSample, PolarScan, PolarScanHeader};
+
+/// Nanoseconds per second, for converting `t_ns` to seconds at the edges.
+pub const NS_PER_S: i64 = 1_000_000_000;
+
+/// Converts a nanosecond timestamp to seconds (for display and arithmetic on
+/// durations; never store time as `f64`).
+#[must_use]
+pub fn ns_to_s(t_ns: i64) -> f64 {
+    t_ns as f64 * 1e-9
+}

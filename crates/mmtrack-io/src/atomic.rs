@@ -1,0 +1,149 @@
+//! Atomic output files: write to a temporary file beside the target, then
+//! rename over it. A crash, an error or a dropped writer leaves the previous
+//! output (if any) untouched and no partial file behind.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use tempfile::NamedTempFile;
+
+use crate::error::{IoError, Result, os_err};
+
+/// What to do when the output already exists.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Overwrite {
+    /// Refuse with [`IoError::OutputExists`] (the default; `--force` changes it).
+    #[default]
+    Refuse,
+    /// Replace the existing output atomically when the new one is complete.
+    Replace,
+}
+
+/// A file being written that only appears at `target` on [`AtomicFile::commit`].
+#[derive(Debug)]
+pub struct AtomicFile {
+    target: PathBuf,
+    temp: NamedTempFile,
+}
+
+impl AtomicFile {
+    /// Starts writing `target`: checks the overwrite policy, creates the parent
+    /// directories and a hidden temporary file in the same directory (so the
+    /// final rename never crosses file systems).
+    pub fn create(target: &Path, overwrite: Overwrite) -> Result<Self> {
+        if overwrite == Overwrite::Refuse && target.exists() {
+            return Err(IoError::OutputExists {
+                path: target.to_path_buf(),
+            });
+        }
+        let dir = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        std::fs::create_dir_all(&dir).map_err(os_err(&dir))?;
+        let file_name = target
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let temp = tempfile::Builder::new()
+            .prefix(&format!(".{file_name}."))
+            .suffix(".partial")
+            .tempfile_in(&dir)
+            .map_err(os_err(&dir))?;
+        Ok(Self {
+            target: target.to_path_buf(),
+            temp,
+        })
+    }
+
+    /// The final path.
+    #[must_use]
+    pub fn target(&self) -> &Path {
+        &self.target
+    }
+
+    /// A second handle on the temporary file, for writers that take ownership.
+    pub fn writer(&self) -> Result<BufWriter<File>> {
+        let file = self.temp.reopen().map_err(os_err(self.temp.path()))?;
+        Ok(BufWriter::with_capacity(1 << 20, file))
+    }
+
+    /// Makes the file visible at its target, replacing what was there. Re-checks
+    /// the overwrite policy, since another process may have created the target
+    /// while this one was writing.
+    pub fn commit(self, overwrite: Overwrite) -> Result<PathBuf> {
+        let Self { target, temp } = self;
+        temp.as_file().sync_all().map_err(os_err(temp.path()))?;
+        match overwrite {
+            Overwrite::Replace => {
+                temp.persist(&target).map_err(|e| IoError::Os {
+                    path: target.clone(),
+                    source: e.error,
+                })?;
+            }
+            Overwrite::Refuse => {
+                temp.persist_noclobber(&target).map_err(|e| {
+                    if e.error.kind() == std::io::ErrorKind::AlreadyExists {
+                        IoError::OutputExists {
+                            path: target.clone(),
+                        }
+                    } else {
+                        IoError::Os {
+                            path: target.clone(),
+                            source: e.error,
+                        }
+                    }
+                })?;
+            }
+        }
+        Ok(target)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    #[test]
+    fn dropped_file_leaves_nothing_and_commit_publishes() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("sub/out.bin");
+        {
+            let f = AtomicFile::create(&target, Overwrite::Refuse).unwrap();
+            f.writer().unwrap().write_all(b"half").unwrap();
+        }
+        assert!(!target.exists());
+        assert_eq!(
+            std::fs::read_dir(dir.path().join("sub")).unwrap().count(),
+            0
+        );
+
+        let f = AtomicFile::create(&target, Overwrite::Refuse).unwrap();
+        let mut w = f.writer().unwrap();
+        w.write_all(b"whole").unwrap();
+        w.flush().unwrap();
+        drop(w);
+        f.commit(Overwrite::Refuse).unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"whole");
+    }
+
+    #[test]
+    fn existing_output_is_refused_unless_replace() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.bin");
+        std::fs::write(&target, b"old").unwrap();
+        assert!(matches!(
+            AtomicFile::create(&target, Overwrite::Refuse),
+            Err(IoError::OutputExists { .. })
+        ));
+        let f = AtomicFile::create(&target, Overwrite::Replace).unwrap();
+        let mut w = f.writer().unwrap();
+        w.write_all(b"new").unwrap();
+        w.flush().unwrap();
+        drop(w);
+        f.commit(Overwrite::Replace).unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+    }
+}

@@ -1,0 +1,121 @@
+//! The topics of a canonical recording: the contract `schemas/mcap/` documents.
+
+/// One topic of a canonical recording.
+#[derive(Debug, Clone, Copy)]
+pub struct ChannelSpec {
+    /// MCAP topic.
+    pub topic: &'static str,
+    /// MCAP schema name(s) allowed on the topic.
+    pub schema_names: &'static [&'static str],
+    /// Whether readers take data from it (`true`) or it only serves display.
+    pub canonical: bool,
+    /// What one message means.
+    pub meaning: &'static str,
+}
+
+/// Topic of radar power images.
+pub const RADAR_IMAGE_TOPIC: &str = "/radar/image";
+/// Topic of radar per-azimuth metadata.
+pub const RADAR_META_TOPIC: &str = "/radar/scan_meta";
+/// Topic of GNSS fixes.
+pub const GNSS_TOPIC: &str = "/gnss/fix";
+/// Display view of GNSS fixes.
+pub const GNSS_VIZ_TOPIC: &str = "/viz/gnss";
+/// Topic of channel impulse responses.
+pub const CIR_TOPIC: &str = "/channel/cir";
+
+/// Which trajectory a pose belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum PoseStream {
+    /// Ground truth (dataset reference trajectory or simulator truth).
+    GroundTruth,
+    /// An estimated trajectory (odometry, SLAM).
+    Estimate,
+}
+
+impl PoseStream {
+    /// Canonical topic.
+    #[must_use]
+    pub fn topic(self) -> &'static str {
+        match self {
+            Self::GroundTruth => "/ground_truth/pose",
+            Self::Estimate => "/estimate/pose",
+        }
+    }
+
+    /// Foxglove display topic.
+    #[must_use]
+    pub fn viz_topic(self) -> &'static str {
+        match self {
+            Self::GroundTruth => "/viz/ground_truth",
+            Self::Estimate => "/viz/estimate",
+        }
+    }
+
+    /// The stream a canonical topic belongs to.
+    #[must_use]
+    pub fn from_topic(topic: &str) -> Option<Self> {
+        [Self::GroundTruth, Self::Estimate]
+            .into_iter()
+            .find(|s| s.topic() == topic)
+    }
+}
+
+/// Every topic a canonical recording may contain.
+pub const CHANNELS: &[ChannelSpec] = &[
+    ChannelSpec {
+        topic: RADAR_IMAGE_TOPIC,
+        schema_names: &["foxglove.RawImage", "foxglove.CompressedImage"],
+        canonical: true,
+        meaning: "radar power of one scan as an image: one row per azimuth, one column per range bin (mono8 RawImage), \
+                  or the dataset's PNG carried byte for byte (CompressedImage, format png, with power_column_offset header columns)",
+    },
+    ChannelSpec {
+        topic: RADAR_META_TOPIC,
+        schema_names: &["mmtrack.RadarScanMeta"],
+        canonical: true,
+        meaning: "per-azimuth time, angle and validity of the scan whose image has the same MCAP sequence number",
+    },
+    ChannelSpec {
+        topic: "/ground_truth/pose",
+        schema_names: &["mmtrack.Pose2D"],
+        canonical: true,
+        meaning: "ground-truth pose world_from_vehicle",
+    },
+    ChannelSpec {
+        topic: "/estimate/pose",
+        schema_names: &["mmtrack.Pose2D"],
+        canonical: true,
+        meaning: "estimated pose world_from_vehicle (odometry or SLAM output)",
+    },
+    ChannelSpec {
+        topic: GNSS_TOPIC,
+        schema_names: &["mmtrack.GnssFix"],
+        canonical: true,
+        meaning: "GNSS position fix",
+    },
+    ChannelSpec {
+        topic: CIR_TOPIC,
+        schema_names: &["mmtrack.CirSnapshot"],
+        canonical: true,
+        meaning: "one channel impulse response snapshot",
+    },
+    ChannelSpec {
+        topic: "/viz/ground_truth",
+        schema_names: &["foxglove.PoseInFrame"],
+        canonical: false,
+        meaning: "display copy of /ground_truth/pose for Foxglove's 3D panel (frame world)",
+    },
+    ChannelSpec {
+        topic: "/viz/estimate",
+        schema_names: &["foxglove.PoseInFrame"],
+        canonical: false,
+        meaning: "display copy of /estimate/pose for Foxglove's 3D panel (frame world)",
+    },
+    ChannelSpec {
+        topic: GNSS_VIZ_TOPIC,
+        schema_names: &["foxglove.LocationFix"],
+        canonical: false,
+        meaning: "display copy of /gnss/fix for Foxglove's map panel",
+    },
+];

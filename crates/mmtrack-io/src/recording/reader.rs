@@ -1,0 +1,402 @@
+use std::collections::{BTreeMap, HashMap};
+use std::fs::File;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use foxglove::schemas::{CompressedImage, RawImage};
+use mcap::records::Record;
+use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
+use mmtrack_core::{
+    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, PolarScan, PolarScanHeader,
+    Se2, StampedPose,
+};
+use prost::Message;
+
+use super::METADATA_NAME;
+use super::channels::{CIR_TOPIC, GNSS_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
+use crate::error::{IoError, Result, os_err};
+use crate::proto;
+
+#[derive(Debug)]
+struct ChannelInfo {
+    topic: String,
+    schema_name: String,
+    message_encoding: String,
+}
+
+/// A raw message: its channel, sequence, time and payload.
+struct RawMessage {
+    channel: Arc<ChannelInfo>,
+    sequence: u32,
+    log_time_ns: u64,
+    data: Vec<u8>,
+}
+
+/// Streams the records of an MCAP file with bounded memory.
+struct RawReader {
+    path: PathBuf,
+    file: File,
+    reader: LinearReader,
+    schemas: HashMap<u16, String>,
+    channels: HashMap<u16, Arc<ChannelInfo>>,
+    metadata: BTreeMap<String, BTreeMap<String, String>>,
+}
+
+impl RawReader {
+    fn open(path: &Path) -> Result<Self> {
+        let file = File::open(path).map_err(os_err(path))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file,
+            reader: LinearReader::new(),
+            schemas: HashMap::new(),
+            channels: HashMap::new(),
+            metadata: BTreeMap::new(),
+        })
+    }
+
+    fn corrupt(&self, detail: impl std::fmt::Display) -> IoError {
+        IoError::CorruptRecording {
+            path: self.path.clone(),
+            detail: detail.to_string(),
+        }
+    }
+
+    /// The next message, or `None` at a clean end of file.
+    fn next_message(&mut self) -> Result<Option<RawMessage>> {
+        while let Some(event) = self.reader.next_event() {
+            match event.map_err(|e| IoError::CorruptRecording {
+                path: self.path.clone(),
+                detail: e.to_string(),
+            })? {
+                LinearReadEvent::ReadRequest(need) => {
+                    let read = self
+                        .file
+                        .read(self.reader.insert(need))
+                        .map_err(os_err(&self.path))?;
+                    self.reader.notify_read(read);
+                }
+                LinearReadEvent::Record { opcode, data } => {
+                    let record = mcap::parse_record(opcode, data).map_err(|e| {
+                        IoError::CorruptRecording {
+                            path: self.path.clone(),
+                            detail: e.to_string(),
+                        }
+                    })?;
+                    match record {
+                        Record::Schema { header, .. } => {
+                            self.schemas.insert(header.id, header.name);
+                        }
+                        Record::Channel(c) => {
+                            let schema_name =
+                                self.schemas.get(&c.schema_id).cloned().unwrap_or_default();
+                            self.channels.insert(
+                                c.id,
+                                Arc::new(ChannelInfo {
+                                    topic: c.topic,
+                                    schema_name,
+                                    message_encoding: c.message_encoding,
+                                }),
+                            );
+                        }
+                        Record::Metadata(m) => {
+                            self.metadata.insert(m.name, m.metadata);
+                        }
+                        Record::Message { header, data } => {
+                            let Some(channel) = self.channels.get(&header.channel_id).cloned()
+                            else {
+                                return Err(self.corrupt(format!(
+                                    "message {} refers to unknown channel {}",
+                                    header.sequence, header.channel_id
+                                )));
+                            };
+                            return Ok(Some(RawMessage {
+                                channel,
+                                sequence: header.sequence,
+                                log_time_ns: header.log_time,
+                                data: data.into_owned(),
+                            }));
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+        Ok(None)
+    }
+}
+
+/// One decoded item of a recording, in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RecordingEvent {
+    /// A complete radar scan (image and metadata joined).
+    RadarScan(PolarScan),
+    /// A trajectory pose.
+    Pose {
+        /// Which trajectory.
+        stream: PoseStream,
+        /// The pose.
+        pose: StampedPose,
+    },
+    /// A GNSS fix.
+    Gnss(GnssFix),
+    /// A channel impulse response.
+    Cir(CirSnapshot),
+}
+
+/// Reads a canonical recording as a stream of [`RecordingEvent`]s, holding at
+/// most one scan in memory. Display channels and unknown topics are skipped.
+pub struct RecordingReader {
+    raw: RawReader,
+    pending_meta: Option<(u32, proto::RadarScanMeta)>,
+}
+
+impl RecordingReader {
+    /// Opens a recording.
+    pub fn open(path: &Path) -> Result<Self> {
+        Ok(Self {
+            raw: RawReader::open(path)?,
+            pending_meta: None,
+        })
+    }
+
+    /// The recording metadata (`mmtrack.recording`); complete once the first
+    /// event has been read, since writers put it at the start of the file.
+    #[must_use]
+    pub fn metadata(&self) -> Option<&BTreeMap<String, String>> {
+        self.raw.metadata.get(METADATA_NAME)
+    }
+
+    fn bad(&self, m: &RawMessage, detail: impl std::fmt::Display) -> IoError {
+        IoError::BadMessage {
+            path: self.raw.path.clone(),
+            topic: m.channel.topic.clone(),
+            sequence: m.sequence,
+            detail: detail.to_string(),
+        }
+    }
+
+    fn decode<M: Message + Default>(&self, m: &RawMessage) -> Result<M> {
+        if m.channel.message_encoding != "protobuf" {
+            return Err(self.bad(
+                m,
+                format!(
+                    "message encoding '{}', expected protobuf",
+                    m.channel.message_encoding
+                ),
+            ));
+        }
+        M::decode(m.data.as_slice())
+            .map_err(|e| self.bad(m, format!("cannot decode {}: {e}", m.channel.schema_name)))
+    }
+
+    fn next_event(&mut self) -> Result<Option<RecordingEvent>> {
+        while let Some(m) = self.raw.next_message()? {
+            let topic = m.channel.topic.as_str();
+            if topic == RADAR_META_TOPIC {
+                let meta: proto::RadarScanMeta = self.decode(&m)?;
+                self.pending_meta = Some((m.sequence, meta));
+            } else if topic == RADAR_IMAGE_TOPIC {
+                return self
+                    .join_scan(&m)
+                    .map(|s| Some(RecordingEvent::RadarScan(s)));
+            } else if let Some(stream) = PoseStream::from_topic(topic) {
+                let p: proto::Pose2D = self.decode(&m)?;
+                let pose = StampedPose {
+                    t_ns: p.t_ns,
+                    parent_from_child: Se2::new(p.x_m, p.y_m, p.yaw_rad),
+                };
+                return Ok(Some(RecordingEvent::Pose { stream, pose }));
+            } else if topic == GNSS_TOPIC {
+                let f: proto::GnssFix = self.decode(&m)?;
+                let quality = GnssFixQuality::from_code(f.quality).ok_or_else(|| {
+                    self.bad(&m, format!("unknown fix quality code {}", f.quality))
+                })?;
+                return Ok(Some(RecordingEvent::Gnss(GnssFix {
+                    t_ns: f.t_ns,
+                    latitude_deg: f.latitude_deg,
+                    longitude_deg: f.longitude_deg,
+                    altitude_m: f.altitude_m,
+                    horizontal_sigma_m: f.horizontal_sigma_m,
+                    num_satellites: f.num_satellites,
+                    quality,
+                })));
+            } else if topic == CIR_TOPIC {
+                let c: proto::CirSnapshot = self.decode(&m)?;
+                if c.taps_re.len() != c.taps_im.len() {
+                    return Err(self.bad(
+                        &m,
+                        format!(
+                            "taps_re has {} values but taps_im has {}",
+                            c.taps_re.len(),
+                            c.taps_im.len()
+                        ),
+                    ));
+                }
+                let taps = c
+                    .taps_re
+                    .iter()
+                    .zip(&c.taps_im)
+                    .map(|(&re, &im)| Complex64::new(re, im))
+                    .collect();
+                return Ok(Some(RecordingEvent::Cir(CirSnapshot {
+                    t_ns: c.t_ns,
+                    set_index: c.set_index,
+                    snapshot_index: c.snapshot_index,
+                    tx_antenna: c.tx_antenna,
+                    rx_antenna: c.rx_antenna,
+                    carrier_hz: c.carrier_hz,
+                    tap_spacing_s: c.tap_spacing_s,
+                    delay_offset_s: c.delay_offset_s,
+                    taps,
+                })));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Joins a radar image with the metadata of the same sequence number.
+    fn join_scan(&mut self, m: &RawMessage) -> Result<PolarScan> {
+        let meta =
+            match self.pending_meta.take() {
+                Some((sequence, meta)) if sequence == m.sequence => meta,
+                _ => return Err(self.bad(
+                    m,
+                    format!(
+                        "radar image without {RADAR_META_TOPIC} message of the same sequence number"
+                    ),
+                )),
+            };
+        let n = meta.azimuth_t_ns.len();
+        if meta.azimuth_rad.len() != n || meta.valid.len() != n {
+            return Err(self.bad(m, "azimuth_t_ns, azimuth_rad and valid differ in length"));
+        }
+        let bins = meta.bins_per_azimuth as usize;
+        let offset = meta.power_column_offset as usize;
+        let (width, height, pixels) = match m.channel.schema_name.as_str() {
+            "foxglove.RawImage" => {
+                let image: RawImage = self.decode(m)?;
+                if image.encoding != "mono8" || image.step != image.width {
+                    return Err(self.bad(
+                        m,
+                        format!(
+                            "raw image encoding '{}' step {}, expected mono8 packed",
+                            image.encoding, image.step
+                        ),
+                    ));
+                }
+                (
+                    image.width as usize,
+                    image.height as usize,
+                    image.data.to_vec(),
+                )
+            }
+            "foxglove.CompressedImage" => {
+                let image: CompressedImage = self.decode(m)?;
+                if image.format != "png" {
+                    return Err(self.bad(
+                        m,
+                        format!("compressed image format '{}', expected png", image.format),
+                    ));
+                }
+                let (width, height, pixels) =
+                    crate::png_gray::decode_gray8(&image.data).map_err(|e| self.bad(m, e))?;
+                (width, height, pixels)
+            }
+            other => return Err(self.bad(m, format!("schema {other} is not an image schema"))),
+        };
+        if height != n || width != offset + bins {
+            return Err(self.bad(
+                m,
+                format!("image is {width} x {height}, metadata says {n} azimuths of {offset} + {bins} columns"),
+            ));
+        }
+        let power = if offset == 0 {
+            pixels
+        } else {
+            pixels
+                .chunks_exact(width)
+                .flat_map(|row| &row[offset..])
+                .copied()
+                .collect()
+        };
+        let azimuths = (0..n)
+            .map(|i| AzimuthSample {
+                t_ns: meta.azimuth_t_ns[i],
+                azimuth_rad: meta.azimuth_rad[i],
+                valid: meta.valid[i],
+            })
+            .collect();
+        let header = PolarScanHeader {
+            t_ns: meta.t_ns,
+            range_resolution_m: meta.range_resolution_m,
+            range_offset_m: meta.range_offset_m,
+            bins_per_azimuth: bins,
+            azimuths,
+        };
+        PolarScan::new(header, power).map_err(|e| self.bad(m, e))
+    }
+}
+
+impl Iterator for RecordingReader {
+    type Item = Result<RecordingEvent>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        self.next_event().transpose()
+    }
+}
+
+/// Per-topic statistics of a recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelSummary {
+    /// Topic.
+    pub topic: String,
+    /// MCAP schema name.
+    pub schema_name: String,
+    /// Message encoding.
+    pub message_encoding: String,
+    /// Number of messages.
+    pub message_count: u64,
+    /// Earliest log time, nanoseconds.
+    pub start_ns: u64,
+    /// Latest log time, nanoseconds.
+    pub end_ns: u64,
+}
+
+/// What `mmtrack inspect` reports about a recording.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingSummary {
+    /// The file.
+    pub path: PathBuf,
+    /// Channels sorted by topic.
+    pub channels: Vec<ChannelSummary>,
+    /// Metadata records by name.
+    pub metadata: BTreeMap<String, BTreeMap<String, String>>,
+}
+
+/// Reads a whole recording (any MCAP file, including ROS 2 bags) and
+/// summarises its channels. Fails on a truncated or corrupted file.
+pub fn inspect_recording(path: &Path) -> Result<RecordingSummary> {
+    let mut raw = RawReader::open(path)?;
+    let mut by_topic: BTreeMap<(String, String), ChannelSummary> = BTreeMap::new();
+    while let Some(m) = raw.next_message()? {
+        let key = (m.channel.topic.clone(), m.channel.schema_name.clone());
+        let entry = by_topic.entry(key).or_insert_with(|| ChannelSummary {
+            topic: m.channel.topic.clone(),
+            schema_name: m.channel.schema_name.clone(),
+            message_encoding: m.channel.message_encoding.clone(),
+            message_count: 0,
+            start_ns: m.log_time_ns,
+            end_ns: m.log_time_ns,
+        });
+        entry.message_count += 1;
+        entry.start_ns = entry.start_ns.min(m.log_time_ns);
+        entry.end_ns = entry.end_ns.max(m.log_time_ns);
+    }
+    Ok(RecordingSummary {
+        path: path.to_path_buf(),
+        channels: by_topic.into_values().collect(),
+        metadata: raw.metadata,
+    })
+}

@@ -1,0 +1,477 @@
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+use foxglove::Encode;
+use foxglove::schemas::{
+    CompressedImage, LocationFix, Pose, PoseInFrame, Quaternion, RawImage, Timestamp, Vector3,
+};
+use mmtrack_core::{CirSnapshot, GnssFix, PolarScan, PolarScanHeader, StampedPose};
+use prost::Message;
+
+use super::METADATA_NAME;
+use super::channels::{
+    CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
+};
+use crate::atomic::{AtomicFile, Overwrite};
+use crate::error::{IoError, Result};
+use crate::proto::{self, SpecMessage};
+
+/// Chunk compression of a recording.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Compression {
+    /// Uncompressed chunks: fastest; radar PNGs carried unchanged are already compressed.
+    None,
+    /// zstd at the given level (1 is fast; 3 is zstd's default).
+    Zstd {
+        /// zstd level, 1..=19.
+        level: u32,
+    },
+    /// lz4 frame compression.
+    Lz4,
+}
+
+/// How a recording is written.
+#[derive(Debug, Clone)]
+pub struct RecordingOptions {
+    /// Chunk compression.
+    pub compression: Compression,
+    /// Target uncompressed chunk size, bytes.
+    pub chunk_size_bytes: u64,
+    /// What to do if the file exists.
+    pub overwrite: Overwrite,
+    /// Also write Foxglove display channels (`/viz/...`).
+    pub foxglove_views: bool,
+}
+
+impl Default for RecordingOptions {
+    fn default() -> Self {
+        Self {
+            compression: Compression::Zstd { level: 1 },
+            chunk_size_bytes: 4 << 20,
+            overwrite: Overwrite::Refuse,
+            foxglove_views: true,
+        }
+    }
+}
+
+/// What `t_ns` counts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TimeBase {
+    /// Nanoseconds since the UNIX epoch (real recordings).
+    UnixEpoch,
+    /// Nanoseconds since the start of a simulated scenario.
+    ScenarioStart,
+}
+
+impl TimeBase {
+    /// Value stored under the metadata key `time_base`.
+    #[must_use]
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::UnixEpoch => "unix_epoch",
+            Self::ScenarioStart => "scenario_start",
+        }
+    }
+
+    /// Parses [`TimeBase::as_str`].
+    #[must_use]
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "unix_epoch" => Some(Self::UnixEpoch),
+            "scenario_start" => Some(Self::ScenarioStart),
+            _ => None,
+        }
+    }
+}
+
+/// Recording-level metadata, stored as the MCAP metadata record `mmtrack.recording`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingMetadata {
+    /// Sequence identifier (becomes the `sequence=` partition of every table).
+    pub sequence_id: String,
+    /// Where the data came from, e.g. `oxford:/data/2019-01-10-14-36-48` or `simulate:scenario.toml`.
+    pub source: String,
+    /// What `t_ns` counts from.
+    pub time_base: TimeBase,
+    /// Sensor configuration and provenance, e.g. `radar.model = CTS350-X`.
+    pub extra: BTreeMap<String, String>,
+}
+
+impl RecordingMetadata {
+    /// Flattens to the string map stored in the file.
+    #[must_use]
+    pub fn to_map(&self) -> BTreeMap<String, String> {
+        let mut map = self.extra.clone();
+        map.insert("sequence_id".into(), self.sequence_id.clone());
+        map.insert("source".into(), self.source.clone());
+        map.insert("time_base".into(), self.time_base.as_str().into());
+        map.insert("mmtrack_version".into(), env!("CARGO_PKG_VERSION").into());
+        map
+    }
+}
+
+/// What [`RecordingWriter::finish`] reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WriteSummary {
+    /// Final path.
+    pub path: PathBuf,
+    /// Messages per topic (display copies included).
+    pub message_counts: BTreeMap<String, u64>,
+    /// Bytes on disk.
+    pub file_bytes: u64,
+}
+
+struct ChannelState {
+    id: u16,
+    next_sequence: u32,
+}
+
+/// Writes one canonical recording. Nothing appears at the target path until
+/// [`RecordingWriter::finish`] succeeds; dropping the writer discards the file.
+pub struct RecordingWriter {
+    file: AtomicFile,
+    overwrite: Overwrite,
+    foxglove_views: bool,
+    mcap: mcap::Writer<BufWriter<File>>,
+    channels: BTreeMap<&'static str, ChannelState>,
+    counts: BTreeMap<String, u64>,
+    buffer: Vec<u8>,
+}
+
+fn timestamp(t_ns: i64) -> Option<Timestamp> {
+    let t_ns = u64::try_from(t_ns).ok()?;
+    let sec = u32::try_from(t_ns / 1_000_000_000).ok()?;
+    Some(Timestamp::new(sec, (t_ns % 1_000_000_000) as u32))
+}
+
+impl RecordingWriter {
+    /// Starts a recording at `path` with its metadata.
+    pub fn create(
+        path: &Path,
+        metadata: &RecordingMetadata,
+        options: &RecordingOptions,
+    ) -> Result<Self> {
+        let file = AtomicFile::create(path, options.overwrite)?;
+        let (compression, level) = match options.compression {
+            Compression::None => (None, 0),
+            Compression::Zstd { level } => (Some(mcap::Compression::Zstd), level),
+            Compression::Lz4 => (Some(mcap::Compression::Lz4), 0),
+        };
+        let mut write_options = mcap::WriteOptions::new()
+            .compression(compression)
+            .chunk_size(Some(options.chunk_size_bytes))
+            .profile("")
+            .library(concat!("mmtrack ", env!("CARGO_PKG_VERSION")));
+        if level > 0 {
+            write_options = write_options.compression_level(level);
+        }
+        let mut mcap = write_options
+            .create(file.writer()?)
+            .map_err(|e| write_err(path, e))?;
+        mcap.write_metadata(&mcap::records::Metadata {
+            name: METADATA_NAME.into(),
+            metadata: metadata.to_map(),
+        })
+        .map_err(|e| write_err(path, e))?;
+        Ok(Self {
+            file,
+            overwrite: options.overwrite,
+            foxglove_views: options.foxglove_views,
+            mcap,
+            channels: BTreeMap::new(),
+            counts: BTreeMap::new(),
+            buffer: Vec::with_capacity(1 << 16),
+        })
+    }
+
+    fn path(&self) -> &Path {
+        self.file.target()
+    }
+
+    /// Registers `topic` on first use and returns its channel id.
+    fn channel(
+        &mut self,
+        topic: &'static str,
+        schema_name: &str,
+        schema_data: &[u8],
+    ) -> Result<u16> {
+        if let Some(state) = self.channels.get(topic) {
+            return Ok(state.id);
+        }
+        let path = self.file.target().to_path_buf();
+        let schema_id = self
+            .mcap
+            .add_schema(schema_name, "protobuf", schema_data)
+            .map_err(|e| write_err(&path, e))?;
+        let id = self
+            .mcap
+            .add_channel(schema_id, topic, "protobuf", &BTreeMap::new())
+            .map_err(|e| write_err(&path, e))?;
+        self.channels.insert(
+            topic,
+            ChannelState {
+                id,
+                next_sequence: 0,
+            },
+        );
+        Ok(id)
+    }
+
+    /// Writes `self.buffer` as the next message on `topic`, with an explicit
+    /// sequence number when given (radar image and meta share one).
+    fn emit(
+        &mut self,
+        topic: &'static str,
+        channel_id: u16,
+        t_ns: i64,
+        sequence: Option<u32>,
+    ) -> Result<u32> {
+        let log_time = u64::try_from(t_ns).map_err(|_| IoError::BadValue {
+            path: self.path().to_path_buf(),
+            record: format!("message on {topic}"),
+            field: "t_ns",
+            detail: format!("{t_ns} is negative; recordings store non-negative nanoseconds"),
+        })?;
+        let state = self
+            .channels
+            .get_mut(topic)
+            .ok_or_else(|| IoError::RecordingWrite {
+                path: self.file.target().to_path_buf(),
+                detail: format!("channel {topic} used before registration"),
+            })?;
+        let sequence = sequence.unwrap_or(state.next_sequence);
+        state.next_sequence = sequence.wrapping_add(1);
+        let header = mcap::records::MessageHeader {
+            channel_id,
+            sequence,
+            log_time,
+            publish_time: log_time,
+        };
+        let path = self.file.target().to_path_buf();
+        self.mcap
+            .write_to_known_channel(&header, &self.buffer)
+            .map_err(|e| write_err(&path, e))?;
+        *self.counts.entry(topic.to_string()).or_insert(0) += 1;
+        Ok(sequence)
+    }
+
+    fn write_spec<M: SpecMessage>(
+        &mut self,
+        topic: &'static str,
+        t_ns: i64,
+        message: &M,
+        sequence: Option<u32>,
+    ) -> Result<u32> {
+        let id = self.channel(topic, M::SPEC.full_name, &M::SPEC.file_descriptor_set())?;
+        self.buffer.clear();
+        message
+            .encode(&mut self.buffer)
+            .map_err(|e| write_err(self.file.target(), e))?;
+        self.emit(topic, id, t_ns, sequence)
+    }
+
+    fn write_foxglove<M: Encode + Message>(
+        &mut self,
+        topic: &'static str,
+        t_ns: i64,
+        message: &M,
+        sequence: Option<u32>,
+    ) -> Result<u32> {
+        let schema = M::get_schema().ok_or_else(|| IoError::RecordingWrite {
+            path: self.path().to_path_buf(),
+            detail: format!("foxglove schema missing for {topic}"),
+        })?;
+        let id = self.channel(topic, &schema.name, &schema.data)?;
+        self.buffer.clear();
+        self.buffer.reserve(Message::encoded_len(message));
+        Message::encode(message, &mut self.buffer).map_err(|e| write_err(self.file.target(), e))?;
+        self.emit(topic, id, t_ns, sequence)
+    }
+
+    fn header_message(
+        &self,
+        header: &PolarScanHeader,
+        power_column_offset: u32,
+    ) -> Result<proto::RadarScanMeta> {
+        let bins = u32::try_from(header.bins_per_azimuth).map_err(|_| IoError::BadValue {
+            path: self.path().to_path_buf(),
+            record: format!("radar scan at {} ns", header.t_ns),
+            field: "bins_per_azimuth",
+            detail: "does not fit in 32 bits".into(),
+        })?;
+        Ok(proto::RadarScanMeta {
+            t_ns: header.t_ns,
+            range_resolution_m: header.range_resolution_m,
+            range_offset_m: header.range_offset_m,
+            bins_per_azimuth: bins,
+            power_column_offset,
+            azimuth_t_ns: header.azimuths.iter().map(|a| a.t_ns).collect(),
+            azimuth_rad: header.azimuths.iter().map(|a| a.azimuth_rad).collect(),
+            valid: header.azimuths.iter().map(|a| a.valid).collect(),
+        })
+    }
+
+    /// Writes a radar scan: its power as a mono8 `foxglove.RawImage` and its
+    /// per-azimuth metadata, both with the same sequence number.
+    pub fn write_radar_scan(&mut self, scan: &PolarScan) -> Result<()> {
+        let header = &scan.header;
+        let meta = self.header_message(header, 0)?;
+        let sequence = self.write_spec(RADAR_META_TOPIC, header.t_ns, &meta, None)?;
+        let image = RawImage {
+            timestamp: timestamp(header.t_ns),
+            frame_id: "radar".into(),
+            width: meta.bins_per_azimuth,
+            height: header.azimuths.len() as u32,
+            encoding: "mono8".into(),
+            step: meta.bins_per_azimuth,
+            data: bytes::Bytes::copy_from_slice(&scan.power),
+        };
+        self.write_foxglove(RADAR_IMAGE_TOPIC, header.t_ns, &image, Some(sequence))?;
+        Ok(())
+    }
+
+    /// Writes a radar scan whose power is a dataset PNG carried byte for byte
+    /// (`foxglove.CompressedImage`, format `png`). `power_column_offset` is the
+    /// number of leading image columns that are not range bins (11 for the
+    /// Oxford/Boreas row header). The caller has checked the PNG's shape.
+    pub fn write_radar_png(
+        &mut self,
+        header: &PolarScanHeader,
+        png: &[u8],
+        power_column_offset: u32,
+    ) -> Result<()> {
+        let meta = self.header_message(header, power_column_offset)?;
+        let sequence = self.write_spec(RADAR_META_TOPIC, header.t_ns, &meta, None)?;
+        let image = CompressedImage {
+            timestamp: timestamp(header.t_ns),
+            frame_id: "radar".into(),
+            data: bytes::Bytes::copy_from_slice(png),
+            format: "png".into(),
+        };
+        self.write_foxglove(RADAR_IMAGE_TOPIC, header.t_ns, &image, Some(sequence))?;
+        Ok(())
+    }
+
+    /// Writes a pose of a trajectory (and its Foxglove display copy).
+    pub fn write_pose(
+        &mut self,
+        stream: PoseStream,
+        pose: &StampedPose,
+        parent_frame: &str,
+        child_frame: &str,
+    ) -> Result<()> {
+        let p = pose.parent_from_child;
+        let message = proto::Pose2D {
+            t_ns: pose.t_ns,
+            parent_frame: parent_frame.into(),
+            child_frame: child_frame.into(),
+            x_m: p.x_m,
+            y_m: p.y_m,
+            yaw_rad: p.yaw_rad,
+        };
+        self.write_spec(stream.topic(), pose.t_ns, &message, None)?;
+        if self.foxglove_views {
+            let half_yaw = 0.5 * p.yaw_rad;
+            let view = PoseInFrame {
+                timestamp: timestamp(pose.t_ns),
+                frame_id: parent_frame.into(),
+                pose: Some(Pose {
+                    position: Some(Vector3 {
+                        x: p.x_m,
+                        y: p.y_m,
+                        z: 0.0,
+                    }),
+                    orientation: Some(Quaternion {
+                        x: 0.0,
+                        y: 0.0,
+                        z: half_yaw.sin(),
+                        w: half_yaw.cos(),
+                    }),
+                }),
+            };
+            self.write_foxglove(stream.viz_topic(), pose.t_ns, &view, None)?;
+        }
+        Ok(())
+    }
+
+    /// Writes a GNSS fix (and its Foxglove display copy).
+    pub fn write_gnss_fix(&mut self, fix: &GnssFix) -> Result<()> {
+        let message = proto::GnssFix {
+            t_ns: fix.t_ns,
+            latitude_deg: fix.latitude_deg,
+            longitude_deg: fix.longitude_deg,
+            altitude_m: fix.altitude_m,
+            horizontal_sigma_m: fix.horizontal_sigma_m,
+            num_satellites: fix.num_satellites,
+            quality: fix.quality.code(),
+        };
+        self.write_spec(GNSS_TOPIC, fix.t_ns, &message, None)?;
+        if self.foxglove_views {
+            let (covariance, covariance_type) = match fix.horizontal_sigma_m {
+                Some(sigma_m) => {
+                    let var_m2 = sigma_m * sigma_m;
+                    (vec![var_m2, 0.0, 0.0, 0.0, var_m2, 0.0, 0.0, 0.0, 0.0], 1)
+                }
+                None => (vec![0.0; 9], 0),
+            };
+            let view = LocationFix {
+                timestamp: timestamp(fix.t_ns),
+                frame_id: "gnss".into(),
+                latitude: fix.latitude_deg,
+                longitude: fix.longitude_deg,
+                altitude: fix.altitude_m,
+                position_covariance: covariance,
+                position_covariance_type: covariance_type,
+                ..Default::default()
+            };
+            self.write_foxglove(GNSS_VIZ_TOPIC, fix.t_ns, &view, None)?;
+        }
+        Ok(())
+    }
+
+    /// Writes a channel impulse response snapshot.
+    pub fn write_cir(&mut self, cir: &CirSnapshot) -> Result<()> {
+        let message = proto::CirSnapshot {
+            t_ns: cir.t_ns,
+            set_index: cir.set_index,
+            snapshot_index: cir.snapshot_index,
+            tx_antenna: cir.tx_antenna,
+            rx_antenna: cir.rx_antenna,
+            carrier_hz: cir.carrier_hz,
+            tap_spacing_s: cir.tap_spacing_s,
+            delay_offset_s: cir.delay_offset_s,
+            taps_re: cir.taps.iter().map(|t| t.re).collect(),
+            taps_im: cir.taps.iter().map(|t| t.im).collect(),
+        };
+        self.write_spec(CIR_TOPIC, cir.t_ns, &message, None)?;
+        Ok(())
+    }
+
+    /// Completes the file (summary, index, footer) and moves it into place.
+    pub fn finish(mut self) -> Result<WriteSummary> {
+        let path = self.file.target().to_path_buf();
+        self.mcap.finish().map_err(|e| write_err(&path, e))?;
+        let mut inner = self.mcap.into_inner();
+        std::io::Write::flush(&mut inner).map_err(|source| IoError::Os {
+            path: path.clone(),
+            source,
+        })?;
+        drop(inner);
+        let path = self.file.commit(self.overwrite)?;
+        let file_bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+        Ok(WriteSummary {
+            path,
+            message_counts: self.counts,
+            file_bytes,
+        })
+    }
+}
+
+fn write_err(path: &Path, e: impl std::fmt::Display) -> IoError {
+    IoError::RecordingWrite {
+        path: path.to_path_buf(),
+        detail: e.to_string(),
+    }
+}

@@ -1,0 +1,349 @@
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use arrow_array::RecordBatch;
+use parquet::arrow::ArrowWriter;
+use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+use parquet::basic::{Compression, ZstdLevel};
+use parquet::file::metadata::KeyValue;
+use parquet::file::properties::WriterProperties;
+
+use super::columns::{Columns, check_no_nulls};
+use super::{TableRow, TableSpec};
+use crate::atomic::{AtomicFile, Overwrite};
+use crate::error::{IoError, Result, os_err};
+
+/// Provenance of a run, stored in every table it writes.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RunInfo {
+    /// The run's full configuration as JSON.
+    pub config_json: String,
+}
+
+/// Path of one partition: `<root>/<table>/sequence=<id>/part-0.parquet`.
+pub fn table_path(root: &Path, table: &str, sequence_id: &str) -> Result<PathBuf> {
+    let safe = !sequence_id.is_empty()
+        && sequence_id != "."
+        && sequence_id != ".."
+        && sequence_id
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if !safe {
+        return Err(IoError::BadValue {
+            path: root.to_path_buf(),
+            record: format!("table {table}"),
+            field: "sequence_id",
+            detail: format!(
+                "'{sequence_id}' is not a valid partition name (use letters, digits, '-', '_', '.')"
+            ),
+        });
+    }
+    Ok(root
+        .join(table)
+        .join(format!("sequence={sequence_id}"))
+        .join("part-0.parquet"))
+}
+
+/// What a finished table write reports.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableWriteSummary {
+    /// The file written.
+    pub path: PathBuf,
+    /// Rows written.
+    pub rows: u64,
+}
+
+/// Writes one partition of one table; nothing appears until [`TableWriter::finish`].
+pub struct TableWriter {
+    spec: &'static TableSpec,
+    schema: Arc<arrow_schema::Schema>,
+    file: AtomicFile,
+    overwrite: Overwrite,
+    writer: ArrowWriter<BufWriter<File>>,
+    rows: u64,
+}
+
+impl TableWriter {
+    /// Starts `<root>/<table>/sequence=<id>/part-0.parquet`.
+    pub fn create(
+        root: &Path,
+        spec: &'static TableSpec,
+        sequence_id: &str,
+        run: &RunInfo,
+        overwrite: Overwrite,
+    ) -> Result<Self> {
+        let path = table_path(root, spec.name, sequence_id)?;
+        let file = AtomicFile::create(&path, overwrite)?;
+        let metadata = vec![
+            KeyValue::new("units".to_string(), spec.units_json()),
+            KeyValue::new("mmtrack.table".to_string(), spec.name.to_string()),
+            KeyValue::new(
+                "mmtrack.version".to_string(),
+                env!("CARGO_PKG_VERSION").to_string(),
+            ),
+            KeyValue::new("mmtrack.run_config".to_string(), run.config_json.clone()),
+        ];
+        let level = ZstdLevel::try_new(3).map_err(|e| table_write_err(&path, e))?;
+        let props = WriterProperties::builder()
+            .set_compression(Compression::ZSTD(level))
+            .set_key_value_metadata(Some(metadata))
+            .build();
+        let schema = Arc::new(spec.arrow_schema());
+        let writer = ArrowWriter::try_new(file.writer()?, schema.clone(), Some(props))
+            .map_err(|e| table_write_err(&path, e))?;
+        Ok(Self {
+            spec,
+            schema,
+            file,
+            overwrite,
+            writer,
+            rows: 0,
+        })
+    }
+
+    /// Appends rows.
+    pub fn write<T: TableRow>(&mut self, rows: &[T]) -> Result<()> {
+        let path = self.file.target().to_path_buf();
+        if T::SPEC.name != self.spec.name {
+            return Err(table_write_err(
+                &path,
+                format!(
+                    "rows of table {} written to table {}",
+                    T::SPEC.name,
+                    self.spec.name
+                ),
+            ));
+        }
+        let batch = RecordBatch::try_new(self.schema.clone(), T::to_columns(rows))
+            .map_err(|e| table_write_err(&path, e))?;
+        self.writer
+            .write(&batch)
+            .map_err(|e| table_write_err(&path, e))?;
+        self.rows += rows.len() as u64;
+        Ok(())
+    }
+
+    /// Completes the file and moves it into place.
+    pub fn finish(self) -> Result<TableWriteSummary> {
+        let path = self.file.target().to_path_buf();
+        let inner = self
+            .writer
+            .into_inner()
+            .map_err(|e| table_write_err(&path, e))?;
+        inner.into_inner().map_err(|e| IoError::Os {
+            path: path.clone(),
+            source: e.into_error(),
+        })?;
+        let path = self.file.commit(self.overwrite)?;
+        Ok(TableWriteSummary {
+            path,
+            rows: self.rows,
+        })
+    }
+}
+
+/// Writes `rows` as one partition in one call.
+pub fn write_table<T: TableRow>(
+    root: &Path,
+    sequence_id: &str,
+    rows: &[T],
+    run: &RunInfo,
+    overwrite: Overwrite,
+) -> Result<TableWriteSummary> {
+    let mut writer = TableWriter::create(root, T::SPEC, sequence_id, run, overwrite)?;
+    writer.write(rows)?;
+    writer.finish()
+}
+
+fn table_write_err(path: &Path, e: impl std::fmt::Display) -> IoError {
+    IoError::TableWrite {
+        path: path.to_path_buf(),
+        detail: e.to_string(),
+    }
+}
+
+fn corrupt(path: &Path, e: impl std::fmt::Display) -> IoError {
+    IoError::CorruptTable {
+        path: path.to_path_buf(),
+        detail: e.to_string(),
+    }
+}
+
+/// Checks a file's Arrow schema against the spec: every column present with
+/// the right type, no unknown columns.
+fn check_schema(path: &Path, spec: &TableSpec, schema: &arrow_schema::Schema) -> Result<()> {
+    for column in spec.columns {
+        let field = schema
+            .field_with_name(column.name)
+            .map_err(|_| IoError::MissingColumn {
+                path: path.to_path_buf(),
+                table: spec.name.to_string(),
+                column: column.name.to_string(),
+                expected: spec.column_list(),
+            })?;
+        if !column.ty.accepts(field.data_type()) {
+            return Err(IoError::WrongColumnType {
+                path: path.to_path_buf(),
+                table: spec.name.to_string(),
+                column: column.name.to_string(),
+                expected: column.ty.doc_name().to_string(),
+                found: field.data_type().to_string(),
+            });
+        }
+    }
+    if let Some(extra) = schema
+        .fields()
+        .iter()
+        .find(|f| !spec.columns.iter().any(|c| c.name == f.name()))
+    {
+        return Err(IoError::UnknownColumn {
+            path: path.to_path_buf(),
+            table: spec.name.to_string(),
+            column: extra.name().to_string(),
+            expected: spec.column_list(),
+        });
+    }
+    Ok(())
+}
+
+/// Reads all rows of one Parquet file of table `T`, validating the schema.
+pub fn read_table<T: TableRow>(path: &Path) -> Result<Vec<T>> {
+    let file = File::open(path).map_err(os_err(path))?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(path, e))?;
+    check_schema(path, T::SPEC, builder.schema())?;
+    let reader = builder.build().map_err(|e| corrupt(path, e))?;
+    let mut rows = Vec::new();
+    for batch in reader {
+        let batch = batch.map_err(|e| corrupt(path, e))?;
+        for column in T::SPEC.columns.iter().filter(|c| !c.nullable) {
+            check_no_nulls(&batch, column.name).map_err(|detail| IoError::CorruptTable {
+                path: path.to_path_buf(),
+                detail,
+            })?;
+        }
+        let offset = rows.len();
+        let batch_rows =
+            T::from_columns(&Columns::new(&batch)).map_err(|detail| IoError::CorruptTable {
+                path: path.to_path_buf(),
+                detail: format!("{detail} (batch starting at row {offset})"),
+            })?;
+        rows.extend(batch_rows);
+    }
+    Ok(rows)
+}
+
+fn partitions(table_dir: &Path) -> Result<Vec<(String, PathBuf)>> {
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(table_dir).map_err(os_err(table_dir))? {
+        let entry = entry.map_err(os_err(table_dir))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if let Some(sequence) = name.strip_prefix("sequence=") {
+            let file = entry.path().join("part-0.parquet");
+            if file.is_file() {
+                found.push((sequence.to_string(), file));
+            }
+        }
+    }
+    found.sort();
+    Ok(found)
+}
+
+/// Reads every `sequence=` partition of table `T` under `root`, by sequence.
+pub fn read_table_dir<T: TableRow>(root: &Path) -> Result<BTreeMap<String, Vec<T>>> {
+    let dir = root.join(T::SPEC.name);
+    partitions(&dir)?
+        .into_iter()
+        .map(|(sequence, file)| Ok((sequence, read_table::<T>(&file)?)))
+        .collect()
+}
+
+/// What `mmtrack inspect` reports about one table file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TableFileSummary {
+    /// Table name.
+    pub table: String,
+    /// Sequence partition.
+    pub sequence: String,
+    /// File.
+    pub path: PathBuf,
+    /// Row count (from the footer).
+    pub rows: i64,
+    /// `name: type [unit]` per column.
+    pub columns: Vec<String>,
+    /// Smallest and largest `t_ns`, when the table has that column.
+    pub t_ns_span: Option<(i64, i64)>,
+}
+
+/// Summarises every table partition under `root` (a results directory) or,
+/// when `root` is itself a table directory, its partitions.
+pub fn inspect_table_dir(root: &Path) -> Result<Vec<TableFileSummary>> {
+    let mut table_dirs = Vec::new();
+    if !partitions(root)?.is_empty() {
+        table_dirs.push(root.to_path_buf());
+    } else {
+        for entry in std::fs::read_dir(root).map_err(os_err(root))? {
+            let entry = entry.map_err(os_err(root))?;
+            if entry.path().is_dir() {
+                table_dirs.push(entry.path());
+            }
+        }
+        table_dirs.sort();
+    }
+    let mut out = Vec::new();
+    for dir in table_dirs {
+        let table = dir
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        for (sequence, path) in partitions(&dir)? {
+            out.push(summarise_file(&table, &sequence, &path)?);
+        }
+    }
+    Ok(out)
+}
+
+fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileSummary> {
+    let file = File::open(path).map_err(os_err(path))?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(path, e))?;
+    let rows = builder.metadata().file_metadata().num_rows();
+    let columns = builder
+        .schema()
+        .fields()
+        .iter()
+        .map(|f| match f.metadata().get("unit") {
+            Some(unit) => format!("{}: {} [{unit}]", f.name(), f.data_type()),
+            None => format!("{}: {}", f.name(), f.data_type()),
+        })
+        .collect();
+    let has_time = builder
+        .schema()
+        .field_with_name("t_ns")
+        .is_ok_and(|f| f.data_type() == &arrow_schema::DataType::Int64);
+    let mut span: Option<(i64, i64)> = None;
+    if has_time {
+        let mask = parquet::arrow::ProjectionMask::columns(builder.parquet_schema(), ["t_ns"]);
+        for batch in builder
+            .with_projection(mask)
+            .build()
+            .map_err(|e| corrupt(path, e))?
+        {
+            let batch = batch.map_err(|e| corrupt(path, e))?;
+            let columns = Columns::new(&batch);
+            let t = columns.i64("t_ns").map_err(|d| corrupt(path, d))?;
+            for v in t.iter().flatten() {
+                span = Some(span.map_or((v, v), |(a, b)| (a.min(v), b.max(v))));
+            }
+        }
+    }
+    Ok(TableFileSummary {
+        table: table.to_string(),
+        sequence: sequence.to_string(),
+        path: path.to_path_buf(),
+        rows,
+        columns,
+        t_ns_span: span,
+    })
+}

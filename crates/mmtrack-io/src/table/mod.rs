@@ -1,0 +1,183 @@
+//! Parquet result tables.
+//!
+//! A table is described by a [`TableSpec`] (name, columns, types, units,
+//! meaning): the one source for the Arrow schema, the `units` metadata and the
+//! documents in `schemas/tables/`. Files are laid out Hive-style,
+//! `<root>/<table>/sequence=<id>/part-0.parquet`, so DuckDB, polars, pyarrow,
+//! Spark and DataFusion read a whole campaign as one dataset. Each file carries
+//! in its key-value metadata:
+//!
+//! - `units`: JSON object column -> unit (also on each Arrow field as `unit`);
+//! - `mmtrack.table`, `mmtrack.version`;
+//! - `mmtrack.run_config`: the run's full configuration as JSON.
+
+mod columns;
+mod io;
+mod rows;
+
+pub use columns::Columns;
+pub use io::{
+    RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table,
+    read_table_dir, table_path, write_table,
+};
+pub use rows::ALL_TABLES;
+
+use std::sync::Arc;
+
+use arrow_array::ArrayRef;
+use arrow_schema::{DataType, Field, Schema};
+
+/// Arrow type of a column, as tables use them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColumnType {
+    /// 64-bit signed integer.
+    Int64,
+    /// 64-bit unsigned integer.
+    UInt64,
+    /// 32-bit unsigned integer.
+    UInt32,
+    /// 64-bit float.
+    Float64,
+    /// Boolean.
+    Boolean,
+    /// UTF-8 string.
+    Utf8,
+    /// Opaque bytes.
+    Binary,
+    /// List of 64-bit floats.
+    ListFloat64,
+    /// List of 64-bit signed integers.
+    ListInt64,
+    /// List of booleans.
+    ListBoolean,
+}
+
+impl ColumnType {
+    /// The Arrow data type.
+    #[must_use]
+    pub fn data_type(self) -> DataType {
+        let list = |t: DataType| DataType::List(Arc::new(Field::new("item", t, true)));
+        match self {
+            Self::Int64 => DataType::Int64,
+            Self::UInt64 => DataType::UInt64,
+            Self::UInt32 => DataType::UInt32,
+            Self::Float64 => DataType::Float64,
+            Self::Boolean => DataType::Boolean,
+            Self::Utf8 => DataType::Utf8,
+            Self::Binary => DataType::Binary,
+            Self::ListFloat64 => list(DataType::Float64),
+            Self::ListInt64 => list(DataType::Int64),
+            Self::ListBoolean => list(DataType::Boolean),
+        }
+    }
+
+    /// Whether `found` is acceptable for this column: lists compare by item
+    /// type only (writers name the item field differently).
+    #[must_use]
+    pub fn accepts(self, found: &DataType) -> bool {
+        match (self.data_type(), found) {
+            (DataType::List(want), DataType::List(got) | DataType::LargeList(got)) => {
+                want.data_type() == got.data_type()
+            }
+            (want, got) => &want == got,
+        }
+    }
+
+    /// Name used in the schema documents.
+    #[must_use]
+    pub fn doc_name(self) -> &'static str {
+        match self {
+            Self::Int64 => "int64",
+            Self::UInt64 => "uint64",
+            Self::UInt32 => "uint32",
+            Self::Float64 => "float64",
+            Self::Boolean => "bool",
+            Self::Utf8 => "string",
+            Self::Binary => "binary",
+            Self::ListFloat64 => "list<float64>",
+            Self::ListInt64 => "list<int64>",
+            Self::ListBoolean => "list<bool>",
+        }
+    }
+}
+
+/// One column of a table.
+#[derive(Debug, Clone, Copy)]
+pub struct ColumnSpec {
+    /// Column name (units in the name).
+    pub name: &'static str,
+    /// Arrow type.
+    pub ty: ColumnType,
+    /// Whether nulls are allowed (meaning "not available").
+    pub nullable: bool,
+    /// Unit, or "" for unitless.
+    pub unit: &'static str,
+    /// Meaning, one sentence.
+    pub meaning: &'static str,
+}
+
+/// A table: its name, what one row is, and its columns.
+#[derive(Debug, Clone, Copy)]
+pub struct TableSpec {
+    /// Table name (the directory under the output root).
+    pub name: &'static str,
+    /// What one row means.
+    pub description: &'static str,
+    /// Columns in file order.
+    pub columns: &'static [ColumnSpec],
+}
+
+impl TableSpec {
+    /// The Arrow schema, with each field's unit in its metadata.
+    #[must_use]
+    pub fn arrow_schema(&self) -> Schema {
+        let fields: Vec<Field> = self
+            .columns
+            .iter()
+            .map(|c| {
+                let field = Field::new(c.name, c.ty.data_type(), c.nullable);
+                if c.unit.is_empty() {
+                    field
+                } else {
+                    field.with_metadata(std::collections::HashMap::from([(
+                        "unit".to_string(),
+                        c.unit.to_string(),
+                    )]))
+                }
+            })
+            .collect();
+        Schema::new(fields)
+    }
+
+    /// JSON object column -> unit, for the `units` key-value metadata.
+    #[must_use]
+    pub fn units_json(&self) -> String {
+        let map: serde_json::Map<String, serde_json::Value> = self
+            .columns
+            .iter()
+            .map(|c| (c.name.to_string(), serde_json::Value::from(c.unit)))
+            .collect();
+        serde_json::Value::Object(map).to_string()
+    }
+
+    /// Column names, comma-separated, for error messages.
+    #[must_use]
+    pub fn column_list(&self) -> String {
+        self.columns
+            .iter()
+            .map(|c| c.name)
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// A Rust type stored as rows of a table.
+pub trait TableRow: Sized {
+    /// The table.
+    const SPEC: &'static TableSpec;
+    /// Column arrays for `rows`, in [`TableSpec::columns`] order.
+    fn to_columns(rows: &[Self]) -> Vec<ArrayRef>;
+    /// Rows from a batch whose columns have been checked against the spec.
+    /// Errors name the row and column.
+    fn from_columns(columns: &Columns<'_>) -> Result<Vec<Self>, String>;
+}
