@@ -52,11 +52,7 @@ impl CirSnapshot {
             });
         }
         if self.taps.is_empty() {
-            return Err(CoreError::ShapeMismatch {
-                what: "CIR taps",
-                expected: 1,
-                found: 0,
-            });
+            return Err(CoreError::ShapeMismatch { what: "CIR taps", expected: 1, found: 0 });
         }
         for tap in &self.taps {
             ensure_finite("tap real part", tap.re)?;
@@ -101,21 +97,9 @@ mod tests {
     fn nan_tap_and_bad_spacing_fail() {
         let mut s = snapshot();
         s.taps[2].im = f64::NAN;
-        assert!(matches!(
-            s.validate(),
-            Err(CoreError::NotFinite {
-                field: "tap imaginary part",
-                ..
-            })
-        ));
+        assert!(matches!(s.validate(), Err(CoreError::NotFinite { field: "tap imaginary part", .. })));
         let mut s = snapshot();
         s.tap_spacing_s = -1e-9;
-        assert!(matches!(
-            s.validate(),
-            Err(CoreError::OutOfRange {
-                field: "tap_spacing_s",
-                ..
-            })
-        ));
+        assert!(matches!(s.validate(), Err(CoreError::OutOfRange { field: "tap_spacing_s", .. })));
     }
 }

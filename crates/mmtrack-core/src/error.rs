@@ -36,9 +36,7 @@ pub enum CoreError {
         expected: &'static str,
     },
     /// Timestamps that must increase strictly do not.
-    #[error(
-        "{what}: time goes backwards or repeats at index {index} ({previous_t_ns} ns then {t_ns} ns)"
-    )]
+    #[error("{what}: time goes backwards or repeats at index {index} ({previous_t_ns} ns then {t_ns} ns)")]
     NonMonotonicTime {
         /// Which sequence of timestamps.
         what: &'static str,
@@ -53,26 +51,10 @@ pub enum CoreError {
 
 /// Fails with [`CoreError::NotFinite`] unless `value` is finite.
 pub(crate) fn ensure_finite(field: &'static str, value: f64) -> Result<(), CoreError> {
-    if value.is_finite() {
-        Ok(())
-    } else {
-        Err(CoreError::NotFinite { field, value })
-    }
+    if value.is_finite() { Ok(()) } else { Err(CoreError::NotFinite { field, value }) }
 }
 
 /// Fails with [`CoreError::ShapeMismatch`] unless `found == expected`.
-pub(crate) fn ensure_len(
-    what: &'static str,
-    expected: usize,
-    found: usize,
-) -> Result<(), CoreError> {
-    if expected == found {
-        Ok(())
-    } else {
-        Err(CoreError::ShapeMismatch {
-            what,
-            expected,
-            found,
-        })
-    }
+pub(crate) fn ensure_len(what: &'static str, expected: usize, found: usize) -> Result<(), CoreError> {
+    if expected == found { Ok(()) } else { Err(CoreError::ShapeMismatch { what, expected, found }) }
 }

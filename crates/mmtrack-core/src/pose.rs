@@ -29,11 +29,7 @@ pub struct Se2 {
 
 impl Se2 {
     /// The identity transform.
-    pub const IDENTITY: Se2 = Se2 {
-        x_m: 0.0,
-        y_m: 0.0,
-        yaw_rad: 0.0,
-    };
+    pub const IDENTITY: Se2 = Se2 { x_m: 0.0, y_m: 0.0, yaw_rad: 0.0 };
 
     /// A transform from its translation and rotation.
     #[must_use]
@@ -58,10 +54,7 @@ impl Se2 {
     #[must_use]
     pub fn transform_point(&self, p: [f64; 2]) -> [f64; 2] {
         let (s, c) = self.yaw_rad.sin_cos();
-        [
-            c * p[0] - s * p[1] + self.x_m,
-            s * p[0] + c * p[1] + self.y_m,
-        ]
+        [c * p[0] - s * p[1] + self.x_m, s * p[0] + c * p[1] + self.y_m]
     }
 
     /// Length of the translation, metres.
@@ -83,11 +76,7 @@ impl Mul for Se2 {
     /// Composition `a_from_c = a_from_b * b_from_c`: `[R1 R2, R1 t2 + t1]`.
     fn mul(self, rhs: Se2) -> Se2 {
         let [x_m, y_m] = self.transform_point([rhs.x_m, rhs.y_m]);
-        Se2 {
-            x_m,
-            y_m,
-            yaw_rad: wrap_angle_rad(self.yaw_rad + rhs.yaw_rad),
-        }
+        Se2 { x_m, y_m, yaw_rad: wrap_angle_rad(self.yaw_rad + rhs.yaw_rad) }
     }
 }
 

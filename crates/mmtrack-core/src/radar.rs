@@ -90,11 +90,7 @@ impl PolarScan {
     /// the declared shape.
     pub fn new(header: PolarScanHeader, power: Vec<u8>) -> Result<Self, CoreError> {
         header.validate()?;
-        ensure_len(
-            "polar scan power",
-            header.azimuths.len() * header.bins_per_azimuth,
-            power.len(),
-        )?;
+        ensure_len("polar scan power", header.azimuths.len() * header.bins_per_azimuth, power.len())?;
         Ok(Self { header, power })
     }
 
@@ -112,13 +108,7 @@ mod tests {
     use super::*;
 
     fn azimuths(n: usize) -> Vec<AzimuthSample> {
-        (0..n)
-            .map(|i| AzimuthSample {
-                t_ns: i as i64 * 1000,
-                azimuth_rad: i as f64 * 0.1,
-                valid: true,
-            })
-            .collect()
+        (0..n).map(|i| AzimuthSample { t_ns: i as i64 * 1000, azimuth_rad: i as f64 * 0.1, valid: true }).collect()
     }
 
     fn header(n: usize, bins: usize, resolution_m: f64, offset_m: f64) -> PolarScanHeader {
@@ -134,14 +124,7 @@ mod tests {
     #[test]
     fn shape_is_checked() {
         let err = PolarScan::new(header(3, 5, 0.04, 0.0), vec![0; 14]).unwrap_err();
-        assert_eq!(
-            err,
-            CoreError::ShapeMismatch {
-                what: "polar scan power",
-                expected: 15,
-                found: 14
-            }
-        );
+        assert_eq!(err, CoreError::ShapeMismatch { what: "polar scan power", expected: 15, found: 14 });
     }
 
     #[test]
@@ -157,10 +140,7 @@ mod tests {
     fn non_monotonic_azimuth_time_is_reported() {
         let mut h = header(4, 1, 0.5, 0.0);
         h.azimuths[2].t_ns = h.azimuths[1].t_ns;
-        assert!(matches!(
-            h.check_azimuth_times(),
-            Err(CoreError::NonMonotonicTime { index: 2, .. })
-        ));
+        assert!(matches!(h.check_azimuth_times(), Err(CoreError::NonMonotonicTime { index: 2, .. })));
     }
 
     #[test]

@@ -33,28 +33,20 @@ impl AtomicFile {
     /// final rename never crosses file systems).
     pub fn create(target: &Path, overwrite: Overwrite) -> Result<Self> {
         if overwrite == Overwrite::Refuse && target.exists() {
-            return Err(IoError::OutputExists {
-                path: target.to_path_buf(),
-            });
+            return Err(IoError::OutputExists { path: target.to_path_buf() });
         }
         let dir = match target.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
         std::fs::create_dir_all(&dir).map_err(os_err(&dir))?;
-        let file_name = target
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let file_name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let temp = tempfile::Builder::new()
             .prefix(&format!(".{file_name}."))
             .suffix(".partial")
             .tempfile_in(&dir)
             .map_err(os_err(&dir))?;
-        Ok(Self {
-            target: target.to_path_buf(),
-            temp,
-        })
+        Ok(Self { target: target.to_path_buf(), temp })
     }
 
     /// The final path.
@@ -77,22 +69,14 @@ impl AtomicFile {
         temp.as_file().sync_all().map_err(os_err(temp.path()))?;
         match overwrite {
             Overwrite::Replace => {
-                temp.persist(&target).map_err(|e| IoError::Os {
-                    path: target.clone(),
-                    source: e.error,
-                })?;
+                temp.persist(&target).map_err(|e| IoError::Os { path: target.clone(), source: e.error })?;
             }
             Overwrite::Refuse => {
                 temp.persist_noclobber(&target).map_err(|e| {
                     if e.error.kind() == std::io::ErrorKind::AlreadyExists {
-                        IoError::OutputExists {
-                            path: target.clone(),
-                        }
+                        IoError::OutputExists { path: target.clone() }
                     } else {
-                        IoError::Os {
-                            path: target.clone(),
-                            source: e.error,
-                        }
+                        IoError::Os { path: target.clone(), source: e.error }
                     }
                 })?;
             }
@@ -115,10 +99,7 @@ mod tests {
             f.writer().unwrap().write_all(b"half").unwrap();
         }
         assert!(!target.exists());
-        assert_eq!(
-            std::fs::read_dir(dir.path().join("sub")).unwrap().count(),
-            0
-        );
+        assert_eq!(std::fs::read_dir(dir.path().join("sub")).unwrap().count(), 0);
 
         let f = AtomicFile::create(&target, Overwrite::Refuse).unwrap();
         let mut w = f.writer().unwrap();
@@ -134,10 +115,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let target = dir.path().join("out.bin");
         std::fs::write(&target, b"old").unwrap();
-        assert!(matches!(
-            AtomicFile::create(&target, Overwrite::Refuse),
-            Err(IoError::OutputExists { .. })
-        ));
+        assert!(matches!(AtomicFile::create(&target, Overwrite::Refuse), Err(IoError::OutputExists { .. })));
         let f = AtomicFile::create(&target, Overwrite::Replace).unwrap();
         let mut w = f.writer().unwrap();
         w.write_all(b"new").unwrap();

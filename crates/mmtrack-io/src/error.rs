@@ -24,9 +24,7 @@ pub enum IoError {
         path: PathBuf,
     },
     /// The MCAP container is malformed or cut short.
-    #[error(
-        "{path}: not a readable MCAP recording ({detail}); the file may be truncated or corrupted"
-    )]
+    #[error("{path}: not a readable MCAP recording ({detail}); the file may be truncated or corrupted")]
     CorruptRecording {
         /// The recording.
         path: PathBuf,
@@ -126,8 +124,5 @@ pub type Result<T, E = IoError> = std::result::Result<T, E>;
 
 /// Attaches a path to an `std::io::Error`.
 pub(crate) fn os_err(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> IoError + '_ {
-    move |source| IoError::Os {
-        path: path.to_path_buf(),
-        source,
-    }
+    move |source| IoError::Os { path: path.to_path_buf(), source }
 }

@@ -25,6 +25,4 @@ pub mod table;
 pub use atomic::{AtomicFile, Overwrite};
 pub use error::{IoError, Result};
 pub use png_gray::decode_gray8;
-pub use recording::{
-    RecordingEvent, RecordingMetadata, RecordingOptions, RecordingReader, RecordingWriter,
-};
+pub use recording::{RecordingEvent, RecordingMetadata, RecordingOptions, RecordingReader, RecordingWriter};

@@ -7,9 +7,7 @@
 /// depth other than 8-bit grey.
 pub fn decode_gray8(bytes: &[u8]) -> Result<(usize, usize, Vec<u8>), String> {
     let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    let mut reader = decoder
-        .read_info()
-        .map_err(|e| format!("not a readable PNG: {e}"))?;
+    let mut reader = decoder.read_info().map_err(|e| format!("not a readable PNG: {e}"))?;
     let info = reader.info();
     if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Eight {
         return Err(format!(
@@ -18,19 +16,12 @@ pub fn decode_gray8(bytes: &[u8]) -> Result<(usize, usize, Vec<u8>), String> {
         ));
     }
     let (width, height) = (info.width as usize, info.height as usize);
-    let size = reader
-        .output_buffer_size()
-        .ok_or("PNG dimensions overflow memory")?;
+    let size = reader.output_buffer_size().ok_or("PNG dimensions overflow memory")?;
     let mut pixels = vec![0; size];
-    let frame = reader
-        .next_frame(&mut pixels)
-        .map_err(|e| format!("PNG data is truncated or corrupt: {e}"))?;
+    let frame = reader.next_frame(&mut pixels).map_err(|e| format!("PNG data is truncated or corrupt: {e}"))?;
     pixels.truncate(frame.buffer_size());
     if pixels.len() != width * height {
-        return Err(format!(
-            "PNG holds {} bytes, expected {width} x {height}",
-            pixels.len()
-        ));
+        return Err(format!("PNG holds {} bytes, expected {width} x {height}", pixels.len()));
     }
     Ok((width, height, pixels))
 }

@@ -11,10 +11,7 @@
 
 use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
-use prost_types::{
-    DescriptorProto, FieldDescriptorProto, FileDescriptorProto, FileDescriptorSet,
-    OneofDescriptorProto,
-};
+use prost_types::{DescriptorProto, FieldDescriptorProto, FieldOptions, FileDescriptorProto, FileDescriptorSet};
 
 /// Protobuf scalar types used by mmtrack messages.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,9 +59,10 @@ impl ProtoType {
 /// How many values a field holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Cardinality {
-    /// Exactly one (proto3 implicit presence: a zero value is not written).
+    /// Exactly one (proto2 `required`: always written, so `-0.0` survives;
+    /// proto3's implicit presence would drop it as a default value).
     One,
-    /// Zero or one, with presence (proto3 `optional`).
+    /// Zero or one, with presence (proto2 `optional`).
     Optional,
     /// Any number (packed).
     Repeated,
@@ -100,9 +98,7 @@ pub struct MessageSpec {
 
 impl MessageSpec {
     fn package_and_name(&self) -> (&'static str, &'static str) {
-        self.full_name
-            .rsplit_once('.')
-            .unwrap_or(("", self.full_name))
+        self.full_name.rsplit_once('.').unwrap_or(("", self.full_name))
     }
 
     /// The serialized `FileDescriptorSet` that MCAP's protobuf profile expects
@@ -110,44 +106,31 @@ impl MessageSpec {
     #[must_use]
     pub fn file_descriptor_set(&self) -> Vec<u8> {
         let (package, name) = self.package_and_name();
-        let mut oneofs = Vec::new();
         let fields = self
             .fields
             .iter()
             .map(|f| {
-                let mut field = FieldDescriptorProto {
+                let packed = f.cardinality == Cardinality::Repeated && f.ty != ProtoType::String;
+                FieldDescriptorProto {
                     name: Some(f.name.to_string()),
                     number: Some(f.number),
                     label: Some(match f.cardinality {
+                        Cardinality::One => Label::Required,
+                        Cardinality::Optional => Label::Optional,
                         Cardinality::Repeated => Label::Repeated,
-                        Cardinality::One | Cardinality::Optional => Label::Optional,
                     } as i32),
                     r#type: Some(f.ty.descriptor_type() as i32),
                     json_name: Some(f.name.to_string()),
+                    options: packed.then(|| FieldOptions { packed: Some(true), ..Default::default() }),
                     ..Default::default()
-                };
-                if f.cardinality == Cardinality::Optional {
-                    // proto3 `optional` is a synthetic one-field oneof.
-                    field.proto3_optional = Some(true);
-                    field.oneof_index = Some(oneofs.len() as i32);
-                    oneofs.push(OneofDescriptorProto {
-                        name: Some(format!("_{}", f.name)),
-                        options: None,
-                    });
                 }
-                field
             })
             .collect();
         let file = FileDescriptorProto {
             name: Some(format!("{}.proto", self.full_name.replace('.', "/"))),
             package: Some(package.to_string()),
-            message_type: vec![DescriptorProto {
-                name: Some(name.to_string()),
-                field: fields,
-                oneof_decl: oneofs,
-                ..Default::default()
-            }],
-            syntax: Some("proto3".to_string()),
+            message_type: vec![DescriptorProto { name: Some(name.to_string()), field: fields, ..Default::default() }],
+            syntax: Some("proto2".to_string()),
             ..Default::default()
         };
         FileDescriptorSet { file: vec![file] }.encode_to_vec()
@@ -157,23 +140,17 @@ impl MessageSpec {
     #[must_use]
     pub fn proto_text(&self) -> String {
         let (package, name) = self.package_and_name();
-        let mut out = format!(
-            "syntax = \"proto3\";\npackage {package};\n\n// {}\nmessage {name} {{\n",
-            self.description
-        );
+        let mut out =
+            format!("syntax = \"proto2\";\npackage {package};\n\n// {}\nmessage {name} {{\n", self.description);
         for f in self.fields {
-            let label = match f.cardinality {
-                Cardinality::One => "",
-                Cardinality::Optional => "optional ",
-                Cardinality::Repeated => "repeated ",
+            let (label, options) = match f.cardinality {
+                Cardinality::One => ("required", ""),
+                Cardinality::Optional => ("optional", ""),
+                Cardinality::Repeated => ("repeated", " [packed = true]"),
             };
-            let unit = if f.unit.is_empty() {
-                String::new()
-            } else {
-                format!(" [{}]", f.unit)
-            };
+            let unit = if f.unit.is_empty() { String::new() } else { format!(" [{}]", f.unit) };
             out.push_str(&format!(
-                "  // {}{unit}\n  {label}{} {} = {};\n",
+                "  // {}{unit}\n  {label} {} {} = {}{options};\n",
                 f.meaning,
                 f.ty.proto_name(),
                 f.name,
@@ -199,14 +176,7 @@ const fn field(
     unit: &'static str,
     meaning: &'static str,
 ) -> FieldSpec {
-    FieldSpec {
-        name,
-        number,
-        ty,
-        cardinality,
-        unit,
-        meaning,
-    }
+    FieldSpec { name, number, ty, cardinality, unit, meaning }
 }
 
 use Cardinality::{One, Optional, Repeated};
@@ -216,22 +186,22 @@ use ProtoType::{Bool, Double, Int64, String as Str, Uint32, Uint64};
 #[derive(Clone, PartialEq, Message)]
 pub struct Pose2D {
     /// See [`POSE2D_SPEC`].
-    #[prost(int64, tag = "1")]
+    #[prost(int64, required, tag = "1")]
     pub t_ns: i64,
     /// See [`POSE2D_SPEC`].
-    #[prost(string, tag = "2")]
+    #[prost(string, required, tag = "2")]
     pub parent_frame: String,
     /// See [`POSE2D_SPEC`].
-    #[prost(string, tag = "3")]
+    #[prost(string, required, tag = "3")]
     pub child_frame: String,
     /// See [`POSE2D_SPEC`].
-    #[prost(double, tag = "4")]
+    #[prost(double, required, tag = "4")]
     pub x_m: f64,
     /// See [`POSE2D_SPEC`].
-    #[prost(double, tag = "5")]
+    #[prost(double, required, tag = "5")]
     pub y_m: f64,
     /// See [`POSE2D_SPEC`].
-    #[prost(double, tag = "6")]
+    #[prost(double, required, tag = "6")]
     pub yaw_rad: f64,
 }
 
@@ -240,54 +210,12 @@ pub const POSE2D_SPEC: MessageSpec = MessageSpec {
     full_name: "mmtrack.Pose2D",
     description: "A planar rigid transform parent_from_child (SE(2)) valid at t_ns: p_parent = R(yaw) p_child + (x, y).",
     fields: &[
-        field(
-            "t_ns",
-            1,
-            Int64,
-            One,
-            "ns",
-            "time of validity, nanoseconds since the UNIX epoch (or scenario start)",
-        ),
-        field(
-            "parent_frame",
-            2,
-            Str,
-            One,
-            "",
-            "frame the pose is expressed in, e.g. world",
-        ),
-        field(
-            "child_frame",
-            3,
-            Str,
-            One,
-            "",
-            "frame being located, e.g. vehicle or radar",
-        ),
-        field(
-            "x_m",
-            4,
-            Double,
-            One,
-            "m",
-            "translation along the parent x axis",
-        ),
-        field(
-            "y_m",
-            5,
-            Double,
-            One,
-            "m",
-            "translation along the parent y axis",
-        ),
-        field(
-            "yaw_rad",
-            6,
-            Double,
-            One,
-            "rad",
-            "rotation about z, counter-clockwise positive",
-        ),
+        field("t_ns", 1, Int64, One, "ns", "time of validity, nanoseconds since the UNIX epoch (or scenario start)"),
+        field("parent_frame", 2, Str, One, "", "frame the pose is expressed in, e.g. world"),
+        field("child_frame", 3, Str, One, "", "frame being located, e.g. vehicle or radar"),
+        field("x_m", 4, Double, One, "m", "translation along the parent x axis"),
+        field("y_m", 5, Double, One, "m", "translation along the parent y axis"),
+        field("yaw_rad", 6, Double, One, "rad", "rotation about z, counter-clockwise positive"),
     ],
 };
 
@@ -299,16 +227,16 @@ impl SpecMessage for Pose2D {
 #[derive(Clone, PartialEq, Message)]
 pub struct GnssFix {
     /// See [`GNSS_FIX_SPEC`].
-    #[prost(int64, tag = "1")]
+    #[prost(int64, required, tag = "1")]
     pub t_ns: i64,
     /// See [`GNSS_FIX_SPEC`].
-    #[prost(double, tag = "2")]
+    #[prost(double, required, tag = "2")]
     pub latitude_deg: f64,
     /// See [`GNSS_FIX_SPEC`].
-    #[prost(double, tag = "3")]
+    #[prost(double, required, tag = "3")]
     pub longitude_deg: f64,
     /// See [`GNSS_FIX_SPEC`].
-    #[prost(double, tag = "4")]
+    #[prost(double, required, tag = "4")]
     pub altitude_m: f64,
     /// See [`GNSS_FIX_SPEC`].
     #[prost(double, optional, tag = "5")]
@@ -317,7 +245,7 @@ pub struct GnssFix {
     #[prost(uint32, optional, tag = "6")]
     pub num_satellites: Option<u32>,
     /// See [`GNSS_FIX_SPEC`].
-    #[prost(uint32, tag = "7")]
+    #[prost(uint32, required, tag = "7")]
     pub quality: u32,
 }
 
@@ -326,38 +254,10 @@ pub const GNSS_FIX_SPEC: MessageSpec = MessageSpec {
     full_name: "mmtrack.GnssFix",
     description: "One WGS-84 GNSS position fix.",
     fields: &[
-        field(
-            "t_ns",
-            1,
-            Int64,
-            One,
-            "ns",
-            "fix time, nanoseconds since the UNIX epoch",
-        ),
-        field(
-            "latitude_deg",
-            2,
-            Double,
-            One,
-            "deg",
-            "geodetic latitude, north positive",
-        ),
-        field(
-            "longitude_deg",
-            3,
-            Double,
-            One,
-            "deg",
-            "geodetic longitude, east positive",
-        ),
-        field(
-            "altitude_m",
-            4,
-            Double,
-            One,
-            "m",
-            "height (datum in the recording metadata key gnss.altitude_datum)",
-        ),
+        field("t_ns", 1, Int64, One, "ns", "fix time, nanoseconds since the UNIX epoch"),
+        field("latitude_deg", 2, Double, One, "deg", "geodetic latitude, north positive"),
+        field("longitude_deg", 3, Double, One, "deg", "geodetic longitude, east positive"),
+        field("altitude_m", 4, Double, One, "m", "height (datum in the recording metadata key gnss.altitude_datum)"),
         field(
             "horizontal_sigma_m",
             5,
@@ -366,14 +266,7 @@ pub const GNSS_FIX_SPEC: MessageSpec = MessageSpec {
             "m",
             "1-sigma horizontal uncertainty, absent when the source gives none",
         ),
-        field(
-            "num_satellites",
-            6,
-            Uint32,
-            Optional,
-            "",
-            "satellites used, absent when not reported",
-        ),
+        field("num_satellites", 6, Uint32, Optional, "", "satellites used, absent when not reported"),
         field(
             "quality",
             7,
@@ -393,19 +286,19 @@ impl SpecMessage for GnssFix {
 #[derive(Clone, PartialEq, Message)]
 pub struct RadarScanMeta {
     /// See [`RADAR_SCAN_META_SPEC`].
-    #[prost(int64, tag = "1")]
+    #[prost(int64, required, tag = "1")]
     pub t_ns: i64,
     /// See [`RADAR_SCAN_META_SPEC`].
-    #[prost(double, tag = "2")]
+    #[prost(double, required, tag = "2")]
     pub range_resolution_m: f64,
     /// See [`RADAR_SCAN_META_SPEC`].
-    #[prost(double, tag = "3")]
+    #[prost(double, required, tag = "3")]
     pub range_offset_m: f64,
     /// See [`RADAR_SCAN_META_SPEC`].
-    #[prost(uint32, tag = "4")]
+    #[prost(uint32, required, tag = "4")]
     pub bins_per_azimuth: u32,
     /// See [`RADAR_SCAN_META_SPEC`].
-    #[prost(uint32, tag = "5")]
+    #[prost(uint32, required, tag = "5")]
     pub power_column_offset: u32,
     /// See [`RADAR_SCAN_META_SPEC`].
     #[prost(int64, repeated, tag = "6")]
@@ -423,24 +316,10 @@ pub const RADAR_SCAN_META_SPEC: MessageSpec = MessageSpec {
     full_name: "mmtrack.RadarScanMeta",
     description: "Timing and geometry of one polar radar scan; the power image with the same MCAP sequence number on /radar/image holds the bins.",
     fields: &[
-        field(
-            "t_ns",
-            1,
-            Int64,
-            One,
-            "ns",
-            "scan timestamp as the dataset stamps it",
-        ),
+        field("t_ns", 1, Int64, One, "ns", "scan timestamp as the dataset stamps it"),
         field("range_resolution_m", 2, Double, One, "m", "range bin size"),
         field("range_offset_m", 3, Double, One, "m", "range of bin 0"),
-        field(
-            "bins_per_azimuth",
-            4,
-            Uint32,
-            One,
-            "",
-            "range bins per azimuth row",
-        ),
+        field("bins_per_azimuth", 4, Uint32, One, "", "range bins per azimuth row"),
         field(
             "power_column_offset",
             5,
@@ -449,14 +328,7 @@ pub const RADAR_SCAN_META_SPEC: MessageSpec = MessageSpec {
             "",
             "image columns before bin 0 (11 for Oxford/Boreas PNGs carried unchanged, whose rows start with a timestamp/encoder header; 0 otherwise)",
         ),
-        field(
-            "azimuth_t_ns",
-            6,
-            Int64,
-            Repeated,
-            "ns",
-            "measurement time of each azimuth row",
-        ),
+        field("azimuth_t_ns", 6, Int64, Repeated, "ns", "measurement time of each azimuth row"),
         field(
             "azimuth_rad",
             7,
@@ -465,14 +337,7 @@ pub const RADAR_SCAN_META_SPEC: MessageSpec = MessageSpec {
             "rad",
             "angle of each azimuth row, [0, 2 pi), as the sensor reports it",
         ),
-        field(
-            "valid",
-            8,
-            Bool,
-            Repeated,
-            "",
-            "false where the sensor flagged a row invalid",
-        ),
+        field("valid", 8, Bool, Repeated, "", "false where the sensor flagged a row invalid"),
     ],
 };
 
@@ -484,28 +349,28 @@ impl SpecMessage for RadarScanMeta {
 #[derive(Clone, PartialEq, Message)]
 pub struct CirSnapshot {
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(int64, tag = "1")]
+    #[prost(int64, required, tag = "1")]
     pub t_ns: i64,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(uint64, tag = "2")]
+    #[prost(uint64, required, tag = "2")]
     pub set_index: u64,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(uint32, tag = "3")]
+    #[prost(uint32, required, tag = "3")]
     pub snapshot_index: u32,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(uint32, tag = "4")]
+    #[prost(uint32, required, tag = "4")]
     pub tx_antenna: u32,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(uint32, tag = "5")]
+    #[prost(uint32, required, tag = "5")]
     pub rx_antenna: u32,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(double, tag = "6")]
+    #[prost(double, required, tag = "6")]
     pub carrier_hz: f64,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(double, tag = "7")]
+    #[prost(double, required, tag = "7")]
     pub tap_spacing_s: f64,
     /// See [`CIR_SNAPSHOT_SPEC`].
-    #[prost(double, tag = "8")]
+    #[prost(double, required, tag = "8")]
     pub delay_offset_s: f64,
     /// See [`CIR_SNAPSHOT_SPEC`].
     #[prost(double, repeated, tag = "9")]
@@ -521,71 +386,15 @@ pub const CIR_SNAPSHOT_SPEC: MessageSpec = MessageSpec {
     description: "One channel impulse response; tap k is at delay delay_offset_s + k * tap_spacing_s.",
     fields: &[
         field("t_ns", 1, Int64, One, "ns", "measurement time"),
-        field(
-            "set_index",
-            2,
-            Uint64,
-            One,
-            "",
-            "index of the sounder's set of snapshots",
-        ),
-        field(
-            "snapshot_index",
-            3,
-            Uint32,
-            One,
-            "",
-            "index of the snapshot within its set",
-        ),
-        field(
-            "tx_antenna",
-            4,
-            Uint32,
-            One,
-            "",
-            "transmit antenna index (0 for SISO)",
-        ),
-        field(
-            "rx_antenna",
-            5,
-            Uint32,
-            One,
-            "",
-            "receive antenna index (0 for SISO)",
-        ),
-        field(
-            "carrier_hz",
-            6,
-            Double,
-            One,
-            "Hz",
-            "carrier frequency (0 = baseband)",
-        ),
-        field(
-            "tap_spacing_s",
-            7,
-            Double,
-            One,
-            "s",
-            "delay between consecutive taps",
-        ),
+        field("set_index", 2, Uint64, One, "", "index of the sounder's set of snapshots"),
+        field("snapshot_index", 3, Uint32, One, "", "index of the snapshot within its set"),
+        field("tx_antenna", 4, Uint32, One, "", "transmit antenna index (0 for SISO)"),
+        field("rx_antenna", 5, Uint32, One, "", "receive antenna index (0 for SISO)"),
+        field("carrier_hz", 6, Double, One, "Hz", "carrier frequency (0 = baseband)"),
+        field("tap_spacing_s", 7, Double, One, "s", "delay between consecutive taps"),
         field("delay_offset_s", 8, Double, One, "s", "delay of tap 0"),
-        field(
-            "taps_re",
-            9,
-            Double,
-            Repeated,
-            "",
-            "real parts of the complex taps (sounder's linear scale)",
-        ),
-        field(
-            "taps_im",
-            10,
-            Double,
-            Repeated,
-            "",
-            "imaginary parts of the complex taps, same length as taps_re",
-        ),
+        field("taps_re", 9, Double, Repeated, "", "real parts of the complex taps (sounder's linear scale)"),
+        field("taps_im", 10, Double, Repeated, "", "imaginary parts of the complex taps, same length as taps_re"),
     ],
 };
 
@@ -594,9 +403,4 @@ impl SpecMessage for CirSnapshot {
 }
 
 /// All mmtrack message schemas, for documentation and tests.
-pub const ALL_SPECS: &[&MessageSpec] = &[
-    &POSE2D_SPEC,
-    &GNSS_FIX_SPEC,
-    &RADAR_SCAN_META_SPEC,
-    &CIR_SNAPSHOT_SPEC,
-];
+pub const ALL_SPECS: &[&MessageSpec] = &[&POSE2D_SPEC, &GNSS_FIX_SPEC, &RADAR_SCAN_META_SPEC, &CIR_SNAPSHOT_SPEC];

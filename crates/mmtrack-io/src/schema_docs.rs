@@ -28,21 +28,13 @@ fn index() -> String {
     let mut out = format!(
         "{GENERATED}# mmtrack schemas\n\nThe contract between mmtrack's stages: every MCAP channel and every Parquet table, with types and units.\n\n"
     );
-    out.push_str(
-        "## MCAP recordings\n\n- [channels](mcap/channels.md): topics of a canonical recording\n",
-    );
+    out.push_str("## MCAP recordings\n\n- [channels](mcap/channels.md): topics of a canonical recording\n");
     for spec in ALL_SPECS {
-        out.push_str(&format!(
-            "- [{0}](mcap/{0}.md): {1}\n",
-            spec.full_name, spec.description
-        ));
+        out.push_str(&format!("- [{0}](mcap/{0}.md): {1}\n", spec.full_name, spec.description));
     }
     out.push_str("\n## Parquet tables\n\nLayout: `<root>/<table>/sequence=<id>/part-0.parquet`, zstd; key-value metadata `units` (JSON column -> unit), `mmtrack.table`, `mmtrack.version`, `mmtrack.run_config` (JSON).\n\n");
     for spec in ALL_TABLES {
-        out.push_str(&format!(
-            "- [{0}](tables/{0}.md): {1}\n",
-            spec.name, spec.description
-        ));
+        out.push_str(&format!("- [{0}](tables/{0}.md): {1}\n", spec.name, spec.description));
     }
     out
 }
@@ -54,17 +46,8 @@ fn channels() -> String {
          Log time = the message's `t_ns`.\n\n| topic | schema | role | meaning |\n|---|---|---|---|\n"
     );
     for c in CHANNELS {
-        let role = if c.canonical {
-            "canonical"
-        } else {
-            "display only"
-        };
-        out.push_str(&format!(
-            "| `{}` | {} | {role} | {} |\n",
-            c.topic,
-            c.schema_names.join(", "),
-            c.meaning
-        ));
+        let role = if c.canonical { "canonical" } else { "display only" };
+        out.push_str(&format!("| `{}` | {} | {role} | {} |\n", c.topic, c.schema_names.join(", "), c.meaning));
     }
     out.push_str("\nFoxglove schemas are the published `foxglove.*` protobuf schemas; see https://docs.foxglove.dev/docs/sdk/schemas.\n");
     out
@@ -77,14 +60,11 @@ fn message(spec: &MessageSpec) -> String {
     );
     for f in spec.fields {
         let ty = match f.cardinality {
-            crate::proto::Cardinality::One => f.ty.proto_name().to_string(),
+            crate::proto::Cardinality::One => format!("required {}", f.ty.proto_name()),
             crate::proto::Cardinality::Optional => format!("optional {}", f.ty.proto_name()),
             crate::proto::Cardinality::Repeated => format!("repeated {}", f.ty.proto_name()),
         };
-        out.push_str(&format!(
-            "| {} | `{}` | {ty} | {} | {} |\n",
-            f.number, f.name, f.unit, f.meaning
-        ));
+        out.push_str(&format!("| {} | `{}` | {ty} | {} | {} |\n", f.number, f.name, f.unit, f.meaning));
     }
     out.push_str(&format!("\n```proto\n{}```\n", spec.proto_text()));
     out

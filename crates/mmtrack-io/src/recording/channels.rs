@@ -55,9 +55,7 @@ impl PoseStream {
     /// The stream a canonical topic belongs to.
     #[must_use]
     pub fn from_topic(topic: &str) -> Option<Self> {
-        [Self::GroundTruth, Self::Estimate]
-            .into_iter()
-            .find(|s| s.topic() == topic)
+        [Self::GroundTruth, Self::Estimate].into_iter().find(|s| s.topic() == topic)
     }
 }
 

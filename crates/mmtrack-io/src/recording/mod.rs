@@ -16,12 +16,8 @@ mod reader;
 mod writer;
 
 pub use channels::{CHANNELS, ChannelSpec, PoseStream};
-pub use reader::{
-    ChannelSummary, RecordingEvent, RecordingReader, RecordingSummary, inspect_recording,
-};
-pub use writer::{
-    Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TimeBase, WriteSummary,
-};
+pub use reader::{ChannelSummary, RecordingEvent, RecordingReader, RecordingSummary, inspect_recording};
+pub use writer::{Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TimeBase, WriteSummary};
 
 /// Name of the MCAP metadata record that holds [`RecordingMetadata`].
 pub const METADATA_NAME: &str = "mmtrack.recording";

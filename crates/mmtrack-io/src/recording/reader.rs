@@ -8,8 +8,7 @@ use foxglove::schemas::{CompressedImage, RawImage};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
 use mmtrack_core::{
-    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, PolarScan, PolarScanHeader,
-    Se2, StampedPose,
+    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, PolarScan, PolarScanHeader, Se2, StampedPose,
 };
 use prost::Message;
 
@@ -57,40 +56,26 @@ impl RawReader {
     }
 
     fn corrupt(&self, detail: impl std::fmt::Display) -> IoError {
-        IoError::CorruptRecording {
-            path: self.path.clone(),
-            detail: detail.to_string(),
-        }
+        IoError::CorruptRecording { path: self.path.clone(), detail: detail.to_string() }
     }
 
     /// The next message, or `None` at a clean end of file.
     fn next_message(&mut self) -> Result<Option<RawMessage>> {
         while let Some(event) = self.reader.next_event() {
-            match event.map_err(|e| IoError::CorruptRecording {
-                path: self.path.clone(),
-                detail: e.to_string(),
-            })? {
+            match event.map_err(|e| IoError::CorruptRecording { path: self.path.clone(), detail: e.to_string() })? {
                 LinearReadEvent::ReadRequest(need) => {
-                    let read = self
-                        .file
-                        .read(self.reader.insert(need))
-                        .map_err(os_err(&self.path))?;
+                    let read = self.file.read(self.reader.insert(need)).map_err(os_err(&self.path))?;
                     self.reader.notify_read(read);
                 }
                 LinearReadEvent::Record { opcode, data } => {
-                    let record = mcap::parse_record(opcode, data).map_err(|e| {
-                        IoError::CorruptRecording {
-                            path: self.path.clone(),
-                            detail: e.to_string(),
-                        }
-                    })?;
+                    let record = mcap::parse_record(opcode, data)
+                        .map_err(|e| IoError::CorruptRecording { path: self.path.clone(), detail: e.to_string() })?;
                     match record {
                         Record::Schema { header, .. } => {
                             self.schemas.insert(header.id, header.name);
                         }
                         Record::Channel(c) => {
-                            let schema_name =
-                                self.schemas.get(&c.schema_id).cloned().unwrap_or_default();
+                            let schema_name = self.schemas.get(&c.schema_id).cloned().unwrap_or_default();
                             self.channels.insert(
                                 c.id,
                                 Arc::new(ChannelInfo {
@@ -104,8 +89,7 @@ impl RawReader {
                             self.metadata.insert(m.name, m.metadata);
                         }
                         Record::Message { header, data } => {
-                            let Some(channel) = self.channels.get(&header.channel_id).cloned()
-                            else {
+                            let Some(channel) = self.channels.get(&header.channel_id).cloned() else {
                                 return Err(self.corrupt(format!(
                                     "message {} refers to unknown channel {}",
                                     header.sequence, header.channel_id
@@ -155,10 +139,7 @@ pub struct RecordingReader {
 impl RecordingReader {
     /// Opens a recording.
     pub fn open(path: &Path) -> Result<Self> {
-        Ok(Self {
-            raw: RawReader::open(path)?,
-            pending_meta: None,
-        })
+        Ok(Self { raw: RawReader::open(path)?, pending_meta: None })
     }
 
     /// The recording metadata (`mmtrack.recording`); complete once the first
@@ -179,16 +160,9 @@ impl RecordingReader {
 
     fn decode<M: Message + Default>(&self, m: &RawMessage) -> Result<M> {
         if m.channel.message_encoding != "protobuf" {
-            return Err(self.bad(
-                m,
-                format!(
-                    "message encoding '{}', expected protobuf",
-                    m.channel.message_encoding
-                ),
-            ));
+            return Err(self.bad(m, format!("message encoding '{}', expected protobuf", m.channel.message_encoding)));
         }
-        M::decode(m.data.as_slice())
-            .map_err(|e| self.bad(m, format!("cannot decode {}: {e}", m.channel.schema_name)))
+        M::decode(m.data.as_slice()).map_err(|e| self.bad(m, format!("cannot decode {}: {e}", m.channel.schema_name)))
     }
 
     fn next_event(&mut self) -> Result<Option<RecordingEvent>> {
@@ -198,21 +172,15 @@ impl RecordingReader {
                 let meta: proto::RadarScanMeta = self.decode(&m)?;
                 self.pending_meta = Some((m.sequence, meta));
             } else if topic == RADAR_IMAGE_TOPIC {
-                return self
-                    .join_scan(&m)
-                    .map(|s| Some(RecordingEvent::RadarScan(s)));
+                return self.join_scan(&m).map(|s| Some(RecordingEvent::RadarScan(s)));
             } else if let Some(stream) = PoseStream::from_topic(topic) {
                 let p: proto::Pose2D = self.decode(&m)?;
-                let pose = StampedPose {
-                    t_ns: p.t_ns,
-                    parent_from_child: Se2::new(p.x_m, p.y_m, p.yaw_rad),
-                };
+                let pose = StampedPose { t_ns: p.t_ns, parent_from_child: Se2::new(p.x_m, p.y_m, p.yaw_rad) };
                 return Ok(Some(RecordingEvent::Pose { stream, pose }));
             } else if topic == GNSS_TOPIC {
                 let f: proto::GnssFix = self.decode(&m)?;
-                let quality = GnssFixQuality::from_code(f.quality).ok_or_else(|| {
-                    self.bad(&m, format!("unknown fix quality code {}", f.quality))
-                })?;
+                let quality = GnssFixQuality::from_code(f.quality)
+                    .ok_or_else(|| self.bad(&m, format!("unknown fix quality code {}", f.quality)))?;
                 return Ok(Some(RecordingEvent::Gnss(GnssFix {
                     t_ns: f.t_ns,
                     latitude_deg: f.latitude_deg,
@@ -227,19 +195,10 @@ impl RecordingReader {
                 if c.taps_re.len() != c.taps_im.len() {
                     return Err(self.bad(
                         &m,
-                        format!(
-                            "taps_re has {} values but taps_im has {}",
-                            c.taps_re.len(),
-                            c.taps_im.len()
-                        ),
+                        format!("taps_re has {} values but taps_im has {}", c.taps_re.len(), c.taps_im.len()),
                     ));
                 }
-                let taps = c
-                    .taps_re
-                    .iter()
-                    .zip(&c.taps_im)
-                    .map(|(&re, &im)| Complex64::new(re, im))
-                    .collect();
+                let taps = c.taps_re.iter().zip(&c.taps_im).map(|(&re, &im)| Complex64::new(re, im)).collect();
                 return Ok(Some(RecordingEvent::Cir(CirSnapshot {
                     t_ns: c.t_ns,
                     set_index: c.set_index,
@@ -258,16 +217,14 @@ impl RecordingReader {
 
     /// Joins a radar image with the metadata of the same sequence number.
     fn join_scan(&mut self, m: &RawMessage) -> Result<PolarScan> {
-        let meta =
-            match self.pending_meta.take() {
-                Some((sequence, meta)) if sequence == m.sequence => meta,
-                _ => return Err(self.bad(
-                    m,
-                    format!(
-                        "radar image without {RADAR_META_TOPIC} message of the same sequence number"
-                    ),
-                )),
-            };
+        let meta = match self.pending_meta.take() {
+            Some((sequence, meta)) if sequence == m.sequence => meta,
+            _ => {
+                return Err(
+                    self.bad(m, format!("radar image without {RADAR_META_TOPIC} message of the same sequence number"))
+                );
+            }
+        };
         let n = meta.azimuth_t_ns.len();
         if meta.azimuth_rad.len() != n || meta.valid.len() != n {
             return Err(self.bad(m, "azimuth_t_ns, azimuth_rad and valid differ in length"));
@@ -280,28 +237,17 @@ impl RecordingReader {
                 if image.encoding != "mono8" || image.step != image.width {
                     return Err(self.bad(
                         m,
-                        format!(
-                            "raw image encoding '{}' step {}, expected mono8 packed",
-                            image.encoding, image.step
-                        ),
+                        format!("raw image encoding '{}' step {}, expected mono8 packed", image.encoding, image.step),
                     ));
                 }
-                (
-                    image.width as usize,
-                    image.height as usize,
-                    image.data.to_vec(),
-                )
+                (image.width as usize, image.height as usize, image.data.to_vec())
             }
             "foxglove.CompressedImage" => {
                 let image: CompressedImage = self.decode(m)?;
                 if image.format != "png" {
-                    return Err(self.bad(
-                        m,
-                        format!("compressed image format '{}', expected png", image.format),
-                    ));
+                    return Err(self.bad(m, format!("compressed image format '{}', expected png", image.format)));
                 }
-                let (width, height, pixels) =
-                    crate::png_gray::decode_gray8(&image.data).map_err(|e| self.bad(m, e))?;
+                let (width, height, pixels) = crate::png_gray::decode_gray8(&image.data).map_err(|e| self.bad(m, e))?;
                 (width, height, pixels)
             }
             other => return Err(self.bad(m, format!("schema {other} is not an image schema"))),
@@ -315,11 +261,7 @@ impl RecordingReader {
         let power = if offset == 0 {
             pixels
         } else {
-            pixels
-                .chunks_exact(width)
-                .flat_map(|row| &row[offset..])
-                .copied()
-                .collect()
+            pixels.chunks_exact(width).flat_map(|row| &row[offset..]).copied().collect()
         };
         let azimuths = (0..n)
             .map(|i| AzimuthSample {

@@ -4,16 +4,12 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use foxglove::Encode;
-use foxglove::schemas::{
-    CompressedImage, LocationFix, Pose, PoseInFrame, Quaternion, RawImage, Timestamp, Vector3,
-};
+use foxglove::schemas::{CompressedImage, LocationFix, Pose, PoseInFrame, Quaternion, RawImage, Timestamp, Vector3};
 use mmtrack_core::{CirSnapshot, GnssFix, PolarScan, PolarScanHeader, StampedPose};
 use prost::Message;
 
 use super::METADATA_NAME;
-use super::channels::{
-    CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
-};
+use super::channels::{CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
 use crate::atomic::{AtomicFile, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
@@ -148,11 +144,7 @@ fn timestamp(t_ns: i64) -> Option<Timestamp> {
 
 impl RecordingWriter {
     /// Starts a recording at `path` with its metadata.
-    pub fn create(
-        path: &Path,
-        metadata: &RecordingMetadata,
-        options: &RecordingOptions,
-    ) -> Result<Self> {
+    pub fn create(path: &Path, metadata: &RecordingMetadata, options: &RecordingOptions) -> Result<Self> {
         let file = AtomicFile::create(path, options.overwrite)?;
         let (compression, level) = match options.compression {
             Compression::None => (None, 0),
@@ -167,14 +159,9 @@ impl RecordingWriter {
         if level > 0 {
             write_options = write_options.compression_level(level);
         }
-        let mut mcap = write_options
-            .create(file.writer()?)
+        let mut mcap = write_options.create(file.writer()?).map_err(|e| write_err(path, e))?;
+        mcap.write_metadata(&mcap::records::Metadata { name: METADATA_NAME.into(), metadata: metadata.to_map() })
             .map_err(|e| write_err(path, e))?;
-        mcap.write_metadata(&mcap::records::Metadata {
-            name: METADATA_NAME.into(),
-            metadata: metadata.to_map(),
-        })
-        .map_err(|e| write_err(path, e))?;
         Ok(Self {
             file,
             overwrite: options.overwrite,
@@ -191,68 +178,36 @@ impl RecordingWriter {
     }
 
     /// Registers `topic` on first use and returns its channel id.
-    fn channel(
-        &mut self,
-        topic: &'static str,
-        schema_name: &str,
-        schema_data: &[u8],
-    ) -> Result<u16> {
+    fn channel(&mut self, topic: &'static str, schema_name: &str, schema_data: &[u8]) -> Result<u16> {
         if let Some(state) = self.channels.get(topic) {
             return Ok(state.id);
         }
         let path = self.file.target().to_path_buf();
-        let schema_id = self
-            .mcap
-            .add_schema(schema_name, "protobuf", schema_data)
-            .map_err(|e| write_err(&path, e))?;
-        let id = self
-            .mcap
-            .add_channel(schema_id, topic, "protobuf", &BTreeMap::new())
-            .map_err(|e| write_err(&path, e))?;
-        self.channels.insert(
-            topic,
-            ChannelState {
-                id,
-                next_sequence: 0,
-            },
-        );
+        let schema_id = self.mcap.add_schema(schema_name, "protobuf", schema_data).map_err(|e| write_err(&path, e))?;
+        let id =
+            self.mcap.add_channel(schema_id, topic, "protobuf", &BTreeMap::new()).map_err(|e| write_err(&path, e))?;
+        self.channels.insert(topic, ChannelState { id, next_sequence: 0 });
         Ok(id)
     }
 
     /// Writes `self.buffer` as the next message on `topic`, with an explicit
     /// sequence number when given (radar image and meta share one).
-    fn emit(
-        &mut self,
-        topic: &'static str,
-        channel_id: u16,
-        t_ns: i64,
-        sequence: Option<u32>,
-    ) -> Result<u32> {
+    fn emit(&mut self, topic: &'static str, channel_id: u16, t_ns: i64, sequence: Option<u32>) -> Result<u32> {
         let log_time = u64::try_from(t_ns).map_err(|_| IoError::BadValue {
             path: self.path().to_path_buf(),
             record: format!("message on {topic}"),
             field: "t_ns",
             detail: format!("{t_ns} is negative; recordings store non-negative nanoseconds"),
         })?;
-        let state = self
-            .channels
-            .get_mut(topic)
-            .ok_or_else(|| IoError::RecordingWrite {
-                path: self.file.target().to_path_buf(),
-                detail: format!("channel {topic} used before registration"),
-            })?;
+        let state = self.channels.get_mut(topic).ok_or_else(|| IoError::RecordingWrite {
+            path: self.file.target().to_path_buf(),
+            detail: format!("channel {topic} used before registration"),
+        })?;
         let sequence = sequence.unwrap_or(state.next_sequence);
         state.next_sequence = sequence.wrapping_add(1);
-        let header = mcap::records::MessageHeader {
-            channel_id,
-            sequence,
-            log_time,
-            publish_time: log_time,
-        };
+        let header = mcap::records::MessageHeader { channel_id, sequence, log_time, publish_time: log_time };
         let path = self.file.target().to_path_buf();
-        self.mcap
-            .write_to_known_channel(&header, &self.buffer)
-            .map_err(|e| write_err(&path, e))?;
+        self.mcap.write_to_known_channel(&header, &self.buffer).map_err(|e| write_err(&path, e))?;
         *self.counts.entry(topic.to_string()).or_insert(0) += 1;
         Ok(sequence)
     }
@@ -266,9 +221,7 @@ impl RecordingWriter {
     ) -> Result<u32> {
         let id = self.channel(topic, M::SPEC.full_name, &M::SPEC.file_descriptor_set())?;
         self.buffer.clear();
-        message
-            .encode(&mut self.buffer)
-            .map_err(|e| write_err(self.file.target(), e))?;
+        message.encode(&mut self.buffer).map_err(|e| write_err(self.file.target(), e))?;
         self.emit(topic, id, t_ns, sequence)
     }
 
@@ -290,11 +243,7 @@ impl RecordingWriter {
         self.emit(topic, id, t_ns, sequence)
     }
 
-    fn header_message(
-        &self,
-        header: &PolarScanHeader,
-        power_column_offset: u32,
-    ) -> Result<proto::RadarScanMeta> {
+    fn header_message(&self, header: &PolarScanHeader, power_column_offset: u32) -> Result<proto::RadarScanMeta> {
         let bins = u32::try_from(header.bins_per_azimuth).map_err(|_| IoError::BadValue {
             path: self.path().to_path_buf(),
             record: format!("radar scan at {} ns", header.t_ns),
@@ -336,12 +285,7 @@ impl RecordingWriter {
     /// (`foxglove.CompressedImage`, format `png`). `power_column_offset` is the
     /// number of leading image columns that are not range bins (11 for the
     /// Oxford/Boreas row header). The caller has checked the PNG's shape.
-    pub fn write_radar_png(
-        &mut self,
-        header: &PolarScanHeader,
-        png: &[u8],
-        power_column_offset: u32,
-    ) -> Result<()> {
+    pub fn write_radar_png(&mut self, header: &PolarScanHeader, png: &[u8], power_column_offset: u32) -> Result<()> {
         let meta = self.header_message(header, power_column_offset)?;
         let sequence = self.write_spec(RADAR_META_TOPIC, header.t_ns, &meta, None)?;
         let image = CompressedImage {
@@ -378,17 +322,8 @@ impl RecordingWriter {
                 timestamp: timestamp(pose.t_ns),
                 frame_id: parent_frame.into(),
                 pose: Some(Pose {
-                    position: Some(Vector3 {
-                        x: p.x_m,
-                        y: p.y_m,
-                        z: 0.0,
-                    }),
-                    orientation: Some(Quaternion {
-                        x: 0.0,
-                        y: 0.0,
-                        z: half_yaw.sin(),
-                        w: half_yaw.cos(),
-                    }),
+                    position: Some(Vector3 { x: p.x_m, y: p.y_m, z: 0.0 }),
+                    orientation: Some(Quaternion { x: 0.0, y: 0.0, z: half_yaw.sin(), w: half_yaw.cos() }),
                 }),
             };
             self.write_foxglove(stream.viz_topic(), pose.t_ns, &view, None)?;
@@ -454,24 +389,14 @@ impl RecordingWriter {
         let path = self.file.target().to_path_buf();
         self.mcap.finish().map_err(|e| write_err(&path, e))?;
         let mut inner = self.mcap.into_inner();
-        std::io::Write::flush(&mut inner).map_err(|source| IoError::Os {
-            path: path.clone(),
-            source,
-        })?;
+        std::io::Write::flush(&mut inner).map_err(|source| IoError::Os { path: path.clone(), source })?;
         drop(inner);
         let path = self.file.commit(self.overwrite)?;
         let file_bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-        Ok(WriteSummary {
-            path,
-            message_counts: self.counts,
-            file_bytes,
-        })
+        Ok(WriteSummary { path, message_counts: self.counts, file_bytes })
     }
 }
 
 fn write_err(path: &Path, e: impl std::fmt::Display) -> IoError {
-    IoError::RecordingWrite {
-        path: path.to_path_buf(),
-        detail: e.to_string(),
-    }
+    IoError::RecordingWrite { path: path.to_path_buf(), detail: e.to_string() }
 }

@@ -1,8 +1,7 @@
 use arrow_array::cast::AsArray;
 use arrow_array::types::{Float64Type, Int64Type, UInt32Type, UInt64Type};
 use arrow_array::{
-    Array, BinaryArray, BooleanArray, Float64Array, Int64Array, ListArray, RecordBatch,
-    UInt32Array, UInt64Array,
+    Array, BinaryArray, BooleanArray, Float64Array, Int64Array, ListArray, RecordBatch, UInt32Array, UInt64Array,
 };
 
 /// Typed access to the columns of a batch already checked against its spec.
@@ -29,67 +28,48 @@ impl<'a> Columns<'a> {
     }
 
     fn column(&self, name: &str) -> Result<&'a dyn Array, String> {
-        self.batch
-            .column_by_name(name)
-            .map(|c| c.as_ref())
-            .ok_or_else(|| missing(name))
+        self.batch.column_by_name(name).map(|c| c.as_ref()).ok_or_else(|| missing(name))
     }
 
     /// An `int64` column.
     pub fn i64(&self, name: &str) -> Result<&'a Int64Array, String> {
-        self.column(name)?
-            .as_primitive_opt::<Int64Type>()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_primitive_opt::<Int64Type>().ok_or_else(|| missing(name))
     }
 
     /// A `uint64` column.
     pub fn u64(&self, name: &str) -> Result<&'a UInt64Array, String> {
-        self.column(name)?
-            .as_primitive_opt::<UInt64Type>()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_primitive_opt::<UInt64Type>().ok_or_else(|| missing(name))
     }
 
     /// A `uint32` column.
     pub fn u32(&self, name: &str) -> Result<&'a UInt32Array, String> {
-        self.column(name)?
-            .as_primitive_opt::<UInt32Type>()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_primitive_opt::<UInt32Type>().ok_or_else(|| missing(name))
     }
 
     /// A `float64` column.
     pub fn f64(&self, name: &str) -> Result<&'a Float64Array, String> {
-        self.column(name)?
-            .as_primitive_opt::<Float64Type>()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_primitive_opt::<Float64Type>().ok_or_else(|| missing(name))
     }
 
     /// A `bool` column.
     pub fn bool(&self, name: &str) -> Result<&'a BooleanArray, String> {
-        self.column(name)?
-            .as_boolean_opt()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_boolean_opt().ok_or_else(|| missing(name))
     }
 
     /// A `binary` column.
     pub fn binary(&self, name: &str) -> Result<&'a BinaryArray, String> {
-        self.column(name)?
-            .as_binary_opt::<i32>()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_binary_opt::<i32>().ok_or_else(|| missing(name))
     }
 
     /// A `list<...>` column.
     pub fn list(&self, name: &str) -> Result<&'a ListArray, String> {
-        self.column(name)?
-            .as_list_opt::<i32>()
-            .ok_or_else(|| missing(name))
+        self.column(name)?.as_list_opt::<i32>().ok_or_else(|| missing(name))
     }
 
     /// Row `row` of a `list<float64>` column, nulls rejected.
     pub fn list_f64(&self, name: &str, row: usize) -> Result<Vec<f64>, String> {
         let values = self.list(name)?.value(row);
-        let values = values
-            .as_primitive_opt::<Float64Type>()
-            .ok_or_else(|| missing(name))?;
+        let values = values.as_primitive_opt::<Float64Type>().ok_or_else(|| missing(name))?;
         no_nulls(values, name, row)?;
         Ok(values.values().to_vec())
     }
@@ -97,9 +77,7 @@ impl<'a> Columns<'a> {
     /// Row `row` of a `list<int64>` column, nulls rejected.
     pub fn list_i64(&self, name: &str, row: usize) -> Result<Vec<i64>, String> {
         let values = self.list(name)?.value(row);
-        let values = values
-            .as_primitive_opt::<Int64Type>()
-            .ok_or_else(|| missing(name))?;
+        let values = values.as_primitive_opt::<Int64Type>().ok_or_else(|| missing(name))?;
         no_nulls(values, name, row)?;
         Ok(values.values().to_vec())
     }
@@ -114,11 +92,7 @@ impl<'a> Columns<'a> {
 }
 
 fn no_nulls(values: &dyn Array, name: &str, row: usize) -> Result<(), String> {
-    if values.null_count() > 0 {
-        Err(format!("row {row}: column '{name}' holds null list items"))
-    } else {
-        Ok(())
-    }
+    if values.null_count() > 0 { Err(format!("row {row}: column '{name}' holds null list items")) } else { Ok(()) }
 }
 
 /// Fails when a non-nullable column holds nulls.
@@ -126,9 +100,7 @@ pub(crate) fn check_no_nulls(batch: &RecordBatch, name: &str) -> Result<(), Stri
     match batch.column_by_name(name) {
         Some(c) if c.null_count() > 0 => {
             let row = (0..c.len()).find(|&i| c.is_null(i)).unwrap_or(0);
-            Err(format!(
-                "row {row}: column '{name}' is null but the schema does not allow nulls"
-            ))
+            Err(format!("row {row}: column '{name}' is null but the schema does not allow nulls"))
         }
         _ => Ok(()),
     }

@@ -28,23 +28,16 @@ pub fn table_path(root: &Path, table: &str, sequence_id: &str) -> Result<PathBuf
     let safe = !sequence_id.is_empty()
         && sequence_id != "."
         && sequence_id != ".."
-        && sequence_id
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+        && sequence_id.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
     if !safe {
         return Err(IoError::BadValue {
             path: root.to_path_buf(),
             record: format!("table {table}"),
             field: "sequence_id",
-            detail: format!(
-                "'{sequence_id}' is not a valid partition name (use letters, digits, '-', '_', '.')"
-            ),
+            detail: format!("'{sequence_id}' is not a valid partition name (use letters, digits, '-', '_', '.')"),
         });
     }
-    Ok(root
-        .join(table)
-        .join(format!("sequence={sequence_id}"))
-        .join("part-0.parquet"))
+    Ok(root.join(table).join(format!("sequence={sequence_id}")).join("part-0.parquet"))
 }
 
 /// What a finished table write reports.
@@ -80,10 +73,7 @@ impl TableWriter {
         let metadata = vec![
             KeyValue::new("units".to_string(), spec.units_json()),
             KeyValue::new("mmtrack.table".to_string(), spec.name.to_string()),
-            KeyValue::new(
-                "mmtrack.version".to_string(),
-                env!("CARGO_PKG_VERSION").to_string(),
-            ),
+            KeyValue::new("mmtrack.version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
             KeyValue::new("mmtrack.run_config".to_string(), run.config_json.clone()),
         ];
         let level = ZstdLevel::try_new(3).map_err(|e| table_write_err(&path, e))?;
@@ -92,16 +82,9 @@ impl TableWriter {
             .set_key_value_metadata(Some(metadata))
             .build();
         let schema = Arc::new(spec.arrow_schema());
-        let writer = ArrowWriter::try_new(file.writer()?, schema.clone(), Some(props))
-            .map_err(|e| table_write_err(&path, e))?;
-        Ok(Self {
-            spec,
-            schema,
-            file,
-            overwrite,
-            writer,
-            rows: 0,
-        })
+        let writer =
+            ArrowWriter::try_new(file.writer()?, schema.clone(), Some(props)).map_err(|e| table_write_err(&path, e))?;
+        Ok(Self { spec, schema, file, overwrite, writer, rows: 0 })
     }
 
     /// Appends rows.
@@ -110,18 +93,12 @@ impl TableWriter {
         if T::SPEC.name != self.spec.name {
             return Err(table_write_err(
                 &path,
-                format!(
-                    "rows of table {} written to table {}",
-                    T::SPEC.name,
-                    self.spec.name
-                ),
+                format!("rows of table {} written to table {}", T::SPEC.name, self.spec.name),
             ));
         }
-        let batch = RecordBatch::try_new(self.schema.clone(), T::to_columns(rows))
-            .map_err(|e| table_write_err(&path, e))?;
-        self.writer
-            .write(&batch)
-            .map_err(|e| table_write_err(&path, e))?;
+        let batch =
+            RecordBatch::try_new(self.schema.clone(), T::to_columns(rows)).map_err(|e| table_write_err(&path, e))?;
+        self.writer.write(&batch).map_err(|e| table_write_err(&path, e))?;
         self.rows += rows.len() as u64;
         Ok(())
     }
@@ -129,19 +106,10 @@ impl TableWriter {
     /// Completes the file and moves it into place.
     pub fn finish(self) -> Result<TableWriteSummary> {
         let path = self.file.target().to_path_buf();
-        let inner = self
-            .writer
-            .into_inner()
-            .map_err(|e| table_write_err(&path, e))?;
-        inner.into_inner().map_err(|e| IoError::Os {
-            path: path.clone(),
-            source: e.into_error(),
-        })?;
+        let inner = self.writer.into_inner().map_err(|e| table_write_err(&path, e))?;
+        inner.into_inner().map_err(|e| IoError::Os { path: path.clone(), source: e.into_error() })?;
         let path = self.file.commit(self.overwrite)?;
-        Ok(TableWriteSummary {
-            path,
-            rows: self.rows,
-        })
+        Ok(TableWriteSummary { path, rows: self.rows })
     }
 }
 
@@ -159,31 +127,23 @@ pub fn write_table<T: TableRow>(
 }
 
 fn table_write_err(path: &Path, e: impl std::fmt::Display) -> IoError {
-    IoError::TableWrite {
-        path: path.to_path_buf(),
-        detail: e.to_string(),
-    }
+    IoError::TableWrite { path: path.to_path_buf(), detail: e.to_string() }
 }
 
 fn corrupt(path: &Path, e: impl std::fmt::Display) -> IoError {
-    IoError::CorruptTable {
-        path: path.to_path_buf(),
-        detail: e.to_string(),
-    }
+    IoError::CorruptTable { path: path.to_path_buf(), detail: e.to_string() }
 }
 
 /// Checks a file's Arrow schema against the spec: every column present with
 /// the right type, no unknown columns.
 fn check_schema(path: &Path, spec: &TableSpec, schema: &arrow_schema::Schema) -> Result<()> {
     for column in spec.columns {
-        let field = schema
-            .field_with_name(column.name)
-            .map_err(|_| IoError::MissingColumn {
-                path: path.to_path_buf(),
-                table: spec.name.to_string(),
-                column: column.name.to_string(),
-                expected: spec.column_list(),
-            })?;
+        let field = schema.field_with_name(column.name).map_err(|_| IoError::MissingColumn {
+            path: path.to_path_buf(),
+            table: spec.name.to_string(),
+            column: column.name.to_string(),
+            expected: spec.column_list(),
+        })?;
         if !column.ty.accepts(field.data_type()) {
             return Err(IoError::WrongColumnType {
                 path: path.to_path_buf(),
@@ -194,11 +154,7 @@ fn check_schema(path: &Path, spec: &TableSpec, schema: &arrow_schema::Schema) ->
             });
         }
     }
-    if let Some(extra) = schema
-        .fields()
-        .iter()
-        .find(|f| !spec.columns.iter().any(|c| c.name == f.name()))
-    {
+    if let Some(extra) = schema.fields().iter().find(|f| !spec.columns.iter().any(|c| c.name == f.name())) {
         return Err(IoError::UnknownColumn {
             path: path.to_path_buf(),
             table: spec.name.to_string(),
@@ -219,17 +175,14 @@ pub fn read_table<T: TableRow>(path: &Path) -> Result<Vec<T>> {
     for batch in reader {
         let batch = batch.map_err(|e| corrupt(path, e))?;
         for column in T::SPEC.columns.iter().filter(|c| !c.nullable) {
-            check_no_nulls(&batch, column.name).map_err(|detail| IoError::CorruptTable {
-                path: path.to_path_buf(),
-                detail,
-            })?;
+            check_no_nulls(&batch, column.name)
+                .map_err(|detail| IoError::CorruptTable { path: path.to_path_buf(), detail })?;
         }
         let offset = rows.len();
-        let batch_rows =
-            T::from_columns(&Columns::new(&batch)).map_err(|detail| IoError::CorruptTable {
-                path: path.to_path_buf(),
-                detail: format!("{detail} (batch starting at row {offset})"),
-            })?;
+        let batch_rows = T::from_columns(&Columns::new(&batch)).map_err(|detail| IoError::CorruptTable {
+            path: path.to_path_buf(),
+            detail: format!("{detail} (batch starting at row {offset})"),
+        })?;
         rows.extend(batch_rows);
     }
     Ok(rows)
@@ -254,10 +207,7 @@ fn partitions(table_dir: &Path) -> Result<Vec<(String, PathBuf)>> {
 /// Reads every `sequence=` partition of table `T` under `root`, by sequence.
 pub fn read_table_dir<T: TableRow>(root: &Path) -> Result<BTreeMap<String, Vec<T>>> {
     let dir = root.join(T::SPEC.name);
-    partitions(&dir)?
-        .into_iter()
-        .map(|(sequence, file)| Ok((sequence, read_table::<T>(&file)?)))
-        .collect()
+    partitions(&dir)?.into_iter().map(|(sequence, file)| Ok((sequence, read_table::<T>(&file)?))).collect()
 }
 
 /// What `mmtrack inspect` reports about one table file.
@@ -294,10 +244,7 @@ pub fn inspect_table_dir(root: &Path) -> Result<Vec<TableFileSummary>> {
     }
     let mut out = Vec::new();
     for dir in table_dirs {
-        let table = dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
+        let table = dir.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         for (sequence, path) in partitions(&dir)? {
             out.push(summarise_file(&table, &sequence, &path)?);
         }
@@ -318,18 +265,12 @@ fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileS
             None => format!("{}: {}", f.name(), f.data_type()),
         })
         .collect();
-    let has_time = builder
-        .schema()
-        .field_with_name("t_ns")
-        .is_ok_and(|f| f.data_type() == &arrow_schema::DataType::Int64);
+    let has_time =
+        builder.schema().field_with_name("t_ns").is_ok_and(|f| f.data_type() == &arrow_schema::DataType::Int64);
     let mut span: Option<(i64, i64)> = None;
     if has_time {
         let mask = parquet::arrow::ProjectionMask::columns(builder.parquet_schema(), ["t_ns"]);
-        for batch in builder
-            .with_projection(mask)
-            .build()
-            .map_err(|e| corrupt(path, e))?
-        {
+        for batch in builder.with_projection(mask).build().map_err(|e| corrupt(path, e))? {
             let batch = batch.map_err(|e| corrupt(path, e))?;
             let columns = Columns::new(&batch);
             let t = columns.i64("t_ns").map_err(|d| corrupt(path, d))?;

@@ -17,8 +17,8 @@ mod rows;
 
 pub use columns::Columns;
 pub use io::{
-    RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table,
-    read_table_dir, table_path, write_table,
+    RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table, read_table_dir,
+    table_path, write_table,
 };
 pub use rows::ALL_TABLES;
 
@@ -139,10 +139,7 @@ impl TableSpec {
                 if c.unit.is_empty() {
                     field
                 } else {
-                    field.with_metadata(std::collections::HashMap::from([(
-                        "unit".to_string(),
-                        c.unit.to_string(),
-                    )]))
+                    field.with_metadata(std::collections::HashMap::from([("unit".to_string(), c.unit.to_string())]))
                 }
             })
             .collect();
@@ -152,22 +149,15 @@ impl TableSpec {
     /// JSON object column -> unit, for the `units` key-value metadata.
     #[must_use]
     pub fn units_json(&self) -> String {
-        let map: serde_json::Map<String, serde_json::Value> = self
-            .columns
-            .iter()
-            .map(|c| (c.name.to_string(), serde_json::Value::from(c.unit)))
-            .collect();
+        let map: serde_json::Map<String, serde_json::Value> =
+            self.columns.iter().map(|c| (c.name.to_string(), serde_json::Value::from(c.unit))).collect();
         serde_json::Value::Object(map).to_string()
     }
 
     /// Column names, comma-separated, for error messages.
     #[must_use]
     pub fn column_list(&self) -> String {
-        self.columns
-            .iter()
-            .map(|c| c.name)
-            .collect::<Vec<_>>()
-            .join(", ")
+        self.columns.iter().map(|c| c.name).collect::<Vec<_>>().join(", ")
     }
 }
 

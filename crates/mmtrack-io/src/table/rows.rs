@@ -3,44 +3,20 @@
 use std::sync::Arc;
 
 use arrow_array::builder::{BooleanBuilder, Float64Builder, Int64Builder, ListBuilder};
-use arrow_array::{
-    Array, ArrayRef, BinaryArray, Float64Array, Int64Array, UInt32Array, UInt64Array,
-};
+use arrow_array::{Array, ArrayRef, BinaryArray, Float64Array, Int64Array, UInt32Array, UInt64Array};
 use mmtrack_core::{
-    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcDetection, MpcTrack,
-    PolarScan, PolarScanHeader, Se2, StampedPose,
+    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcDetection, MpcTrack, PolarScan, PolarScanHeader,
+    Se2, StampedPose,
 };
 
 use super::{ColumnSpec, ColumnType, Columns, TableRow, TableSpec};
 
-const fn col(
-    name: &'static str,
-    ty: ColumnType,
-    unit: &'static str,
-    meaning: &'static str,
-) -> ColumnSpec {
-    ColumnSpec {
-        name,
-        ty,
-        nullable: false,
-        unit,
-        meaning,
-    }
+const fn col(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'static str) -> ColumnSpec {
+    ColumnSpec { name, ty, nullable: false, unit, meaning }
 }
 
-const fn nullable(
-    name: &'static str,
-    ty: ColumnType,
-    unit: &'static str,
-    meaning: &'static str,
-) -> ColumnSpec {
-    ColumnSpec {
-        name,
-        ty,
-        nullable: true,
-        unit,
-        meaning,
-    }
+const fn nullable(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'static str) -> ColumnSpec {
+    ColumnSpec { name, ty, nullable: true, unit, meaning }
 }
 
 use ColumnType::{Binary, Float64, Int64, ListBoolean, ListFloat64, ListInt64, UInt32, UInt64};
@@ -90,12 +66,7 @@ pub const POSES: TableSpec = TableSpec {
         col("t_ns", Int64, "ns", "time of validity"),
         col("x_m", Float64, "m", "x of the vehicle in the world frame"),
         col("y_m", Float64, "m", "y of the vehicle in the world frame"),
-        col(
-            "yaw_rad",
-            Float64,
-            "rad",
-            "heading, counter-clockwise from world x",
-        ),
+        col("yaw_rad", Float64, "rad", "heading, counter-clockwise from world x"),
     ],
 };
 
@@ -112,12 +83,7 @@ impl TableRow for StampedPose {
     }
 
     fn from_columns(c: &Columns<'_>) -> Result<Vec<Self>, String> {
-        let (t, x, y, yaw) = (
-            c.i64("t_ns")?,
-            c.f64("x_m")?,
-            c.f64("y_m")?,
-            c.f64("yaw_rad")?,
-        );
+        let (t, x, y, yaw) = (c.i64("t_ns")?, c.f64("x_m")?, c.f64("y_m")?, c.f64("yaw_rad")?);
         Ok((0..c.num_rows())
             .map(|i| StampedPose {
                 t_ns: t.value(i),
@@ -133,31 +99,11 @@ pub const GNSS_FIXES: TableSpec = TableSpec {
     description: "One WGS-84 GNSS fix per row.",
     columns: &[
         col("t_ns", Int64, "ns", "fix time"),
-        col(
-            "latitude_deg",
-            Float64,
-            "deg",
-            "geodetic latitude, north positive",
-        ),
-        col(
-            "longitude_deg",
-            Float64,
-            "deg",
-            "geodetic longitude, east positive",
-        ),
+        col("latitude_deg", Float64, "deg", "geodetic latitude, north positive"),
+        col("longitude_deg", Float64, "deg", "geodetic longitude, east positive"),
         col("altitude_m", Float64, "m", "height"),
-        nullable(
-            "horizontal_sigma_m",
-            Float64,
-            "m",
-            "1-sigma horizontal uncertainty; null when not reported",
-        ),
-        nullable(
-            "num_satellites",
-            UInt32,
-            "",
-            "satellites used; null when not reported",
-        ),
+        nullable("horizontal_sigma_m", Float64, "m", "1-sigma horizontal uncertainty; null when not reported"),
+        nullable("num_satellites", UInt32, "", "satellites used; null when not reported"),
         col(
             "quality",
             UInt32,
@@ -176,32 +122,16 @@ impl TableRow for GnssFix {
             f64s(rows.iter().map(|r| r.latitude_deg)),
             f64s(rows.iter().map(|r| r.longitude_deg)),
             f64s(rows.iter().map(|r| r.altitude_m)),
-            Arc::new(
-                rows.iter()
-                    .map(|r| r.horizontal_sigma_m)
-                    .collect::<Float64Array>(),
-            ),
-            Arc::new(
-                rows.iter()
-                    .map(|r| r.num_satellites)
-                    .collect::<UInt32Array>(),
-            ),
+            Arc::new(rows.iter().map(|r| r.horizontal_sigma_m).collect::<Float64Array>()),
+            Arc::new(rows.iter().map(|r| r.num_satellites).collect::<UInt32Array>()),
             u32s(rows.iter().map(|r| r.quality.code())),
         ]
     }
 
     fn from_columns(c: &Columns<'_>) -> Result<Vec<Self>, String> {
-        let (t, lat, lon, alt) = (
-            c.i64("t_ns")?,
-            c.f64("latitude_deg")?,
-            c.f64("longitude_deg")?,
-            c.f64("altitude_m")?,
-        );
-        let (sigma, sats, quality) = (
-            c.f64("horizontal_sigma_m")?,
-            c.u32("num_satellites")?,
-            c.u32("quality")?,
-        );
+        let (t, lat, lon, alt) =
+            (c.i64("t_ns")?, c.f64("latitude_deg")?, c.f64("longitude_deg")?, c.f64("altitude_m")?);
+        let (sigma, sats, quality) = (c.f64("horizontal_sigma_m")?, c.u32("num_satellites")?, c.u32("quality")?);
         (0..c.num_rows())
             .map(|i| {
                 let code = quality.value(i);
@@ -240,33 +170,20 @@ impl TableRow for PolarScan {
     const SPEC: &'static TableSpec = &RADAR_SCANS;
 
     fn to_columns(rows: &[Self]) -> Vec<ArrayRef> {
-        let az_t: Vec<Vec<i64>> = rows
-            .iter()
-            .map(|r| r.header.azimuths.iter().map(|a| a.t_ns).collect())
-            .collect();
-        let az_rad: Vec<Vec<f64>> = rows
-            .iter()
-            .map(|r| r.header.azimuths.iter().map(|a| a.azimuth_rad).collect())
-            .collect();
-        let valid: Vec<Vec<bool>> = rows
-            .iter()
-            .map(|r| r.header.azimuths.iter().map(|a| a.valid).collect())
-            .collect();
+        let az_t: Vec<Vec<i64>> = rows.iter().map(|r| r.header.azimuths.iter().map(|a| a.t_ns).collect()).collect();
+        let az_rad: Vec<Vec<f64>> =
+            rows.iter().map(|r| r.header.azimuths.iter().map(|a| a.azimuth_rad).collect()).collect();
+        let valid: Vec<Vec<bool>> = rows.iter().map(|r| r.header.azimuths.iter().map(|a| a.valid).collect()).collect();
         vec![
             i64s(rows.iter().map(|r| r.header.t_ns)),
             f64s(rows.iter().map(|r| r.header.range_resolution_m)),
             f64s(rows.iter().map(|r| r.header.range_offset_m)),
             // Bin counts beyond 32 bits cannot come from a PolarScan built by any reader.
-            u32s(
-                rows.iter()
-                    .map(|r| u32::try_from(r.header.bins_per_azimuth).unwrap_or(u32::MAX)),
-            ),
+            u32s(rows.iter().map(|r| u32::try_from(r.header.bins_per_azimuth).unwrap_or(u32::MAX))),
             list_i64(az_t.iter().map(Vec::as_slice)),
             list_f64(az_rad.iter().map(Vec::as_slice)),
             list_bool(valid.iter().map(Vec::as_slice)),
-            Arc::new(BinaryArray::from_iter_values(
-                rows.iter().map(|r| r.power.as_slice()),
-            )),
+            Arc::new(BinaryArray::from_iter_values(rows.iter().map(|r| r.power.as_slice()))),
         ]
     }
 
@@ -284,16 +201,10 @@ impl TableRow for PolarScan {
                 let az_rad = c.list_f64("azimuth_rad", i)?;
                 let valid = c.list_bool("valid", i)?;
                 if az_rad.len() != az_t.len() || valid.len() != az_t.len() {
-                    return Err(format!(
-                        "row {i}: azimuth_t_ns, azimuth_rad and valid differ in length"
-                    ));
+                    return Err(format!("row {i}: azimuth_t_ns, azimuth_rad and valid differ in length"));
                 }
                 let azimuths = (0..az_t.len())
-                    .map(|k| AzimuthSample {
-                        t_ns: az_t[k],
-                        azimuth_rad: az_rad[k],
-                        valid: valid[k],
-                    })
+                    .map(|k| AzimuthSample { t_ns: az_t[k], azimuth_rad: az_rad[k], valid: valid[k] })
                     .collect();
                 let header = PolarScanHeader {
                     t_ns: t.value(i),
@@ -330,14 +241,8 @@ impl TableRow for CirSnapshot {
     const SPEC: &'static TableSpec = &CIR_SNAPSHOTS;
 
     fn to_columns(rows: &[Self]) -> Vec<ArrayRef> {
-        let re: Vec<Vec<f64>> = rows
-            .iter()
-            .map(|r| r.taps.iter().map(|t| t.re).collect())
-            .collect();
-        let im: Vec<Vec<f64>> = rows
-            .iter()
-            .map(|r| r.taps.iter().map(|t| t.im).collect())
-            .collect();
+        let re: Vec<Vec<f64>> = rows.iter().map(|r| r.taps.iter().map(|t| t.re).collect()).collect();
+        let im: Vec<Vec<f64>> = rows.iter().map(|r| r.taps.iter().map(|t| t.im).collect()).collect();
         vec![
             i64s(rows.iter().map(|r| r.t_ns)),
             u64s(rows.iter().map(|r| r.set_index)),
@@ -353,28 +258,15 @@ impl TableRow for CirSnapshot {
     }
 
     fn from_columns(c: &Columns<'_>) -> Result<Vec<Self>, String> {
-        let (t, set, snap, tx, rx) = (
-            c.i64("t_ns")?,
-            c.u64("set_index")?,
-            c.u32("snapshot_index")?,
-            c.u32("tx_antenna")?,
-            c.u32("rx_antenna")?,
-        );
-        let (fc, dt, d0) = (
-            c.f64("carrier_hz")?,
-            c.f64("tap_spacing_s")?,
-            c.f64("delay_offset_s")?,
-        );
+        let (t, set, snap, tx, rx) =
+            (c.i64("t_ns")?, c.u64("set_index")?, c.u32("snapshot_index")?, c.u32("tx_antenna")?, c.u32("rx_antenna")?);
+        let (fc, dt, d0) = (c.f64("carrier_hz")?, c.f64("tap_spacing_s")?, c.f64("delay_offset_s")?);
         (0..c.num_rows())
             .map(|i| {
                 let re = c.list_f64("taps_re", i)?;
                 let im = c.list_f64("taps_im", i)?;
                 if re.len() != im.len() {
-                    return Err(format!(
-                        "row {i}: taps_re has {} values, taps_im {}",
-                        re.len(),
-                        im.len()
-                    ));
+                    return Err(format!("row {i}: taps_re has {} values, taps_im {}", re.len(), im.len()));
                 }
                 Ok(CirSnapshot {
                     t_ns: t.value(i),
@@ -385,11 +277,7 @@ impl TableRow for CirSnapshot {
                     carrier_hz: fc.value(i),
                     tap_spacing_s: dt.value(i),
                     delay_offset_s: d0.value(i),
-                    taps: re
-                        .into_iter()
-                        .zip(im)
-                        .map(|(re, im)| Complex64::new(re, im))
-                        .collect(),
+                    taps: re.into_iter().zip(im).map(|(re, im)| Complex64::new(re, im)).collect(),
                 })
             })
             .collect()
@@ -405,24 +293,9 @@ pub const MPC_DETECTIONS: TableSpec = TableSpec {
         col("set_index", UInt64, "", "sounder set"),
         col("snapshot_index", UInt32, "", "snapshot within the set"),
         col("delay_s", Float64, "s", "estimated delay"),
-        col(
-            "amplitude_re",
-            Float64,
-            "",
-            "real part of the complex amplitude",
-        ),
-        col(
-            "amplitude_im",
-            Float64,
-            "",
-            "imaginary part of the complex amplitude",
-        ),
-        col(
-            "power_db",
-            Float64,
-            "dB",
-            "20 log10 |amplitude| (derived, for convenience)",
-        ),
+        col("amplitude_re", Float64, "", "real part of the complex amplitude"),
+        col("amplitude_im", Float64, "", "imaginary part of the complex amplitude"),
+        col("power_db", Float64, "dB", "20 log10 |amplitude| (derived, for convenience)"),
     ],
 };
 
@@ -475,34 +348,14 @@ pub const MPC_TRACKS: TableSpec = TableSpec {
     name: "mpc_tracks",
     description: "One associated detection of a multipath-component track per row; rows of a track are consecutive and in time order.",
     columns: &[
-        col(
-            "track_id",
-            UInt64,
-            "",
-            "track identifier, unique within the run",
-        ),
-        nullable(
-            "doppler_hz",
-            Float64,
-            "Hz",
-            "Doppler of the track from its delay slope; null when not estimated",
-        ),
+        col("track_id", UInt64, "", "track identifier, unique within the run"),
+        nullable("doppler_hz", Float64, "Hz", "Doppler of the track from its delay slope; null when not estimated"),
         col("t_ns", Int64, "ns", "time of the snapshot"),
         col("set_index", UInt64, "", "sounder set"),
         col("snapshot_index", UInt32, "", "snapshot within the set"),
         col("delay_s", Float64, "s", "estimated delay"),
-        col(
-            "amplitude_re",
-            Float64,
-            "",
-            "real part of the complex amplitude",
-        ),
-        col(
-            "amplitude_im",
-            Float64,
-            "",
-            "imaginary part of the complex amplitude",
-        ),
+        col("amplitude_re", Float64, "", "real part of the complex amplitude"),
+        col("amplitude_im", Float64, "", "imaginary part of the complex amplitude"),
         col("power_db", Float64, "dB", "20 log10 |amplitude|"),
     ],
 };
@@ -511,17 +364,10 @@ impl TableRow for MpcTrack {
     const SPEC: &'static TableSpec = &MPC_TRACKS;
 
     fn to_columns(rows: &[Self]) -> Vec<ArrayRef> {
-        let points = rows
-            .iter()
-            .flat_map(|t| t.detections.iter().map(move |d| (t, d)));
+        let points = rows.iter().flat_map(|t| t.detections.iter().map(move |d| (t, d)));
         let mut columns = vec![
             u64s(points.clone().map(|(t, _)| t.track_id)),
-            Arc::new(
-                points
-                    .clone()
-                    .map(|(t, _)| t.doppler_hz)
-                    .collect::<Float64Array>(),
-            ) as ArrayRef,
+            Arc::new(points.clone().map(|(t, _)| t.doppler_hz).collect::<Float64Array>()) as ArrayRef,
         ];
         columns.extend(detection_columns(points.map(|(_, d)| d)));
         columns
@@ -540,11 +386,7 @@ impl TableRow for MpcTrack {
                     if tracks.iter().any(|t| t.track_id == id) {
                         return Err(format!("row {i}: rows of track {id} are not consecutive"));
                     }
-                    tracks.push(MpcTrack {
-                        track_id: id,
-                        doppler_hz,
-                        detections: vec![detection],
-                    });
+                    tracks.push(MpcTrack { track_id: id, doppler_hz, detections: vec![detection] });
                 }
             }
         }
@@ -553,11 +395,5 @@ impl TableRow for MpcTrack {
 }
 
 /// Every table of this module, for documentation and tests.
-pub const ALL_TABLES: &[&TableSpec] = &[
-    &POSES,
-    &GNSS_FIXES,
-    &RADAR_SCANS,
-    &CIR_SNAPSHOTS,
-    &MPC_DETECTIONS,
-    &MPC_TRACKS,
-];
+pub const ALL_TABLES: &[&TableSpec] =
+    &[&POSES, &GNSS_FIXES, &RADAR_SCANS, &CIR_SNAPSHOTS, &MPC_DETECTIONS, &MPC_TRACKS];
