@@ -1,1 +1,151 @@
-fn main() {}
+//! # mmtrack
+//!
+//! The command-line tool: the only crate that wires the others together and the
+//! only one that talks to the terminal (progress bars, messages, exit codes).
+//!
+//! Exit codes: 0 success; 1 error (bad input, I/O; one line on stderr naming
+//! the file and the problem); 2 usage error; 3 the requested feature is not
+//! built yet (the message names the issue that will build it).
+
+mod bench;
+mod demo;
+mod ingest;
+mod inspect;
+mod progress;
+mod simulate;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Exit code for a feature that is planned but not built yet.
+const EXIT_NOT_BUILT: u8 = 3;
+
+#[derive(Parser)]
+#[command(
+    name = "mmtrack",
+    version,
+    about = "Vehicular mmWave sensing and links: ingest recordings, run the published trackers, analyze the results.",
+    long_about = "mmtrack turns raw recordings (Navtech radar scans, channel-sounder impulse responses, GNSS/INS logs, \
+ROS 2 bags) into canonical MCAP recordings, runs published algorithms on them (radar odometry, multipath tracking, \
+beam tracking, mmWave SLAM) and writes Parquet tables and plots.\n\n\
+Data flow: raw files --ingest--> recording.mcap --process--> tables (Parquet) --analyze--> metrics + plots.\n\n\
+Exit codes: 0 success, 1 error (one line naming the file and the problem), 2 usage error, 3 feature not built yet.",
+    after_help = "Start with `mmtrack demo`, then `mmtrack inspect out/demo/recording.mcap`."
+)]
+struct Cli {
+    /// Print nothing but errors (no progress bars, no summaries).
+    #[arg(long, short, global = true)]
+    quiet: bool,
+
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Turn a raw dataset into a canonical MCAP recording (one per sequence).
+    Ingest(ingest::IngestArgs),
+    /// Produce a recording (or a dataset-layout folder) from a scenario file, with ground truth.
+    Simulate(simulate::SimulateArgs),
+    /// Run a pipeline (odometry, mpc, beam, slam) on a recording and write Parquet tables.
+    Process {
+        /// Pipeline and its arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Compute metrics and plots from Parquet tables.
+    Analyze {
+        /// Tables and options.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Re-run a paper's experiment and compare with its published numbers.
+    Reproduce {
+        /// Experiment and options.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Show what a recording (.mcap, including ROS 2 bags) or a table directory contains.
+    Inspect(inspect::InspectArgs),
+    /// Run the whole chain on the embedded demo data and print where the outputs are.
+    Demo(demo::DemoArgs),
+    /// Write or check the schema documents (`schemas/`) generated from the code.
+    Schemas {
+        /// Directory to write the documents to.
+        #[arg(long, value_name = "DIR", conflicts_with = "check")]
+        write: Option<PathBuf>,
+        /// Directory whose documents must match the code (exit 1 when stale).
+        #[arg(long, value_name = "DIR")]
+        check: Option<PathBuf>,
+    },
+    /// Measure throughput against a same-run baseline (no wall-clock assertions).
+    Bench(bench::BenchArgs),
+}
+
+fn not_built(what: &str, issue: u32) -> anyhow::Result<ExitCode> {
+    eprintln!("error: `mmtrack {what}` is not built yet (tracked in issue #{issue}); nothing was done");
+    Ok(ExitCode::from(EXIT_NOT_BUILT))
+}
+
+fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyhow::Result<ExitCode> {
+    let documents = mmtrack_io::schema_docs::documents();
+    if let Some(dir) = write {
+        for (relative, contents) in &documents {
+            let path = dir.join(relative);
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent)?;
+            }
+            std::fs::write(&path, contents)?;
+        }
+        if !quiet {
+            println!("wrote {} schema documents to {}", documents.len(), dir.display());
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let dir = check.unwrap_or_else(|| PathBuf::from("schemas"));
+    let stale: Vec<&String> = documents
+        .iter()
+        .filter(|(relative, contents)| std::fs::read_to_string(dir.join(relative)).ok().as_deref() != Some(contents))
+        .map(|(relative, _)| relative)
+        .collect();
+    if stale.is_empty() {
+        if !quiet {
+            println!("{}: all {} schema documents match the code", dir.display(), documents.len());
+        }
+        Ok(ExitCode::SUCCESS)
+    } else {
+        anyhow::bail!(
+            "{}: stale schema documents: {stale:?}; run `mmtrack schemas --write {}`",
+            dir.display(),
+            dir.display()
+        )
+    }
+}
+
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    let quiet = cli.quiet;
+    match cli.command {
+        Command::Ingest(args) => ingest::run(args, quiet),
+        Command::Simulate(args) => simulate::run(args, quiet),
+        Command::Process { .. } => not_built("process", 4),
+        Command::Analyze { .. } => not_built("analyze", 4),
+        Command::Reproduce { .. } => not_built("reproduce", 4),
+        Command::Inspect(args) => inspect::run(&args),
+        Command::Demo(args) => demo::run(&args, quiet),
+        Command::Schemas { write, check } => schemas(write, check, quiet),
+        Command::Bench(args) => bench::run(&args, quiet),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

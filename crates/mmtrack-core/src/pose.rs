@@ -74,6 +74,8 @@ impl Mul for Se2 {
     type Output = Se2;
 
     /// Composition `a_from_c = a_from_b * b_from_c`: `[R1 R2, R1 t2 + t1]`.
+    // Group composition adds rotation angles; clippy's heuristic flags the `+`.
+    #[allow(clippy::suspicious_arithmetic_impl)]
     fn mul(self, rhs: Se2) -> Se2 {
         let [x_m, y_m] = self.transform_point([rhs.x_m, rhs.y_m]);
         Se2 { x_m, y_m, yaw_rad: wrap_angle_rad(self.yaw_rad + rhs.yaw_rad) }

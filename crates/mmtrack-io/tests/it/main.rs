@@ -1,5 +1,7 @@
 //! Integration tests of mmtrack-io (one binary: every test binary links the world).
 
+#![allow(clippy::unwrap_used)]
+
 mod bad_input;
 mod roundtrip;
 mod samples;

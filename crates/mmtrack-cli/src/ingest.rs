@@ -1,0 +1,180 @@
+//! `mmtrack ingest <kind> <input> -o <recording.mcap>`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use clap::{Args, Subcommand, ValueEnum};
+use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+use mmtrack_io::recording::Compression;
+use mmtrack_io::{Overwrite, RecordingOptions};
+
+use crate::progress;
+
+/// Options shared by every ingest kind.
+#[derive(Args, Clone)]
+pub struct OutputArgs {
+    /// The recording to write (one MCAP file per sequence).
+    #[arg(short, long, value_name = "RECORDING.mcap")]
+    pub output: PathBuf,
+    /// Replace an existing output (atomically, once the new one is complete).
+    #[arg(long)]
+    pub force: bool,
+    /// Chunk compression of the recording.
+    #[arg(long, value_enum, default_value_t = CompressionArg::Zstd)]
+    pub compression: CompressionArg,
+    /// zstd level (1 fast .. 19 small).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=19))]
+    pub zstd_level: u32,
+    /// Omit the Foxglove display channels (/viz/...).
+    #[arg(long)]
+    pub no_foxglove_views: bool,
+}
+
+/// Chunk compression choices.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum CompressionArg {
+    /// No compression (fastest; carried PNGs are compressed already).
+    None,
+    /// zstd (see --zstd-level).
+    Zstd,
+    /// lz4.
+    Lz4,
+}
+
+impl OutputArgs {
+    pub fn recording_options(&self) -> RecordingOptions {
+        RecordingOptions {
+            compression: match self.compression {
+                CompressionArg::None => Compression::None,
+                CompressionArg::Zstd => Compression::Zstd { level: self.zstd_level },
+                CompressionArg::Lz4 => Compression::Lz4,
+            },
+            overwrite: if self.force { Overwrite::Replace } else { Overwrite::Refuse },
+            foxglove_views: !self.no_foxglove_views,
+            ..RecordingOptions::default()
+        }
+    }
+}
+
+#[derive(Args)]
+pub struct IngestArgs {
+    #[command(subcommand)]
+    kind: Kind,
+}
+
+#[derive(Subcommand)]
+enum Kind {
+    /// Oxford Radar RobotCar sequence folder: radar/<t_us>.png, radar.timestamps, gt/radar_odometry.csv.
+    Oxford {
+        /// The sequence folder.
+        input: PathBuf,
+        #[command(flatten)]
+        output: OutputArgs,
+        /// Range bin size in metres (dataset SDK: 0.0432; CFEAR uses 0.0438).
+        #[arg(long, default_value_t = oxford::OXFORD.range_resolution_m)]
+        range_resolution_m: f64,
+        /// Range bins per azimuth: a number, or `auto` to take the PNG width as it is.
+        #[arg(long, default_value = "3768")]
+        bins: String,
+        /// Store decoded mono8 images instead of carrying the PNG bytes unchanged.
+        #[arg(long)]
+        decode: bool,
+        /// Sequence id (default: the folder name).
+        #[arg(long)]
+        sequence_id: Option<String>,
+    },
+    /// Boreas sequence folder (not built yet: issue #3).
+    Boreas {
+        /// Arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// MulRan sequence folder (not built yet: issue #3).
+    Mulran {
+        /// Arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Trajectory files: KITTI, TUM, Oxford, Boreas (not built yet: issue #3).
+    Poses {
+        /// Arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// NMEA 0183 GNSS log (not built yet: issue #3).
+    Nmea {
+        /// Arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Channel-sounder CIR/CFR files (not built yet: issue #3).
+    Cir {
+        /// Arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// ROS 2 MCAP bag (not built yet: issue #3).
+    Ros2 {
+        /// Arguments.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+}
+
+pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    match args.kind {
+        Kind::Oxford { input, output, range_resolution_m, bins, decode, sequence_id } => {
+            let expected_bins = match bins.as_str() {
+                "auto" => None,
+                n => Some(n.parse::<usize>().with_context(|| format!("--bins '{n}': expected a number or `auto`"))?),
+            };
+            if !(range_resolution_m.is_finite() && range_resolution_m > 0.0) {
+                anyhow::bail!("--range-resolution-m {range_resolution_m}: expected a positive number of metres");
+            }
+            let options = OxfordOptions {
+                layout: oxford::NavtechLayout { range_resolution_m, expected_bins, ..oxford::OXFORD },
+                carry_png: !decode,
+                sequence_id,
+            };
+            oxford_folder(&input, &output, &options, quiet)
+        }
+        Kind::Boreas { .. } => crate::not_built("ingest boreas", 3),
+        Kind::Mulran { .. } => crate::not_built("ingest mulran", 3),
+        Kind::Poses { .. } => crate::not_built("ingest poses", 3),
+        Kind::Nmea { .. } => crate::not_built("ingest nmea", 3),
+        Kind::Cir { .. } => crate::not_built("ingest cir", 3),
+        Kind::Ros2 { .. } => crate::not_built("ingest ros2", 3),
+    }
+}
+
+/// Ingests one Oxford folder, with a progress bar.
+pub fn oxford_folder(
+    input: &std::path::Path,
+    output: &OutputArgs,
+    options: &OxfordOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let folder = OxfordFolder::open(input)?;
+    let bar = progress::bar(folder.scans.len() as u64, "ingest oxford", "scans", quiet);
+    let report =
+        oxford::ingest_oxford(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+            bar.set_position(done);
+        })?;
+    bar.finish_and_clear();
+    if !quiet {
+        println!(
+            "{}: {} scans, {} ground-truth poses{} ({:.1} MB)",
+            report.output.path.display(),
+            report.scans,
+            report.ground_truth_poses,
+            if report.skipped_invalid_scans > 0 {
+                format!(", {} scans skipped (flagged invalid in radar.timestamps)", report.skipped_invalid_scans)
+            } else {
+                String::new()
+            },
+            report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}

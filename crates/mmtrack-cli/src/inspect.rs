@@ -1,0 +1,117 @@
+//! `mmtrack inspect <recording.mcap | table dir>`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+use mmtrack_io::recording::{RecordingSummary, inspect_recording};
+use mmtrack_io::table::{TableFileSummary, inspect_table_dir};
+use serde_json::json;
+
+#[derive(Args)]
+pub struct InspectArgs {
+    /// An MCAP file (ours or any other, e.g. a ROS 2 bag) or a directory of Parquet tables.
+    path: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+impl InspectArgs {
+    /// Text output for `path`.
+    pub fn new(path: PathBuf) -> Self {
+        Self { path, json: false }
+    }
+}
+
+fn seconds(ns: u64) -> f64 {
+    ns as f64 * 1e-9
+}
+
+fn recording_json(summary: &RecordingSummary) -> serde_json::Value {
+    json!({
+        "path": summary.path,
+        "metadata": summary.metadata,
+        "channels": summary.channels.iter().map(|c| json!({
+            "topic": c.topic,
+            "schema": c.schema_name,
+            "message_encoding": c.message_encoding,
+            "messages": c.message_count,
+            "start_ns": c.start_ns,
+            "end_ns": c.end_ns,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+fn print_recording(summary: &RecordingSummary) {
+    println!("recording {}", summary.path.display());
+    for (name, map) in &summary.metadata {
+        println!("  metadata {name}:");
+        for (k, v) in map {
+            println!("    {k} = {v}");
+        }
+    }
+    let start = summary.channels.iter().map(|c| c.start_ns).min();
+    let end = summary.channels.iter().map(|c| c.end_ns).max();
+    if let (Some(start), Some(end)) = (start, end) {
+        println!("  time span: {:.3} s ({start} .. {end} ns)", seconds(end - start));
+    }
+    println!("  {:<24} {:<28} {:>9} {:>12}", "topic", "schema", "messages", "span [s]");
+    for c in &summary.channels {
+        println!(
+            "  {:<24} {:<28} {:>9} {:>12.3}",
+            c.topic,
+            c.schema_name,
+            c.message_count,
+            seconds(c.end_ns - c.start_ns)
+        );
+    }
+}
+
+fn tables_json(tables: &[TableFileSummary]) -> serde_json::Value {
+    json!(
+        tables
+            .iter()
+            .map(|t| json!({
+                "table": t.table, "sequence": t.sequence, "path": t.path, "rows": t.rows,
+                "columns": t.columns, "t_ns_span": t.t_ns_span,
+            }))
+            .collect::<Vec<_>>()
+    )
+}
+
+fn print_tables(root: &std::path::Path, tables: &[TableFileSummary]) {
+    println!("tables under {}", root.display());
+    for t in tables {
+        let span = t.t_ns_span.map(|(a, b)| format!(", {:.3} s", (b - a) as f64 * 1e-9)).unwrap_or_default();
+        println!("  {} / sequence={}: {} rows{span}", t.table, t.sequence, t.rows);
+        for c in &t.columns {
+            println!("      {c}");
+        }
+    }
+}
+
+pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+    if args.path.is_dir() {
+        let tables = inspect_table_dir(&args.path)?;
+        if tables.is_empty() {
+            anyhow::bail!(
+                "{}: no Parquet tables found (expected <table>/sequence=<id>/part-0.parquet)",
+                args.path.display()
+            );
+        }
+        if args.json {
+            println!("{}", tables_json(&tables));
+        } else {
+            print_tables(&args.path, &tables);
+        }
+    } else {
+        let summary = inspect_recording(&args.path)?;
+        if args.json {
+            println!("{}", recording_json(&summary));
+        } else {
+            print_recording(&summary);
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,45 @@
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// Errors of the ingest adapters. Each names the file, the record (row, line,
+/// scan) and the field, and says what was expected.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum IngestError {
+    /// An operating-system error on a file.
+    #[error("{path}: {source}")]
+    Os {
+        /// The file.
+        path: PathBuf,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The input folder lacks what the format requires.
+    #[error("{path}: {detail}")]
+    BadLayout {
+        /// The folder or file.
+        path: PathBuf,
+        /// What is missing or wrong.
+        detail: String,
+    },
+    /// A record is malformed.
+    #[error("{path}: {record}: {field}: {detail}")]
+    BadRecord {
+        /// The file.
+        path: PathBuf,
+        /// Which record, e.g. "azimuth row 17" or "line 5".
+        record: String,
+        /// The field, e.g. "timestamp (bytes 0-7)".
+        field: String,
+        /// What is wrong and what was expected.
+        detail: String,
+    },
+    /// Writing the recording failed.
+    #[error(transparent)]
+    Io(#[from] mmtrack_io::IoError),
+}
+
+pub(crate) fn os_err(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> IngestError + '_ {
+    move |source| IngestError::Os { path: path.to_path_buf(), source }
+}

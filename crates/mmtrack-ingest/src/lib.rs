@@ -1,0 +1,21 @@
+//! # mmtrack-ingest
+//!
+//! Adapters from the formats users have to mmtrack's canonical recording
+//! (`mmtrack-io`). Each adapter parses bytes into core types (pure functions,
+//! tested on bytes) and streams them into a [`mmtrack_io::RecordingWriter`] so
+//! memory stays flat however long the sequence. Ingest never modifies its
+//! input and decodes no more than it must: radar PNGs are carried unchanged.
+//!
+//! It depends on `mmtrack-core` and `mmtrack-io` only, never on algorithms, and
+//! does not print: long operations report through a progress callback.
+//!
+//! Sources so far: Oxford Radar RobotCar radar folders ([`oxford`]), with their
+//! `gt/radar_odometry.csv` ground truth.
+
+mod error;
+pub mod oxford;
+
+pub use error::IngestError;
+
+/// Progress of a long ingest: `done` of `total` items (scans, lines, ...).
+pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
