@@ -1,0 +1,11 @@
+//! End-to-end tests of the `mmtrack` binary and workspace-wide checks (one
+//! binary: every test binary links the world).
+
+#![allow(clippy::unwrap_used)]
+
+mod architecture;
+mod cli;
+mod common;
+mod fixtures;
+mod independent_readers;
+mod realdata_oxford;
