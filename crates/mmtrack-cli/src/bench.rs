@@ -10,6 +10,7 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
+use anyhow::Context;
 use clap::{Args, Subcommand};
 use mmtrack_core::PolarScan;
 use mmtrack_io::recording::{Compression, RecordingMetadata, TimeBase};
@@ -42,6 +43,9 @@ enum Kind {
         /// Directory for the temporary files (default: the system temp dir).
         #[arg(long)]
         dir: Option<std::path::PathBuf>,
+        /// Replace the block between `<!-- bench-io:begin -->` and `<!-- bench-io:end -->` in this file.
+        #[arg(long, value_name = "README.md")]
+        readme: Option<std::path::PathBuf>,
     },
 }
 
@@ -109,14 +113,17 @@ fn read_recording(path: &Path) -> anyhow::Result<usize> {
     Ok(count)
 }
 
-fn io(
+struct IoArgs<'a> {
     scans: usize,
     repeats: usize,
     check: bool,
-    as_json: bool,
-    dir: Option<&Path>,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
+    json: bool,
+    dir: Option<&'a Path>,
+    readme: Option<&'a Path>,
+}
+
+fn io(args: &IoArgs<'_>, quiet: bool) -> anyhow::Result<ExitCode> {
+    let IoArgs { scans, repeats, check, json: as_json, dir, readme } = *args;
     let scans_data = oxford_size_scans(scans);
     let payload_bytes: usize = scans_data.iter().map(|s| s.power.len()).sum();
     let payload_mb = payload_bytes as f64 / 1e6;
@@ -197,11 +204,58 @@ fn io(
             );
         }
     }
+    if let Some(readme) = readme {
+        replace_block(readme, "bench-io", &markdown(&report))?;
+    }
     Ok(if check && !all_met { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+fn markdown(report: &serde_json::Value) -> String {
+    let f = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    let mut out = format!(
+        "`mmtrack bench io` (release build, {} scans of {:.2} MB, best of {}): baseline `std::fs::copy` of the same bytes {:.0} MB/s.\n\n\
+         | compression | file MB | write MB/s | write / copy | read MB/s | read / copy | target |\n|---|---|---|---|---|---|---|\n",
+        report["scans"],
+        f(&report["message_mb"]),
+        report["repeats"],
+        f(&report["copy_mb_per_s"])
+    );
+    for r in report["results"].as_array().into_iter().flatten() {
+        let target = match (r["write_target_ratio"].as_f64(), r["target_met"].as_bool()) {
+            (Some(t), Some(true)) => format!("write >= {t} x copy: met"),
+            (Some(t), _) => format!("write >= {t} x copy: **missed**"),
+            _ => "-".into(),
+        };
+        out.push_str(&format!(
+            "| {} | {:.0} | {:.0} | {:.2} | {:.0} | {:.2} | {target} |\n",
+            r["compression"].as_str().unwrap_or(""),
+            f(&r["file_mb"]),
+            f(&r["write_mb_per_s"]),
+            f(&r["write_ratio_to_copy"]),
+            f(&r["read_mb_per_s"]),
+            f(&r["read_ratio_to_copy"]),
+        ));
+    }
+    out
+}
+
+/// Replaces the text between `<!-- {name}:begin -->` and `<!-- {name}:end -->`.
+fn replace_block(path: &Path, name: &str, body: &str) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let (begin, end) = (format!("<!-- {name}:begin -->"), format!("<!-- {name}:end -->"));
+    let (Some(start), Some(stop)) = (text.find(&begin), text.find(&end)) else {
+        anyhow::bail!("{}: markers {begin} / {end} not found", path.display());
+    };
+    let updated = format!("{}{begin}\n{body}{}", &text[..start], &text[stop..]);
+    std::fs::write(path, updated).with_context(|| path.display().to_string())?;
+    Ok(())
 }
 
 pub fn run(args: &BenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.kind {
-        Kind::Io { scans, repeats, check, json, dir } => io(*scans, *repeats, *check, *json, dir.as_deref(), quiet),
+        Kind::Io { scans, repeats, check, json, dir, readme } => io(
+            &IoArgs { scans: *scans, repeats: *repeats, check: *check, json: *json, dir: dir.as_deref(), readme: readme.as_deref() },
+            quiet,
+        ),
     }
 }

@@ -18,7 +18,9 @@ use super::common::{mmtrack, root};
 const REQUIREMENTS: &str = "mcap==1.6.0 mcap-protobuf-support==0.6.0 protobuf==7.36.2 pyarrow==26.0.1 duckdb==2.0.0";
 
 fn venv_python() -> Option<PathBuf> {
-    let target = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target");
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"));
     let venv = std::env::var_os("MMTRACK_PY_VENV").map(PathBuf::from).unwrap_or_else(|| target.join("py-venv"));
     let python = venv.join("bin/python");
     let stamp = venv.join("requirements.txt");

@@ -1,0 +1,45 @@
+# mmtrack task runner. Every recipe is a plain cargo command, so everything
+# here also works without `just` (see README).
+
+set positional-arguments
+
+# List recipes.
+default:
+    @just --list
+
+# Ingest a raw dataset: just ingest oxford <folder> -o <recording.mcap>
+ingest *args:
+    cargo run -q -p mmtrack-cli -- ingest "$@"
+
+# Run a pipeline on a recording (odometry, mpc, beam, slam).
+process *args:
+    cargo run -q -p mmtrack-cli -- process "$@"
+
+# Metrics and plots from Parquet tables.
+analyze *args:
+    cargo run -q -p mmtrack-cli -- analyze "$@"
+
+# The whole chain on the embedded demo data.
+demo *args:
+    cargo run -q -p mmtrack-cli -- demo "$@"
+
+# Show what a recording or table directory holds.
+inspect *args:
+    cargo run -q -p mmtrack-cli -- inspect "$@"
+
+# All tests (the same command CI runs).
+test:
+    cargo test --workspace
+
+# Benchmarks in release mode; refreshes the README's results block.
+bench:
+    cargo run -q --release -p mmtrack-cli -- bench io --check --readme README.md
+
+# Paper experiments.
+reproduce *args:
+    cargo run -q --release -p mmtrack-cli -- reproduce "$@"
+
+# Regenerate schemas/ and data/ fixtures from the code.
+regenerate:
+    cargo run -q -p mmtrack-cli -- schemas --write schemas
+    cargo run -q -p mmtrack-cli -- simulate radar --scenario data/demo/radar-scenario.toml --format oxford -o data/demo/oxford-demo --force
