@@ -42,6 +42,7 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         compression: CompressionArg::Zstd,
         zstd_level: 1,
         no_foxglove_views: false,
+        no_sync: false,
     };
     let options = OxfordOptions {
         layout: oxford::NavtechLayout {
@@ -67,9 +68,9 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     if !quiet {
         println!();
-        inspect::run(&inspect::InspectArgs::new(recording.clone()))?;
+        inspect::run(&inspect::InspectArgs::new(recording.clone()), quiet)?;
         println!();
-        inspect::run(&inspect::InspectArgs::new(tables.clone()))?;
+        inspect::run(&inspect::InspectArgs::new(tables.clone()), quiet)?;
         println!("\nOutputs:");
         println!("  input folder (Oxford layout): {}", input.display());
         println!("  recording (open in Foxglove):  {}", recording.display());

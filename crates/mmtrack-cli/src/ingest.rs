@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_io::recording::Compression;
-use mmtrack_io::{Overwrite, RecordingOptions};
+use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use crate::progress;
 
@@ -29,6 +29,10 @@ pub struct OutputArgs {
     /// Omit the Foxglove display channels (/viz/...).
     #[arg(long)]
     pub no_foxglove_views: bool,
+    /// Skip the fsync before the final rename: faster on large recordings, but a
+    /// power cut right afterwards may lose the new file.
+    #[arg(long)]
+    pub no_sync: bool,
 }
 
 /// Chunk compression choices.
@@ -52,6 +56,7 @@ impl OutputArgs {
             },
             overwrite: if self.force { Overwrite::Replace } else { Overwrite::Refuse },
             foxglove_views: !self.no_foxglove_views,
+            durability: if self.no_sync { Durability::PageCache } else { Durability::Fsync },
             ..RecordingOptions::default()
         }
     }

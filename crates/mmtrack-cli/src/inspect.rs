@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use mmtrack_io::recording::{RecordingSummary, inspect_recording};
+use mmtrack_io::recording::{RecordingSummary, inspect_recording_with_progress};
 use mmtrack_io::table::{TableFileSummary, inspect_table_dir};
 use serde_json::json;
 
@@ -91,7 +91,7 @@ fn print_tables(root: &std::path::Path, tables: &[TableFileSummary]) {
     }
 }
 
-pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
+pub fn run(args: &InspectArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if args.path.is_dir() {
         let tables = inspect_table_dir(&args.path)?;
         if tables.is_empty() {
@@ -106,7 +106,13 @@ pub fn run(args: &InspectArgs) -> anyhow::Result<ExitCode> {
             print_tables(&args.path, &tables);
         }
     } else {
-        let summary = inspect_recording(&args.path)?;
+        let bar = crate::progress::bytes_bar("inspect", quiet);
+        let summary = inspect_recording_with_progress(&args.path, &mut |done, total| {
+            bar.set_length(total);
+            bar.set_position(done);
+        });
+        bar.finish_and_clear();
+        let summary = summary?;
         if args.json {
             println!("{}", recording_json(&summary));
         } else {

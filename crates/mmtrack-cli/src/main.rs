@@ -132,7 +132,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Process { .. } => not_built("process", 4),
         Command::Analyze { .. } => not_built("analyze", 4),
         Command::Reproduce { .. } => not_built("reproduce", 4),
-        Command::Inspect(args) => inspect::run(&args),
+        Command::Inspect(args) => inspect::run(&args, quiet),
         Command::Demo(args) => demo::run(&args, quiet),
         Command::Schemas { write, check } => schemas(write, check, quiet),
         Command::Bench(args) => bench::run(&args, quiet),

@@ -20,6 +20,17 @@ pub enum Overwrite {
     Replace,
 }
 
+/// Whether a committed file is flushed to disk before it replaces the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Durability {
+    /// `fsync` before the rename (the default): crash-safe replacement.
+    #[default]
+    Fsync,
+    /// Leave flushing to the operating system: faster for large files; a power
+    /// cut right after the rename may lose the new file's contents.
+    PageCache,
+}
+
 /// A file being written that only appears at `target` on [`AtomicFile::commit`].
 #[derive(Debug)]
 pub struct AtomicFile {
@@ -63,10 +74,14 @@ impl AtomicFile {
 
     /// Makes the file visible at its target, replacing what was there. Re-checks
     /// the overwrite policy, since another process may have created the target
-    /// while this one was writing.
-    pub fn commit(self, overwrite: Overwrite) -> Result<PathBuf> {
+    /// while this one was writing. With [`Durability::Fsync`] the data reaches
+    /// the disk before the rename, so a power cut cannot leave an empty file
+    /// in place of the old one.
+    pub fn commit(self, overwrite: Overwrite, durability: Durability) -> Result<PathBuf> {
         let Self { target, temp } = self;
-        temp.as_file().sync_all().map_err(os_err(temp.path()))?;
+        if durability == Durability::Fsync {
+            temp.as_file().sync_all().map_err(os_err(temp.path()))?;
+        }
         match overwrite {
             Overwrite::Replace => {
                 temp.persist(&target).map_err(|e| IoError::Os { path: target.clone(), source: e.error })?;
@@ -106,7 +121,7 @@ mod tests {
         w.write_all(b"whole").unwrap();
         w.flush().unwrap();
         drop(w);
-        f.commit(Overwrite::Refuse).unwrap();
+        f.commit(Overwrite::Refuse, Durability::Fsync).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole");
     }
 
@@ -121,7 +136,7 @@ mod tests {
         w.write_all(b"new").unwrap();
         w.flush().unwrap();
         drop(w);
-        f.commit(Overwrite::Replace).unwrap();
+        f.commit(Overwrite::Replace, Durability::PageCache).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"new");
     }
 }

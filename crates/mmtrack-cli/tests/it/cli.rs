@@ -77,6 +77,34 @@ fn table_with_a_missing_column_is_one_line_exit_1() {
 }
 
 #[test]
+fn known_table_with_a_missing_column_is_one_line_exit_1() {
+    let dir = tempfile::tempdir().unwrap();
+    assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
+    // Rewrite the demo's poses table without its y_m column, with pyarrow-free
+    // tooling: read it with parquet's Arrow reader and write a projection.
+    let file = dir.path().join("d/tables/poses/sequence=oxford-demo/part-0.parquet");
+    let batch = {
+        let reader =
+            parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(std::fs::File::open(&file).unwrap())
+                .unwrap()
+                .build()
+                .unwrap();
+        reader.into_iter().next().unwrap().unwrap()
+    };
+    let projected = batch.project(&[0, 1, 3]).unwrap();
+    let mut writer =
+        parquet::arrow::ArrowWriter::try_new(std::fs::File::create(&file).unwrap(), projected.schema(), None).unwrap();
+    writer.write(&projected).unwrap();
+    writer.close().unwrap();
+
+    let out = mmtrack(dir.path(), &["inspect", "d/tables"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("part-0.parquet") && stderr.contains("no column 'y_m'"), "{stderr}");
+}
+
+#[test]
 fn existing_output_without_force_is_refused_and_untouched() {
     let dir = tempfile::tempdir().unwrap();
     let fixture = root().join("data/demo/oxford-demo");

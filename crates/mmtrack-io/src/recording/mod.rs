@@ -16,7 +16,10 @@ mod reader;
 mod writer;
 
 pub use channels::{CHANNELS, ChannelSpec, PoseStream};
-pub use reader::{ChannelSummary, RecordingEvent, RecordingReader, RecordingSummary, inspect_recording};
+pub use reader::{
+    ChannelSummary, RecordingEvent, RecordingReader, RecordingSummary, inspect_recording,
+    inspect_recording_with_progress,
+};
 pub use writer::{Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TimeBase, WriteSummary};
 
 /// Name of the MCAP metadata record that holds [`RecordingMetadata`].

@@ -29,13 +29,16 @@ struct RawMessage {
     channel: Arc<ChannelInfo>,
     sequence: u32,
     log_time_ns: u64,
-    data: Vec<u8>,
+    /// Owned payload; `Bytes` so that prost decodes `bytes` fields as
+    /// zero-copy slices of it.
+    data: bytes::Bytes,
 }
 
 /// Streams the records of an MCAP file with bounded memory.
 struct RawReader {
     path: PathBuf,
     file: File,
+    bytes_read: u64,
     reader: LinearReader,
     schemas: HashMap<u16, String>,
     channels: HashMap<u16, Arc<ChannelInfo>>,
@@ -48,6 +51,7 @@ impl RawReader {
         Ok(Self {
             path: path.to_path_buf(),
             file,
+            bytes_read: 0,
             reader: LinearReader::new(),
             schemas: HashMap::new(),
             channels: HashMap::new(),
@@ -66,6 +70,7 @@ impl RawReader {
                 LinearReadEvent::ReadRequest(need) => {
                     let read = self.file.read(self.reader.insert(need)).map_err(os_err(&self.path))?;
                     self.reader.notify_read(read);
+                    self.bytes_read += read as u64;
                 }
                 LinearReadEvent::Record { opcode, data } => {
                     let record = mcap::parse_record(opcode, data)
@@ -99,7 +104,7 @@ impl RawReader {
                                 channel,
                                 sequence: header.sequence,
                                 log_time_ns: header.log_time,
-                                data: data.into_owned(),
+                                data: bytes::Bytes::from(data.into_owned()),
                             }));
                         }
                         _ => {}
@@ -162,7 +167,7 @@ impl RecordingReader {
         if m.channel.message_encoding != "protobuf" {
             return Err(self.bad(m, format!("message encoding '{}', expected protobuf", m.channel.message_encoding)));
         }
-        M::decode(m.data.as_slice()).map_err(|e| self.bad(m, format!("cannot decode {}: {e}", m.channel.schema_name)))
+        M::decode(m.data.clone()).map_err(|e| self.bad(m, format!("cannot decode {}: {e}", m.channel.schema_name)))
     }
 
     fn next_event(&mut self) -> Result<Option<RecordingEvent>> {
@@ -320,7 +325,13 @@ pub struct RecordingSummary {
 /// Reads a whole recording (any MCAP file, including ROS 2 bags) and
 /// summarises its channels. Fails on a truncated or corrupted file.
 pub fn inspect_recording(path: &Path) -> Result<RecordingSummary> {
+    inspect_recording_with_progress(path, &mut |_, _| {})
+}
+
+/// [`inspect_recording`], reporting `(bytes read, file size)` as it goes.
+pub fn inspect_recording_with_progress(path: &Path, progress: &mut dyn FnMut(u64, u64)) -> Result<RecordingSummary> {
     let mut raw = RawReader::open(path)?;
+    let total = raw.file.metadata().map(|m| m.len()).unwrap_or(0);
     let mut by_topic: BTreeMap<(String, String), ChannelSummary> = BTreeMap::new();
     while let Some(m) = raw.next_message()? {
         let key = (m.channel.topic.clone(), m.channel.schema_name.clone());
@@ -335,6 +346,7 @@ pub fn inspect_recording(path: &Path) -> Result<RecordingSummary> {
         entry.message_count += 1;
         entry.start_ns = entry.start_ns.min(m.log_time_ns);
         entry.end_ns = entry.end_ns.max(m.log_time_ns);
+        progress(raw.bytes_read, total);
     }
     Ok(RecordingSummary {
         path: path.to_path_buf(),

@@ -10,7 +10,7 @@ use prost::Message;
 
 use super::METADATA_NAME;
 use super::channels::{CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
-use crate::atomic::{AtomicFile, Overwrite};
+use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
 
@@ -39,6 +39,8 @@ pub struct RecordingOptions {
     pub overwrite: Overwrite,
     /// Also write Foxglove display channels (`/viz/...`).
     pub foxglove_views: bool,
+    /// Flush to disk before the final rename.
+    pub durability: Durability,
 }
 
 impl Default for RecordingOptions {
@@ -48,6 +50,7 @@ impl Default for RecordingOptions {
             chunk_size_bytes: 4 << 20,
             overwrite: Overwrite::Refuse,
             foxglove_views: true,
+            durability: Durability::Fsync,
         }
     }
 }
@@ -129,6 +132,7 @@ struct ChannelState {
 pub struct RecordingWriter {
     file: AtomicFile,
     overwrite: Overwrite,
+    durability: Durability,
     foxglove_views: bool,
     mcap: mcap::Writer<BufWriter<File>>,
     channels: BTreeMap<&'static str, ChannelState>,
@@ -157,7 +161,9 @@ impl RecordingWriter {
             .profile("")
             .library(concat!("mmtrack ", env!("CARGO_PKG_VERSION")));
         if level > 0 {
-            write_options = write_options.compression_level(level);
+            // zstd's own worker threads compress chunks on the other cores.
+            let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
+            write_options = write_options.compression_level(level).compression_threads(threads);
         }
         let mut mcap = write_options.create(file.writer()?).map_err(|e| write_err(path, e))?;
         mcap.write_metadata(&mcap::records::Metadata { name: METADATA_NAME.into(), metadata: metadata.to_map() })
@@ -165,6 +171,7 @@ impl RecordingWriter {
         Ok(Self {
             file,
             overwrite: options.overwrite,
+            durability: options.durability,
             foxglove_views: options.foxglove_views,
             mcap,
             channels: BTreeMap::new(),
@@ -391,7 +398,7 @@ impl RecordingWriter {
         let mut inner = self.mcap.into_inner();
         std::io::Write::flush(&mut inner).map_err(|source| IoError::Os { path: path.clone(), source })?;
         drop(inner);
-        let path = self.file.commit(self.overwrite)?;
+        let path = self.file.commit(self.overwrite, self.durability)?;
         let file_bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
         Ok(WriteSummary { path, message_counts: self.counts, file_bytes })
     }

@@ -13,7 +13,7 @@ use parquet::file::properties::WriterProperties;
 
 use super::columns::{Columns, check_no_nulls};
 use super::{TableRow, TableSpec};
-use crate::atomic::{AtomicFile, Overwrite};
+use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result, os_err};
 
 /// Provenance of a run, stored in every table it writes.
@@ -108,7 +108,7 @@ impl TableWriter {
         let path = self.file.target().to_path_buf();
         let inner = self.writer.into_inner().map_err(|e| table_write_err(&path, e))?;
         inner.into_inner().map_err(|e| IoError::Os { path: path.clone(), source: e.into_error() })?;
-        let path = self.file.commit(self.overwrite)?;
+        let path = self.file.commit(self.overwrite, Durability::Fsync)?;
         Ok(TableWriteSummary { path, rows: self.rows })
     }
 }
@@ -252,9 +252,14 @@ pub fn inspect_table_dir(root: &Path) -> Result<Vec<TableFileSummary>> {
     Ok(out)
 }
 
+/// Summarises one partition; a table mmtrack knows (by directory name) is
+/// also checked against its schema, so a missing or renamed column is an error.
 fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileSummary> {
     let file = File::open(path).map_err(os_err(path))?;
     let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(path, e))?;
+    if let Some(spec) = super::ALL_TABLES.iter().find(|s| s.name == table) {
+        check_schema(path, spec, builder.schema())?;
+    }
     let rows = builder.metadata().file_metadata().num_rows();
     let columns = builder
         .schema()
