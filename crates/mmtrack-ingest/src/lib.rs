@@ -12,7 +12,9 @@
 //! Sources so far: Oxford Radar RobotCar radar folders ([`oxford`]), with their
 //! `gt/radar_odometry.csv` ground truth.
 
+pub mod cir;
 mod error;
+pub mod nmea;
 pub mod oxford;
 
 pub use error::IngestError;

@@ -1,0 +1,1 @@
+//! Channel-sounder impulse responses (being written: see issue #3).
