@@ -169,10 +169,11 @@ pub fn oxford_folder(
     bar.finish_and_clear();
     if !quiet {
         println!(
-            "{}: {} scans, {} ground-truth poses{} ({:.1} MB)",
+            "{}: {} scans, {} ground-truth poses, {} GNSS fixes{} ({:.1} MB)",
             report.output.path.display(),
             report.scans,
             report.ground_truth_poses,
+            report.gnss_fixes,
             if report.skipped_invalid_scans > 0 {
                 format!(", {} scans skipped (flagged invalid in radar.timestamps)", report.skipped_invalid_scans)
             } else {

@@ -52,6 +52,73 @@ fn oxford_tiny_folder_gives_11_scans_and_a_19_4_m_ground_truth() {
     assert!((length_m - 19.409_088_995_767_974).abs() < 1e-9, "{length_m}");
 }
 
+/// RMS distance, metres, between two planar paths after the best proper rigid
+/// alignment of `a` onto `b` (2D Kabsch: rotation from the cross-covariance).
+fn rms_after_alignment_m(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
+    let n = a.len() as f64;
+    let mean = |p: &[[f64; 2]]| [p.iter().map(|q| q[0]).sum::<f64>() / n, p.iter().map(|q| q[1]).sum::<f64>() / n];
+    let (ma, mb) = (mean(a), mean(b));
+    let (mut dot, mut cross) = (0.0, 0.0);
+    for (p, q) in a.iter().zip(b) {
+        let (pa, qb) = ([p[0] - ma[0], p[1] - ma[1]], [q[0] - mb[0], q[1] - mb[1]]);
+        dot += pa[0] * qb[0] + pa[1] * qb[1];
+        cross += pa[0] * qb[1] - pa[1] * qb[0];
+    }
+    let (s, c) = cross.atan2(dot).sin_cos();
+    let sum: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(p, q)| {
+            let pa = [p[0] - ma[0], p[1] - ma[1]];
+            let r = [c * pa[0] - s * pa[1] + mb[0], s * pa[0] + c * pa[1] + mb[1]];
+            (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2)
+        })
+        .sum();
+    (sum / n).sqrt()
+}
+
+/// GPS (easting, northing) linearly interpolated at `t_ns`.
+fn gps_at(rows: &[mmtrack_ingest::oxford::gps::OxfordGpsRow], t_ns: i64) -> Option<[f64; 2]> {
+    let i = rows.partition_point(|r| r.fix.t_ns <= t_ns);
+    let (a, b) = (rows.get(i.checked_sub(1)?)?, rows.get(i)?);
+    let w = (t_ns - a.fix.t_ns) as f64 / (b.fix.t_ns - a.fix.t_ns) as f64;
+    Some([a.easting_m + w * (b.easting_m - a.easting_m), a.northing_m + w * (b.northing_m - a.northing_m)])
+}
+
+#[test]
+fn oxford_ground_truth_yaw_sign_matches_the_gps_track() {
+    use mmtrack_ingest::oxford::{gps::read_gps_csv, odometry};
+    let Some(realdata) = super::common::realdata("oxford_yaw_sign") else { return };
+    let folder = realdata.join("oxford-radar-tiny");
+    let csv = folder.join("gt/radar_odometry.csv");
+    let gps = read_gps_csv(&folder.join("gps/gps.csv")).unwrap();
+    let rows = odometry::parse_radar_odometry(&csv, &std::fs::read_to_string(&csv).unwrap()).unwrap();
+    let fit = |rows: &[odometry::RelativePose]| {
+        let poses = odometry::chain(&csv, rows).unwrap();
+        let (path, reference): (Vec<[f64; 2]>, Vec<[f64; 2]>) = poses
+            .iter()
+            .filter_map(|p| Some(([p.parent_from_child.x_m, p.parent_from_child.y_m], gps_at(&gps, p.t_ns)?)))
+            .unzip();
+        assert!(path.len() > 2000, "poses inside the GPS span: {}", path.len());
+        rms_after_alignment_m(&path, &reference)
+    };
+    // As ingested: (x, -y, -yaw). 2.2 m measured (GPS sigma is about 0.7 m per
+    // axis, and radar and GPS clocks differ by up to a scan); 5 m leaves room.
+    let ours_m = fit(&rows);
+    assert!(ours_m < 5.0, "{ours_m} m");
+    // The CSV's own yaw sign in a z-up frame drifts away from the GPS (239 m).
+    let flipped: Vec<_> = rows
+        .iter()
+        .map(|r| {
+            let mut r = *r;
+            r.destination_from_source.yaw_rad = -r.destination_from_source.yaw_rad;
+            r
+        })
+        .collect();
+    let theirs_m = fit(&flipped);
+    assert!(theirs_m > 20.0 * ours_m, "ours {ours_m} m, flipped {theirs_m} m");
+}
+
 #[test]
 fn oxford_full_sequence_ground_truth_chains_to_9_km() {
     let Some(realdata) = super::common::realdata("oxford_full_sequence_ground_truth") else { return };

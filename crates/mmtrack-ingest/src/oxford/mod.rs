@@ -2,13 +2,16 @@
 //!
 //! Layout: `radar/<t_us>.png` (polar scans, see [`png_scan`]),
 //! `radar.timestamps` (`<t_us> <valid>` per scan; scans flagged 0 are skipped
-//! and counted), optional `gt/radar_odometry.csv` (see [`odometry`]). Without
+//! and counted), optional `gt/radar_odometry.csv` (see [`odometry`]) and
+//! `gps/gps.csv` (see [`gps`]). Ground truth and GNSS fixes are kept within the
+//! time span of the scans. Without
 //! `radar.timestamps`, every `radar/*.png` with a numeric name is taken in
 //! time order.
 //!
 //! Attribution for the real sample used in tests: Oxford Radar RobotCar
 //! Dataset (Barnes et al., ICRA 2020), CC BY-NC-SA 4.0.
 
+pub mod gps;
 pub mod odometry;
 pub mod png_scan;
 
@@ -43,6 +46,8 @@ pub struct OxfordFolder {
     pub skipped_invalid: u64,
     /// `gt/radar_odometry.csv`, when present.
     pub ground_truth: Option<PathBuf>,
+    /// `gps/gps.csv`, when present.
+    pub gps: Option<PathBuf>,
 }
 
 fn parse_stamp(path: &Path, line: usize, raw: &str) -> Result<i64, IngestError> {
@@ -115,7 +120,14 @@ impl OxfordFolder {
             return Err(IngestError::BadLayout { path: radar_dir, detail: "no scans found (empty folder?)".into() });
         }
         let gt = root.join("gt").join("radar_odometry.csv");
-        Ok(Self { root: root.to_path_buf(), scans, skipped_invalid, ground_truth: gt.is_file().then_some(gt) })
+        let gps = root.join("gps").join("gps.csv");
+        Ok(Self {
+            root: root.to_path_buf(),
+            scans,
+            skipped_invalid,
+            ground_truth: gt.is_file().then_some(gt),
+            gps: gps.is_file().then_some(gps),
+        })
     }
 
     /// Sequence id: the folder name.
@@ -155,6 +167,8 @@ pub struct IngestReport {
     pub skipped_invalid_scans: u64,
     /// Ground-truth poses written (those within the scans' time span).
     pub ground_truth_poses: u64,
+    /// GNSS fixes written (those within the scans' time span).
+    pub gnss_fixes: u64,
     /// The recording.
     pub output: WriteSummary,
 }
@@ -181,6 +195,14 @@ pub fn ingest_oxford(
         }
         None => Vec::new(),
     };
+    let gps = match &folder.gps {
+        Some(path) => {
+            extra.insert("gnss.source".into(), path.display().to_string());
+            extra.insert("gnss.altitude_datum".into(), "as in the Oxford gps.csv (NovAtel)".into());
+            gps::read_gps_csv(path)?
+        }
+        None => Vec::new(),
+    };
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("oxford:{}", folder.root.display()),
@@ -204,11 +226,16 @@ pub fn ingest_oxford(
     for pose in &in_span {
         writer.write_pose(PoseStream::GroundTruth, pose, "world", "radar")?;
     }
+    let fixes_in_span: Vec<_> = gps.iter().filter(|row| (first..=last).contains(&row.fix.t_ns)).collect();
+    for row in &fixes_in_span {
+        writer.write_gnss_fix(&row.fix)?;
+    }
     let output = writer.finish()?;
     Ok(IngestReport {
         scans: total,
         skipped_invalid_scans: folder.skipped_invalid,
         ground_truth_poses: in_span.len() as u64,
+        gnss_fixes: fixes_in_span.len() as u64,
         output,
     })
 }
@@ -245,7 +272,8 @@ pub fn write_oxford_folder(
             let (source_us, destination_us) = (w[1].t_ns / 1000, w[0].t_ns / 1000);
             csv.push_str(&format!(
                 "{source_us},{destination_us},{:.6},{:.6},0.000000,0.000000,0.000000,{:.6},{source_us},{destination_us}\n",
-                relative.x_m, relative.y_m, relative.yaw_rad
+                // Back to the dataset's x forward / y right / z down frame (see `odometry`).
+                relative.x_m, -relative.y_m, -relative.yaw_rad
             ));
         }
         let path = gt_dir.join("radar_odometry.csv");

@@ -1,0 +1,169 @@
+//! Oxford `gps/gps.csv`: the NovAtel GNSS fixes of a sequence.
+//!
+//! Columns: `timestamp` (UNIX microseconds), `num_satellites`, `latitude`,
+//! `longitude` (degrees), `altitude` (metres), `latitude_sigma`,
+//! `longitude_sigma`, `altitude_sigma` (metres, 1 sigma), `northing`,
+//! `easting`, `down` (metres, UTM), `utm_zone`. Columns are found by name, so
+//! their order does not matter; a missing one is an error naming it.
+//!
+//! `horizontal_sigma_m` is the RMS of the two horizontal sigmas,
+//! `sqrt((sigma_lat^2 + sigma_lon^2) / 2)`: the per-axis 1-sigma a reader
+//! would use for an isotropic horizontal covariance. Fix quality is not in the
+//! file: fixes are marked `Unknown`.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use mmtrack_core::{GnssFix, GnssFixQuality};
+
+use crate::IngestError;
+use crate::error::os_err;
+
+/// One row: the fix and the UTM position the file also gives.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OxfordGpsRow {
+    /// The fix.
+    pub fix: GnssFix,
+    /// UTM northing, metres.
+    pub northing_m: f64,
+    /// UTM easting, metres.
+    pub easting_m: f64,
+}
+
+const COLUMNS: [&str; 10] = [
+    "timestamp",
+    "num_satellites",
+    "latitude",
+    "longitude",
+    "altitude",
+    "latitude_sigma",
+    "longitude_sigma",
+    "altitude_sigma",
+    "northing",
+    "easting",
+];
+
+/// Parses `gps.csv` text. Rows must be in strictly increasing time.
+pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, IngestError> {
+    let mut lines = text.lines().enumerate();
+    let header = lines.next().map(|(_, l)| l).ok_or_else(|| IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: "empty file: no header line".into(),
+    })?;
+    let index: HashMap<&str, usize> = header.split(',').map(str::trim).enumerate().map(|(i, c)| (c, i)).collect();
+    for name in COLUMNS {
+        if !index.contains_key(name) {
+            return Err(IngestError::BadRecord {
+                path: path.to_path_buf(),
+                record: "line 1 (header)".into(),
+                field: name.into(),
+                detail: format!("missing column; expected {}", COLUMNS.join(", ")),
+            });
+        }
+    }
+    let mut rows: Vec<OxfordGpsRow> = Vec::new();
+    for (line_index, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        let bad = |field: &str, detail: String| IngestError::BadRecord {
+            path: path.to_path_buf(),
+            record: format!("line {}", line_index + 1),
+            field: field.into(),
+            detail,
+        };
+        let raw = |name: &str| {
+            fields.get(index[name]).copied().ok_or_else(|| bad(name, format!("row has {} fields", fields.len())))
+        };
+        let number = |name: &str| -> Result<f64, IngestError> {
+            let text = raw(name)?;
+            text.parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| bad(name, format!("'{text}' is not a finite number")))
+        };
+        let t_text = raw("timestamp")?;
+        let t_ns = t_text
+            .parse::<i64>()
+            .ok()
+            .and_then(|us| us.checked_mul(1000))
+            .filter(|t| *t > 0)
+            .ok_or_else(|| bad("timestamp", format!("'{t_text}' is not a microsecond UNIX timestamp")))?;
+        if let Some(previous) = rows.last()
+            && t_ns <= previous.fix.t_ns
+        {
+            return Err(bad(
+                "timestamp",
+                format!("{} us does not increase (previous {} us)", t_ns / 1000, previous.fix.t_ns / 1000),
+            ));
+        }
+        let satellites = raw("num_satellites")?;
+        let latitude_deg = number("latitude")?;
+        let longitude_deg = number("longitude")?;
+        if !(-90.0..=90.0).contains(&latitude_deg) || !(-180.0..=180.0).contains(&longitude_deg) {
+            return Err(bad(
+                "latitude/longitude",
+                format!("({latitude_deg}, {longitude_deg}) is not a geodetic position"),
+            ));
+        }
+        let (sigma_lat_m, sigma_lon_m) = (number("latitude_sigma")?, number("longitude_sigma")?);
+        rows.push(OxfordGpsRow {
+            fix: GnssFix {
+                t_ns,
+                latitude_deg,
+                longitude_deg,
+                altitude_m: number("altitude")?,
+                horizontal_sigma_m: Some(((sigma_lat_m * sigma_lat_m + sigma_lon_m * sigma_lon_m) / 2.0).sqrt()),
+                num_satellites: Some(
+                    satellites.parse().map_err(|_| bad("num_satellites", format!("'{satellites}' is not a count")))?,
+                ),
+                quality: GnssFixQuality::Unknown,
+            },
+            northing_m: number("northing")?,
+            easting_m: number("easting")?,
+        });
+    }
+    Ok(rows)
+}
+
+/// Reads `gps.csv`.
+pub fn read_gps_csv(path: &Path) -> Result<Vec<OxfordGpsRow>, IngestError> {
+    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    parse_gps_csv(path, &text)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str = "timestamp,num_satellites,latitude,longitude,altitude,latitude_sigma,longitude_sigma,altitude_sigma,northing,easting,down,utm_zone";
+
+    #[test]
+    fn parses_a_row_and_combines_sigmas() {
+        let text = format!(
+            "{HEADER}\n0001547131010502681,7,51.762042,-1.262751,65.176138,0.6,0.8,0.955170,5736000.13,619890.11,-65.17,30U\n"
+        );
+        let rows = parse_gps_csv(Path::new("gps.csv"), &text).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!(rows[0].fix.t_ns, 1_547_131_010_502_681_000);
+        assert_eq!(rows[0].fix.num_satellites, Some(7));
+        // sqrt((0.36 + 0.64) / 2) = sqrt(0.5)
+        assert!((rows[0].fix.horizontal_sigma_m.unwrap() - 0.5f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn missing_column_nan_and_backwards_time_are_named() {
+        let renamed = HEADER.replace("latitude_sigma", "lat_sigma");
+        let err = parse_gps_csv(Path::new("gps.csv"), &format!("{renamed}\n")).unwrap_err().to_string();
+        assert!(err.contains("latitude_sigma") && err.contains("missing column"), "{err}");
+
+        let nan = format!("{HEADER}\n1,7,NaN,-1.2,65,0.6,0.8,0.9,1,2,3,30U\n");
+        let err = parse_gps_csv(Path::new("gps.csv"), &nan).unwrap_err().to_string();
+        assert!(err.contains("line 2") && err.contains("latitude"), "{err}");
+
+        let backwards = format!("{HEADER}\n5,7,51,-1,65,0.6,0.8,0.9,1,2,3,30U\n4,7,51,-1,65,0.6,0.8,0.9,1,2,3,30U\n");
+        let err = parse_gps_csv(Path::new("gps.csv"), &backwards).unwrap_err().to_string();
+        assert!(err.contains("line 3") && err.contains("does not increase"), "{err}");
+    }
+}
