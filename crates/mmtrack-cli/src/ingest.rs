@@ -6,7 +6,9 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+use mmtrack_ingest::ros2::{self, Ros2Topics};
 use mmtrack_io::recording::Compression;
+use mmtrack_io::recording::PoseStream;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use crate::progress;
@@ -119,11 +121,23 @@ enum Kind {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
-    /// ROS 2 MCAP bag (not built yet: issue #3).
+    /// ROS 2 MCAP bag (cdr): poses from nav_msgs/Odometry or PoseWithCovarianceStamped, fixes from NavSatFix.
+    ///
+    /// `mmtrack inspect <bag.mcap>` lists the topics a bag holds.
     Ros2 {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
+        /// The bag (.mcap).
+        input: PathBuf,
+        #[command(flatten)]
+        output: OutputArgs,
+        /// Pose topic (Odometry or PoseWithCovarianceStamped); `none` to skip poses.
+        #[arg(long, default_value = "/odom")]
+        pose_topic: String,
+        /// Record the poses as ground truth instead of as an estimate.
+        #[arg(long)]
+        poses_are_ground_truth: bool,
+        /// NavSatFix topic, if any.
+        #[arg(long)]
+        gnss_topic: Option<String>,
     },
 }
 
@@ -149,7 +163,31 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         Kind::Poses { .. } => crate::not_built("ingest poses", 3),
         Kind::Nmea { .. } => crate::not_built("ingest nmea", 3),
         Kind::Cir { .. } => crate::not_built("ingest cir", 3),
-        Kind::Ros2 { .. } => crate::not_built("ingest ros2", 3),
+        Kind::Ros2 { input, output, pose_topic, poses_are_ground_truth, gnss_topic } => {
+            let topics = Ros2Topics {
+                pose_topic: (pose_topic != "none").then_some(pose_topic),
+                pose_stream: if poses_are_ground_truth { PoseStream::GroundTruth } else { PoseStream::Estimate },
+                gnss_topic,
+            };
+            let bar = progress::bytes_bar("ingest ros2", quiet);
+            let report =
+                ros2::ingest_ros2(&input, &output.output, &topics, &output.recording_options(), &mut |done, total| {
+                    bar.set_length(total);
+                    bar.set_position(done);
+                });
+            bar.finish_and_clear();
+            let report = report?;
+            if !quiet {
+                println!(
+                    "{}: {} poses, {} GNSS fixes ({} NavSatFix without a fix skipped)",
+                    report.output.path.display(),
+                    report.poses,
+                    report.gnss_fixes,
+                    report.no_fix
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 

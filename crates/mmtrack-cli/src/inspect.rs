@@ -56,10 +56,12 @@ fn print_recording(summary: &RecordingSummary) {
     if let (Some(start), Some(end)) = (start, end) {
         println!("  time span: {:.3} s ({start} .. {end} ns)", seconds(end - start));
     }
-    println!("  {:<24} {:<28} {:>9} {:>12}", "topic", "schema", "messages", "span [s]");
+    let topic_width = summary.channels.iter().map(|c| c.topic.len()).max().unwrap_or(0).max(5);
+    let schema_width = summary.channels.iter().map(|c| c.schema_name.len()).max().unwrap_or(0).max(6);
+    println!("  {:<topic_width$} {:<schema_width$} {:>9} {:>12}", "topic", "schema", "messages", "span [s]");
     for c in &summary.channels {
         println!(
-            "  {:<24} {:<28} {:>9} {:>12.3}",
+            "  {:<topic_width$} {:<schema_width$} {:>9} {:>12.3}",
             c.topic,
             c.schema_name,
             c.message_count,

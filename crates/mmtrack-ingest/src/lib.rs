@@ -9,13 +9,14 @@
 //! It depends on `mmtrack-core` and `mmtrack-io` only, never on algorithms, and
 //! does not print: long operations report through a progress callback.
 //!
-//! Sources so far: Oxford Radar RobotCar radar folders ([`oxford`]), with their
-//! `gt/radar_odometry.csv` ground truth.
+//! Sources so far: Oxford Radar RobotCar folders ([`oxford`]) with their
+//! ground truth and GPS, and ROS 2 bags ([`ros2`]).
 
 pub mod cir;
 mod error;
 pub mod nmea;
 pub mod oxford;
+pub mod ros2;
 
 pub use error::IngestError;
 

@@ -9,3 +9,4 @@ mod common;
 mod fixtures;
 mod independent_readers;
 mod realdata_oxford;
+mod realdata_ros2;

@@ -17,25 +17,34 @@ use super::channels::{CIR_TOPIC, GNSS_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADA
 use crate::error::{IoError, Result, os_err};
 use crate::proto;
 
+/// A channel of an MCAP file.
 #[derive(Debug)]
-struct ChannelInfo {
-    topic: String,
-    schema_name: String,
-    message_encoding: String,
+pub struct ChannelInfo {
+    /// Topic.
+    pub topic: String,
+    /// Schema name (e.g. `nav_msgs/msg/Odometry`), empty without a schema.
+    pub schema_name: String,
+    /// Message encoding (e.g. `cdr`, `protobuf`).
+    pub message_encoding: String,
 }
 
 /// A raw message: its channel, sequence, time and payload.
-struct RawMessage {
-    channel: Arc<ChannelInfo>,
-    sequence: u32,
-    log_time_ns: u64,
+#[derive(Debug)]
+pub struct RawMessage {
+    /// The channel.
+    pub channel: Arc<ChannelInfo>,
+    /// MCAP sequence number.
+    pub sequence: u32,
+    /// Log time, nanoseconds.
+    pub log_time_ns: u64,
     /// Owned payload; `Bytes` so that prost decodes `bytes` fields as
     /// zero-copy slices of it.
-    data: bytes::Bytes,
+    pub data: bytes::Bytes,
 }
 
-/// Streams the records of an MCAP file with bounded memory.
-struct RawReader {
+/// Streams the messages of any MCAP file (ours, ROS 2 bags, ...) in file
+/// order with bounded memory, without decoding them.
+pub struct RawReader {
     path: PathBuf,
     file: File,
     bytes_read: u64,
@@ -46,7 +55,8 @@ struct RawReader {
 }
 
 impl RawReader {
-    fn open(path: &Path) -> Result<Self> {
+    /// Opens a file.
+    pub fn open(path: &Path) -> Result<Self> {
         let file = File::open(path).map_err(os_err(path))?;
         Ok(Self {
             path: path.to_path_buf(),
@@ -63,8 +73,20 @@ impl RawReader {
         IoError::CorruptRecording { path: self.path.clone(), detail: detail.to_string() }
     }
 
+    /// The file.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Bytes of the file read so far (for progress).
+    #[must_use]
+    pub fn bytes_read(&self) -> u64 {
+        self.bytes_read
+    }
+
     /// The next message, or `None` at a clean end of file.
-    fn next_message(&mut self) -> Result<Option<RawMessage>> {
+    pub fn next_message(&mut self) -> Result<Option<RawMessage>> {
         while let Some(event) = self.reader.next_event() {
             match event.map_err(|e| IoError::CorruptRecording { path: self.path.clone(), detail: e.to_string() })? {
                 LinearReadEvent::ReadRequest(need) => {

@@ -1,0 +1,44 @@
+//! Ingest of a real ROS 2 bag written by the standard tooling (MichaelGrupp/evo
+//! test data, GPL-3.0; a simulated TurtleBot, but a real third-party file).
+
+use mmtrack_io::recording::PoseStream;
+use mmtrack_io::{RecordingEvent, RecordingReader};
+
+use super::common::{mmtrack, text};
+
+#[test]
+fn ros2_bag_odom_becomes_poses() {
+    let Some(realdata) = super::common::realdata("ros2_bag") else { return };
+    let bag = realdata.join("ros2-mcap/nav2_turtlebot.mcap");
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "ros2", bag.to_str().unwrap(), "-o", "bag.mcap"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    // `mmtrack inspect` of the bag counts 2639 messages on /odom.
+    assert!(stdout.contains("2639 poses"), "{stdout}");
+    let poses: Vec<_> = RecordingReader::open(&dir.path().join("bag.mcap"))
+        .unwrap()
+        .filter_map(|e| match e.unwrap() {
+            RecordingEvent::Pose { stream: PoseStream::Estimate, pose } => Some(pose),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(poses.len(), 2639);
+    assert!(poses.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
+    // A TurtleBot in a small simulated world: positions within tens of metres.
+    assert!(poses.iter().all(|p| p.parent_from_child.translation_norm_m() < 50.0));
+
+    // /amcl_pose is a PoseWithCovarianceStamped topic.
+    let out = mmtrack(
+        dir.path(),
+        &["ingest", "ros2", bag.to_str().unwrap(), "-o", "amcl.mcap", "--pose-topic", "/amcl_pose"],
+    );
+    assert!(text(&out).0.contains("135 poses"), "{}", text(&out).1);
+
+    // A topic the bag lacks is one clear error listing what it has.
+    let out = mmtrack(dir.path(), &["ingest", "ros2", bag.to_str().unwrap(), "-o", "x.mcap", "--gnss-topic", "/fix"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("no topic /fix") && stderr.contains("/odom"), "{stderr}");
+    assert!(!dir.path().join("x.mcap").exists());
+}

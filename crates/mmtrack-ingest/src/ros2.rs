@@ -1,0 +1,381 @@
+//! ROS 2 MCAP bags (message encoding `cdr`).
+//!
+//! Decoded message types: `nav_msgs/msg/Odometry` and
+//! `geometry_msgs/msg/PoseWithCovarianceStamped` (as planar poses: x, y and
+//! the yaw of the orientation quaternion; ROS frames are z up, as ours), and
+//! `sensor_msgs/msg/NavSatFix` (as GNSS fixes). A pose is stamped with its
+//! message's `header.stamp`, not the bag's log time.
+//!
+//! CDR (OMG XCDR1, as ROS 2's rmw implementations write it): a 4-byte
+//! encapsulation header (`00 01` little-endian, `00 00` big-endian, then two
+//! option bytes), then the fields in declaration order, each primitive aligned
+//! to its own size counted from the end of the encapsulation header; strings
+//! are a `uint32` length including the terminating NUL, then the bytes. We
+//! decode by hand: the few fixed message layouts we need do not justify a
+//! general IDL machinery, and every read is bounds-checked so a truncated or
+//! corrupted message is an error naming the field, never a panic.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use mmtrack_core::{GnssFix, GnssFixQuality, Se2, StampedPose};
+use mmtrack_io::recording::{PoseStream, RawReader, RecordingMetadata, TimeBase, WriteSummary};
+use mmtrack_io::{RecordingOptions, RecordingWriter};
+
+use crate::{IngestError, Progress};
+
+/// A bounds-checked CDR reader over one message.
+pub struct Cdr<'a> {
+    body: &'a [u8],
+    position: usize,
+    little_endian: bool,
+}
+
+impl<'a> Cdr<'a> {
+    /// Starts after the encapsulation header.
+    pub fn new(data: &'a [u8]) -> Result<Self, String> {
+        let header = data.get(..4).ok_or("shorter than the 4-byte CDR encapsulation header")?;
+        let little_endian = match header[..2] {
+            [0x00, 0x01] | [0x00, 0x03] => true,
+            [0x00, 0x00] | [0x00, 0x02] => false,
+            _ => return Err(format!("unknown CDR encapsulation {:02x}{:02x}", header[0], header[1])),
+        };
+        Ok(Self { body: &data[4..], position: 0, little_endian })
+    }
+
+    fn take(&mut self, field: &str, size: usize, align: usize) -> Result<&'a [u8], String> {
+        let start = self.position.next_multiple_of(align);
+        let end = start.checked_add(size).ok_or_else(|| format!("{field}: length overflows"))?;
+        let bytes = self
+            .body
+            .get(start..end)
+            .ok_or_else(|| format!("{field}: message ends at byte {} but the field needs {end}", self.body.len()))?;
+        self.position = end;
+        Ok(bytes)
+    }
+
+    fn array<const N: usize>(&mut self, field: &str) -> Result<[u8; N], String> {
+        let mut out = [0u8; N];
+        out.copy_from_slice(self.take(field, N, N)?);
+        if !self.little_endian {
+            out.reverse();
+        }
+        Ok(out)
+    }
+
+    /// A `uint8`.
+    pub fn u8(&mut self, field: &str) -> Result<u8, String> {
+        Ok(self.take(field, 1, 1)?[0])
+    }
+
+    /// A `uint16`.
+    pub fn u16(&mut self, field: &str) -> Result<u16, String> {
+        Ok(u16::from_le_bytes(self.array(field)?))
+    }
+
+    /// A `uint32`.
+    pub fn u32(&mut self, field: &str) -> Result<u32, String> {
+        Ok(u32::from_le_bytes(self.array(field)?))
+    }
+
+    /// An `int32`.
+    pub fn i32(&mut self, field: &str) -> Result<i32, String> {
+        Ok(i32::from_le_bytes(self.array(field)?))
+    }
+
+    /// A `float64`.
+    pub fn f64(&mut self, field: &str) -> Result<f64, String> {
+        Ok(f64::from_le_bytes(self.array(field)?))
+    }
+
+    /// A `string`.
+    pub fn string(&mut self, field: &str) -> Result<String, String> {
+        let len = self.u32(field)? as usize;
+        let bytes = self.take(field, len, 1)?;
+        let text = bytes.strip_suffix(&[0]).unwrap_or(bytes);
+        String::from_utf8(text.to_vec()).map_err(|_| format!("{field}: not UTF-8"))
+    }
+
+    /// A `builtin_interfaces/Time`, as nanoseconds.
+    pub fn stamp_ns(&mut self, field: &str) -> Result<i64, String> {
+        let sec = self.i32(field)?;
+        let nanosec = self.u32(field)?;
+        if nanosec >= 1_000_000_000 {
+            return Err(format!("{field}: nanosec {nanosec} is not below one second"));
+        }
+        Ok(i64::from(sec) * 1_000_000_000 + i64::from(nanosec))
+    }
+}
+
+/// A planar pose decoded from a ROS message, with its frames.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RosPose {
+    /// `header.stamp` as the pose, parent from child.
+    pub pose: StampedPose,
+    /// `header.frame_id`.
+    pub frame_id: String,
+    /// `child_frame_id` (Odometry), empty otherwise.
+    pub child_frame_id: String,
+}
+
+fn header(cdr: &mut Cdr<'_>) -> Result<(i64, String), String> {
+    Ok((cdr.stamp_ns("header.stamp")?, cdr.string("header.frame_id")?))
+}
+
+/// `geometry_msgs/Pose` as a planar transform: yaw of the quaternion,
+/// `atan2(2 (w z + x y), 1 - 2 (y^2 + z^2))`.
+fn planar_pose(cdr: &mut Cdr<'_>) -> Result<Se2, String> {
+    let (x, y) = (cdr.f64("pose.position.x")?, cdr.f64("pose.position.y")?);
+    let _z = cdr.f64("pose.position.z")?;
+    let q =
+        [cdr.f64("orientation.x")?, cdr.f64("orientation.y")?, cdr.f64("orientation.z")?, cdr.f64("orientation.w")?];
+    let pose = Se2::new(x, y, (2.0 * (q[3] * q[2] + q[0] * q[1])).atan2(1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2])));
+    if pose.is_finite() { Ok(pose) } else { Err("pose is not finite".into()) }
+}
+
+/// Decodes `nav_msgs/msg/Odometry` (the pose part).
+pub fn decode_odometry(data: &[u8]) -> Result<RosPose, String> {
+    let mut cdr = Cdr::new(data)?;
+    let (t_ns, frame_id) = header(&mut cdr)?;
+    let child_frame_id = cdr.string("child_frame_id")?;
+    let pose = planar_pose(&mut cdr)?;
+    Ok(RosPose { pose: StampedPose { t_ns, parent_from_child: pose }, frame_id, child_frame_id })
+}
+
+/// Decodes `geometry_msgs/msg/PoseWithCovarianceStamped` (the pose part).
+pub fn decode_pose_with_covariance_stamped(data: &[u8]) -> Result<RosPose, String> {
+    let mut cdr = Cdr::new(data)?;
+    let (t_ns, frame_id) = header(&mut cdr)?;
+    let pose = planar_pose(&mut cdr)?;
+    Ok(RosPose { pose: StampedPose { t_ns, parent_from_child: pose }, frame_id, child_frame_id: String::new() })
+}
+
+/// Decodes `sensor_msgs/msg/NavSatFix`; `None` when its status says no fix (-1).
+///
+/// `horizontal_sigma_m` is `sqrt((C_ee + C_nn) / 2)` from the ENU covariance
+/// when its type is not UNKNOWN (0). ROS status 0/1/2 (fix, SBAS, GBAS) map to
+/// autonomous / differential / differential.
+pub fn decode_nav_sat_fix(data: &[u8]) -> Result<Option<GnssFix>, String> {
+    let mut cdr = Cdr::new(data)?;
+    let (t_ns, _) = header(&mut cdr)?;
+    let status = cdr.u8("status.status")? as i8;
+    let _service = cdr.u16("status.service")?;
+    let (latitude_deg, longitude_deg, altitude_m) = (cdr.f64("latitude")?, cdr.f64("longitude")?, cdr.f64("altitude")?);
+    let mut covariance = [0.0; 9];
+    for c in &mut covariance {
+        *c = cdr.f64("position_covariance")?;
+    }
+    let covariance_type = cdr.u8("position_covariance_type")?;
+    if status < 0 {
+        return Ok(None);
+    }
+    if !(latitude_deg.is_finite() && longitude_deg.is_finite() && altitude_m.is_finite()) {
+        return Err("latitude/longitude/altitude not finite".into());
+    }
+    let sigma =
+        (covariance_type != 0).then(|| ((covariance[0] + covariance[4]) / 2.0).sqrt()).filter(|s| s.is_finite());
+    Ok(Some(GnssFix {
+        t_ns,
+        latitude_deg,
+        longitude_deg,
+        altitude_m,
+        horizontal_sigma_m: sigma,
+        num_satellites: None,
+        quality: if status == 0 { GnssFixQuality::Autonomous } else { GnssFixQuality::Differential },
+    }))
+}
+
+/// Which topics to take from a bag, and as what.
+#[derive(Debug, Clone)]
+pub struct Ros2Topics {
+    /// Pose topic (`nav_msgs/msg/Odometry` or `geometry_msgs/msg/PoseWithCovarianceStamped`).
+    pub pose_topic: Option<String>,
+    /// Whether the poses are ground truth or an estimate.
+    pub pose_stream: PoseStream,
+    /// `sensor_msgs/msg/NavSatFix` topic.
+    pub gnss_topic: Option<String>,
+}
+
+impl Default for Ros2Topics {
+    fn default() -> Self {
+        Self { pose_topic: Some("/odom".into()), pose_stream: PoseStream::Estimate, gnss_topic: None }
+    }
+}
+
+/// What a bag ingest did.
+#[derive(Debug, Clone)]
+pub struct Ros2Report {
+    /// Poses written.
+    pub poses: u64,
+    /// GNSS fixes written.
+    pub gnss_fixes: u64,
+    /// NavSatFix messages without a fix (skipped).
+    pub no_fix: u64,
+    /// The recording.
+    pub output: WriteSummary,
+}
+
+/// Ingests the chosen topics of a ROS 2 bag into a new recording. Messages
+/// must come in increasing header time per topic.
+pub fn ingest_ros2(
+    bag: &Path,
+    out: &Path,
+    topics: &Ros2Topics,
+    recording: &RecordingOptions,
+    progress: Progress<'_>,
+) -> Result<Ros2Report, IngestError> {
+    let bag_bytes = std::fs::metadata(bag).map(|m| m.len()).unwrap_or(0);
+    let mut reader = RawReader::open(bag)?;
+    let metadata = RecordingMetadata {
+        sequence_id: bag.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bag".into()),
+        source: format!("ros2:{}", bag.display()),
+        time_base: TimeBase::UnixEpoch,
+        extra: BTreeMap::from([
+            ("ros2.pose_topic".to_string(), topics.pose_topic.clone().unwrap_or_default()),
+            ("ros2.gnss_topic".to_string(), topics.gnss_topic.clone().unwrap_or_default()),
+        ]),
+    };
+    let mut writer = RecordingWriter::create(out, &metadata, recording)?;
+    let (mut poses, mut gnss_fixes, mut no_fix) = (0, 0, 0);
+    let (mut last_pose_ns, mut last_fix_ns) = (i64::MIN, i64::MIN);
+    let mut found_topics = std::collections::BTreeSet::new();
+    while let Some(message) = reader.next_message()? {
+        let channel = &message.channel;
+        found_topics.insert(channel.topic.clone());
+        let bad = |detail: String| IngestError::BadRecord {
+            path: bag.to_path_buf(),
+            record: format!("message {} on {}", message.sequence, channel.topic),
+            field: channel.schema_name.clone(),
+            detail,
+        };
+        let is_pose = topics.pose_topic.as_deref() == Some(channel.topic.as_str());
+        let is_gnss = topics.gnss_topic.as_deref() == Some(channel.topic.as_str());
+        if (is_pose || is_gnss) && channel.message_encoding != "cdr" {
+            return Err(bad(format!("message encoding '{}', expected cdr", channel.message_encoding)));
+        }
+        if is_pose {
+            let decoded = match channel.schema_name.as_str() {
+                "nav_msgs/msg/Odometry" => decode_odometry(&message.data),
+                "geometry_msgs/msg/PoseWithCovarianceStamped" => decode_pose_with_covariance_stamped(&message.data),
+                other => {
+                    return Err(bad(format!("{other} is not a pose type (Odometry or PoseWithCovarianceStamped)")));
+                }
+            }
+            .map_err(bad)?;
+            if decoded.pose.t_ns <= last_pose_ns {
+                return Err(bad(format!("header.stamp {} ns does not increase", decoded.pose.t_ns)));
+            }
+            last_pose_ns = decoded.pose.t_ns;
+            let child = if decoded.child_frame_id.is_empty() { "vehicle" } else { decoded.child_frame_id.as_str() };
+            writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id, child)?;
+            poses += 1;
+        } else if is_gnss {
+            if channel.schema_name != "sensor_msgs/msg/NavSatFix" {
+                return Err(bad(format!("{} is not sensor_msgs/msg/NavSatFix", channel.schema_name)));
+            }
+            match decode_nav_sat_fix(&message.data).map_err(bad)? {
+                Some(fix) => {
+                    if fix.t_ns <= last_fix_ns {
+                        return Err(bad(format!("header.stamp {} ns does not increase", fix.t_ns)));
+                    }
+                    last_fix_ns = fix.t_ns;
+                    writer.write_gnss_fix(&fix)?;
+                    gnss_fixes += 1;
+                }
+                None => no_fix += 1,
+            }
+        }
+        progress(reader.bytes_read(), bag_bytes);
+    }
+    for topic in [&topics.pose_topic, &topics.gnss_topic].into_iter().flatten() {
+        if !found_topics.contains(topic) {
+            return Err(IngestError::BadLayout {
+                path: bag.to_path_buf(),
+                detail: format!(
+                    "no topic {topic} in the bag (topics: {})",
+                    found_topics.iter().cloned().collect::<Vec<_>>().join(", ")
+                ),
+            });
+        }
+    }
+    let output = writer.finish()?;
+    Ok(Ros2Report { poses, gnss_fixes, no_fix, output })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A CDR little-endian writer for test messages.
+    struct Writer(Vec<u8>);
+
+    impl Writer {
+        fn new() -> Self {
+            Self(vec![0, 1, 0, 0])
+        }
+        fn align(&mut self, n: usize) {
+            while !(self.0.len() - 4).is_multiple_of(n) {
+                self.0.push(0);
+            }
+        }
+        fn u32(&mut self, v: u32) -> &mut Self {
+            self.align(4);
+            self.0.extend_from_slice(&v.to_le_bytes());
+            self
+        }
+        fn f64(&mut self, v: f64) -> &mut Self {
+            self.align(8);
+            self.0.extend_from_slice(&v.to_le_bytes());
+            self
+        }
+        fn string(&mut self, s: &str) -> &mut Self {
+            self.u32(s.len() as u32 + 1);
+            self.0.extend_from_slice(s.as_bytes());
+            self.0.push(0);
+            self
+        }
+    }
+
+    fn odometry(yaw: f64) -> Vec<u8> {
+        let mut w = Writer::new();
+        w.u32(12).u32(500).string("odom").string("base_link");
+        w.f64(1.5).f64(-2.0).f64(0.0);
+        w.f64(0.0).f64(0.0).f64((yaw / 2.0).sin()).f64((yaw / 2.0).cos());
+        for _ in 0..36 {
+            w.f64(0.0);
+        }
+        w.0
+    }
+
+    #[test]
+    fn odometry_decodes_with_alignment_and_yaw() {
+        let decoded = decode_odometry(&odometry(0.75)).unwrap();
+        assert_eq!(decoded.pose.t_ns, 12_000_000_500);
+        assert_eq!((decoded.frame_id.as_str(), decoded.child_frame_id.as_str()), ("odom", "base_link"));
+        let p = decoded.pose.parent_from_child;
+        assert_eq!((p.x_m, p.y_m), (1.5, -2.0));
+        assert!((p.yaw_rad - 0.75).abs() < 1e-12);
+    }
+
+    #[test]
+    fn truncated_message_names_the_field() {
+        let data = odometry(0.1);
+        let err = decode_odometry(&data[..60]).unwrap_err();
+        assert!(err.contains("orientation") || err.contains("pose.position"), "{err}");
+        assert!(decode_odometry(&[0, 1]).unwrap_err().contains("encapsulation"));
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 512, ..ProptestConfig::default() })]
+        #[test]
+        fn decoders_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..400), cut in 0usize..400) {
+            let _ = decode_odometry(&bytes);
+            let _ = decode_nav_sat_fix(&bytes);
+            let mut valid = odometry(0.3);
+            valid.truncate(cut.min(valid.len()));
+            let _ = decode_odometry(&valid);
+            let _ = decode_pose_with_covariance_stamped(&valid);
+        }
+    }
+}
