@@ -29,7 +29,7 @@ inspect *args:
 
 # All tests (the same command CI runs).
 test:
-    cargo test --workspace
+    cargo test --workspace -- --show-output
 
 # Benchmarks in release mode; refreshes the README's results block.
 bench:
