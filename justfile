@@ -31,9 +31,11 @@ inspect *args:
 test:
     cargo test --workspace -- --show-output
 
-# Benchmarks in release mode; refreshes the README's results block.
+# Benchmarks in release mode; refresh the README's results blocks.
 bench:
     cargo run -q --release -p mmtrack-cli -- bench io --check --readme README.md
+    cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md --from ../shared/realdata/oxford-radar-tiny
+    cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md
 
 # Paper experiments.
 reproduce *args:

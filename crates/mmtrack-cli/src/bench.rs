@@ -26,6 +26,28 @@ pub struct BenchArgs {
 
 #[derive(Subcommand)]
 enum Kind {
+    /// Oxford-folder ingest (PNG bytes carried) in scans/s vs copying the folder; peak memory at two folder sizes.
+    Ingest {
+        /// Scans in the large folder (400 x 3768 each).
+        #[arg(long, default_value_t = 200)]
+        scans: usize,
+        /// Runs per measurement; the best is reported.
+        #[arg(long, default_value_t = 3)]
+        repeats: usize,
+        /// Exit 1 when a target is missed.
+        #[arg(long)]
+        check: bool,
+        /// Directory for the temporary files (default: the system temp dir).
+        #[arg(long)]
+        dir: Option<std::path::PathBuf>,
+        /// Replace the block `<!-- bench-ingest-real:begin -->` (with --from) or `bench-ingest-simulated` in this file.
+        #[arg(long, value_name = "README.md")]
+        readme: Option<std::path::PathBuf>,
+        /// Build the folders from this Oxford folder's real PNG bytes, repeated under new
+        /// stamps (e.g. ../shared/realdata/oxford-radar-tiny); default: simulated scans.
+        #[arg(long, value_name = "OXFORD_FOLDER")]
+        from: Option<std::path::PathBuf>,
+    },
     /// MCAP write/read throughput of 1.5 MB radar-scan messages vs std::fs::copy.
     Io {
         /// Number of scans (1.5 MB each).
@@ -245,8 +267,172 @@ fn replace_block(path: &Path, name: &str, body: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Issue #3: ingest of an Oxford folder, bytes carried, on this 2-core machine.
+const INGEST_TARGET_SCANS_PER_S: f64 = 200.0;
+
+/// Peak resident memory of this process since the last reset, bytes (Linux:
+/// `VmHWM`, reset by writing 5 to `/proc/self/clear_refs`).
+fn reset_peak_rss() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+fn peak_rss_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+fn copy_dir(from: &Path, to: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(to)?;
+    for entry in std::fs::read_dir(from)? {
+        let entry = entry?;
+        let target = to.join(entry.file_name());
+        if entry.file_type()?.is_dir() {
+            copy_dir(&entry.path(), &target)?;
+        } else {
+            std::fs::copy(entry.path(), target)?;
+        }
+    }
+    Ok(())
+}
+
+fn ingest_folder(folder: &Path, out: &Path) -> anyhow::Result<u64> {
+    use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+    let folder = OxfordFolder::open(folder)?;
+    let recording = RecordingOptions {
+        compression: Compression::None,
+        overwrite: Overwrite::Replace,
+        durability: Durability::PageCache,
+        ..RecordingOptions::default()
+    };
+    let report = oxford::ingest_oxford(&folder, out, &OxfordOptions::default(), &recording, &mut |_, _| {})?;
+    Ok(report.scans)
+}
+
+fn ingest(args: &IngestBench<'_>, quiet: bool) -> anyhow::Result<ExitCode> {
+    let temp = match args.dir {
+        Some(d) => tempfile::tempdir_in(d)?,
+        None => tempfile::tempdir()?,
+    };
+    let layout = mmtrack_ingest::oxford::OXFORD;
+    let small_scans = (args.scans / 4).max(1);
+    let (large, small) = (temp.path().join("large"), temp.path().join("small"));
+    let source = match args.from {
+        Some(real) => {
+            replicate_real_folder(real, &large, args.scans)?;
+            replicate_real_folder(real, &small, small_scans)?;
+            format!("real PNG bytes of {} repeated", real.display())
+        }
+        None => {
+            let scans = oxford_size_scans(args.scans);
+            mmtrack_ingest::oxford::write_oxford_folder(&large, &scans, &[], &layout)?;
+            mmtrack_ingest::oxford::write_oxford_folder(&small, &scans[..small_scans], &[], &layout)?;
+            "simulated scans (noisier than real ones: larger PNGs, slower to decode)".to_string()
+        }
+    };
+    let folder_mb = dir_bytes(&large.join("radar"))? as f64 / 1e6;
+
+    let copy_target = temp.path().join("copy");
+    let copy = best_of(args.repeats, || {
+        let _ = std::fs::remove_dir_all(&copy_target);
+        copy_dir(&large, &copy_target)
+    })?;
+    let out = temp.path().join("out.mcap");
+    let ingest_time = best_of(args.repeats, || {
+        ingest_folder(&large, &out)?;
+        Ok(())
+    })?;
+    reset_peak_rss();
+    let before = peak_rss_bytes();
+    ingest_folder(&small, &out)?;
+    let peak_small = peak_rss_bytes();
+    reset_peak_rss();
+    ingest_folder(&large, &out)?;
+    let peak_large = peak_rss_bytes();
+
+    let scans_per_s = args.scans as f64 / ingest_time.as_secs_f64();
+    let copy_scans_per_s = args.scans as f64 / copy.as_secs_f64();
+    let met = scans_per_s >= INGEST_TARGET_SCANS_PER_S;
+    let mb = |b: Option<u64>| b.map_or(f64::NAN, |b| b as f64 / 1e6);
+    let text = format!(
+        "`mmtrack bench ingest`: Oxford folder of {} scans (400 x 3779 PNG, {:.0} MB; {source}), PNG bytes carried, no chunk compression, best of {} runs.\n\n\
+         | measure | value |\n|---|---|\n\
+         | ingest | {scans_per_s:.0} scans/s |\n\
+         | baseline: copy the folder | {copy_scans_per_s:.0} scans/s |\n\
+         | ingest / copy | {:.2} |\n\
+         | target: >= {INGEST_TARGET_SCANS_PER_S} scans/s | {} |\n\
+         | peak memory, {small_scans} scans | {:.0} MB |\n\
+         | peak memory, {} scans | {:.0} MB |\n\
+         | memory before ingest | {:.0} MB |\n",
+        args.scans,
+        folder_mb,
+        args.repeats,
+        scans_per_s / copy_scans_per_s,
+        if met { "met" } else { "**missed**" },
+        mb(peak_small),
+        args.scans,
+        mb(peak_large),
+        mb(before),
+    );
+    if !quiet {
+        print!("{text}");
+    }
+    if let Some(readme) = args.readme {
+        let block = if args.from.is_some() { "bench-ingest-real" } else { "bench-ingest-simulated" };
+        replace_block(readme, block, &text)?;
+    }
+    Ok(if args.check && !met { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+}
+
+/// Writes an Oxford folder of `count` scans whose PNGs are the real ones of
+/// `real`, cycled, under new increasing stamps (the ingest reads the scan stamp
+/// from the file name and the azimuth times from the rows).
+fn replicate_real_folder(real: &Path, to: &Path, count: usize) -> anyhow::Result<()> {
+    let folder = mmtrack_ingest::oxford::OxfordFolder::open(real)?;
+    std::fs::create_dir_all(to.join("radar"))?;
+    let mut timestamps = String::new();
+    let first_us = folder.scans[0].t_ns / 1000;
+    for i in 0..count {
+        let t_us = first_us + i as i64 * 250_000;
+        std::fs::copy(&folder.scans[i % folder.scans.len()].path, to.join("radar").join(format!("{t_us}.png")))?;
+        timestamps.push_str(&format!("{t_us} 1\n"));
+    }
+    std::fs::write(to.join("radar.timestamps"), timestamps)?;
+    Ok(())
+}
+
+/// Total bytes of the files in `dir` (not recursive).
+fn dir_bytes(dir: &Path) -> anyhow::Result<u64> {
+    let mut total = 0;
+    for entry in std::fs::read_dir(dir)? {
+        total += entry?.metadata()?.len();
+    }
+    Ok(total)
+}
+
+struct IngestBench<'a> {
+    scans: usize,
+    repeats: usize,
+    check: bool,
+    dir: Option<&'a Path>,
+    readme: Option<&'a Path>,
+    from: Option<&'a Path>,
+}
+
 pub fn run(args: &BenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.kind {
+        Kind::Ingest { scans, repeats, check, dir, readme, from } => ingest(
+            &IngestBench {
+                scans: *scans,
+                repeats: *repeats,
+                check: *check,
+                dir: dir.as_deref(),
+                readme: readme.as_deref(),
+                from: from.as_deref(),
+            },
+            quiet,
+        ),
         Kind::Io { scans, repeats, check, json, dir, readme } => io(
             &IoArgs {
                 scans: *scans,

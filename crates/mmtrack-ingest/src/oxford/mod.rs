@@ -24,7 +24,7 @@ use mmtrack_io::{RecordingOptions, RecordingWriter};
 
 use crate::error::os_err;
 use crate::{IngestError, Progress};
-pub use png_scan::{HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
+pub use png_scan::{DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
 
 /// One scan file of a folder.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -211,16 +211,16 @@ pub fn ingest_oxford(
     };
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;
     let total = folder.scans.len() as u64;
-    for (index, scan) in folder.scans.iter().enumerate() {
-        let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
-        let decoded = decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?;
+    let mut write = |index: usize, decoded: DecodedScanPng, bytes: Vec<u8>| -> Result<(), IngestError> {
         if options.carry_png {
             writer.write_radar_png(&decoded.header, &bytes, HEADER_COLUMNS as u32)?;
         } else {
             writer.write_radar_scan(&decoded.into_scan())?;
         }
         progress(index as u64 + 1, total);
-    }
+        Ok(())
+    };
+    decode_in_order(&folder.scans, layout, &mut write)?;
     let (first, last) = (folder.scans[0].t_ns, folder.scans[folder.scans.len() - 1].t_ns);
     let in_span: Vec<&StampedPose> = ground_truth.iter().filter(|p| (first..=last).contains(&p.t_ns)).collect();
     for pose in &in_span {
@@ -239,6 +239,56 @@ pub fn ingest_oxford(
         output,
     })
 }
+
+/// Reads and decodes the scans on one worker per core and hands them to
+/// `write` in file order.
+///
+/// Worker `w` takes scans `w, w + n, w + 2n, ...` and sends each down its own
+/// channel of capacity [`DECODED_AHEAD`]; the caller's thread receives from the
+/// workers round-robin, so order is kept and at most `n * (DECODED_AHEAD + 1)`
+/// scans are in memory whatever the folder size. PNG decoding (inflate and
+/// unfilter, needed to reach the row headers) is most of an ingest's time.
+fn decode_in_order(
+    scans: &[ScanFile],
+    layout: &NavtechLayout,
+    write: &mut dyn FnMut(usize, DecodedScanPng, Vec<u8>) -> Result<(), IngestError>,
+) -> Result<(), IngestError> {
+    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(scans.len().max(1));
+    let decode = |scan: &ScanFile| -> Result<(DecodedScanPng, Vec<u8>), IngestError> {
+        let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
+        let decoded = decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?;
+        Ok((decoded, bytes))
+    };
+    std::thread::scope(|scope| {
+        let receivers: Vec<_> = (0..workers)
+            .map(|w| {
+                let (sender, receiver) = std::sync::mpsc::sync_channel(DECODED_AHEAD);
+                let decode = &decode;
+                scope.spawn(move || {
+                    for scan in scans.iter().skip(w).step_by(workers) {
+                        // A closed channel means the writer stopped on an error.
+                        if sender.send(decode(scan)).is_err() {
+                            return;
+                        }
+                    }
+                });
+                receiver
+            })
+            .collect();
+        for index in 0..scans.len() {
+            let received = receivers[index % workers].recv().map_err(|_| IngestError::BadLayout {
+                path: scans[index].path.clone(),
+                detail: "decoder thread stopped unexpectedly".into(),
+            })?;
+            let (decoded, bytes) = received?;
+            write(index, decoded, bytes)?;
+        }
+        Ok(())
+    })
+}
+
+/// Decoded scans each worker may hold ready ahead of the writer.
+const DECODED_AHEAD: usize = 2;
 
 /// Writes scans (and optional relative-pose ground truth) as an Oxford-layout
 /// folder: the inverse of [`OxfordFolder::open`], for fixtures and benchmarks.
