@@ -6,6 +6,7 @@ use std::process::ExitCode;
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_ingest::ros2::{self, Ros2Topics};
 use mmtrack_io::recording::Compression;
 use mmtrack_io::recording::PoseStream;
@@ -64,6 +65,36 @@ impl OutputArgs {
     }
 }
 
+/// Trajectory file formats.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum PoseFormat {
+    /// `timestamp tx ty tz qx qy qz qw` per line.
+    Tum,
+    /// 12 numbers per line (3x4 matrix), times from --times.
+    Kitti,
+    /// Oxford Radar RobotCar gt/radar_odometry.csv (relative poses, chained).
+    Oxford,
+}
+
+impl PoseFormat {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Tum => "tum",
+            Self::Kitti => "kitti",
+            Self::Oxford => "oxford",
+        }
+    }
+}
+
+/// Ground planes.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum PlaneArg {
+    /// x-y with z up.
+    Xy,
+    /// x-z of a camera frame (x right, y down, z forward).
+    XzCamera,
+}
+
 #[derive(Args)]
 pub struct IngestArgs {
     #[command(subcommand)]
@@ -103,11 +134,30 @@ enum Kind {
         #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
         args: Vec<String>,
     },
-    /// Trajectory files: KITTI, TUM, Oxford, Boreas (not built yet: issue #3).
+    /// Trajectory file (TUM, KITTI, Oxford radar_odometry.csv) into a new recording or added to one.
     Poses {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
+        /// The trajectory file.
+        input: PathBuf,
+        /// File format.
+        #[arg(long, value_enum)]
+        format: PoseFormat,
+        #[command(flatten)]
+        output: OutputArgs,
+        /// Copy this recording and add the poses to it (may be the output itself).
+        #[arg(long, value_name = "RECORDING.mcap")]
+        add_to: Option<PathBuf>,
+        /// Record the poses as an estimate instead of ground truth.
+        #[arg(long)]
+        estimate: bool,
+        /// KITTI: the times file (decimal seconds per line).
+        #[arg(long, value_name = "times.txt")]
+        times: Option<PathBuf>,
+        /// KITTI: nanoseconds added to every time of --times.
+        #[arg(long, default_value_t = 0)]
+        t0_ns: i64,
+        /// Ground plane: x-y with z up, or the x-z plane of a KITTI camera frame.
+        #[arg(long, value_enum, default_value_t = PlaneArg::Xy)]
+        plane: PlaneArg,
     },
     /// NMEA 0183 GNSS log (not built yet: issue #3).
     Nmea {
@@ -160,7 +210,42 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         }
         Kind::Boreas { .. } => crate::not_built("ingest boreas", 3),
         Kind::Mulran { .. } => crate::not_built("ingest mulran", 3),
-        Kind::Poses { .. } => crate::not_built("ingest poses", 3),
+        Kind::Poses { input, format, mut output, add_to, estimate, times, t0_ns, plane } => {
+            let plane = match plane {
+                PlaneArg::Xy => Plane::Xy,
+                PlaneArg::XzCamera => Plane::XzCamera,
+            };
+            let text = poses::read_text(&input)?;
+            let trajectory = match format {
+                PoseFormat::Tum => poses::parse_tum(&input, &text, plane)?,
+                PoseFormat::Kitti => {
+                    let times_path = times.context("KITTI pose files carry no time: give --times <times.txt>")?;
+                    let times = poses::parse_times(&times_path, &poses::read_text(&times_path)?, t0_ns)?;
+                    poses::parse_kitti(&input, &text, &times, plane)?
+                }
+                PoseFormat::Oxford => oxford::odometry::read_radar_odometry(&input)?,
+            };
+            // Adding to the output file itself replaces it, once the new one is complete.
+            if let Some(existing) = &add_to
+                && existing.canonicalize().ok() == output.output.canonicalize().ok()
+            {
+                output.force = true;
+            }
+            let stream = if estimate { PoseStream::Estimate } else { PoseStream::GroundTruth };
+            let source = format!("{}:{}", format.name(), input.display());
+            let summary = poses::write_poses(
+                &trajectory,
+                stream,
+                &source,
+                add_to.as_deref(),
+                &output.output,
+                &output.recording_options(),
+            )?;
+            if !quiet {
+                println!("{}: {} poses on {}", summary.path.display(), trajectory.len(), stream.topic());
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Kind::Nmea { .. } => crate::not_built("ingest nmea", 3),
         Kind::Cir { .. } => crate::not_built("ingest cir", 3),
         Kind::Ros2 { input, output, pose_topic, poses_are_ground_truth, gnss_topic } => {

@@ -16,6 +16,7 @@ pub mod cir;
 mod error;
 pub mod nmea;
 pub mod oxford;
+pub mod poses;
 pub mod ros2;
 
 pub use error::IngestError;

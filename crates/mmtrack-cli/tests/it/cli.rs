@@ -154,3 +154,38 @@ fn schema_documents_are_current() {
     let out = mmtrack(&root(), &["schemas", "--check", "schemas"]);
     assert!(out.status.success(), "{}", text(&out).1);
 }
+
+#[test]
+fn poses_are_added_to_an_existing_recording_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
+    let tum = "# t x y z qx qy qz qw\n1700000000.0 0 0 0 0 0 0 1\n1700000000.5 1.0 0.1 0 0 0 0.0499792 0.9987503\n";
+    std::fs::write(dir.path().join("est.txt"), tum).unwrap();
+    let rec = "d/recording.mcap";
+    let out = mmtrack(
+        dir.path(),
+        &["ingest", "poses", "est.txt", "--format", "tum", "--estimate", "--add-to", rec, "-o", rec],
+    );
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("2 poses on /estimate/pose"), "{stdout}");
+
+    let inspect = mmtrack(dir.path(), &["inspect", "--json", rec]);
+    let summary: serde_json::Value = serde_json::from_slice(&inspect.stdout).unwrap();
+    let count = |topic: &str| {
+        summary["channels"].as_array().unwrap().iter().find(|c| c["topic"] == topic).map(|c| c["messages"].clone())
+    };
+    assert_eq!(count("/estimate/pose"), Some(serde_json::json!(2)));
+    assert_eq!(count("/radar/image"), Some(serde_json::json!(8)), "the scans were copied");
+    assert_eq!(count("/ground_truth/pose"), Some(serde_json::json!(8)));
+    assert_eq!(summary["metadata"]["mmtrack.recording"]["sequence_id"], "oxford-demo");
+
+    // A second ground truth is refused and the recording is left as it was.
+    let before = std::fs::read(dir.path().join(rec)).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "poses", "est.txt", "--format", "tum", "--add-to", rec, "-o", rec]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("already has /ground_truth/pose"), "{stderr}");
+    assert_eq!(std::fs::read(dir.path().join(rec)).unwrap(), before);
+    assert_eq!(files(&dir.path().join("d")).iter().filter(|p| p.to_string_lossy().contains("partial")).count(), 0);
+}

@@ -26,6 +26,12 @@ pub struct ChannelInfo {
     pub schema_name: String,
     /// Message encoding (e.g. `cdr`, `protobuf`).
     pub message_encoding: String,
+    /// Schema encoding (e.g. `ros2msg`, `protobuf`), empty without a schema.
+    pub schema_encoding: String,
+    /// Schema data (e.g. a protobuf `FileDescriptorSet`).
+    pub schema_data: Arc<[u8]>,
+    /// Channel metadata.
+    pub metadata: BTreeMap<String, String>,
 }
 
 /// A raw message: its channel, sequence, time and payload.
@@ -49,7 +55,7 @@ pub struct RawReader {
     file: File,
     bytes_read: u64,
     reader: LinearReader,
-    schemas: HashMap<u16, String>,
+    schemas: HashMap<u16, (String, String, Arc<[u8]>)>,
     channels: HashMap<u16, Arc<ChannelInfo>>,
     metadata: BTreeMap<String, BTreeMap<String, String>>,
 }
@@ -79,6 +85,12 @@ impl RawReader {
         &self.path
     }
 
+    /// Metadata records read so far, by name (writers put them first).
+    #[must_use]
+    pub fn metadata(&self) -> &BTreeMap<String, BTreeMap<String, String>> {
+        &self.metadata
+    }
+
     /// Bytes of the file read so far (for progress).
     #[must_use]
     pub fn bytes_read(&self) -> u64 {
@@ -98,17 +110,24 @@ impl RawReader {
                     let record = mcap::parse_record(opcode, data)
                         .map_err(|e| IoError::CorruptRecording { path: self.path.clone(), detail: e.to_string() })?;
                     match record {
-                        Record::Schema { header, .. } => {
-                            self.schemas.insert(header.id, header.name);
+                        Record::Schema { header, data } => {
+                            self.schemas.insert(header.id, (header.name, header.encoding, Arc::from(data.as_ref())));
                         }
                         Record::Channel(c) => {
-                            let schema_name = self.schemas.get(&c.schema_id).cloned().unwrap_or_default();
+                            let (schema_name, schema_encoding, schema_data) = self
+                                .schemas
+                                .get(&c.schema_id)
+                                .cloned()
+                                .unwrap_or_else(|| (String::new(), String::new(), Arc::from(&[][..])));
                             self.channels.insert(
                                 c.id,
                                 Arc::new(ChannelInfo {
                                     topic: c.topic,
                                     schema_name,
                                     message_encoding: c.message_encoding,
+                                    schema_encoding,
+                                    schema_data,
+                                    metadata: c.metadata,
                                 }),
                             );
                         }

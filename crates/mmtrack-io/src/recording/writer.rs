@@ -10,6 +10,7 @@ use prost::Message;
 
 use super::METADATA_NAME;
 use super::channels::{CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
+use super::reader::RawMessage;
 use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
@@ -99,6 +100,18 @@ pub struct RecordingMetadata {
 }
 
 impl RecordingMetadata {
+    /// Parses the map stored in a recording (the inverse of [`Self::to_map`]);
+    /// `None` when a required key is missing.
+    #[must_use]
+    pub fn from_map(map: &BTreeMap<String, String>) -> Option<Self> {
+        let mut extra = map.clone();
+        let sequence_id = extra.remove("sequence_id")?;
+        let source = extra.remove("source")?;
+        let time_base = TimeBase::parse(&extra.remove("time_base")?)?;
+        extra.remove("mmtrack_version");
+        Some(Self { sequence_id, source, time_base, extra })
+    }
+
     /// Flattens to the string map stored in the file.
     #[must_use]
     pub fn to_map(&self) -> BTreeMap<String, String> {
@@ -122,6 +135,13 @@ pub struct WriteSummary {
     pub file_bytes: u64,
 }
 
+/// Encodings and metadata of a channel being registered.
+struct ChannelEncoding<'a> {
+    schema: &'a str,
+    message: &'a str,
+    metadata: &'a BTreeMap<String, String>,
+}
+
 struct ChannelState {
     id: u16,
     next_sequence: u32,
@@ -135,7 +155,7 @@ pub struct RecordingWriter {
     durability: Durability,
     foxglove_views: bool,
     mcap: mcap::Writer<BufWriter<File>>,
-    channels: BTreeMap<&'static str, ChannelState>,
+    channels: BTreeMap<String, ChannelState>,
     counts: BTreeMap<String, u64>,
     buffer: Vec<u8>,
 }
@@ -185,21 +205,63 @@ impl RecordingWriter {
     }
 
     /// Registers `topic` on first use and returns its channel id.
-    fn channel(&mut self, topic: &'static str, schema_name: &str, schema_data: &[u8]) -> Result<u16> {
+    fn channel(&mut self, topic: &str, schema_name: &str, schema_data: &[u8]) -> Result<u16> {
+        let encoding = ChannelEncoding { schema: "protobuf", message: "protobuf", metadata: &BTreeMap::new() };
+        self.channel_with(topic, schema_name, schema_data, &encoding)
+    }
+
+    fn channel_with(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema_data: &[u8],
+        encoding: &ChannelEncoding<'_>,
+    ) -> Result<u16> {
         if let Some(state) = self.channels.get(topic) {
             return Ok(state.id);
         }
         let path = self.file.target().to_path_buf();
-        let schema_id = self.mcap.add_schema(schema_name, "protobuf", schema_data).map_err(|e| write_err(&path, e))?;
-        let id =
-            self.mcap.add_channel(schema_id, topic, "protobuf", &BTreeMap::new()).map_err(|e| write_err(&path, e))?;
-        self.channels.insert(topic, ChannelState { id, next_sequence: 0 });
+        let schema_id = if schema_name.is_empty() {
+            0
+        } else {
+            self.mcap.add_schema(schema_name, encoding.schema, schema_data).map_err(|e| write_err(&path, e))?
+        };
+        let id = self
+            .mcap
+            .add_channel(schema_id, topic, encoding.message, encoding.metadata)
+            .map_err(|e| write_err(&path, e))?;
+        self.channels.insert(topic.to_string(), ChannelState { id, next_sequence: 0 });
         Ok(id)
+    }
+
+    /// Copies a message read from another file (e.g. the recording being
+    /// extended), keeping its channel, schema, sequence number and log time.
+    pub fn copy_message(&mut self, message: &RawMessage) -> Result<()> {
+        let channel = &message.channel;
+        let encoding = ChannelEncoding {
+            schema: &channel.schema_encoding,
+            message: &channel.message_encoding,
+            metadata: &channel.metadata,
+        };
+        let id = self.channel_with(&channel.topic, &channel.schema_name, &channel.schema_data, &encoding)?;
+        let header = mcap::records::MessageHeader {
+            channel_id: id,
+            sequence: message.sequence,
+            log_time: message.log_time_ns,
+            publish_time: message.log_time_ns,
+        };
+        let path = self.file.target().to_path_buf();
+        self.mcap.write_to_known_channel(&header, &message.data).map_err(|e| write_err(&path, e))?;
+        if let Some(state) = self.channels.get_mut(&channel.topic) {
+            state.next_sequence = state.next_sequence.max(message.sequence.wrapping_add(1));
+        }
+        *self.counts.entry(channel.topic.clone()).or_insert(0) += 1;
+        Ok(())
     }
 
     /// Writes `self.buffer` as the next message on `topic`, with an explicit
     /// sequence number when given (radar image and meta share one).
-    fn emit(&mut self, topic: &'static str, channel_id: u16, t_ns: i64, sequence: Option<u32>) -> Result<u32> {
+    fn emit(&mut self, topic: &str, channel_id: u16, t_ns: i64, sequence: Option<u32>) -> Result<u32> {
         let log_time = u64::try_from(t_ns).map_err(|_| IoError::BadValue {
             path: self.path().to_path_buf(),
             record: format!("message on {topic}"),
