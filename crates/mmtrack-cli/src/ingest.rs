@@ -159,11 +159,15 @@ enum Kind {
         #[arg(long, value_enum, default_value_t = PlaneArg::Xy)]
         plane: PlaneArg,
     },
-    /// NMEA 0183 GNSS log (not built yet: issue #3).
+    /// NMEA 0183 GNSS log (GGA + RMC, any talker) into a new recording or added to one.
     Nmea {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
+        /// The log.
+        input: PathBuf,
+        #[command(flatten)]
+        output: OutputArgs,
+        /// Copy this recording and add the fixes to it (may be the output itself).
+        #[arg(long, value_name = "RECORDING.mcap")]
+        add_to: Option<PathBuf>,
     },
     /// Channel-sounder CIR/CFR files (not built yet: issue #3).
     Cir {
@@ -225,12 +229,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 }
                 PoseFormat::Oxford => oxford::odometry::read_radar_odometry(&input)?,
             };
-            // Adding to the output file itself replaces it, once the new one is complete.
-            if let Some(existing) = &add_to
-                && existing.canonicalize().ok() == output.output.canonicalize().ok()
-            {
-                output.force = true;
-            }
+            allow_in_place(add_to.as_deref(), &mut output);
             let stream = if estimate { PoseStream::Estimate } else { PoseStream::GroundTruth };
             let source = format!("{}:{}", format.name(), input.display());
             let summary = poses::write_poses(
@@ -246,7 +245,29 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Kind::Nmea { .. } => crate::not_built("ingest nmea", 3),
+        Kind::Nmea { input, mut output, add_to } => {
+            allow_in_place(add_to.as_deref(), &mut output);
+            let report = mmtrack_ingest::nmea::ingest_nmea(
+                &input,
+                &output.output,
+                add_to.as_deref(),
+                &output.recording_options(),
+            )?;
+            let log = &report.log;
+            if !quiet {
+                println!(
+                    "{}: {} GNSS fixes; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix; {} other sentences ignored",
+                    report.output.path.display(),
+                    log.fixes.len(),
+                    log.bad_checksum_lines,
+                    log.first_bad_checksum_line.map(|l| format!(" (first at line {l})")).unwrap_or_default(),
+                    log.unparsable_lines,
+                    log.epochs_without_fix,
+                    log.ignored_sentences
+                );
+            }
+            Ok(ExitCode::SUCCESS)
+        }
         Kind::Cir { .. } => crate::not_built("ingest cir", 3),
         Kind::Ros2 { input, output, pose_topic, poses_are_ground_truth, gnss_topic } => {
             let topics = Ros2Topics {
@@ -273,6 +294,15 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+    }
+}
+
+/// Adding to the output file itself replaces it, once the new one is complete.
+fn allow_in_place(add_to: Option<&std::path::Path>, output: &mut OutputArgs) {
+    if let Some(existing) = add_to
+        && existing.canonicalize().ok() == output.output.canonicalize().ok()
+    {
+        output.force = true;
     }
 }
 

@@ -10,14 +10,15 @@
 //! does not print: long operations report through a progress callback.
 //!
 //! Sources so far: Oxford Radar RobotCar folders ([`oxford`]) with their
-//! ground truth and GPS, and ROS 2 bags ([`ros2`]).
+//! ground truth and GPS, ROS 2 bags ([`ros2`]), trajectory files ([`poses`])
+//! and NMEA 0183 logs ([`nmea`]).
 
-pub mod cir;
 mod error;
 pub mod nmea;
 pub mod oxford;
 pub mod poses;
 pub mod ros2;
+pub mod target;
 
 pub use error::IngestError;
 

@@ -20,8 +20,10 @@
 use std::path::Path;
 
 use mmtrack_core::{Se2, StampedPose};
-use mmtrack_io::recording::{PoseStream, RawReader, RecordingMetadata, TimeBase, WriteSummary};
-use mmtrack_io::{RecordingOptions, RecordingWriter};
+use std::collections::BTreeMap;
+
+use mmtrack_io::RecordingOptions;
+use mmtrack_io::recording::{PoseStream, WriteSummary};
 
 use crate::IngestError;
 use crate::error::os_err;
@@ -164,8 +166,7 @@ pub fn read_text(path: &Path) -> Result<String, IngestError> {
 }
 
 /// Writes `poses` as `stream` into `out`: a new recording, or, with `extend`,
-/// a copy of that recording plus the poses (written beside it and renamed
-/// over `out`, so a failure leaves the original untouched).
+/// a copy of that recording plus the poses (see [`crate::target`]).
 pub fn write_poses(
     poses: &[StampedPose],
     stream: PoseStream,
@@ -174,59 +175,9 @@ pub fn write_poses(
     out: &Path,
     recording: &RecordingOptions,
 ) -> Result<WriteSummary, IngestError> {
-    let mut writer = match extend {
-        None => {
-            let metadata = RecordingMetadata {
-                sequence_id: out
-                    .file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_else(|| "poses".into()),
-                source: source.to_string(),
-                time_base: TimeBase::UnixEpoch,
-                extra: Default::default(),
-            };
-            RecordingWriter::create(out, &metadata, recording)?
-        }
-        Some(existing) => {
-            let mut reader = RawReader::open(existing)?;
-            let mut pending = Vec::new();
-            // The metadata record precedes the messages in our recordings.
-            while reader.metadata().is_empty() {
-                match reader.next_message()? {
-                    Some(message) => pending.push(message),
-                    None => break,
-                }
-            }
-            let mut metadata = reader
-                .metadata()
-                .get(mmtrack_io::recording::METADATA_NAME)
-                .and_then(RecordingMetadata::from_map)
-                .ok_or_else(|| IngestError::BadLayout {
-                    path: existing.to_path_buf(),
-                    detail: "not an mmtrack recording (no mmtrack.recording metadata)".into(),
-                })?;
-            metadata.extra.insert(format!("{}.source", stream.topic().trim_start_matches('/')), source.to_string());
-            let mut writer = RecordingWriter::create(out, &metadata, recording)?;
-            let mut pending = pending.into_iter();
-            loop {
-                let message = match pending.next() {
-                    Some(m) => m,
-                    None => match reader.next_message()? {
-                        Some(m) => m,
-                        None => break,
-                    },
-                };
-                if message.channel.topic == stream.topic() {
-                    return Err(IngestError::BadLayout {
-                        path: existing.to_path_buf(),
-                        detail: format!("already has {}; write the poses to a new recording instead", stream.topic()),
-                    });
-                }
-                writer.copy_message(&message)?;
-            }
-            writer
-        }
-    };
+    let extra = BTreeMap::from([(format!("{}.source", stream.topic().trim_start_matches('/')), source.to_string())]);
+    let mut writer =
+        crate::target::open_writer(out, extend, source, extra, &[stream.topic(), stream.viz_topic()], recording)?;
     for pose in poses {
         writer.write_pose(stream, pose, "world", "vehicle")?;
     }

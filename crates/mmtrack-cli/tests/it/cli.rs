@@ -18,7 +18,7 @@ fn unbuilt_subcommands_say_so_and_exit_3() {
         &["process", "odometry", "x.mcap"][..],
         &["analyze", "out"],
         &["reproduce", "mpc-artificial"],
-        &["ingest", "boreas", "seq"],
+        &["ingest", "mulran", "seq"],
     ] {
         let out = mmtrack(&root(), args);
         assert_eq!(out.status.code(), Some(3), "{args:?}");

@@ -8,5 +8,6 @@ mod cli;
 mod common;
 mod fixtures;
 mod independent_readers;
+mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;

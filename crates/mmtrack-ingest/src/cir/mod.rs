@@ -1,1 +1,0 @@
-//! Channel-sounder impulse responses (being written: see issue #3).
