@@ -82,9 +82,13 @@ impl Mul for Se2 {
     }
 }
 
-/// Wraps an angle to (-pi, pi].
+/// Wraps an angle to (-pi, pi]. Angles already in range are returned
+/// unchanged (bit for bit), so composing small rotations adds no rounding.
 #[must_use]
 pub fn wrap_angle_rad(angle_rad: f64) -> f64 {
+    if angle_rad > -PI && angle_rad <= PI {
+        return angle_rad;
+    }
     let wrapped = (angle_rad + PI).rem_euclid(2.0 * PI) - PI;
     if wrapped == -PI { PI } else { wrapped }
 }
@@ -154,5 +158,6 @@ mod tests {
         assert_eq!(wrap_angle_rad(PI), PI);
         assert_eq!(wrap_angle_rad(-PI), PI);
         assert!((wrap_angle_rad(3.0 * PI + 0.1) - (-PI + 0.1)).abs() < 1e-12);
+        assert_eq!(wrap_angle_rad(-0.1), -0.1);
     }
 }

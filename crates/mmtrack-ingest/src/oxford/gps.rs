@@ -11,12 +11,12 @@
 //! would use for an isotropic horizontal covariance. Fix quality is not in the
 //! file: fixes are marked `Unknown`.
 
-use std::collections::HashMap;
 use std::path::Path;
 
 use mmtrack_core::{GnssFix, GnssFixQuality};
 
 use crate::IngestError;
+use crate::csv::CsvTable;
 use crate::error::os_err;
 
 /// One row: the fix and the UTM position the file also gives.
@@ -45,83 +45,43 @@ const COLUMNS: [&str; 10] = [
 
 /// Parses `gps.csv` text. Rows must be in strictly increasing time.
 pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, IngestError> {
-    let mut lines = text.lines().enumerate();
-    let header = lines.next().map(|(_, l)| l).ok_or_else(|| IngestError::BadLayout {
-        path: path.to_path_buf(),
-        detail: "empty file: no header line".into(),
-    })?;
-    let index: HashMap<&str, usize> = header.split(',').map(str::trim).enumerate().map(|(i, c)| (c, i)).collect();
-    for name in COLUMNS {
-        if !index.contains_key(name) {
-            return Err(IngestError::BadRecord {
-                path: path.to_path_buf(),
-                record: "line 1 (header)".into(),
-                field: name.into(),
-                detail: format!("missing column; expected {}", COLUMNS.join(", ")),
-            });
-        }
-    }
+    let table = CsvTable::parse(path, text, &COLUMNS)?;
     let mut rows: Vec<OxfordGpsRow> = Vec::new();
-    for (line_index, line) in lines {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let bad = |field: &str, detail: String| IngestError::BadRecord {
-            path: path.to_path_buf(),
-            record: format!("line {}", line_index + 1),
-            field: field.into(),
-            detail,
-        };
-        let raw = |name: &str| {
-            fields.get(index[name]).copied().ok_or_else(|| bad(name, format!("row has {} fields", fields.len())))
-        };
-        let number = |name: &str| -> Result<f64, IngestError> {
-            let text = raw(name)?;
-            text.parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| bad(name, format!("'{text}' is not a finite number")))
-        };
-        let t_text = raw("timestamp")?;
-        let t_ns = t_text
-            .parse::<i64>()
-            .ok()
-            .and_then(|us| us.checked_mul(1000))
-            .filter(|t| *t > 0)
-            .ok_or_else(|| bad("timestamp", format!("'{t_text}' is not a microsecond UNIX timestamp")))?;
+    for row in table.rows() {
+        let t_ns = row.micros_ns("timestamp")?;
         if let Some(previous) = rows.last()
             && t_ns <= previous.fix.t_ns
         {
-            return Err(bad(
+            return Err(row.bad(
                 "timestamp",
                 format!("{} us does not increase (previous {} us)", t_ns / 1000, previous.fix.t_ns / 1000),
             ));
         }
-        let satellites = raw("num_satellites")?;
-        let latitude_deg = number("latitude")?;
-        let longitude_deg = number("longitude")?;
+        let satellites = row.text("num_satellites")?;
+        let latitude_deg = row.finite("latitude")?;
+        let longitude_deg = row.finite("longitude")?;
         if !(-90.0..=90.0).contains(&latitude_deg) || !(-180.0..=180.0).contains(&longitude_deg) {
-            return Err(bad(
-                "latitude/longitude",
-                format!("({latitude_deg}, {longitude_deg}) is not a geodetic position"),
-            ));
+            return Err(
+                row.bad("latitude/longitude", format!("({latitude_deg}, {longitude_deg}) is not a geodetic position"))
+            );
         }
-        let (sigma_lat_m, sigma_lon_m) = (number("latitude_sigma")?, number("longitude_sigma")?);
+        let (sigma_lat_m, sigma_lon_m) = (row.finite("latitude_sigma")?, row.finite("longitude_sigma")?);
         rows.push(OxfordGpsRow {
             fix: GnssFix {
                 t_ns,
                 latitude_deg,
                 longitude_deg,
-                altitude_m: number("altitude")?,
+                altitude_m: row.finite("altitude")?,
                 horizontal_sigma_m: Some(((sigma_lat_m * sigma_lat_m + sigma_lon_m * sigma_lon_m) / 2.0).sqrt()),
                 num_satellites: Some(
-                    satellites.parse().map_err(|_| bad("num_satellites", format!("'{satellites}' is not a count")))?,
+                    satellites
+                        .parse()
+                        .map_err(|_| row.bad("num_satellites", format!("'{satellites}' is not a count")))?,
                 ),
                 quality: GnssFixQuality::Unknown,
             },
-            northing_m: number("northing")?,
-            easting_m: number("easting")?,
+            northing_m: row.finite("northing")?,
+            easting_m: row.finite("easting")?,
         });
     }
     Ok(rows)

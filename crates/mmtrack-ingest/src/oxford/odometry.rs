@@ -20,12 +20,12 @@
 //! (`source_radar_timestamp`, which equal the scan file names) when present,
 //! else with `source_timestamp`.
 
-use std::collections::HashMap;
 use std::path::Path;
 
 use mmtrack_core::{Se2, StampedPose};
 
 use crate::IngestError;
+use crate::csv::CsvTable;
 use crate::error::os_err;
 
 /// One parsed row.
@@ -43,70 +43,24 @@ const REQUIRED: [&str; 5] = ["source_timestamp", "destination_timestamp", "x", "
 
 /// Parses the CSV text. Errors name the line and column.
 pub fn parse_radar_odometry(path: &Path, text: &str) -> Result<Vec<RelativePose>, IngestError> {
-    let mut lines = text.lines().enumerate();
-    let header = lines.next().map(|(_, l)| l).ok_or_else(|| IngestError::BadLayout {
-        path: path.to_path_buf(),
-        detail: "empty file: no header line".into(),
-    })?;
-    let columns: HashMap<&str, usize> = header.split(',').map(str::trim).enumerate().map(|(i, c)| (c, i)).collect();
-    for name in REQUIRED {
-        if !columns.contains_key(name) {
-            return Err(IngestError::BadRecord {
-                path: path.to_path_buf(),
-                record: "line 1 (header)".into(),
-                field: name.into(),
-                detail: format!("missing column; expected {}", REQUIRED.join(", ")),
-            });
-        }
-    }
-    let radar_time =
-        columns.contains_key("source_radar_timestamp") && columns.contains_key("destination_radar_timestamp");
-    let (source_col, destination_col) = if radar_time {
-        ("source_radar_timestamp", "destination_radar_timestamp")
-    } else {
-        ("source_timestamp", "destination_timestamp")
-    };
-    let mut rows = Vec::new();
-    for (index, line) in lines {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
-        let record = || format!("line {}", index + 1);
-        let get = |name: &str| -> Result<&str, IngestError> {
-            fields.get(columns[name]).copied().ok_or_else(|| IngestError::BadRecord {
-                path: path.to_path_buf(),
-                record: record(),
-                field: name.into(),
-                detail: format!("row has {} fields, header has {}", fields.len(), columns.len()),
-            })
+    let table = CsvTable::parse(path, text, &REQUIRED)?;
+    let (source_col, destination_col) =
+        if table.has("source_radar_timestamp") && table.has("destination_radar_timestamp") {
+            ("source_radar_timestamp", "destination_radar_timestamp")
+        } else {
+            ("source_timestamp", "destination_timestamp")
         };
-        let time = |name: &str| -> Result<i64, IngestError> {
-            let raw = get(name)?;
-            raw.parse::<i64>().ok().and_then(|us| us.checked_mul(1000)).ok_or_else(|| IngestError::BadRecord {
-                path: path.to_path_buf(),
-                record: record(),
-                field: name.into(),
-                detail: format!("'{raw}' is not a microsecond timestamp"),
+    table
+        .rows()
+        .map(|row| {
+            Ok(RelativePose {
+                source_t_ns: row.micros_ns(source_col)?,
+                destination_t_ns: row.micros_ns(destination_col)?,
+                // x forward / y right / z down -> x forward / y left / z up.
+                destination_from_source: Se2::new(row.finite("x")?, -row.finite("y")?, -row.finite("yaw")?),
             })
-        };
-        let number = |name: &str| -> Result<f64, IngestError> {
-            let raw = get(name)?;
-            raw.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| IngestError::BadRecord {
-                path: path.to_path_buf(),
-                record: record(),
-                field: name.into(),
-                detail: format!("'{raw}' is not a finite number"),
-            })
-        };
-        rows.push(RelativePose {
-            source_t_ns: time(source_col)?,
-            destination_t_ns: time(destination_col)?,
-            // x forward / y right / z down -> x forward / y left / z up.
-            destination_from_source: Se2::new(number("x")?, -number("y")?, -number("yaw")?),
-        });
-    }
-    Ok(rows)
+        })
+        .collect()
 }
 
 /// Chains relative poses into absolute `world_from_vehicle` poses, the first
@@ -152,4 +106,36 @@ pub fn chain(path: &Path, rows: &[RelativePose]) -> Result<Vec<StampedPose>, Ing
 pub fn read_radar_odometry(path: &Path) -> Result<Vec<StampedPose>, IngestError> {
     let text = std::fs::read_to_string(path).map_err(os_err(path))?;
     chain(path, &parse_radar_odometry(path, &text)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEADER: &str = "source_timestamp,destination_timestamp,x,y,z,roll,pitch,yaw,source_radar_timestamp,destination_radar_timestamp";
+
+    #[test]
+    fn rows_chain_in_the_z_up_frame() {
+        let text = format!("{HEADER}\n20,10,1.0,0.5,0,0,0,0.1,21,11\n30,20,2.0,0,0,0,0,0,31,21\n");
+        let path = Path::new("radar_odometry.csv");
+        let poses = chain(path, &parse_radar_odometry(path, &text).unwrap()).unwrap();
+        // Keyed on the radar timestamps; the first pose is the identity.
+        assert_eq!(poses.iter().map(|p| p.t_ns).collect::<Vec<_>>(), vec![11_000, 21_000, 31_000]);
+        let second = poses[1].parent_from_child;
+        assert_eq!((second.x_m, second.y_m, second.yaw_rad), (1.0, -0.5, -0.1));
+    }
+
+    #[test]
+    fn renamed_column_nan_and_broken_chain_are_named() {
+        let path = Path::new("radar_odometry.csv");
+        let err = parse_radar_odometry(path, &HEADER.replace(",yaw,", ",heading,")).unwrap_err().to_string();
+        assert!(err.contains("yaw") && err.contains("missing column"), "{err}");
+        let err =
+            parse_radar_odometry(path, &format!("{HEADER}\n20,10,NaN,0,0,0,0,0,21,11\n")).unwrap_err().to_string();
+        assert!(err.contains("line 2") && err.contains(": x:"), "{err}");
+        let rows = parse_radar_odometry(path, &format!("{HEADER}\n20,10,1,0,0,0,0,0,21,11\n40,30,1,0,0,0,0,0,41,31\n"))
+            .unwrap();
+        let err = chain(path, &rows).unwrap_err().to_string();
+        assert!(err.contains("line 3") && err.contains("does not continue the chain"), "{err}");
+    }
 }
