@@ -160,3 +160,109 @@ pub fn encode_scan_png(scan: &PolarScan, layout: &NavtechLayout) -> Result<Vec<u
     writer.finish().map_err(|e| e.to_string())?;
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn scan(azimuths: usize, bins: usize) -> PolarScan {
+        let azimuths: Vec<AzimuthSample> = (0..azimuths)
+            .map(|a| AzimuthSample {
+                t_ns: 1_547_131_046_353_776_000 + a as i64 * 625_000,
+                azimuth_rad: a as f64 * TAU / 400.0,
+                valid: a != 3,
+            })
+            .collect();
+        let power = (0..azimuths.len() * bins).map(|i| (i % 251) as u8).collect();
+        let header = PolarScanHeader {
+            t_ns: 1,
+            range_resolution_m: 0.0432,
+            range_offset_m: 0.0,
+            bins_per_azimuth: bins,
+            azimuths,
+        };
+        PolarScan::new(header, power).unwrap()
+    }
+
+    fn layout(bins: usize) -> NavtechLayout {
+        NavtechLayout { expected_bins: Some(bins), ..OXFORD }
+    }
+
+    fn gray_png(width: u32, height: u32, depth: png::BitDepth, pixels: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(depth);
+        encoder.write_header().unwrap().write_image_data(pixels).unwrap();
+        out
+    }
+
+    #[test]
+    fn encode_decode_round_trip_keeps_rows_and_headers() {
+        let original = scan(20, 30);
+        let png = encode_scan_png(&original, &layout(30)).unwrap();
+        let decoded = decode_scan_png(Path::new("s.png"), &png, 1, &layout(30)).unwrap().into_scan();
+        assert_eq!(decoded.power, original.power);
+        for (a, b) in decoded.header.azimuths.iter().zip(&original.header.azimuths) {
+            // The format keeps microseconds and encoder counts (2 pi / 5600 rad).
+            assert_eq!(a.t_ns, b.t_ns / 1000 * 1000);
+            assert!((a.azimuth_rad - b.azimuth_rad).abs() <= TAU / 5600.0 / 2.0 + 1e-12);
+            assert_eq!(a.valid, b.valid);
+        }
+    }
+
+    #[test]
+    fn wrong_width_depth_and_time_are_named() {
+        let png = encode_scan_png(&scan(4, 30), &layout(30)).unwrap();
+        let err = decode_scan_png(Path::new("s.png"), &png, 1, &layout(3768)).unwrap_err().to_string();
+        assert!(err.contains("s.png") && err.contains("width") && err.contains("3768"), "{err}");
+
+        let sixteen = gray_png(41, 4, png::BitDepth::Sixteen, &vec![0; 41 * 4 * 2]);
+        let err = decode_scan_png(Path::new("s.png"), &sixteen, 1, &layout(30)).unwrap_err().to_string();
+        assert!(err.contains("16-bit") && err.contains("8-bit greyscale"), "{err}");
+
+        let mut backwards = scan(4, 30);
+        backwards.header.azimuths[2].t_ns = backwards.header.azimuths[1].t_ns - 1000;
+        let png = encode_scan_png(&backwards, &layout(30)).unwrap();
+        let err = decode_scan_png(Path::new("s.png"), &png, 1, &layout(30)).unwrap_err().to_string();
+        assert!(
+            err.contains("azimuth row 2") && err.contains("timestamp") && err.contains("does not increase"),
+            "{err}"
+        );
+
+        let mut pixels = vec![0u8; 41 * 2];
+        pixels[..8].copy_from_slice(&1_000_000i64.to_le_bytes());
+        pixels[8..10].copy_from_slice(&6000u16.to_le_bytes());
+        let err = decode_scan_png(Path::new("s.png"), &gray_png(41, 2, png::BitDepth::Eight, &pixels), 1, &layout(30))
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("azimuth row 0") && err.contains("encoder") && err.contains("5600"), "{err}");
+    }
+
+    #[test]
+    fn empty_folder_is_a_clear_error() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("radar")).unwrap();
+        let err = super::super::OxfordFolder::open(dir.path()).unwrap_err().to_string();
+        assert!(err.contains("no scans found"), "{err}");
+        let err = super::super::OxfordFolder::open(&dir.path().join("radar")).unwrap_err().to_string();
+        assert!(err.contains("no radar/ folder"), "{err}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 128, ..ProptestConfig::default() })]
+        /// Arbitrary row headers and arbitrary bytes never panic the decoder.
+        #[test]
+        fn row_header_parser_never_panics(rows in proptest::collection::vec(proptest::collection::vec(any::<u8>(), 14), 1..6),
+                                          junk in proptest::collection::vec(any::<u8>(), 0..300)) {
+            let pixels: Vec<u8> = rows.concat();
+            let png = gray_png(14, rows.len() as u32, png::BitDepth::Eight, &pixels);
+            let _ = decode_scan_png(Path::new("p.png"), &png, 1, &layout(3));
+            let _ = decode_scan_png(Path::new("p.png"), &junk, 1, &layout(3));
+            let mut cut = png.clone();
+            cut.truncate(junk.len().min(png.len()));
+            let _ = decode_scan_png(Path::new("p.png"), &cut, 1, &layout(3));
+        }
+    }
+}
