@@ -13,6 +13,7 @@
 //! ground truth and GPS, ROS 2 bags ([`ros2`]), trajectory files ([`poses`])
 //! and NMEA 0183 logs ([`nmea`]).
 
+pub mod cir;
 mod csv;
 mod error;
 pub mod nmea;

@@ -1,0 +1,422 @@
+//! NMEA 0183 GNSS logs: GGA and RMC (and GST when present) from any talker
+//! (GP, GN, GL, GA, GB, GQ, ...), one fix per epoch.
+//!
+//! Each line is `$<talker:2><type:3>,<fields>*<checksum:2 hex>`, the checksum
+//! being the XOR of the bytes between `$` and `*`. Every line is accounted for
+//! in [`NmeaLog`]:
+//! - a wrong checksum: skipped and counted ([`NmeaLog::bad_checksum_lines`]),
+//!   never fatal;
+//! - not a sentence at all (blank, binary junk, truncated, a missing `*` or a
+//!   checksum that is not two hex digits), *and* GGA/RMC/GST sentences with a
+//!   valid checksum whose fields do not parse (non-numeric or out-of-range
+//!   latitude, NaN altitude, a bad date, ...): skipped and counted as
+//!   [`NmeaLog::unparsable_lines`], the first one described in
+//!   [`NmeaLog::first_unparsable`]. Skipping rather than failing is deliberate:
+//!   an 8-bit checksum lets about one corrupted line in 256 through, and one
+//!   such line must not make a whole drive unreadable;
+//! - other sentence types (GSA, GSV, VTG, GLL, TXT, ...) and proprietary ones
+//!   (`$PUBX`, ...): counted as [`NmeaLog::ignored_sentences`].
+//!
+//! Epochs: consecutive GGA, RMC and GST sentences with the same time of day
+//! form one epoch, whatever their order (u-blox writes RMC before GGA, other
+//! receivers GGA before RMC). The GGA gives time of day, position, quality,
+//! satellites and altitude; the RMC of the same epoch gives the date, and its
+//! status `V` means no fix; the GST gives `horizontal_sigma_m`. An epoch
+//! without its own RMC is dated from the latest known time (the latest RMC or
+//! fix), taking the day that puts it nearest, so a midnight rollover between
+//! RMCs is handled; GGAs before the first RMC are dated by that RMC the same
+//! way. A log with GGA fixes but no dated RMC at all is an error: there is no
+//! way to give UNIX times. Time is computed from the digits with integers, so
+//! fractional seconds are exact to the nanosecond.
+//!
+//! Epochs whose GGA quality is 0 or whose RMC status is `V` are not fixes:
+//! they are counted ([`NmeaLog::epochs_without_fix`]), not emitted (u-blox
+//! receivers print `$GPGGA,,,,,,0,...` with no time before their first fix;
+//! that is such an epoch, not an error). Fix quality maps from GGA: 1
+//! autonomous, 2 differential, 4 RTK fixed, 5 RTK float, 6 dead reckoning,
+//! anything else unknown. An epoch seen twice (the same GGA time again, e.g.
+//! `GPGGA` and `GNGGA` of one epoch) is merged into the first and counted in
+//! [`NmeaLog::duplicate_epochs`]; a fix earlier than the previous one is an
+//! error naming the line, as the recording requires increasing time.
+//!
+//! `altitude_m` is the height above the WGS-84 ellipsoid (GGA altitude above
+//! mean sea level plus the geoid separation) when every fix gives the geoid
+//! separation, else the altitude above mean sea level for all fixes;
+//! [`NmeaLog::altitude_datum`] says which. HDOP is not a standard deviation
+//! and there is no standard factor from it to metres, so `horizontal_sigma_m`
+//! is `None` unless a GST sentence of the same epoch gives the latitude and
+//! longitude sigmas; it is then their RMS, `sqrt((s_lat^2 + s_lon^2) / 2)`,
+//! as for the other GNSS sources.
+//!
+//! Written by hand: the `nmea` crate is not a dependency of this crate, and we
+//! need what a sentence-at-a-time parser does not give: bad checksums told
+//! apart from junk with line numbers, empty-field cold-start sentences
+//! accepted, time from the digits. GGA, RMC and GST are three short, fixed
+//! layouts (the field parsers are in the private `sentence` submodule).
+
+mod enu;
+mod sentence;
+#[cfg(test)]
+mod tests;
+
+use std::path::Path;
+
+use mmtrack_core::{GnssFix, GnssFixQuality};
+
+use self::sentence::{GgaPosition, Line, NS_PER_DAY};
+use crate::IngestError;
+use crate::error::os_err;
+
+pub use self::enu::{EnuOrigin, geodetic_to_enu_m};
+
+/// A skipped line and why it was skipped.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SkippedLine {
+    /// Line number, 1-based.
+    pub line: usize,
+    /// What is wrong and what was expected, e.g. `GNGGA: latitude: '37x5.58,N' is not ddmm.mm,N|S ...`.
+    pub reason: String,
+}
+
+/// What a log gave.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct NmeaLog {
+    /// Fixes in strictly increasing time order.
+    pub fixes: Vec<GnssFix>,
+    /// Lines skipped for a wrong checksum.
+    pub bad_checksum_lines: u64,
+    /// First line (1-based) with a wrong checksum.
+    pub first_bad_checksum_line: Option<usize>,
+    /// Lines skipped because they are not NMEA sentences, or are GGA/RMC/GST
+    /// sentences whose fields do not parse.
+    pub unparsable_lines: u64,
+    /// The first unparsable line and why.
+    pub first_unparsable: Option<SkippedLine>,
+    /// Valid sentences of other types (GSA, GSV, VTG, GLL, TXT, proprietary, ...).
+    pub ignored_sentences: u64,
+    /// Epochs without a fix (GGA quality 0 or RMC status V), not emitted.
+    pub epochs_without_fix: u64,
+    /// Repeated epochs (a GGA time already seen) merged into the first.
+    pub duplicate_epochs: u64,
+    /// `ellipsoid` or `mean sea level` (empty when there are no fixes).
+    pub altitude_datum: &'static str,
+}
+
+/// GGA, RMC and GST sentences sharing one time of day.
+struct Epoch {
+    time_of_day_ns: i64,
+    /// The first GGA with a fix (or without: quality 0) and its line.
+    gga: Option<(Option<GgaPosition>, GnssFixQuality, usize)>,
+    /// RMC status valid, and its date (days since the epoch).
+    rmc: Option<(bool, Option<i64>)>,
+    horizontal_sigma_m: Option<f64>,
+}
+
+impl Epoch {
+    fn new(time_of_day_ns: i64) -> Self {
+        Self { time_of_day_ns, gga: None, rmc: None, horizontal_sigma_m: None }
+    }
+
+    /// Adds a sentence of this epoch; the first of each type wins. Returns
+    /// whether it was a second GGA (a duplicate epoch).
+    fn join(&mut self, part: Part, line: usize) -> bool {
+        match part {
+            Part::Gga(gga) if self.gga.is_none() => self.gga = Some((gga.position, gga.quality, line)),
+            Part::Gga(_) => return true,
+            Part::Rmc(rmc) => {
+                self.rmc.get_or_insert((rmc.valid, rmc.days));
+            }
+            Part::Gst(gst) => self.horizontal_sigma_m = self.horizontal_sigma_m.or(gst.horizontal_sigma_m),
+        }
+        false
+    }
+}
+
+/// A parsed sentence of a type we use.
+enum Part {
+    Gga(sentence::Gga),
+    Rmc(sentence::Rmc),
+    Gst(sentence::Gst),
+}
+
+impl Part {
+    fn time_of_day_ns(&self) -> Option<i64> {
+        match self {
+            Self::Gga(gga) => gga.time_of_day_ns,
+            Self::Rmc(rmc) => rmc.time_of_day_ns,
+            Self::Gst(gst) => gst.time_of_day_ns,
+        }
+    }
+}
+
+/// A fix whose date is not known yet (GGAs before the first RMC).
+struct Undated {
+    time_of_day_ns: i64,
+    position: GgaPosition,
+    quality: GnssFixQuality,
+    horizontal_sigma_m: Option<f64>,
+    line: usize,
+}
+
+/// The time `time_of_day_ns` on the day that puts it nearest `reference_ns`.
+fn nearest_ns(reference_ns: i64, time_of_day_ns: i64) -> i64 {
+    let midnight = reference_ns.div_euclid(NS_PER_DAY) * NS_PER_DAY;
+    [midnight - NS_PER_DAY, midnight, midnight + NS_PER_DAY]
+        .map(|day| day + time_of_day_ns)
+        .into_iter()
+        .min_by_key(|t| t.abs_diff(reference_ns))
+        .unwrap_or(midnight + time_of_day_ns)
+}
+
+/// `hhmmss.sssssssss` of a time in nanoseconds, for messages.
+fn clock(t_ns: i64) -> String {
+    let ns = t_ns.rem_euclid(NS_PER_DAY);
+    let s = ns / 1_000_000_000;
+    format!("{:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, ns % 1_000_000_000)
+}
+
+struct Assembler<'a> {
+    path: &'a Path,
+    log: NmeaLog,
+    /// Line of each fix, for messages.
+    fix_lines: Vec<usize>,
+    /// Geoid separation of each fix.
+    separations_m: Vec<Option<f64>>,
+    /// Latest known UNIX time (an RMC's date and time, or a fix), for dating.
+    reference_ns: Option<i64>,
+    undated: Vec<Undated>,
+}
+
+impl Assembler<'_> {
+    fn close(&mut self, epoch: Epoch) -> Result<(), IngestError> {
+        let rmc_date = epoch.rmc.and_then(|(_, days)| days);
+        if let Some(days) = rmc_date {
+            let reference_ns = days * NS_PER_DAY + epoch.time_of_day_ns;
+            self.reference_ns = Some(reference_ns);
+            for undated in std::mem::take(&mut self.undated) {
+                let t_ns = nearest_ns(reference_ns, undated.time_of_day_ns);
+                self.emit(t_ns, undated.position, undated.quality, undated.horizontal_sigma_m, undated.line)?;
+            }
+        }
+        let Some((position, quality, line)) = epoch.gga else { return Ok(()) };
+        let rmc_says_no_fix = epoch.rmc.is_some_and(|(valid, _)| !valid);
+        let Some(position) = position.filter(|_| !rmc_says_no_fix) else {
+            self.log.epochs_without_fix += 1;
+            return Ok(());
+        };
+        let t_ns = match (rmc_date, self.reference_ns) {
+            (Some(days), _) => days * NS_PER_DAY + epoch.time_of_day_ns,
+            (None, Some(reference_ns)) => nearest_ns(reference_ns, epoch.time_of_day_ns),
+            (None, None) => {
+                let time_of_day_ns = epoch.time_of_day_ns;
+                let horizontal_sigma_m = epoch.horizontal_sigma_m;
+                self.undated.push(Undated { time_of_day_ns, position, quality, horizontal_sigma_m, line });
+                return Ok(());
+            }
+        };
+        self.emit(t_ns, position, quality, epoch.horizontal_sigma_m, line)?;
+        self.reference_ns = Some(t_ns);
+        Ok(())
+    }
+
+    fn emit(
+        &mut self,
+        t_ns: i64,
+        position: GgaPosition,
+        quality: GnssFixQuality,
+        horizontal_sigma_m: Option<f64>,
+        line: usize,
+    ) -> Result<(), IngestError> {
+        if let (Some(last), Some(last_line)) = (self.log.fixes.last(), self.fix_lines.last()) {
+            if t_ns == last.t_ns {
+                self.log.duplicate_epochs += 1;
+                return Ok(());
+            }
+            if t_ns < last.t_ns {
+                let back_ns = last.t_ns - t_ns;
+                return Err(IngestError::BadRecord {
+                    path: self.path.to_path_buf(),
+                    record: format!("line {line}"),
+                    field: "time".into(),
+                    detail: format!(
+                        "fix at {} UTC is {}.{:09} s before the previous fix ({} UTC, line {last_line}); \
+                         fix times must increase",
+                        clock(t_ns),
+                        back_ns / 1_000_000_000,
+                        back_ns % 1_000_000_000,
+                        clock(last.t_ns),
+                    ),
+                });
+            }
+        }
+        self.fix_lines.push(line);
+        self.separations_m.push(position.geoid_separation_m);
+        self.log.fixes.push(GnssFix {
+            t_ns,
+            latitude_deg: position.latitude_deg,
+            longitude_deg: position.longitude_deg,
+            altitude_m: position.altitude_msl_m,
+            horizontal_sigma_m,
+            num_satellites: position.num_satellites,
+            quality,
+        });
+        Ok(())
+    }
+
+    fn unparsable(&mut self, line: usize, reason: impl FnOnce() -> String) {
+        self.log.unparsable_lines += 1;
+        if self.log.first_unparsable.is_none() {
+            self.log.first_unparsable = Some(SkippedLine { line, reason: reason() });
+        }
+    }
+}
+
+/// Parses a whole log. Fails only when time goes backwards or when there are
+/// fixes but no date; everything else is skipped and counted (see the module
+/// documentation).
+pub fn parse_nmea(path: &Path, text: &str) -> Result<NmeaLog, IngestError> {
+    let mut assembler = Assembler {
+        path,
+        log: NmeaLog::default(),
+        fix_lines: Vec::new(),
+        separations_m: Vec::new(),
+        reference_ns: None,
+        undated: Vec::new(),
+    };
+    let mut current: Option<Epoch> = None;
+    for (index, raw) in text.lines().enumerate() {
+        let line_number = index + 1;
+        let (id, kind, fields) = match sentence::split_sentence(raw.trim()) {
+            Line::Sentence { id, kind, fields } => (id, kind, fields),
+            Line::Proprietary => {
+                assembler.log.ignored_sentences += 1;
+                continue;
+            }
+            Line::BadChecksum => {
+                assembler.log.bad_checksum_lines += 1;
+                assembler.log.first_bad_checksum_line.get_or_insert(line_number);
+                continue;
+            }
+            Line::Junk(reason) => {
+                assembler.unparsable(line_number, || format!("not an NMEA sentence: {reason}"));
+                continue;
+            }
+        };
+        let parsed = match kind {
+            "GGA" => sentence::parse_gga(&fields).map(Part::Gga),
+            "RMC" => sentence::parse_rmc(&fields).map(Part::Rmc),
+            "GST" => sentence::parse_gst(&fields).map(Part::Gst),
+            _ => {
+                assembler.log.ignored_sentences += 1;
+                continue;
+            }
+        };
+        let part = match parsed {
+            Ok(part) => part,
+            Err(e) => {
+                assembler.unparsable(line_number, || format!("{id}: {}: {}", e.field, e.detail));
+                continue;
+            }
+        };
+        let Some(time_of_day_ns) = part.time_of_day_ns() else {
+            // No time: a GGA without fix counts as such; an RMC `V` has
+            // nothing to add, nor a GST without time.
+            match part {
+                Part::Gga(_) => assembler.log.epochs_without_fix += 1,
+                Part::Gst(_) => assembler.log.ignored_sentences += 1,
+                Part::Rmc(_) => {}
+            }
+            continue;
+        };
+        if let Some(epoch) = current.take_if(|epoch| epoch.time_of_day_ns != time_of_day_ns) {
+            assembler.close(epoch)?;
+        }
+        let epoch = current.get_or_insert_with(|| Epoch::new(time_of_day_ns));
+        if epoch.join(part, line_number) {
+            assembler.log.duplicate_epochs += 1;
+        }
+    }
+    if let Some(epoch) = current {
+        assembler.close(epoch)?;
+    }
+    if let Some(first) = assembler.undated.first() {
+        return Err(IngestError::BadLayout {
+            path: path.to_path_buf(),
+            detail: format!(
+                "{} GGA fixes (the first at line {}) but no RMC sentence with a date: \
+                 fixes cannot be given UNIX times",
+                assembler.undated.len(),
+                first.line
+            ),
+        });
+    }
+    let mut log = assembler.log;
+    if !log.fixes.is_empty() {
+        if assembler.separations_m.iter().all(Option::is_some) {
+            for (fix, separation_m) in log.fixes.iter_mut().zip(&assembler.separations_m) {
+                fix.altitude_m += separation_m.unwrap_or(0.0);
+            }
+            log.altitude_datum = "ellipsoid";
+        } else {
+            log.altitude_datum = "mean sea level";
+        }
+    }
+    Ok(log)
+}
+
+/// Reads and parses a log file. Bytes that are not UTF-8 make their lines
+/// unparsable, not the file.
+pub fn read_nmea(path: &Path) -> Result<NmeaLog, IngestError> {
+    let bytes = std::fs::read(path).map_err(os_err(path))?;
+    parse_nmea(path, &String::from_utf8_lossy(&bytes))
+}
+
+/// What an NMEA ingest did.
+#[derive(Debug, Clone)]
+pub struct NmeaReport {
+    /// The parsed log (fixes and skip counts).
+    pub log: NmeaLog,
+    /// The recording.
+    pub output: mmtrack_io::recording::WriteSummary,
+}
+
+/// Writes the fixes of an NMEA log into `out` (new, or a copy of `extend` plus
+/// the fixes). The metadata records the altitude datum and the origin of the
+/// local ENU frame (the first fix) that analyses use, e.g. for distance
+/// travelled.
+pub fn ingest_nmea(
+    input: &Path,
+    out: &Path,
+    extend: Option<&Path>,
+    recording: &mmtrack_io::RecordingOptions,
+) -> Result<NmeaReport, IngestError> {
+    use mmtrack_io::recording::channels::{GNSS_TOPIC, GNSS_VIZ_TOPIC};
+    let log = read_nmea(input)?;
+    let first = log.fixes.first().ok_or_else(|| IngestError::BadLayout {
+        path: input.to_path_buf(),
+        detail: format!(
+            "no fixes (bad checksums {}, unparsable lines {}{}, epochs without fix {})",
+            log.bad_checksum_lines,
+            log.unparsable_lines,
+            log.first_unparsable
+                .as_ref()
+                .map(|s| format!(" (first at line {}: {})", s.line, s.reason))
+                .unwrap_or_default(),
+            log.epochs_without_fix
+        ),
+    })?;
+    let extra = std::collections::BTreeMap::from([
+        ("gnss.source".to_string(), format!("nmea:{}", input.display())),
+        ("gnss.altitude_datum".to_string(), log.altitude_datum.to_string()),
+        ("gnss.enu_origin_latitude_deg".to_string(), first.latitude_deg.to_string()),
+        ("gnss.enu_origin_longitude_deg".to_string(), first.longitude_deg.to_string()),
+        ("gnss.enu_origin_altitude_m".to_string(), first.altitude_m.to_string()),
+    ]);
+    let source = format!("nmea:{}", input.display());
+    let mut writer = crate::target::open_writer(out, extend, &source, extra, &[GNSS_TOPIC, GNSS_VIZ_TOPIC], recording)?;
+    for fix in &log.fixes {
+        writer.write_gnss_fix(fix)?;
+    }
+    let output = writer.finish()?;
+    Ok(NmeaReport { log, output })
+}

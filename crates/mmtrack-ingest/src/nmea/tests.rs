@@ -1,0 +1,285 @@
+use proptest::prelude::*;
+
+use super::sentence::days_from_civil;
+use super::*;
+
+fn sentence(payload: &str) -> String {
+    format!("${payload}*{:02X}", payload.bytes().fold(0u8, |a, b| a ^ b))
+}
+
+fn rmc(talker: &str, hhmmss: &str, status: &str, ddmmyy: &str) -> String {
+    sentence(&format!("{talker}RMC,{hhmmss},{status},3725.58362,N,12205.61915,W,0.028,65.13,{ddmmyy},13.06,E,F,V"))
+}
+
+fn gga(talker: &str, hhmmss: &str, quality: &str) -> String {
+    sentence(&format!("{talker}GGA,{hhmmss},3725.58362,N,12205.61915,W,{quality},12,0.76,4.4,M,-30.0,M,0.0,2000"))
+}
+
+/// An epoch as a u-blox receiver writes it: RMC, then GGA, then GSA.
+fn epoch(talker: &str, hhmmss: &str) -> String {
+    format!(
+        "{}\n{}\n{}\n",
+        rmc(talker, hhmmss, "A", "070220"),
+        gga(talker, hhmmss, "5"),
+        sentence("GNGSA,A,3,17,02,06,28,12,13,15,24,19,,,,1.48,0.76,1.27,1")
+    )
+}
+
+fn parse(text: &str) -> Result<NmeaLog, IngestError> {
+    parse_nmea(Path::new("drive.nmea"), text)
+}
+
+/// 2020-02-07 02:14:17 UTC in UNIX seconds (`date -u -d @1581041657`).
+const T0_S: i64 = 1_581_041_657;
+
+#[test]
+fn epoch_gives_exact_time_position_and_ellipsoid_height() {
+    let log = parse(&epoch("GN", "021417.25")).unwrap();
+    assert_eq!(log.fixes.len(), 1);
+    let fix = &log.fixes[0];
+    assert_eq!(fix.t_ns, T0_S * 1_000_000_000 + 250_000_000);
+    assert!((fix.latitude_deg - (37.0 + 25.58362 / 60.0)).abs() < 1e-12);
+    assert!((fix.longitude_deg + (122.0 + 5.61915 / 60.0)).abs() < 1e-12);
+    assert!((fix.altitude_m - (4.4 - 30.0)).abs() < 1e-12);
+    assert_eq!((fix.quality, fix.num_satellites, fix.horizontal_sigma_m), (GnssFixQuality::RtkFloat, Some(12), None));
+    assert_eq!((log.altitude_datum, log.ignored_sentences), ("ellipsoid", 1));
+    // Nanosecond digits are kept exactly (an f64 of seconds would not).
+    let log = parse(&epoch("GN", "021417.123456789")).unwrap();
+    assert_eq!(log.fixes[0].t_ns, T0_S * 1_000_000_000 + 123_456_789);
+}
+
+#[test]
+fn every_talker_is_accepted_and_quality_maps() {
+    let talkers = ["GP", "GN", "GL", "GA", "GB", "GQ", "BD"];
+    let text: String = talkers.iter().enumerate().map(|(i, t)| epoch(t, &format!("02141{i}.00"))).collect();
+    let log = parse(&text).unwrap();
+    assert_eq!(log.fixes.len(), talkers.len());
+    for (quality, expected) in [
+        ("1", GnssFixQuality::Autonomous),
+        ("2", GnssFixQuality::Differential),
+        ("3", GnssFixQuality::Unknown),
+        ("4", GnssFixQuality::RtkFixed),
+        ("5", GnssFixQuality::RtkFloat),
+        ("6", GnssFixQuality::DeadReckoning),
+        ("8", GnssFixQuality::Unknown),
+    ] {
+        let text = format!("{}\n{}\n", rmc("GN", "021417.00", "A", "070220"), gga("GN", "021417.00", quality));
+        assert_eq!(parse(&text).unwrap().fixes[0].quality, expected, "quality {quality}");
+    }
+}
+
+#[test]
+fn bad_checksums_junk_and_a_truncated_last_line_are_skipped_and_counted() {
+    let mut text = epoch("GN", "021417.00");
+    // Line 4: one digit of the GGA changed, checksum kept.
+    text.push_str(&gga("GN", "021418.00", "5").replace("3725.58362", "3725.58363"));
+    text.push('\n');
+    // The u-blox corruption seen in the real log: the talker's G doubled.
+    text.push_str("$GGPGSV,3,3,10,28,32,082,46,30,07,147,27,1*65\n");
+    text.push_str(&epoch("GN", "021419.00"));
+    text.push_str("\n\u{0}\u{1}\u{fffd}binary\n$PUBX,00*33\n");
+    // A last line cut off in the middle, then one cut inside its checksum.
+    let cut = gga("GN", "021420.00", "5");
+    text.push_str(&format!("{}\n{}", &cut[..40], &cut[..cut.len() - 1]));
+    let log = parse(&text).unwrap();
+    assert_eq!(log.fixes.len(), 2);
+    assert_eq!((log.bad_checksum_lines, log.first_bad_checksum_line), (2, Some(4)));
+    // Blank line, binary line, the two truncated lines.
+    assert_eq!(log.unparsable_lines, 4);
+    assert_eq!(
+        log.first_unparsable.as_ref().map(|s| (s.line, s.reason.as_str())),
+        Some((9, "not an NMEA sentence: blank line"))
+    );
+    // Two GSA and the proprietary PUBX.
+    assert_eq!(log.ignored_sentences, 3);
+}
+
+#[test]
+fn bad_fields_in_a_valid_sentence_skip_the_line_and_name_it() {
+    let mut text = rmc("GN", "021417.00", "A", "070220") + "\n";
+    text += &sentence("GNGGA,021417.00,37x5.58,N,12205.61915,W,1,12,0.76,4.4,M,-30.0,M,,");
+    text += "\n";
+    for (hhmmss, field, replacement) in [
+        ("021418.00", "3725.58362,N", "9125.58362,N"),
+        ("021419.00", "12205.61915,W", "NaN,W"),
+        ("021420.00", ",4.4,M", ",inf,M"),
+        ("021421.00", "070220", "300220"),
+    ] {
+        let line = if field == "070220" { rmc("GN", hhmmss, "A", "070220") } else { gga("GN", hhmmss, "1") };
+        let payload = line[1..line.len() - 3].replace(field, replacement);
+        text += &(sentence(&payload) + "\n");
+    }
+    text += &epoch("GN", "021422.00");
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.unparsable_lines), (1, 5));
+    let first = log.first_unparsable.unwrap();
+    assert_eq!(first.line, 2);
+    assert!(first.reason.contains("GNGGA: latitude:") && first.reason.contains("'37x5.58,N'"), "{}", first.reason);
+}
+
+#[test]
+fn gga_without_rmc_is_an_error() {
+    let text = [gga("GN", "021417.00", "1"), gga("GN", "021418.00", "1")].join("\n");
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("drive.nmea") && err.contains("no RMC") && err.contains("line 1"), "{err}");
+    // Without any fix there is nothing to date: not an error.
+    let log = parse(&gga("GN", "021417.00", "0")).unwrap();
+    assert_eq!((log.fixes.len(), log.epochs_without_fix), (0, 1));
+}
+
+#[test]
+fn time_going_backwards_names_the_line_and_duplicates_merge() {
+    let text = epoch("GN", "021417.00") + &epoch("GN", "021416.00");
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(
+        err.contains("drive.nmea: line 5: time:") && err.contains("1.000000000 s before") && err.contains("line 2"),
+        "{err}"
+    );
+    // The same epoch twice (and a GPGGA beside the GNGGA) is merged, not an error.
+    let text = epoch("GN", "021417.00") + &gga("GP", "021417.00", "5") + "\n" + &epoch("GN", "021417.00");
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.duplicate_epochs), (1, 2));
+}
+
+#[test]
+fn gga_before_rmc_and_midnight_rollover_are_dated_right() {
+    // GGA first (as many receivers write it): the first epoch is kept and the
+    // RMC status V of an epoch applies to its GGA.
+    let lines = [
+        gga("GP", "235958.00", "1"),
+        rmc("GP", "235958.00", "A", "310120"),
+        gga("GP", "235959.00", "1"),
+        rmc("GP", "235959.00", "V", "310120"),
+        gga("GP", "000000.00", "1"),
+        rmc("GP", "000000.00", "A", "010220"),
+        // No RMC after midnight: dated from the previous fix.
+        gga("GP", "000001.00", "1"),
+    ];
+    let log = parse(&lines.join("\n")).unwrap();
+    let midnight_s = days_from_civil(2020, 2, 1) * 86_400;
+    let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000_000 - midnight_s).collect();
+    assert_eq!(times, vec![-2, 0, 1]);
+    assert_eq!(log.epochs_without_fix, 1);
+    // GGAs before the first RMC, across midnight, dated by that RMC.
+    let lines = [gga("GN", "235959.00", "1"), gga("GN", "000000.00", "1"), rmc("GN", "000001.00", "A", "010220")];
+    let log = parse(&lines.join("\n")).unwrap();
+    let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000_000 - midnight_s).collect();
+    assert_eq!(times, vec![-1, 0]);
+}
+
+#[test]
+fn cold_start_no_fix_and_gst_sigma() {
+    let text = [
+        "$GPRMC,,V,,,,,,,,,,N*53".to_string(),
+        "$GPGGA,,,,,,0,00,99.99,,,,,,*48".to_string(),
+        rmc("GP", "021417.00", "V", "070220"),
+        gga("GP", "021417.00", "0"),
+        rmc("GP", "021418.00", "A", "070220"),
+        gga("GP", "021418.00", "1"),
+        sentence("GPGST,021418.00,1.2,0.5,0.3,45.0,0.3,0.4,0.9"),
+    ]
+    .join("\r\n");
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.epochs_without_fix, log.unparsable_lines), (1, 2, 0));
+    assert!((log.fixes[0].horizontal_sigma_m.unwrap() - 0.125f64.sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn altitude_is_above_mean_sea_level_unless_every_fix_gives_the_geoid() {
+    let without_geoid = sentence("GNGGA,021418.00,3725.58362,N,12205.61915,W,1,12,0.76,4.4,M,,M,,");
+    let text = epoch("GN", "021417.00") + &rmc("GN", "021418.00", "A", "070220") + "\n" + &without_geoid;
+    let log = parse(&text).unwrap();
+    assert_eq!(log.altitude_datum, "mean sea level");
+    assert!(log.fixes.iter().all(|f| (f.altitude_m - 4.4).abs() < 1e-12));
+    assert_eq!(parse("").unwrap(), NmeaLog::default());
+}
+
+#[test]
+fn real_ublox_drive_gives_1653_fixes() {
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/realdata/nmea-ublox-f9k/MTV.Local1.ublox-F9K.20200206-181434.nmea"
+    ));
+    if !path.is_file() {
+        eprintln!("skipped: real data not found at {}", path.display());
+        return;
+    }
+    // google/gps-measurement-tools, Apache-2.0. 45498 lines: 1653 epochs of
+    // RMC, VTG, GGA, 4 GSA, 17-20 GSV and GLL from talkers GN, GP, GL, GA, GB.
+    let log = read_nmea(path).unwrap();
+    assert_eq!(log.fixes.len(), 1653);
+    assert!(log.fixes.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
+    // 2020-02-07 02:14:17 to 02:43:04 UTC: the file name's 2020-02-06 18:14
+    // is Pacific local time.
+    assert_eq!(log.fixes[0].t_ns / NS_PER_DAY, days_from_civil(2020, 2, 7));
+    assert_eq!(log.fixes[0].t_ns, T0_S * 1_000_000_000);
+    assert_eq!(log.fixes[1652].t_ns, (T0_S + 28 * 60 + 47) * 1_000_000_000);
+    assert!(
+        log.fixes
+            .iter()
+            .all(|f| (37.41..37.43).contains(&f.latitude_deg) && (-122.10..-122.06).contains(&f.longitude_deg))
+    );
+    // Counted independently with a Python XOR over each line: 13 corrupted
+    // GSV/VTG lines ("$GGPGSV..."), no other junk; GSV 32260 + GSA 6612 +
+    // GLL 1654 + VTG 1652 + TXT 1 ignored.
+    assert_eq!((log.bad_checksum_lines, log.first_bad_checksum_line), (13, Some(7181)));
+    assert_eq!((log.unparsable_lines, log.ignored_sentences), (0, 42_179));
+    assert_eq!((log.epochs_without_fix, log.duplicate_epochs, log.altitude_datum), (0, 0, "ellipsoid"));
+    let count = |q: GnssFixQuality| log.fixes.iter().filter(|f| f.quality == q).count();
+    assert_eq!(
+        (count(GnssFixQuality::RtkFixed), count(GnssFixQuality::RtkFloat), count(GnssFixQuality::Differential)),
+        (967, 632, 54)
+    );
+}
+
+/// A valid multi-epoch log to mutate.
+fn valid_log() -> String {
+    epoch("GN", "235958.50") + &epoch("GP", "235959.99") + &gga("GL", "000000.00", "4") + "\n"
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    #[test]
+    fn parser_never_panics_on_arbitrary_text(text in "\\PC{0,300}", bytes in proptest::collection::vec(any::<u8>(), 0..300)) {
+        let _ = parse(&text);
+        let _ = parse(&String::from_utf8_lossy(&bytes));
+    }
+
+    /// Byte edits of a valid log; the payload edits re-sign the line so they
+    /// reach the field parsers instead of stopping at the checksum.
+    #[test]
+    fn parser_never_panics_on_mutated_sentences(
+        edits in proptest::collection::vec((0usize..400, any::<u8>(), 0u8..3), 1..6),
+        resign in any::<bool>(),
+        cut in 0usize..400,
+    ) {
+        let mut bytes = valid_log().into_bytes();
+        for (at, value, op) in edits {
+            let at = at % (bytes.len() + 1);
+            match op {
+                0 if at < bytes.len() => bytes[at] = value,
+                1 => bytes.insert(at, value),
+                _ if at < bytes.len() => { bytes.remove(at); }
+                _ => {}
+            }
+        }
+        bytes.truncate(cut.max(1));
+        let text = String::from_utf8_lossy(&bytes).into_owned();
+        let text = if resign {
+            text.lines()
+                .map(|l| match l.strip_prefix('$').and_then(|b| b.rsplit_once('*')) {
+                    Some((payload, _)) => sentence(payload),
+                    None => l.to_string(),
+                })
+                .collect::<Vec<_>>()
+                .join("\n")
+        } else {
+            text
+        };
+        if let Ok(log) = parse(&text) {
+            prop_assert!(log.fixes.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
+            prop_assert!(log.fixes.iter().all(|f| f.latitude_deg.abs() <= 90.0 && f.altitude_m.is_finite()));
+        }
+    }
+}
