@@ -7,10 +7,13 @@
 //! the file and the problem); 2 usage error; 3 the requested feature is not
 //! built yet (the message names the issue that will build it).
 
+mod analyze;
 mod bench;
 mod demo;
+mod export;
 mod ingest;
 mod inspect;
+mod process;
 mod progress;
 mod simulate;
 
@@ -50,17 +53,11 @@ enum Command {
     /// Produce a recording (or a dataset-layout folder) from a scenario file, with ground truth.
     Simulate(simulate::SimulateArgs),
     /// Run a pipeline (odometry, mpc, beam, slam) on a recording and write Parquet tables.
-    Process {
-        /// Pipeline and its arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
-    /// Compute metrics and plots from Parquet tables.
-    Analyze {
-        /// Tables and options.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
+    Process(process::ProcessArgs),
+    /// Compute metrics, result tables and plots from Parquet tables.
+    Analyze(analyze::AnalyzeArgs),
+    /// Write trajectory tables as standard text (TUM, KITTI) for evo, pyboreas or the KITTI devkit.
+    Export(export::ExportArgs),
     /// Re-run a paper's experiment and compare with its published numbers.
     Reproduce {
         /// Experiment and options.
@@ -129,8 +126,9 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Ingest(args) => ingest::run(args, quiet),
         Command::Simulate(args) => simulate::run(args, quiet),
-        Command::Process { .. } => not_built("process", 4),
-        Command::Analyze { .. } => not_built("analyze", 4),
+        Command::Process(args) => process::run(&args, quiet),
+        Command::Analyze(args) => analyze::run(&args, quiet),
+        Command::Export(args) => export::run(&args, quiet),
         Command::Reproduce { .. } => not_built("reproduce", 4),
         Command::Inspect(args) => inspect::run(&args, quiet),
         Command::Demo(args) => demo::run(&args, quiet),

@@ -9,7 +9,7 @@
 //! - [`PolarScan`]: a spinning-radar sweep with per-azimuth time, angle and validity;
 //! - [`CirSnapshot`]: one channel impulse response with its tap spacing and its
 //!   position in the sounder's set/snapshot structure;
-//! - [`GnssFix`], [`MpcDetection`] and [`MpcTrack`].
+//! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`] and [`OdometryEstimate`].
 //!
 //! It must not do I/O, print, or depend on any other mmtrack crate: it sits at
 //! the bottom of the data flow (`ingest -> recording -> process -> tables ->
@@ -22,6 +22,7 @@ mod cir;
 mod error;
 mod gnss;
 mod mpc;
+mod odometry;
 mod pose;
 mod radar;
 
@@ -29,6 +30,7 @@ pub use cir::CirSnapshot;
 pub use error::CoreError;
 pub use gnss::{GnssFix, GnssFixQuality};
 pub use mpc::{MpcDetection, MpcTrack};
+pub use odometry::{OdometryEstimate, OdometryTiming};
 pub use num_complex::Complex64;
 pub use pose::{Se2, StampedPose, path_length_m, wrap_angle_rad};
 pub use radar::{AzimuthSample, PolarScan, PolarScanHeader};

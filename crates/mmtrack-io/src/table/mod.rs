@@ -13,6 +13,7 @@
 
 mod columns;
 mod io;
+mod odometry_rows;
 mod rows;
 
 pub use columns::Columns;
@@ -20,6 +21,7 @@ pub use io::{
     RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table, read_table_dir,
     table_path, write_table,
 };
+pub use odometry_rows::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, ODOMETRY_TIMING};
 pub use rows::ALL_TABLES;
 
 use std::sync::Arc;

@@ -395,5 +395,14 @@ impl TableRow for MpcTrack {
 }
 
 /// Every table of this module, for documentation and tests.
-pub const ALL_TABLES: &[&TableSpec] =
-    &[&POSES, &GNSS_FIXES, &RADAR_SCANS, &CIR_SNAPSHOTS, &MPC_DETECTIONS, &MPC_TRACKS];
+pub const ALL_TABLES: &[&TableSpec] = &[
+    &POSES,
+    &super::GROUND_TRUTH,
+    &super::ODOMETRY,
+    &super::ODOMETRY_TIMING,
+    &GNSS_FIXES,
+    &RADAR_SCANS,
+    &CIR_SNAPSHOTS,
+    &MPC_DETECTIONS,
+    &MPC_TRACKS,
+];
