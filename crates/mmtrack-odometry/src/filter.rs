@@ -1,0 +1,184 @@
+//! Stage 1: the k-strongest conservative filter, and placing the kept bins in
+//! the vehicle frame with optional per-azimuth motion compensation.
+
+use mmtrack_core::{PolarScan, Se2};
+
+/// A point kept by the filter, in the vehicle frame at the scan's stamp.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilteredPoint {
+    /// Position, metres (x forward, y left).
+    pub xy_m: [f64; 2],
+    /// Power of the bin, counts.
+    pub power: u8,
+}
+
+/// Constant body velocity of the vehicle: what motion compensation undoes.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct BodyVelocity {
+    /// Forward speed, m/s.
+    pub vx_mps: f64,
+    /// Leftward speed, m/s.
+    pub vy_mps: f64,
+    /// Yaw rate, rad/s, counter-clockwise.
+    pub yaw_rate_radps: f64,
+}
+
+impl BodyVelocity {
+    /// The motion over `dt_s` at this constant body velocity: the SE(2)
+    /// exponential of the twist times `dt_s` (exact arc, not a straight step).
+    #[must_use]
+    pub fn motion_over(&self, dt_s: f64) -> Se2 {
+        let (vx, vy, w) = (self.vx_mps * dt_s, self.vy_mps * dt_s, self.yaw_rate_radps * dt_s);
+        // V = [[sin w / w, -(1 - cos w) / w], [(1 - cos w) / w, sin w / w]] -> 1 and 0 as w -> 0.
+        let (a, b) = if w.abs() < 1e-9 { (1.0 - w * w / 6.0, w / 2.0) } else { (w.sin() / w, (1.0 - w.cos()) / w) };
+        Se2::new(a * vx - b * vy, b * vx + a * vy, w)
+    }
+
+    /// The velocity that moves by `motion` in `dt_s` (inverse of [`Self::motion_over`]).
+    #[must_use]
+    pub fn from_motion(motion: Se2, dt_s: f64) -> Self {
+        let w = motion.yaw_rad;
+        let (a, b) = if w.abs() < 1e-9 { (1.0 - w * w / 6.0, w / 2.0) } else { (w.sin() / w, (1.0 - w.cos()) / w) };
+        // Invert V (a 2x2 rotation-scaling: det = a^2 + b^2).
+        let det = a * a + b * b;
+        let vx = (a * motion.x_m + b * motion.y_m) / det;
+        let vy = (-b * motion.x_m + a * motion.y_m) / det;
+        Self { vx_mps: vx / dt_s, vy_mps: vy / dt_s, yaw_rate_radps: w / dt_s }
+    }
+}
+
+/// A bin kept by the filter, in polar form with its time offset, so it can be
+/// placed for any assumed motion during the sweep.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PolarPoint {
+    /// Range of the bin, metres.
+    pub range_m: f64,
+    /// Point direction in the vehicle frame at the azimuth's time, unit
+    /// (`(cos a, -sin a)` for clockwise azimuth `a`).
+    pub direction: [f64; 2],
+    /// Azimuth time minus scan stamp, seconds.
+    pub dt_s: f64,
+    /// Power of the bin, counts.
+    pub power: u8,
+}
+
+/// Keeps, for every valid azimuth, the `k` strongest bins with power at least
+/// `min_power` between `min_range_m` and `max_range_m` (ties: the nearer bin
+/// first, as the authors' code does). Azimuths are clockwise from forward, so a
+/// bin at range `r` and azimuth `a` lies at `r (cos a, -sin a)`.
+///
+/// # References
+/// Liu et al., SPEBT, Sec. III-A.1 (k-strongest conservative filtering).
+#[must_use]
+pub fn k_strongest(scan: &PolarScan, k: usize, min_power: u8, min_range_m: f64, max_range_m: f64) -> Vec<PolarPoint> {
+    let header = &scan.header;
+    let resolution_m = header.range_resolution_m;
+    let first_bin = ((min_range_m - header.range_offset_m) / resolution_m).ceil().max(0.0) as usize;
+    let end_bin = (((max_range_m - header.range_offset_m) / resolution_m).floor() + 1.0).max(0.0) as usize;
+    let end_bin = end_bin.min(header.bins_per_azimuth);
+    let mut points = Vec::with_capacity(header.azimuths.len() * k);
+    let mut strongest: Vec<(u8, usize)> = Vec::with_capacity(k + 1);
+    for (row_index, azimuth) in header.azimuths.iter().enumerate() {
+        let Some(row) = scan.row(row_index) else { break };
+        if !azimuth.valid || first_bin >= end_bin {
+            continue;
+        }
+        strongest.clear();
+        for (offset, &power) in row[first_bin..end_bin].iter().enumerate() {
+            if power < min_power || (strongest.len() == k && power <= strongest[k - 1].0) {
+                continue;
+            }
+            // Insert keeping (power desc, bin asc); a later bin never displaces an equal earlier one.
+            let at = strongest.iter().position(|&(p, _)| p < power).unwrap_or(strongest.len());
+            strongest.insert(at, (power, first_bin + offset));
+            strongest.truncate(k);
+        }
+        let (sin_a, cos_a) = azimuth.azimuth_rad.sin_cos();
+        let dt_s = (azimuth.t_ns - header.t_ns) as f64 * 1e-9;
+        for &(power, bin) in &strongest {
+            points.push(PolarPoint { range_m: header.range_m(bin), direction: [cos_a, -sin_a], dt_s, power });
+        }
+    }
+    points
+}
+
+/// Places the kept bins in the vehicle frame at the scan stamp. With
+/// `velocity = Some(v)` each point is moved from the pose at its azimuth's time
+/// to the pose at the stamp, assuming the constant body velocity `v` during the
+/// sweep (motion compensation, CFEAR Sec. III-B): `p = stamp_from_azimuth * p_a`
+/// with `stamp_from_azimuth = exp(v dt)`. With `None` the sweep is taken as
+/// instantaneous, as Fast-CFEAR does.
+///
+/// # References
+/// Adolfsson et al., CFEAR, T-RO 2023, Sec. III-B (motion compensation).
+#[must_use]
+pub fn place(points: &[PolarPoint], velocity: Option<BodyVelocity>) -> Vec<FilteredPoint> {
+    points
+        .iter()
+        .map(|p| {
+            let in_azimuth_frame = [p.range_m * p.direction[0], p.range_m * p.direction[1]];
+            let xy_m = match velocity {
+                Some(v) => v.motion_over(p.dt_s).transform_point(in_azimuth_frame),
+                None => in_azimuth_frame,
+            };
+            FilteredPoint { xy_m, power: p.power }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use mmtrack_core::{AzimuthSample, PolarScanHeader};
+
+    use super::*;
+
+    fn scan(rows: &[Vec<u8>]) -> PolarScan {
+        let bins = rows[0].len();
+        let azimuths = (0..rows.len())
+            .map(|i| AzimuthSample {
+                t_ns: i as i64 * 1_000_000,
+                azimuth_rad: i as f64 * std::f64::consts::TAU / rows.len() as f64,
+                valid: true,
+            })
+            .collect();
+        let header =
+            PolarScanHeader { t_ns: 0, range_resolution_m: 1.0, range_offset_m: 0.0, bins_per_azimuth: bins, azimuths };
+        PolarScan::new(header, rows.concat()).unwrap()
+    }
+
+    #[test]
+    fn keeps_the_k_strongest_above_threshold_nearer_first_on_ties() {
+        let row = vec![0, 90, 50, 80, 90, 70, 90, 10];
+        let s = scan(&[row, vec![0; 8], vec![0; 8], vec![0; 8]]);
+        let points = place(&k_strongest(&s, 2, 60, 0.0, 100.0), None);
+        let ranges: Vec<f64> = points.iter().map(|p| p.xy_m[0]).collect();
+        assert_eq!(ranges, vec![1.0, 4.0]);
+        assert!(points.iter().all(|p| p.power == 90));
+    }
+
+    #[test]
+    fn range_limits_are_inclusive_bin_centres() {
+        let s = scan(&[vec![100; 10], vec![0; 10], vec![0; 10], vec![0; 10]]);
+        let points = place(&k_strongest(&s, 10, 1, 2.0, 5.0), None);
+        let ranges: Vec<f64> = points.iter().map(|p| p.xy_m[0]).collect();
+        assert_eq!(ranges, vec![2.0, 3.0, 4.0, 5.0]);
+    }
+
+    #[test]
+    fn azimuths_turn_clockwise() {
+        // Row 1 of 4 is azimuth 90 deg clockwise: the vehicle's right, y < 0.
+        let mut rows = vec![vec![0; 10]; 4];
+        rows[1][5] = 200;
+        let points = place(&k_strongest(&scan(&rows), 1, 10, 0.0, 100.0), None);
+        assert_eq!(points.len(), 1);
+        assert!(points[0].xy_m[0].abs() < 1e-12 && (points[0].xy_m[1] + 5.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn velocity_round_trips_through_the_exponential() {
+        let v = BodyVelocity { vx_mps: 8.0, vy_mps: -0.3, yaw_rate_radps: 0.4 };
+        let back = BodyVelocity::from_motion(v.motion_over(0.25), 0.25);
+        assert!((back.vx_mps - 8.0).abs() < 1e-12 && (back.vy_mps + 0.3).abs() < 1e-12);
+        assert!((back.yaw_rate_radps - 0.4).abs() < 1e-12);
+    }
+}
