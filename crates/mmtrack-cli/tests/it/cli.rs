@@ -14,10 +14,7 @@ fn help_explains_every_subcommand() {
 
 #[test]
 fn unbuilt_subcommands_say_so_and_exit_3() {
-    for args in [
-        &["process", "mpc", "x.mcap"][..],
-        &["reproduce", "mpc-artificial"],
-    ] {
+    for args in [&["process", "mpc", "x.mcap"][..], &["reproduce", "mpc-artificial"]] {
         let out = mmtrack(&root(), args);
         assert_eq!(out.status.code(), Some(3), "{args:?}");
         let (_, stderr) = text(&out);

@@ -8,6 +8,7 @@ mod cli;
 mod common;
 mod fixtures;
 mod independent_readers;
+mod process_odometry;
 mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;

@@ -195,6 +195,12 @@ impl RecordingReader {
         self.raw.metadata.get(METADATA_NAME)
     }
 
+    /// Bytes of the file read so far (for progress bars).
+    #[must_use]
+    pub fn bytes_read(&self) -> u64 {
+        self.raw.bytes_read()
+    }
+
     fn bad(&self, m: &RawMessage, detail: impl std::fmt::Display) -> IoError {
         IoError::BadMessage {
             path: self.raw.path.clone(),

@@ -1,0 +1,71 @@
+//! `mmtrack process odometry`: tables from a recording, refusal without
+//! --force, clear errors for recordings without scans and bad configs.
+
+use mmtrack_core::OdometryEstimate;
+use mmtrack_io::table::{GroundTruthPose, read_table_dir};
+
+use super::common::{mmtrack, text};
+
+#[test]
+fn real_oxford_recording_gives_odometry_and_ground_truth_tables() {
+    let Some(realdata) = super::common::realdata("process_odometry") else { return };
+    let input = realdata.join("oxford-radar-tiny");
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "oxford", input.to_str().unwrap(), "-o", "tiny.mcap", "--quiet"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+
+    let out = mmtrack(dir.path(), &["process", "odometry", "tiny.mcap", "-o", "tables"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("11 scans") && stdout.contains("odometry/sequence=oxford-radar-tiny"), "{stdout}");
+
+    let estimates = read_table_dir::<OdometryEstimate>(&dir.path().join("tables")).unwrap();
+    let truth = read_table_dir::<GroundTruthPose>(&dir.path().join("tables")).unwrap();
+    let (estimates, truth) = (&estimates["oxford-radar-tiny"], &truth["oxford-radar-tiny"]);
+    assert_eq!((estimates.len(), truth.len()), (11, 11));
+    assert!(estimates.iter().all(|e| !e.low_confidence && e.world_from_vehicle.is_finite()));
+    // End point within 1 m of the ground truth's after 19.4 m (per-pair errors are in the odometry crate's test).
+    let (end, true_end) = (estimates[10].world_from_vehicle, truth[10].0.parent_from_child);
+    let true_start = truth[0].0.parent_from_child;
+    let relative_truth = true_start.inverse() * true_end;
+    assert!((relative_truth.inverse() * end).translation_norm_m() < 1.0, "{end:?} vs {relative_truth:?}");
+
+    // Again without --force: refused, nothing changed.
+    let again = mmtrack(dir.path(), &["process", "odometry", "tiny.mcap", "-o", "tables"]);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(text(&again).1.contains("--force"));
+
+    // Same input, same config: identical deterministic table.
+    let forced = mmtrack(dir.path(), &["process", "odometry", "tiny.mcap", "-o", "tables", "--force", "-q"]);
+    assert!(forced.status.success());
+    let again = read_table_dir::<OdometryEstimate>(&dir.path().join("tables")).unwrap();
+    assert_eq!(&again["oxford-radar-tiny"], estimates);
+}
+
+#[test]
+fn a_recording_without_radar_scans_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("poses.tum"), "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n").unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "poses", "poses.tum", "--format", "tum", "-o", "poses.mcap", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(dir.path(), &["process", "odometry", "poses.mcap", "-o", "tables"]);
+    assert_eq!(out.status.code(), Some(1));
+    let (_, stderr) = text(&out);
+    assert!(stderr.contains("poses.mcap") && stderr.contains("no radar scans"), "{stderr}");
+    assert!(!dir.path().join("tables").exists());
+}
+
+#[test]
+fn config_overrides_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bad.toml"), "grid_meters = 3.0\n").unwrap();
+    let out =
+        mmtrack(dir.path(), &["process", "odometry", "x.mcap", "-o", "t", "--config", "bad.toml", "--print-config"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("unknown odometry parameter 'grid_meters'"), "{}", text(&out).1);
+    std::fs::write(dir.path().join("ok.toml"), "k_strongest = 12\n").unwrap();
+    let out =
+        mmtrack(dir.path(), &["process", "odometry", "x.mcap", "-o", "t", "--config", "ok.toml", "--print-config"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    assert!(text(&out).0.contains("k_strongest = 12"));
+}
