@@ -1,8 +1,8 @@
 //! `mmtrack demo`: the whole chain on embedded data, no files needed.
 //!
-//! Today: simulate the demo radar scenario as an Oxford-layout folder, ingest
-//! it into a recording, write its ground truth as a Parquet table, and show
-//! both. Later issues extend it with process (odometry, mpc) and analyze.
+//! Simulate the demo radar scenario as an Oxford-layout folder, ingest it into
+//! a recording, write its ground truth as a Parquet table, run radar odometry
+//! (the `cfear` preset) on it, and show where everything is.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -14,9 +14,10 @@ use mmtrack_ingest::oxford::{self, OxfordOptions};
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
+use mmtrack_odometry::OdometryConfig;
 
 use crate::ingest::{CompressionArg, OutputArgs};
-use crate::{inspect, simulate};
+use crate::{inspect, process, simulate};
 
 /// The demo scenario, embedded so the demo runs from any directory.
 pub const DEMO_SCENARIO: &str = include_str!("../../../data/demo/radar-scenario.toml");
@@ -66,6 +67,12 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     };
     write_table(&tables, DEMO_SEQUENCE, &ground_truth, &run, Overwrite::Replace)?;
 
+    let preset = "cfear";
+    let config = OdometryConfig::cfear();
+    let odometry = process::run_odometry(&recording, config.clone(), quiet)?;
+    let written =
+        process::write_outputs(&tables, DEMO_SEQUENCE, &odometry, &config, preset, &recording, Overwrite::Replace)?;
+
     if !quiet {
         println!();
         inspect::run(&inspect::InspectArgs::new(recording.clone()), quiet)?;
@@ -75,7 +82,26 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!("  input folder (Oxford layout): {}", input.display());
         println!("  recording (open in Foxglove):  {}", recording.display());
         println!("  tables (Parquet, Hive layout): {}", tables.display());
-        println!("\nNot in the demo yet: process (odometry, mpc, beam, slam) and analyze (issues #4, #5).");
+        let last = odometry.estimates.last().map(|e| e.world_from_vehicle);
+        let truth_end = odometry
+            .ground_truth
+            .first()
+            .zip(odometry.ground_truth.last())
+            .map(|(a, b)| a.parent_from_child.inverse() * b.parent_from_child);
+        if let (Some(estimate), Some(truth)) = (last, truth_end) {
+            println!(
+                "  radar odometry ({preset}, {} scans, {} low-confidence): end point {:.2} m from the ground truth's after {:.1} m",
+                odometry.estimates.len(),
+                odometry.estimates.iter().filter(|e| e.low_confidence).count(),
+                (truth.inverse() * estimate).translation_norm_m(),
+                truth.translation_norm_m()
+            );
+        }
+        println!(
+            "  odometry tables: {}",
+            written.iter().map(|w| w.path.display().to_string()).collect::<Vec<_>>().join(", ")
+        );
+        println!("\nNot in the demo yet: mpc, beam and slam pipelines (issue #5 and later).");
     }
     Ok(ExitCode::SUCCESS)
 }
