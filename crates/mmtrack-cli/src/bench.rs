@@ -26,6 +26,8 @@ pub struct BenchArgs {
 
 #[derive(Subcommand)]
 enum Kind {
+    /// End-to-end radar odometry scans/s on real Oxford scans (PNG decode included), per stage.
+    Odometry(crate::bench_odometry::OdometryBenchArgs),
     /// Oxford-folder ingest (PNG bytes carried) in scans/s vs copying the folder; peak memory at two folder sizes.
     Ingest {
         /// Scans in the large folder (400 x 3768 each).
@@ -256,7 +258,7 @@ fn markdown(report: &serde_json::Value) -> String {
 }
 
 /// Replaces the text between `<!-- {name}:begin -->` and `<!-- {name}:end -->`.
-fn replace_block(path: &Path, name: &str, body: &str) -> anyhow::Result<()> {
+pub fn replace_block(path: &Path, name: &str, body: &str) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
     let (begin, end) = (format!("<!-- {name}:begin -->"), format!("<!-- {name}:end -->"));
     let (Some(start), Some(stop)) = (text.find(&begin), text.find(&end)) else {
@@ -422,6 +424,7 @@ struct IngestBench<'a> {
 
 pub fn run(args: &BenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.kind {
+        Kind::Odometry(odometry) => crate::bench_odometry::run(odometry, quiet),
         Kind::Ingest { scans, repeats, check, dir, readme, from } => ingest(
             &IngestBench {
                 scans: *scans,

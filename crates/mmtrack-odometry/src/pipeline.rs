@@ -176,12 +176,15 @@ impl RadarOdometry {
         let mut first_reference = first_reference_at(predicted);
         let mut surface = surface_points(&place(kept, velocity_at(predicted)), &self.surface);
         clock.lap_surface();
+        let sweep_s = kept.iter().map(|p| p.dt_s.abs()).fold(0.0, f64::max);
+        let mut placed_for = predicted;
         let mut pose = predicted;
         let mut trusted = true;
-        for round in 0..config.association_rounds {
-            if round > 0 && config.motion_compensation {
+        for _ in 0..config.association_rounds {
+            if config.motion_compensation && !same_placement(velocity_at(placed_for), velocity_at(pose), sweep_s) {
                 surface = surface_points(&place(kept, velocity_at(pose)), &self.surface);
                 first_reference = first_reference_at(pose);
+                placed_for = pose;
                 clock.lap_surface();
             }
             let references: Vec<&Reference> = match &first_reference {
@@ -206,7 +209,9 @@ impl RadarOdometry {
         }
         estimate.low_confidence |= !trusted;
         estimate.world_from_vehicle = if trusted { pose } else { predicted };
-        if config.motion_compensation {
+        if config.motion_compensation
+            && !same_placement(velocity_at(placed_for), velocity_at(estimate.world_from_vehicle), sweep_s)
+        {
             surface = surface_points(&place(kept, velocity_at(estimate.world_from_vehicle)), &self.surface);
             first_reference = first_reference_at(estimate.world_from_vehicle);
             clock.lap_surface();
@@ -232,6 +237,21 @@ impl RadarOdometry {
                 self.keyframes.pop_front();
             }
         }
+    }
+}
+
+/// True when two compensation velocities place every point of a sweep of
+/// `sweep_s` within 1 mm and 1e-5 rad of each other: re-placing the points
+/// would not change the surface points measurably, so it is skipped.
+fn same_placement(a: Option<BodyVelocity>, b: Option<BodyVelocity>, sweep_s: f64) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => {
+            let translation_m = (a.vx_mps - b.vx_mps).hypot(a.vy_mps - b.vy_mps) * sweep_s;
+            let rotation_rad = (a.yaw_rate_radps - b.yaw_rate_radps).abs() * sweep_s;
+            translation_m < 1e-3 && rotation_rad < 1e-5
+        }
+        (None, None) => true,
+        _ => false,
     }
 }
 
