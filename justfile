@@ -36,6 +36,7 @@ bench:
     cargo run -q --release -p mmtrack-cli -- bench io --check --readme README.md
     cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md --from ../shared/realdata/oxford-radar-tiny
     cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md
+    cargo run -q --release -p mmtrack-cli -- bench odometry --readme README.md
 
 # Paper experiments.
 reproduce *args:
