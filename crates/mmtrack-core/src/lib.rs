@@ -30,8 +30,8 @@ pub use cir::CirSnapshot;
 pub use error::CoreError;
 pub use gnss::{GnssFix, GnssFixQuality};
 pub use mpc::{MpcDetection, MpcTrack};
-pub use odometry::{OdometryEstimate, OdometryTiming};
 pub use num_complex::Complex64;
+pub use odometry::{OdometryEstimate, OdometryTiming};
 pub use pose::{Se2, StampedPose, path_length_m, wrap_angle_rad};
 pub use radar::{AzimuthSample, PolarScan, PolarScanHeader};
 
