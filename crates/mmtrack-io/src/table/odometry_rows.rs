@@ -3,26 +3,14 @@
 
 use std::sync::Arc;
 
-use arrow_array::{ArrayRef, BooleanArray, Float64Array, Int64Array, UInt32Array};
+use arrow_array::{ArrayRef, BooleanArray};
 use mmtrack_core::{OdometryEstimate, OdometryTiming, Se2, StampedPose};
 
-use super::{ColumnSpec, ColumnType, Columns, TableRow, TableSpec};
+use super::rows::{POSES, col, f64s, i64s, u32s};
+use super::{ColumnType, Columns, TableRow, TableSpec};
 
 use ColumnType::{Boolean, Float64, Int64, UInt32};
 
-const fn col(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'static str) -> ColumnSpec {
-    ColumnSpec { name, ty, nullable: false, unit, meaning }
-}
-
-fn i64s(values: impl Iterator<Item = i64>) -> ArrayRef {
-    Arc::new(Int64Array::from_iter_values(values))
-}
-fn u32s(values: impl Iterator<Item = u32>) -> ArrayRef {
-    Arc::new(UInt32Array::from_iter_values(values))
-}
-fn f64s(values: impl Iterator<Item = f64>) -> ArrayRef {
-    Arc::new(Float64Array::from_iter_values(values))
-}
 fn bools(values: impl Iterator<Item = bool>) -> ArrayRef {
     Arc::new(values.map(Some).collect::<BooleanArray>())
 }
@@ -36,36 +24,19 @@ pub struct GroundTruthPose(pub StampedPose);
 pub const GROUND_TRUTH: TableSpec = TableSpec {
     name: "ground_truth",
     description: "One ground-truth pose world_from_vehicle per row, in time order, as the recording gives it.",
-    columns: &[
-        col("t_ns", Int64, "ns", "time of validity"),
-        col("x_m", Float64, "m", "x of the vehicle in the world frame"),
-        col("y_m", Float64, "m", "y of the vehicle in the world frame"),
-        col("yaw_rad", Float64, "rad", "heading, counter-clockwise from world x"),
-    ],
+    columns: POSES.columns,
 };
 
 impl TableRow for GroundTruthPose {
     const SPEC: &'static TableSpec = &GROUND_TRUTH;
 
     fn to_columns(rows: &[Self]) -> Vec<ArrayRef> {
-        vec![
-            i64s(rows.iter().map(|r| r.0.t_ns)),
-            f64s(rows.iter().map(|r| r.0.parent_from_child.x_m)),
-            f64s(rows.iter().map(|r| r.0.parent_from_child.y_m)),
-            f64s(rows.iter().map(|r| r.0.parent_from_child.yaw_rad)),
-        ]
+        let poses: Vec<StampedPose> = rows.iter().map(|r| r.0.clone()).collect();
+        StampedPose::to_columns(&poses)
     }
 
     fn from_columns(c: &Columns<'_>) -> Result<Vec<Self>, String> {
-        let (t, x, y, yaw) = (c.i64("t_ns")?, c.f64("x_m")?, c.f64("y_m")?, c.f64("yaw_rad")?);
-        Ok((0..c.num_rows())
-            .map(|i| {
-                GroundTruthPose(StampedPose {
-                    t_ns: t.value(i),
-                    parent_from_child: Se2::new(x.value(i), y.value(i), yaw.value(i)),
-                })
-            })
-            .collect())
+        Ok(StampedPose::from_columns(c)?.into_iter().map(GroundTruthPose).collect())
     }
 }
 

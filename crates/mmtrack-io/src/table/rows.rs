@@ -11,26 +11,31 @@ use mmtrack_core::{
 
 use super::{ColumnSpec, ColumnType, Columns, TableRow, TableSpec};
 
-const fn col(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'static str) -> ColumnSpec {
+pub(super) const fn col(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'static str) -> ColumnSpec {
     ColumnSpec { name, ty, nullable: false, unit, meaning }
 }
 
-const fn nullable(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'static str) -> ColumnSpec {
+pub(super) const fn nullable(
+    name: &'static str,
+    ty: ColumnType,
+    unit: &'static str,
+    meaning: &'static str,
+) -> ColumnSpec {
     ColumnSpec { name, ty, nullable: true, unit, meaning }
 }
 
 use ColumnType::{Binary, Float64, Int64, ListBoolean, ListFloat64, ListInt64, UInt32, UInt64};
 
-fn i64s(values: impl Iterator<Item = i64>) -> ArrayRef {
+pub(super) fn i64s(values: impl Iterator<Item = i64>) -> ArrayRef {
     Arc::new(Int64Array::from_iter_values(values))
 }
-fn u64s(values: impl Iterator<Item = u64>) -> ArrayRef {
+pub(super) fn u64s(values: impl Iterator<Item = u64>) -> ArrayRef {
     Arc::new(UInt64Array::from_iter_values(values))
 }
-fn u32s(values: impl Iterator<Item = u32>) -> ArrayRef {
+pub(super) fn u32s(values: impl Iterator<Item = u32>) -> ArrayRef {
     Arc::new(UInt32Array::from_iter_values(values))
 }
-fn f64s(values: impl Iterator<Item = f64>) -> ArrayRef {
+pub(super) fn f64s(values: impl Iterator<Item = f64>) -> ArrayRef {
     Arc::new(Float64Array::from_iter_values(values))
 }
 fn list_f64<'a>(rows: impl Iterator<Item = &'a [f64]>) -> ArrayRef {
