@@ -1,16 +1,20 @@
-//! `mmtrack simulate radar --scenario <toml> -o <out>`.
+//! `mmtrack simulate radar --scenario <toml> [--trajectory <file>] -o <out>`:
+//! reads the scenario (and a trajectory file), streams the simulator's scans
+//! into a recording with ground truth or an Oxford-layout folder.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
+use mmtrack_core::StampedPose;
 use mmtrack_ingest::oxford::{self, NavtechLayout};
+use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_io::RecordingWriter;
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
-use mmtrack_sim::radar::{self, RadarScenario};
+use mmtrack_sim::radar::{RadarSimulator, Scenario, SimOptions, Trajectory};
 
-use crate::ingest::OutputArgs;
+use crate::ingest::{OutputArgs, PoseFormat};
 
 #[derive(Args)]
 pub struct SimulateArgs {
@@ -20,17 +24,15 @@ pub struct SimulateArgs {
 
 #[derive(Subcommand)]
 enum Kind {
-    /// Spinning radar in a planar scene of points and walls (see data/demo/radar-scenario.toml).
-    Radar {
-        /// Scenario file (TOML).
-        #[arg(long, value_name = "SCENARIO.toml")]
-        scenario: PathBuf,
-        /// Output layout: an Oxford-style folder (to exercise ingest) or a recording.
-        #[arg(long, value_enum, default_value_t = Format::Recording)]
-        format: Format,
-        #[command(flatten)]
-        output: OutputArgs,
-    },
+    /// Navtech-like spinning radar driving through a 2D world (see data/demo/radar-scenario.toml).
+    ///
+    /// The world is the scenario's [[reflectors]] plus, with a [generator] table, a procedural
+    /// street scene (buildings, junctions, parked cars, poles, trees, clutter) laid along the
+    /// trajectory. The trajectory is the scenario's [motion] (constant turn) or a file given
+    /// with --trajectory (e.g. Oxford gt/radar_odometry.csv). One scan every sweep period over
+    /// the trajectory's span, cut by --max-scans / --max-distance-m. Same scenario, trajectory
+    /// and seed give identical bytes.
+    Radar(Box<RadarArgs>),
     /// Channel sounder (not built yet: issue #5).
     Sounder {
         /// Arguments.
@@ -39,41 +41,124 @@ enum Kind {
     },
 }
 
+#[derive(Args)]
+struct RadarArgs {
+    /// Scenario file (TOML): seed, [sensor], [motion], [generator], [[reflectors]].
+    #[arg(long, value_name = "SCENARIO.toml")]
+    scenario: PathBuf,
+    /// Drive along this trajectory instead of the scenario's [motion].
+    #[arg(long, value_name = "FILE")]
+    trajectory: Option<PathBuf>,
+    /// Format of --trajectory.
+    #[arg(long, value_enum, default_value_t = PoseFormat::Oxford, requires = "trajectory")]
+    trajectory_format: PoseFormat,
+    /// KITTI trajectories: the times file (decimal seconds per line).
+    #[arg(long, value_name = "times.txt", requires = "trajectory")]
+    times: Option<PathBuf>,
+    /// KITTI trajectories: nanoseconds added to every time of --times.
+    #[arg(long, default_value_t = 0, requires = "times")]
+    t0_ns: i64,
+    /// Render at most this many scans (overrides the scenario's max_scans).
+    #[arg(long, value_name = "N")]
+    max_scans: Option<usize>,
+    /// Stop after this many metres of path (overrides the scenario's max_distance_m).
+    #[arg(long, value_name = "METRES")]
+    max_distance_m: Option<f64>,
+    /// Worker threads (0: all cores). The output does not depend on it.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Output layout: a recording with ground truth, or an Oxford-style folder (to exercise ingest).
+    #[arg(long, value_enum, default_value_t = Format::Recording)]
+    format: Format,
+    #[command(flatten)]
+    output: OutputArgs,
+}
+
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
 enum Format {
-    /// A canonical MCAP recording with ground truth.
+    /// A canonical MCAP recording with the ground truth as a pose stream.
     Recording,
     /// An Oxford Radar RobotCar folder (radar/*.png, radar.timestamps, gt/radar_odometry.csv).
     Oxford,
 }
 
 /// Parses a radar scenario file.
-pub fn load_scenario(path: &Path) -> anyhow::Result<RadarScenario> {
+pub fn load_scenario(path: &Path) -> anyhow::Result<Scenario> {
     let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
     parse_scenario(&text).with_context(|| format!("{}", path.display()))
 }
 
-/// Parses radar scenario text.
-pub fn parse_scenario(text: &str) -> anyhow::Result<RadarScenario> {
-    Ok(toml::from_str(text)?)
+/// Parses and checks radar scenario text.
+pub fn parse_scenario(text: &str) -> anyhow::Result<Scenario> {
+    let scenario: Scenario = toml::from_str(text)?;
+    scenario.validate()?;
+    Ok(scenario)
 }
 
-/// Writes a simulated scenario as an Oxford folder at `dir` (replaced atomically:
-/// built beside it, then renamed).
-pub fn write_oxford(scenario: &RadarScenario, dir: &Path, force: bool) -> anyhow::Result<()> {
+/// Reads a trajectory file as `world_from_vehicle` poses.
+pub fn read_trajectory(
+    path: &Path,
+    format: PoseFormat,
+    times: Option<&Path>,
+    t0_ns: i64,
+) -> anyhow::Result<Vec<StampedPose>> {
+    let poses = match format {
+        PoseFormat::Oxford => oxford::odometry::read_radar_odometry(path)?,
+        PoseFormat::Tum => poses::parse_tum(path, &poses::read_text(path)?, Plane::Xy)?,
+        PoseFormat::Kitti => {
+            let times_path = times.context("KITTI pose files carry no time: give --times <times.txt>")?;
+            let times = poses::parse_times(times_path, &poses::read_text(times_path)?, t0_ns)?;
+            poses::parse_kitti(path, &poses::read_text(path)?, &times, Plane::Xy)?
+        }
+    };
+    Ok(poses)
+}
+
+/// Writes the scenario's own drive as an Oxford folder at `dir` (replaced
+/// atomically: built beside it, then renamed).
+pub fn write_oxford(scenario: &Scenario, dir: &Path, force: bool) -> anyhow::Result<()> {
+    let trajectory = scenario.motion_trajectory()?;
+    let world = scenario.build_world(&trajectory)?;
+    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, scenario.options())?;
+    write_oxford_streaming(scenario, simulator, dir, force, &|| {})
+}
+
+fn write_oxford_streaming(
+    scenario: &Scenario,
+    simulator: RadarSimulator<'_>,
+    dir: &Path,
+    force: bool,
+    tick: &dyn Fn(),
+) -> anyhow::Result<()> {
     if dir.exists() && !force {
         anyhow::bail!("{}: output already exists (pass --force to replace it)", dir.display());
     }
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
     let staging = tempfile::Builder::new().prefix(".simulate-").tempdir_in(parent)?;
-    let (scans, truth) = radar::simulate(scenario);
     let layout = NavtechLayout {
         range_resolution_m: scenario.sensor.range_resolution_m,
         expected_bins: Some(scenario.sensor.bins),
         ..oxford::OXFORD
     };
-    oxford::write_oxford_folder(staging.path(), &scans, &truth, &layout)?;
+    let radar_dir = staging.path().join("radar");
+    std::fs::create_dir_all(&radar_dir).with_context(|| radar_dir.display().to_string())?;
+    let mut truth = Vec::new();
+    let mut timestamps = String::new();
+    for (scan, pose) in simulator {
+        let t_us = scan.header.t_ns / 1000;
+        let path = radar_dir.join(format!("{t_us}.png"));
+        let png = oxford::encode_scan_png(&scan, &layout).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        std::fs::write(&path, png).with_context(|| path.display().to_string())?;
+        timestamps.push_str(&format!("{t_us} 1\n"));
+        truth.push(pose);
+        tick();
+    }
+    // The ingest crate's writer produces gt/radar_odometry.csv (its frame conventions);
+    // radar.timestamps is rewritten after it with the scans streamed above.
+    oxford::write_oxford_folder(staging.path(), &[], &truth, &layout)?;
+    let path = staging.path().join("radar.timestamps");
+    std::fs::write(&path, timestamps).with_context(|| path.display().to_string())?;
     if dir.exists() {
         std::fs::remove_dir_all(dir).with_context(|| dir.display().to_string())?;
     }
@@ -82,35 +167,82 @@ pub fn write_oxford(scenario: &RadarScenario, dir: &Path, force: bool) -> anyhow
     Ok(())
 }
 
+fn write_recording(
+    args: &RadarArgs,
+    scenario: &Scenario,
+    simulator: RadarSimulator<'_>,
+    tick: &dyn Fn(),
+) -> anyhow::Result<()> {
+    let output = &args.output;
+    let mut extra = std::collections::BTreeMap::from([
+        ("simulator.seed".to_string(), scenario.seed.to_string()),
+        ("simulator.scenario".to_string(), args.scenario.display().to_string()),
+        ("radar.model".to_string(), "simulated Navtech CTS350-X-like".to_string()),
+    ]);
+    if let Some(t) = &args.trajectory {
+        extra.insert("simulator.trajectory".to_string(), t.display().to_string());
+    }
+    let metadata = RecordingMetadata {
+        sequence_id: output
+            .output
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "simulated".into()),
+        source: format!("simulate:{}", args.scenario.display()),
+        time_base: TimeBase::UnixEpoch,
+        extra,
+    };
+    let mut writer = RecordingWriter::create(&output.output, &metadata, &output.recording_options())?;
+    for (scan, pose) in simulator {
+        writer.write_radar_scan(&scan)?;
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "radar")?;
+        tick();
+    }
+    writer.finish()?;
+    Ok(())
+}
+
+fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
+    let mut scenario = load_scenario(&args.scenario)?;
+    if args.max_scans.is_some() {
+        scenario.max_scans = args.max_scans;
+    }
+    if args.max_distance_m.is_some() {
+        scenario.max_distance_m = args.max_distance_m;
+    }
+    let trajectory = match &args.trajectory {
+        Some(path) => {
+            let poses = read_trajectory(path, args.trajectory_format, args.times.as_deref(), args.t0_ns)?;
+            Trajectory::from_poses(poses).with_context(|| path.display().to_string())?
+        }
+        None => scenario.motion_trajectory().with_context(|| args.scenario.display().to_string())?,
+    };
+    let world = scenario.build_world(&trajectory).with_context(|| args.scenario.display().to_string())?;
+    let options = SimOptions { threads: args.threads, ..scenario.options() };
+    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)?;
+    let total = simulator.len();
+    let bar = crate::progress::bar(total as u64, "simulate radar", "scans", quiet);
+    let tick = || bar.inc(1);
+    match args.format {
+        Format::Oxford => write_oxford_streaming(&scenario, simulator, &args.output.output, args.output.force, &tick)?,
+        Format::Recording => write_recording(args, &scenario, simulator, &tick)?,
+    }
+    bar.finish_and_clear();
+    if !quiet {
+        println!(
+            "{}: {total} simulated scans ({} surfaces, {} point targets in the world)",
+            args.output.output.display(),
+            world.segment_count(),
+            world.point_count()
+        );
+    }
+    Ok(())
+}
+
 pub fn run(args: SimulateArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match args.kind {
-        Kind::Radar { scenario, format, output } => {
-            let parsed = load_scenario(&scenario)?;
-            match format {
-                Format::Oxford => write_oxford(&parsed, &output.output, output.force)?,
-                Format::Recording => {
-                    let (scans, truth) = radar::simulate(&parsed);
-                    let metadata = RecordingMetadata {
-                        sequence_id: output
-                            .output
-                            .file_stem()
-                            .map(|s| s.to_string_lossy().into_owned())
-                            .unwrap_or_else(|| "simulated".into()),
-                        source: format!("simulate:{}", scenario.display()),
-                        time_base: TimeBase::UnixEpoch,
-                        extra: [("simulator.seed".to_string(), parsed.seed.to_string())].into(),
-                    };
-                    let mut writer = RecordingWriter::create(&output.output, &metadata, &output.recording_options())?;
-                    for (scan, pose) in scans.iter().zip(&truth) {
-                        writer.write_radar_scan(scan)?;
-                        writer.write_pose(PoseStream::GroundTruth, pose, "world", "radar")?;
-                    }
-                    writer.finish()?;
-                }
-            }
-            if !quiet {
-                println!("{}: {} simulated scans", output.output.display(), parsed.scans);
-            }
+        Kind::Radar(radar) => {
+            run_radar(&radar, quiet)?;
             Ok(ExitCode::SUCCESS)
         }
         Kind::Sounder { .. } => crate::not_built("simulate sounder", 5),

@@ -1,4 +1,7 @@
-//! A spinning FMCW radar (Navtech-like) observing a planar scene.
+//! The minimal renderer that came first: point and wall reflectors with a
+//! fixed strength law, uniform noise, no speckle. Kept (unchanged in output)
+//! because `mmtrack bench io` builds its synthetic scans with it; new code
+//! uses [`super::RadarSimulator`], whose model is calibrated on real scans.
 //!
 //! Per azimuth `a` at time `t_a`, the sensor pose is `world_from_vehicle(t_a)`
 //! (so vehicle motion during the sweep distorts the scan, as on the real
@@ -20,6 +23,8 @@ use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader, Se2, StampedPose};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::Deserialize;
+
+use super::trajectory::ConstantTurn;
 
 /// Sensor parameters.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -61,29 +66,6 @@ pub enum Reflector {
         /// Peak power at 10 m, counts.
         strength_counts: f64,
     },
-}
-
-/// Constant speed and yaw rate from the origin, heading along world x.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ConstantTurn {
-    /// Forward speed, metres per second.
-    pub speed_mps: f64,
-    /// Yaw rate, radians per second, counter-clockwise positive.
-    pub yaw_rate_radps: f64,
-}
-
-impl ConstantTurn {
-    /// `world_from_vehicle` at `t_s` seconds after the start (exact arc).
-    #[must_use]
-    pub fn pose_at(&self, t_s: f64) -> Se2 {
-        let (v, w) = (self.speed_mps, self.yaw_rate_radps);
-        if w.abs() < 1e-12 {
-            return Se2::new(v * t_s, 0.0, 0.0);
-        }
-        let yaw = w * t_s;
-        Se2::new(v / w * yaw.sin(), v / w * (1.0 - yaw.cos()), yaw)
-    }
 }
 
 /// A radar scenario: sensor, scene, motion, length and seed.
@@ -262,13 +244,5 @@ mod tests {
         let row = scans[0].row(0).unwrap();
         assert!(row[100] > 50, "wall at 10 m");
         assert!(row[200] <= 2, "point at 20 m hidden");
-    }
-
-    #[test]
-    fn constant_turn_is_an_exact_arc() {
-        let m = ConstantTurn { speed_mps: 10.0, yaw_rate_radps: std::f64::consts::FRAC_PI_2 };
-        let p = m.pose_at(1.0);
-        let r = 10.0 / std::f64::consts::FRAC_PI_2;
-        assert!((p.x_m - r).abs() < 1e-12 && (p.y_m - r).abs() < 1e-12);
     }
 }
