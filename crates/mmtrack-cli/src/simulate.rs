@@ -219,7 +219,9 @@ fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
     };
     let world = scenario.build_world(&trajectory).with_context(|| args.scenario.display().to_string())?;
     let options = SimOptions { threads: args.threads, ..scenario.options() };
-    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)?;
+    let trajectory_source = args.trajectory.as_ref().unwrap_or(&args.scenario);
+    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)
+        .with_context(|| trajectory_source.display().to_string())?;
     let total = simulator.len();
     let bar = crate::progress::bar(total as u64, "simulate radar", "scans", quiet);
     let tick = || bar.inc(1);

@@ -12,3 +12,4 @@ mod process_odometry;
 mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;
+mod simulate_radar;

@@ -40,6 +40,8 @@ pub struct GeneratorConfig {
     pub building_depth_m: [f64; 2],
     /// Gap between neighbouring buildings of a block, metres.
     pub building_gap_m: [f64; 2],
+    /// Share of buildings with a second-row building behind them.
+    pub second_row_fraction: f64,
     /// Share of 6 m kerb slots holding a parked car.
     pub parked_car_fraction: f64,
     /// Mean spacing of poles along built blocks, metres.
@@ -55,16 +57,17 @@ pub struct GeneratorConfig {
 impl Default for GeneratorConfig {
     fn default() -> Self {
         Self {
-            street_half_width_m: [8.0, 13.0],
-            block_length_m: [50.0, 140.0],
-            junction_gap_m: [12.0, 24.0],
+            street_half_width_m: [8.0, 14.0],
+            block_length_m: [40.0, 110.0],
+            junction_gap_m: [14.0, 30.0],
             open_block_fraction: 0.15,
             building_length_m: [8.0, 30.0],
             building_depth_m: [8.0, 20.0],
-            building_gap_m: [0.0, 4.0],
+            building_gap_m: [0.5, 6.0],
+            second_row_fraction: 0.8,
             parked_car_fraction: 0.5,
             pole_spacing_m: 20.0,
-            clutter_per_100m: 12.0,
+            clutter_per_100m: 25.0,
             tree_fraction: 0.3,
             clearance_m: 2.5,
         }
@@ -92,6 +95,7 @@ impl GeneratorConfig {
         for (field, v) in [
             ("open_block_fraction", self.open_block_fraction),
             ("parked_car_fraction", self.parked_car_fraction),
+            ("second_row_fraction", self.second_row_fraction),
             ("tree_fraction", self.tree_fraction),
         ] {
             ensure_within(&format!("generator.{field}"), v, 0.0, 1.0, "a fraction in [0, 1]")?;
@@ -131,7 +135,8 @@ impl Path {
         let i = self.s_m.partition_point(|v| *v <= s).clamp(1, self.poses.len().max(2) - 1);
         let (a, b) = (self.poses[i - 1], self.poses[i]);
         let span = (self.s_m[i] - self.s_m[i - 1]).max(1e-9);
-        let f = ((s - self.s_m[i - 1]) / span).clamp(0.0, 1.0);
+        // Beyond the ends the first / last step is extended in a straight line.
+        let f = (s - self.s_m[i - 1]) / span;
         let (x, y) = (a.x_m + f * (b.x_m - a.x_m), a.y_m + f * (b.y_m - a.y_m));
         let (dx, dy) = if span > 1e-6 { ((b.x_m - a.x_m) / span, (b.y_m - a.y_m) / span) } else { a.yaw_rad.sin_cos() };
         [x - dy * offset_m, y + dx * offset_m]
@@ -157,7 +162,7 @@ pub fn generate_world(
     }
     let mut out = Vec::new();
     for (side_index, side) in [1.0, -1.0].into_iter().enumerate() {
-        let mut rng = Pcg64::seed_from_u64(super::hash(&[seed, 0x6765_6e, side_index as u64]));
+        let mut rng = Pcg64::seed_from_u64(super::hash(&[seed, 0x0067_656e, side_index as u64]));
         generate_side(config, &path, side, &mut rng, &mut out);
     }
     let boxes: Vec<[f64; 4]> = path.poses.iter().map(|p| [p.x_m, p.y_m, p.x_m, p.y_m]).collect();
@@ -207,9 +212,12 @@ fn built_block(
         let back = front + uniform(rng, config.building_depth_m);
         let steps = (frontage / 3.0).ceil().max(1.0) as usize;
         let along: Vec<f64> = (0..=steps).map(|k| s + frontage * k as f64 / steps as f64).collect();
-        let mut vertices: Vec<[f64; 2]> = along.iter().map(|a| path.offset(*a, side * front)).collect();
-        vertices.extend(along.iter().rev().map(|a| path.offset(*a, side * back)));
-        out.push(ReflectorSpec::Polygon { vertices_m: vertices, material: Material::Building, strength_db: None });
+        out.push(building(path, side, &along, front, back));
+        if rng.random_bool(config.second_row_fraction) {
+            // A building of the next row, seen through gaps and junctions.
+            let front2 = back + rng.random_range(4.0..20.0);
+            out.push(building(path, side, &along, front2, front2 + uniform(rng, config.building_depth_m)));
+        }
         s += frontage + uniform(rng, config.building_gap_m);
     }
     let kerb = half_width - 3.2; // car centres: a 2.5 m pavement and half a car
@@ -229,6 +237,13 @@ fn built_block(
         pole += config.pole_spacing_m * rng.random_range(0.7..1.3);
     }
     trees(config, path, side, start, end, [half_width - 1.8, half_width - 1.8], [1.0, 1.8], rng, out);
+}
+
+/// A building outline between offsets `front` and `back`, following the path over `along`.
+fn building(path: &Path, side: f64, along: &[f64], front: f64, back: f64) -> ReflectorSpec {
+    let mut vertices: Vec<[f64; 2]> = along.iter().map(|a| path.offset(*a, side * front)).collect();
+    vertices.extend(along.iter().rev().map(|a| path.offset(*a, side * back)));
+    ReflectorSpec::Polygon { vertices_m: vertices, material: Material::Building, strength_db: None }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -309,7 +324,7 @@ fn scatter_clutter(
         let s = rng.random_range(start..end.max(start + 1e-6));
         let offset = rng.random_range((half_width - 2.5).max(0.0)..half_width - 0.3);
         let p = path.offset(s, side * offset);
-        out.push(ReflectorSpec::Point { x_m: p[0], y_m: p[1], strength_db: rng.random_range(94.0..108.0) });
+        out.push(ReflectorSpec::Point { x_m: p[0], y_m: p[1], strength_db: rng.random_range(100.0..112.0) });
     }
 }
 

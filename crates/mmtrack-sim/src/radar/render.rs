@@ -36,6 +36,8 @@ struct Return {
     range_m: f64,
     power: f64,
     key: u64,
+    /// Volume tail behind the peak, bins (0: none).
+    tail_bins: f64,
 }
 
 impl RenderContext<'_> {
@@ -62,7 +64,7 @@ impl RenderContext<'_> {
             self.fill_noise(scan, a as u64, &mut row);
             for r in &returns {
                 let speckle = speckle_intensity(self.seed, scan, r.key, sensor.speckle_static_fraction);
-                add_profile(&mut row, r.range_m / sensor.range_resolution_m, r.power * speckle, sensor);
+                add_profile(&mut row, r.range_m / sensor.range_resolution_m, r.power * speckle, r.tail_bins, sensor);
             }
             for (o, p) in out.iter_mut().zip(&row) {
                 *o = self.prepared.quantize(*p);
@@ -83,7 +85,7 @@ impl RenderContext<'_> {
     fn fill_noise(&self, scan: u64, a: u64, row: &mut [f32]) {
         let noise = &self.prepared.noise;
         let span = noise.len().saturating_sub(row.len()).max(1);
-        let offset = (hash(&[self.seed, 0x6e6f_6973_65, scan, a]) % span as u64) as usize;
+        let offset = (hash(&[self.seed, 0x006e_6f69_7365, scan, a]) % span as u64) as usize;
         let slice = noise.get(offset..offset + row.len()).unwrap_or(&[]);
         for ((r, n), f) in row.iter_mut().zip(slice).zip(&self.prepared.floor) {
             *r = n * f;
@@ -116,7 +118,7 @@ impl RenderContext<'_> {
                 .map(|h| self.world.segments.get(h.segment as usize).map_or(0.0, |s| s.transmission))
                 .product();
             if t > 0.0 {
-                out.push(Return { range_m, power: power * t * t, key: (2 << 60) | u64::from(id) });
+                out.push(Return { range_m, power: power * t * t, key: (2 << 60) | u64::from(id), tail_bins: 0.0 });
             }
         }
         if let (Some(loss_db), Some(first)) = (sensor.multipath_loss_db, hits.first())
@@ -130,12 +132,13 @@ impl RenderContext<'_> {
     /// Mean power of a surface hit seen at path range `range_m` through `transmission` (one-way).
     fn surface_return(&self, hit: &Hit, range_m: f64, transmission: f64, bounce: u64) -> Return {
         let Some(s) = self.world.segments.get(hit.segment as usize) else {
-            return Return { range_m, power: 0.0, key: 0 };
+            return Return { range_m, power: 0.0, key: 0, tail_bins: 0.0 };
         };
         let incidence = s.diffuse_fraction + (1.0 - s.diffuse_fraction) * hit.cos_incidence.powi(2);
         let power = s.power_10m * incidence * (REFERENCE_RANGE_M / range_m).powi(3) * transmission * transmission;
         let patch = (hit.along_m / SPECKLE_PATCH_M).floor().max(0.0) as u64 & 0xff_ffff;
-        Return { range_m, power, key: (bounce << 60) | (u64::from(hit.segment) << 24) | patch }
+        let key = (bounce << 60) | (u64::from(hit.segment) << 24) | patch;
+        Return { range_m, power, key, tail_bins: s.depth_m / self.sensor.range_resolution_m }
     }
 
     /// The ghost of the first surface when it mirrors: the beam reflected
@@ -211,17 +214,28 @@ impl RenderContext<'_> {
     }
 }
 
-/// Adds a Gaussian range profile of total peak `peak` centred on `centre_bin`.
-fn add_profile(row: &mut [f32], centre_bin: f64, peak: f64, sensor: &Sensor) {
+/// Level of a volume tail just behind the peak, relative to the peak.
+const TAIL_LEVEL: f64 = 0.03;
+
+/// Adds a return of peak power `peak` centred on `centre_bin`: a Gaussian
+/// range profile, and behind it (when `tail_bins > 0`) a volume tail
+/// `TAIL_LEVEL * exp(-(bin - centre) / tail_bins)`, whichever is larger.
+fn add_profile(row: &mut [f32], centre_bin: f64, peak: f64, tail_bins: f64, sensor: &Sensor) {
     let sigma = sensor.range_profile_sigma_bins;
     let reach = (4.0 * sigma).ceil() as i64;
+    let tail_reach = if tail_bins > 0.0 { (7.0 * tail_bins).ceil() as i64 } else { 0 };
     let centre = centre_bin.round() as i64;
     let first = (centre - reach).max(0);
-    let last = (centre + reach).min(row.len() as i64 - 1);
+    let last = (centre + reach.max(tail_reach)).min(row.len() as i64 - 1);
     for bin in first..=last {
-        let z = (bin as f64 - centre_bin) / sigma;
+        let offset = bin as f64 - centre_bin;
+        let z = offset / sigma;
+        let mut gain = (-0.5 * z * z).exp();
+        if tail_bins > 0.0 && offset > 0.0 {
+            gain = gain.max(TAIL_LEVEL * (-offset / tail_bins).exp());
+        }
         if let Some(v) = row.get_mut(bin as usize) {
-            *v += (peak * (-0.5 * z * z).exp()) as f32;
+            *v += (peak * gain) as f32;
         }
     }
 }

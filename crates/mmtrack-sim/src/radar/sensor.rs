@@ -59,8 +59,8 @@ impl Default for Sensor {
             beam_width_deg: 1.8,
             range_profile_sigma_bins: 2.7,
             noise_power_db: 10.8,
-            noise_texture_shape: 0.4,
-            ground_clutter_db: 4.8,
+            noise_texture_shape: 0.3,
+            ground_clutter_db: 6.0,
             ground_clutter_range_m: 60.0,
             counts_per_ln_amplitude: 8.56,
             speckle_static_fraction: 0.7,
@@ -126,6 +126,8 @@ impl Sensor {
 const NOISE_BUFFER_LEN: usize = 1 << 18;
 /// Amplitudes below this are converted to counts by table look-up.
 const TABLE_AMPLITUDES: usize = 1 << 12;
+/// Spacing of the noise texture's knots, bins.
+const TEXTURE_STEP: usize = 16;
 
 /// What a sensor needs at render time, computed once: the noise buffer, the
 /// per-bin floor, the compression table.
@@ -156,7 +158,12 @@ impl Prepared {
         let counts = (0..TABLE_AMPLITUDES)
             .map(|n| if n <= 1 { 0 } else { (k * (n as f64).ln()).round().min(255.0) as u8 })
             .collect();
-        Self { noise: noise_buffer(sensor.noise_texture_shape, seed), floor, counts, k }
+        Self {
+            noise: noise_buffer(sensor.noise_texture_shape, seed, NOISE_BUFFER_LEN.max(4 * sensor.bins)),
+            floor,
+            counts,
+            k,
+        }
     }
 
     /// 8-bit counts of a linear power: the integer amplitude `n = round(sqrt(p))`
@@ -173,12 +180,14 @@ impl Prepared {
 }
 
 /// Noise power with unit mean: `|z|^2 * g`, where `z` is complex Gaussian
-/// smoothed along range (the sensor's range window correlates neighbouring
-/// bins) and `g` a gamma texture of shape `nu` smoothed over about 8 bins
-/// (clutter patches), i.e. K-distributed.
-fn noise_buffer(nu: f64, seed: u64) -> Vec<f32> {
+/// smoothed along range (sigma 2 bins: the sensor's range window correlates
+/// neighbouring bins) and `g` a gamma texture of shape `nu` drawn every 16
+/// bins and interpolated (clutter patches), i.e. K-distributed. Fitted to the
+/// real far-range floor: count CDF within 0.04, range autocorrelation of the
+/// counts 0.90 / 0.52 at lags 1 / 5 (real 0.95 / 0.57).
+fn noise_buffer(nu: f64, seed: u64, len: usize) -> Vec<f32> {
     let mut rng = Pcg64::seed_from_u64(seed ^ 0x6e6f_6973_655f_6275);
-    let n = NOISE_BUFFER_LEN;
+    let n = len;
     let gauss = |rng: &mut Pcg64| -> f64 {
         let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
         let u2: f64 = rng.random();
@@ -186,12 +195,15 @@ fn noise_buffer(nu: f64, seed: u64) -> Vec<f32> {
     };
     let re: Vec<f64> = (0..n).map(|_| gauss(&mut rng)).collect();
     let im: Vec<f64> = (0..n).map(|_| gauss(&mut rng)).collect();
-    let texture: Vec<f64> = (0..n).map(|_| gamma(&mut rng, nu)).collect();
-    let smooth_re = smooth(&re, 1.2);
-    let smooth_im = smooth(&im, 1.2);
-    let smooth_texture = smooth(&texture, 3.0);
-    let raw: Vec<f64> =
-        (0..n).map(|i| (smooth_re[i].powi(2) + smooth_im[i].powi(2)) * smooth_texture[i].max(0.0)).collect();
+    let smooth_re = smooth(&re, 2.0);
+    let smooth_im = smooth(&im, 2.0);
+    // Texture: gamma draws every TEXTURE_STEP bins, linearly interpolated.
+    let knots: Vec<f64> = (0..=n / TEXTURE_STEP + 1).map(|_| gamma(&mut rng, nu)).collect();
+    let texture = |i: usize| {
+        let (k, f) = (i / TEXTURE_STEP, (i % TEXTURE_STEP) as f64 / TEXTURE_STEP as f64);
+        knots.get(k).copied().unwrap_or(1.0) * (1.0 - f) + knots.get(k + 1).copied().unwrap_or(1.0) * f
+    };
+    let raw: Vec<f64> = (0..n).map(|i| (smooth_re[i].powi(2) + smooth_im[i].powi(2)) * texture(i)).collect();
     let mean = raw.iter().sum::<f64>() / n as f64;
     raw.iter().map(|v| (v / mean) as f32).collect()
 }
@@ -246,7 +258,7 @@ mod tests {
 
     #[test]
     fn noise_buffer_has_unit_mean() {
-        let noise = noise_buffer(0.4, 3);
+        let noise = noise_buffer(0.3, 3, 1 << 16);
         let mean = noise.iter().map(|v| f64::from(*v)).sum::<f64>() / noise.len() as f64;
         assert!((mean - 1.0).abs() < 1e-4, "{mean}");
     }

@@ -15,11 +15,11 @@ use crate::error::{ensure_finite, ensure_positive, invalid};
 pub enum Material {
     /// Building facade: strong, opaque, mirrors the beam (multipath).
     Building,
-    /// Free-standing wall: opaque, no multipath.
+    /// Free-standing (garden) wall: a roof-mounted radar sees partly over it (transmission 0.3).
     Wall,
     /// Fence or railing: lets half the power through (each way).
     Fence,
-    /// Vehicle body: strong, opaque.
+    /// Vehicle body: strong; a roof-mounted radar sees partly over it (transmission 0.4).
     Car,
     /// Hedge or tree crown: diffuse (no incidence dependence), lets a third of the power through.
     Vegetation,
@@ -37,6 +37,10 @@ pub struct SurfaceProperties {
     pub diffuse_fraction: f64,
     /// Whether the surface mirrors the beam into multipath ghosts.
     pub mirror: bool,
+    /// Depth of the scattering volume behind the surface, metres: the return
+    /// trails off behind its peak as `exp(-x / depth_m)` (window recesses,
+    /// foliage, a car's interior), so it covers more bins than the profile.
+    pub depth_m: f64,
 }
 
 impl Material {
@@ -44,19 +48,19 @@ impl Material {
     /// against the real scans' k-strongest statistics).
     #[must_use]
     pub fn properties(self) -> SurfaceProperties {
-        let (strength_db, transmission, diffuse_fraction, mirror) = match self {
-            Self::Building => (108.0, 0.0, 0.2, true),
-            Self::Wall => (104.0, 0.0, 0.25, false),
-            Self::Fence => (98.0, 0.5, 0.5, false),
-            Self::Car => (110.0, 0.0, 0.3, false),
-            Self::Vegetation => (100.0, 0.35, 1.0, false),
+        let (strength_db, transmission, diffuse_fraction, mirror, depth_m) = match self {
+            Self::Building => (114.0, 0.0, 0.2, true, 0.05),
+            Self::Wall => (108.0, 0.3, 0.25, false, 0.05),
+            Self::Fence => (102.0, 0.5, 0.5, false, 0.05),
+            Self::Car => (114.0, 0.4, 0.3, false, 0.1),
+            Self::Vegetation => (104.0, 0.35, 1.0, false, 0.6),
         };
-        SurfaceProperties { strength_db, transmission, diffuse_fraction, mirror }
+        SurfaceProperties { strength_db, transmission, diffuse_fraction, mirror, depth_m }
     }
 }
 
 /// Default return level of a pole at 10 m, dB.
-pub const POLE_STRENGTH_DB: f64 = 116.0;
+pub const POLE_STRENGTH_DB: f64 = 120.0;
 
 fn building() -> Material {
     Material::Building
@@ -122,7 +126,7 @@ pub enum ReflectorSpec {
         x_m: f64,
         /// Position y.
         y_m: f64,
-        /// Overrides the default strength (116 dB at 10 m).
+        /// Overrides the default strength (120 dB at 10 m).
         #[serde(default)]
         strength_db: Option<f64>,
     },
@@ -147,6 +151,7 @@ pub(crate) struct Segment {
     pub transmission: f64,
     pub diffuse_fraction: f64,
     pub mirror: bool,
+    pub depth_m: f64,
 }
 
 /// A compiled point target.
@@ -334,6 +339,7 @@ fn surface(a: [f64; 2], b: [f64; 2], material: Material, strength_db: Option<f64
         transmission: props.transmission,
         diffuse_fraction: props.diffuse_fraction,
         mirror: props.mirror,
+        depth_m: props.depth_m,
     }
 }
 
@@ -420,12 +426,12 @@ mod tests {
         let world = World::new(&[
             wall([30.0, -5.0], [30.0, 5.0], Material::Building),
             wall([10.0, -5.0], [10.0, 5.0], Material::Vegetation),
-            wall([20.0, -5.0], [20.0, 5.0], Material::Wall),
+            wall([20.0, -5.0], [20.0, 5.0], Material::Building),
         ])
         .unwrap();
         let hits = world.cast([0.0, 0.0], [1.0, 0.0], 100.0, &mut Scratch::default());
         let ranges: Vec<f64> = hits.iter().map(|h| h.range_m).collect();
-        assert_eq!(ranges, vec![10.0, 20.0]);
+        assert_eq!(ranges, vec![10.0, 20.0]); // the facade at 30 m is hidden
         assert!((hits[0].cos_incidence - 1.0).abs() < 1e-12);
     }
 
@@ -433,10 +439,10 @@ mod tests {
     fn rays_from_outside_the_grid_and_long_walls_are_found() {
         let world = World::new(&[wall([-500.0, 40.0], [500.0, 40.0], Material::Building)]).unwrap();
         let dir = [0.6, 0.8];
-        let hits = world.cast([-600.0, -10.0], dir, 200.0, &mut Scratch::default());
+        let hits = world.cast([-450.0, -10.0], dir, 200.0, &mut Scratch::default());
         assert_eq!(hits.len(), 1);
         assert!((hits[0].range_m - 62.5).abs() < 1e-9, "{}", hits[0].range_m);
-        assert!(world.cast([-600.0, -10.0], dir, 60.0, &mut Scratch::default()).is_empty());
+        assert!(world.cast([-450.0, -10.0], dir, 60.0, &mut Scratch::default()).is_empty());
     }
 
     #[test]
