@@ -1,0 +1,30 @@
+//! # mmtrack-analysis
+//!
+//! The `analyze` stage: reads the Parquet tables that `process` writes and
+//! turns them into metrics, result tables, plots and a short report.
+//!
+//! - [`trajectory`]: pure metrics on in-memory poses (no I/O): association by
+//!   time, KITTI drift as the KITTI devkit computes it, relative pose error,
+//!   absolute trajectory error after SE(2) alignment;
+//! - [`tables`]: result tables (`trajectory_metrics`, `drift_per_length`,
+//!   `relative_pose_errors`) as `mmtrack-io` [`TableRow`](mmtrack_io::table::TableRow)s,
+//!   with units; [`TABLES`] lists their specs for `schemas/`;
+//! - [`plots`]: SVG plots (plotters, SVG backend only);
+//! - [`report`]: the Markdown report;
+//! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
+//!   and writes everything into an output directory that replaces an old one
+//!   only when complete;
+//! - [`export`]: trajectories as TUM, KITTI and Boreas text files for evo,
+//!   the KITTI devkit and pyboreas.
+//!
+//! Place in the data flow: `tables (Parquet) --analyze--> metrics (Parquet) +
+//! plots + report`. It depends on `mmtrack-core` and `mmtrack-io` only, never
+//! on algorithm crates, and never prints (the CLI does).
+//!
+//! ARCHITECTURE.md places polars here. This crate does not use it yet: the
+//! metrics so far are a few vectors per sequence, written through
+//! `mmtrack-io`'s `TableRow`, and polars would multiply the build time of the
+//! workspace on small machines for nothing we need. Campaign-wide queries run
+//! on the Hive-partitioned output with DuckDB or polars outside the binary.
+
+pub mod trajectory;
