@@ -12,8 +12,9 @@
 //! - [`plots`]: SVG plots (plotters, SVG backend only);
 //! - [`report`]: the Markdown report;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
-//!   and writes everything into an output directory that replaces an old one
-//!   only when complete;
+//!   and computes them per sequence;
+//! - [`output`]: writes tables, plots and report into an output directory
+//!   that replaces an old one only when complete;
 //! - [`export`]: trajectories as TUM, KITTI and Boreas text files for evo,
 //!   the KITTI devkit and pyboreas.
 //!
@@ -27,4 +28,12 @@
 //! workspace on small machines for nothing we need. Campaign-wide queries run
 //! on the Hive-partitioned output with DuckDB or polars outside the binary.
 
+pub mod export;
+pub mod output;
+pub mod pipeline;
+pub mod plots;
+pub mod report;
+pub mod tables;
 pub mod trajectory;
+
+pub use tables::TABLES;

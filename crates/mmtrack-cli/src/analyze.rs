@@ -1,17 +1,122 @@
-//! `mmtrack analyze`: metrics, result tables and plots from process outputs.
-//! (Being built for issue #4; see that issue for the scope.)
+//! `mmtrack analyze`: metrics, result tables, plots and a report from the
+//! tables `mmtrack process` writes. The work is in `mmtrack-analysis`; this
+//! module parses arguments and talks to the terminal.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+use anyhow::{Context, bail};
 use clap::Args;
+use mmtrack_analysis::output::{check_output, write_results};
+use mmtrack_analysis::pipeline::{analyze_all, inventory, plan};
+use mmtrack_analysis::report::one_line;
+use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{GROUND_TRUTH, ODOMETRY, RunInfo};
 
 #[derive(Args)]
+#[command(
+    long_about = "Reads a table directory written by `mmtrack process` (any number of sequences), computes the metrics \
+that apply and writes result tables (Parquet), SVG plots and a Markdown report.\n\n\
+Metrics: tables `odometry` + `ground_truth` of a sequence -> trajectory metrics: KITTI drift exactly as the KITTI \
+odometry devkit computes it (translational %, rotational deg/m and deg/100 m; segments of 100..800 m, first frames \
+every 10 frames), frame-to-frame relative pose error, absolute trajectory error after SE(2) alignment, and \
+unaligned x/y/yaw RMSE. The estimate is associated with ground truth by time (interpolated); estimate poses outside \
+the ground-truth span are dropped and counted.\n\n\
+Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors}/sequence=<id>/part-0.parquet, \
+<OUT>/plots/<id>/*.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
+only with --force and only if it holds nothing but earlier results.",
+    after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
+)]
 pub struct AnalyzeArgs {
     /// Table directory written by `mmtrack process` (any number of sequences).
     tables: PathBuf,
+    /// Output directory for tables/, plots/ and report.md.
+    #[arg(short, long, value_name = "DIR")]
+    output: PathBuf,
+    /// Replace earlier results in the output directory.
+    #[arg(long)]
+    force: bool,
+    /// KITTI segment lengths in metres, comma-separated [default: 100,200,...,800 as the devkit]. Short simulated
+    /// drives need shorter ones, e.g. 10,20,...,80.
+    #[arg(long, value_delimiter = ',', value_name = "M,M,...")]
+    segment_lengths_m: Option<Vec<f64>>,
+    /// Start a KITTI segment every N frames [default: 10, as the devkit].
+    #[arg(long, value_name = "N", conflicts_with = "step_m")]
+    step_frames: Option<usize>,
+    /// Start a KITTI segment every X metres of ground-truth path instead (independent of the frame rate).
+    #[arg(long, value_name = "M")]
+    step_m: Option<f64>,
 }
 
-pub fn run(_args: &AnalyzeArgs, _quiet: bool) -> anyhow::Result<ExitCode> {
-    crate::not_built("analyze", 4)
+fn drift_options(args: &AnalyzeArgs) -> DriftOptions {
+    DriftOptions {
+        segment_lengths_m: args.segment_lengths_m.clone().unwrap_or_else(|| KITTI_SEGMENT_LENGTHS_M.to_vec()),
+        step: match (args.step_m, args.step_frames) {
+            (Some(m), _) => FirstFrameStep::Metres(m),
+            (None, n) => FirstFrameStep::Frames(n.unwrap_or(KITTI_STEP_FRAMES)),
+        },
+    }
+}
+
+/// Refuses an output directory that is, or contains, the input.
+fn check_not_inside(tables: &Path, output: &Path) -> anyhow::Result<()> {
+    let (Ok(tables), Ok(output)) = (tables.canonicalize(), output.canonicalize()) else { return Ok(()) };
+    if tables.starts_with(&output) {
+        bail!("{}: the output directory contains the input tables; choose another output", output.display());
+    }
+    Ok(())
+}
+
+pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
+    if !args.tables.is_dir() {
+        bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", args.tables.display());
+    }
+    check_not_inside(&args.tables, &args.output)?;
+    check_output(&args.output, overwrite)?;
+    let options = drift_options(args);
+    // Options are checked by the metric too, but a usage error should not wait for the tables to load.
+    mmtrack_analysis::trajectory::kitti_drift(&[], &[], &options).context("--segment-lengths-m / --step-*")?;
+
+    let found = inventory(&args.tables)?;
+    let plan = plan(&found);
+    if plan.trajectory.is_empty() {
+        let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
+        bail!(
+            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics); found {}{reasons}",
+            args.tables.display(),
+            ODOMETRY.name,
+            GROUND_TRUTH.name,
+            found.describe()
+        );
+    }
+    let results = analyze_all(&args.tables, &plan, &options)?;
+    let run = RunInfo {
+        config_json: serde_json::json!({
+            "command": "analyze",
+            "tables": args.tables.display().to_string(),
+            "segment_lengths_m": options.segment_lengths_m,
+            "step": format!("{:?}", options.step),
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    let written = write_results(&args.output, &results, &plan.skipped, &options, &run, overwrite)?;
+    if !quiet {
+        for r in &results {
+            println!("{}", one_line(r));
+        }
+        for (sequence, reason) in &plan.skipped {
+            println!("{sequence}: not analyzed: {reason}");
+        }
+        println!(
+            "wrote {} files: tables {}, plots {}, report {}",
+            written.files,
+            written.tables_dir.display(),
+            written.plots_dir.display(),
+            written.report.display()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }

@@ -88,7 +88,7 @@ fn not_built(what: &str, issue: u32) -> anyhow::Result<ExitCode> {
 }
 
 fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyhow::Result<ExitCode> {
-    let documents = mmtrack_io::schema_docs::documents();
+    let documents = mmtrack_io::schema_docs::documents_with(mmtrack_analysis::TABLES);
     if let Some(dir) = write {
         for (relative, contents) in &documents {
             let path = dir.join(relative);

@@ -1,0 +1,166 @@
+//! Writes the results of `mmtrack analyze` into one directory that appears
+//! whole or not at all: everything is written into a hidden staging directory
+//! beside the target, which then takes the target's place. A failure leaves
+//! the previous results untouched and no staging directory behind.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{RunInfo, write_table};
+
+use crate::pipeline::TrajectoryResult;
+use crate::trajectory::DriftOptions;
+use crate::{plots, report};
+
+/// Entries of a results directory; `--force` replaces only a directory that
+/// holds nothing else, so a mistyped `-o` cannot delete unrelated files.
+pub const OWN_ENTRIES: [&str; 3] = ["tables", "plots", "report.md"];
+
+/// What [`write_results`] wrote (final paths).
+#[derive(Debug, Clone, PartialEq)]
+pub struct WrittenResults {
+    /// The results directory.
+    pub out_dir: PathBuf,
+    /// `<out>/tables`.
+    pub tables_dir: PathBuf,
+    /// `<out>/plots`.
+    pub plots_dir: PathBuf,
+    /// `<out>/report.md`.
+    pub report: PathBuf,
+    /// Number of table files and plots written.
+    pub files: usize,
+}
+
+/// Checks, before any work, that `out` may be written: absent, or (with
+/// [`Overwrite::Replace`]) a directory holding only [`OWN_ENTRIES`].
+pub fn check_output(out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
+    if !out.exists() {
+        return Ok(());
+    }
+    if !out.is_dir() {
+        bail!("{}: exists and is not a directory; choose another output", out.display());
+    }
+    let mut foreign = Vec::new();
+    let mut any = false;
+    for entry in std::fs::read_dir(out).with_context(|| out.display().to_string())? {
+        let name = entry.with_context(|| out.display().to_string())?.file_name().to_string_lossy().into_owned();
+        any = true;
+        if !OWN_ENTRIES.contains(&name.as_str()) {
+            foreign.push(name);
+        }
+    }
+    if !foreign.is_empty() {
+        foreign.sort();
+        bail!(
+            "{}: holds {} which `mmtrack analyze` does not write; refusing to replace it (choose an empty or new output)",
+            out.display(),
+            foreign.join(", ")
+        );
+    }
+    if any && overwrite == Overwrite::Refuse {
+        bail!("{}: holds results; use --force to replace them (nothing was written)", out.display());
+    }
+    Ok(())
+}
+
+fn parent_dir(path: &Path) -> PathBuf {
+    match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Writes tables, plots and the report for `results` into `out`.
+pub fn write_results(
+    out: &Path,
+    results: &[TrajectoryResult],
+    skipped: &[(String, String)],
+    options: &DriftOptions,
+    run: &RunInfo,
+    overwrite: Overwrite,
+) -> anyhow::Result<WrittenResults> {
+    check_output(out, overwrite)?;
+    let parent = parent_dir(out);
+    std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "results".into());
+    let staging = tempfile::Builder::new()
+        .prefix(&format!(".{name}."))
+        .suffix(".partial")
+        .tempdir_in(&parent)
+        .with_context(|| format!("{}: cannot create a staging directory", parent.display()))?;
+    let files = write_into(staging.path(), results, skipped, options, run)?;
+    publish(staging.keep(), out, overwrite)?;
+    Ok(WrittenResults {
+        out_dir: out.to_path_buf(),
+        tables_dir: out.join("tables"),
+        plots_dir: out.join("plots"),
+        report: out.join("report.md"),
+        files,
+    })
+}
+
+fn write_into(
+    dir: &Path,
+    results: &[TrajectoryResult],
+    skipped: &[(String, String)],
+    options: &DriftOptions,
+    run: &RunInfo,
+) -> anyhow::Result<usize> {
+    let tables = dir.join("tables");
+    let mut files = 0;
+    for r in results {
+        let seq = &r.sequence;
+        write_table(&tables, seq, std::slice::from_ref(&r.metrics), run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.drift_rows(), run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.rpe_rows(), run, Overwrite::Refuse)?;
+        let plot_dir = dir.join("plots").join(seq);
+        std::fs::create_dir_all(&plot_dir).with_context(|| plot_dir.display().to_string())?;
+        let plots = [
+            ("trajectory.svg", plots::trajectory_svg(r)),
+            ("errors_vs_distance.svg", plots::errors_vs_distance_svg(r)),
+            ("drift_per_length.svg", plots::drift_per_length_svg(r)),
+        ];
+        for (file, svg) in plots {
+            let path = plot_dir.join(file);
+            let svg = svg.with_context(|| format!("sequence {seq}: {file}"))?;
+            std::fs::write(&path, svg).with_context(|| path.display().to_string())?;
+        }
+        files += 6;
+    }
+    let report_path = dir.join("report.md");
+    std::fs::write(&report_path, report::markdown(results, skipped, options))
+        .with_context(|| report_path.display().to_string())?;
+    Ok(files + 1)
+}
+
+/// Moves the complete `staged` directory to `out`. An existing `out` is
+/// first moved aside and deleted only after the new one is in place; if the
+/// second rename fails, the old one is moved back.
+fn publish(staged: PathBuf, out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
+    let result = publish_inner(&staged, out, overwrite);
+    if result.is_err() {
+        let _ = std::fs::remove_dir_all(&staged);
+    }
+    result
+}
+
+fn publish_inner(staged: &Path, out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
+    if !out.exists() {
+        return std::fs::rename(staged, out)
+            .with_context(|| format!("{}: cannot move results into place", out.display()));
+    }
+    // Re-check: another process may have written here while we worked.
+    check_output(out, overwrite)?;
+    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let aside = parent_dir(out).join(format!(".{name}.replaced-{}", std::process::id()));
+    if aside.exists() {
+        std::fs::remove_dir_all(&aside).with_context(|| aside.display().to_string())?;
+    }
+    std::fs::rename(out, &aside).with_context(|| format!("{}: cannot move the old results aside", out.display()))?;
+    if let Err(e) = std::fs::rename(staged, out) {
+        let _ = std::fs::rename(&aside, out);
+        return Err(e).with_context(|| format!("{}: cannot move results into place (old results kept)", out.display()));
+    }
+    std::fs::remove_dir_all(&aside).with_context(|| format!("{}: new results in place; old copy left", aside.display()))
+}

@@ -1,0 +1,265 @@
+//! What `mmtrack analyze` does, without the terminal: find the tables that
+//! exist, pick the metrics that apply, compute them per sequence.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
+use mmtrack_io::table::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, read_table_dir};
+
+use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
+use crate::trajectory::{
+    Association, DriftOptions, FirstFrameStep, KittiDrift, RelativePoseError, TrajectoryError,
+    absolute_trajectory_error, associate, kitti_drift, relative_pose_errors, trajectory_distances_m, unaligned_errors,
+};
+
+/// Tables found under a table directory: table name -> sequences, sorted.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Inventory {
+    /// The directory.
+    pub root: PathBuf,
+    /// Table name -> sequences with a `part-0.parquet`.
+    pub tables: BTreeMap<String, Vec<String>>,
+}
+
+impl Inventory {
+    /// Sequences of `table` (empty when absent).
+    #[must_use]
+    pub fn sequences(&self, table: &str) -> &[String] {
+        self.tables.get(table).map_or(&[], Vec::as_slice)
+    }
+
+    /// `table (n sequences), ...` or `no tables`, for messages.
+    #[must_use]
+    pub fn describe(&self) -> String {
+        if self.tables.is_empty() {
+            return "no tables".into();
+        }
+        let parts: Vec<String> = self
+            .tables
+            .iter()
+            .map(|(t, s)| format!("{t} ({} sequence{})", s.len(), if s.len() == 1 { "" } else { "s" }))
+            .collect();
+        parts.join(", ")
+    }
+}
+
+/// Lists `<root>/<table>/sequence=<id>/part-0.parquet`.
+pub fn inventory(root: &Path) -> anyhow::Result<Inventory> {
+    let mut tables = BTreeMap::new();
+    let entries =
+        std::fs::read_dir(root).with_context(|| format!("{}: cannot read table directory", root.display()))?;
+    for entry in entries {
+        let entry = entry.with_context(|| root.display().to_string())?;
+        if !entry.path().is_dir() {
+            continue;
+        }
+        let mut sequences = Vec::new();
+        for part in std::fs::read_dir(entry.path()).with_context(|| entry.path().display().to_string())? {
+            let part = part.with_context(|| entry.path().display().to_string())?;
+            let name = part.file_name().to_string_lossy().into_owned();
+            if let Some(seq) = name.strip_prefix("sequence=")
+                && part.path().join("part-0.parquet").is_file()
+            {
+                sequences.push(seq.to_string());
+            }
+        }
+        if !sequences.is_empty() {
+            sequences.sort();
+            tables.insert(entry.file_name().to_string_lossy().into_owned(), sequences);
+        }
+    }
+    Ok(Inventory { root: root.to_path_buf(), tables })
+}
+
+/// What was planned for each sequence.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Plan {
+    /// Sequences with both an estimate and ground truth: trajectory metrics.
+    pub trajectory: Vec<String>,
+    /// Sequences that have tables but no metric applies, with the reason.
+    pub skipped: Vec<(String, String)>,
+}
+
+/// Picks the metrics that apply: `odometry` + `ground_truth` of the same
+/// sequence -> trajectory metrics.
+#[must_use]
+pub fn plan(inventory: &Inventory) -> Plan {
+    let mut plan = Plan::default();
+    let truth = inventory.sequences(GROUND_TRUTH.name);
+    for seq in inventory.sequences(ODOMETRY.name) {
+        if truth.contains(seq) {
+            plan.trajectory.push(seq.clone());
+        } else {
+            plan.skipped.push((
+                seq.clone(),
+                format!(
+                    "has an {} table but no {} table: trajectory metrics need both",
+                    ODOMETRY.name, GROUND_TRUTH.name
+                ),
+            ));
+        }
+    }
+    for seq in truth.iter().filter(|s| !inventory.sequences(ODOMETRY.name).contains(s)) {
+        plan.skipped
+            .push((seq.clone(), format!("has {} but no estimate ({} table)", GROUND_TRUTH.name, ODOMETRY.name)));
+    }
+    plan
+}
+
+/// Everything computed for one sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrajectoryResult {
+    /// Sequence id.
+    pub sequence: String,
+    /// Estimate and ground truth at the same times, both from the identity.
+    pub association: Association,
+    /// KITTI drift.
+    pub drift: KittiDrift,
+    /// Per-frame relative pose errors.
+    pub rpe: Vec<RelativePoseError>,
+    /// Summary row.
+    pub metrics: TrajectoryMetrics,
+}
+
+impl TrajectoryResult {
+    /// Rows of `drift_per_length`.
+    #[must_use]
+    pub fn drift_rows(&self) -> Vec<DriftPerLength> {
+        self.drift
+            .per_length
+            .iter()
+            .map(|l| DriftPerLength {
+                length_m: l.length_m,
+                segments: l.segments as u64,
+                translational_pct: l.translational_pct,
+                rotational_deg_per_m: l.rotational_deg_per_m,
+            })
+            .collect()
+    }
+
+    /// Rows of `relative_pose_errors`.
+    #[must_use]
+    pub fn rpe_rows(&self) -> Vec<RelativePoseErrorRow> {
+        self.rpe
+            .iter()
+            .map(|e| RelativePoseErrorRow {
+                frame: e.frame as u64,
+                t_ns: e.t_ns,
+                distance_m: e.distance_m,
+                translation_error_m: e.translation_error_m,
+                yaw_error_rad: e.yaw_error_rad,
+            })
+            .collect()
+    }
+}
+
+fn rms(values: impl Iterator<Item = f64>) -> f64 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+}
+
+fn path_length(poses: &[Se2]) -> f64 {
+    trajectory_distances_m(poses).last().copied().unwrap_or(0.0)
+}
+
+/// All trajectory metrics of one sequence.
+pub fn analyze_trajectory(
+    sequence: &str,
+    estimate: &[StampedPose],
+    ground_truth: &[StampedPose],
+    options: &DriftOptions,
+) -> Result<TrajectoryResult, TrajectoryError> {
+    let association = associate(estimate, ground_truth)?;
+    let (est, gt) = (&association.estimate, &association.ground_truth);
+    let drift = kitti_drift(est, gt, options)?;
+    let rpe = relative_pose_errors(&association.t_ns, est, gt)?;
+    let ate = absolute_trajectory_error(est, gt)?;
+    let unaligned = unaligned_errors(est, gt)?;
+    let summary = drift.summary;
+    let (step_frames, step_m) = match options.step {
+        FirstFrameStep::Frames(n) => (Some(n as u64), None),
+        FirstFrameStep::Metres(m) => (None, Some(m)),
+    };
+    let metrics = TrajectoryMetrics {
+        estimate_poses: estimate.len() as u64,
+        associated_poses: association.len() as u64,
+        interpolated_poses: association.interpolated as u64,
+        dropped_poses: association.dropped() as u64,
+        first_t_ns: association.t_ns.first().copied().unwrap_or(0),
+        last_t_ns: association.t_ns.last().copied().unwrap_or(0),
+        path_length_m: drift.path_length_m,
+        estimate_path_length_m: path_length(est),
+        segment_lengths_m: options.segment_lengths_m.clone(),
+        step_frames,
+        step_m,
+        kitti_segments: drift.segments.len() as u64,
+        kitti_translational_pct: summary.map(|s| s.translational_pct),
+        kitti_rotational_deg_per_m: summary.map(|s| s.rotational_deg_per_m),
+        kitti_rotational_deg_per_100m: summary.map(|s| s.rotational_deg_per_100m()),
+        ate_rmse_m: ate.position_rmse_m,
+        ate_max_m: ate.position_max_m,
+        x_rmse_m: unaligned.x_rmse_m,
+        y_rmse_m: unaligned.y_rmse_m,
+        position_rmse_m: unaligned.position_rmse_m,
+        yaw_rmse_rad: unaligned.yaw_rmse_rad,
+        final_position_error_m: unaligned.final_position_error_m,
+        rpe_translation_rmse_m: rms(rpe.iter().map(|e| e.translation_error_m)),
+        rpe_yaw_rmse_rad: rms(rpe.iter().map(|e| e.yaw_error_rad)),
+    };
+    Ok(TrajectoryResult { sequence: sequence.to_string(), association, drift, rpe, metrics })
+}
+
+/// An estimate and (when present) its ground truth, as read from tables.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrajectoryInput {
+    /// The `odometry` table as poses.
+    pub estimate: Vec<StampedPose>,
+    /// The `ground_truth` table, when the sequence has one.
+    pub ground_truth: Option<Vec<StampedPose>>,
+}
+
+/// Reads the `odometry` and `ground_truth` tables of every sequence under
+/// `root` (errors name the file). Sequences without an estimate are absent.
+pub fn read_trajectories(root: &Path) -> anyhow::Result<BTreeMap<String, TrajectoryInput>> {
+    let inv = inventory(root)?;
+    let mut out = BTreeMap::new();
+    if inv.sequences(ODOMETRY.name).is_empty() {
+        return Ok(out);
+    }
+    let estimates = read_table_dir::<OdometryEstimate>(root)?;
+    let mut truths = if inv.sequences(GROUND_TRUTH.name).is_empty() {
+        BTreeMap::new()
+    } else {
+        read_table_dir::<GroundTruthPose>(root)?
+    };
+    for (sequence, rows) in estimates {
+        let estimate =
+            rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
+        let ground_truth = truths.remove(&sequence).map(|g| g.into_iter().map(|p| p.0).collect());
+        out.insert(sequence, TrajectoryInput { estimate, ground_truth });
+    }
+    Ok(out)
+}
+
+/// Analyzes every sequence of `plan`; an error names the sequence and the
+/// table files it came from.
+pub fn analyze_all(root: &Path, plan: &Plan, options: &DriftOptions) -> anyhow::Result<Vec<TrajectoryResult>> {
+    let inputs = read_trajectories(root)?;
+    let mut results = Vec::new();
+    for sequence in &plan.trajectory {
+        let input = inputs.get(sequence).with_context(|| format!("sequence {sequence}: odometry table vanished"))?;
+        let truth = input.ground_truth.as_deref().unwrap_or_default();
+        let result = analyze_trajectory(sequence, &input.estimate, truth, options).with_context(|| {
+            let file = |t: &str| root.join(t).join(format!("sequence={sequence}")).join("part-0.parquet");
+            format!(
+                "sequence {sequence} (estimate {}, ground truth {})",
+                file(ODOMETRY.name).display(),
+                file(GROUND_TRUTH.name).display()
+            )
+        })?;
+        results.push(result);
+    }
+    Ok(results)
+}
