@@ -42,7 +42,11 @@ pub fn one_line(r: &TrajectoryResult) -> String {
         m.ate_rmse_m,
         m.final_position_error_m,
         if m.dropped_poses > 0 {
-            format!(", {} poses outside ground truth dropped", m.dropped_poses)
+            format!(
+                ", {} estimate pose{} outside the ground-truth span dropped",
+                m.dropped_poses,
+                if m.dropped_poses == 1 { "" } else { "s" }
+            )
         } else {
             String::new()
         }

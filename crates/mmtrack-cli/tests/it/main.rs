@@ -3,6 +3,7 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod analyze;
 mod architecture;
 mod cli;
 mod common;

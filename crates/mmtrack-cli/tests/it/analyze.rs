@@ -1,0 +1,282 @@
+//! `mmtrack analyze` and `mmtrack export` end to end, and an independent check
+//! of the KITTI drift: a Python re-implementation of the devkit
+//! (`tests/python/kitti_devkit.py`) reads the exported KITTI files.
+
+use std::path::Path;
+use std::process::Command;
+
+use mmtrack_analysis::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
+use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{GroundTruthPose, RunInfo, read_table, table_path, write_table};
+
+use super::common::{mmtrack, text};
+
+const T0_NS: i64 = 1_600_000_000_123_456_789;
+
+fn estimate_row(t_ns: i64, pose: Se2) -> OdometryEstimate {
+    OdometryEstimate {
+        t_ns,
+        world_from_vehicle: pose,
+        filtered_points: 0,
+        surface_points: 0,
+        correspondences: 0,
+        iterations: 0,
+        cost_m2: 0.0,
+        low_confidence: false,
+    }
+}
+
+/// A ~`frames * 2` m drive: ground truth at 10 Hz with a varying turn rate;
+/// the estimate at 4 Hz, 30 ms after ground-truth samples (so ground truth
+/// is interpolated), composed from the true motion with a 2 % scale error,
+/// a yaw bias and deterministic wobble; its first pose precedes the ground
+/// truth (so it is dropped).
+fn drive(gt_frames: usize) -> (Vec<OdometryEstimate>, Vec<GroundTruthPose>) {
+    let step_ns = 100_000_000;
+    let mut gt = vec![Se2::IDENTITY];
+    for k in 1..gt_frames {
+        let s = k as f64;
+        let step = Se2::new(0.8 + 0.2 * (0.013 * s).sin(), 0.0, 0.02 * (0.021 * s).sin() + 0.004);
+        gt.push(gt[k - 1] * step);
+    }
+    let world_from_gt0 = Se2::new(1234.5, -678.25, 2.0);
+    let truth: Vec<GroundTruthPose> = gt
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            GroundTruthPose(StampedPose { t_ns: T0_NS + k as i64 * step_ns, parent_from_child: world_from_gt0 * *p })
+        })
+        .collect();
+    let mut estimate = vec![estimate_row(T0_NS - 50_000_000, Se2::IDENTITY)];
+    let mut pose = Se2::IDENTITY;
+    let mut previous_truth = gt[0];
+    for (j, k) in (0..gt_frames - 1).step_by(5).enumerate().skip(1) {
+        // Between gt k and k + 1, 30 ms past k (k steps by 2.5 samples on average).
+        let t = T0_NS + k as i64 * step_ns + 30_000_000;
+        let truth_at =
+            gt[k] * Se2::new(0.3 * (gt[k].inverse() * gt[k + 1]).x_m, 0.0, 0.3 * (gt[k].inverse() * gt[k + 1]).yaw_rad);
+        let true_step = previous_truth.inverse() * truth_at;
+        let wobble = (0.7 * j as f64).sin();
+        pose = pose
+            * Se2::new(1.02 * true_step.x_m, true_step.y_m + 0.01 * wobble, true_step.yaw_rad + 2e-3 + 2e-3 * wobble);
+        estimate.push(estimate_row(t, pose));
+        previous_truth = truth_at;
+    }
+    (estimate, truth)
+}
+
+fn write_pair(root: &Path, sequence: &str, estimate: &[OdometryEstimate], truth: Option<&[GroundTruthPose]>) {
+    let run = RunInfo { config_json: "{}".into() };
+    write_table(root, sequence, estimate, &run, Overwrite::Refuse).unwrap();
+    if let Some(truth) = truth {
+        write_table(root, sequence, truth, &run, Overwrite::Refuse).unwrap();
+    }
+}
+
+fn python3() -> Option<&'static str> {
+    let ok = Command::new("python3").args(["-c", "import numpy"]).output().is_ok_and(|o| o.status.success());
+    ok.then_some("python3")
+}
+
+fn relative_diff(a: f64, b: f64) -> f64 {
+    (a - b).abs() / a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
+}
+
+#[test]
+fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (estimate, truth) = drive(4000);
+    write_pair(&dir.path().join("tables"), "drive-a", &estimate, Some(&truth));
+    let lengths = "50,100,150,200,250,300,350,400";
+    let out = mmtrack(dir.path(), &["analyze", "tables", "-o", "analysis", "--segment-lengths-m", lengths]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("drive-a:") && stdout.contains("KITTI") && stdout.contains("analysis/report.md"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("1 estimate pose outside the ground-truth span dropped"), "{stdout}");
+    for plot in ["trajectory.svg", "errors_vs_distance.svg", "drift_per_length.svg"] {
+        let svg = std::fs::read_to_string(dir.path().join("analysis/plots/drive-a").join(plot)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("polyline"), "{plot}");
+    }
+    let report = std::fs::read_to_string(dir.path().join("analysis/report.md")).unwrap();
+    assert!(report.contains("| drive-a |") && report.contains("plots/drive-a/trajectory.svg"), "{report}");
+
+    let tables = dir.path().join("analysis/tables");
+    let metrics: Vec<TrajectoryMetrics> =
+        read_table(&table_path(&tables, "trajectory_metrics", "drive-a").unwrap()).unwrap();
+    let per_length: Vec<DriftPerLength> =
+        read_table(&table_path(&tables, "drift_per_length", "drive-a").unwrap()).unwrap();
+    let rpe: Vec<RelativePoseErrorRow> =
+        read_table(&table_path(&tables, "relative_pose_errors", "drive-a").unwrap()).unwrap();
+    let m = &metrics[0];
+    assert_eq!((m.dropped_poses, m.associated_poses as usize), (1, estimate.len() - 1));
+    assert_eq!(rpe.len(), estimate.len() - 2);
+    assert!(m.path_length_m > 3000.0 && m.kitti_segments > 100, "{m:?}");
+    // The 2 % scale error dominates the translational drift.
+    let t_pct = m.kitti_translational_pct.unwrap();
+    assert!(t_pct > 1.5 && t_pct < 10.0, "{t_pct}");
+
+    let export = mmtrack(dir.path(), &["export", "--format", "kitti", "tables", "-o", "kitti"]);
+    assert!(export.status.success(), "{}", text(&export).1);
+    let kitti = dir.path().join("kitti");
+    let times = std::fs::read_to_string(kitti.join("drive-a.times.txt")).unwrap();
+    assert_eq!(times.lines().count(), estimate.len() - 1);
+    assert!(times.starts_with("0.000000000\n"), "{}", &times[..40]);
+
+    let Some(python) = python3() else {
+        eprintln!("skipped: independent KITTI devkit check: python3 with numpy not available");
+        return;
+    };
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/kitti_devkit.py");
+    let run = Command::new(python)
+        .arg(script)
+        .arg(kitti.join("drive-a.ground_truth.kitti.txt"))
+        .arg(kitti.join("drive-a.estimate.kitti.txt"))
+        .arg(lengths)
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let devkit: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert_eq!(devkit["segments"].as_u64().unwrap(), m.kitti_segments);
+    // 1e-9 relative: both sides read the same f64s; they differ only in the
+    // rounding of the matrix products (ulps), amplified by acos near 1.
+    let t = devkit["t_err"].as_f64().unwrap() * 100.0;
+    let r = devkit["r_err"].as_f64().unwrap().to_degrees();
+    assert!(relative_diff(t, t_pct) < 1e-9, "translational {t} % (devkit) vs {t_pct} %");
+    let ours_r = m.kitti_rotational_deg_per_m.unwrap();
+    assert!(relative_diff(r, ours_r) < 1e-9, "rotational {r} deg/m (devkit) vs {ours_r} deg/m");
+    let theirs = devkit["per_length"].as_array().unwrap();
+    assert_eq!(theirs.len(), per_length.len());
+    for (d, ours) in theirs.iter().zip(&per_length) {
+        assert_eq!(d["segments"].as_u64().unwrap(), ours.segments);
+        let t = d["t_err"].as_f64().unwrap() * 100.0;
+        assert!(relative_diff(t, ours.translational_pct) < 1e-9, "{d} vs {ours:?}");
+        let r = d["r_err"].as_f64().unwrap().to_degrees();
+        assert!(relative_diff(r, ours.rotational_deg_per_m) < 1e-9, "{d} vs {ours:?}");
+    }
+}
+
+#[test]
+fn analyze_refuses_to_overwrite_and_force_replaces_only_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let (estimate, truth) = drive(300);
+    write_pair(&dir.path().join("tables"), "s1", &estimate, Some(&truth));
+    let args = ["analyze", "tables", "-o", "res", "--segment-lengths-m", "10,20,40", "--quiet"];
+    assert!(mmtrack(dir.path(), &args).status.success());
+    let report = std::fs::read(dir.path().join("res/report.md")).unwrap();
+    let again = mmtrack(dir.path(), &args);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(text(&again).1.contains("--force"), "{}", text(&again).1);
+    let forced = mmtrack(dir.path(), &[&args[..], &["--force"]].concat());
+    assert!(forced.status.success(), "{}", text(&forced).1);
+    // Deterministic: the same input gives the same report.
+    assert_eq!(std::fs::read(dir.path().join("res/report.md")).unwrap(), report);
+    // A directory with other files is never replaced, even with --force.
+    std::fs::write(dir.path().join("res/notes.txt"), "mine").unwrap();
+    let refused = mmtrack(dir.path(), &[&args[..], &["--force"]].concat());
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(text(&refused).1.contains("notes.txt"), "{}", text(&refused).1);
+    assert!(dir.path().join("res/notes.txt").is_file() && dir.path().join("res/report.md").is_file());
+    // No staging directory is left behind.
+    let hidden: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+}
+
+#[test]
+fn analyze_says_what_it_looked_for_and_what_is_wrong() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("empty")).unwrap();
+    let out = mmtrack(dir.path(), &["analyze", "empty", "-o", "res"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr.contains("odometry") && stderr.contains("ground_truth") && stderr.contains("found no tables"),
+        "{stderr}"
+    );
+
+    let (estimate, truth) = drive(300);
+    write_pair(&dir.path().join("only-est"), "s1", &estimate, None);
+    let out = mmtrack(dir.path(), &["analyze", "only-est", "-o", "res"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("sequence s1") && stderr.contains("no ground_truth table"), "{stderr}");
+    assert!(!dir.path().join("res").exists());
+
+    let mut backwards = estimate.clone();
+    backwards[7].t_ns = backwards[5].t_ns;
+    write_pair(&dir.path().join("bad-time"), "s2", &backwards, Some(&truth));
+    let out = mmtrack(dir.path(), &["analyze", "bad-time", "-o", "res"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr.contains("sequence s2") && stderr.contains("row 7") && stderr.contains("does not increase"),
+        "{stderr}"
+    );
+
+    let mut nan_truth = truth.clone();
+    nan_truth[3].0.parent_from_child.y_m = f64::NAN;
+    write_pair(&dir.path().join("nan"), "s3", &estimate, Some(&nan_truth));
+    let out = mmtrack(dir.path(), &["analyze", "nan", "-o", "res"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("ground truth: row 3") && stderr.contains("ground_truth/sequence=s3"), "{stderr}");
+    assert!(!dir.path().join("res").exists());
+}
+
+#[test]
+fn short_drive_reports_no_kitti_segment_instead_of_nan() {
+    let dir = tempfile::tempdir().unwrap();
+    let (estimate, truth) = drive(100);
+    write_pair(&dir.path().join("tables"), "s1", &estimate, Some(&truth));
+    let out = mmtrack(dir.path(), &["analyze", "tables", "-o", "res"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("KITTI n/a") && stdout.contains("shorter than the shortest segment length 100 m"),
+        "{stdout}"
+    );
+    let metrics: Vec<TrajectoryMetrics> =
+        read_table(&table_path(&dir.path().join("res/tables"), "trajectory_metrics", "s1").unwrap()).unwrap();
+    assert_eq!((metrics[0].kitti_segments, metrics[0].kitti_translational_pct), (0, None));
+    assert!(metrics[0].ate_rmse_m.is_finite());
+}
+
+#[test]
+fn export_writes_tum_and_boreas_files_that_parse_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let (estimate, truth) = drive(300);
+    write_pair(&dir.path().join("tables"), "s1", &estimate, Some(&truth));
+    write_pair(&dir.path().join("tables"), "s2", &estimate, None);
+    let out = mmtrack(dir.path(), &["export", "--format", "tum", "tables", "-o", "tum"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("s2: no ground_truth table"), "{stdout}");
+    let tum = std::fs::read_to_string(dir.path().join("tum/s1.estimate.tum.txt")).unwrap();
+    assert_eq!(tum.lines().count(), estimate.len());
+    let second: Vec<&str> = tum.lines().nth(1).unwrap().split(' ').collect();
+    assert_eq!(second.len(), 8);
+    assert_eq!(second[0], format!("{}.{:09}", estimate[1].t_ns / 1_000_000_000, estimate[1].t_ns % 1_000_000_000));
+    assert_eq!(second[1].parse::<f64>().unwrap(), estimate[1].world_from_vehicle.x_m);
+    let gt = std::fs::read_to_string(dir.path().join("tum/s1.ground_truth.tum.txt")).unwrap();
+    assert_eq!(gt.lines().count(), truth.len());
+    // Refuses to overwrite; one sequence on request.
+    let again = mmtrack(dir.path(), &["export", "--format", "tum", "tables", "-o", "tum", "--sequence", "s1"]);
+    assert_eq!(again.status.code(), Some(1));
+    let missing = mmtrack(dir.path(), &["export", "--format", "tum", "tables", "-o", "x", "--sequence", "nope"]);
+    assert!(text(&missing).1.contains("sequences: s1, s2"), "{}", text(&missing).1);
+
+    let out = mmtrack(dir.path(), &["export", "--format", "boreas", "tables", "-o", "b", "--sequence", "s1"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let boreas = std::fs::read_to_string(dir.path().join("b/boreas/estimate/s1.txt")).unwrap();
+    let first: Vec<f64> = boreas.lines().next().unwrap().split(' ').map(|v| v.parse().unwrap()).collect();
+    assert_eq!(first.len(), 13);
+    assert_eq!(first[0], (estimate[1].t_ns / 1000) as f64);
+    assert!(dir.path().join("b/boreas/ground_truth/s1.txt").is_file());
+}
