@@ -171,7 +171,7 @@ mod tests {
     use super::*;
 
     fn drive() -> Vec<Se2> {
-        (0..100).map(|i| f64::from(i)).map(|s| Se2::new(s, 5.0 * (0.1 * s).sin(), 0.3 * (0.1 * s).cos())).collect()
+        (0..100).map(f64::from).map(|s| Se2::new(s, 5.0 * (0.1 * s).sin(), 0.3 * (0.1 * s).cos())).collect()
     }
 
     #[test]
