@@ -8,6 +8,11 @@ use num_complex::Complex64;
 /// 0.717 ms apart, a set every 10 ms); `set_index` and `snapshot_index` keep that
 /// structure. MIMO sounders give one snapshot per antenna pair (`tx_antenna`,
 /// `rx_antenna`); SISO recordings use 0 for both.
+///
+/// Some receivers estimate the first (leading-edge) path themselves, e.g. the
+/// DW1000's `HLP` register; [`CirSnapshot::first_path_hint_s`] keeps that
+/// estimate on the same delay axis as the taps so algorithms can be compared
+/// against it. It is a hint from the device, not ground truth.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CirSnapshot {
     /// Measurement time, nanoseconds.
@@ -28,15 +33,22 @@ pub struct CirSnapshot {
     pub delay_offset_s: f64,
     /// Complex tap amplitudes (linear, unitless: the sounder's own scale).
     pub taps: Vec<Complex64>,
+    /// The receiver's own first-path estimate, seconds, on the delay axis of
+    /// the taps (a fractional tap index `i` is `delay_offset_s + i *
+    /// tap_spacing_s`); `None` when the source gives none.
+    pub first_path_hint_s: Option<f64>,
 }
 
 impl CirSnapshot {
     /// Checks the invariants: finite positive carrier and tap spacing, finite
-    /// offset, at least one tap, all taps finite.
+    /// offset and first-path hint, at least one tap, all taps finite.
     pub fn validate(&self) -> Result<(), CoreError> {
         ensure_finite("carrier_hz", self.carrier_hz)?;
         ensure_finite("tap_spacing_s", self.tap_spacing_s)?;
         ensure_finite("delay_offset_s", self.delay_offset_s)?;
+        if let Some(hint) = self.first_path_hint_s {
+            ensure_finite("first_path_hint_s", hint)?;
+        }
         if self.tap_spacing_s <= 0.0 {
             return Err(CoreError::OutOfRange {
                 field: "tap_spacing_s",
@@ -83,6 +95,7 @@ mod tests {
             tap_spacing_s: 1e-9,
             delay_offset_s: 0.0,
             taps: vec![Complex64::new(1.0, -1.0); 4],
+            first_path_hint_s: Some(1.5e-9),
         }
     }
 
@@ -101,5 +114,8 @@ mod tests {
         let mut s = snapshot();
         s.tap_spacing_s = -1e-9;
         assert!(matches!(s.validate(), Err(CoreError::OutOfRange { field: "tap_spacing_s", .. })));
+        let mut s = snapshot();
+        s.first_path_hint_s = Some(f64::INFINITY);
+        assert!(matches!(s.validate(), Err(CoreError::NotFinite { field: "first_path_hint_s", .. })));
     }
 }

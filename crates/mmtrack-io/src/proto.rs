@@ -378,6 +378,9 @@ pub struct CirSnapshot {
     /// See [`CIR_SNAPSHOT_SPEC`].
     #[prost(double, repeated, tag = "10")]
     pub taps_im: Vec<f64>,
+    /// See [`CIR_SNAPSHOT_SPEC`].
+    #[prost(double, optional, tag = "11")]
+    pub first_path_hint_s: Option<f64>,
 }
 
 /// Schema of [`CirSnapshot`].
@@ -395,6 +398,14 @@ pub const CIR_SNAPSHOT_SPEC: MessageSpec = MessageSpec {
         field("delay_offset_s", 8, Double, One, "s", "delay of tap 0"),
         field("taps_re", 9, Double, Repeated, "", "real parts of the complex taps (sounder's linear scale)"),
         field("taps_im", 10, Double, Repeated, "", "imaginary parts of the complex taps, same length as taps_re"),
+        field(
+            "first_path_hint_s",
+            11,
+            Double,
+            Optional,
+            "s",
+            "the receiver's own first-path (leading-edge) estimate on the taps' delay axis, e.g. DW1000 HLP; absent when the source gives none",
+        ),
     ],
 };
 

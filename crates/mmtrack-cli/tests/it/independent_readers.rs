@@ -80,6 +80,7 @@ fn write_samples(dir: &Path) {
         tap_spacing_s: 1e-9,
         delay_offset_s: 0.0,
         taps: (0..16).map(|k| Complex64::new(k as f64, -(k as f64))).collect(),
+        first_path_hint_s: Some(2.5e-9),
     };
     writer.write_cir(&cir).unwrap();
     writer.finish().unwrap();

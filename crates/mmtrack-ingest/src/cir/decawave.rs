@@ -39,6 +39,9 @@
 //! - Delay: tap 0 is at delay 0 (the accumulator's own start) by default;
 //!   [`DecawaveDelayReference::FirstPath`] puts the chip's first path (`HLP`)
 //!   at delay 0, as the dataset authors' `loadCIR.py` does.
+//! - `HLP` is also kept on the snapshot as
+//!   [`CirSnapshot::first_path_hint_s`] = `delay_offset_s + HLP * tap_spacing_s`
+//!   (0 under [`DecawaveDelayReference::FirstPath`]).
 //! - `set_index` is the index of the frame among the `RX OK` frames (0-based;
 //!   error messages use the same "frame N"), `snapshot_index` and antennas 0.
 //!
@@ -300,6 +303,7 @@ pub fn parse_decawave_log_detailed(
                 tap_spacing_s: config.tap_spacing_s,
                 delay_offset_s,
                 taps,
+                first_path_hint_s: Some(delay_offset_s + header.hlp_taps * config.tap_spacing_s),
             };
             cir.validate().map_err(|e| bad(p.line, "CIR", e.to_string()))?;
             log.frames.push(DecawaveFrame {
@@ -532,6 +536,8 @@ mod tests {
             assert_eq!((a.cir.set_index, b.cir.set_index), (0, 1));
             assert_eq!((a.cir.carrier_hz, a.cir.delay_offset_s), (3993.6e6, 0.0));
             assert!((a.cir.tap_spacing_s - 1.001_602_564e-9).abs() < 1e-18);
+            // HLP kept as a delay: 745.3125 taps of 1.0016 ns (1e-21 s: rounding of one product).
+            assert!((a.cir.first_path_hint_s.unwrap() - 745.3125 / 998.4e6).abs() < 1e-21);
             // 0x20 ticks across the wrap = 32 / 63.8976 GHz = 0.5 ns, rounded to 1 ns.
             assert_eq!((a.cir.t_ns, b.cir.t_ns), (0, 1));
             assert_eq!(text.lines().nth(b.header_line - 1).map(|l| l.starts_with("RX OK")), Some(true));
@@ -550,6 +556,8 @@ mod tests {
         assert_eq!(frames.iter().map(|f| f.cir.t_ns).collect::<Vec<_>>(), [1_000, 350_001_000]);
         let f = &frames[0];
         assert!((f.cir.delay_s(745) - (745.0 - 745.3125) * f.cir.tap_spacing_s).abs() < 1e-18);
+        // The HLP hint sits at delay 0 when the first path is the reference.
+        assert_eq!(f.cir.first_path_hint_s, Some(0.0));
         // The frame period does not need RC.
         let no_rc = sample_log().replace("RC(00FF FFFFFFF0), ", "");
         assert_eq!(parse_decawave_log(Path::new("1.log"), &no_rc, &config).unwrap().len(), 2);

@@ -514,6 +514,7 @@ fn snapshots(path: &Path, array: &MatArray, layout: &MatCirLayout) -> Result<Vec
                 tap_spacing_s: layout.tap_spacing_s,
                 delay_offset_s: layout.delay_offset_s,
                 taps,
+                first_path_hint_s: None,
             };
             snapshot.validate().map_err(|e| bad(&format!("taps of TX {tx}, RX {rx}"), e.to_string()))?;
             out.push(snapshot);

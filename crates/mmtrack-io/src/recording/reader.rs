@@ -261,6 +261,7 @@ impl RecordingReader {
                     tap_spacing_s: c.tap_spacing_s,
                     delay_offset_s: c.delay_offset_s,
                     taps,
+                    first_path_hint_s: c.first_path_hint_s,
                 })));
             }
         }

@@ -448,6 +448,7 @@ impl RecordingWriter {
             delay_offset_s: cir.delay_offset_s,
             taps_re: cir.taps.iter().map(|t| t.re).collect(),
             taps_im: cir.taps.iter().map(|t| t.im).collect(),
+            first_path_hint_s: cir.first_path_hint_s,
         };
         self.write_spec(CIR_TOPIC, cir.t_ns, &message, None)?;
         Ok(())

@@ -239,6 +239,12 @@ pub const CIR_SNAPSHOTS: TableSpec = TableSpec {
         col("delay_offset_s", Float64, "s", "delay of tap 0"),
         col("taps_re", ListFloat64, "", "real parts of the taps"),
         col("taps_im", ListFloat64, "", "imaginary parts of the taps"),
+        nullable(
+            "first_path_hint_s",
+            Float64,
+            "s",
+            "the receiver's own first-path estimate on the taps' delay axis (e.g. DW1000 HLP); null when not given",
+        ),
     ],
 };
 
@@ -259,6 +265,7 @@ impl TableRow for CirSnapshot {
             f64s(rows.iter().map(|r| r.delay_offset_s)),
             list_f64(re.iter().map(Vec::as_slice)),
             list_f64(im.iter().map(Vec::as_slice)),
+            Arc::new(rows.iter().map(|r| r.first_path_hint_s).collect::<Float64Array>()),
         ]
     }
 
@@ -266,6 +273,7 @@ impl TableRow for CirSnapshot {
         let (t, set, snap, tx, rx) =
             (c.i64("t_ns")?, c.u64("set_index")?, c.u32("snapshot_index")?, c.u32("tx_antenna")?, c.u32("rx_antenna")?);
         let (fc, dt, d0) = (c.f64("carrier_hz")?, c.f64("tap_spacing_s")?, c.f64("delay_offset_s")?);
+        let hint = c.f64("first_path_hint_s")?;
         (0..c.num_rows())
             .map(|i| {
                 let re = c.list_f64("taps_re", i)?;
@@ -283,6 +291,7 @@ impl TableRow for CirSnapshot {
                     tap_spacing_s: dt.value(i),
                     delay_offset_s: d0.value(i),
                     taps: re.into_iter().zip(im).map(|(re, im)| Complex64::new(re, im)).collect(),
+                    first_path_hint_s: hint.is_valid(i).then(|| hint.value(i)),
                 })
             })
             .collect()

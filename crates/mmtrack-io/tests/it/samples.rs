@@ -72,6 +72,8 @@ pub fn cir(set_index: u64, snapshot_index: u32, taps: usize) -> CirSnapshot {
         tap_spacing_s: 1e-9,
         delay_offset_s: -2.5e-9,
         taps: (0..taps).map(|k| Complex64::new(AWKWARD[k % 6] * 1e-3, (k as f64).sin() * 1e-7)).collect(),
+        // Present on even sets, absent on odd ones: both sides of the optional field round-trip.
+        first_path_hint_s: set_index.is_multiple_of(2).then_some(3.25e-9),
     }
 }
 

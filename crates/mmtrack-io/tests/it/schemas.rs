@@ -120,6 +120,7 @@ fn descriptors_match_prost_encoding() {
         delay_offset_s: 1.0,
         taps_re: vec![1.0],
         taps_im: vec![1.0],
+        first_path_hint_s: Some(1.0),
     });
     assert_eq!(ALL_SPECS.len(), 4, "a new message needs a sample above");
 }
