@@ -17,7 +17,7 @@ fn lengths(options: &DriftOptions) -> String {
 
 fn step(options: &DriftOptions) -> String {
     match options.step {
-        crate::trajectory::FirstFrameStep::Frames(n) => format!("every {n} frames"),
+        crate::trajectory::FirstFrameStep::Frames(n) => format!("every {n} frame{}", if n == 1 { "" } else { "s" }),
         crate::trajectory::FirstFrameStep::Metres(m) => format!("every {m} m"),
     }
 }
