@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
+use mmtrack_ingest::cir::{CirFormat, ingest_cir};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_ingest::ros2::{self, Ros2Topics};
@@ -82,6 +83,36 @@ impl PoseFormat {
             Self::Tum => "tum",
             Self::Kitti => "kitti",
             Self::Oxford => "oxford",
+        }
+    }
+}
+
+/// CIR file formats.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum CirFormatArg {
+    /// NumPy .npy (complex64/complex128, or real with a trailing I/Q axis of 2).
+    Npy,
+    /// NumPy .npz archive (the sidecar's `variable` picks the array).
+    Npz,
+    /// MATLAB v5/v7 .mat (the sidecar's `variable` picks the array).
+    Mat,
+    /// SigMF .sigmf-meta + .sigmf-data (cf32_le, ci16_le).
+    Sigmf,
+    /// CSV, one snapshot per row: [t_ns,set_index,snapshot_index,tx_antenna,rx_antenna,]re_0,im_0,re_1,im_1,...
+    Csv,
+    /// DecaWave DecaRanging accumulator log (DW1000; HLP kept as first-path hint).
+    Decawave,
+}
+
+impl CirFormatArg {
+    fn format(self) -> CirFormat {
+        match self {
+            Self::Npy => CirFormat::Npy,
+            Self::Npz => CirFormat::Npz,
+            Self::Mat => CirFormat::Mat,
+            Self::Sigmf => CirFormat::Sigmf,
+            Self::Csv => CirFormat::Csv,
+            Self::Decawave => CirFormat::Decawave,
         }
     }
 }
@@ -169,11 +200,22 @@ enum Kind {
         #[arg(long, value_name = "RECORDING.mcap")]
         add_to: Option<PathBuf>,
     },
-    /// Channel-sounder CIR/CFR files (not built yet: issue #3).
+    /// Channel-sounder CIR/CFR file (NumPy, MATLAB, SigMF, CSV, DecaWave log) into a new recording.
+    ///
+    /// A sidecar TOML gives what the file lacks (carrier_hz, tap_spacing_s or
+    /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable);
+    /// see the mmtrack_ingest::cir::sidecar docs for every key.
     Cir {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
+        /// The file (.npy, .npz, .mat, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
+        input: PathBuf,
+        /// File format.
+        #[arg(long, value_enum)]
+        format: CirFormatArg,
+        /// Sidecar TOML with what the file does not say.
+        #[arg(long, value_name = "SIDECAR.toml")]
+        sidecar: Option<PathBuf>,
+        #[command(flatten)]
+        output: OutputArgs,
     },
     /// ROS 2 MCAP bag (cdr): poses from nav_msgs/Odometry or PoseWithCovarianceStamped, fixes from NavSatFix.
     ///
@@ -268,7 +310,9 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
-        Kind::Cir { .. } => crate::not_built("ingest cir", 3),
+        Kind::Cir { input, format, sidecar, output } => {
+            cir_file(&input, format.format(), sidecar.as_deref(), &output, quiet)
+        }
         Kind::Ros2 { input, output, pose_topic, poses_are_ground_truth, gnss_topic } => {
             let topics = Ros2Topics {
                 pose_topic: (pose_topic != "none").then_some(pose_topic),
@@ -333,6 +377,37 @@ pub fn oxford_folder(
                 String::new()
             },
             report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Ingests one CIR file, with a progress bar.
+fn cir_file(
+    input: &std::path::Path,
+    format: CirFormat,
+    sidecar: Option<&std::path::Path>,
+    output: &OutputArgs,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let bar = progress::bar(0, "ingest cir", "snapshots", quiet);
+    let report = ingest_cir(format, input, sidecar, &output.output, &output.recording_options(), &mut |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    if !quiet {
+        let (fewest, most) = report.taps;
+        let taps = if fewest == most { format!("{most}") } else { format!("{fewest}-{most}") };
+        println!(
+            "{}: {} CIR snapshots of {taps} taps, {:.4} ns apart; {} with a first-path hint; {} receptions skipped; domain {}",
+            report.output.path.display(),
+            report.snapshots,
+            report.tap_spacing_s * 1e9,
+            report.with_first_path_hint,
+            report.skipped,
+            report.metadata.get("cir.domain").and_then(|d| d.split(':').next()).unwrap_or("cir"),
         );
     }
     Ok(ExitCode::SUCCESS)

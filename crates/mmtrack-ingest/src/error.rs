@@ -35,6 +35,16 @@ pub enum IngestError {
         /// What is wrong and what was expected.
         detail: String,
     },
+    /// A sidecar file (TOML) is malformed or inconsistent.
+    #[error("{path}: key `{key}`: {detail}")]
+    BadSidecar {
+        /// The sidecar file.
+        path: PathBuf,
+        /// The key at fault (`(syntax)` for a TOML syntax error).
+        key: String,
+        /// What is wrong and what was expected.
+        detail: String,
+    },
     /// Writing the recording failed.
     #[error(transparent)]
     Io(#[from] mmtrack_io::IoError),

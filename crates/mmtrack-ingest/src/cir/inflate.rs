@@ -59,6 +59,13 @@ pub(crate) fn zlib_decompress(input: &[u8], max_output: usize) -> Result<Vec<u8>
     Ok(output)
 }
 
+/// Decompresses a raw DEFLATE stream (no zlib header or checksum; ZIP
+/// members, whose CRC-32 the caller checks).
+pub(crate) fn inflate_raw(input: &[u8], max_output: usize) -> Result<Vec<u8>, String> {
+    let mut bits = BitReader { data: input, pos: 0, bit_buf: 0, bit_count: 0 };
+    inflate(&mut bits, max_output)
+}
+
 pub(super) fn adler32(data: &[u8]) -> u32 {
     const MOD: u32 = 65_521;
     let (mut a, mut b) = (1u32, 0u32);

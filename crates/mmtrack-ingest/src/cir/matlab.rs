@@ -101,6 +101,32 @@ pub fn read_mat_cir_file(path: &Path, layout: &MatCirLayout) -> Result<Vec<CirSn
     read_mat_cir(path, &bytes, layout)
 }
 
+/// The numeric array `variable` as a complex array in MATLAB's column-major
+/// order, for the sidecar-driven reader ([`super::read_cir_file`]). A real
+/// array is refused unless `allow_real` (see the module docs).
+pub(crate) fn read_mat_array(
+    path: &Path,
+    bytes: &[u8],
+    variable: &str,
+    allow_real: bool,
+) -> Result<super::array::NdComplex, IngestError> {
+    let array = find_variable(path, bytes, variable)?;
+    if array.imag.is_none() && !allow_real {
+        return Err(IngestError::BadRecord {
+            path: path.to_path_buf(),
+            record: format!("variable `{variable}` ({})", array.describe()),
+            field: "complex flag".into(),
+            detail: "a real array; expected complex taps (set `allow_real = true` in the sidecar to read it with \
+                     zero imaginary part)"
+                .into(),
+        });
+    }
+    let imag = array.imag.as_deref();
+    let values =
+        array.real.iter().enumerate().map(|(i, &re)| Complex64::new(re, imag.map_or(0.0, |im| im[i]))).collect();
+    Ok(super::array::NdComplex::new(array.dims, values, true))
+}
+
 fn check_layout(path: &Path, layout: &MatCirLayout) -> Result<(), IngestError> {
     let bad = |detail: String| Err(IngestError::BadLayout { path: path.to_path_buf(), detail });
     if !(layout.tap_spacing_s.is_finite() && layout.tap_spacing_s > 0.0) {

@@ -6,16 +6,28 @@
 //! - [`matlab`]: numeric arrays in MATLAB v5/v7 `.mat` files (compressed or
 //!   not), one CIR per antenna pair, with a caller-given [`matlab::MatCirLayout`]
 //!   saying which dimension holds the taps and the antennas.
+//! - NumPy `.npy` / `.npz`, SigMF and CSV files, read through
+//!   [`read_cir_file`] with a [`CirSidecar`] (TOML) giving what the file lacks;
+//!   `.mat` files go the same way there.
+//! - [`ingest_cir`] writes any of them into a recording on `/channel/cir`.
 //!
-//! Both are pure parse functions on text or bytes, plus a helper reading the
+//! All are pure parse functions on text or bytes, plus helpers reading the
 //! file; errors name the file, the record and the field.
 
+mod array;
+mod csv_cir;
 pub mod decawave;
 mod inflate;
+mod ingest;
 pub mod matlab;
+mod npy;
+pub mod sidecar;
+mod sigmf;
 
 pub use decawave::{
     DecawaveConfig, DecawaveDelayReference, DecawaveFrame, DecawaveLog, DecawaveTimeBase, parse_decawave_log,
     parse_decawave_log_detailed, read_decawave_log,
 };
+pub use ingest::{CirFile, CirFormat, CirIngestReport, ingest_cir, read_cir_file};
 pub use matlab::{MatCirLayout, read_mat_cir, read_mat_cir_file};
+pub use sidecar::{AxisRole, CirSidecar, Domain};

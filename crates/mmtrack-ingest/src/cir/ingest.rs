@@ -1,0 +1,259 @@
+//! One entry point for every CIR format: read a file (with its sidecar) into
+//! snapshots, and write them into a recording on `/channel/cir`.
+//!
+//! The whole file is read and checked before the recording is created, so a
+//! bad input leaves no output (and the writer renames into place only on
+//! success). What the reader assumed goes into the recording metadata
+//! (`cir.*` keys): format, domain and the CFR conversion, axes, sidecar,
+//! time origin.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use mmtrack_core::CirSnapshot;
+use mmtrack_io::RecordingOptions;
+use mmtrack_io::recording::WriteSummary;
+use mmtrack_io::recording::channels::CIR_TOPIC;
+
+use super::array::{NdComplex, cut_snapshots, resolve_axes};
+use super::decawave::{DecawaveConfig, DecawaveTimeBase, read_decawave_log};
+use super::sidecar::{CirSidecar, Domain, TapSpacing};
+use crate::error::os_err;
+use crate::{IngestError, Progress};
+
+/// The formats `mmtrack ingest cir --format` reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CirFormat {
+    /// NumPy `.npy`.
+    Npy,
+    /// NumPy `.npz` archive.
+    Npz,
+    /// MATLAB v5/v7 `.mat`.
+    Mat,
+    /// SigMF meta + data.
+    Sigmf,
+    /// CSV, one snapshot per row.
+    Csv,
+    /// DecaWave DecaRanging accumulator log.
+    Decawave,
+}
+
+/// Sidecar keys of the sampled axes and timing, used by every array format.
+const COMMON_KEYS: &[&str] = &[
+    "carrier_hz",
+    "tap_spacing_s",
+    "bandwidth_hz",
+    "subcarrier_spacing_hz",
+    "domain",
+    "delay_offset_s",
+    "t0_ns",
+    "snapshot_period_s",
+    "snapshots_per_set",
+    "set_period_s",
+];
+
+impl CirFormat {
+    /// The `--format` name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Npy => "npy",
+            Self::Npz => "npz",
+            Self::Mat => "mat",
+            Self::Sigmf => "sigmf",
+            Self::Csv => "csv",
+            Self::Decawave => "decawave",
+        }
+    }
+
+    /// Sidecar keys this format uses.
+    fn keys(self) -> Vec<&'static str> {
+        let extra: &[&str] = match self {
+            Self::Npy => &["axes"],
+            Self::Npz => &["axes", "variable"],
+            Self::Mat => &["axes", "variable", "allow_real"],
+            Self::Sigmf => &["taps_per_snapshot"],
+            Self::Csv => &[],
+            Self::Decawave => return vec!["carrier_hz", "tap_spacing_s", "bandwidth_hz", "t0_ns", "snapshot_period_s"],
+        };
+        COMMON_KEYS.iter().chain(extra).copied().collect()
+    }
+}
+
+/// Snapshots read from one file, and what the reader assumed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CirFile {
+    /// In time order, then TX, then RX.
+    pub snapshots: Vec<CirSnapshot>,
+    /// `cir.*` recording metadata.
+    pub metadata: BTreeMap<String, String>,
+    /// Receptions the format tolerates and the reader skipped (DecaWave `RX E` frames).
+    pub skipped: usize,
+}
+
+/// Reads a CIR file of `format`, with its sidecar (`None`: no sidecar).
+pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSidecar>) -> Result<CirFile, IngestError> {
+    let empty = CirSidecar::empty();
+    let sidecar = sidecar.unwrap_or(&empty);
+    sidecar.check_keys_apply(format.name(), &format.keys())?;
+    let mut metadata = BTreeMap::new();
+    metadata.insert("cir.format".to_string(), format.name().to_string());
+    let sidecar_name =
+        if sidecar.path.as_os_str().is_empty() { "none".into() } else { sidecar.path.display().to_string() };
+    metadata.insert("cir.sidecar".into(), sidecar_name);
+    let domain = match sidecar.domain {
+        Domain::Cir => "cir: the file holds impulse responses".to_string(),
+        Domain::Cfr => "cfr: frequency responses turned into CIRs by the inverse DFT h[n] = (1/N) sum_k H[k] \
+                        exp(+j 2 pi k n / N), bins in file order"
+            .to_string(),
+    };
+    metadata.insert("cir.domain".into(), domain);
+    let origin = if sidecar.t0_ns.is_some() { "t0_ns of the sidecar" } else { "none given: snapshot 0 at t = 0" };
+    metadata.insert("cir.time_origin".into(), origin.into());
+    let (snapshots, skipped) = match format {
+        CirFormat::Decawave => return read_decawave(input, sidecar, metadata),
+        CirFormat::Csv => {
+            let text = std::fs::read_to_string(input).map_err(os_err(input))?;
+            (super::csv_cir::parse_cir_csv(input, &text, sidecar)?, 0)
+        }
+        CirFormat::Sigmf => {
+            let s = super::sigmf::read_sigmf(input, sidecar)?;
+            let mut filled = sidecar.clone();
+            filled.carrier_hz = filled.carrier_hz.or(s.frequency_hz);
+            if filled.t0_ns.is_none() && s.t0_ns.is_some() {
+                filled.t0_ns = s.t0_ns;
+                metadata.insert("cir.time_origin".into(), "SigMF captures[0].core:datetime".into());
+            }
+            metadata.insert("cir.sigmf_datatype".into(), s.datatype.clone());
+            let rate = s.sample_rate_hz.map(|r| 1.0 / r);
+            (cut_snapshots(input, &s.array, &filled, "data", rate)?, 0)
+        }
+        CirFormat::Npy | CirFormat::Npz | CirFormat::Mat => {
+            let (record, array) = read_array(format, input, sidecar)?;
+            let axes = resolve_axes(input, &array, sidecar, &record)?;
+            let axes: Vec<&str> = axes.iter().map(|a| a.as_str()).collect();
+            metadata.insert("cir.axes".into(), format!("{} (shape {:?})", axes.join(", "), array.dims));
+            metadata.insert("cir.array".into(), record.clone());
+            (cut_snapshots(input, &array, sidecar, &record, None)?, 0)
+        }
+    };
+    Ok(CirFile { snapshots, metadata, skipped })
+}
+
+fn read_array(format: CirFormat, input: &Path, sidecar: &CirSidecar) -> Result<(String, NdComplex), IngestError> {
+    let bytes = std::fs::read(input).map_err(os_err(input))?;
+    match format {
+        CirFormat::Npy => Ok(("array".into(), super::npy::parse_npy(input, "array", &bytes)?)),
+        CirFormat::Npz => {
+            let (name, array) = super::npy::parse_npz(input, &bytes, sidecar.variable.as_deref())?;
+            Ok((format!("member `{name}.npy`"), array))
+        }
+        _ => {
+            let Some(variable) = sidecar.variable.as_deref() else {
+                return Err(
+                    sidecar.error("variable", format!("required: name the MATLAB variable of {}", input.display()))
+                );
+            };
+            let array = super::matlab::read_mat_array(input, &bytes, variable, sidecar.allow_real)?;
+            Ok((format!("variable `{variable}`"), array))
+        }
+    }
+}
+
+fn read_decawave(
+    input: &Path,
+    sidecar: &CirSidecar,
+    mut metadata: BTreeMap<String, String>,
+) -> Result<CirFile, IngestError> {
+    let mut config = DecawaveConfig::default();
+    if let Some(carrier) = sidecar.carrier_hz {
+        config.carrier_hz = carrier;
+    }
+    if let Some(spacing) = sidecar.tap_spacing {
+        config.tap_spacing_s = match spacing {
+            TapSpacing::Seconds(s) => s,
+            TapSpacing::Bandwidth(b) => 1.0 / b,
+            TapSpacing::SubcarrierSpacing(_) => config.tap_spacing_s,
+        };
+    }
+    config.t0_ns = sidecar.t0_ns.unwrap_or(0);
+    let time_base = if let Some(period) = sidecar.snapshot_period_s {
+        let period_ns = (period * 1e9).round() as i64;
+        if period_ns <= 0 {
+            return Err(sidecar.error("snapshot_period_s", format!("{period} s rounds to 0 ns")));
+        }
+        config.time_base = DecawaveTimeBase::FramePeriod { period_ns };
+        "frame period of the sidecar (snapshot_period_s)"
+    } else {
+        "DW1000 RX timestamp (RC), unwrapped; first frame at t0_ns"
+    };
+    let log = read_decawave_log(input, &config)?;
+    metadata.insert("cir.decawave_time_base".into(), time_base.into());
+    metadata.insert(
+        "cir.first_path_hint".into(),
+        "DW1000 HLP (hardware leading-edge index) as first_path_hint_s = HLP * tap_spacing_s".into(),
+    );
+    if let Some(channel) = log.channel {
+        metadata.insert("cir.decawave_channel".into(), channel.to_string());
+    }
+    let skipped = log.skipped_receptions.len();
+    Ok(CirFile { snapshots: log.frames.into_iter().map(|f| f.cir).collect(), metadata, skipped })
+}
+
+/// What [`ingest_cir`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CirIngestReport {
+    /// The recording written.
+    pub output: WriteSummary,
+    /// Snapshots written.
+    pub snapshots: usize,
+    /// Fewest and most taps of a snapshot.
+    pub taps: (usize, usize),
+    /// Tap spacing of the first snapshot, seconds.
+    pub tap_spacing_s: f64,
+    /// Snapshots carrying a first-path hint.
+    pub with_first_path_hint: usize,
+    /// Receptions skipped (DecaWave `RX E`).
+    pub skipped: usize,
+    /// The `cir.*` metadata written.
+    pub metadata: BTreeMap<String, String>,
+}
+
+/// Reads `input` and writes its snapshots into a new recording `out`.
+pub fn ingest_cir(
+    format: CirFormat,
+    input: &Path,
+    sidecar: Option<&Path>,
+    out: &Path,
+    recording: &RecordingOptions,
+    progress: Progress<'_>,
+) -> Result<CirIngestReport, IngestError> {
+    let sidecar = sidecar.map(CirSidecar::read).transpose()?;
+    let file = read_cir_file(format, input, sidecar.as_ref())?;
+    let Some(first) = file.snapshots.first() else {
+        return Err(IngestError::BadLayout { path: input.to_path_buf(), detail: "holds no CIR snapshots".into() });
+    };
+    let tap_spacing_s = first.tap_spacing_s;
+    let source = format!("cir-{}:{}", format.name(), absolute(input).display());
+    let mut writer = crate::target::open_writer(out, None, &source, file.metadata.clone(), &[CIR_TOPIC], recording)?;
+    let total = file.snapshots.len() as u64;
+    for (i, snapshot) in file.snapshots.iter().enumerate() {
+        writer.write_cir(snapshot)?;
+        progress(i as u64 + 1, total);
+    }
+    let output = writer.finish()?;
+    let taps = file.snapshots.iter().map(|s| s.taps.len());
+    Ok(CirIngestReport {
+        output,
+        snapshots: file.snapshots.len(),
+        taps: (taps.clone().min().unwrap_or(0), taps.max().unwrap_or(0)),
+        tap_spacing_s,
+        with_first_path_hint: file.snapshots.iter().filter(|s| s.first_path_hint_s.is_some()).count(),
+        skipped: file.skipped,
+        metadata: file.metadata,
+    })
+}
+
+fn absolute(path: &Path) -> PathBuf {
+    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+}

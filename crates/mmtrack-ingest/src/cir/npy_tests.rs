@@ -1,0 +1,173 @@
+use super::*;
+
+/// A `.npy` (version 1) with the given header dict and data.
+pub(crate) fn npy(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
+    let dict = format!(
+        "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}",
+        if fortran { "True" } else { "False" }
+    );
+    let mut header = dict.into_bytes();
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(b' ');
+    }
+    header.push(b'\n');
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend(header);
+    out.extend_from_slice(data);
+    out
+}
+
+/// A stored (uncompressed) ZIP of `(name, bytes)` members.
+pub(crate) fn stored_zip(members: &[(&str, Vec<u8>)]) -> Vec<u8> {
+    let (mut out, mut central) = (Vec::new(), Vec::new());
+    for (name, data) in members {
+        let offset = out.len() as u32;
+        let (crc, len) = (crc32(data), data.len() as u32);
+        let common = |out: &mut Vec<u8>| {
+            out.extend_from_slice(&20u16.to_le_bytes()); // version needed
+            out.extend_from_slice(&[0, 0, 0, 0, 0, 0, 0, 0]); // flags, method 0, time, date
+            out.extend_from_slice(&crc.to_le_bytes());
+            out.extend_from_slice(&len.to_le_bytes());
+            out.extend_from_slice(&len.to_le_bytes());
+            out.extend_from_slice(&(name.len() as u16).to_le_bytes());
+            out.extend_from_slice(&0u16.to_le_bytes()); // extra
+        };
+        out.extend_from_slice(&0x0403_4b50u32.to_le_bytes());
+        common(&mut out);
+        out.extend_from_slice(name.as_bytes());
+        out.extend_from_slice(data);
+        central.extend_from_slice(&0x0201_4b50u32.to_le_bytes());
+        central.extend_from_slice(&20u16.to_le_bytes()); // version made by
+        common(&mut central);
+        central.extend_from_slice(&[0; 6]); // comment, disk, internal attrs
+        central.extend_from_slice(&0u32.to_le_bytes()); // external attrs
+        central.extend_from_slice(&offset.to_le_bytes());
+        central.extend_from_slice(name.as_bytes());
+    }
+    let cd_offset = out.len() as u32;
+    out.extend_from_slice(&central);
+    out.extend_from_slice(&0x0605_4b50u32.to_le_bytes());
+    out.extend_from_slice(&[0, 0, 0, 0]);
+    out.extend_from_slice(&(members.len() as u16).to_le_bytes());
+    out.extend_from_slice(&(members.len() as u16).to_le_bytes());
+    out.extend_from_slice(&(central.len() as u32).to_le_bytes());
+    out.extend_from_slice(&cd_offset.to_le_bytes());
+    out.extend_from_slice(&0u16.to_le_bytes());
+    out
+}
+
+fn c16(values: &[(f64, f64)]) -> Vec<u8> {
+    values.iter().flat_map(|(re, im)| [re.to_le_bytes(), im.to_le_bytes()].concat()).collect()
+}
+
+#[test]
+fn dtypes_orders_and_versions() {
+    let p = Path::new("a.npy");
+    let a =
+        parse_npy(p, "array", &npy("<c16", false, "(2, 2)", &c16(&[(1.0, -1.0), (2.0, 0.0), (3.0, 0.5), (4.0, 4.0)])))
+            .unwrap();
+    assert_eq!(a.dims, [2, 2]);
+    assert_eq!(a.values[2], Complex64::new(3.0, 0.5));
+    assert_eq!(a.strides, [2, 1]);
+    let f = parse_npy(p, "array", &npy("<c16", true, "(2, 2)", &c16(&[(1.0, 0.0); 4]))).unwrap();
+    assert_eq!(f.strides, [1, 2]);
+    let c8: Vec<u8> = [1.5f32, -2.0].iter().flat_map(|v| v.to_le_bytes()).collect();
+    assert_eq!(parse_npy(p, "array", &npy("<c8", false, "(1,)", &c8)).unwrap().values, [Complex64::new(1.5, -2.0)]);
+    let be: Vec<u8> = [1.5f32, -2.0].iter().flat_map(|v| v.to_be_bytes()).collect();
+    assert_eq!(parse_npy(p, "array", &npy(">f4", false, "(1, 2)", &be)).unwrap().values, [Complex64::new(1.5, -2.0)]);
+    let i2: Vec<u8> = [3i16, -4, 5, 6].iter().flat_map(|v| v.to_le_bytes()).collect();
+    let iq = parse_npy(p, "array", &npy("<i2", false, "(2, 2)", &i2)).unwrap();
+    assert_eq!((iq.dims.as_slice(), iq.values[1]), (&[2][..], Complex64::new(5.0, 6.0)));
+    // Version 2 header (u32 length).
+    let mut v2 = npy("<c16", false, "(1,)", &c16(&[(7.0, 8.0)]));
+    let header_len = u16::from_le_bytes([v2[8], v2[9]]);
+    v2.splice(6..10, [2u8, 0, 0, 0, 0, 0]);
+    v2[8..12].copy_from_slice(&u32::from(header_len).to_le_bytes());
+    assert_eq!(parse_npy(p, "array", &v2).unwrap().values, [Complex64::new(7.0, 8.0)]);
+}
+
+#[test]
+fn bad_npy_is_named() {
+    let p = Path::new("bad.npy");
+    let err = |bytes: &[u8]| parse_npy(p, "array", bytes).unwrap_err().to_string();
+    let e = err(&npy("<i4", false, "(2,)", &[0; 8]));
+    assert!(e.starts_with("bad.npy: array: descr: dtype `<i4`, expected complex64"), "{e}");
+    let e = err(&npy("|O", false, "(2,)", &[0; 16]));
+    assert!(e.contains("dtype `|O`"), "{e}");
+    let e = err(&npy("<f8", false, "(3,)", &[0; 24]));
+    assert!(e.contains("trailing I/Q axis of size 2"), "{e}");
+    let good = npy("<c16", false, "(2, 3)", &c16(&[(1.0, 1.0); 6]));
+    let e = err(&good[..good.len() - 1]);
+    assert!(e.contains("data: truncated: shape [2, 3] of `<c16` needs 96 bytes of data, the file has 95"), "{e}");
+    assert!(err(b"PK\x03\x04").contains("magic"));
+    assert!(err(&npy("<c16", false, "(2, x)", &[])).contains("shape: `(2, x)`"));
+    // Every truncation and byte flip: an error or an array, never a panic.
+    for cut in 0..good.len() {
+        assert!(parse_npy(p, "array", &good[..cut]).is_err(), "cut {cut}");
+    }
+    for at in 0..good.len() {
+        let mut b = good.clone();
+        b[at] ^= 0xa5;
+        let _ = parse_npy(p, "array", &b);
+    }
+}
+
+#[test]
+fn npz_members() {
+    let p = Path::new("a.npz");
+    let h = npy("<c16", false, "(3,)", &c16(&[(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]));
+    let g = npy("<c8", false, "(0,)", &[]);
+    let zip = stored_zip(&[("h.npy", h.clone()), ("g.npy", g)]);
+    let (name, a) = parse_npz(p, &zip, Some("h")).unwrap();
+    assert_eq!((name.as_str(), a.values[2]), ("h", Complex64::new(5.0, 6.0)));
+    let e = parse_npz(p, &zip, None).unwrap_err().to_string();
+    assert!(e.contains("holds [\"h\", \"g\"]; choose one with `variable"), "{e}");
+    let e = parse_npz(p, &zip, Some("x")).unwrap_err().to_string();
+    assert!(e.contains("no array `x`"), "{e}");
+    let single = stored_zip(&[("h.npy", h)]);
+    assert_eq!(parse_npz(p, &single, None).unwrap().0, "h");
+    // A flipped data byte fails the CRC; truncations fail cleanly.
+    let mut flipped = single.clone();
+    flipped[200] ^= 1;
+    let e = parse_npz(p, &flipped, None).unwrap_err().to_string();
+    assert!(e.contains("member `h.npy`: ZIP member: CRC-32"), "{e}");
+    for cut in 0..single.len() {
+        assert!(parse_npz(p, &single[..cut], None).is_err(), "cut {cut}");
+    }
+}
+
+/// NumPy itself (an independent writer) when Python with numpy is available:
+/// `savez_compressed` (deflate, ZIP64 local headers), Fortran order, complex64
+/// and float32 I/Q.
+#[test]
+fn numpy_written_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = "import numpy as np, sys\n\
+        d = sys.argv[1]\n\
+        h = (np.arange(24).reshape(2, 3, 4) * (1 - 0.5j)).astype(np.complex64)\n\
+        np.save(d + '/f.npy', np.asfortranarray(h.astype(np.complex128)))\n\
+        iq = np.stack([h.real, h.imag], axis=-1).astype(np.float32)\n\
+        np.savez_compressed(d + '/z.npz', cir=h, iq=iq, other=np.zeros(3))\n";
+    let ran = std::process::Command::new("python3").arg("-c").arg(script).arg(dir.path()).output();
+    if !matches!(&ran, Ok(o) if o.status.success()) {
+        eprintln!("skipped: python3 with numpy not available for the NumPy conformance test");
+        return;
+    }
+    let expected = |i: usize| Complex64::new(i as f64, -0.5 * i as f64);
+    let f = parse_npy(Path::new("f.npy"), "array", &std::fs::read(dir.path().join("f.npy")).unwrap()).unwrap();
+    assert_eq!(f.dims, [2, 3, 4]);
+    // Element (1, 2, 3) = 12 + 8 + 3 = 23, whatever the storage order.
+    let at = |a: &NdComplex, i: [usize; 3]| a.values[i.iter().zip(&a.strides).map(|(i, s)| i * s).sum::<usize>()];
+    assert_eq!(at(&f, [1, 2, 3]), expected(23));
+    let npz = std::fs::read(dir.path().join("z.npz")).unwrap();
+    let (_, cir) = parse_npz(Path::new("z.npz"), &npz, Some("cir")).unwrap();
+    let (_, iq) = parse_npz(Path::new("z.npz"), &npz, Some("iq")).unwrap();
+    for a in [&cir, &iq] {
+        assert_eq!(a.dims, [2, 3, 4]);
+        assert_eq!(at(a, [1, 2, 3]), expected(23));
+        assert_eq!(at(a, [0, 1, 2]), expected(6));
+    }
+    let e = parse_npz(Path::new("z.npz"), &npz, Some("other")).unwrap_err().to_string();
+    assert!(e.contains("member `other.npy`") && e.contains("dtype `<f8`"), "{e}");
+}
