@@ -2,13 +2,17 @@
 //!
 //! Simulate the demo radar scenario as an Oxford-layout folder, ingest it into
 //! a recording, write its ground truth as a Parquet table, run radar odometry
-//! (the `cfear` preset) on it, and show where everything is.
+//! (the `cfear` preset) on it, compute trajectory metrics and plots against
+//! the ground truth, and show where everything is.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::Args;
+use mmtrack_analysis::output::write_results;
+use mmtrack_analysis::pipeline::analyze_trajectory;
+use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep};
 use mmtrack_core::StampedPose;
 use mmtrack_ingest::oxford::{self, OxfordOptions};
 use mmtrack_io::recording::PoseStream;
@@ -73,6 +77,20 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let written =
         process::write_outputs(&tables, DEMO_SEQUENCE, &odometry, &config, preset, &recording, Overwrite::Replace)?;
 
+    // Trajectory metrics and plots. The demo drive is 14 m, so the KITTI
+    // segments are scaled down from the devkit's 100..800 m.
+    let options = DriftOptions { segment_lengths_m: vec![4.0, 8.0, 12.0], step: FirstFrameStep::Frames(1) };
+    let estimate: Vec<StampedPose> = odometry
+        .estimates
+        .iter()
+        .map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle })
+        .collect();
+    let result = analyze_trajectory(DEMO_SEQUENCE, &estimate, &odometry.ground_truth, &options)?;
+    let info = RunInfo {
+        config_json: serde_json::json!({"command": "demo", "segment_lengths_m": options.segment_lengths_m}).to_string(),
+    };
+    let analysis = write_results(&args.out.join("analysis"), &[result], &[], &options, &info, Overwrite::Replace)?;
+
     if !quiet {
         println!();
         inspect::run(&inspect::InspectArgs::new(recording.clone()), quiet)?;
@@ -100,6 +118,11 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!(
             "  odometry tables: {}",
             written.iter().map(|w| w.path.display().to_string()).collect::<Vec<_>>().join(", ")
+        );
+        println!(
+            "  analysis (metrics, plots):    {} (report {})",
+            analysis.out_dir.display(),
+            analysis.report.display()
         );
         println!("\nNot in the demo yet: mpc, beam and slam pipelines (issue #5 and later).");
     }

@@ -16,6 +16,7 @@ mod ingest;
 mod inspect;
 mod process;
 mod progress;
+mod reproduce;
 mod simulate;
 
 use std::path::PathBuf;
@@ -60,11 +61,7 @@ enum Command {
     /// Write trajectory tables as standard text (TUM, KITTI) for evo, pyboreas or the KITTI devkit.
     Export(export::ExportArgs),
     /// Re-run a paper's experiment and compare with its published numbers.
-    Reproduce {
-        /// Experiment and options.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
+    Reproduce(reproduce::ReproduceArgs),
     /// Show what a recording (.mcap, including ROS 2 bags) or a table directory contains.
     Inspect(inspect::InspectArgs),
     /// Run the whole chain on the embedded demo data and print where the outputs are.
@@ -130,7 +127,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Process(args) => process::run(&args, quiet),
         Command::Analyze(args) => analyze::run(&args, quiet),
         Command::Export(args) => export::run(&args, quiet),
-        Command::Reproduce { .. } => not_built("reproduce", 4),
+        Command::Reproduce(args) => reproduce::run(&args, quiet),
         Command::Inspect(args) => inspect::run(&args, quiet),
         Command::Demo(args) => demo::run(&args, quiet),
         Command::Schemas { write, check } => schemas(write, check, quiet),

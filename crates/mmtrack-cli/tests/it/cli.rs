@@ -30,6 +30,7 @@ fn demo_writes_a_recording_and_a_table_and_says_where() {
     assert!(out.status.success(), "{stderr}");
     assert!(stdout.contains("demo-out/recording.mcap") && stdout.contains("demo-out/tables"), "{stdout}");
     assert!(stdout.contains("/radar/image") && stdout.contains("foxglove.CompressedImage"));
+    assert!(stdout.contains("demo-out/analysis/report.md"), "{stdout}");
     // Running it again replaces its own outputs.
     let again = mmtrack(dir.path(), &["demo", "--out", "demo-out", "--quiet"]);
     assert!(again.status.success(), "{}", text(&again).1);

@@ -13,4 +13,5 @@ mod process_odometry;
 mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;
+mod reproduce;
 mod simulate_radar;
