@@ -8,7 +8,6 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use mmtrack_io::RecordingReader;
 use mmtrack_odometry::OdometryConfig;
 
 use crate::bench::replace_block;
@@ -35,14 +34,16 @@ pub struct OdometryBenchArgs {
     readme: Option<PathBuf>,
 }
 
-/// Reads and decodes every scan of the recording: the baseline.
+/// Reads and decodes every scan of the recording through the same reader
+/// and decode workers as `process odometry`: the baseline.
 fn decode_only(recording: &Path) -> anyhow::Result<usize> {
     let mut scans = 0;
-    for event in RecordingReader::open(recording)? {
-        if let mmtrack_io::RecordingEvent::RadarScan(_) = event? {
+    crate::process::for_each_event(recording, |event, _| {
+        if let mmtrack_io::RecordingEvent::RadarScan(_) = event {
             scans += 1;
         }
-    }
+        Ok(())
+    })?;
     Ok(scans)
 }
 
@@ -115,7 +116,7 @@ pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 fn markdown(args: &OdometryBenchArgs, decode_per_s: f64, results: &[PresetResult]) -> String {
     let mut out = format!(
         "`mmtrack bench odometry`: the {} real Oxford scans (400 x 3768) of `{}` in a recording, {} passes per \
-         preset, each a fresh pipeline; PNG decoding runs on a reader thread beside the odometry. Baseline in \
+         preset, each a fresh pipeline; a reader thread feeds PNG decoding workers (one per core) beside the odometry. Baseline in \
          the same run: reading and decoding alone, {decode_per_s:.0} scans/s.\n\n\
          | preset | scans | end-to-end scans/s | / decode-only | filter ms | surface points ms | registration ms | \
          target >= {ODOMETRY_TARGET_SCANS_PER_S} scans/s |\n|---|---|---|---|---|---|---|---|\n",

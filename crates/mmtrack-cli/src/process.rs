@@ -1,5 +1,6 @@
 //! `mmtrack process <pipeline>`: run an algorithm on a recording, write tables.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::mpsc;
@@ -9,6 +10,7 @@ use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose, path_length_m};
 use mmtrack_io::recording::PoseStream;
+use mmtrack_io::recording::{EncodedScan, RecordingItem};
 use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary, table_path, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
@@ -110,39 +112,19 @@ pub struct OdometryRun {
     pub elapsed_s: f64,
 }
 
-/// Reads the recording on a second thread (PNG decoding happens there) and
-/// runs the odometry on this one, so the two overlap on two cores.
+/// Reads the recording on a second thread and decodes its scans on a pool of
+/// workers (one per core), so reading, PNG inflating and the odometry on this
+/// thread overlap.
 pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> anyhow::Result<OdometryRun> {
     let started = Instant::now();
     let mut odometry = RadarOdometry::new(config)?;
-    let mut reader = RecordingReader::open(recording)?;
     let total_bytes = std::fs::metadata(recording).map(|m| m.len()).unwrap_or(0);
     let bar = progress::bytes_bar("odometry", quiet);
     bar.set_length(total_bytes);
-    let (sender, receiver) = mpsc::sync_channel::<Result<(RecordingEvent, u64), mmtrack_io::IoError>>(4);
-    let (metadata_sender, metadata_receiver) = mpsc::channel();
-    let reader_thread = std::thread::spawn(move || {
-        let mut metadata_sent = false;
-        while let Some(event) = reader.next() {
-            if !metadata_sent && let Some(map) = reader.metadata() {
-                let _ = metadata_sender.send(map.clone());
-                metadata_sent = true;
-            }
-            let item = event.map(|e| (e, reader.bytes_read()));
-            let failed = item.is_err();
-            if sender.send(item).is_err() || failed {
-                return;
-            }
-        }
-        if !metadata_sent && let Some(map) = reader.metadata() {
-            let _ = metadata_sender.send(map.clone());
-        }
-    });
     let mut estimates = Vec::new();
     let mut timings = Vec::new();
     let mut ground_truth = Vec::new();
-    for item in receiver {
-        let (event, bytes_read) = item?;
+    let metadata = for_each_event(recording, |event, bytes_read| {
         bar.set_position(bytes_read);
         match event {
             RecordingEvent::RadarScan(scan) => {
@@ -153,10 +135,9 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> an
             RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => ground_truth.push(pose),
             _ => {}
         }
-    }
-    reader_thread.join().map_err(|_| anyhow::anyhow!("the recording reader thread panicked"))?;
+        Ok(())
+    })?;
     bar.finish_and_clear();
-    let metadata = metadata_receiver.try_recv().ok();
     let sequence_id = metadata
         .as_ref()
         .and_then(RecordingMetadata::from_map)
@@ -166,6 +147,86 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> an
         bail!("{}: the recording has no radar scans (topic /radar/image); nothing written", recording.display());
     }
     Ok(OdometryRun { estimates, timings, ground_truth, sequence_id, elapsed_s: started.elapsed().as_secs_f64() })
+}
+
+/// An event, or a scan being decoded by a worker.
+enum Pending {
+    Event(RecordingEvent),
+    Scan(mpsc::Receiver<Result<PolarScan, mmtrack_io::IoError>>),
+}
+
+/// Calls `f` with every event of the recording in file order (and the bytes
+/// read so far). A reader thread hands the scans to decode workers, one per
+/// core, round robin; each result comes back through its own channel, so the
+/// order is kept, and bounded channels keep at most a few scans in memory.
+/// Returns the recording metadata.
+pub fn for_each_event(
+    recording: &Path,
+    mut f: impl FnMut(RecordingEvent, u64) -> anyhow::Result<()>,
+) -> anyhow::Result<Option<BTreeMap<String, String>>> {
+    let mut reader = RecordingReader::open(recording)?;
+    let workers = std::thread::available_parallelism().map_or(2, std::num::NonZero::get).clamp(1, 8);
+    let (sender, receiver) = mpsc::sync_channel::<Result<(Pending, u64), mmtrack_io::IoError>>(2 * workers);
+    let mut outcome = Ok(());
+    let metadata = std::thread::scope(|scope| {
+        let reader_thread = scope.spawn(move || {
+            std::thread::scope(|pool| {
+                let jobs: Vec<_> = (0..workers)
+                    .map(|_| {
+                        type Job = (EncodedScan, mpsc::SyncSender<Result<PolarScan, mmtrack_io::IoError>>);
+                        let (job_sender, job_receiver) = mpsc::sync_channel::<Job>(1);
+                        pool.spawn(move || {
+                            for (scan, reply) in job_receiver {
+                                let _ = reply.send(scan.decode());
+                            }
+                        });
+                        job_sender
+                    })
+                    .collect();
+                let mut next_worker = 0;
+                while let Some(item) = reader.next_item() {
+                    let pending = match item {
+                        Ok(RecordingItem::Event(event)) => Ok(Pending::Event(event)),
+                        Ok(RecordingItem::Scan(scan)) => {
+                            let (reply, result) = mpsc::sync_channel(1);
+                            if jobs[next_worker].send((scan, reply)).is_err() {
+                                break;
+                            }
+                            next_worker = (next_worker + 1) % workers;
+                            Ok(Pending::Scan(result))
+                        }
+                        Err(e) => Err(e),
+                    };
+                    let failed = pending.is_err();
+                    if sender.send(pending.map(|p| (p, reader.bytes_read()))).is_err() || failed {
+                        break;
+                    }
+                }
+                drop(jobs);
+            });
+            reader.metadata().cloned()
+        });
+        for item in receiver.iter() {
+            let step = item.map_err(anyhow::Error::from).and_then(|(pending, bytes_read)| {
+                let event = match pending {
+                    Pending::Event(event) => event,
+                    Pending::Scan(result) => RecordingEvent::RadarScan(
+                        result.recv().map_err(|_| anyhow::anyhow!("a scan decoding worker stopped"))??,
+                    ),
+                };
+                f(event, bytes_read)
+            });
+            if let Err(e) = step {
+                outcome = Err(e);
+                break;
+            }
+        }
+        // Dropping the receiver stops the reader at its next send.
+        drop(receiver);
+        reader_thread.join().map_err(|_| anyhow::anyhow!("the recording reader thread panicked"))
+    })?;
+    outcome?;
+    Ok(metadata)
 }
 
 fn process_scan(

@@ -1,9 +1,7 @@
 //! Stages 2 and 3: grid downsampling and oriented surface points.
 
-use std::collections::BTreeMap;
-
 use crate::filter::FilteredPoint;
-use crate::grid::{GridIndex, cell_of};
+use crate::grid::GridIndex;
 
 /// An oriented surface point: the mean of nearby filtered points and the
 /// normal of the line they lie on.
@@ -44,49 +42,82 @@ pub struct SurfaceParams {
 /// Liu et al., SPEBT, Sec. III-A.2 and III-A.3 (the covariance of eq. (6)).
 #[must_use]
 pub fn surface_points(filtered: &[FilteredPoint], params: &SurfaceParams) -> Vec<SurfacePoint> {
-    let mut cells: BTreeMap<(i64, i64), ([f64; 2], u32)> = BTreeMap::new();
-    for p in filtered {
-        let entry = cells.entry(cell_of(p.xy_m, params.cell_m)).or_insert(([0.0, 0.0], 0));
-        entry.0[0] += p.xy_m[0];
-        entry.0[1] += p.xy_m[1];
-        entry.1 += 1;
-    }
-    let index = GridIndex::new(filtered.iter().map(|p| p.xy_m), params.radius_m);
+    let xy = || filtered.iter().map(|p| p.xy_m);
+    let index = GridIndex::new(xy(), params.radius_m);
+    let separate_cells;
+    let cells = if params.cell_m == params.radius_m && index.cell_m() == params.radius_m {
+        &index
+    } else {
+        separate_cells = GridIndex::new(xy(), params.cell_m);
+        &separate_cells
+    };
     let radius_sq = params.radius_m * params.radius_m;
-    let mut out = Vec::with_capacity(cells.len());
-    let mut neighbourhood: Vec<[f64; 2]> = Vec::new();
-    for (sum, count) in cells.values() {
-        let centre = [sum[0] / f64::from(*count), sum[1] / f64::from(*count)];
-        neighbourhood.clear();
-        neighbourhood.extend(index.candidates(centre).map(|i| filtered[i].xy_m).filter(|q| {
+    let mut out = Vec::new();
+    for cell in cells.occupied_cells() {
+        let sum = cell.iter().fold([0.0, 0.0], |acc, &i| {
+            let p = filtered[i as usize].xy_m;
+            [acc[0] + p[0], acc[1] + p[1]]
+        });
+        let count = cell.len() as f64;
+        let centre = [sum[0] / count, sum[1] / count];
+        let mut moments = Moments::default();
+        for i in index.candidates(centre) {
+            let q = filtered[i].xy_m;
             let (dx, dy) = (q[0] - centre[0], q[1] - centre[1]);
-            dx * dx + dy * dy <= radius_sq
-        }));
-        if neighbourhood.len() < params.min_neighbours.max(2) {
+            if dx * dx + dy * dy <= radius_sq {
+                moments.add(dx, dy);
+            }
+        }
+        if moments.n < params.min_neighbours.max(2) {
             continue;
         }
-        if let Some(point) = oriented_point(&neighbourhood, params.max_condition_number) {
+        if let Some(point) = moments.oriented_point(centre, params.max_condition_number) {
             out.push(point);
         }
     }
     out
 }
 
-/// Mean, covariance and normal of one neighbourhood (two or more points), or
-/// `None` when the covariance is degenerate or too elongated.
-fn oriented_point(points: &[[f64; 2]], max_condition_number: f64) -> Option<SurfacePoint> {
-    let n = points.len() as f64;
-    let mean = points.iter().fold([0.0, 0.0], |acc, p| [acc[0] + p[0], acc[1] + p[1]]);
-    let mean = [mean[0] / n, mean[1] / n];
-    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
-    for p in points {
-        let (dx, dy) = (p[0] - mean[0], p[1] - mean[1]);
-        sxx += dx * dx;
-        syy += dy * dy;
-        sxy += dx * dy;
+/// Running sums of a neighbourhood's offsets from its query centre: one pass
+/// gives the sample mean and covariance (offsets are at most d_D, so the
+/// shifted sums lose no precision).
+#[derive(Debug, Default)]
+struct Moments {
+    n: usize,
+    sx: f64,
+    sy: f64,
+    sxx: f64,
+    syy: f64,
+    sxy: f64,
+}
+
+impl Moments {
+    fn add(&mut self, dx: f64, dy: f64) {
+        self.n += 1;
+        self.sx += dx;
+        self.sy += dy;
+        self.sxx += dx * dx;
+        self.syy += dy * dy;
+        self.sxy += dx * dy;
     }
-    let (sxx, syy, sxy) = (sxx / (n - 1.0), syy / (n - 1.0), sxy / (n - 1.0));
-    // Closed-form eigen-decomposition of the symmetric 2x2 [[sxx, sxy], [sxy, syy]].
+
+    /// Mean, covariance and normal (two or more points), or `None` when the
+    /// covariance is degenerate or too elongated.
+    fn oriented_point(&self, centre: [f64; 2], max_condition_number: f64) -> Option<SurfacePoint> {
+        let n = self.n as f64;
+        let (mx, my) = (self.sx / n, self.sy / n);
+        let sxx = (self.sxx - n * mx * mx) / (n - 1.0);
+        let syy = (self.syy - n * my * my) / (n - 1.0);
+        let sxy = (self.sxy - n * mx * my) / (n - 1.0);
+        let normal = smallest_eigenvector(sxx, syy, sxy, max_condition_number)?;
+        Some(SurfacePoint { mean_m: [centre[0] + mx, centre[1] + my], normal, neighbours: self.n as u32 })
+    }
+}
+
+/// Unit eigenvector of the smallest eigenvalue of the symmetric 2x2
+/// `[[sxx, sxy], [sxy, syy]]` (closed form), or `None` when the matrix is not
+/// positive definite or its condition number exceeds `max_condition_number`.
+fn smallest_eigenvector(sxx: f64, syy: f64, sxy: f64, max_condition_number: f64) -> Option<[f64; 2]> {
     let half_trace = 0.5 * (sxx + syy);
     let root = (0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy).sqrt();
     let (large, small) = (half_trace + root, half_trace - root);
@@ -99,8 +130,7 @@ fn oriented_point(points: &[[f64; 2]], max_condition_number: f64) -> Option<Surf
     let (c, d) = (small - syy, sxy);
     let v = if a * a + b * b >= c * c + d * d { [a, b] } else { [c, d] };
     let norm = v[0].hypot(v[1]);
-    let normal = if norm > 0.0 { [v[0] / norm, v[1] / norm] } else { [1.0, 0.0] };
-    Some(SurfacePoint { mean_m: mean, normal, neighbours: points.len() as u32 })
+    Some(if norm > 0.0 { [v[0] / norm, v[1] / norm] } else { [1.0, 0.0] })
 }
 
 #[cfg(test)]
@@ -151,7 +181,9 @@ mod tests {
                     [c * along - s * across, s * along + c * across]
                 })
                 .collect();
-            let p = oriented_point(&pts, 1e9).unwrap();
+            let mut moments = Moments::default();
+            pts.iter().for_each(|q| moments.add(q[0] - 0.3, q[1] + 0.2));
+            let p = moments.oriented_point([0.3, -0.2], 1e9).unwrap();
             // The normal solves the eigen-equation Sigma n = lambda n with the smaller lambda.
             let n = pts.len() as f64;
             let cov = |u: [f64; 2], v: [f64; 2]| {

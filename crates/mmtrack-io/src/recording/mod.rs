@@ -17,8 +17,8 @@ mod writer;
 
 pub use channels::{CHANNELS, ChannelSpec, PoseStream};
 pub use reader::{
-    ChannelInfo, ChannelSummary, RawMessage, RawReader, RecordingEvent, RecordingReader, RecordingSummary,
-    inspect_recording, inspect_recording_with_progress,
+    ChannelInfo, ChannelSummary, EncodedScan, RawMessage, RawReader, RecordingEvent, RecordingItem, RecordingReader,
+    RecordingSummary, inspect_recording, inspect_recording_with_progress,
 };
 pub use writer::{Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TimeBase, WriteSummary};
 

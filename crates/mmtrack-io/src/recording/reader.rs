@@ -217,23 +217,30 @@ impl RecordingReader {
         M::decode(m.data.clone()).map_err(|e| self.bad(m, format!("cannot decode {}: {e}", m.channel.schema_name)))
     }
 
-    fn next_event(&mut self) -> Result<Option<RecordingEvent>> {
+    /// The next item with radar scans left undecoded: [`EncodedScan::decode`]
+    /// (the PNG inflate, most of the reading time) can then run on other
+    /// threads while this one reads on. Items come in file order.
+    pub fn next_item(&mut self) -> Option<Result<RecordingItem>> {
+        self.next_item_inner().transpose()
+    }
+
+    fn next_item_inner(&mut self) -> Result<Option<RecordingItem>> {
         while let Some(m) = self.raw.next_message()? {
             let topic = m.channel.topic.as_str();
             if topic == RADAR_META_TOPIC {
                 let meta: proto::RadarScanMeta = self.decode(&m)?;
                 self.pending_meta = Some((m.sequence, meta));
             } else if topic == RADAR_IMAGE_TOPIC {
-                return self.join_scan(&m).map(|s| Some(RecordingEvent::RadarScan(s)));
+                return self.join_scan(m).map(|s| Some(RecordingItem::Scan(s)));
             } else if let Some(stream) = PoseStream::from_topic(topic) {
                 let p: proto::Pose2D = self.decode(&m)?;
                 let pose = StampedPose { t_ns: p.t_ns, parent_from_child: Se2::new(p.x_m, p.y_m, p.yaw_rad) };
-                return Ok(Some(RecordingEvent::Pose { stream, pose }));
+                return Ok(Some(RecordingItem::Event(RecordingEvent::Pose { stream, pose })));
             } else if topic == GNSS_TOPIC {
                 let f: proto::GnssFix = self.decode(&m)?;
                 let quality = GnssFixQuality::from_code(f.quality)
                     .ok_or_else(|| self.bad(&m, format!("unknown fix quality code {}", f.quality)))?;
-                return Ok(Some(RecordingEvent::Gnss(GnssFix {
+                return Ok(Some(RecordingItem::Event(RecordingEvent::Gnss(GnssFix {
                     t_ns: f.t_ns,
                     latitude_deg: f.latitude_deg,
                     longitude_deg: f.longitude_deg,
@@ -241,7 +248,7 @@ impl RecordingReader {
                     horizontal_sigma_m: f.horizontal_sigma_m,
                     num_satellites: f.num_satellites,
                     quality,
-                })));
+                }))));
             } else if topic == CIR_TOPIC {
                 let c: proto::CirSnapshot = self.decode(&m)?;
                 if c.taps_re.len() != c.taps_im.len() {
@@ -251,7 +258,7 @@ impl RecordingReader {
                     ));
                 }
                 let taps = c.taps_re.iter().zip(&c.taps_im).map(|(&re, &im)| Complex64::new(re, im)).collect();
-                return Ok(Some(RecordingEvent::Cir(CirSnapshot {
+                return Ok(Some(RecordingItem::Event(RecordingEvent::Cir(CirSnapshot {
                     t_ns: c.t_ns,
                     set_index: c.set_index,
                     snapshot_index: c.snapshot_index,
@@ -262,54 +269,98 @@ impl RecordingReader {
                     delay_offset_s: c.delay_offset_s,
                     taps,
                     first_path_hint_s: c.first_path_hint_s,
-                })));
+                }))));
             }
         }
         Ok(None)
     }
 
     /// Joins a radar image with the metadata of the same sequence number.
-    fn join_scan(&mut self, m: &RawMessage) -> Result<PolarScan> {
-        let meta = match self.pending_meta.take() {
-            Some((sequence, meta)) if sequence == m.sequence => meta,
-            _ => {
-                return Err(
-                    self.bad(m, format!("radar image without {RADAR_META_TOPIC} message of the same sequence number"))
-                );
+    fn join_scan(&mut self, m: RawMessage) -> Result<EncodedScan> {
+        match self.pending_meta.take() {
+            Some((sequence, meta)) if sequence == m.sequence => {
+                Ok(EncodedScan { path: self.raw.path.clone(), message: m, meta })
             }
-        };
+            _ => {
+                Err(self.bad(&m, format!("radar image without {RADAR_META_TOPIC} message of the same sequence number")))
+            }
+        }
+    }
+}
+
+/// An item of [`RecordingReader::next_item`].
+#[derive(Debug)]
+pub enum RecordingItem {
+    /// Anything but a radar scan, decoded.
+    Event(RecordingEvent),
+    /// A radar scan, still encoded.
+    Scan(EncodedScan),
+}
+
+/// A radar scan as stored: its metadata message and its (PNG or raw) image.
+#[derive(Debug)]
+pub struct EncodedScan {
+    path: PathBuf,
+    message: RawMessage,
+    meta: proto::RadarScanMeta,
+}
+
+impl EncodedScan {
+    /// Scan time (first azimuth), nanoseconds.
+    #[must_use]
+    pub fn t_ns(&self) -> i64 {
+        self.meta.t_ns
+    }
+
+    fn bad(&self, detail: impl std::fmt::Display) -> IoError {
+        IoError::BadMessage {
+            path: self.path.clone(),
+            topic: self.message.channel.topic.clone(),
+            sequence: self.message.sequence,
+            detail: detail.to_string(),
+        }
+    }
+
+    fn decode_message<M: Message + Default>(&self) -> Result<M> {
+        let m = &self.message;
+        if m.channel.message_encoding != "protobuf" {
+            return Err(self.bad(format!("message encoding '{}', expected protobuf", m.channel.message_encoding)));
+        }
+        M::decode(m.data.clone()).map_err(|e| self.bad(format!("cannot decode {}: {e}", m.channel.schema_name)))
+    }
+
+    /// Decodes the image (inflating a PNG) and checks it against the metadata.
+    pub fn decode(self) -> Result<PolarScan> {
+        let meta = &self.meta;
         let n = meta.azimuth_t_ns.len();
         if meta.azimuth_rad.len() != n || meta.valid.len() != n {
-            return Err(self.bad(m, "azimuth_t_ns, azimuth_rad and valid differ in length"));
+            return Err(self.bad("azimuth_t_ns, azimuth_rad and valid differ in length"));
         }
         let bins = meta.bins_per_azimuth as usize;
         let offset = meta.power_column_offset as usize;
-        let (width, height, pixels) = match m.channel.schema_name.as_str() {
+        let (width, height, pixels) = match self.message.channel.schema_name.as_str() {
             "foxglove.RawImage" => {
-                let image: RawImage = self.decode(m)?;
+                let image: RawImage = self.decode_message()?;
                 if image.encoding != "mono8" || image.step != image.width {
-                    return Err(self.bad(
-                        m,
-                        format!("raw image encoding '{}' step {}, expected mono8 packed", image.encoding, image.step),
-                    ));
+                    return Err(self.bad(format!(
+                        "raw image encoding '{}' step {}, expected mono8 packed",
+                        image.encoding, image.step
+                    )));
                 }
                 (image.width as usize, image.height as usize, image.data.to_vec())
             }
             "foxglove.CompressedImage" => {
-                let image: CompressedImage = self.decode(m)?;
+                let image: CompressedImage = self.decode_message()?;
                 if image.format != "png" {
-                    return Err(self.bad(m, format!("compressed image format '{}', expected png", image.format)));
+                    return Err(self.bad(format!("compressed image format '{}', expected png", image.format)));
                 }
-                let (width, height, pixels) = crate::png_gray::decode_gray8(&image.data).map_err(|e| self.bad(m, e))?;
-                (width, height, pixels)
+                crate::png_gray::decode_gray8(&image.data).map_err(|e| self.bad(e))?
             }
-            other => return Err(self.bad(m, format!("schema {other} is not an image schema"))),
+            other => return Err(self.bad(format!("schema {other} is not an image schema"))),
         };
         if height != n || width != offset + bins {
-            return Err(self.bad(
-                m,
-                format!("image is {width} x {height}, metadata says {n} azimuths of {offset} + {bins} columns"),
-            ));
+            return Err(self
+                .bad(format!("image is {width} x {height}, metadata says {n} azimuths of {offset} + {bins} columns")));
         }
         let power = if offset == 0 {
             pixels
@@ -330,7 +381,7 @@ impl RecordingReader {
             bins_per_azimuth: bins,
             azimuths,
         };
-        PolarScan::new(header, power).map_err(|e| self.bad(m, e))
+        PolarScan::new(header, power).map_err(|e| self.bad(e))
     }
 }
 
@@ -338,7 +389,10 @@ impl Iterator for RecordingReader {
     type Item = Result<RecordingEvent>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        self.next_event().transpose()
+        Some(self.next_item()?.and_then(|item| match item {
+            RecordingItem::Event(event) => Ok(event),
+            RecordingItem::Scan(scan) => scan.decode().map(RecordingEvent::RadarScan),
+        }))
     }
 }
 
