@@ -29,6 +29,9 @@ pub struct OdometryBenchArgs {
     /// Exit 1 when the target is missed.
     #[arg(long)]
     check: bool,
+    /// Scans of the long simulated drive of the memory check (laps of 100 scans; one lap is the short drive).
+    #[arg(long, default_value_t = 1200)]
+    memory_scans: usize,
     /// Replace the block `<!-- bench-odometry:begin -->` ... `end` in this file.
     #[arg(long, value_name = "README.md")]
     readme: Option<PathBuf>,
@@ -102,14 +105,16 @@ pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             register_ms: per_scan_ms(register_s),
         });
     }
-    let text = markdown(args, decode_per_s, &results);
+    let memory = memory_check(args.memory_scans, dir.path())?;
+    let mut text = markdown(args, decode_per_s, &results);
+    text.push_str(&memory.markdown());
     if !quiet {
         print!("{text}");
     }
     if let Some(readme) = &args.readme {
         replace_block(readme, "bench-odometry", &text)?;
     }
-    let met = results.iter().all(|r| r.scans_per_s >= ODOMETRY_TARGET_SCANS_PER_S);
+    let met = results.iter().all(|r| r.scans_per_s >= ODOMETRY_TARGET_SCANS_PER_S) && memory.flat();
     Ok(if args.check && !met { ExitCode::FAILURE } else { ExitCode::SUCCESS })
 }
 
@@ -138,4 +143,155 @@ fn markdown(args: &OdometryBenchArgs, decode_per_s: f64, results: &[PresetResult
         ));
     }
     out
+}
+
+/// Memory of `process odometry` (cfear) on a short and a long drive.
+struct MemoryCheck {
+    short_scans: usize,
+    long_scans: usize,
+    short: ChildMemory,
+    long: ChildMemory,
+    short_recording_mb: f64,
+    long_recording_mb: f64,
+}
+
+/// "Memory does not grow with sequence length": resident memory late in the
+/// long run may exceed that early in it by at most this factor.
+const MEMORY_GROWTH_LIMIT: f64 = 1.10;
+
+impl MemoryCheck {
+    /// Mean resident memory over the last quarter of the long run against the second quarter.
+    fn growth(&self) -> f64 {
+        self.long.mean_rss_mb(3) / self.long.mean_rss_mb(1)
+    }
+
+    fn flat(&self) -> bool {
+        self.growth() <= MEMORY_GROWTH_LIMIT
+    }
+
+    fn markdown(&self) -> String {
+        format!(
+            "\nMemory (`cfear` on simulated Oxford-size drives around a generated circular street, laps of \
+             {MEMORY_LAP_SCANS} scans, in a `process odometry` child process sampled every 5 ms): {} scans ({:.0} MB \
+             recording) peak {:.0} MB; {} scans ({:.0} MB recording) peak {:.0} MB, mean resident memory {:.1} MB \
+             over the second quarter of the run and {:.1} MB over the last: ratio {:.2} (target: at most \
+             {MEMORY_GROWTH_LIMIT:.2}, memory does not grow with the sequence): {}.\n",
+            self.short_scans,
+            self.short_recording_mb,
+            self.short.peak_mb,
+            self.long_scans,
+            self.long_recording_mb,
+            self.long.peak_mb,
+            self.long.mean_rss_mb(1),
+            self.long.mean_rss_mb(3),
+            self.growth(),
+            if self.flat() { "met" } else { "**missed**" }
+        )
+    }
+}
+
+/// Resident memory of a child process over its life.
+struct ChildMemory {
+    /// `VmHWM` at the last sample, MB.
+    peak_mb: f64,
+    /// `VmRSS` samples, MB, in time order (taken at a fixed period).
+    rss_mb: Vec<f64>,
+}
+
+impl ChildMemory {
+    /// Mean of the samples of quarter `q` (0..4) of the run.
+    fn mean_rss_mb(&self, q: usize) -> f64 {
+        let n = self.rss_mb.len();
+        let part = &self.rss_mb[n * q / 4..(n * (q + 1) / 4).max(n * q / 4 + 1).min(n)];
+        part.iter().sum::<f64>() / part.len().max(1) as f64
+    }
+}
+
+/// Sweeps per lap of the memory check's circular drive.
+const MEMORY_LAP_SCANS: usize = 100;
+
+/// Simulates a drive of `scans` sweeps as an Oxford folder and ingests it.
+fn simulated_recording(scans: usize, dir: &Path) -> anyhow::Result<PathBuf> {
+    use mmtrack_sim::radar::{
+        ConstantTurn, GeneratorConfig, RadarSimulator, ScanLimits, Scenario, SimOptions, Trajectory,
+    };
+    let scenario: Scenario = toml::from_str("seed = 11\n[generator]\n")?;
+    debug_assert_eq!(scenario.generator, Some(GeneratorConfig::default()));
+    // Laps of a circle of one short drive (a quarter of the long one): every lap
+    // sees the same street, so only the sequence length differs.
+    let lap_s = (scans.min(MEMORY_LAP_SCANS)) as f64 * 0.25;
+    let motion = ConstantTurn { speed_mps: 8.0, yaw_rate_radps: std::f64::consts::TAU / lap_s };
+    let trajectory = Trajectory::constant_turn(motion, 1_700_000_000_000_000_000, scans as f64 * 0.25 + 1.0)?;
+    let world = scenario.build_world(&trajectory)?;
+    let options =
+        SimOptions { limits: ScanLimits { max_scans: Some(scans), max_distance_m: None }, ..scenario.options() };
+    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)?;
+    let folder = dir.join(format!("drive-{scans}"));
+    crate::simulate::write_oxford_streaming(&scenario, simulator, &folder, true, &|| {})?;
+    let recording = dir.join(format!("drive-{scans}.mcap"));
+    let output = OutputArgs {
+        output: recording.clone(),
+        force: true,
+        compression: CompressionArg::Zstd,
+        zstd_level: 1,
+        no_foxglove_views: true,
+        no_sync: true,
+    };
+    crate::ingest::oxford_folder(&folder, &output, &Default::default(), true)?;
+    std::fs::remove_dir_all(&folder)?;
+    Ok(recording)
+}
+
+/// Runs `mmtrack process odometry` (cfear) as a child process, so the
+/// simulator's memory in this one does not count, and samples its resident
+/// memory (`/proc/<pid>/status`, Linux) until it exits.
+fn child_memory(recording: &Path, tables: &Path) -> anyhow::Result<ChildMemory> {
+    let exe = std::env::current_exe()?;
+    let mut child = std::process::Command::new(exe)
+        .args(["--quiet", "process", "odometry", "--preset", "cfear", "-o"])
+        .arg(tables)
+        .arg(recording)
+        .stdout(std::process::Stdio::null())
+        .spawn()?;
+    let status_path = format!("/proc/{}/status", child.id());
+    let field_kib = |status: &str, name: &str| {
+        status
+            .lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .and_then(|v| v.parse::<u64>().ok())
+    };
+    let mut memory = ChildMemory { peak_mb: 0.0, rss_mb: Vec::new() };
+    let status = loop {
+        if let Ok(status) = std::fs::read_to_string(&status_path)
+            && let (Some(rss), Some(hwm)) = (field_kib(&status, "VmRSS:"), field_kib(&status, "VmHWM:"))
+        {
+            memory.rss_mb.push(rss as f64 * 1024.0 / 1e6);
+            memory.peak_mb = memory.peak_mb.max(hwm as f64 * 1024.0 / 1e6);
+        }
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    };
+    anyhow::ensure!(status.success(), "{}: process odometry failed ({status})", recording.display());
+    anyhow::ensure!(!memory.rss_mb.is_empty(), "no /proc/<pid>/status to read memory from (Linux only)");
+    Ok(memory)
+}
+
+fn memory_check(long_scans: usize, dir: &Path) -> anyhow::Result<MemoryCheck> {
+    let short_scans = MEMORY_LAP_SCANS.min(long_scans / 4).max(2);
+    let mb = |b: u64| b as f64 / 1e6;
+    let mut runs = Vec::new();
+    let mut sizes = Vec::new();
+    for scans in [short_scans, long_scans] {
+        let recording = simulated_recording(scans, dir)?;
+        sizes.push(mb(std::fs::metadata(&recording)?.len()));
+        let tables = dir.join(format!("tables-{scans}"));
+        runs.push(child_memory(&recording, &tables)?);
+        std::fs::remove_file(&recording)?;
+    }
+    let long = runs.pop().context("long run")?;
+    let short = runs.pop().context("short run")?;
+    Ok(MemoryCheck { short_scans, long_scans, short, long, short_recording_mb: sizes[0], long_recording_mb: sizes[1] })
 }

@@ -166,7 +166,7 @@ pub fn for_each_event(
 ) -> anyhow::Result<Option<BTreeMap<String, String>>> {
     let mut reader = RecordingReader::open(recording)?;
     let workers = std::thread::available_parallelism().map_or(2, std::num::NonZero::get).clamp(1, 8);
-    let (sender, receiver) = mpsc::sync_channel::<Result<(Pending, u64), mmtrack_io::IoError>>(2 * workers);
+    let (sender, receiver) = mpsc::sync_channel::<Result<(Pending, u64), mmtrack_io::IoError>>(workers);
     let mut outcome = Ok(());
     let metadata = std::thread::scope(|scope| {
         let reader_thread = scope.spawn(move || {

@@ -123,7 +123,8 @@ pub fn write_oxford(scenario: &Scenario, dir: &Path, force: bool) -> anyhow::Res
     write_oxford_streaming(scenario, simulator, dir, force, &|| {})
 }
 
-fn write_oxford_streaming(
+/// Streams `simulator`'s scans into an Oxford folder at `dir` (see [`write_oxford`]).
+pub fn write_oxford_streaming(
     scenario: &Scenario,
     simulator: RadarSimulator<'_>,
     dir: &Path,
