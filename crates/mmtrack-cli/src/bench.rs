@@ -15,7 +15,9 @@ use clap::{Args, Subcommand};
 use mmtrack_core::PolarScan;
 use mmtrack_io::recording::{Compression, RecordingMetadata, TimeBase};
 use mmtrack_io::{Durability, Overwrite, RecordingEvent, RecordingOptions, RecordingReader, RecordingWriter};
-use mmtrack_sim::radar::{self, ConstantTurn, RadarScenario, RadarSensor, Reflector};
+use mmtrack_sim::radar::{
+    ConstantTurn, GeneratorConfig, RadarSimulator, ScanLimits, Sensor, SimOptions, Trajectory, World, generate_world,
+};
 use serde_json::json;
 
 #[derive(Args)]
@@ -75,30 +77,16 @@ enum Kind {
 
 /// Oxford-size scans with realistic content (noise floor, walls, poles), so
 /// compression sees data like the real sensor's rather than zeros.
-fn oxford_size_scans(count: usize) -> Vec<PolarScan> {
-    let scenario = RadarScenario {
-        seed: 1,
-        start_t_ns: 1_547_131_046_353_776_000,
-        scans: count,
-        sensor: RadarSensor {
-            azimuths: 400,
-            bins: 3768,
-            range_resolution_m: 0.0432,
-            sweep_period_s: 0.25,
-            range_spread_bins: 3.0,
-            noise_counts: 40,
-        },
-        motion: ConstantTurn { speed_mps: 10.0, yaw_rate_radps: 0.02 },
-        reflectors: (0..40)
-            .map(|i| Reflector::Point {
-                x_m: -80.0 + 4.0 * f64::from(i),
-                y_m: if i % 2 == 0 { 12.0 } else { -15.0 },
-                strength_counts: 200.0,
-            })
-            .chain([Reflector::Wall { a_m: [-100.0, 30.0], b_m: [150.0, 40.0], strength_counts: 180.0 }])
-            .collect(),
-    };
-    radar::simulate(&scenario).0
+/// `count` Oxford-size scans (400 x 3768) of a simulated drive through a
+/// generated street (the full radar simulator, default sensor and scene).
+fn oxford_size_scans(count: usize) -> anyhow::Result<Vec<PolarScan>> {
+    let motion = ConstantTurn { speed_mps: 10.0, yaw_rate_radps: 0.02 };
+    let trajectory = Trajectory::constant_turn(motion, 1_547_131_046_353_776_000, count as f64 * 0.25 + 1.0)?;
+    let world = World::new(&generate_world(&GeneratorConfig::default(), &trajectory, 1)?)?;
+    let sensor = Sensor::default();
+    let options =
+        SimOptions { seed: 1, limits: ScanLimits { max_scans: Some(count), max_distance_m: None }, threads: 0 };
+    Ok(RadarSimulator::new(&world, &sensor, &trajectory, options)?.map(|(scan, _)| scan).collect())
 }
 
 fn best_of(repeats: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<Duration> {
@@ -154,7 +142,7 @@ struct IoArgs<'a> {
 
 fn io(args: &IoArgs<'_>, quiet: bool) -> anyhow::Result<ExitCode> {
     let IoArgs { scans, repeats, check, json: as_json, dir, readme } = *args;
-    let scans_data = oxford_size_scans(scans);
+    let scans_data = oxford_size_scans(scans)?;
     let payload_bytes: usize = scans_data.iter().map(|s| s.power.len()).sum();
     let payload_mb = payload_bytes as f64 / 1e6;
     let temp = match dir {
@@ -327,10 +315,10 @@ fn ingest(args: &IngestBench<'_>, quiet: bool) -> anyhow::Result<ExitCode> {
             format!("real PNG bytes of {} repeated", real.display())
         }
         None => {
-            let scans = oxford_size_scans(args.scans);
+            let scans = oxford_size_scans(args.scans)?;
             mmtrack_ingest::oxford::write_oxford_folder(&large, &scans, &[], &layout)?;
             mmtrack_ingest::oxford::write_oxford_folder(&small, &scans[..small_scans], &[], &layout)?;
-            "simulated scans (noisier than real ones: larger PNGs, slower to decode)".to_string()
+            "simulated scans of the radar simulator in a generated street".to_string()
         }
     };
     let folder_mb = dir_bytes(&large.join("radar"))? as f64 / 1e6;

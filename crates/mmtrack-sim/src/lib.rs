@@ -50,8 +50,6 @@
 //! - [`radar::RadarSimulator`]: `Iterator<Item = (PolarScan, StampedPose)>`,
 //!   rendering `threads` sweeps at a time (per-sweep randomness from
 //!   `(seed, sweep index)`), or any single sweep with `render(index)`.
-//! - [`radar::simulate`] and friends: the first, minimal renderer, kept for
-//!   `mmtrack bench io`.
 //!
 //! Speed (release build, this project's 2-core machine, Oxford-size sweeps of
 //! 400 x 3768 in the default generated city, `cargo run --release -p

@@ -94,7 +94,6 @@
 
 mod generator;
 mod grid;
-pub mod minimal;
 mod render;
 mod scenario;
 mod sensor;
@@ -103,9 +102,7 @@ mod trajectory;
 mod world;
 
 pub use generator::{GeneratorConfig, distance_to_path_m, generate_world};
-pub use minimal::{RadarScenario, RadarSensor, Reflector, simulate};
 pub use scenario::{Motion, Scenario, simulate_scenario};
-// The minimal renderer keeps its names (`Reflector`, `RadarScenario`, ...) for `bench io`.
 pub use sensor::Sensor;
 pub use simulator::{RadarSimulator, SimOptions};
 pub use trajectory::{ConstantTurn, ScanLimits, Trajectory, scan_stamps};
