@@ -41,7 +41,8 @@
 //! - Multipath: when the first surface is a building facade, the beam
 //!   reflected specularly off it is traced to its first surface, which
 //!   appears at the summed path length (a ghost behind the facade) with
-//!   `multipath_loss_db` less power.
+//!   `multipath_loss_db` less power (`multipath_ghosts = false` in the
+//!   `[sensor]` table turns them off).
 //! - Speckle: each return's power is multiplied by
 //!   `|sqrt(f) z_static + sqrt(1 - f) z_sweep|^2 / 2` (unit complex Gaussians
 //!   from hashes of the seed, the scatterer and, for `z_sweep`, the sweep),

@@ -121,10 +121,11 @@ impl RenderContext<'_> {
                 out.push(Return { range_m, power: power * t * t, key: (2 << 60) | u64::from(id), tail_bins: 0.0 });
             }
         }
-        if let (Some(loss_db), Some(first)) = (sensor.multipath_loss_db, hits.first())
+        if sensor.multipath_ghosts
+            && let Some(first) = hits.first()
             && let Some(ghost) = self.ghost(origin, dir, first, max_range_m, scratch)
         {
-            out.push(Return { power: ghost.power * Sensor::db_to_power(-loss_db), ..ghost });
+            out.push(Return { power: ghost.power * Sensor::db_to_power(-sensor.multipath_loss_db), ..ghost });
         }
         out
     }

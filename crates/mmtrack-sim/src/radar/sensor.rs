@@ -44,9 +44,11 @@ pub struct Sensor {
     /// Share of a return's speckle that stays from sweep to sweep for a static
     /// scene (complex-amplitude weight): 0 = fresh every sweep, 1 = frozen.
     pub speckle_static_fraction: f64,
-    /// Loss of a multipath ghost (beam mirrored once by a building) relative to
-    /// a direct return at the same path length, dB; `None` turns ghosts off.
-    pub multipath_loss_db: Option<f64>,
+    /// Render multipath ghosts (the beam mirrored once by a building front).
+    pub multipath_ghosts: bool,
+    /// Loss of a multipath ghost relative to a direct return at the same
+    /// path length, dB.
+    pub multipath_loss_db: f64,
 }
 
 impl Default for Sensor {
@@ -64,7 +66,8 @@ impl Default for Sensor {
             ground_clutter_range_m: 60.0,
             counts_per_ln_amplitude: 8.56,
             speckle_static_fraction: 0.7,
-            multipath_loss_db: Some(12.0),
+            multipath_ghosts: true,
+            multipath_loss_db: 12.0,
         }
     }
 }
@@ -97,8 +100,8 @@ impl Sensor {
             1.0,
             "a fraction in [0, 1]",
         )?;
-        if let Some(loss) = self.multipath_loss_db {
-            ensure_non_negative("sensor.multipath_loss_db", loss)?;
+        if self.multipath_ghosts {
+            ensure_non_negative("sensor.multipath_loss_db", self.multipath_loss_db)?;
         }
         Ok(())
     }

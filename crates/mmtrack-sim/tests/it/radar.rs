@@ -9,7 +9,7 @@ use mmtrack_sim::radar::{
 
 /// A quiet sensor (no speckle variation, no ghosts) for geometry tests.
 fn sensor(bins: usize, resolution_m: f64) -> Sensor {
-    Sensor { bins, range_resolution_m: resolution_m, multipath_loss_db: None, ..Sensor::default() }
+    Sensor { bins, range_resolution_m: resolution_m, multipath_ghosts: false, ..Sensor::default() }
 }
 
 fn still(seconds: f64) -> Trajectory {
@@ -206,4 +206,29 @@ fn bad_sensors_and_cuts_are_named() {
         .err()
         .unwrap();
     assert!(err.to_string().contains("max_distance_m"), "{err}");
+}
+
+#[test]
+fn multipath_ghosts_appear_behind_a_facade_and_can_be_switched_off() {
+    // A facade 10 m ahead (mirrors the beam straight back) and a building
+    // front 15 m behind: the ghost of the rear front sits at 10 + 25 = 35 m
+    // in the forward row, where nothing real is.
+    let world = World::new(&[
+        wall([10.0, -30.0], [10.0, 30.0], Material::Building),
+        wall([-15.0, -30.0], [-15.0, 30.0], Material::Building),
+    ])
+    .unwrap();
+    let forward_level_at = |ghosts: bool, range_m: f64| {
+        let s = Sensor { bins: 900, range_resolution_m: 0.05, multipath_ghosts: ghosts, ..Sensor::default() };
+        let scans = render(&world, &s, &still(1.0), 3, 1);
+        let bin = (range_m / 0.05).round() as usize;
+        // Rows around 0 deg (forward), the best of +-3 bins.
+        (0..3).flat_map(|a| scans[0].0.row(a).unwrap()[bin - 3..=bin + 3].to_vec()).max().unwrap()
+    };
+    let with = forward_level_at(true, 35.0);
+    let without = forward_level_at(false, 35.0);
+    assert!(with >= without + 10, "ghost {with} counts vs {without} without ghosts");
+    let floor = forward_level_at(true, 30.0);
+    assert!(with >= floor + 10, "ghost {with} counts vs floor {floor} at 30 m");
+    assert!(Sensor::default().multipath_ghosts, "on by default; `multipath_ghosts = false` in [sensor] turns them off");
 }
