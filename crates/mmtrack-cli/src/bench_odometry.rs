@@ -62,15 +62,7 @@ struct PresetResult {
 pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let dir = tempfile::tempdir()?;
     let recording = dir.path().join("bench.mcap");
-    let output = OutputArgs {
-        output: recording.clone(),
-        force: true,
-        compression: CompressionArg::Zstd,
-        zstd_level: 1,
-        no_foxglove_views: true,
-        no_sync: true,
-    };
-    crate::ingest::oxford_folder(&args.from, &output, &Default::default(), true)
+    ingest_quietly(&args.from, &recording)
         .with_context(|| format!("{}: cannot build the bench recording", args.from.display()))?;
 
     let started = Instant::now();
@@ -207,6 +199,20 @@ impl ChildMemory {
     }
 }
 
+/// Ingests an Oxford folder into a zstd recording without display channels.
+fn ingest_quietly(folder: &Path, recording: &Path) -> anyhow::Result<()> {
+    let output = OutputArgs {
+        output: recording.to_path_buf(),
+        force: true,
+        compression: CompressionArg::Zstd,
+        zstd_level: 1,
+        no_foxglove_views: true,
+        no_sync: true,
+    };
+    crate::ingest::oxford_folder(folder, &output, &Default::default(), true)?;
+    Ok(())
+}
+
 /// Sweeps per lap of the memory check's circular drive.
 const MEMORY_LAP_SCANS: usize = 100;
 
@@ -229,15 +235,7 @@ fn simulated_recording(scans: usize, dir: &Path) -> anyhow::Result<PathBuf> {
     let folder = dir.join(format!("drive-{scans}"));
     crate::simulate::write_oxford_streaming(&scenario, simulator, &folder, true, &|| {})?;
     let recording = dir.join(format!("drive-{scans}.mcap"));
-    let output = OutputArgs {
-        output: recording.clone(),
-        force: true,
-        compression: CompressionArg::Zstd,
-        zstd_level: 1,
-        no_foxglove_views: true,
-        no_sync: true,
-    };
-    crate::ingest::oxford_folder(&folder, &output, &Default::default(), true)?;
+    ingest_quietly(&folder, &recording)?;
     std::fs::remove_dir_all(&folder)?;
     Ok(recording)
 }
