@@ -39,7 +39,7 @@ pub struct ReproduceArgs {
 
 #[derive(Subcommand)]
 enum Experiment {
-    /// Radar odometry drift on a simulated drive along a real trajectory (issue #4).
+    /// Radar odometry drift on a simulated drive along a real trajectory (issue #4)
     ///
     /// Renders Oxford-size Navtech scans (400 x 3768) along the trajectory
     /// through a generated street scene, runs the `fast-cfear` and `cfear`
