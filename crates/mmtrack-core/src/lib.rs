@@ -9,7 +9,9 @@
 //! - [`PolarScan`]: a spinning-radar sweep with per-azimuth time, angle and validity;
 //! - [`CirSnapshot`]: one channel impulse response with its tap spacing and its
 //!   position in the sounder's set/snapshot structure;
-//! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`] and [`OdometryEstimate`].
+//! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`], [`MpcTruth`] and [`OdometryEstimate`];
+//! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
+//!   window, path spectra) shared by the sounder simulator and the MPC detector.
 //!
 //! It must not do I/O, print, or depend on any other mmtrack crate: it sits at
 //! the bottom of the data flow (`ingest -> recording -> process -> tables ->
@@ -25,11 +27,12 @@ mod mpc;
 mod odometry;
 mod pose;
 mod radar;
+pub mod sounder;
 
 pub use cir::CirSnapshot;
 pub use error::CoreError;
 pub use gnss::{GnssFix, GnssFixQuality};
-pub use mpc::{MpcDetection, MpcTrack};
+pub use mpc::{MpcDetection, MpcTrack, MpcTruth};
 pub use num_complex::Complex64;
 pub use odometry::{OdometryEstimate, OdometryTiming};
 pub use pose::{Se2, StampedPose, path_length_m, wrap_angle_rad};

@@ -36,6 +36,37 @@ pub struct MpcTrack {
     pub detections: Vec<MpcDetection>,
 }
 
+/// A true multipath component in one snapshot, as a simulator knows it.
+///
+/// `path_id` names the propagation path (the same reflector keeps its id while
+/// it is visible), so tracks can be scored for purity and births/deaths
+/// counted from the truth.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcTruth {
+    /// Time of the snapshot, nanoseconds.
+    pub t_ns: i64,
+    /// Set of the snapshot.
+    pub set_index: u64,
+    /// Snapshot within its set.
+    pub snapshot_index: u32,
+    /// Identifier of the propagation path (stable while the path exists).
+    pub path_id: u64,
+    /// True propagation delay, seconds (on the recording's delay axis).
+    pub delay_s: f64,
+    /// True complex amplitude (linear, the sounder's scale).
+    pub amplitude: Complex64,
+    /// True Doppler shift, hertz (`-f_c d(tau)/dt`).
+    pub doppler_hz: f64,
+}
+
+impl MpcTruth {
+    /// Power of the component, dB: `20 log10 |amplitude|`.
+    #[must_use]
+    pub fn power_db(&self) -> f64 {
+        20.0 * self.amplitude.norm().log10()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
