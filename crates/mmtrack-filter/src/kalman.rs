@@ -1,0 +1,227 @@
+//! Linear Kalman prediction and update, the two single-target roles the
+//! trackers are assembled from.
+//!
+//! Prediction: `m' = F m`, `P' = F P F^T + Q`.
+//!
+//! Update with measurement `z` under `z = H x + w`, `w ~ N(0, R)`:
+//!
+//! ```text
+//! eta = H m            (predicted measurement)
+//! S   = H P H^T + R    (innovation covariance)
+//! K   = P H^T S^-1     (gain)
+//! m+  = m + K (z - eta)
+//! P+  = (I - K H) P (I - K H)^T + K R K^T     (Joseph form, the default)
+//!     = (I - K H) P                           (standard form)
+//! ```
+//!
+//! `eta`, `S`, `K` and `P+` do not depend on `z`; [`PreparedUpdate`] computes
+//! them once per prior so that a GM-PHD update against many measurements costs
+//! one factorisation per component.
+//!
+//! # References
+//! B.-N. Vo and W.-K. Ma, IEEE TSP 54(11), 2006, Table I, steps 2 and 4 (the
+//! same quantities, there per mixture component); R. S. Bucy and P. D. Joseph,
+//! *Filtering for Stochastic Processes with Applications to Guidance*, 1968 (the
+//! Joseph form).
+
+use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
+
+use crate::error::{FilterError, ensure_finite_vector, ensure_len};
+use crate::gaussian::{Gaussian, cholesky, log_normal_pdf_with, mahalanobis_squared_with, symmetrise};
+use crate::models::{LinearMeasurement, TransitionModel};
+
+/// How the posterior covariance is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CovarianceUpdate {
+    /// `P+ = (I - K H) P (I - K H)^T + K R K^T`.
+    ///
+    /// Stays symmetric positive definite: it is a congruence of the SPD `P`
+    /// plus the positive semi-definite `K R K^T`, so `x^T P+ x > 0` for every
+    /// `x != 0` (if `(I - K H)^T x = 0` then `x = H^T K^T x`, so `K^T x != 0`
+    /// and the second term is positive). This holds for *any* gain `K`, so the
+    /// round-off in `K` cannot make `P+` indefinite, and the formula is
+    /// symmetric by construction (we still symmetrise to remove the last ulp).
+    #[default]
+    Joseph,
+    /// `P+ = (I - K H) P`, symmetrised. Cheaper, exact only for the optimal
+    /// gain; with a badly conditioned `S` the subtraction can lose definiteness,
+    /// which is then reported as [`FilterError::NotPositiveDefinite`].
+    Standard,
+}
+
+/// The prediction role: pushes a Gaussian through a [`TransitionModel`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct KalmanPredictor<T> {
+    /// The motion model.
+    pub model: T,
+}
+
+impl<T: TransitionModel> KalmanPredictor<T> {
+    /// Wraps a motion model.
+    pub fn new(model: T) -> Self {
+        Self { model }
+    }
+
+    /// `N(F m, F P F^T + Q)` for a step of `dt_s` seconds.
+    ///
+    /// # Errors
+    /// [`FilterError::DimensionMismatch`] when the prior does not have the
+    /// model's state dimension; the model's own errors for a bad `dt_s`;
+    /// [`FilterError::NotPositiveDefinite`] / [`FilterError::NotFinite`] if the
+    /// result is not a valid covariance (e.g. overflow).
+    pub fn predict(&self, prior: &Gaussian, dt_s: f64) -> Result<Gaussian, FilterError> {
+        let n = self.model.state_dim();
+        ensure_len("prior mean", prior.mean(), n)?;
+        let (f, q) = self.model.matrices(dt_s)?;
+        let mean = &f * prior.mean();
+        let cov = symmetrise(&f * prior.cov() * f.transpose() + q);
+        Gaussian::new(mean, cov)
+    }
+}
+
+/// The update role: conditions a Gaussian on a linear measurement.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KalmanUpdater {
+    /// The measurement model.
+    pub model: LinearMeasurement,
+    /// Posterior covariance formula.
+    pub covariance_update: CovarianceUpdate,
+}
+
+impl KalmanUpdater {
+    /// An updater with the default (Joseph) covariance update.
+    #[must_use]
+    pub fn new(model: LinearMeasurement) -> Self {
+        Self { model, covariance_update: CovarianceUpdate::default() }
+    }
+
+    /// Computes the `z`-independent parts of the update for `prior`.
+    ///
+    /// # Errors
+    /// [`FilterError::DimensionMismatch`] if the prior's dimension is not the
+    /// model's; [`FilterError::NotPositiveDefinite`] if `S` or `P+` is not SPD.
+    pub fn prepare(&self, prior: &Gaussian) -> Result<PreparedUpdate, FilterError> {
+        let h = self.model.h();
+        let r = self.model.r();
+        ensure_len("prior mean", prior.mean(), self.model.state_dim())?;
+        let p = prior.cov();
+        let s = symmetrise(h * p * h.transpose() + r);
+        let s_chol = cholesky("innovation covariance S", &s)?;
+        // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
+        let gain = s_chol.solve(&(h * p)).transpose();
+        let n = prior.dim();
+        let i_kh = DMatrix::identity(n, n) - &gain * h;
+        let post = match self.covariance_update {
+            CovarianceUpdate::Joseph => &i_kh * p * i_kh.transpose() + &gain * r * gain.transpose(),
+            CovarianceUpdate::Standard => &i_kh * p,
+        };
+        let posterior_cov = symmetrise(post);
+        // Validate once here so `posterior` only has to check the mean.
+        let posterior_cov = Gaussian::new(prior.mean().clone(), posterior_cov)?.cov().clone();
+        Ok(PreparedUpdate {
+            prior_mean: prior.mean().clone(),
+            predicted_measurement: h * prior.mean(),
+            s,
+            s_chol,
+            gain,
+            posterior_cov,
+        })
+    }
+
+    /// One full update of `prior` with measurement `z`.
+    ///
+    /// # Errors
+    /// As [`KalmanUpdater::prepare`], plus [`FilterError::DimensionMismatch`] /
+    /// [`FilterError::NotFinite`] for a bad `z`.
+    pub fn update(&self, prior: &Gaussian, z: &DVector<f64>) -> Result<Gaussian, FilterError> {
+        self.prepare(prior)?.posterior(z)
+    }
+}
+
+/// The measurement-independent part of a Kalman update (see the module docs).
+#[derive(Debug, Clone)]
+pub struct PreparedUpdate {
+    prior_mean: DVector<f64>,
+    predicted_measurement: DVector<f64>,
+    s: DMatrix<f64>,
+    s_chol: Cholesky<f64, Dyn>,
+    gain: DMatrix<f64>,
+    posterior_cov: DMatrix<f64>,
+}
+
+impl PreparedUpdate {
+    /// Predicted measurement `eta = H m`.
+    #[must_use]
+    pub fn predicted_measurement(&self) -> &DVector<f64> {
+        &self.predicted_measurement
+    }
+
+    /// Innovation covariance `S = H P H^T + R`.
+    #[must_use]
+    pub fn innovation_cov(&self) -> &DMatrix<f64> {
+        &self.s
+    }
+
+    /// Gain `K`.
+    #[must_use]
+    pub fn gain(&self) -> &DMatrix<f64> {
+        &self.gain
+    }
+
+    /// Posterior covariance `P+` (the same for every `z`).
+    #[must_use]
+    pub fn posterior_cov(&self) -> &DMatrix<f64> {
+        &self.posterior_cov
+    }
+
+    /// Innovation `z - eta`.
+    ///
+    /// # Errors
+    /// [`FilterError::DimensionMismatch`] / [`FilterError::NotFinite`] for a bad `z`.
+    pub fn innovation(&self, z: &DVector<f64>) -> Result<DVector<f64>, FilterError> {
+        ensure_len("measurement", z, self.predicted_measurement.len())?;
+        ensure_finite_vector("measurement", z)?;
+        Ok(z - &self.predicted_measurement)
+    }
+
+    /// Squared Mahalanobis distance of `z` from the prediction, `nu^T S^-1 nu`.
+    ///
+    /// # Errors
+    /// As [`PreparedUpdate::innovation`].
+    pub fn mahalanobis_squared(&self, z: &DVector<f64>) -> Result<f64, FilterError> {
+        Ok(mahalanobis_squared_with(&self.s_chol, &self.innovation(z)?))
+    }
+
+    /// `ln N(z; eta, S)`, the log measurement likelihood `ln q(z)` of Vo & Ma
+    /// Table I, step 4.
+    ///
+    /// # Errors
+    /// As [`PreparedUpdate::innovation`].
+    pub fn log_likelihood(&self, z: &DVector<f64>) -> Result<f64, FilterError> {
+        Ok(log_normal_pdf_with(&self.s_chol, &self.innovation(z)?))
+    }
+
+    /// `ln N(nu; 0, S)` for an innovation already computed.
+    pub(crate) fn log_likelihood_of_innovation(&self, nu: &DVector<f64>) -> f64 {
+        log_normal_pdf_with(&self.s_chol, nu)
+    }
+
+    /// `nu^T S^-1 nu` for an innovation already computed.
+    pub(crate) fn mahalanobis_squared_of_innovation(&self, nu: &DVector<f64>) -> f64 {
+        mahalanobis_squared_with(&self.s_chol, nu)
+    }
+
+    /// Posterior `N(m + K (z - eta), P+)`.
+    ///
+    /// # Errors
+    /// As [`PreparedUpdate::innovation`].
+    pub fn posterior(&self, z: &DVector<f64>) -> Result<Gaussian, FilterError> {
+        let nu = self.innovation(z)?;
+        self.posterior_of_innovation(&nu)
+    }
+
+    /// Posterior for an innovation already computed.
+    pub(crate) fn posterior_of_innovation(&self, nu: &DVector<f64>) -> Result<Gaussian, FilterError> {
+        Gaussian::new(&self.prior_mean + &self.gain * nu, self.posterior_cov.clone())
+    }
+}
