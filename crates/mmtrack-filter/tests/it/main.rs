@@ -1,1 +1,8 @@
-//! Integration tests of mmtrack-filter.
+//! Integration tests of mmtrack-filter (one test binary, one module per topic).
+
+mod assignment;
+mod bad_input;
+mod gmphd;
+mod kalman;
+mod metrics;
+mod support;

@@ -1,0 +1,36 @@
+//! Small deterministic helpers shared by the tests.
+
+use mmtrack_filter::nalgebra::{DMatrix, DVector};
+
+/// Column vector from a slice.
+pub fn v(xs: &[f64]) -> DVector<f64> {
+    DVector::from_column_slice(xs)
+}
+
+/// Row-major matrix.
+pub fn m(rows: usize, cols: usize, xs: &[f64]) -> DMatrix<f64> {
+    DMatrix::from_row_slice(rows, cols, xs)
+}
+
+/// Deterministic standard-normal samples (64-bit LCG + Box-Muller), so the
+/// scenario tests do not depend on a random-number crate or its versions.
+pub struct Normal {
+    state: u64,
+}
+
+impl Normal {
+    pub fn new(seed: u64) -> Self {
+        Self { state: seed }
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.state = self.state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        // 53 high bits -> (0, 1).
+        ((self.state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    pub fn sample(&mut self) -> f64 {
+        let (u1, u2) = (self.uniform(), self.uniform());
+        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    }
+}
