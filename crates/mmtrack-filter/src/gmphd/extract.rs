@@ -34,6 +34,10 @@ pub struct Estimate {
     pub weight: f64,
     /// The component's Gaussian (mean = the state estimate).
     pub density: Gaussian,
+    /// The measurement that produced the component (see
+    /// [`Component::measurement`]): after merging, the one with the largest
+    /// association weight among the merged members.
+    pub measurement: Option<usize>,
 }
 
 /// The state-extraction role.
@@ -78,9 +82,19 @@ impl StateExtractor {
                 }
                 let c = &mixture[i];
                 let copies = (c.weight.round().min(MAX_COPIES_PER_COMPONENT as f64) as usize).max(1);
-                estimates.push(Estimate { label: c.label, weight: c.weight, density: c.density.clone() });
+                estimates.push(Estimate {
+                    label: c.label,
+                    weight: c.weight,
+                    density: c.density.clone(),
+                    measurement: c.measurement,
+                });
                 for _ in 1..copies {
-                    estimates.push(Estimate { label: fresh(), weight: c.weight, density: c.density.clone() });
+                    estimates.push(Estimate {
+                        label: fresh(),
+                        weight: c.weight,
+                        density: c.density.clone(),
+                        measurement: c.measurement,
+                    });
                 }
             }
         }

@@ -74,6 +74,10 @@ pub struct Component {
     pub weight: f64,
     /// The Gaussian `N(m, P)`.
     pub density: Gaussian,
+    /// Index (in the last update's measurement set) of the measurement that
+    /// produced this component; `None` for predicted, birth and
+    /// missed-detection components. Merging keeps the heaviest member's.
+    pub measurement: Option<usize>,
 }
 
 /// An unlabelled weighted Gaussian: a term of the birth intensity.
@@ -225,6 +229,7 @@ impl<T: TransitionModel> GmPhdFilter<T> {
                 label: c.label,
                 weight: self.params.p_survival * c.weight,
                 density: self.predictor.predict(&c.density, dt_s)?,
+                measurement: None,
             });
         }
         let mut labels = Vec::with_capacity(births.len());
@@ -232,7 +237,7 @@ impl<T: TransitionModel> GmPhdFilter<T> {
         for b in births {
             let label = self.fresh_label();
             labels.push(label);
-            self.mixture.push(Component { label, weight: b.weight, density: b.density });
+            self.mixture.push(Component { label, weight: b.weight, density: b.density, measurement: None });
         }
         Ok(labels)
     }

@@ -17,7 +17,8 @@
 //!   does not; Stone Soup does), so `sum w` may drop by at most the pruned mass;
 //! - ties in `argmax` go to the component that comes first in the mixture,
 //!   which makes the result deterministic;
-//! - the merged component takes the label of `j` (the heaviest member);
+//! - the merged component takes the label (and the measurement provenance) of
+//!   `j`, the heaviest member;
 //! - `P~` is a weighted sum of SPD matrices plus positive semi-definite outer
 //!   products, hence SPD; it is symmetrised against round-off.
 
@@ -140,5 +141,10 @@ fn merge_group(kept: &[&Component], group: &[usize], leader: usize) -> Result<Co
         cov += (kept[i].density.cov() + &d * d.transpose()) * kept[i].weight;
     }
     cov /= w_total;
-    Ok(Component { label: kept[leader].label, weight: w_total, density: Gaussian::new(mean, symmetrise(cov))? })
+    Ok(Component {
+        label: kept[leader].label,
+        weight: w_total,
+        density: Gaussian::new(mean, symmetrise(cov))?,
+        measurement: kept[leader].measurement,
+    })
 }

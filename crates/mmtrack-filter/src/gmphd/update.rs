@@ -92,7 +92,12 @@ pub(crate) fn update<G: Gate>(
     let mut out: Vec<Component> = predicted
         .iter()
         .filter(|c| (1.0 - p_d) * c.weight > 0.0)
-        .map(|c| Component { label: c.label, weight: (1.0 - p_d) * c.weight, density: c.density.clone() })
+        .map(|c| Component {
+            label: c.label,
+            weight: (1.0 - p_d) * c.weight,
+            density: c.density.clone(),
+            measurement: None,
+        })
         .collect();
     let mut measurement_weights = Vec::with_capacity(measurements.len());
     let mut assoc: BTreeMap<(Label, usize), f64> = BTreeMap::new();
@@ -130,7 +135,12 @@ pub(crate) fn update<G: Gate>(
                     continue;
                 }
                 let label = predicted[i].label;
-                out.push(Component { label, weight, density: prepared[i].posterior_of_innovation(&nu)? });
+                out.push(Component {
+                    label,
+                    weight,
+                    density: prepared[i].posterior_of_innovation(&nu)?,
+                    measurement: Some(j),
+                });
                 *assoc.entry((label, j)).or_insert(0.0) += weight;
                 total += weight;
             }

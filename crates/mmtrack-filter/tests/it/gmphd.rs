@@ -105,7 +105,12 @@ fn two_targets_cardinality_and_labels() {
 }
 
 fn comp(label: u64, weight: f64, mean: f64, var: f64) -> Component {
-    Component { label: Label(label), weight, density: Gaussian::new(v(&[mean]), m(1, 1, &[var])).expect("valid") }
+    Component {
+        label: Label(label),
+        weight,
+        density: Gaussian::new(v(&[mean]), m(1, 1, &[var])).expect("valid"),
+        measurement: Some(label as usize),
+    }
 }
 
 /// Table II by hand: T = 0.01, U = 0.1.
@@ -129,6 +134,7 @@ fn pruning_and_merging_by_hand() {
     assert!((merged.weight - 0.9).abs() < 1e-15);
     assert!((merged.density.mean()[0] - 1.0 / 30.0).abs() < 1e-15);
     assert!((merged.density.cov()[(0, 0)] - (1.0 + 1.0 / 450.0)).abs() < 1e-15);
+    assert_eq!(merged.measurement, Some(1), "provenance of the heaviest member");
     assert_eq!(out[1].label, Label(3));
 
     // J_max = 1 keeps the heaviest.
