@@ -32,7 +32,14 @@
 //! # Ok::<(), mmtrack_sim::SimError>(())
 //! ```
 //!
-//! The pieces:
+//! ## Channel sounder ([`sounder`])
+//!
+//! A wideband sounder (5.7 GHz, 1 GHz, sets of snapshots) observing the
+//! artificial two-MPC channel of Mahler et al. 2017 ([`sounder::artificial_channel`])
+//! or a two-car convoy through a curved tunnel or on a highway
+//! ([`sounder::ConvoySimulator`]), with the true MPCs and both cars' poses.
+//!
+//! The radar pieces:
 //!
 //! - [`radar::Scenario`]: the TOML scenario (sensor, `[motion]`,
 //!   `[generator]`, `[[reflectors]]`, seed, cuts), with
@@ -58,5 +65,6 @@
 
 mod error;
 pub mod radar;
+pub mod sounder;
 
 pub use error::SimError;
