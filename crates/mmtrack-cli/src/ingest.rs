@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
+use mmtrack_ingest::boreas::{BoreasFolder, BoreasOptions, ingest_boreas};
 use mmtrack_ingest::cir::{CirFormat, ingest_cir};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_ingest::poses::{self, Plane};
@@ -153,11 +154,26 @@ enum Kind {
         #[arg(long)]
         sequence_id: Option<String>,
     },
-    /// Boreas sequence folder (not built yet: issue #3).
+    /// Boreas sequence folder: radar/<t_us>.png, applanix/radar_poses.csv.
+    ///
+    /// Range bins of 0.0596 m before 2021-09-21 and 0.04381 m from then on (date
+    /// from the folder name boreas-YYYY-MM-DD-HH-MM), range offset -0.31 m, bins
+    /// per azimuth from each PNG; poses in a local east-north frame whose origin
+    /// is in the metadata.
     Boreas {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
+        /// The sequence folder.
+        input: PathBuf,
+        #[command(flatten)]
+        output: OutputArgs,
+        /// Range bin size in metres (default: chosen by recording date).
+        #[arg(long)]
+        range_resolution_m: Option<f64>,
+        /// Store decoded mono8 images instead of carrying the PNG bytes unchanged.
+        #[arg(long)]
+        decode: bool,
+        /// Sequence id (default: the folder name).
+        #[arg(long)]
+        sequence_id: Option<String>,
     },
     /// MulRan sequence folder (not built yet: issue #3).
     Mulran {
@@ -244,9 +260,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 "auto" => None,
                 n => Some(n.parse::<usize>().with_context(|| format!("--bins '{n}': expected a number or `auto`"))?),
             };
-            if !(range_resolution_m.is_finite() && range_resolution_m > 0.0) {
-                anyhow::bail!("--range-resolution-m {range_resolution_m}: expected a positive number of metres");
-            }
+            positive_metres("--range-resolution-m", range_resolution_m)?;
             let options = OxfordOptions {
                 layout: oxford::NavtechLayout { range_resolution_m, expected_bins, ..oxford::OXFORD },
                 carry_png: !decode,
@@ -254,7 +268,13 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             };
             oxford_folder(&input, &output, &options, quiet)
         }
-        Kind::Boreas { .. } => crate::not_built("ingest boreas", 3),
+        Kind::Boreas { input, output, range_resolution_m, decode, sequence_id } => {
+            if let Some(r) = range_resolution_m {
+                positive_metres("--range-resolution-m", r)?;
+            }
+            let options = BoreasOptions { range_resolution_m, decode, sequence_id };
+            boreas_folder(&input, &output, &options, quiet)
+        }
         Kind::Mulran { .. } => crate::not_built("ingest mulran", 3),
         Kind::Poses { input, format, mut output, add_to, estimate, times, t0_ns, plane } => {
             let plane = match plane {
@@ -339,6 +359,43 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// Checks that a length flag is a positive, finite number of metres.
+fn positive_metres(flag: &str, value: f64) -> anyhow::Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        anyhow::bail!("{flag} {value}: expected a positive number of metres")
+    }
+}
+
+/// Ingests one Boreas folder, with a progress bar.
+fn boreas_folder(
+    input: &std::path::Path,
+    output: &OutputArgs,
+    options: &BoreasOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let folder = BoreasFolder::open(input)?;
+    let bar = progress::bar(folder.scans.len() as u64, "ingest boreas", "scans", quiet);
+    let report = ingest_boreas(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    if !quiet {
+        println!(
+            "{}: {} scans ({} m range bins: {}), {} ground-truth poses ({:.1} MB)",
+            report.output.path.display(),
+            report.scans,
+            report.range_resolution_m,
+            report.range_resolution_source,
+            report.ground_truth_poses,
+            report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Adding to the output file itself replaces it, once the new one is complete.

@@ -9,10 +9,13 @@
 //! It depends on `mmtrack-core` and `mmtrack-io` only, never on algorithms, and
 //! does not print: long operations report through a progress callback.
 //!
-//! Sources so far: Oxford Radar RobotCar folders ([`oxford`]) with their
-//! ground truth and GPS, ROS 2 bags ([`ros2`]), trajectory files ([`poses`])
-//! and NMEA 0183 logs ([`nmea`]).
+//! Sources so far: Navtech polar scan folders of Oxford Radar RobotCar
+//! ([`oxford`], with ground truth, GPS and INS), Boreas ([`boreas`], with the
+//! Applanix poses) and MulRan ([`mulran`], with its global poses); ROS 2 bags
+//! ([`ros2`]); trajectory files ([`poses`]); NMEA 0183 logs ([`nmea`]);
+//! channel-sounder CIR/CFR files ([`cir`]).
 
+pub mod boreas;
 pub mod cir;
 mod csv;
 mod error;
@@ -20,6 +23,7 @@ pub mod nmea;
 pub mod oxford;
 pub mod poses;
 pub mod ros2;
+pub mod scan_folder;
 pub mod target;
 
 pub use error::IngestError;

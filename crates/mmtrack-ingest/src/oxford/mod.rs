@@ -23,17 +23,11 @@ use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummar
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
 use crate::error::os_err;
+use crate::scan_folder::{StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check};
 use crate::{IngestError, Progress};
 pub use png_scan::{DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
 
-/// One scan file of a folder.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ScanFile {
-    /// Scan stamp from the file name, nanoseconds.
-    pub t_ns: i64,
-    /// The PNG.
-    pub path: PathBuf,
-}
+pub use crate::scan_folder::ScanFile;
 
 /// An Oxford-layout sequence folder, listed but not yet read.
 #[derive(Debug, Clone)]
@@ -51,14 +45,7 @@ pub struct OxfordFolder {
 }
 
 fn parse_stamp(path: &Path, line: usize, raw: &str) -> Result<i64, IngestError> {
-    raw.parse::<i64>().ok().and_then(|us| us.checked_mul(1000)).filter(|t| *t > 0).ok_or_else(|| {
-        IngestError::BadRecord {
-            path: path.to_path_buf(),
-            record: format!("line {line}"),
-            field: "timestamp".into(),
-            detail: format!("'{raw}' is not a microsecond UNIX timestamp"),
-        }
-    })
+    StampUnit::Micros.parse(path, &format!("line {line}"), raw)
 }
 
 impl OxfordFolder {
@@ -99,25 +86,9 @@ impl OxfordFolder {
                 }
                 scans.push(ScanFile { t_ns, path });
             }
+            scans = sort_and_check(&radar_dir, scans)?;
         } else {
-            for entry in std::fs::read_dir(&radar_dir).map_err(os_err(&radar_dir))? {
-                let path = entry.map_err(os_err(&radar_dir))?.path();
-                let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("");
-                if path.extension().is_some_and(|e| e == "png") && stem.bytes().all(|b| b.is_ascii_digit()) {
-                    let t_ns = parse_stamp(&path, 0, stem)?;
-                    scans.push(ScanFile { t_ns, path });
-                }
-            }
-        }
-        scans.sort_by_key(|s| s.t_ns);
-        if let Some(w) = scans.windows(2).find(|w| w[0].t_ns == w[1].t_ns) {
-            return Err(IngestError::BadLayout {
-                path: w[1].path.clone(),
-                detail: "scan timestamp listed twice".into(),
-            });
-        }
-        if scans.is_empty() {
-            return Err(IngestError::BadLayout { path: radar_dir, detail: "no scans found (empty folder?)".into() });
+            scans = list_scan_pngs(&radar_dir, StampUnit::Micros)?;
         }
         let gt = root.join("gt").join("radar_odometry.csv");
         let gps = root.join("gps").join("gps.csv");
@@ -133,11 +104,7 @@ impl OxfordFolder {
     /// Sequence id: the folder name.
     #[must_use]
     pub fn sequence_id(&self) -> String {
-        self.root
-            .canonicalize()
-            .ok()
-            .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-            .unwrap_or_else(|| "sequence".into())
+        folder_name(&self.root)
     }
 }
 
@@ -211,16 +178,7 @@ pub fn ingest_oxford(
     };
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;
     let total = folder.scans.len() as u64;
-    let mut write = |index: usize, decoded: DecodedScanPng, bytes: Vec<u8>| -> Result<(), IngestError> {
-        if options.carry_png {
-            writer.write_radar_png(&decoded.header, &bytes, HEADER_COLUMNS as u32)?;
-        } else {
-            writer.write_radar_scan(&decoded.into_scan())?;
-        }
-        progress(index as u64 + 1, total);
-        Ok(())
-    };
-    decode_in_order(&folder.scans, layout, &mut write)?;
+    write_navtech_scans(&mut writer, &folder.scans, layout, options.carry_png, progress)?;
     let (first, last) = (folder.scans[0].t_ns, folder.scans[folder.scans.len() - 1].t_ns);
     let in_span: Vec<&StampedPose> = ground_truth.iter().filter(|p| (first..=last).contains(&p.t_ns)).collect();
     for pose in &in_span {
@@ -240,55 +198,31 @@ pub fn ingest_oxford(
     })
 }
 
-/// Reads and decodes the scans on one worker per core and hands them to
-/// `write` in file order.
-///
-/// Worker `w` takes scans `w, w + n, w + 2n, ...` and sends each down its own
-/// channel of capacity [`DECODED_AHEAD`]; the caller's thread receives from the
-/// workers round-robin, so order is kept and at most `n * (DECODED_AHEAD + 1)`
-/// scans are in memory whatever the folder size. PNG decoding (inflate and
-/// unfilter, needed to reach the row headers) is most of an ingest's time.
-fn decode_in_order(
+/// Decodes Oxford/Boreas-style scan PNGs (one worker per core) and writes them
+/// in order: the PNG bytes carried unchanged, or decoded mono8 images.
+pub(crate) fn write_navtech_scans(
+    writer: &mut RecordingWriter,
     scans: &[ScanFile],
     layout: &NavtechLayout,
-    write: &mut dyn FnMut(usize, DecodedScanPng, Vec<u8>) -> Result<(), IngestError>,
+    carry_png: bool,
+    progress: Progress<'_>,
 ) -> Result<(), IngestError> {
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(scans.len().max(1));
+    let total = scans.len() as u64;
     let decode = |scan: &ScanFile| -> Result<(DecodedScanPng, Vec<u8>), IngestError> {
         let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
-        let decoded = decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?;
-        Ok((decoded, bytes))
+        Ok((decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?, bytes))
     };
-    std::thread::scope(|scope| {
-        let receivers: Vec<_> = (0..workers)
-            .map(|w| {
-                let (sender, receiver) = std::sync::mpsc::sync_channel(DECODED_AHEAD);
-                let decode = &decode;
-                scope.spawn(move || {
-                    for scan in scans.iter().skip(w).step_by(workers) {
-                        // A closed channel means the writer stopped on an error.
-                        if sender.send(decode(scan)).is_err() {
-                            return;
-                        }
-                    }
-                });
-                receiver
-            })
-            .collect();
-        for index in 0..scans.len() {
-            let received = receivers[index % workers].recv().map_err(|_| IngestError::BadLayout {
-                path: scans[index].path.clone(),
-                detail: "decoder thread stopped unexpectedly".into(),
-            })?;
-            let (decoded, bytes) = received?;
-            write(index, decoded, bytes)?;
+    let mut write = |index: usize, (decoded, bytes): (DecodedScanPng, Vec<u8>)| -> Result<(), IngestError> {
+        if carry_png {
+            writer.write_radar_png(&decoded.header, &bytes, HEADER_COLUMNS as u32)?;
+        } else {
+            writer.write_radar_scan(&decoded.into_scan())?;
         }
+        progress(index as u64 + 1, total);
         Ok(())
-    })
+    };
+    decode_in_order(scans, &decode, &mut write)
 }
-
-/// Decoded scans each worker may hold ready ahead of the writer.
-const DECODED_AHEAD: usize = 2;
 
 /// Writes scans (and optional relative-pose ground truth) as an Oxford-layout
 /// folder: the inverse of [`OxfordFolder::open`], for fixtures and benchmarks.

@@ -3,7 +3,9 @@
 //! Each image row is one azimuth: bytes 0-7 the azimuth's UNIX time in
 //! microseconds (int64 little-endian), bytes 8-9 the encoder count (uint16
 //! little-endian, `counts_per_turn` per revolution), byte 10 the valid flag
-//! (255 = a real measurement, as the Oxford SDK tests it), then the range bins.
+//! (255 = a real measurement, as the Oxford SDK tests it; Boreas documents the
+//! byte as unused, see [`NavtechLayout::valid_byte_is_flag`]), then the range
+//! bins.
 
 use std::f64::consts::TAU;
 use std::path::Path;
@@ -26,13 +28,21 @@ pub struct NavtechLayout {
     pub range_offset_m: f64,
     /// Required number of range bins, or `None` to take it from each file.
     pub expected_bins: Option<usize>,
+    /// Whether byte 10 flags the row (255 = valid). `false` marks every row
+    /// valid: Boreas documents the byte as unused.
+    pub valid_byte_is_flag: bool,
 }
 
 /// Oxford Radar RobotCar (Navtech CTS350-X): 3768 bins of 0.0432 m, as the
 /// dataset SDK states (CFEAR's code uses 0.0438 m; `--range-resolution-m`
 /// overrides it).
-pub const OXFORD: NavtechLayout =
-    NavtechLayout { counts_per_turn: 5600, range_resolution_m: 0.0432, range_offset_m: 0.0, expected_bins: Some(3768) };
+pub const OXFORD: NavtechLayout = NavtechLayout {
+    counts_per_turn: 5600,
+    range_resolution_m: 0.0432,
+    range_offset_m: 0.0,
+    expected_bins: Some(3768),
+    valid_byte_is_flag: true,
+};
 
 /// A decoded scan PNG: the header and the full image (header columns included).
 #[derive(Debug, Clone, PartialEq)]
@@ -121,7 +131,7 @@ pub fn decode_scan_png(
         azimuths.push(AzimuthSample {
             t_ns,
             azimuth_rad: f64::from(counts) / f64::from(layout.counts_per_turn) * TAU,
-            valid: row[10] == 255,
+            valid: !layout.valid_byte_is_flag || row[10] == 255,
         });
     }
     let header = PolarScanHeader {
