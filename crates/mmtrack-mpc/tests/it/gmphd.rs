@@ -161,3 +161,29 @@ fn config_defaults_are_table_one_and_bad_fields_are_named() {
         assert!(matches!(track_gmphd(&scenario(), &bad), Err(GmPhdError::BadConfig { .. })));
     }
 }
+
+/// The magnitude gate: a 20 dB drop of MPC 1 half-way (beyond the 10 dB
+/// `max_magnitude_change_db`) cannot update the old track, so the old track
+/// ends and a new one starts; with the gate widened to 30 dB it is one track.
+#[test]
+fn magnitude_jump_beyond_the_gate_splits_the_track() {
+    let mut snaps = scenario();
+    for snap in snaps.iter_mut().skip(36) {
+        for d in &mut snap.detections {
+            if (d.delay_s - truth_delay_s(0, d.t_ns as f64 * 1e-9)).abs() < 1e-10 {
+                d.amplitude *= 0.1;
+            }
+        }
+    }
+    let near_mpc0 = |tracks: &[mmtrack_core::MpcTrack]| {
+        tracks
+            .iter()
+            .filter(|t| (t.detections[0].delay_s - truth_delay_s(0, t.detections[0].t_ns as f64 * 1e-9)).abs() < 1e-10)
+            .count()
+    };
+    let gated = track_gmphd(&snaps, &GmPhdConfig::default()).expect("valid input");
+    assert_eq!(near_mpc0(&gated), 2, "split at the jump");
+    let wide = GmPhdConfig { max_magnitude_change_db: 30.0, ..GmPhdConfig::default() };
+    let joined = track_gmphd(&snaps, &wide).expect("valid input");
+    assert_eq!(near_mpc0(&joined), 1, "one track with a wide gate");
+}
