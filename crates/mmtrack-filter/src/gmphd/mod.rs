@@ -15,11 +15,11 @@
 //!    intensity `kappa` and measurements `Z`,
 //!    `v(x) = (1 - p_D) v_pred(x) + sum_{z in Z} sum_i w_i(z) N(x; m_i(z), P_i)`,
 //!    `w_i(z) = p_D w_i q_i(z) / (kappa(z) + p_D sum_l w_l q_l(z))`,
-//!    `q_i(z) = N(z; H m_i, H P_i H^T + R)` ([`update`]);
+//!    `q_i(z) = N(z; H m_i, H P_i H^T + R)` ([`GmPhdFilter::update`]);
 //! 3. **pruning and merging** (Table II) with truncation threshold `T`, merge
-//!    threshold `U` and at most `J_max` components ([`reduce`]);
+//!    threshold `U` and at most `J_max` components ([`MixtureReducer`]);
 //! 4. **state extraction** (Table III) of the components above a weight
-//!    threshold ([`extract`]).
+//!    threshold ([`StateExtractor`]).
 //!
 //! The roles (predictor, updater, gate, reducer, extractor) are separate values
 //! held by [`GmPhdFilter`], as in Stone Soup's `PointProcessMultiTargetTracker`.
