@@ -201,9 +201,12 @@ impl PreparedUpdate {
         Ok(log_normal_pdf_with(&self.s_chol, &self.innovation(z)?))
     }
 
-    /// `ln N(nu; 0, S)` for an innovation already computed.
-    pub(crate) fn log_likelihood_of_innovation(&self, nu: &DVector<f64>) -> f64 {
-        log_normal_pdf_with(&self.s_chol, nu)
+    /// `ln N(nu; 0, S)` from `d2 = nu^T S^-1 nu` already computed:
+    /// `-(m ln 2 pi + ln det S + d2) / 2`, `ln det S = 2 sum ln L_ii`.
+    pub(crate) fn log_likelihood_from_mahalanobis(&self, d2: f64) -> f64 {
+        let m = self.predicted_measurement.len() as f64;
+        let log_det: f64 = 2.0 * self.s_chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
+        -0.5 * (m * (2.0 * std::f64::consts::PI).ln() + log_det + d2)
     }
 
     /// `nu^T S^-1 nu` for an innovation already computed.

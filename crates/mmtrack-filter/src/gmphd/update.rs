@@ -107,18 +107,19 @@ pub(crate) fn update<G: Gate>(
         let mut terms = Vec::new();
         for (i, (c, prep)) in predicted.iter().zip(&prepared).enumerate() {
             let nu = z - prep.predicted_measurement();
+            let mahalanobis_squared = prep.mahalanobis_squared_of_innovation(&nu);
             let candidate = GateCandidate {
                 label: c.label,
                 prior: &c.density,
                 measurement_index: j,
                 measurement: z,
                 innovation: &nu,
-                mahalanobis_squared: prep.mahalanobis_squared_of_innovation(&nu),
+                mahalanobis_squared,
             };
             if !gate.admits(&candidate) {
                 continue;
             }
-            let log_numerator = (p_d * c.weight).ln() + prep.log_likelihood_of_innovation(&nu);
+            let log_numerator = (p_d * c.weight).ln() + prep.log_likelihood_from_mahalanobis(mahalanobis_squared);
             if log_numerator > f64::NEG_INFINITY {
                 terms.push((i, log_numerator, nu));
             }
