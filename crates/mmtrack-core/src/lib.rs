@@ -32,7 +32,7 @@ pub mod sounder;
 pub use cir::CirSnapshot;
 pub use error::CoreError;
 pub use gnss::{GnssFix, GnssFixQuality};
-pub use mpc::{MpcDetection, MpcTrack, MpcTruth};
+pub use mpc::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth};
 pub use num_complex::Complex64;
 pub use odometry::{OdometryEstimate, OdometryTiming};
 pub use pose::{Se2, StampedPose, path_length_m, wrap_angle_rad};

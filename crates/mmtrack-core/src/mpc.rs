@@ -67,6 +67,64 @@ impl MpcTruth {
     }
 }
 
+/// One short-term track's place in a long-term track (Mahler et al. 2017,
+/// Sec. V): the full-lifetime track `short_track_id` of set `set_index`,
+/// summarised by its mean delay and power and its Doppler, and how it was
+/// related to the previous set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcLongTermEntry {
+    /// Identifier of the long-term track, unique within one run.
+    pub long_track_id: u64,
+    /// Set of this entry.
+    pub set_index: u64,
+    /// Mean time of the short-term track's detections, nanoseconds.
+    pub t_ns: i64,
+    /// The short-term track (its `track_id`).
+    pub short_track_id: u64,
+    /// Mean delay over the set, seconds (tau-bar of eq. (33)).
+    pub mean_delay_s: f64,
+    /// Power of the mean linear power over the set, dB (a-bar of eq. (33)).
+    pub mean_power_db: f64,
+    /// Doppler of the short-term track, hertz (nu of eq. (31)).
+    pub doppler_hz: f64,
+    /// Larger of the two-way delay prediction errors of the link from the
+    /// previous set, seconds (eqs. (41)-(42)); `None` for the first entry.
+    pub link_error_s: Option<f64>,
+    /// Smallest confidence class chi that holds the link, seconds (eq. (40));
+    /// `None` for the first entry.
+    pub chi_class_s: Option<f64>,
+}
+
+/// Per-set summary of detection and tracking: counts and channel gains
+/// (Mahler et al. 2017, Figs. 8-9: the captured gains give the power losses).
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcSetStats {
+    /// The set.
+    pub set_index: u64,
+    /// Time of its first snapshot, nanoseconds.
+    pub t_ns: i64,
+    /// Snapshots in the set.
+    pub snapshots: u32,
+    /// Snapshots skipped (e.g. all-zero CIRs).
+    pub skipped_snapshots: u32,
+    /// Detections over the set.
+    pub detections: u32,
+    /// Short-term tracks of the set.
+    pub short_term_tracks: u32,
+    /// Short-term tracks that span the whole set.
+    pub full_lifetime_tracks: u32,
+    /// Mean noise floor of the set's snapshots, dB.
+    pub noise_floor_db: f64,
+    /// Mean channel gain after thresholding and windowing, dB.
+    pub channel_gain_db: f64,
+    /// Mean gain captured by the detections, dB.
+    pub detected_gain_db: f64,
+    /// Mean gain captured by the short-term tracks, dB.
+    pub tracked_gain_db: f64,
+    /// Mean gain captured by the full-lifetime tracks, dB.
+    pub full_lifetime_gain_db: f64,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

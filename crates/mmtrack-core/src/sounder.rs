@@ -83,21 +83,26 @@ impl SounderBand {
         (self.signed_bin(k) + (self.taps / 2) as i64) as usize
     }
 
-    /// The Kaiser window of eq. (10) with parameter `a` (the paper uses 6), one
-    /// weight per FFT bin (applied in band order).
+    /// The Kaiser window of eq. (10) with shape `beta`, one weight per FFT bin
+    /// (applied in band order):
     ///
-    /// `z[u] = I0(pi a sqrt(1 - (2u/(U-1) - 1)^2)) / I0(pi a)`.
+    /// `z[u] = I0(beta sqrt(1 - (2u/(U-1) - 1)^2)) / I0(beta)`.
+    ///
+    /// Eq. (10) writes `beta = pi a` with `a = 6`, but the paper's own pulse
+    /// width (2.47 ns at -10 dB for 1 GHz) is what `beta = 6` gives (2.50 ns for
+    /// a flat band; `beta = 6 pi` gives 4.25 ns): the authors evidently used
+    /// MATLAB's `kaiser(U, 6)`, whose parameter is `beta`.
     ///
     /// # References
     /// Mahler et al. 2017, eq. (10); Kaiser and Schafer 1980.
     #[must_use]
-    pub fn kaiser_window(&self, a: f64) -> Vec<f64> {
+    pub fn kaiser_window(&self, beta: f64) -> Vec<f64> {
         let u_max = (self.taps - 1) as f64;
-        let norm = bessel_i0(std::f64::consts::PI * a);
+        let norm = bessel_i0(beta);
         (0..self.taps)
             .map(|k| {
                 let x = 2.0 * self.band_position(k) as f64 / u_max - 1.0;
-                bessel_i0(std::f64::consts::PI * a * (1.0 - x * x).max(0.0).sqrt()) / norm
+                bessel_i0(beta * (1.0 - x * x).max(0.0).sqrt()) / norm
             })
             .collect()
     }
@@ -189,10 +194,10 @@ mod tests {
     fn kaiser_window_is_symmetric_and_peaks_at_band_centre() {
         let band = SounderBand::new(9, 1e-9).unwrap();
         let z = band.kaiser_window(6.0);
-        // Band centre u = 4 is FFT bin 0; its weight is I0(pi a)/I0(pi a) = 1.
+        // Band centre u = 4 is FFT bin 0; its weight is I0(beta)/I0(beta) = 1.
         assert!((z[0] - 1.0).abs() < 1e-15);
-        // Band edges u = 0 and u = 8 (bins 5 and 4) weigh 1 / I0(6 pi).
-        let edge = 1.0 / bessel_i0(6.0 * std::f64::consts::PI);
+        // Band edges u = 0 and u = 8 (bins 5 and 4) weigh 1 / I0(6).
+        let edge = 1.0 / bessel_i0(6.0);
         assert!((z[4] - edge).abs() < 1e-18 && (z[5] - edge).abs() < 1e-18);
         // I0(1) = 1.2660658777520082 (Abramowitz and Stegun, Table 9.8).
         assert!((bessel_i0(1.0) - 1.266_065_877_752_008_2).abs() < 1e-15);

@@ -1,1 +1,5 @@
 //! Integration tests of mmtrack-mpc.
+
+mod common;
+mod detect;
+mod gmphd;

@@ -1,0 +1,230 @@
+//! Parameters of detection and tracking, with the paper's values as defaults.
+
+use serde::{Deserialize, Serialize};
+
+use crate::MpcError;
+
+/// How the noise floor of a snapshot is estimated (detection step 1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "method", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum NoiseFloor {
+    /// Mean tap power of the quietest quarter of consecutive, non-overlapping
+    /// windows of `window_taps` taps. The paper estimates the floor "in a part
+    /// of the impulse response where no MPCs occur (usually at larger delays)";
+    /// this finds such a part without knowing where the paths are. Averaging a
+    /// quarter of the windows keeps the low bias of picking quiet windows small
+    /// (about -0.3 dB for 32-tap windows of white noise).
+    QuietestWindows {
+        /// Taps per window.
+        window_taps: usize,
+    },
+    /// Mean tap power between two delays on the recording's delay axis.
+    DelayRange {
+        /// First delay of the range, seconds.
+        start_s: f64,
+        /// Last delay of the range, seconds.
+        end_s: f64,
+    },
+    /// A known floor, dB (`10 log10` of the mean tap power).
+    Fixed {
+        /// Floor, dB.
+        power_db: f64,
+    },
+}
+
+/// Detection per snapshot: search and subtract (Mahler et al. 2017, Sec. III-A).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DetectionConfig {
+    /// How the noise floor is estimated.
+    pub noise_floor: NoiseFloor,
+    /// Margin added to the noise floor; taps below floor + margin are zeroed
+    /// and peaks below it end the search, dB (paper: 6 dB).
+    pub threshold_margin_db: f64,
+    /// Kaiser window shape `beta` (eq. (10) with `beta = pi a`) applied to the
+    /// transfer function; `None` skips the window. Default 6: the paper says
+    /// `a = 6`, but its pulse width of 2.47 ns at -10 dB is what `beta = 6`
+    /// gives (2.50 ns for a flat 1 GHz band; `beta = 6 pi` gives 4.25 ns), see
+    /// [`mmtrack_core::sounder::SounderBand::kaiser_window`].
+    pub kaiser_beta: Option<f64>,
+    /// Width of the delay range blocked around each detection, seconds;
+    /// `None` takes the (windowed) pulse's width at 10 dB below its peak, as
+    /// the paper does (2.47 ns for its sounder).
+    pub blocked_width_s: Option<f64>,
+    /// Most MPCs detected per snapshot (a guard; the search normally ends at
+    /// the threshold).
+    pub max_mpcs: usize,
+}
+
+impl Default for DetectionConfig {
+    fn default() -> Self {
+        Self {
+            noise_floor: NoiseFloor::QuietestWindows { window_taps: 32 },
+            threshold_margin_db: 6.0,
+            kaiser_beta: Some(6.0),
+            blocked_width_s: None,
+            max_mpcs: 200,
+        }
+    }
+}
+
+/// Short-term tracking within a set of snapshots (Sec. III-B, eqs. (13)-(32)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShortTermConfig {
+    /// Largest delay change between the first two detections of a track,
+    /// seconds (xi_tau of eq. (15)). The paper derives it from "the physical
+    /// limits of the moving objects" without a value; 0.5 ns covers a
+    /// 200 m/s change of path length over 0.717 ms (0.48 ns) and matches the
+    /// search tolerance.
+    pub initial_delay_gate_s: f64,
+    /// Largest magnitude change between the first two detections, dB (xi_a);
+    /// not given in the paper; 10 dB like the search tolerance.
+    pub initial_magnitude_gate_db: f64,
+    /// Delay search tolerance around the linear prediction, seconds
+    /// (epsilon_tau of eq. (23); paper: 0.5 ns).
+    pub delay_tolerance_s: f64,
+    /// Magnitude search tolerance around the linear prediction, dB
+    /// (epsilon_a; paper: 10 dB).
+    pub magnitude_tolerance_db: f64,
+    /// Fewest consecutive detections that make a track (paper: 3).
+    pub min_track_length: usize,
+}
+
+impl Default for ShortTermConfig {
+    fn default() -> Self {
+        Self {
+            initial_delay_gate_s: 0.5e-9,
+            initial_magnitude_gate_db: 10.0,
+            delay_tolerance_s: 0.5e-9,
+            magnitude_tolerance_db: 10.0,
+            min_track_length: 3,
+        }
+    }
+}
+
+/// Long-term tracking across sets (Sec. V, eqs. (33)-(43)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LongTermConfig {
+    /// Largest change of mean delay between sets for a candidate, seconds
+    /// (xi_tau of eq. (35); paper: 1 ns).
+    pub delay_gate_s: f64,
+    /// Largest change of mean power between sets for a candidate, dB
+    /// (xi_a; paper: 5 dB).
+    pub magnitude_gate_db: f64,
+    /// Confidence classes chi of eq. (40), ascending, seconds; a link is
+    /// kept when both two-way prediction errors are below the last one
+    /// (paper: 0.1, 0.2, 0.5, 1.0 ns).
+    pub chi_classes_s: Vec<f64>,
+}
+
+impl Default for LongTermConfig {
+    fn default() -> Self {
+        Self { delay_gate_s: 1e-9, magnitude_gate_db: 5.0, chi_classes_s: vec![0.1e-9, 0.2e-9, 0.5e-9, 1e-9] }
+    }
+}
+
+/// Every parameter of `process mpc`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MpcConfig {
+    /// Detection per snapshot.
+    pub detection: DetectionConfig,
+    /// Tracking within a set.
+    pub short_term: ShortTermConfig,
+    /// Tracking across sets.
+    pub long_term: LongTermConfig,
+}
+
+fn bad(field: &'static str, value: impl ToString, expected: &'static str) -> MpcError {
+    MpcError::BadConfig { field, value: value.to_string(), expected }
+}
+
+fn positive(field: &'static str, value: f64) -> Result<(), MpcError> {
+    if value.is_finite() && value > 0.0 { Ok(()) } else { Err(bad(field, value, "a finite positive number")) }
+}
+
+impl DetectionConfig {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), MpcError> {
+        match &self.noise_floor {
+            NoiseFloor::QuietestWindows { window_taps } if *window_taps == 0 => {
+                return Err(bad("detection.noise_floor.window_taps", window_taps, "at least one tap"));
+            }
+            NoiseFloor::DelayRange { start_s, end_s } if !(start_s.is_finite() && end_s > start_s) => {
+                return Err(bad("detection.noise_floor.end_s", end_s, "a finite delay after start_s"));
+            }
+            NoiseFloor::Fixed { power_db } if !power_db.is_finite() => {
+                return Err(bad("detection.noise_floor.power_db", power_db, "a finite power"));
+            }
+            _ => {}
+        }
+        if !self.threshold_margin_db.is_finite() {
+            return Err(bad("detection.threshold_margin_db", self.threshold_margin_db, "a finite margin in dB"));
+        }
+        if let Some(a) = self.kaiser_beta
+            && !(a.is_finite() && a >= 0.0)
+        {
+            return Err(bad("detection.kaiser_beta", a, "a finite non-negative window parameter"));
+        }
+        if let Some(width) = self.blocked_width_s {
+            positive("detection.blocked_width_s", width)?;
+        }
+        if self.max_mpcs == 0 {
+            return Err(bad("detection.max_mpcs", self.max_mpcs, "at least 1"));
+        }
+        Ok(())
+    }
+}
+
+impl ShortTermConfig {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), MpcError> {
+        positive("short_term.initial_delay_gate_s", self.initial_delay_gate_s)?;
+        positive("short_term.initial_magnitude_gate_db", self.initial_magnitude_gate_db)?;
+        positive("short_term.delay_tolerance_s", self.delay_tolerance_s)?;
+        positive("short_term.magnitude_tolerance_db", self.magnitude_tolerance_db)?;
+        if self.min_track_length < 3 {
+            return Err(bad(
+                "short_term.min_track_length",
+                self.min_track_length,
+                "at least 3 (a linear prediction needs two points and a check)",
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl LongTermConfig {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), MpcError> {
+        positive("long_term.delay_gate_s", self.delay_gate_s)?;
+        positive("long_term.magnitude_gate_db", self.magnitude_gate_db)?;
+        if self.chi_classes_s.is_empty() {
+            return Err(bad("long_term.chi_classes_s", "[]", "at least one class"));
+        }
+        for pair in self.chi_classes_s.windows(2) {
+            if pair[1] <= pair[0] {
+                return Err(bad(
+                    "long_term.chi_classes_s",
+                    format!("{:?}", self.chi_classes_s),
+                    "strictly ascending classes",
+                ));
+            }
+        }
+        for &chi in &self.chi_classes_s {
+            positive("long_term.chi_classes_s", chi)?;
+        }
+        Ok(())
+    }
+}
+
+impl MpcConfig {
+    /// Checks every field; the error names the first bad one.
+    pub fn validate(&self) -> Result<(), MpcError> {
+        self.detection.validate()?;
+        self.short_term.validate()?;
+        self.long_term.validate()
+    }
+}
