@@ -7,9 +7,11 @@ use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_ingest::boreas::{BoreasFolder, BoreasOptions, ingest_boreas};
 use mmtrack_ingest::cir::{CirFormat, ingest_cir};
+use mmtrack_ingest::mulran::{self, MulranFolder, MulranOptions, ingest_mulran};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_ingest::ros2::{self, Ros2Topics};
+use mmtrack_ingest::sweep::{StampAt, SweepTiming};
 use mmtrack_io::recording::Compression;
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
@@ -118,6 +120,41 @@ impl CirFormatArg {
     }
 }
 
+/// Which azimuth of a sweep an image stamp marks.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum StampAtArg {
+    /// The first azimuth is at the stamp.
+    Start,
+    /// The last azimuth is at the stamp (a sweep is stamped once received).
+    End,
+}
+
+/// Timing of polar images that carry one stamp per sweep.
+#[derive(Args, Clone)]
+pub struct SweepArgs {
+    /// Which azimuth the image stamp marks; the others are spread evenly over the scan period.
+    #[arg(long, value_enum, default_value_t = StampAtArg::End)]
+    stamp_at: StampAtArg,
+    /// Scan period in seconds (Navtech at 4 Hz: 0.25).
+    #[arg(long, default_value_t = 0.25)]
+    scan_period_s: f64,
+}
+
+impl SweepArgs {
+    fn timing(&self) -> anyhow::Result<SweepTiming> {
+        if !(self.scan_period_s.is_finite() && self.scan_period_s > 0.0 && self.scan_period_s < 60.0) {
+            anyhow::bail!("--scan-period-s {}: expected a positive number of seconds below 60", self.scan_period_s);
+        }
+        Ok(SweepTiming {
+            period_ns: (self.scan_period_s * 1e9).round() as i64,
+            stamp_at: match self.stamp_at {
+                StampAtArg::Start => StampAt::Start,
+                StampAtArg::End => StampAt::End,
+            },
+        })
+    }
+}
+
 /// Ground planes.
 #[derive(Clone, Copy, ValueEnum)]
 pub enum PlaneArg {
@@ -175,11 +212,25 @@ enum Kind {
         #[arg(long)]
         sequence_id: Option<String>,
     },
-    /// MulRan sequence folder (not built yet: issue #3).
+    /// MulRan sequence folder: sensor_data/radar/polar/<t_ns>.png, global_pose.csv.
+    ///
+    /// Polar PNGs with range along rows and azimuth along columns, transposed
+    /// into one row per azimuth; per-azimuth times spread evenly over the scan
+    /// period against the file time (--stamp-at); global_pose.csv as ground truth
+    /// in a local frame whose origin is in the metadata.
     Mulran {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
+        /// The sequence folder.
+        input: PathBuf,
+        #[command(flatten)]
+        output: OutputArgs,
+        /// Range bin size in metres.
+        #[arg(long, default_value_t = mulran::RANGE_RESOLUTION_M)]
+        range_resolution_m: f64,
+        #[command(flatten)]
+        sweep: SweepArgs,
+        /// Sequence id (default: the folder name).
+        #[arg(long)]
+        sequence_id: Option<String>,
     },
     /// Trajectory file (TUM, KITTI, Oxford radar_odometry.csv) into a new recording or added to one.
     Poses {
@@ -275,7 +326,11 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             let options = BoreasOptions { range_resolution_m, decode, sequence_id };
             boreas_folder(&input, &output, &options, quiet)
         }
-        Kind::Mulran { .. } => crate::not_built("ingest mulran", 3),
+        Kind::Mulran { input, output, range_resolution_m, sweep, sequence_id } => {
+            positive_metres("--range-resolution-m", range_resolution_m)?;
+            let options = MulranOptions { range_resolution_m, timing: sweep.timing()?, sequence_id };
+            mulran_folder(&input, &output, &options, quiet)
+        }
         Kind::Poses { input, format, mut output, add_to, estimate, times, t0_ns, plane } => {
             let plane = match plane {
                 PlaneArg::Xy => Plane::Xy,
@@ -391,6 +446,33 @@ fn boreas_folder(
             report.scans,
             report.range_resolution_m,
             report.range_resolution_source,
+            report.ground_truth_poses,
+            report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Ingests one MulRan folder, with a progress bar.
+fn mulran_folder(
+    input: &std::path::Path,
+    output: &OutputArgs,
+    options: &MulranOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let folder = MulranFolder::open(input)?;
+    let bar = progress::bar(folder.scans.len() as u64, "ingest mulran", "scans", quiet);
+    let report = ingest_mulran(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    if !quiet {
+        println!(
+            "{}: {} scans (azimuth times: file time at the sweep's {}), {} ground-truth poses ({:.1} MB)",
+            report.output.path.display(),
+            report.scans,
+            options.timing.stamp_at.name(),
             report.ground_truth_poses,
             report.output.file_bytes as f64 / 1e6
         );

@@ -19,11 +19,13 @@ pub mod boreas;
 pub mod cir;
 mod csv;
 mod error;
+pub mod mulran;
 pub mod nmea;
 pub mod oxford;
 pub mod poses;
 pub mod ros2;
 pub mod scan_folder;
+pub mod sweep;
 pub mod target;
 
 pub use error::IngestError;
