@@ -18,6 +18,7 @@ mod process;
 mod progress;
 mod reproduce;
 mod simulate;
+mod simulate_sounder;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

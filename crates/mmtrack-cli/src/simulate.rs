@@ -33,12 +33,16 @@ enum Kind {
     /// the trajectory's span, cut by --max-scans / --max-distance-m. Same scenario, trajectory
     /// and seed give identical bytes.
     Radar(Box<RadarArgs>),
-    /// Channel sounder (not built yet: issue #5).
-    Sounder {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
+    /// Wideband channel sounder with true MPCs (see data/sounder/*.toml).
+    ///
+    /// The scenario holds a seed and one channel: [artificial] (Mahler et al. 2017, Sec. IV-A:
+    /// two equal-power MPCs approaching in delay over continuous snapshots, plus a noise floor) or
+    /// [convoy] (Sec. II: two cars in convoy through a curved tunnel or on a highway; LOS, wall
+    /// bounces, traffic, diffuse scattering and noise; sets of snapshots). The recording carries
+    /// the CIRs (/channel/cir), the true MPCs (/channel/mpc_truth), both cars' poses per set
+    /// (/ground_truth/tx, /ground_truth/rx) and the pulse spectrum in its metadata. Same scenario
+    /// and seed give identical bytes.
+    Sounder(Box<crate::simulate_sounder::SounderArgs>),
 }
 
 #[derive(Args)]
@@ -248,6 +252,9 @@ pub fn run(args: SimulateArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             run_radar(&radar, quiet)?;
             Ok(ExitCode::SUCCESS)
         }
-        Kind::Sounder { .. } => crate::not_built("simulate sounder", 5),
+        Kind::Sounder(sounder) => {
+            crate::simulate_sounder::run_sounder(&sounder, quiet)?;
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }

@@ -413,5 +413,70 @@ impl SpecMessage for CirSnapshot {
     const SPEC: &'static MessageSpec = &CIR_SNAPSHOT_SPEC;
 }
 
+/// One true multipath component of one CIR snapshot, as a simulator knows it
+/// (`mmtrack.MpcTruth`).
+#[derive(Clone, PartialEq, Message)]
+pub struct MpcTruth {
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(int64, required, tag = "1")]
+    pub t_ns: i64,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(uint64, required, tag = "2")]
+    pub set_index: u64,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(uint32, required, tag = "3")]
+    pub snapshot_index: u32,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(uint64, required, tag = "4")]
+    pub path_id: u64,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(double, required, tag = "5")]
+    pub delay_s: f64,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(double, required, tag = "6")]
+    pub amplitude_re: f64,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(double, required, tag = "7")]
+    pub amplitude_im: f64,
+    /// See [`MPC_TRUTH_SPEC`].
+    #[prost(double, required, tag = "8")]
+    pub doppler_hz: f64,
+}
+
+/// Schema of [`MpcTruth`].
+pub const MPC_TRUTH_SPEC: MessageSpec = MessageSpec {
+    full_name: "mmtrack.MpcTruth",
+    description: "One true multipath component (MPC) of the CIR snapshot with the same t_ns, set_index and snapshot_index on /channel/cir (simulator ground truth); power in dB is 20 log10 |amplitude|.",
+    fields: &[
+        field("t_ns", 1, Int64, One, "ns", "time of the snapshot"),
+        field("set_index", 2, Uint64, One, "", "set of the snapshot"),
+        field("snapshot_index", 3, Uint32, One, "", "snapshot within its set"),
+        field(
+            "path_id",
+            4,
+            Uint64,
+            One,
+            "",
+            "propagation path, stable while the path exists (the simulator documents its numbering, e.g. 0 = LOS)",
+        ),
+        field(
+            "delay_s",
+            5,
+            Double,
+            One,
+            "s",
+            "true propagation delay on the CIR's delay axis (tap k at delay_offset_s + k * tap_spacing_s)",
+        ),
+        field("amplitude_re", 6, Double, One, "", "real part of the true complex amplitude (the taps' linear scale)"),
+        field("amplitude_im", 7, Double, One, "", "imaginary part of the true complex amplitude"),
+        field("doppler_hz", 8, Double, One, "Hz", "true Doppler shift, -carrier_hz * d(delay_s)/dt"),
+    ],
+};
+
+impl SpecMessage for MpcTruth {
+    const SPEC: &'static MessageSpec = &MPC_TRUTH_SPEC;
+}
+
 /// All mmtrack message schemas, for documentation and tests.
-pub const ALL_SPECS: &[&MessageSpec] = &[&POSE2D_SPEC, &GNSS_FIX_SPEC, &RADAR_SCAN_META_SPEC, &CIR_SNAPSHOT_SPEC];
+pub const ALL_SPECS: &[&MessageSpec] =
+    &[&POSE2D_SPEC, &GNSS_FIX_SPEC, &RADAR_SCAN_META_SPEC, &CIR_SNAPSHOT_SPEC, &MPC_TRUTH_SPEC];

@@ -23,23 +23,40 @@ pub const GNSS_TOPIC: &str = "/gnss/fix";
 pub const GNSS_VIZ_TOPIC: &str = "/viz/gnss";
 /// Topic of channel impulse responses.
 pub const CIR_TOPIC: &str = "/channel/cir";
+/// Topic of the true multipath components of simulated CIRs.
+pub const MPC_TRUTH_TOPIC: &str = "/channel/mpc_truth";
 
 /// Which trajectory a pose belongs to.
+///
+/// A recording of one platform (radar, GNSS) uses [`PoseStream::GroundTruth`]
+/// and [`PoseStream::Estimate`]. A channel-sounder recording has two vehicles:
+/// its ground truth is [`PoseStream::GroundTruthTx`] and
+/// [`PoseStream::GroundTruthRx`], on their own topics, so readers of
+/// `/ground_truth/pose` never mistake one car's poses for the other's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum PoseStream {
     /// Ground truth (dataset reference trajectory or simulator truth).
     GroundTruth,
     /// An estimated trajectory (odometry, SLAM).
     Estimate,
+    /// Ground truth of a channel sounder's transmitter vehicle.
+    GroundTruthTx,
+    /// Ground truth of a channel sounder's receiver vehicle.
+    GroundTruthRx,
 }
 
 impl PoseStream {
+    /// Every stream.
+    pub const ALL: [PoseStream; 4] = [Self::GroundTruth, Self::Estimate, Self::GroundTruthTx, Self::GroundTruthRx];
+
     /// Canonical topic.
     #[must_use]
     pub fn topic(self) -> &'static str {
         match self {
             Self::GroundTruth => "/ground_truth/pose",
             Self::Estimate => "/estimate/pose",
+            Self::GroundTruthTx => "/ground_truth/tx",
+            Self::GroundTruthRx => "/ground_truth/rx",
         }
     }
 
@@ -49,13 +66,21 @@ impl PoseStream {
         match self {
             Self::GroundTruth => "/viz/ground_truth",
             Self::Estimate => "/viz/estimate",
+            Self::GroundTruthTx => "/viz/ground_truth_tx",
+            Self::GroundTruthRx => "/viz/ground_truth_rx",
         }
+    }
+
+    /// Whether the stream is ground truth (of any vehicle).
+    #[must_use]
+    pub fn is_ground_truth(self) -> bool {
+        self != Self::Estimate
     }
 
     /// The stream a canonical topic belongs to.
     #[must_use]
     pub fn from_topic(topic: &str) -> Option<Self> {
-        [Self::GroundTruth, Self::Estimate].into_iter().find(|s| s.topic() == topic)
+        Self::ALL.into_iter().find(|s| s.topic() == topic)
     }
 }
 
@@ -87,6 +112,18 @@ pub const CHANNELS: &[ChannelSpec] = &[
         meaning: "estimated pose world_from_vehicle (odometry or SLAM output)",
     },
     ChannelSpec {
+        topic: "/ground_truth/tx",
+        schema_names: &["mmtrack.Pose2D"],
+        canonical: true,
+        meaning: "ground-truth pose world_from_vehicle of a channel sounder's transmitter car (one per set)",
+    },
+    ChannelSpec {
+        topic: "/ground_truth/rx",
+        schema_names: &["mmtrack.Pose2D"],
+        canonical: true,
+        meaning: "ground-truth pose world_from_vehicle of a channel sounder's receiver car (one per set)",
+    },
+    ChannelSpec {
         topic: GNSS_TOPIC,
         schema_names: &["mmtrack.GnssFix"],
         canonical: true,
@@ -99,6 +136,13 @@ pub const CHANNELS: &[ChannelSpec] = &[
         meaning: "one channel impulse response snapshot",
     },
     ChannelSpec {
+        topic: MPC_TRUTH_TOPIC,
+        schema_names: &["mmtrack.MpcTruth"],
+        canonical: true,
+        meaning: "one true multipath component of a simulated CIR snapshot (same t_ns, set_index, snapshot_index); \
+                  a snapshot has as many as it has true paths, possibly none",
+    },
+    ChannelSpec {
         topic: "/viz/ground_truth",
         schema_names: &["foxglove.PoseInFrame"],
         canonical: false,
@@ -109,6 +153,18 @@ pub const CHANNELS: &[ChannelSpec] = &[
         schema_names: &["foxglove.PoseInFrame"],
         canonical: false,
         meaning: "display copy of /estimate/pose for Foxglove's 3D panel (frame world)",
+    },
+    ChannelSpec {
+        topic: "/viz/ground_truth_tx",
+        schema_names: &["foxglove.PoseInFrame"],
+        canonical: false,
+        meaning: "display copy of /ground_truth/tx for Foxglove's 3D panel (frame world)",
+    },
+    ChannelSpec {
+        topic: "/viz/ground_truth_rx",
+        schema_names: &["foxglove.PoseInFrame"],
+        canonical: false,
+        meaning: "display copy of /ground_truth/rx for Foxglove's 3D panel (frame world)",
     },
     ChannelSpec {
         topic: GNSS_VIZ_TOPIC,

@@ -12,6 +12,7 @@
 //! The channel table lives in [`channels`] and is what `schemas/` documents.
 
 pub mod channels;
+pub mod pulse;
 mod reader;
 mod writer;
 

@@ -8,12 +8,13 @@ use foxglove::schemas::{CompressedImage, RawImage};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
 use mmtrack_core::{
-    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, PolarScan, PolarScanHeader, Se2, StampedPose,
+    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTruth, PolarScan, PolarScanHeader, Se2,
+    StampedPose,
 };
 use prost::Message;
 
 use super::METADATA_NAME;
-use super::channels::{CIR_TOPIC, GNSS_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
+use super::channels::{CIR_TOPIC, GNSS_TOPIC, MPC_TRUTH_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
 use crate::error::{IoError, Result, os_err};
 use crate::proto;
 
@@ -173,6 +174,8 @@ pub enum RecordingEvent {
     Gnss(GnssFix),
     /// A channel impulse response.
     Cir(CirSnapshot),
+    /// A true multipath component of a simulated CIR snapshot.
+    MpcTruth(MpcTruth),
 }
 
 /// Reads a canonical recording as a stream of [`RecordingEvent`]s, holding at
@@ -269,6 +272,17 @@ impl RecordingReader {
                     delay_offset_s: c.delay_offset_s,
                     taps,
                     first_path_hint_s: c.first_path_hint_s,
+                }))));
+            } else if topic == MPC_TRUTH_TOPIC {
+                let t: proto::MpcTruth = self.decode(&m)?;
+                return Ok(Some(RecordingItem::Event(RecordingEvent::MpcTruth(MpcTruth {
+                    t_ns: t.t_ns,
+                    set_index: t.set_index,
+                    snapshot_index: t.snapshot_index,
+                    path_id: t.path_id,
+                    delay_s: t.delay_s,
+                    amplitude: Complex64::new(t.amplitude_re, t.amplitude_im),
+                    doppler_hz: t.doppler_hz,
                 }))));
             }
         }

@@ -5,11 +5,13 @@ use std::path::{Path, PathBuf};
 
 use foxglove::Encode;
 use foxglove::schemas::{CompressedImage, LocationFix, Pose, PoseInFrame, Quaternion, RawImage, Timestamp, Vector3};
-use mmtrack_core::{CirSnapshot, GnssFix, PolarScan, PolarScanHeader, StampedPose};
+use mmtrack_core::{CirSnapshot, GnssFix, MpcTruth, PolarScan, PolarScanHeader, StampedPose};
 use prost::Message;
 
 use super::METADATA_NAME;
-use super::channels::{CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
+use super::channels::{
+    CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
+};
 use super::reader::RawMessage;
 use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
@@ -451,6 +453,23 @@ impl RecordingWriter {
             first_path_hint_s: cir.first_path_hint_s,
         };
         self.write_spec(CIR_TOPIC, cir.t_ns, &message, None)?;
+        Ok(())
+    }
+
+    /// Writes one true multipath component of a simulated CIR snapshot
+    /// (`mmtrack.MpcTruth` on `/channel/mpc_truth`, log time `truth.t_ns`).
+    pub fn write_mpc_truth(&mut self, truth: &MpcTruth) -> Result<()> {
+        let message = proto::MpcTruth {
+            t_ns: truth.t_ns,
+            set_index: truth.set_index,
+            snapshot_index: truth.snapshot_index,
+            path_id: truth.path_id,
+            delay_s: truth.delay_s,
+            amplitude_re: truth.amplitude.re,
+            amplitude_im: truth.amplitude.im,
+            doppler_hz: truth.doppler_hz,
+        };
+        self.write_spec(MPC_TRUTH_TOPIC, truth.t_ns, &message, None)?;
         Ok(())
     }
 

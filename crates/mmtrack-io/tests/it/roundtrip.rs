@@ -85,6 +85,59 @@ fn recording_round_trips_every_type_bit_exactly() {
 }
 
 #[test]
+fn sounder_truth_and_both_vehicles_round_trip_bit_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sounder.mcap");
+    let mut writer = RecordingWriter::create(&path, &samples::metadata(), &RecordingOptions::default()).unwrap();
+    let poses = samples::poses();
+    for (i, truth) in samples::mpc_truth().iter().enumerate() {
+        if truth.snapshot_index == 0 {
+            writer.write_pose(PoseStream::GroundTruthTx, &poses[i / 6], "world", "tx").unwrap();
+            writer.write_pose(PoseStream::GroundTruthRx, &poses[i / 6 + 2], "world", "rx").unwrap();
+        }
+        writer.write_mpc_truth(truth).unwrap();
+    }
+    let summary = writer.finish().unwrap();
+    assert_eq!(summary.message_counts["/channel/mpc_truth"], 12);
+    assert_eq!(summary.message_counts["/viz/ground_truth_tx"], 2);
+    let events = read_everything(&path);
+    let truth: Vec<&mmtrack_core::MpcTruth> =
+        events.iter().filter_map(|e| if let RecordingEvent::MpcTruth(t) = e { Some(t) } else { None }).collect();
+    let want = samples::mpc_truth();
+    assert_eq!(truth.len(), want.len());
+    let bits = |t: &mmtrack_core::MpcTruth| {
+        (
+            t.t_ns,
+            t.set_index,
+            t.snapshot_index,
+            t.path_id,
+            t.delay_s.to_bits(),
+            t.amplitude.re.to_bits(),
+            t.amplitude.im.to_bits(),
+            t.doppler_hz.to_bits(),
+        )
+    };
+    assert_eq!(truth.iter().map(|t| bits(t)).collect::<Vec<_>>(), want.iter().map(bits).collect::<Vec<_>>());
+    let stream = |wanted: PoseStream| -> Vec<(i64, u64, u64, u64)> {
+        events
+            .iter()
+            .filter_map(|e| match e {
+                RecordingEvent::Pose { stream, pose } if *stream == wanted => Some(pose_bits(pose)),
+                _ => None,
+            })
+            .collect()
+    };
+    assert_eq!(stream(PoseStream::GroundTruthTx), vec![pose_bits(&poses[0]), pose_bits(&poses[1])]);
+    assert_eq!(stream(PoseStream::GroundTruthRx), vec![pose_bits(&poses[2]), pose_bits(&poses[3])]);
+    // Readers of the single-platform ground truth see none of the two cars' poses.
+    assert!(stream(PoseStream::GroundTruth).is_empty());
+    assert!(PoseStream::GroundTruthRx.is_ground_truth() && !PoseStream::Estimate.is_ground_truth());
+    for s in PoseStream::ALL {
+        assert_eq!(PoseStream::from_topic(s.topic()), Some(s));
+    }
+}
+
+#[test]
 fn inspect_reports_channels_counts_and_metadata() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("rec.mcap");

@@ -105,3 +105,17 @@ pub fn metadata() -> RecordingMetadata {
         extra: BTreeMap::from([("radar.model".to_string(), "CTS350-X".to_string())]),
     }
 }
+
+pub fn mpc_truth() -> Vec<mmtrack_core::MpcTruth> {
+    (0..12u64)
+        .map(|i| mmtrack_core::MpcTruth {
+            t_ns: 1_000_000 + i as i64 * 717_000,
+            set_index: i / 6,
+            snapshot_index: (i % 6) as u32,
+            path_id: [0, 100, 1003, u64::MAX][i as usize % 4],
+            delay_s: 2.6e-7 + AWKWARD[i as usize % 6] * 1e-12,
+            amplitude: Complex64::new(AWKWARD[(i as usize + 1) % 6], -AWKWARD[(i as usize + 3) % 6]),
+            doppler_hz: [-0.0, 105.6, -3.3e3, 5e-324][i as usize % 4],
+        })
+        .collect()
+}

@@ -122,5 +122,15 @@ fn descriptors_match_prost_encoding() {
         taps_im: vec![1.0],
         first_path_hint_s: Some(1.0),
     });
-    assert_eq!(ALL_SPECS.len(), 4, "a new message needs a sample above");
+    check(&proto::MpcTruth {
+        t_ns: 1,
+        set_index: 1,
+        snapshot_index: 1,
+        path_id: 1,
+        delay_s: 1.0,
+        amplitude_re: 1.0,
+        amplitude_im: 1.0,
+        doppler_hz: 1.0,
+    });
+    assert_eq!(ALL_SPECS.len(), 5, "a new message needs a sample above");
 }
