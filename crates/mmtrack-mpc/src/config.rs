@@ -11,9 +11,9 @@ pub enum NoiseFloor {
     /// Mean tap power of the quietest quarter of consecutive, non-overlapping
     /// windows of `window_taps` taps. The paper estimates the floor "in a part
     /// of the impulse response where no MPCs occur (usually at larger delays)";
-    /// this finds such a part without knowing where the paths are. Averaging a
-    /// quarter of the windows keeps the low bias of picking quiet windows small
-    /// (about -0.3 dB for 32-tap windows of white noise).
+    /// this finds such a part without knowing where the paths are. Windows are
+    /// ranked on their even taps and averaged on their odd taps, so picking
+    /// quiet windows does not bias the floor low.
     QuietestWindows {
         /// Taps per window.
         window_taps: usize,
@@ -41,6 +41,11 @@ pub struct DetectionConfig {
     /// Margin added to the noise floor; taps below floor + margin are zeroed
     /// and peaks below it end the search, dB (paper: 6 dB).
     pub threshold_margin_db: f64,
+    /// Zero the CIR taps below floor + margin before the search, as the
+    /// paper's step 1 does. Switching it off keeps the weak skirts of each
+    /// pulse (a -116 dB path over a -140 dB floor: mean delay error 0.029
+    /// instead of 0.037 ns) at the price of more noise peaks to reject.
+    pub zero_below_threshold: bool,
     /// Kaiser window shape `beta` (eq. (10) with `beta = pi a`) applied to the
     /// transfer function; `None` skips the window. Default 6: the paper says
     /// `a = 6`, but its pulse width of 2.47 ns at -10 dB is what `beta = 6`
@@ -61,6 +66,7 @@ impl Default for DetectionConfig {
         Self {
             noise_floor: NoiseFloor::QuietestWindows { window_taps: 32 },
             threshold_margin_db: 6.0,
+            zero_below_threshold: true,
             kaiser_beta: Some(6.0),
             blocked_width_s: None,
             max_mpcs: 200,

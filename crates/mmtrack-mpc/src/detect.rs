@@ -3,24 +3,32 @@
 //!
 //! For one CIR `h` of `U` taps:
 //! 1. estimate the noise floor ([`NoiseFloor`]), add the margin (6 dB), zero
-//!    the taps below it;
-//! 2. window the transfer function `H = DFT(h)` with the Kaiser window of
-//!    eq. (10), and the pulse with it: `w` is then the windowed pulse;
-//! 3. find the strongest correlation `|w(tau)^H h_l|` outside the blocked
-//!    delay ranges: the coarse peak on the tap grid (one inverse FFT of
-//!    `conj(W) H_l`), refined to sub-tap delay by Newton steps on
-//!    `|c(tau)|^2` with `c(tau) = (1/U) sum_k conj(W_k) H_l,k exp(j 2 pi f_k tau)`
-//!    evaluated exactly (eq. (7), maximum likelihood for one path in white
-//!    noise);
-//! 4. amplitude `alpha = c(tau) / (w^H w)` (eq. (8));
-//! 5. block `tau +- width / 2` around it (width: the pulse's width 10 dB below
-//!    its peak, 2.47 ns in the paper);
-//! 6. subtract `alpha W exp(-j 2 pi f tau)` from the transfer function
-//!    (eq. (9)) and repeat until the strongest remaining amplitude is below
-//!    the threshold.
+//!    the taps below it (can be switched off: `zero_below_threshold`);
+//! 2. window the transfer function `H = DFT(h)` with the Kaiser window `z` of
+//!    eq. (10): a path of amplitude `alpha` at `tau` is then
+//!    `alpha W exp(-j 2 pi f tau)` with `W = z P`, `P` the sounder pulse;
+//! 3. find the strongest correlation with the sounder pulse outside the
+//!    blocked delay ranges, `c(tau) = p(tau)^H h_w` (eq. (7)): the coarse peak
+//!    on the tap grid (one inverse FFT of `conj(P) H_w`), refined to sub-tap
+//!    delay by Newton steps on `|c(tau)|^2` with
+//!    `c(tau) = (1/U) sum_k conj(P_k) H_w,k exp(j 2 pi f_k tau)` evaluated
+//!    exactly;
+//! 4. amplitude `alpha = c(tau) / ((1/U) sum_k z_k |P_k|^2)` (eq. (8), with the
+//!    normaliser that makes it unbiased for a windowed path);
+//! 5. block `tau +- width / 2` around it (width: the windowed pulse's width
+//!    10 dB below its peak, 2.47 ns in the paper);
+//! 6. subtract `alpha W exp(-j 2 pi f tau)` from the windowed transfer
+//!    function (eq. (9)) and repeat until the strongest remaining amplitude is
+//!    below the threshold.
 //!
-//! The paper states eq. (7) with `w^T h` for a real pulse; with a measured,
-//! complex pulse the matched filter is `w^H h`, which is what this computes.
+//! Choices where the paper is not explicit: the template of eq. (7) is the
+//! sounder pulse itself, so the data are windowed once. Correlating with the
+//! windowed pulse instead (the window applied twice) widens the main lobe and
+//! raised the delay error of a -116 dB path over a -140 dB floor from
+//! 0.037 to 0.051 ns (mean, 400 trials; the unwindowed, unthresholded
+//! maximum-likelihood estimate reaches 0.020 ns, the Cramer-Rao level). The
+//! paper states eq. (7) with `w^T h` for a real pulse; with a measured,
+//! complex pulse the matched filter uses the conjugate.
 
 use std::sync::Arc;
 
@@ -55,11 +63,17 @@ pub struct Detector {
     band: SounderBand,
     /// Kaiser weight per FFT bin (ones without a window).
     window: Vec<f64>,
-    /// Windowed pulse spectrum `W = z P`.
+    /// Windowed pulse spectrum `W = z P`: what one path looks like after
+    /// windowing.
     pulse_w: Vec<Complex64>,
-    /// `|W|^2`, the spectrum of the pulse's autocorrelation.
-    pulse_w_power: Vec<f64>,
-    /// Pulse energy `w^H w = (1/U) sum |W|^2`.
+    /// The sounder pulse `P`, the matched-filter template.
+    template: Vec<Complex64>,
+    /// `conj(P) W = z |P|^2`: the correlation of the template with one
+    /// windowed path, as a spectrum.
+    kernel: Vec<f64>,
+    /// Correlation of a unit path at its own delay, `(1/U) sum z |P|^2`.
+    kernel_peak: f64,
+    /// Windowed pulse energy `w^H w = (1/U) sum |W|^2`.
     pulse_energy: f64,
     /// Half the blocked delay range, seconds.
     blocked_half_width_s: f64,
@@ -88,16 +102,28 @@ impl Detector {
             None => vec![1.0; band.taps()],
         };
         let pulse_w: Vec<Complex64> = pulse.spectrum().iter().zip(&window).map(|(p, z)| p * z).collect();
-        let pulse_w_power: Vec<f64> = pulse_w.iter().map(|w| w.norm_sqr()).collect();
-        let pulse_energy = pulse_w_power.iter().sum::<f64>() / band.taps() as f64;
-        if !(pulse_energy.is_finite() && pulse_energy > 0.0) {
+        let kernel: Vec<f64> = pulse.spectrum().iter().zip(&window).map(|(p, z)| p.norm_sqr() * z).collect();
+        let kernel_peak = kernel.iter().sum::<f64>() / band.taps() as f64;
+        let pulse_energy = pulse_w.iter().map(Complex64::norm_sqr).sum::<f64>() / band.taps() as f64;
+        if !(pulse_energy.is_finite() && pulse_energy > 0.0 && kernel_peak > 0.0) {
             return Err(MpcError::BadPulse { detail: "the windowed pulse has no energy".into() });
         }
         let mut planner = FftPlanner::new();
         let fft = planner.plan_fft_forward(band.taps());
         let ifft = planner.plan_fft_inverse(band.taps());
-        let mut detector =
-            Self { config, band, window, pulse_w, pulse_w_power, pulse_energy, blocked_half_width_s: 0.0, fft, ifft };
+        let mut detector = Self {
+            config,
+            band,
+            window,
+            pulse_w,
+            template: pulse.spectrum().to_vec(),
+            kernel,
+            kernel_peak,
+            pulse_energy,
+            blocked_half_width_s: 0.0,
+            fft,
+            ifft,
+        };
         detector.blocked_half_width_s = match detector.config.blocked_width_s {
             Some(width) => width / 2.0,
             None => detector.pulse_width_s(-10.0) / 2.0,
@@ -157,24 +183,25 @@ impl Detector {
         // f64 round-off of the FFTs lives, so nothing below it is a path.
         let floor = self.noise_floor(snapshot, &power, index)?.max(peak_power * 1e-15);
         let threshold = floor * 10f64.powf(self.config.threshold_margin_db / 10.0);
+        let zero = self.config.zero_below_threshold;
         let mut spectrum: Vec<Complex64> = snapshot
             .taps
             .iter()
             .zip(&power)
-            .map(|(h, p)| if *p < threshold { Complex64::default() } else { *h })
+            .map(|(h, p)| if zero && *p < threshold { Complex64::default() } else { *h })
             .collect();
         self.fft.process(&mut spectrum);
         let u = self.band.taps() as f64;
         let mut channel_gain = 0.0;
-        // G = conj(W) z H / U: the correlation spectrum, c = IFFT(G) without further scaling.
+        // G = conj(P) z H / U: the correlation spectrum, c = IFFT(G) without further scaling.
         let mut correlation_spectrum: Vec<Complex64> = spectrum
             .iter()
             .zip(&self.window)
-            .zip(&self.pulse_w)
-            .map(|((h, z), w)| {
+            .zip(&self.template)
+            .map(|((h, z), p)| {
                 let hw = h * z;
                 channel_gain += hw.norm_sqr();
-                w.conj() * hw / u
+                p.conj() * hw / u
             })
             .collect();
         channel_gain /= u;
@@ -243,7 +270,7 @@ impl Detector {
         }
     }
 
-    /// Steps 3-6 on the correlation spectrum `G = conj(W) H / U`.
+    /// Steps 3-6 on the correlation spectrum `G = conj(P) H_w / U`.
     fn search_and_subtract(
         &self,
         snapshot: &CirSnapshot,
@@ -261,14 +288,14 @@ impl Detector {
             self.ifft.process(&mut correlation);
             let Some(coarse) = strongest_unblocked(&correlation, &blocked) else { break };
             let peak = refine_peak(&self.band, correlation_spectrum, &correlation, coarse);
-            let amplitude = peak.value / self.pulse_energy;
+            let amplitude = peak.value / self.kernel_peak;
             if amplitude.norm_sqr() < threshold {
                 break;
             }
             let delay_taps = peak.x_taps;
             block(&mut blocked, delay_taps, half_block_taps);
-            // Eq. (9) in the frequency domain: H_l -= alpha W exp(-j 2 pi f tau), so G -= alpha |W|^2 exp(..) / U.
-            subtract_path(&self.band, correlation_spectrum, &self.pulse_w_power, delay_taps, amplitude / taps as f64);
+            // Eq. (9) in the frequency domain: H_w -= alpha W exp(-j 2 pi f tau), so G -= alpha z |P|^2 exp(..) / U.
+            subtract_path(&self.band, correlation_spectrum, &self.kernel, delay_taps, amplitude / taps as f64);
             detections.push(MpcDetection {
                 t_ns: snapshot.t_ns,
                 set_index: snapshot.set_index,
@@ -281,13 +308,22 @@ impl Detector {
     }
 }
 
-/// Mean power of the quietest quarter of non-overlapping windows.
+/// Mean power of the quietest quarter of non-overlapping windows. Windows
+/// are ranked by the mean power of their even taps and the floor is the mean
+/// of their odd taps: ranking and averaging the same samples would bias the
+/// floor low (by about 1 dB for 32-tap windows of white noise), while with
+/// independent noise on neighbouring taps (a sounder sampled at 1/B) this
+/// split leaves it unbiased.
 fn quietest_windows_power(power: &[f64], window_taps: usize) -> f64 {
-    let mut means: Vec<f64> =
-        power.chunks(window_taps.min(power.len())).map(|w| w.iter().sum::<f64>() / w.len() as f64).collect();
-    means.sort_by(f64::total_cmp);
-    let keep = means.len().div_ceil(4);
-    means[..keep].iter().sum::<f64>() / keep as f64
+    let window_taps = window_taps.max(2).min(power.len());
+    let mean = |taps: &[f64], parity: usize| {
+        let values: Vec<f64> = taps.iter().skip(parity).step_by(2).copied().collect();
+        if values.is_empty() { 0.0 } else { values.iter().sum::<f64>() / values.len() as f64 }
+    };
+    let mut windows: Vec<(f64, f64)> = power.chunks(window_taps).map(|w| (mean(w, 0), mean(w, 1))).collect();
+    windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let keep = windows.len().div_ceil(4);
+    windows[..keep].iter().map(|w| w.1).sum::<f64>() / keep as f64
 }
 
 fn strongest_unblocked(correlation: &[Complex64], blocked: &[bool]) -> Option<usize> {
@@ -312,9 +348,9 @@ fn block(blocked: &mut [bool], delay_taps: f64, half_width_taps: f64) {
 }
 
 /// `G[k] -= scale |W_k|^2 exp(-j 2 pi s_k x / U)`.
-fn subtract_path(band: &SounderBand, spectrum: &mut [Complex64], pulse_w_power: &[f64], x_taps: f64, scale: Complex64) {
+fn subtract_path(band: &SounderBand, spectrum: &mut [Complex64], kernel: &[f64], x_taps: f64, scale: Complex64) {
     let phasors = Phasors::new(band.taps(), -x_taps);
-    for (k, (g, p)) in spectrum.iter_mut().zip(pulse_w_power).enumerate() {
+    for (k, (g, p)) in spectrum.iter_mut().zip(kernel).enumerate() {
         *g -= scale * *p * phasors.at(band.signed_bin(k));
     }
 }
