@@ -95,6 +95,11 @@
 //! `(seed, stream, set, snapshot)`, so output is identical for any thread
 //! count.
 //!
+//! Speed (release build, this project's 2-core machine, `cargo run --release
+//! -p mmtrack-sim --example sounder_convoy 1666 1`): the paper's 1666 sets
+//! (9996 CIRs of 512 taps, about 110 paths each, most of them diffuse) in
+//! 2.7 s on one thread; summing the path phasors is most of it.
+//!
 //! # References
 //! Mahler, Keusgen, Tufvesson, Zemen, Caire, "Tracking of wideband
 //! multipath components in a vehicular communication scenario", IEEE TVT
