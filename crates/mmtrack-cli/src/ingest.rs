@@ -172,7 +172,7 @@ pub struct IngestArgs {
 
 #[derive(Subcommand)]
 enum Kind {
-    /// Oxford Radar RobotCar sequence folder: radar/<t_us>.png, radar.timestamps, gt/radar_odometry.csv.
+    /// Oxford Radar RobotCar sequence folder: radar/<t_us>.png, radar.timestamps, gt/radar_odometry.csv, gps/gps.csv, gps/ins.csv.
     Oxford {
         /// The sequence folder.
         input: PathBuf,
@@ -514,7 +514,16 @@ pub fn oxford_folder(
                 format!(", {} scans skipped (flagged invalid in radar.timestamps)", report.skipped_invalid_scans)
             } else {
                 String::new()
-            },
+            } + &report
+                .ins_used_as
+                .as_ref()
+                .map(|used| {
+                    format!(
+                        "; gps/ins.csv used as {used} ({} rows not INS_SOLUTION_GOOD skipped)",
+                        report.ins_rows_not_good
+                    )
+                })
+                .unwrap_or_default(),
             report.output.file_bytes as f64 / 1e6
         );
     }

@@ -3,7 +3,9 @@
 //! Layout: `radar/<t_us>.png` (polar scans, see [`png_scan`]),
 //! `radar.timestamps` (`<t_us> <valid>` per scan; scans flagged 0 are skipped
 //! and counted), optional `gt/radar_odometry.csv` (see [`odometry`]) and
-//! `gps/gps.csv` (see [`gps`]). Ground truth and GNSS fixes are kept within the
+//! `gps/gps.csv` (see [`gps`]) and `gps/ins.csv` (see [`ins`]; its poses are the
+//! ground truth when there is no `radar_odometry.csv`, its positions the GNSS
+//! fixes when there is no `gps.csv`). Ground truth and GNSS fixes are kept within the
 //! time span of the scans. Without
 //! `radar.timestamps`, every `radar/*.png` with a numeric name is taken in
 //! time order.
@@ -12,13 +14,14 @@
 //! Dataset (Barnes et al., ICRA 2020), CC BY-NC-SA 4.0.
 
 pub mod gps;
+pub mod ins;
 pub mod odometry;
 pub mod png_scan;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use mmtrack_core::{PolarScan, StampedPose};
+use mmtrack_core::{GnssFix, PolarScan, StampedPose};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
@@ -42,6 +45,8 @@ pub struct OxfordFolder {
     pub ground_truth: Option<PathBuf>,
     /// `gps/gps.csv`, when present.
     pub gps: Option<PathBuf>,
+    /// `gps/ins.csv`, when present.
+    pub ins: Option<PathBuf>,
 }
 
 fn parse_stamp(path: &Path, line: usize, raw: &str) -> Result<i64, IngestError> {
@@ -92,12 +97,14 @@ impl OxfordFolder {
         }
         let gt = root.join("gt").join("radar_odometry.csv");
         let gps = root.join("gps").join("gps.csv");
+        let ins = root.join("gps").join("ins.csv");
         Ok(Self {
             root: root.to_path_buf(),
             scans,
             skipped_invalid,
             ground_truth: gt.is_file().then_some(gt),
             gps: gps.is_file().then_some(gps),
+            ins: ins.is_file().then_some(ins),
         })
     }
 
@@ -136,8 +143,73 @@ pub struct IngestReport {
     pub ground_truth_poses: u64,
     /// GNSS fixes written (those within the scans' time span).
     pub gnss_fixes: u64,
+    /// What `gps/ins.csv` was used as (`ground truth`, `GNSS fixes`, both, or
+    /// nothing when the other files take precedence); `None` without one.
+    pub ins_used_as: Option<String>,
+    /// `ins.csv` rows skipped because their status is not `INS_SOLUTION_GOOD`.
+    pub ins_rows_not_good: u64,
     /// The recording.
     pub output: WriteSummary,
+}
+
+/// Ground truth and GNSS fixes of a folder, from whichever files it has.
+struct Auxiliary {
+    ground_truth: Vec<StampedPose>,
+    ground_truth_frame: &'static str,
+    fixes: Vec<GnssFix>,
+    ins_used_as: Option<String>,
+    ins_rows_not_good: u64,
+}
+
+/// Reads `radar_odometry.csv`, `gps.csv` and `ins.csv` (each when present);
+/// `ins.csv` fills in for whichever of the other two is missing.
+fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -> Result<Auxiliary, IngestError> {
+    let mut aux = Auxiliary {
+        ground_truth: Vec::new(),
+        ground_truth_frame: "radar",
+        fixes: Vec::new(),
+        ins_used_as: None,
+        ins_rows_not_good: 0,
+    };
+    if let Some(path) = &folder.ground_truth {
+        extra.insert("ground_truth.source".into(), path.display().to_string());
+        aux.ground_truth = odometry::read_radar_odometry(path)?;
+    }
+    if let Some(path) = &folder.gps {
+        extra.insert("gnss.source".into(), path.display().to_string());
+        extra.insert("gnss.altitude_datum".into(), "as in the Oxford gps.csv (NovAtel)".into());
+        aux.fixes = gps::read_gps_csv(path)?.into_iter().map(|row| row.fix).collect();
+    }
+    let Some(path) = &folder.ins else { return Ok(aux) };
+    let solution = ins::read_ins_csv(path)?;
+    let mut used = Vec::new();
+    if folder.ground_truth.is_none() {
+        extra.insert("ground_truth.source".into(), path.display().to_string());
+        extra.insert("ground_truth.frame".into(), "ins (local east-north frame about the origin)".into());
+        for (axis, value) in ["east", "north", "up"].iter().zip(solution.origin) {
+            extra.insert(format!("ground_truth.origin_{axis}_m"), value.to_string());
+        }
+        extra.insert("ground_truth.origin_utm_zone".into(), solution.utm_zone.clone());
+        aux.ground_truth = solution.poses;
+        aux.ground_truth_frame = "ins";
+        used.push("ground truth");
+    }
+    if folder.gps.is_none() {
+        extra.insert("gnss.source".into(), path.display().to_string());
+        extra.insert("gnss.altitude_datum".into(), "as in the Oxford ins.csv (NovAtel)".into());
+        aux.fixes = solution.fixes;
+        used.push("GNSS fixes");
+    }
+    let used_as = if used.is_empty() {
+        "nothing (radar_odometry.csv and gps.csv take precedence)".to_string()
+    } else {
+        used.join(" and ")
+    };
+    extra.insert("ins.source".into(), path.display().to_string());
+    extra.insert("ins.used_as".into(), used_as.clone());
+    aux.ins_used_as = Some(used_as);
+    aux.ins_rows_not_good = solution.skipped_not_good;
+    Ok(aux)
 }
 
 /// Ingests an Oxford folder into a new recording at `out`, one scan at a time.
@@ -155,21 +227,7 @@ pub fn ingest_oxford(
         ("radar.encoder_counts_per_turn".to_string(), layout.counts_per_turn.to_string()),
         ("radar.carried_png".to_string(), options.carry_png.to_string()),
     ]);
-    let ground_truth = match &folder.ground_truth {
-        Some(path) => {
-            extra.insert("ground_truth.source".into(), path.display().to_string());
-            odometry::read_radar_odometry(path)?
-        }
-        None => Vec::new(),
-    };
-    let gps = match &folder.gps {
-        Some(path) => {
-            extra.insert("gnss.source".into(), path.display().to_string());
-            extra.insert("gnss.altitude_datum".into(), "as in the Oxford gps.csv (NovAtel)".into());
-            gps::read_gps_csv(path)?
-        }
-        None => Vec::new(),
-    };
+    let aux = read_auxiliary(folder, &mut extra)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("oxford:{}", folder.root.display()),
@@ -180,13 +238,13 @@ pub fn ingest_oxford(
     let total = folder.scans.len() as u64;
     write_navtech_scans(&mut writer, &folder.scans, layout, options.carry_png, progress)?;
     let (first, last) = (folder.scans[0].t_ns, folder.scans[folder.scans.len() - 1].t_ns);
-    let in_span: Vec<&StampedPose> = ground_truth.iter().filter(|p| (first..=last).contains(&p.t_ns)).collect();
+    let in_span: Vec<&StampedPose> = aux.ground_truth.iter().filter(|p| (first..=last).contains(&p.t_ns)).collect();
     for pose in &in_span {
-        writer.write_pose(PoseStream::GroundTruth, pose, "world", "radar")?;
+        writer.write_pose(PoseStream::GroundTruth, pose, "world", aux.ground_truth_frame)?;
     }
-    let fixes_in_span: Vec<_> = gps.iter().filter(|row| (first..=last).contains(&row.fix.t_ns)).collect();
-    for row in &fixes_in_span {
-        writer.write_gnss_fix(&row.fix)?;
+    let fixes_in_span: Vec<&GnssFix> = aux.fixes.iter().filter(|fix| (first..=last).contains(&fix.t_ns)).collect();
+    for fix in &fixes_in_span {
+        writer.write_gnss_fix(fix)?;
     }
     let output = writer.finish()?;
     Ok(IngestReport {
@@ -194,6 +252,8 @@ pub fn ingest_oxford(
         skipped_invalid_scans: folder.skipped_invalid,
         ground_truth_poses: in_span.len() as u64,
         gnss_fixes: fixes_in_span.len() as u64,
+        ins_used_as: aux.ins_used_as,
+        ins_rows_not_good: aux.ins_rows_not_good,
         output,
     })
 }
