@@ -13,6 +13,7 @@
 
 mod columns;
 mod io;
+mod mpc_rows;
 mod odometry_rows;
 mod rows;
 
@@ -21,8 +22,12 @@ pub use io::{
     RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table, read_table_dir,
     table_path, write_table,
 };
+pub use mpc_rows::{
+    GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_LONG_TERM, MPC_SETS,
+    MPC_TRACKS_GMPHD, MPC_TRUTH,
+};
 pub use odometry_rows::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, ODOMETRY_TIMING};
-pub use rows::ALL_TABLES;
+pub use rows::{ALL_TABLES, MPC_DETECTIONS, MPC_TRACKS, POSES};
 
 use std::sync::Arc;
 

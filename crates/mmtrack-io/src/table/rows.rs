@@ -419,4 +419,10 @@ pub const ALL_TABLES: &[&TableSpec] = &[
     &CIR_SNAPSHOTS,
     &MPC_DETECTIONS,
     &MPC_TRACKS,
+    &super::MPC_TRACKS_GMPHD,
+    &super::MPC_LONG_TERM,
+    &super::MPC_SETS,
+    &super::MPC_TRUTH,
+    &super::GROUND_TRUTH_TX,
+    &super::GROUND_TRUTH_RX,
 ];

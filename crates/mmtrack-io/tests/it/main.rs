@@ -4,5 +4,6 @@
 
 mod bad_input;
 mod roundtrip;
+mod roundtrip_mpc;
 mod samples;
 mod schemas;
