@@ -25,7 +25,7 @@ pub mod gmphd;
 mod pulse;
 
 pub use config::{DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig};
-pub use detect::{Detector, SnapshotDetections};
+pub use detect::{Detector, SnapshotDetections, first_path};
 pub use error::MpcError;
 pub use gmphd::{GmPhdConfig, GmPhdError, GmPhdSnapshot, track_gmphd};
 pub use pulse::SounderPulse;

@@ -27,6 +27,38 @@ impl SounderPulse {
         Self { spectrum: vec![Complex64::new(1.0, 0.0); band.taps()] }
     }
 
+    /// A band-limited pulse inside an oversampled band: a raised-cosine
+    /// spectrum of `bandwidth_hz` (between the -6 dB points) and roll-off
+    /// `rolloff` in 0..=1, zero beyond `(1 + rolloff) bandwidth / 2`. Models
+    /// receivers that sample faster than their signal bandwidth, such as the
+    /// DW1000 (499.2 MHz channels sampled at 998.4 MHz).
+    pub fn raised_cosine(band: &SounderBand, bandwidth_hz: f64, rolloff: f64) -> Result<Self, MpcError> {
+        if !(bandwidth_hz.is_finite() && bandwidth_hz > 0.0 && (0.0..=1.0).contains(&rolloff)) {
+            return Err(MpcError::BadPulse {
+                detail: format!(
+                    "raised cosine of {bandwidth_hz} Hz, roll-off {rolloff}: expected a positive bandwidth and a roll-off in 0..=1"
+                ),
+            });
+        }
+        let half = bandwidth_hz / 2.0;
+        let spectrum = (0..band.taps())
+            .map(|k| {
+                let f = band.frequency_hz(k).abs();
+                let (inner, outer) = (half * (1.0 - rolloff), half * (1.0 + rolloff));
+                let gain = if f <= inner {
+                    1.0
+                } else if f >= outer {
+                    0.0
+                } else {
+                    0.5 * (1.0 + (std::f64::consts::PI * (f - inner) / (outer - inner)).cos())
+                };
+                Complex64::new(gain, 0.0)
+            })
+            .collect::<Vec<_>>();
+        let peak = spectrum.iter().map(|p| p.re).sum::<f64>() / band.taps() as f64;
+        Self::from_spectrum(spectrum.into_iter().map(|p| p / peak).collect())
+    }
+
     /// A pulse given as its transfer function in FFT order, as a simulator
     /// knows it. It must be finite and not all zero; it is used as given.
     pub fn from_spectrum(spectrum: Vec<Complex64>) -> Result<Self, MpcError> {
