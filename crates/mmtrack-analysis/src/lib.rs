@@ -9,6 +9,9 @@
 //! - [`tables`]: result tables (`trajectory_metrics`, `drift_per_length`,
 //!   `relative_pose_errors`) as `mmtrack-io` [`TableRow`](mmtrack_io::table::TableRow)s,
 //!   with units; [`TABLES`] lists their specs for `schemas/`;
+//! - [`mpc`], [`mpc_tables`], [`mpc_plots`], [`mpc_report`]: multipath-component
+//!   statistics of `process mpc` tables (Mahler et al. 2017, Figs. 7-9,
+//!   12-13), their result tables, plots and report section;
 //! - [`plots`]: SVG plots (plotters, SVG backend only);
 //! - [`report`]: the Markdown report;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
@@ -29,6 +32,10 @@
 //! on the Hive-partitioned output with DuckDB or polars outside the binary.
 
 pub mod export;
+pub mod mpc;
+pub mod mpc_plots;
+pub mod mpc_report;
+pub mod mpc_tables;
 pub mod output;
 pub mod pipeline;
 pub mod plots;

@@ -9,9 +9,10 @@ use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
 
+use crate::mpc::MpcResult;
 use crate::pipeline::TrajectoryResult;
 use crate::trajectory::DriftOptions;
-use crate::{plots, report};
+use crate::{mpc_plots, mpc_report, plots, report};
 
 /// Entries of a results directory; `--force` replaces only a directory that
 /// holds nothing else, so a mistyped `-o` cannot delete unrelated files.
@@ -71,10 +72,23 @@ fn parent_dir(path: &Path) -> PathBuf {
     }
 }
 
-/// Writes tables, plots and the report for `results` into `out`.
+/// Writes tables, plots and the report for trajectory `results` into `out`.
 pub fn write_results(
     out: &Path,
     results: &[TrajectoryResult],
+    skipped: &[(String, String)],
+    options: &DriftOptions,
+    run: &RunInfo,
+    overwrite: Overwrite,
+) -> anyhow::Result<WrittenResults> {
+    write_all_results(out, results, &[], skipped, options, run, overwrite)
+}
+
+/// Writes tables, plots and the report for trajectory and MPC results into `out`.
+pub fn write_all_results(
+    out: &Path,
+    results: &[TrajectoryResult],
+    mpc: &[MpcResult],
     skipped: &[(String, String)],
     options: &DriftOptions,
     run: &RunInfo,
@@ -89,7 +103,15 @@ pub fn write_results(
         .suffix(".partial")
         .tempdir_in(&parent)
         .with_context(|| format!("{}: cannot create a staging directory", parent.display()))?;
-    let files = write_into(staging.path(), results, skipped, options, run)?;
+    let mut files = write_into(staging.path(), results, skipped, options, run)?;
+    files += write_mpc_into(staging.path(), mpc, run)?;
+    if !mpc.is_empty() {
+        let report_path = staging.path().join("report.md");
+        let mut text = report::markdown(results, &[], options);
+        mpc_report::section(&mut text, mpc);
+        text.push_str(&report::not_analyzed(skipped));
+        std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
+    }
     publish(staging.keep(), out, overwrite)?;
     Ok(WrittenResults {
         out_dir: out.to_path_buf(),
@@ -132,6 +154,35 @@ fn write_into(
     std::fs::write(&report_path, report::markdown(results, skipped, options))
         .with_context(|| report_path.display().to_string())?;
     Ok(files + 1)
+}
+
+fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::Result<usize> {
+    let tables = dir.join("tables");
+    let mut files = 0;
+    for r in results {
+        let seq = &r.sequence;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.per_set, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.counts, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.power_std, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.chi, run, Overwrite::Refuse)?;
+        let plot_dir = dir.join("plots").join(seq);
+        std::fs::create_dir_all(&plot_dir).with_context(|| plot_dir.display().to_string())?;
+        let svgs = [
+            mpc_plots::delay_tracks_svg(r),
+            mpc_plots::count_svg(r),
+            mpc_plots::birth_death_svg(r),
+            mpc_plots::power_loss_svg(r),
+            mpc_plots::power_std_svg(r),
+        ];
+        for ((file, _), svg) in mpc_report::PLOTS.iter().zip(svgs) {
+            let path = plot_dir.join(file);
+            let svg = svg.with_context(|| format!("sequence {seq}: {file}"))?;
+            std::fs::write(&path, svg).with_context(|| path.display().to_string())?;
+        }
+        files += 5 + mpc_report::PLOTS.len();
+    }
+    Ok(files)
 }
 
 /// Moves the complete `staged` directory to `out`. An existing `out` is

@@ -5,8 +5,16 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
-use mmtrack_io::table::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, read_table_dir};
+use mmtrack_core::{
+    MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, OdometryEstimate, Se2, StampedPose,
+};
+use mmtrack_io::table::{
+    GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose,
+    MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, ODOMETRY, TableRow, read_table,
+    read_table_dir, table_path,
+};
+
+use crate::mpc::{DistanceSource, MpcInput, MpcResult, analyze_mpc};
 
 use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
 use crate::trajectory::{
@@ -78,15 +86,33 @@ pub fn inventory(root: &Path) -> anyhow::Result<Inventory> {
 pub struct Plan {
     /// Sequences with both an estimate and ground truth: trajectory metrics.
     pub trajectory: Vec<String>,
+    /// Sequences with MPC tables (`mpc_sets` and the others of `process mpc`):
+    /// MPC statistics.
+    pub mpc: Vec<String>,
     /// Sequences that have tables but no metric applies, with the reason.
     pub skipped: Vec<(String, String)>,
 }
 
 /// Picks the metrics that apply: `odometry` + `ground_truth` of the same
-/// sequence -> trajectory metrics.
+/// sequence -> trajectory metrics; `mpc_sets` (with the other tables of
+/// `process mpc`) -> MPC statistics.
 #[must_use]
 pub fn plan(inventory: &Inventory) -> Plan {
     let mut plan = Plan::default();
+    for seq in inventory.sequences(MPC_SETS.name) {
+        let missing: Vec<&str> = [MPC_DETECTIONS.name, MPC_TRACKS.name, MPC_LONG_TERM.name]
+            .into_iter()
+            .filter(|t| !inventory.sequences(t).contains(seq))
+            .collect();
+        if missing.is_empty() {
+            plan.mpc.push(seq.clone());
+        } else {
+            plan.skipped.push((
+                seq.clone(),
+                format!("has an {} table but not {}: MPC statistics need them all", MPC_SETS.name, missing.join(", ")),
+            ));
+        }
+    }
     let truth = inventory.sequences(GROUND_TRUTH.name);
     for seq in inventory.sequences(ODOMETRY.name) {
         if truth.contains(seq) {
@@ -263,3 +289,78 @@ pub fn analyze_all(root: &Path, plan: &Plan, options: &DriftOptions) -> anyhow::
     }
     Ok(results)
 }
+
+/// Reads one partition of table `T`, or `None` when the file is absent.
+fn read_optional<T: TableRow>(root: &Path, sequence: &str) -> anyhow::Result<Option<Vec<T>>> {
+    let path = table_path(root, T::SPEC.name, sequence)?;
+    if !path.is_file() {
+        return Ok(None);
+    }
+    Ok(Some(read_table::<T>(&path)?))
+}
+
+fn read_required<T: TableRow>(root: &Path, sequence: &str) -> anyhow::Result<Vec<T>> {
+    read_optional::<T>(root, sequence)?
+        .with_context(|| format!("sequence {sequence}: table {} vanished under {}", T::SPEC.name, root.display()))
+}
+
+/// The distance source of a sequence: both sounder vehicles' ground truth,
+/// else `ground_truth`, else `odometry`, else none.
+fn read_distance(root: &Path, sequence: &str) -> anyhow::Result<DistanceSource> {
+    let tx = read_optional::<GroundTruthTxPose>(root, sequence)?;
+    let rx = read_optional::<GroundTruthRxPose>(root, sequence)?;
+    if let (Some(tx), Some(rx)) = (tx, rx)
+        && tx.len() >= 2
+        && rx.len() >= 2
+    {
+        return Ok(DistanceSource::BothVehicles {
+            tx: tx.into_iter().map(|p| p.0).collect(),
+            rx: rx.into_iter().map(|p| p.0).collect(),
+        });
+    }
+    if let Some(gt) = read_optional::<GroundTruthPose>(root, sequence)?.filter(|g| g.len() >= 2) {
+        let poses = gt.into_iter().map(|p| p.0).collect();
+        return Ok(DistanceSource::OneVehicle { table: GROUND_TRUTH.name.into(), poses });
+    }
+    if let Some(odo) = read_optional::<OdometryEstimate>(root, sequence)?.filter(|o| o.len() >= 2) {
+        let poses = odo.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
+        return Ok(DistanceSource::OneVehicle { table: ODOMETRY.name.into(), poses });
+    }
+    Ok(DistanceSource::None)
+}
+
+/// Reads the MPC tables of one sequence partition (errors name the file).
+pub fn read_mpc(root: &Path, sequence: &str) -> anyhow::Result<MpcInput> {
+    Ok(MpcInput {
+        detections: read_required::<MpcDetection>(root, sequence)?,
+        tracks: read_required::<MpcTrack>(root, sequence)?,
+        gmphd_tracks: read_optional::<GmPhdTrack>(root, sequence)?.map(|t| t.into_iter().map(|t| t.0).collect()),
+        long_term: read_required::<MpcLongTermEntry>(root, sequence)?,
+        sets: read_required::<MpcSetStats>(root, sequence)?,
+        truth: read_optional::<MpcTruth>(root, sequence)?,
+        distance: read_distance(root, sequence)?,
+    })
+}
+
+/// MPC statistics of every sequence of `plan`.
+pub fn analyze_mpc_all(root: &Path, plan: &Plan) -> anyhow::Result<Vec<MpcResult>> {
+    plan.mpc
+        .iter()
+        .map(|sequence| {
+            let input = read_mpc(root, sequence).with_context(|| format!("sequence {sequence}: MPC tables"))?;
+            Ok(analyze_mpc(sequence, input))
+        })
+        .collect()
+}
+
+/// Table names `process mpc` writes, for messages.
+pub const MPC_TABLE_NAMES: [&str; 8] = [
+    MPC_DETECTIONS.name,
+    MPC_TRACKS.name,
+    MPC_TRACKS_GMPHD.name,
+    MPC_LONG_TERM.name,
+    MPC_SETS.name,
+    MPC_TRUTH.name,
+    GROUND_TRUTH_TX.name,
+    GROUND_TRUTH_RX.name,
+];

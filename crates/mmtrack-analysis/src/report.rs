@@ -60,6 +60,14 @@ pub fn markdown(results: &[TrajectoryResult], skipped: &[(String, String)], opti
     if !results.is_empty() {
         trajectory_section(&mut out, results, options);
     }
+    out.push_str(&not_analyzed(skipped));
+    out
+}
+
+/// The "Not analyzed" section (empty when nothing was skipped).
+#[must_use]
+pub fn not_analyzed(skipped: &[(String, String)]) -> String {
+    let mut out = String::new();
     if !skipped.is_empty() {
         out.push_str("## Not analyzed\n\n");
         for (sequence, reason) in skipped {

@@ -20,7 +20,16 @@ const fn opt(name: &'static str, ty: ColumnType, unit: &'static str, meaning: &'
 }
 
 /// Every result table of this crate, for `schemas/`.
-pub const TABLES: &[&TableSpec] = &[&TRAJECTORY_METRICS, &DRIFT_PER_LENGTH, &RELATIVE_POSE_ERRORS];
+pub const TABLES: &[&TableSpec] = &[
+    &TRAJECTORY_METRICS,
+    &DRIFT_PER_LENGTH,
+    &RELATIVE_POSE_ERRORS,
+    &crate::mpc_tables::MPC_SUMMARY,
+    &crate::mpc_tables::MPC_SET_METRICS,
+    &crate::mpc_tables::MPC_COUNT_DISTRIBUTION,
+    &crate::mpc_tables::MPC_TRACK_POWER_STD,
+    &crate::mpc_tables::MPC_CHI_CLASSES,
+];
 
 /// `trajectory_metrics`: one row per sequence.
 pub const TRAJECTORY_METRICS: TableSpec = TableSpec {

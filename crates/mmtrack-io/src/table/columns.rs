@@ -1,7 +1,8 @@
 use arrow_array::cast::AsArray;
 use arrow_array::types::{Float64Type, Int64Type, UInt32Type, UInt64Type};
 use arrow_array::{
-    Array, BinaryArray, BooleanArray, Float64Array, Int64Array, ListArray, RecordBatch, UInt32Array, UInt64Array,
+    Array, BinaryArray, BooleanArray, Float64Array, Int64Array, ListArray, RecordBatch, StringArray, UInt32Array,
+    UInt64Array,
 };
 
 /// Typed access to the columns of a batch already checked against its spec.
@@ -54,6 +55,11 @@ impl<'a> Columns<'a> {
     /// A `bool` column.
     pub fn bool(&self, name: &str) -> Result<&'a BooleanArray, String> {
         self.column(name)?.as_boolean_opt().ok_or_else(|| missing(name))
+    }
+
+    /// A `string` column.
+    pub fn utf8(&self, name: &str) -> Result<&'a StringArray, String> {
+        self.column(name)?.as_string_opt::<i32>().ok_or_else(|| missing(name))
     }
 
     /// A `binary` column.

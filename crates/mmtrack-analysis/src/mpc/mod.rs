@@ -1,0 +1,510 @@
+//! Multipath-component statistics (Mahler et al. 2017, Secs. IV-VI): pure
+//! functions on the tables `mmtrack process mpc` writes, already in memory.
+//!
+//! - number of MPCs per set: the long-term (full-lifetime) tracks present in
+//!   each set, its distribution and CDF (Fig. 12);
+//! - birth and death rates per metre travelled (Fig. 13): across each pair of
+//!   consecutive sets, births are long-term tracks whose first entry is the
+//!   later set, deaths those whose last entry is the earlier set; divided by
+//!   the distance both vehicles drove between the two sets' times (or by the
+//!   time between them when no trajectory is available);
+//! - power loss: channel gain minus the gain captured by detection, by the
+//!   short-term tracks, by the full-lifetime tracks and (when present) by the
+//!   GM-PHD tracks, per set and its mean in dB (Figs. 8-9);
+//! - per-track power standard deviation over the set (Fig. 7);
+//! - share of the long-term link power per confidence class chi (Sec. VI-A:
+//!   72 % at chi <= 0.1 ns in the paper) and the share of full-lifetime power
+//!   related to no adjacent set (5 % in the paper);
+//! - against the simulator's truth ([`truth`]): detection precision and
+//!   recall, track purity, true birth and death rates.
+
+pub mod truth;
+
+use std::collections::BTreeMap;
+
+use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
+
+pub use truth::{TruthScores, match_detections};
+
+/// Where the distance travelled comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum DistanceSource {
+    /// Both sounder vehicles' ground truth (`ground_truth_tx`, `ground_truth_rx`):
+    /// the paper's cumulative distance of both vehicles.
+    BothVehicles {
+        /// Transmitter car.
+        tx: Vec<StampedPose>,
+        /// Receiver car.
+        rx: Vec<StampedPose>,
+    },
+    /// One trajectory (a `ground_truth` or `odometry` table), named.
+    OneVehicle {
+        /// Table it came from.
+        table: String,
+        /// The poses.
+        poses: Vec<StampedPose>,
+    },
+    /// No trajectory: rates are per second only.
+    None,
+}
+
+impl DistanceSource {
+    /// Short label for tables and reports.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match self {
+            Self::BothVehicles { .. } => "ground_truth_tx+ground_truth_rx".into(),
+            Self::OneVehicle { table, .. } => table.clone(),
+            Self::None => "none".into(),
+        }
+    }
+
+    /// Distance driven between `t0_ns` and `t1_ns` (both vehicles summed),
+    /// from positions interpolated at both times; `None` without poses or
+    /// outside their time span.
+    #[must_use]
+    pub fn distance_m(&self, t0_ns: i64, t1_ns: i64) -> Option<f64> {
+        let one = |poses: &[StampedPose]| -> Option<f64> {
+            let (a, b) = (position_at(poses, t0_ns)?, position_at(poses, t1_ns)?);
+            Some((b.0 - a.0).hypot(b.1 - a.1))
+        };
+        match self {
+            Self::BothVehicles { tx, rx } => Some(one(tx)? + one(rx)?),
+            Self::OneVehicle { poses, .. } => one(poses),
+            Self::None => None,
+        }
+    }
+}
+
+/// Position at `t_ns`, linearly interpolated; `None` outside the span.
+fn position_at(poses: &[StampedPose], t_ns: i64) -> Option<(f64, f64)> {
+    let i = poses.partition_point(|p| p.t_ns < t_ns);
+    let at = |p: &StampedPose| (p.parent_from_child.x_m, p.parent_from_child.y_m);
+    let after = poses.get(i)?;
+    if after.t_ns == t_ns {
+        return Some(at(after));
+    }
+    let before = poses.get(i.checked_sub(1)?)?;
+    let w = (t_ns - before.t_ns) as f64 / (after.t_ns - before.t_ns) as f64;
+    let (a, b) = (at(before), at(after));
+    Some((a.0 + w * (b.0 - a.0), a.1 + w * (b.1 - a.1)))
+}
+
+/// The MPC tables of one sequence partition.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcInput {
+    /// `mpc_detections`.
+    pub detections: Vec<MpcDetection>,
+    /// `mpc_tracks` (short-term tracks).
+    pub tracks: Vec<MpcTrack>,
+    /// `mpc_tracks_gmphd`, when written.
+    pub gmphd_tracks: Option<Vec<MpcTrack>>,
+    /// `mpc_long_term`.
+    pub long_term: Vec<MpcLongTermEntry>,
+    /// `mpc_sets`.
+    pub sets: Vec<MpcSetStats>,
+    /// `mpc_truth`, when the recording had truth.
+    pub truth: Option<Vec<MpcTruth>>,
+    /// Trajectories for the distance travelled.
+    pub distance: DistanceSource,
+}
+
+/// Per-set results (rows of `mpc_set_metrics`).
+#[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
+pub struct SetMetrics {
+    pub set_index: u64,
+    pub t_ns: i64,
+    pub long_term_mpcs: u64,
+    pub detections: u64,
+    pub full_lifetime_tracks: u64,
+    pub births: Option<u64>,
+    pub deaths: Option<u64>,
+    pub distance_m: Option<f64>,
+    pub birth_rate_per_m: Option<f64>,
+    pub death_rate_per_m: Option<f64>,
+    pub birth_rate_per_s: Option<f64>,
+    pub death_rate_per_s: Option<f64>,
+    pub channel_gain_db: f64,
+    pub detected_gain_db: f64,
+    pub tracked_gain_db: f64,
+    pub full_lifetime_gain_db: f64,
+    pub gmphd_tracked_gain_db: Option<f64>,
+    pub detection_loss_db: f64,
+    pub tracking_loss_db: f64,
+    pub gmphd_tracking_loss_db: Option<f64>,
+    pub true_births: Option<u64>,
+    pub true_deaths: Option<u64>,
+}
+
+/// Per-track power spread (rows of `mpc_track_power_std`).
+#[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
+pub struct TrackPowerStd {
+    pub track_id: u64,
+    pub set_index: u64,
+    pub detections: u64,
+    pub full_lifetime: bool,
+    pub power_std_db: f64,
+}
+
+/// Power share of one confidence class (rows of `mpc_chi_classes`).
+#[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
+pub struct ChiClassShare {
+    pub chi_class_s: Option<f64>,
+    pub entries: u64,
+    pub power_share: f64,
+}
+
+/// One value of the number-of-MPCs distribution (rows of `mpc_count_distribution`).
+#[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
+pub struct CountBin {
+    pub mpcs: u64,
+    pub sets: u64,
+    pub cdf: f64,
+}
+
+/// Summary of one sequence (the row of `mpc_summary`).
+#[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
+pub struct MpcSummary {
+    pub sets: u64,
+    pub detections: u64,
+    pub short_term_tracks: u64,
+    pub full_lifetime_tracks: u64,
+    pub long_term_tracks: u64,
+    pub mean_mpcs_per_set: f64,
+    pub median_mpcs_per_set: f64,
+    pub distance_source: String,
+    pub distance_m: Option<f64>,
+    pub duration_s: f64,
+    pub births: u64,
+    pub deaths: u64,
+    pub birth_rate_per_m: Option<f64>,
+    pub death_rate_per_m: Option<f64>,
+    pub birth_rate_per_s: Option<f64>,
+    pub death_rate_per_s: Option<f64>,
+    pub mean_detection_loss_db: Option<f64>,
+    pub mean_tracking_loss_db: Option<f64>,
+    pub mean_full_lifetime_loss_db: Option<f64>,
+    pub mean_gmphd_tracking_loss_db: Option<f64>,
+    pub full_lifetime_std_below_1db: Option<f64>,
+    pub all_tracks_std_below_1_5db: Option<f64>,
+    pub chi_0_1ns_power_share: Option<f64>,
+    pub unrelated_power_share: Option<f64>,
+    pub truth_mpcs: Option<u64>,
+    pub precision: Option<f64>,
+    pub recall: Option<f64>,
+    pub recall_above_floor: Option<f64>,
+    pub track_purity: Option<f64>,
+    pub true_births: Option<u64>,
+    pub true_deaths: Option<u64>,
+    pub true_birth_rate_per_m: Option<f64>,
+    pub true_death_rate_per_m: Option<f64>,
+}
+
+/// Everything computed for one sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcResult {
+    /// Sequence partition.
+    pub sequence: String,
+    /// Per set.
+    pub per_set: Vec<SetMetrics>,
+    /// Per short-term track.
+    pub power_std: Vec<TrackPowerStd>,
+    /// Per chi class, then the unrelated share (class `None`).
+    pub chi: Vec<ChiClassShare>,
+    /// Distribution of the number of MPCs per set.
+    pub counts: Vec<CountBin>,
+    /// Summary.
+    pub summary: MpcSummary,
+    /// Detections and short-term tracks for the delay-vs-time plot.
+    pub detections: Vec<MpcDetection>,
+    /// Short-term tracks (for the plot).
+    pub tracks: Vec<MpcTrack>,
+}
+
+fn db(linear: f64) -> f64 {
+    10.0 * linear.log10()
+}
+
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.filter(|v| v.is_finite()).fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    (n > 0).then(|| sum / n as f64)
+}
+
+/// Sample standard deviation with `n - 1` (0 for a single value).
+fn std_dev(values: &[f64]) -> f64 {
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let m = values.iter().sum::<f64>() / values.len() as f64;
+    (values.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (values.len() - 1) as f64).sqrt()
+}
+
+fn ratio(a: u64, b: f64) -> Option<f64> {
+    (b > 0.0).then(|| a as f64 / b)
+}
+
+/// First and last set of every long-term track.
+fn long_term_spans(entries: &[MpcLongTermEntry]) -> BTreeMap<u64, (u64, u64)> {
+    let mut spans: BTreeMap<u64, (u64, u64)> = BTreeMap::new();
+    for e in entries {
+        let span = spans.entry(e.long_track_id).or_insert((e.set_index, e.set_index));
+        span.0 = span.0.min(e.set_index);
+        span.1 = span.1.max(e.set_index);
+    }
+    spans
+}
+
+/// Gain captured by `tracks` per set: mean over the set's processed snapshots
+/// of sum |a|^2, dB (the definition of `mpc_sets`).
+fn tracks_gain_db(tracks: &[MpcTrack], sets: &[MpcSetStats]) -> BTreeMap<u64, f64> {
+    let mut power: BTreeMap<u64, f64> = BTreeMap::new();
+    for d in tracks.iter().flat_map(|t| &t.detections) {
+        *power.entry(d.set_index).or_default() += d.amplitude.norm_sqr();
+    }
+    sets.iter()
+        .map(|s| {
+            let n = f64::from(s.snapshots.saturating_sub(s.skipped_snapshots).max(1));
+            (s.set_index, db(power.get(&s.set_index).copied().unwrap_or(0.0) / n))
+        })
+        .collect()
+}
+
+/// All MPC statistics of one sequence.
+#[must_use]
+pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
+    let mut sets = input.sets.clone();
+    sets.sort_by_key(|s| s.set_index);
+    let mut per_set_count: BTreeMap<u64, u64> = sets.iter().map(|s| (s.set_index, 0)).collect();
+    for e in &input.long_term {
+        *per_set_count.entry(e.set_index).or_default() += 1;
+    }
+    let spans = long_term_spans(&input.long_term);
+    let gmphd_gain = input.gmphd_tracks.as_deref().map(|t| tracks_gain_db(t, &sets));
+    let truth_scores = input.truth.as_deref().map(|t| truth::score(t, &input.detections, &input.tracks, &sets));
+
+    let mut per_set = Vec::with_capacity(sets.len());
+    for (k, s) in sets.iter().enumerate() {
+        let previous = k.checked_sub(1).and_then(|p| sets.get(p));
+        let births = previous.map(|_| spans.values().filter(|span| span.0 == s.set_index).count() as u64);
+        let deaths = previous.map(|p| spans.values().filter(|span| span.1 == p.set_index).count() as u64);
+        let distance_m = previous.and_then(|p| input.distance.distance_m(p.t_ns, s.t_ns));
+        let dt_s = previous.map(|p| (s.t_ns - p.t_ns) as f64 * 1e-9);
+        let per = |n: Option<u64>, d: Option<f64>| n.zip(d).and_then(|(n, d)| ratio(n, d));
+        let gmphd = gmphd_gain.as_ref().and_then(|g| g.get(&s.set_index).copied());
+        let (true_births, true_deaths) = truth_scores
+            .as_ref()
+            .and_then(|t| t.transitions.get(&s.set_index))
+            .map_or((None, None), |&(b, d)| (Some(b), Some(d)));
+        per_set.push(SetMetrics {
+            set_index: s.set_index,
+            t_ns: s.t_ns,
+            long_term_mpcs: per_set_count.get(&s.set_index).copied().unwrap_or(0),
+            detections: u64::from(s.detections),
+            full_lifetime_tracks: u64::from(s.full_lifetime_tracks),
+            births,
+            deaths,
+            distance_m,
+            birth_rate_per_m: per(births, distance_m),
+            death_rate_per_m: per(deaths, distance_m),
+            birth_rate_per_s: per(births, dt_s),
+            death_rate_per_s: per(deaths, dt_s),
+            channel_gain_db: s.channel_gain_db,
+            detected_gain_db: s.detected_gain_db,
+            tracked_gain_db: s.tracked_gain_db,
+            full_lifetime_gain_db: s.full_lifetime_gain_db,
+            gmphd_tracked_gain_db: gmphd,
+            detection_loss_db: s.channel_gain_db - s.detected_gain_db,
+            tracking_loss_db: s.channel_gain_db - s.tracked_gain_db,
+            gmphd_tracking_loss_db: gmphd.map(|g| s.channel_gain_db - g),
+            true_births,
+            true_deaths,
+        });
+    }
+
+    let power_std = track_power_std(&input.tracks, &sets);
+    let chi = chi_shares(&input.long_term);
+    let counts = count_distribution(per_set.iter().map(|s| s.long_term_mpcs));
+    let summary = summarise(&input, &per_set, &power_std, &chi, &spans, truth_scores.as_ref());
+    MpcResult {
+        sequence: sequence.to_string(),
+        per_set,
+        power_std,
+        chi,
+        counts,
+        summary,
+        detections: input.detections,
+        tracks: input.tracks,
+    }
+}
+
+fn track_power_std(tracks: &[MpcTrack], sets: &[MpcSetStats]) -> Vec<TrackPowerStd> {
+    let lengths: BTreeMap<u64, u32> =
+        sets.iter().map(|s| (s.set_index, s.snapshots.saturating_sub(s.skipped_snapshots))).collect();
+    tracks
+        .iter()
+        .filter_map(|t| {
+            let first = t.detections.first()?;
+            let powers: Vec<f64> = t.detections.iter().map(MpcDetection::power_db).collect();
+            let n = t.detections.len() as u64;
+            Some(TrackPowerStd {
+                track_id: t.track_id,
+                set_index: first.set_index,
+                detections: n,
+                full_lifetime: lengths.get(&first.set_index).is_some_and(|&len| u64::from(len) == n),
+                power_std_db: std_dev(&powers),
+            })
+        })
+        .collect()
+}
+
+/// Share of linked power per chi class (the power of the entry a link leads
+/// to), then the share of all full-lifetime power in entries related to no
+/// adjacent set (class `None`).
+fn chi_shares(entries: &[MpcLongTermEntry]) -> Vec<ChiClassShare> {
+    let power = |e: &MpcLongTermEntry| 10f64.powf(e.mean_power_db / 10.0);
+    let mut classes: BTreeMap<u64, (u64, f64)> = BTreeMap::new();
+    for e in entries {
+        if let Some(chi) = e.chi_class_s {
+            let slot = classes.entry(chi.to_bits()).or_default();
+            slot.0 += 1;
+            slot.1 += power(e);
+        }
+    }
+    let linked: f64 = classes.values().map(|c| c.1).sum();
+    let mut out: Vec<ChiClassShare> = classes
+        .iter()
+        .map(|(&bits, &(n, p))| ChiClassShare {
+            chi_class_s: Some(f64::from_bits(bits)),
+            entries: n,
+            power_share: if linked > 0.0 { p / linked } else { 0.0 },
+        })
+        .collect();
+    out.sort_by(|a, b| a.chi_class_s.partial_cmp(&b.chi_class_s).unwrap_or(std::cmp::Ordering::Equal));
+    // An entry is related when it was linked from the previous set or the
+    // next entry of its track links to it.
+    let mut by_track: BTreeMap<u64, Vec<&MpcLongTermEntry>> = BTreeMap::new();
+    for e in entries {
+        by_track.entry(e.long_track_id).or_default().push(e);
+    }
+    let total: f64 = entries.iter().map(power).sum();
+    let (mut unrelated, mut unrelated_n) = (0.0, 0u64);
+    for track in by_track.values() {
+        if track.len() == 1 && track[0].chi_class_s.is_none() {
+            unrelated += power(track[0]);
+            unrelated_n += 1;
+        }
+    }
+    if !entries.is_empty() {
+        out.push(ChiClassShare {
+            chi_class_s: None,
+            entries: unrelated_n,
+            power_share: if total > 0.0 { unrelated / total } else { 0.0 },
+        });
+    }
+    out
+}
+
+fn count_distribution(counts: impl Iterator<Item = u64>) -> Vec<CountBin> {
+    let mut bins: BTreeMap<u64, u64> = BTreeMap::new();
+    for c in counts {
+        *bins.entry(c).or_default() += 1;
+    }
+    let total: u64 = bins.values().sum();
+    let mut cumulative = 0;
+    bins.into_iter()
+        .map(|(mpcs, sets)| {
+            cumulative += sets;
+            CountBin { mpcs, sets, cdf: cumulative as f64 / total as f64 }
+        })
+        .collect()
+}
+
+fn median(mut values: Vec<f64>) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
+}
+
+fn share_below(values: impl Iterator<Item = f64>, limit: f64) -> Option<f64> {
+    let (below, n) = values.fold((0usize, 0usize), |(b, n), v| (b + usize::from(v < limit), n + 1));
+    (n > 0).then(|| below as f64 / n as f64)
+}
+
+fn summarise(
+    input: &MpcInput,
+    per_set: &[SetMetrics],
+    power_std: &[TrackPowerStd],
+    chi: &[ChiClassShare],
+    spans: &BTreeMap<u64, (u64, u64)>,
+    truth: Option<&TruthScores>,
+) -> MpcSummary {
+    let births: u64 = per_set.iter().filter_map(|s| s.births).sum();
+    let deaths: u64 = per_set.iter().filter_map(|s| s.deaths).sum();
+    let transitions: Vec<&SetMetrics> = per_set.iter().skip(1).collect();
+    let distance_m = if transitions.is_empty() || transitions.iter().any(|s| s.distance_m.is_none()) {
+        None
+    } else {
+        Some(transitions.iter().filter_map(|s| s.distance_m).sum::<f64>())
+    };
+    let duration_s = match (per_set.first(), per_set.last()) {
+        (Some(a), Some(b)) => (b.t_ns - a.t_ns) as f64 * 1e-9,
+        _ => 0.0,
+    };
+    let per_m = |n: u64| distance_m.and_then(|d| ratio(n, d));
+    let counts: Vec<f64> = per_set.iter().map(|s| s.long_term_mpcs as f64).collect();
+    let chi_01 = chi
+        .iter()
+        .filter(|c| c.chi_class_s.is_some_and(|x| x <= 0.1e-9 * (1.0 + 1e-9)))
+        .map(|c| c.power_share)
+        .reduce(|a, b| a + b)
+        .or_else(|| chi.iter().any(|c| c.chi_class_s.is_some()).then_some(0.0));
+    MpcSummary {
+        sets: per_set.len() as u64,
+        detections: input.detections.len() as u64,
+        short_term_tracks: input.tracks.len() as u64,
+        full_lifetime_tracks: power_std.iter().filter(|p| p.full_lifetime).count() as u64,
+        long_term_tracks: spans.len() as u64,
+        mean_mpcs_per_set: mean(counts.iter().copied()).unwrap_or(0.0),
+        median_mpcs_per_set: median(counts),
+        distance_source: input.distance.label(),
+        distance_m,
+        duration_s,
+        births,
+        deaths,
+        birth_rate_per_m: per_m(births),
+        death_rate_per_m: per_m(deaths),
+        birth_rate_per_s: ratio(births, duration_s),
+        death_rate_per_s: ratio(deaths, duration_s),
+        mean_detection_loss_db: mean(per_set.iter().map(|s| s.detection_loss_db)),
+        mean_tracking_loss_db: mean(per_set.iter().map(|s| s.tracking_loss_db)),
+        mean_full_lifetime_loss_db: mean(per_set.iter().map(|s| s.channel_gain_db - s.full_lifetime_gain_db)),
+        mean_gmphd_tracking_loss_db: mean(per_set.iter().filter_map(|s| s.gmphd_tracking_loss_db)),
+        full_lifetime_std_below_1db: share_below(
+            power_std.iter().filter(|p| p.full_lifetime).map(|p| p.power_std_db),
+            1.0,
+        ),
+        all_tracks_std_below_1_5db: share_below(power_std.iter().map(|p| p.power_std_db), 1.5),
+        chi_0_1ns_power_share: chi_01,
+        unrelated_power_share: chi.iter().find(|c| c.chi_class_s.is_none()).map(|c| c.power_share),
+        truth_mpcs: truth.map(|t| t.truth_mpcs),
+        precision: truth.and_then(|t| t.precision),
+        recall: truth.and_then(|t| t.recall),
+        recall_above_floor: truth.and_then(|t| t.recall_above_floor),
+        track_purity: truth.and_then(|t| t.track_purity),
+        true_births: truth.map(|t| t.transitions.values().map(|v| v.0).sum()),
+        true_deaths: truth.map(|t| t.transitions.values().map(|v| v.1).sum()),
+        true_birth_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.0).sum())),
+        true_death_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.1).sum())),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,167 @@
+use mmtrack_core::{Complex64, MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, Se2, StampedPose};
+
+use super::*;
+
+const SET_NS: i64 = 10_000_000;
+
+fn set(i: u64) -> MpcSetStats {
+    MpcSetStats {
+        set_index: i,
+        t_ns: i as i64 * SET_NS,
+        snapshots: 6,
+        skipped_snapshots: 0,
+        detections: 10,
+        short_term_tracks: 3,
+        full_lifetime_tracks: 2,
+        noise_floor_db: -140.0,
+        channel_gain_db: -80.0,
+        detected_gain_db: -82.0,
+        tracked_gain_db: -83.0,
+        full_lifetime_gain_db: -84.0,
+    }
+}
+
+fn entry(track: u64, set: u64, chi_ns: Option<f64>) -> MpcLongTermEntry {
+    MpcLongTermEntry {
+        long_track_id: track,
+        set_index: set,
+        t_ns: set as i64 * SET_NS + 1_800_000,
+        short_track_id: track * 100 + set,
+        mean_delay_s: 1e-7 + track as f64 * 1e-8,
+        mean_power_db: -90.0,
+        doppler_hz: 0.0,
+        link_error_s: chi_ns.map(|c| c * 0.5e-9),
+        chi_class_s: chi_ns.map(|c| c * 1e-9),
+    }
+}
+
+/// Long-term tracks A: sets 0-3, B: 1-2, C: 3, D: 0, E: 2 (linked entries
+/// carry a chi class; A's links at 0.1 ns, B's at 0.5 ns).
+fn long_term() -> Vec<MpcLongTermEntry> {
+    vec![
+        entry(0, 0, None),
+        entry(3, 0, None),
+        entry(0, 1, Some(0.1)),
+        entry(1, 1, None),
+        entry(0, 2, Some(0.1)),
+        entry(1, 2, Some(0.5)),
+        entry(4, 2, None),
+        entry(0, 3, Some(0.1)),
+        entry(2, 3, None),
+    ]
+}
+
+/// Both cars drive along x at 100 m/s: 1 m each per 10 ms set period.
+fn straight(offset_m: f64) -> Vec<StampedPose> {
+    (0..=4)
+        .map(|i| StampedPose { t_ns: i * SET_NS, parent_from_child: Se2::new(offset_m + i as f64, 0.0, 0.0) })
+        .collect()
+}
+
+fn input(distance: DistanceSource) -> MpcInput {
+    MpcInput {
+        detections: Vec::new(),
+        tracks: Vec::new(),
+        gmphd_tracks: None,
+        long_term: long_term(),
+        sets: (0..4).map(set).collect(),
+        truth: None,
+        distance,
+    }
+}
+
+#[test]
+fn births_deaths_and_counts_follow_the_long_term_tracks() {
+    let r = analyze_mpc("s", input(DistanceSource::BothVehicles { tx: straight(50.0), rx: straight(0.0) }));
+    let counts: Vec<u64> = r.per_set.iter().map(|s| s.long_term_mpcs).collect();
+    assert_eq!(counts, vec![2, 2, 3, 2]);
+    let births: Vec<Option<u64>> = r.per_set.iter().map(|s| s.births).collect();
+    let deaths: Vec<Option<u64>> = r.per_set.iter().map(|s| s.deaths).collect();
+    assert_eq!(births, vec![None, Some(1), Some(1), Some(1)]);
+    assert_eq!(deaths, vec![None, Some(1), Some(0), Some(2)]);
+    // 1 m per car per transition, both cars: 2 m (interpolation is exact on a line; 1e-12 covers rounding).
+    assert!((r.per_set[3].distance_m.unwrap() - 2.0).abs() < 1e-12);
+    assert!((r.per_set[3].death_rate_per_m.unwrap() - 1.0).abs() < 1e-12);
+    assert!((r.per_set[3].death_rate_per_s.unwrap() - 200.0).abs() < 1e-9);
+    let s = &r.summary;
+    assert_eq!((s.births, s.deaths, s.long_term_tracks), (3, 3, 5));
+    assert!((s.distance_m.unwrap() - 6.0).abs() < 1e-12);
+    assert!((s.birth_rate_per_m.unwrap() - 0.5).abs() < 1e-12);
+    assert_eq!(s.distance_source, "ground_truth_tx+ground_truth_rx");
+    assert!((s.mean_mpcs_per_set - 2.25).abs() < 1e-12);
+    assert_eq!(s.median_mpcs_per_set, 2.0);
+    assert_eq!(r.counts, vec![CountBin { mpcs: 2, sets: 3, cdf: 0.75 }, CountBin { mpcs: 3, sets: 1, cdf: 1.0 }]);
+    assert!((s.mean_detection_loss_db.unwrap() - 2.0).abs() < 1e-12);
+    assert!((s.mean_tracking_loss_db.unwrap() - 3.0).abs() < 1e-12);
+}
+
+#[test]
+fn chi_shares_and_unrelated_power() {
+    let r = analyze_mpc("s", input(DistanceSource::None));
+    // Equal powers: three links at 0.1 ns and one at 0.5 ns; C, D, E (3 of 9 entries) are unrelated.
+    assert_eq!(r.chi.len(), 3);
+    assert!((r.chi[0].chi_class_s.unwrap() - 0.1e-9).abs() < 1e-24);
+    assert!((r.chi[0].power_share - 0.75).abs() < 1e-12);
+    assert_eq!(r.chi[2].chi_class_s, None);
+    assert_eq!(r.chi[2].entries, 3);
+    assert!((r.chi[2].power_share - 1.0 / 3.0).abs() < 1e-12);
+    assert!((r.summary.chi_0_1ns_power_share.unwrap() - 0.75).abs() < 1e-12);
+    // Without a trajectory only the per-second rates exist.
+    assert_eq!(r.summary.distance_source, "none");
+    assert_eq!(r.summary.birth_rate_per_m, None);
+    assert!((r.summary.birth_rate_per_s.unwrap() - 100.0).abs() < 1e-9);
+}
+
+fn detection(snapshot: u32, delay_ns: f64, amplitude: f64) -> MpcDetection {
+    MpcDetection {
+        t_ns: i64::from(snapshot) * 717_000,
+        set_index: 0,
+        snapshot_index: snapshot,
+        delay_s: delay_ns * 1e-9,
+        amplitude: Complex64::new(amplitude, 0.0),
+    }
+}
+
+fn truth_mpc(snapshot: u32, path_id: u64, delay_ns: f64, amplitude: f64) -> MpcTruth {
+    MpcTruth {
+        t_ns: i64::from(snapshot) * 717_000,
+        set_index: 0,
+        snapshot_index: snapshot,
+        path_id,
+        delay_s: delay_ns * 1e-9,
+        amplitude: Complex64::new(amplitude, 0.0),
+        doppler_hz: 0.0,
+    }
+}
+
+#[test]
+fn matching_is_one_to_one_strongest_first_within_half_a_nanosecond() {
+    let truth = vec![truth_mpc(0, 1, 10.0, 1e-5), truth_mpc(0, 2, 10.4, 1e-4), truth_mpc(1, 1, 10.0, 1e-5)];
+    let detections = vec![
+        detection(0, 10.1, 1e-5),
+        detection(0, 10.3, 1e-4),
+        detection(0, 13.0, 1e-6),
+        detection(1, 10.6, 1e-5), // 0.6 ns off: no match
+    ];
+    assert_eq!(truth::match_detections(&truth, &detections), vec![Some(1), Some(2), None, None]);
+}
+
+#[test]
+fn purity_precision_and_recall() {
+    // Path 1 at 10 ns in all six snapshots; a track follows it for four and
+    // then jumps to path 2 at 10.9 ns for two.
+    let mut truth = Vec::new();
+    let mut detections = Vec::new();
+    for k in 0..6 {
+        truth.push(truth_mpc(k, 1, 10.0, 1e-4));
+        truth.push(truth_mpc(k, 2, 10.9, 1e-4));
+        detections.push(detection(k, if k < 4 { 10.05 } else { 10.85 }, 1e-4));
+    }
+    let track = MpcTrack { track_id: 0, doppler_hz: None, detections: detections.clone() };
+    let mut sets = vec![set(0)];
+    sets[0].noise_floor_db = -200.0;
+    let scores = truth::score(&truth, &detections, &[track], &sets);
+    assert_eq!(scores.precision, Some(1.0));
+    assert_eq!(scores.recall, Some(0.5));
+    assert!((scores.track_purity.unwrap() - 4.0 / 6.0).abs() < 1e-12);
+}
