@@ -23,12 +23,15 @@ pub mod detect;
 mod error;
 pub mod gmphd;
 mod pulse;
+pub mod short_term;
+pub mod short_term;
 
 pub use config::{DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig};
 pub use detect::{Detector, SnapshotDetections, first_path};
 pub use error::MpcError;
 pub use gmphd::{GmPhdConfig, GmPhdError, GmPhdSnapshot, track_gmphd};
 pub use pulse::SounderPulse;
+pub use short_term::short_term_tracks;
 
 /// Speed of light in vacuum, m/s.
 pub const SPEED_OF_LIGHT_M_PER_S: f64 = 299_792_458.0;
