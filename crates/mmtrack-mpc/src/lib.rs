@@ -24,7 +24,6 @@ mod error;
 pub mod gmphd;
 mod pulse;
 pub mod short_term;
-pub mod short_term;
 
 pub use config::{DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig};
 pub use detect::{Detector, SnapshotDetections, first_path};

@@ -4,3 +4,4 @@ mod common;
 mod detect;
 mod gmphd;
 mod realdata_cir;
+mod short_term;
