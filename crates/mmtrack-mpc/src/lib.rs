@@ -22,6 +22,7 @@ mod config;
 pub mod detect;
 mod error;
 pub mod gmphd;
+pub mod long_term;
 mod pulse;
 pub mod short_term;
 
@@ -29,6 +30,7 @@ pub use config::{DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTe
 pub use detect::{Detector, SnapshotDetections, first_path};
 pub use error::MpcError;
 pub use gmphd::{GmPhdConfig, GmPhdError, GmPhdSnapshot, track_gmphd};
+pub use long_term::LongTermTracker;
 pub use pulse::SounderPulse;
 pub use short_term::short_term_tracks;
 

@@ -1,7 +1,9 @@
 //! Integration tests of mmtrack-mpc.
+#![allow(clippy::unwrap_used)]
 
 mod common;
 mod detect;
 mod gmphd;
+mod long_term;
 mod realdata_cir;
 mod short_term;

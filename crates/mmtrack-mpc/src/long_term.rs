@@ -1,0 +1,235 @@
+//! Long-term MPC tracking: relating the full-lifetime short-term tracks of
+//! consecutive sets (Mahler et al. 2017, Sec. V, eqs. (33)-(43)).
+//!
+//! Each full-lifetime track `k` of set `i` is summarised ([`TrackSummary`],
+//! eqs. (33)-(34)) by its mean delay `tau_k`, the power of its mean linear
+//! power `a_k` (dB), its Doppler `nu_k` (eq. (31)) and its mean time `t_k`.
+//! Then, for the tracks of set `i` **strongest first** (ties: smaller delay,
+//! then input order):
+//!
+//! 1. **Candidates** (eqs. (35)-(36)): the tracks `c` of set `i + 1` not yet
+//!    related with `|a_c - a_k| <= xi_a` and `|tau_c - tau_k| <= xi_tau`
+//!    (componentwise, as in eq. (15); `xi_a` =
+//!    [`LongTermConfig::magnitude_gate_db`], 5 dB; `xi_tau` =
+//!    [`LongTermConfig::delay_gate_s`], 1 ns).
+//! 2. **Forward prediction** (eq. (37)):
+//!    `tau~_r = tau_k + m_k T_r` with the delay rate `m_k = -nu_k / f_c` and
+//!    `T_r = t_c - t_k` (the difference of the two tracks' mean times).
+//!    The paper prints `tau~_r = tau_k - nu_k f_c T_r`, which is
+//!    dimensionally wrong (Hz * Hz * s is not a delay); since eq. (31) defines
+//!    `nu = -m f_c`, the delay rate is `-nu / f_c`, which is what is used.
+//! 3. **Closest candidate** (eq. (38)): `eta = argmin_c |tau~_r - tau_c|`
+//!    (ties: input order).
+//! 4. **Backward prediction** (eq. (39)) from `eta` with its own Doppler:
+//!    `tau~_k = tau_eta - m_eta T_r = tau_eta + nu_eta T_r / f_c` (the
+//!    paper's `+ nu f_c T_r` has the same slip as eq. (37)).
+//! 5. **Check** (eqs. (40)-(42)): with `d_r = |tau~_r - tau_eta|` and
+//!    `d_k = |tau~_k - tau_k|`, the tracks are related if both are at most
+//!    the largest confidence class `chi`
+//!    ([`LongTermConfig::chi_classes_s`]); the link's class is the smallest
+//!    `chi >= max(d_r, d_k)` (the classes of the paper's Figs. 10-11:
+//!    0.1, 0.2, 0.5, 1 ns). Only `eta` is checked, as in the paper: when it
+//!    fails, `k` has no successor.
+//!
+//! A track of set `i + 1` relates to at most one track of set `i` (the
+//! strongest that chose it); the relation is one-to-one. [`LongTermTracker`]
+//! chains the relations into long-term tracks: a track inherits the long-term
+//! id of the track it is related to, otherwise it starts a new one
+//! (eq. (43)).
+//!
+//! # References
+//! T. Mahler et al., "Tracking of wideband multipath components in a vehicular
+//! communication scenario", IEEE TVT 66(1), 2017, Sec. V, eqs. (33)-(43).
+
+use mmtrack_core::{MpcLongTermEntry, MpcTrack};
+
+use crate::{LongTermConfig, MpcError};
+
+/// A full-lifetime track as long-term tracking sees it: `q_k` of eq. (34)
+/// plus its identity and mean time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackSummary {
+    /// The short-term track's `track_id`.
+    pub short_track_id: u64,
+    /// Set of the track (of its first detection).
+    pub set_index: u64,
+    /// Mean time of the track's detections, nanoseconds (rounded).
+    pub t_ns: i64,
+    /// Mean delay, seconds (tau-bar of eq. (33)).
+    pub mean_delay_s: f64,
+    /// `10 log10` of the mean linear power `|alpha|^2`, dB (a-bar of eq. (33)).
+    pub mean_power_db: f64,
+    /// Doppler of the track, hertz (eq. (31)).
+    pub doppler_hz: f64,
+}
+
+impl TrackSummary {
+    /// The summary of `track`; `None` for a track without detections or
+    /// without a Doppler estimate (fewer than two distinct times).
+    #[must_use]
+    pub fn of(track: &MpcTrack) -> Option<Self> {
+        let first = track.detections.first()?;
+        let doppler_hz = track.doppler_hz?;
+        let n = track.detections.len();
+        let t_sum: i128 = track.detections.iter().map(|d| i128::from(d.t_ns)).sum();
+        let t_ns = i64::try_from(div_round(t_sum, n as i128)).ok()?;
+        let mean_delay_s = track.detections.iter().map(|d| d.delay_s).sum::<f64>() / n as f64;
+        let mean_power = track.detections.iter().map(|d| d.amplitude.norm_sqr()).sum::<f64>() / n as f64;
+        Some(Self {
+            short_track_id: track.track_id,
+            set_index: first.set_index,
+            t_ns,
+            mean_delay_s,
+            mean_power_db: 10.0 * mean_power.log10(),
+            doppler_hz,
+        })
+    }
+}
+
+/// `a / b` rounded to the nearest integer (halves away from zero), `b > 0`.
+fn div_round(a: i128, b: i128) -> i128 {
+    let q = a.div_euclid(b);
+    let r = a.rem_euclid(b);
+    if 2 * r >= b { q + 1 } else { q }
+}
+
+/// A relation between track `current` of one set and track `next` of the
+/// following set (indices into the slices given to [`relate_sets`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LongTermLink {
+    /// Index of the track of the current set.
+    pub current: usize,
+    /// Index of the related track of the next set.
+    pub next: usize,
+    /// Forward prediction error `d_r`, seconds (eq. (41)).
+    pub forward_error_s: f64,
+    /// Backward prediction error `d_k`, seconds (eq. (42)).
+    pub backward_error_s: f64,
+    /// Smallest confidence class holding both errors, seconds (eq. (40)).
+    pub chi_class_s: f64,
+}
+
+impl LongTermLink {
+    /// The larger of the two prediction errors, seconds.
+    #[must_use]
+    pub fn error_s(&self) -> f64 {
+        self.forward_error_s.max(self.backward_error_s)
+    }
+}
+
+/// Relates the tracks of the current set to those of the next set (steps
+/// 1-5 of the module docs). Links come in the order they were made
+/// (strongest current track first); each `next` index appears at most once.
+#[must_use]
+pub fn relate_sets(
+    current: &[TrackSummary],
+    next: &[TrackSummary],
+    carrier_hz: f64,
+    config: &LongTermConfig,
+) -> Vec<LongTermLink> {
+    let mut order: Vec<usize> = (0..current.len()).collect();
+    order.sort_by(|&i, &j| {
+        let (p, q) = (&current[i], &current[j]);
+        q.mean_power_db.total_cmp(&p.mean_power_db).then(p.mean_delay_s.total_cmp(&q.mean_delay_s)).then(i.cmp(&j))
+    });
+    let mut taken = vec![false; next.len()];
+    let mut links = Vec::new();
+    for k in order {
+        let q_k = &current[k];
+        // (index, T_r, forward prediction error d_r) of each candidate.
+        let closest = next
+            .iter()
+            .enumerate()
+            .filter(|&(c, q_c)| {
+                !taken[c]
+                    && (q_c.mean_power_db - q_k.mean_power_db).abs() <= config.magnitude_gate_db
+                    && (q_c.mean_delay_s - q_k.mean_delay_s).abs() <= config.delay_gate_s
+            })
+            .map(|(c, q_c)| {
+                let t_r_s = (i128::from(q_c.t_ns) - i128::from(q_k.t_ns)) as f64 * 1e-9;
+                let predicted_s = q_k.mean_delay_s - q_k.doppler_hz / carrier_hz * t_r_s;
+                (c, t_r_s, (predicted_s - q_c.mean_delay_s).abs())
+            })
+            .min_by(|x, y| x.2.total_cmp(&y.2).then(x.0.cmp(&y.0)));
+        let Some((eta, t_r_s, forward_error_s)) = closest else { continue };
+        let q_eta = &next[eta];
+        let back_predicted_s = q_eta.mean_delay_s + q_eta.doppler_hz / carrier_hz * t_r_s;
+        let backward_error_s = (back_predicted_s - q_k.mean_delay_s).abs();
+        let worst = forward_error_s.max(backward_error_s);
+        let Some(&chi_class_s) = config.chi_classes_s.iter().find(|&&chi| worst <= chi) else { continue };
+        taken[eta] = true;
+        links.push(LongTermLink { current: k, next: eta, forward_error_s, backward_error_s, chi_class_s });
+    }
+    links
+}
+
+/// Chains [`relate_sets`] over a stream of sets into long-term tracks.
+///
+/// Holds only the previous set's summaries and long-term ids.
+#[derive(Debug, Clone)]
+pub struct LongTermTracker {
+    config: LongTermConfig,
+    carrier_hz: f64,
+    next_long_id: u64,
+    /// The previous set's summaries with their long-term ids.
+    previous: Vec<(TrackSummary, u64)>,
+}
+
+impl LongTermTracker {
+    /// A tracker for a carrier of `carrier_hz`; long-term ids start at
+    /// `first_long_id`.
+    ///
+    /// # Errors
+    /// [`MpcError::BadConfig`] for an invalid config or carrier.
+    pub fn new(config: LongTermConfig, carrier_hz: f64, first_long_id: u64) -> Result<Self, MpcError> {
+        config.validate()?;
+        if !(carrier_hz.is_finite() && carrier_hz > 0.0) {
+            return Err(MpcError::BadConfig {
+                field: "carrier_hz",
+                value: carrier_hz.to_string(),
+                expected: "a finite positive frequency",
+            });
+        }
+        Ok(Self { config, carrier_hz, next_long_id: first_long_id, previous: Vec::new() })
+    }
+
+    /// Takes the full-lifetime tracks of the next set (the caller selects
+    /// them, e.g. with [`crate::short_term::is_full_lifetime`]) and returns
+    /// one entry per track, in input order. Tracks without a Doppler estimate
+    /// are left out (they cannot be predicted). Fresh long-term ids are given
+    /// in input order. A set without tracks breaks every chain.
+    pub fn push_set(&mut self, full_lifetime_tracks: &[MpcTrack]) -> Vec<MpcLongTermEntry> {
+        let summaries: Vec<TrackSummary> = full_lifetime_tracks.iter().filter_map(TrackSummary::of).collect();
+        let current: Vec<TrackSummary> = self.previous.iter().map(|(s, _)| s.clone()).collect();
+        let links = relate_sets(&current, &summaries, self.carrier_hz, &self.config);
+        let mut link_of: Vec<Option<&LongTermLink>> = vec![None; summaries.len()];
+        for link in &links {
+            link_of[link.next] = Some(link);
+        }
+        let mut entries = Vec::with_capacity(summaries.len());
+        let mut previous = Vec::with_capacity(summaries.len());
+        for (summary, link) in summaries.into_iter().zip(link_of) {
+            let long_track_id = match link {
+                Some(link) => self.previous[link.current].1,
+                None => {
+                    self.next_long_id += 1;
+                    self.next_long_id - 1
+                }
+            };
+            entries.push(MpcLongTermEntry {
+                long_track_id,
+                set_index: summary.set_index,
+                t_ns: summary.t_ns,
+                short_track_id: summary.short_track_id,
+                mean_delay_s: summary.mean_delay_s,
+                mean_power_db: summary.mean_power_db,
+                doppler_hz: summary.doppler_hz,
+                link_error_s: link.map(LongTermLink::error_s),
+                chi_class_s: link.map(|l| l.chi_class_s),
+            });
+            previous.push((summary, long_track_id));
+        }
+        self.previous = previous;
+        entries
+    }
+}

@@ -1,0 +1,189 @@
+//! Long-term tracking (Mahler et al. 2017, Sec. V) on hand-made
+//! full-lifetime tracks.
+
+use mmtrack_core::{Complex64, MpcDetection, MpcTrack};
+use mmtrack_mpc::long_term::{TrackSummary, relate_sets};
+use mmtrack_mpc::short_term::doppler_hz;
+use mmtrack_mpc::{LongTermConfig, LongTermTracker, MpcError};
+
+use crate::common::CARRIER_HZ;
+
+/// The paper's timing: 6 snapshots 0.717 ms apart, a set every 10 ms.
+const SNAPSHOT_NS: i64 = 717_000;
+const SET_NS: i64 = 10_000_000;
+
+/// A full-lifetime track of set `set` for a path with delay
+/// `tau0 + rate t` (t from 0 at set 0), power `power_db` and an extra delay
+/// offset `offset_s` (to mimic a wrong association).
+fn track(id: u64, set: u64, tau0_s: f64, rate: f64, power_db: f64, offset_s: f64) -> MpcTrack {
+    let detections: Vec<MpcDetection> = (0..6u32)
+        .map(|n| {
+            let t_ns = set as i64 * SET_NS + i64::from(n) * SNAPSHOT_NS;
+            MpcDetection {
+                t_ns,
+                set_index: set,
+                snapshot_index: n,
+                delay_s: tau0_s + rate * t_ns as f64 * 1e-9 + offset_s,
+                amplitude: Complex64::from_polar(10f64.powf(power_db / 20.0), 0.0),
+            }
+        })
+        .collect();
+    MpcTrack { track_id: id, doppler_hz: doppler_hz(&detections, CARRIER_HZ), detections }
+}
+
+fn tracker() -> LongTermTracker {
+    LongTermTracker::new(LongTermConfig::default(), CARRIER_HZ, 1000).unwrap()
+}
+
+#[test]
+fn summary_is_mean_delay_power_of_mean_power_and_doppler() {
+    let mut t = track(3, 2, 40e-9, 5e-8, -100.0, 0.0);
+    for (n, d) in t.detections.iter_mut().enumerate() {
+        if n % 2 == 1 {
+            d.amplitude = Complex64::from_polar(10f64.powf(-110.0 / 20.0), 1.0);
+        }
+    }
+    let s = TrackSummary::of(&t).unwrap();
+    assert_eq!((s.short_track_id, s.set_index), (3, 2));
+    // Mean time: set start + 2.5 snapshots.
+    assert_eq!(s.t_ns, 2 * SET_NS + 5 * SNAPSHOT_NS / 2);
+    // 10 log10((1e-10 + 1e-11) / 2) = -102.596 dB, not the mean of the dB
+    // values (-105); 1e-9 dB: round-off.
+    let expected_db = 10.0 * ((1e-10 + 1e-11) / 2.0f64).log10();
+    assert!((s.mean_power_db - expected_db).abs() < 1e-9, "{}", s.mean_power_db);
+    // The mean delay of a linear delay is the delay at the mean time.
+    let expected_s = 40e-9 + 5e-8 * s.t_ns as f64 * 1e-9;
+    assert!((s.mean_delay_s - expected_s).abs() < 1e-18, "{}", s.mean_delay_s);
+    // nu = -rate f_c = -285 Hz; 1e-3 Hz: round-off of the fit.
+    assert!((s.doppler_hz + 285.0).abs() < 1e-3, "{}", s.doppler_hz);
+    assert_eq!(TrackSummary::of(&MpcTrack { track_id: 0, doppler_hz: None, detections: vec![] }), None);
+}
+
+#[test]
+fn two_sets_link_by_their_doppler_at_the_smallest_class() {
+    // Two paths drifting 0.5 ns and -0.3 ns per 10 ms (rates 5e-8, -3e-8 s/s:
+    // nu = -285 Hz, +171 Hz). The eq. (37) as printed (`- nu f_c T_r`)
+    // would predict kilometres of delay; with the delay rate -nu / f_c the
+    // prediction is exact, so both links are in the 0.1 ns class. With the
+    // sign of the rate flipped the error would be 1 ns and 0.6 ns instead.
+    let mut lt = tracker();
+    let set0 = [track(0, 0, 30e-9, 5e-8, -100.0, 0.0), track(1, 0, 45e-9, -3e-8, -104.0, 0.0)];
+    let first = lt.push_set(&set0);
+    assert_eq!(first.len(), 2);
+    assert_eq!((first[0].long_track_id, first[1].long_track_id), (1000, 1001));
+    assert!(first.iter().all(|e| e.link_error_s.is_none() && e.chi_class_s.is_none()));
+
+    // The next set lists the tracks in the other order: relations go by
+    // prediction, not position.
+    let set1 = [track(10, 1, 45e-9, -3e-8, -103.0, 0.0), track(11, 1, 30e-9, 5e-8, -101.0, 0.0)];
+    let second = lt.push_set(&set1);
+    assert_eq!(second.len(), 2);
+    assert_eq!((second[0].short_track_id, second[0].long_track_id), (10, 1001));
+    assert_eq!((second[1].short_track_id, second[1].long_track_id), (11, 1000));
+    for entry in &second {
+        assert_eq!(entry.set_index, 1);
+        assert_eq!(entry.chi_class_s, Some(0.1e-9));
+        // Exact linear delays: the error is round-off of ~1e-8 s values, far
+        // below 1e-3 ns.
+        assert!(entry.link_error_s.unwrap() < 1e-12, "{entry:?}");
+    }
+    // Doppler is carried into the entry (-285 Hz for the 5e-8 s/s path).
+    assert!((second[1].doppler_hz + 285.0).abs() < 1e-3);
+}
+
+#[test]
+fn the_link_class_is_the_smallest_chi_holding_both_errors() {
+    // The next set's track is off its prediction by `offset`: both the
+    // forward and the backward error equal |offset| (same Doppler on both
+    // sides), so the class is the first chi >= |offset|.
+    for (offset_ns, class_ns) in [(0.05, Some(0.1)), (0.15, Some(0.2)), (-0.4, Some(0.5)), (0.8, Some(1.0))] {
+        let mut lt = tracker();
+        lt.push_set(&[track(0, 0, 30e-9, 1e-8, -100.0, 0.0)]);
+        let next = lt.push_set(&[track(1, 1, 30e-9, 1e-8, -100.0, offset_ns * 1e-9)]);
+        assert_eq!(next[0].chi_class_s.map(|c| c * 1e9), class_ns, "offset {offset_ns} ns");
+        // 1e-6 ns: round-off of the two-way predictions.
+        assert!((next[0].link_error_s.unwrap() * 1e9 - offset_ns.abs()).abs() < 1e-6, "{next:?}");
+        assert_eq!(next[0].long_track_id, 1000);
+    }
+}
+
+#[test]
+fn the_backward_prediction_uses_the_candidates_own_doppler() {
+    // Same mean delays as a consistent pair, but the next set's track has a
+    // Doppler for a rate of 1.4e-7 s/s instead of 5e-8: forward error 0
+    // (the current track predicts it), backward error (1.4e-7 - 5e-8) * 10 ms
+    // = 0.9 ns: class 1 ns. With 2e-7 s/s the backward error is 1.5 ns: no
+    // relation, and the next track starts a new long-term track.
+    for (rate, class_ns) in [(1.4e-7, Some(1.0)), (2e-7, None)] {
+        let mut lt = tracker();
+        lt.push_set(&[track(0, 0, 30e-9, 5e-8, -100.0, 0.0)]);
+        let mut next = track(1, 1, 30e-9, 5e-8, -100.0, 0.0);
+        next.doppler_hz = Some(-rate * CARRIER_HZ);
+        let entries = lt.push_set(&[next]);
+        assert_eq!(entries[0].chi_class_s.map(|c| (c * 1e9 * 1e6).round() / 1e6), class_ns, "rate {rate}");
+        let expected_long_id = if class_ns.is_some() { 1000 } else { 1001 };
+        assert_eq!(entries[0].long_track_id, expected_long_id);
+    }
+}
+
+#[test]
+fn candidates_are_gated_in_power_and_delay() {
+    let config = LongTermConfig::default();
+    let current = [TrackSummary::of(&track(0, 0, 30e-9, 0.0, -100.0, 0.0)).unwrap()];
+    // 6 dB weaker: outside xi_a = 5 dB. 4 dB: inside.
+    for (power_db, related) in [(-106.0, false), (-104.0, true)] {
+        let next = [TrackSummary::of(&track(1, 1, 30e-9, 0.0, power_db, 0.0)).unwrap()];
+        assert_eq!(relate_sets(&current, &next, CARRIER_HZ, &config).len(), usize::from(related), "{power_db}");
+    }
+    // 1.2 ns away: outside xi_tau = 1 ns, even with a wide chi.
+    let wide = LongTermConfig { chi_classes_s: vec![5e-9], ..config.clone() };
+    let next = [TrackSummary::of(&track(1, 1, 31.2e-9, 0.0, -100.0, 0.0)).unwrap()];
+    assert!(relate_sets(&current, &next, CARRIER_HZ, &wide).is_empty());
+}
+
+#[test]
+fn relations_are_one_to_one_strongest_current_first() {
+    // Two current tracks 0.3 ns apart, both with the same next track as
+    // their only candidate: the stronger one takes it; the weaker one, though
+    // nearer in delay, is left without a successor.
+    let config = LongTermConfig::default();
+    let current = [
+        TrackSummary::of(&track(0, 0, 30.3e-9, 0.0, -103.0, 0.0)).unwrap(),
+        TrackSummary::of(&track(1, 0, 30.0e-9, 0.0, -100.0, 0.0)).unwrap(),
+    ];
+    let next = [TrackSummary::of(&track(2, 1, 30.25e-9, 0.0, -102.0, 0.0)).unwrap()];
+    let links = relate_sets(&current, &next, CARRIER_HZ, &config);
+    assert_eq!(links.len(), 1, "{links:?}");
+    assert_eq!((links[0].current, links[0].next), (1, 0));
+    // 0.25 ns off: class 0.5 ns.
+    assert_eq!(links[0].chi_class_s, 0.5e-9);
+
+    // With a second next track near the weaker one, each gets its own.
+    let next = [
+        TrackSummary::of(&track(2, 1, 30.02e-9, 0.0, -100.0, 0.0)).unwrap(),
+        TrackSummary::of(&track(3, 1, 30.31e-9, 0.0, -103.0, 0.0)).unwrap(),
+    ];
+    let mut pairs: Vec<(usize, usize)> =
+        relate_sets(&current, &next, CARRIER_HZ, &config).iter().map(|l| (l.current, l.next)).collect();
+    pairs.sort_unstable();
+    assert_eq!(pairs, vec![(0, 1), (1, 0)]);
+}
+
+#[test]
+fn an_empty_set_breaks_the_chains() {
+    let mut lt = tracker();
+    lt.push_set(&[track(0, 0, 30e-9, 0.0, -100.0, 0.0)]);
+    assert!(lt.push_set(&[]).is_empty());
+    let entries = lt.push_set(&[track(1, 2, 30e-9, 0.0, -100.0, 0.0)]);
+    assert_eq!(entries[0].long_track_id, 1001);
+    assert_eq!(entries[0].chi_class_s, None);
+}
+
+#[test]
+fn bad_configs_are_refused_by_name() {
+    let err = LongTermTracker::new(LongTermConfig::default(), 0.0, 0).unwrap_err();
+    assert!(matches!(err, MpcError::BadConfig { field: "carrier_hz", .. }), "{err}");
+    let config = LongTermConfig { chi_classes_s: vec![0.5e-9, 0.2e-9], ..LongTermConfig::default() };
+    let err = LongTermTracker::new(config, CARRIER_HZ, 0).unwrap_err();
+    assert!(matches!(err, MpcError::BadConfig { field: "long_term.chi_classes_s", .. }), "{err}");
+}
