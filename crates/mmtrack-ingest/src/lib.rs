@@ -24,6 +24,7 @@ pub mod nmea;
 pub mod oxford;
 pub mod poses;
 pub mod ros2;
+pub mod ros2_image;
 pub mod scan_folder;
 pub mod sweep;
 pub mod target;

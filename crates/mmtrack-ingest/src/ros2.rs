@@ -2,8 +2,9 @@
 //!
 //! Decoded message types: `nav_msgs/msg/Odometry` and
 //! `geometry_msgs/msg/PoseWithCovarianceStamped` (as planar poses: x, y and
-//! the yaw of the orientation quaternion; ROS frames are z up, as ours), and
-//! `sensor_msgs/msg/NavSatFix` (as GNSS fixes). A pose is stamped with its
+//! the yaw of the orientation quaternion; ROS frames are z up, as ours),
+//! `sensor_msgs/msg/NavSatFix` (as GNSS fixes) and `sensor_msgs/msg/Image`
+//! (as Navtech polar scans, see [`crate::ros2_image`]). A pose is stamped with its
 //! message's `header.stamp`, not the bag's log time.
 //!
 //! CDR (OMG XCDR1, as ROS 2's rmw implementations write it): a 4-byte
@@ -22,6 +23,7 @@ use mmtrack_core::{GnssFix, GnssFixQuality, Se2, StampedPose};
 use mmtrack_io::recording::{PoseStream, RawReader, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
+use crate::sweep::SweepTiming;
 use crate::{IngestError, Progress};
 
 /// A bounds-checked CDR reader over one message.
@@ -94,6 +96,12 @@ impl<'a> Cdr<'a> {
         let bytes = self.take(field, len, 1)?;
         let text = bytes.strip_suffix(&[0]).unwrap_or(bytes);
         String::from_utf8(text.to_vec()).map_err(|_| format!("{field}: not UTF-8"))
+    }
+
+    /// A `sequence<uint8>` (a `uint32` count, then the bytes), borrowed.
+    pub fn byte_sequence(&mut self, field: &str) -> Result<&'a [u8], String> {
+        let len = self.u32(field)? as usize;
+        self.take(field, len, 1)
     }
 
     /// A `builtin_interfaces/Time`, as nanoseconds.
@@ -185,6 +193,18 @@ pub fn decode_nav_sat_fix(data: &[u8]) -> Result<Option<GnssFix>, String> {
     }))
 }
 
+/// A `sensor_msgs/msg/Image` topic of Navtech polar scans (see
+/// [`crate::ros2_image`]).
+#[derive(Debug, Clone)]
+pub struct RadarTopic {
+    /// The topic.
+    pub topic: String,
+    /// Range bin size, metres (not in the message).
+    pub range_resolution_m: f64,
+    /// How azimuth times are placed against `header.stamp`.
+    pub timing: SweepTiming,
+}
+
 /// Which topics to take from a bag, and as what.
 #[derive(Debug, Clone)]
 pub struct Ros2Topics {
@@ -194,11 +214,13 @@ pub struct Ros2Topics {
     pub pose_stream: PoseStream,
     /// `sensor_msgs/msg/NavSatFix` topic.
     pub gnss_topic: Option<String>,
+    /// Polar radar image topic.
+    pub radar: Option<RadarTopic>,
 }
 
 impl Default for Ros2Topics {
     fn default() -> Self {
-        Self { pose_topic: Some("/odom".into()), pose_stream: PoseStream::Estimate, gnss_topic: None }
+        Self { pose_topic: Some("/odom".into()), pose_stream: PoseStream::Estimate, gnss_topic: None, radar: None }
     }
 }
 
@@ -211,8 +233,107 @@ pub struct Ros2Report {
     pub gnss_fixes: u64,
     /// NavSatFix messages without a fix (skipped).
     pub no_fix: u64,
+    /// Radar scans written.
+    pub radar_scans: u64,
     /// The recording.
     pub output: WriteSummary,
+}
+
+/// Writes the chosen topics' messages, checking that each topic's header
+/// stamps increase.
+struct Sink<'a> {
+    topics: &'a Ros2Topics,
+    writer: RecordingWriter,
+    poses: u64,
+    gnss_fixes: u64,
+    no_fix: u64,
+    radar_scans: u64,
+    last_ns: [i64; 3],
+}
+
+impl Sink<'_> {
+    fn increasing(&mut self, slot: usize, t_ns: i64) -> Result<(), String> {
+        if t_ns <= self.last_ns[slot] {
+            return Err(format!("header.stamp {t_ns} ns does not increase (previous {} ns)", self.last_ns[slot]));
+        }
+        self.last_ns[slot] = t_ns;
+        Ok(())
+    }
+
+    /// Handles one message; `Ok(Err(..))` is a bad message (the caller names it).
+    fn handle(&mut self, topic: &str, schema: &str, data: &[u8]) -> Result<Result<(), String>, IngestError> {
+        let topics = self.topics;
+        if topics.pose_topic.as_deref() == Some(topic) {
+            let decoded = match schema {
+                "nav_msgs/msg/Odometry" => decode_odometry(data),
+                "geometry_msgs/msg/PoseWithCovarianceStamped" => decode_pose_with_covariance_stamped(data),
+                other => Err(format!("{other} is not a pose type (Odometry or PoseWithCovarianceStamped)")),
+            };
+            let decoded = match decoded.and_then(|d| self.increasing(0, d.pose.t_ns).map(|()| d)) {
+                Ok(d) => d,
+                Err(e) => return Ok(Err(e)),
+            };
+            let child = if decoded.child_frame_id.is_empty() { "vehicle" } else { decoded.child_frame_id.as_str() };
+            self.writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id, child)?;
+            self.poses += 1;
+        } else if topics.gnss_topic.as_deref() == Some(topic) {
+            if schema != "sensor_msgs/msg/NavSatFix" {
+                return Ok(Err(format!("{schema} is not sensor_msgs/msg/NavSatFix")));
+            }
+            match decode_nav_sat_fix(data) {
+                Ok(Some(fix)) => {
+                    if let Err(e) = self.increasing(1, fix.t_ns) {
+                        return Ok(Err(e));
+                    }
+                    self.writer.write_gnss_fix(&fix)?;
+                    self.gnss_fixes += 1;
+                }
+                Ok(None) => self.no_fix += 1,
+                Err(e) => return Ok(Err(e)),
+            }
+        } else if let Some(radar) = topics.radar.as_ref().filter(|r| r.topic == topic) {
+            if schema != "sensor_msgs/msg/Image" {
+                return Ok(Err(format!("{schema} is not sensor_msgs/msg/Image")));
+            }
+            let scan = crate::ros2_image::decode_image(data)
+                .and_then(|image| crate::ros2_image::image_to_scan(&image, &radar.timing, radar.range_resolution_m))
+                .and_then(|scan| self.increasing(2, scan.header.t_ns).map(|()| scan));
+            match scan {
+                Ok(scan) => self.writer.write_radar_scan(&scan)?,
+                Err(e) => return Ok(Err(e)),
+            }
+            self.radar_scans += 1;
+        }
+        Ok(Ok(()))
+    }
+}
+
+fn metadata(bag: &Path, topics: &Ros2Topics) -> RecordingMetadata {
+    let mut extra = BTreeMap::from([
+        ("ros2.pose_topic".to_string(), topics.pose_topic.clone().unwrap_or_default()),
+        ("ros2.gnss_topic".to_string(), topics.gnss_topic.clone().unwrap_or_default()),
+    ]);
+    if let Some(radar) = &topics.radar {
+        extra.insert("ros2.radar_topic".into(), radar.topic.clone());
+        extra.insert("radar.format".into(), "ros2 sensor_msgs/Image mono8 (rows = azimuths)".into());
+        extra.insert("radar.range_resolution_m".into(), radar.range_resolution_m.to_string());
+        extra.insert(
+            "radar.azimuth_times".into(),
+            format!(
+                "spread evenly over {} ns, header.stamp at the sweep's {}",
+                radar.timing.period_ns,
+                radar.timing.stamp_at.name()
+            ),
+        );
+        extra.insert("radar.scan_period_ns".into(), radar.timing.period_ns.to_string());
+        extra.insert("radar.stamp_at".into(), radar.timing.stamp_at.name().into());
+    }
+    RecordingMetadata {
+        sequence_id: bag.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bag".into()),
+        source: format!("ros2:{}", bag.display()),
+        time_base: TimeBase::UnixEpoch,
+        extra,
+    }
 }
 
 /// Ingests the chosen topics of a ROS 2 bag into a new recording. Messages
@@ -226,18 +347,13 @@ pub fn ingest_ros2(
 ) -> Result<Ros2Report, IngestError> {
     let bag_bytes = std::fs::metadata(bag).map(|m| m.len()).unwrap_or(0);
     let mut reader = RawReader::open(bag)?;
-    let metadata = RecordingMetadata {
-        sequence_id: bag.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bag".into()),
-        source: format!("ros2:{}", bag.display()),
-        time_base: TimeBase::UnixEpoch,
-        extra: BTreeMap::from([
-            ("ros2.pose_topic".to_string(), topics.pose_topic.clone().unwrap_or_default()),
-            ("ros2.gnss_topic".to_string(), topics.gnss_topic.clone().unwrap_or_default()),
-        ]),
-    };
-    let mut writer = RecordingWriter::create(out, &metadata, recording)?;
-    let (mut poses, mut gnss_fixes, mut no_fix) = (0, 0, 0);
-    let (mut last_pose_ns, mut last_fix_ns) = (i64::MIN, i64::MIN);
+    let writer = RecordingWriter::create(out, &metadata(bag, topics), recording)?;
+    let mut sink = Sink { topics, writer, poses: 0, gnss_fixes: 0, no_fix: 0, radar_scans: 0, last_ns: [i64::MIN; 3] };
+    let wanted: Vec<&str> = [topics.pose_topic.as_deref(), topics.gnss_topic.as_deref()]
+        .into_iter()
+        .flatten()
+        .chain(topics.radar.as_ref().map(|r| r.topic.as_str()))
+        .collect();
     let mut found_topics = std::collections::BTreeSet::new();
     while let Some(message) = reader.next_message()? {
         let channel = &message.channel;
@@ -248,58 +364,23 @@ pub fn ingest_ros2(
             field: channel.schema_name.clone(),
             detail,
         };
-        let is_pose = topics.pose_topic.as_deref() == Some(channel.topic.as_str());
-        let is_gnss = topics.gnss_topic.as_deref() == Some(channel.topic.as_str());
-        if (is_pose || is_gnss) && channel.message_encoding != "cdr" {
+        if wanted.contains(&channel.topic.as_str()) && channel.message_encoding != "cdr" {
             return Err(bad(format!("message encoding '{}', expected cdr", channel.message_encoding)));
         }
-        if is_pose {
-            let decoded = match channel.schema_name.as_str() {
-                "nav_msgs/msg/Odometry" => decode_odometry(&message.data),
-                "geometry_msgs/msg/PoseWithCovarianceStamped" => decode_pose_with_covariance_stamped(&message.data),
-                other => {
-                    return Err(bad(format!("{other} is not a pose type (Odometry or PoseWithCovarianceStamped)")));
-                }
-            }
-            .map_err(bad)?;
-            if decoded.pose.t_ns <= last_pose_ns {
-                return Err(bad(format!("header.stamp {} ns does not increase", decoded.pose.t_ns)));
-            }
-            last_pose_ns = decoded.pose.t_ns;
-            let child = if decoded.child_frame_id.is_empty() { "vehicle" } else { decoded.child_frame_id.as_str() };
-            writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id, child)?;
-            poses += 1;
-        } else if is_gnss {
-            if channel.schema_name != "sensor_msgs/msg/NavSatFix" {
-                return Err(bad(format!("{} is not sensor_msgs/msg/NavSatFix", channel.schema_name)));
-            }
-            match decode_nav_sat_fix(&message.data).map_err(bad)? {
-                Some(fix) => {
-                    if fix.t_ns <= last_fix_ns {
-                        return Err(bad(format!("header.stamp {} ns does not increase", fix.t_ns)));
-                    }
-                    last_fix_ns = fix.t_ns;
-                    writer.write_gnss_fix(&fix)?;
-                    gnss_fixes += 1;
-                }
-                None => no_fix += 1,
-            }
-        }
+        sink.handle(&channel.topic, &channel.schema_name, &message.data)?.map_err(bad)?;
         progress(reader.bytes_read(), bag_bytes);
     }
-    for topic in [&topics.pose_topic, &topics.gnss_topic].into_iter().flatten() {
-        if !found_topics.contains(topic) {
-            return Err(IngestError::BadLayout {
-                path: bag.to_path_buf(),
-                detail: format!(
-                    "no topic {topic} in the bag (topics: {})",
-                    found_topics.iter().cloned().collect::<Vec<_>>().join(", ")
-                ),
-            });
-        }
+    if let Some(topic) = wanted.iter().find(|t| !found_topics.contains(**t)) {
+        return Err(IngestError::BadLayout {
+            path: bag.to_path_buf(),
+            detail: format!(
+                "no topic {topic} in the bag (topics: {})",
+                found_topics.iter().cloned().collect::<Vec<_>>().join(", ")
+            ),
+        });
     }
-    let output = writer.finish()?;
-    Ok(Ros2Report { poses, gnss_fixes, no_fix, output })
+    let Sink { poses, gnss_fixes, no_fix, radar_scans, writer, .. } = sink;
+    Ok(Ros2Report { poses, gnss_fixes, no_fix, radar_scans, output: writer.finish()? })
 }
 
 #[cfg(test)]

@@ -282,4 +282,55 @@ proptest! {
             prop_assert!(log.fixes.iter().all(|f| f.latitude_deg.abs() <= 90.0 && f.altitude_m.is_finite()));
         }
     }
+
+    /// A fix written as GGA + RMC (positions to 7 decimals of a minute, time to
+    /// the centisecond) parses back to the same time exactly and the same
+    /// position within the printing's rounding.
+    #[test]
+    fn fixes_round_trip_through_gga_and_rmc(
+        lat_deg in -89.999_999f64..89.999_999,
+        lon_deg in -179.999_999f64..179.999_999,
+        alt_dm in -5_000i32..50_000,
+        second_of_day in 0u32..86_400,
+        centis in 0u32..100,
+        (year, month, day) in (2000i64..2080, 1i64..=12, 1i64..=28),
+    ) {
+        let hhmmss = format!(
+            "{:02}{:02}{:02}.{centis:02}",
+            second_of_day / 3600,
+            second_of_day / 60 % 60,
+            second_of_day % 60
+        );
+        let ddmmyy = format!("{day:02}{month:02}{:02}", year % 100);
+        let angle = |value: f64, degree_digits: usize, hemispheres: [char; 2]| {
+            let degrees = value.abs().trunc();
+            let minutes = (value.abs() - degrees) * 60.0;
+            // Printing minutes to 7 decimals can round up to 60.0000000; carry it.
+            let (degrees, minutes) = if format!("{minutes:.7}").starts_with("60") { (degrees + 1.0, 0.0) } else { (degrees, minutes) };
+            let hemisphere = if value < 0.0 { hemispheres[1] } else { hemispheres[0] };
+            format!("{:0width$}{minutes:010.7},{hemisphere}", degrees as u32, width = degree_digits)
+        };
+        let (lat, lon) = (angle(lat_deg, 2, ['N', 'S']), angle(lon_deg, 3, ['E', 'W']));
+        let altitude_m = f64::from(alt_dm) / 10.0;
+        let text = format!(
+            "{}\n{}\n",
+            sentence(&format!("GNRMC,{hhmmss},A,{lat},{lon},0.0,0.0,{ddmmyy},,,A")),
+            sentence(&format!("GNGGA,{hhmmss},{lat},{lon},1,9,0.9,{altitude_m:.1},M,,M,,")),
+        );
+        let log = parse(&text).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        prop_assert_eq!(log.fixes.len(), 1, "{}", text);
+        let fix = &log.fixes[0];
+        // Days since 1970-01-01 counted naively, independent of the parser's arithmetic.
+        let leap = |y: i64| (y % 4 == 0 && y % 100 != 0) || y % 400 == 0;
+        let month_days = [31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31];
+        let days: i64 = (1970..year).map(|y| if leap(y) { 366 } else { 365 }).sum::<i64>()
+            + (1..month).map(|m| month_days[(m - 1) as usize] + i64::from(m == 2 && leap(year))).sum::<i64>()
+            + day - 1;
+        let t_ns = (days * 86_400 + i64::from(second_of_day)) * 1_000_000_000 + i64::from(centis) * 10_000_000;
+        prop_assert_eq!(fix.t_ns, t_ns);
+        // 7 decimals of a minute round by at most 5e-8 min = 8.3e-10 deg.
+        prop_assert!((fix.latitude_deg - lat_deg).abs() < 1e-9, "{} vs {}", fix.latitude_deg, lat_deg);
+        prop_assert!((fix.longitude_deg - lon_deg).abs() < 1e-9, "{} vs {}", fix.longitude_deg, lon_deg);
+        prop_assert!((fix.altitude_m - altitude_m).abs() < 1e-9);
+    }
 }

@@ -274,5 +274,39 @@ mod tests {
             cut.truncate(junk.len().min(png.len()));
             let _ = decode_scan_png(Path::new("p.png"), &cut, 1, &layout(3));
         }
+
+        /// Any scan the format can hold (increasing microsecond times, angles
+        /// in [0, 2 pi), any valid flags and power) decodes to itself, up to the
+        /// encoder-count quantisation of the angle.
+        #[test]
+        fn row_headers_round_trip(
+            rows in proptest::collection::vec((1i64..2_000_000, 0.0f64..TAU, any::<bool>()), 1..24),
+            bins in 1usize..9,
+            t0_us in 1i64..4_000_000_000_000_000,
+            seed in any::<u8>(),
+        ) {
+            let mut t_us = t0_us;
+            let azimuths: Vec<AzimuthSample> = rows
+                .iter()
+                .map(|&(step_us, azimuth_rad, valid)| {
+                    t_us += step_us;
+                    AzimuthSample { t_ns: t_us * 1000, azimuth_rad, valid }
+                })
+                .collect();
+            let power: Vec<u8> = (0..azimuths.len() * bins).map(|i| (i as u8).wrapping_mul(31) ^ seed).collect();
+            let header = PolarScanHeader { t_ns: 7, range_resolution_m: 0.0432, range_offset_m: 0.0, bins_per_azimuth: bins, azimuths };
+            let original = PolarScan::new(header, power).unwrap();
+            let png = encode_scan_png(&original, &layout(bins)).unwrap();
+            let decoded = decode_scan_png(Path::new("p.png"), &png, 7, &layout(bins)).unwrap().into_scan();
+            prop_assert_eq!(&decoded.power, &original.power);
+            for (a, b) in decoded.header.azimuths.iter().zip(&original.header.azimuths) {
+                prop_assert_eq!(a.t_ns, b.t_ns);
+                prop_assert_eq!(a.valid, b.valid);
+                // Nearest encoder count: within half a count (2 pi / 5600 / 2), or
+                // a whole turn less when the angle rounds up to 5600 counts = 0.
+                let error = (a.azimuth_rad - b.azimuth_rad).rem_euclid(TAU);
+                prop_assert!(error.min(TAU - error) <= TAU / 5600.0 / 2.0 + 1e-12, "{} vs {}", a.azimuth_rad, b.azimuth_rad);
+            }
+        }
     }
 }
