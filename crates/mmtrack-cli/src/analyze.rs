@@ -7,12 +7,12 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use mmtrack_analysis::output::{check_output, write_results};
-use mmtrack_analysis::pipeline::{analyze_all, inventory, plan};
+use mmtrack_analysis::output::{check_output, write_all_results};
+use mmtrack_analysis::pipeline::{analyze_all, analyze_mpc_all, inventory, plan};
 use mmtrack_analysis::report::one_line;
 use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{GROUND_TRUTH, ODOMETRY, RunInfo};
+use mmtrack_io::table::{GROUND_TRUTH, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, ODOMETRY, RunInfo};
 
 #[derive(Args)]
 #[command(
@@ -23,7 +23,13 @@ odometry devkit computes it (translational %, rotational deg/m and deg/100 m; se
 every 10 frames), frame-to-frame relative pose error, absolute trajectory error after SE(2) alignment, and \
 unaligned x/y/yaw RMSE. The estimate is associated with ground truth by time (interpolated); estimate poses outside \
 the ground-truth span are dropped and counted.\n\n\
-Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors}/sequence=<id>/part-0.parquet, \
+Tables of `mmtrack process mpc` (mpc_sets, mpc_detections, mpc_tracks, mpc_long_term) of a sequence -> MPC \
+statistics after Mahler et al. 2017: number of MPCs per set and its CDF, birth and death rates per metre travelled by \
+both vehicles (ground_truth_tx + ground_truth_rx; else ground_truth or odometry; else per second, and the report says \
+which), detection and tracking power loss, per-track power standard deviation, long-term link power per chi class, \
+and with mpc_truth: detection precision/recall (0.5 ns), track purity, true birth/death rates.\n\n\
+Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
+mpc_count_distribution,mpc_track_power_std,mpc_chi_classes}/sequence=<id>/part-0.parquet, \
 <OUT>/plots/<id>/*.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.",
     after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
@@ -81,17 +87,23 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     let found = inventory(&args.tables)?;
     let plan = plan(&found);
-    if plan.trajectory.is_empty() {
+    if plan.trajectory.is_empty() && plan.mpc.is_empty() {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         bail!(
-            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics); found {}{reasons}",
+            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics) and {} with \
+             {}, {}, {} (MPC statistics); found {}{reasons}",
             args.tables.display(),
             ODOMETRY.name,
             GROUND_TRUTH.name,
+            MPC_SETS.name,
+            MPC_DETECTIONS.name,
+            MPC_TRACKS.name,
+            MPC_LONG_TERM.name,
             found.describe()
         );
     }
     let results = analyze_all(&args.tables, &plan, &options)?;
+    let mpc_results = analyze_mpc_all(&args.tables, &plan)?;
     let run = RunInfo {
         config_json: serde_json::json!({
             "command": "analyze",
@@ -102,10 +114,13 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         })
         .to_string(),
     };
-    let written = write_results(&args.output, &results, &plan.skipped, &options, &run, overwrite)?;
+    let written = write_all_results(&args.output, &results, &mpc_results, &plan.skipped, &options, &run, overwrite)?;
     if !quiet {
         for r in &results {
             println!("{}", one_line(r));
+        }
+        for r in &mpc_results {
+            println!("{}", mmtrack_analysis::mpc_report::one_line(r));
         }
         for (sequence, reason) in &plan.skipped {
             println!("{sequence}: not analyzed: {reason}");

@@ -17,6 +17,9 @@ use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 
 use crate::progress;
 
+#[path = "process_mpc.rs"]
+mod process_mpc;
+
 #[derive(Args)]
 pub struct ProcessArgs {
     #[command(subcommand)]
@@ -35,12 +38,19 @@ enum Pipeline {
     /// `mmtrack export --format tum <out>` for evo / pyboreas / the KITTI devkit.
     #[command(verbatim_doc_comment)]
     Odometry(OdometryArgs),
-    /// Multipath-component detection and tracking (issue #5).
-    Mpc {
-        /// Arguments.
-        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-        args: Vec<String>,
-    },
+    /// Multipath-component detection and tracking (Mahler et al. 2017) on the recording's CIR snapshots.
+    ///
+    /// Writes, under the output directory, per sequence partition:
+    /// `mpc_detections` (one row per detected MPC), `mpc_tracks` (short-term
+    /// tracks within a set), `mpc_long_term` (full-lifetime tracks related
+    /// across sets, with their confidence class chi), `mpc_sets` (per-set
+    /// counts and channel gains), with `--gmphd` `mpc_tracks_gmphd` (the
+    /// GM-PHD baseline on the same detections), and when the recording has
+    /// them `mpc_truth` and `ground_truth_tx` / `ground_truth_rx`.
+    /// Several TX/RX links: each is its own partition `<sequence>-tx<T>-rx<R>`
+    /// unless `--link T:R` picks one. Then run `mmtrack analyze <out>`.
+    #[command(verbatim_doc_comment)]
+    Mpc(process_mpc::MpcArgs),
 }
 
 #[derive(Args)]
@@ -74,7 +84,10 @@ pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             odometry(odometry_args, quiet)?;
             Ok(ExitCode::SUCCESS)
         }
-        Pipeline::Mpc { .. } => crate::not_built("process mpc", 5),
+        Pipeline::Mpc(mpc_args) => {
+            process_mpc::run(mpc_args, quiet)?;
+            Ok(ExitCode::SUCCESS)
+        }
     }
 }
 

@@ -11,6 +11,7 @@ mod fixtures;
 mod independent_readers;
 mod ingest_navtech;
 mod process_odometry;
+mod process_mpc;
 mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;

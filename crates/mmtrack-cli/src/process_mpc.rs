@@ -1,0 +1,409 @@
+//! `mmtrack process mpc`: multipath-component detection and tracking
+//! (Mahler et al. 2017) on the CIR snapshots of a recording, written as
+//! Parquet tables.
+//!
+//! The recording is read as a stream: snapshots are grouped by link (TX, RX
+//! antenna) and by `set_index`, and each complete set goes to that link's
+//! [`MpcPipeline`]. Only the current set of each link is held as CIRs; the
+//! results (detections, tracks) are kept until the end and then written, one
+//! table file each, atomically.
+//!
+//! Links: a recording with one link writes the partition `<sequence>`; with
+//! several, each link is its own partition `<sequence>-tx<T>-rx<R>` (its own
+//! long-term tracking, since MPCs of different antenna pairs are different
+//! paths), unless `--link T:R` picks one, which is then written as
+//! `<sequence>`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use clap::Args;
+use mmtrack_core::sounder::SounderBand;
+use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
+use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
+use mmtrack_io::recording::{PoseStream, RecordingItem};
+use mmtrack_io::table::{
+    GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM,
+    MPC_SETS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, RunInfo, TableWriteSummary, table_path, write_table,
+};
+use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
+use mmtrack_mpc::{MpcConfig, MpcPipeline, SounderPulse};
+
+use crate::progress;
+
+/// Every table `process mpc` may write.
+const TABLES: [&str; 8] = [
+    MPC_DETECTIONS.name,
+    MPC_TRACKS.name,
+    MPC_TRACKS_GMPHD.name,
+    MPC_LONG_TERM.name,
+    MPC_SETS.name,
+    MPC_TRUTH.name,
+    GROUND_TRUTH_TX.name,
+    GROUND_TRUTH_RX.name,
+];
+
+#[derive(Args)]
+pub struct MpcArgs {
+    /// Recording with CIR snapshots on /channel/cir (from `mmtrack ingest cir` or `mmtrack simulate sounder`).
+    pub recording: PathBuf,
+    /// Output table directory (created if missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// TOML file overriding single fields of the default configuration (see `--print-config`).
+    #[arg(long, value_name = "TOML")]
+    pub config: Option<PathBuf>,
+    /// Print the effective configuration as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+    /// Sounder pulse: `flat` (the band's flat spectrum), or a `.npy` file holding a back-to-back calibration CIR
+    /// [default: the pulse spectrum in the recording's metadata (`sounder.pulse_spectrum`), else flat].
+    #[arg(long, value_name = "flat|FILE.npy")]
+    pub pulse: Option<String>,
+    /// Process only the link TX:RX (antenna indices), written as the sequence itself. Without it every link is
+    /// processed, each as partition `<sequence>-tx<T>-rx<R>` when there are several.
+    #[arg(long, value_name = "TX:RX")]
+    pub link: Option<String>,
+    /// Also run the GM-PHD baseline (Mahler et al. 2017, Table I) on the same detections, set by set (table
+    /// mpc_tracks_gmphd); the same as `run_gmphd = true` in the configuration.
+    #[arg(long)]
+    pub gmphd: bool,
+    /// Worker threads for detection [default: one per core].
+    #[arg(long, value_name = "N")]
+    pub threads: Option<usize>,
+    /// Sequence id of the output partitions (default: the recording's).
+    #[arg(long)]
+    pub sequence: Option<String>,
+    /// Replace existing output tables of this sequence.
+    #[arg(long)]
+    pub force: bool,
+}
+
+fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
+    let parse = || -> Option<(u32, u32)> {
+        let (tx, rx) = text.split_once(':')?;
+        Some((tx.trim().parse().ok()?, rx.trim().parse().ok()?))
+    };
+    parse().with_context(|| format!("--link '{text}': expected TX:RX antenna indices, e.g. 0:1"))
+}
+
+/// The default configuration with the TOML file's fields on top.
+fn effective_config(path: Option<&Path>) -> anyhow::Result<MpcConfig> {
+    let Some(path) = path else { return Ok(MpcConfig::default()) };
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let config: MpcConfig =
+        toml::from_str(&text).with_context(|| format!("{}: not a valid MPC configuration", path.display()))?;
+    config.validate().with_context(|| path.display().to_string())?;
+    Ok(config)
+}
+
+/// What one link accumulates.
+struct LinkRun {
+    pipeline: MpcPipeline,
+    current_set: Option<u64>,
+    pending: Vec<CirSnapshot>,
+    detections: Vec<MpcDetection>,
+    tracks: Vec<MpcTrack>,
+    gmphd_tracks: Vec<MpcTrack>,
+    long_term: Vec<MpcLongTermEntry>,
+    sets: Vec<MpcSetStats>,
+}
+
+impl LinkRun {
+    fn flush(&mut self) -> anyhow::Result<()> {
+        if self.pending.is_empty() {
+            return Ok(());
+        }
+        let set = self.pending[0].set_index;
+        let out = self.pipeline.push_set(&self.pending).with_context(|| format!("set {set}"))?;
+        for snapshot in out.per_snapshot {
+            self.detections.extend(snapshot.detections);
+        }
+        self.tracks.extend(out.short_term_tracks);
+        if let Some(tracks) = out.gmphd_tracks {
+            self.gmphd_tracks.extend(tracks);
+        }
+        self.long_term.extend(out.long_term_entries);
+        self.sets.push(out.stats);
+        self.pending.clear();
+        Ok(())
+    }
+}
+
+/// Everything read and computed.
+struct MpcRun {
+    sequence_id: String,
+    links: BTreeMap<(u32, u32), LinkRun>,
+    truth: Vec<MpcTruth>,
+    tx: Vec<StampedPose>,
+    rx: Vec<StampedPose>,
+    snapshots: u64,
+}
+
+fn choose_pulse(
+    choice: Option<&str>,
+    metadata: Option<&BTreeMap<String, String>>,
+    first: &CirSnapshot,
+    recording: &Path,
+) -> anyhow::Result<SounderPulse> {
+    let flat = || -> anyhow::Result<SounderPulse> {
+        let band = SounderBand::new(first.taps.len(), first.tap_spacing_s)
+            .with_context(|| format!("{}: first CIR snapshot (t_ns {})", recording.display(), first.t_ns))?;
+        Ok(SounderPulse::flat(&band))
+    };
+    match choice {
+        Some("flat") => flat(),
+        Some(file) => {
+            let path = Path::new(file);
+            let cir = mmtrack_ingest::cir::read_cir_file(mmtrack_ingest::cir::CirFormat::Npy, path, None)
+                .with_context(|| format!("--pulse {}: back-to-back CIR", path.display()))?;
+            let taps = cir.snapshots.first().map(|s| s.taps.clone()).with_context(|| {
+                format!("--pulse {}: no CIR in the file (expected one back-to-back CIR)", path.display())
+            })?;
+            SounderPulse::from_back_to_back_cir(&taps).with_context(|| format!("--pulse {}", path.display()))
+        }
+        None => match metadata.and_then(|m| m.get(PULSE_SPECTRUM_KEY)) {
+            Some(text) => {
+                let spectrum = decode_pulse_spectrum(text).with_context(|| {
+                    format!(
+                        "{}: metadata {PULSE_SPECTRUM_KEY} is not a list of finite re/im pairs",
+                        recording.display()
+                    )
+                })?;
+                SounderPulse::from_spectrum(spectrum)
+                    .with_context(|| format!("{}: metadata {PULSE_SPECTRUM_KEY}", recording.display()))
+            }
+            None => flat(),
+        },
+    }
+}
+
+fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::Result<MpcRun> {
+    let path = &args.recording;
+    let link_filter = args.link.as_deref().map(parse_link).transpose()?;
+    let threads = args.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from)).max(1);
+    let mut reader = RecordingReader::open(path)?;
+    let bar = progress::bytes_bar("mpc", quiet);
+    bar.set_length(std::fs::metadata(path).map(|m| m.len()).unwrap_or(0));
+    let mut pulse: Option<SounderPulse> = None;
+    let mut run = MpcRun {
+        sequence_id: String::new(),
+        links: BTreeMap::new(),
+        truth: Vec::new(),
+        tx: Vec::new(),
+        rx: Vec::new(),
+        snapshots: 0,
+    };
+    while let Some(item) = reader.next_item() {
+        let event = match item? {
+            RecordingItem::Event(event) => event,
+            RecordingItem::Scan(_) => continue,
+        };
+        bar.set_position(reader.bytes_read());
+        match event {
+            RecordingEvent::Cir(snapshot) => {
+                let key = (snapshot.tx_antenna, snapshot.rx_antenna);
+                if link_filter.is_some_and(|l| l != key) {
+                    continue;
+                }
+                let index = run.snapshots;
+                run.snapshots += 1;
+                let context = || {
+                    format!(
+                        "{}: CIR snapshot {index} (t_ns {}, set {})",
+                        path.display(),
+                        snapshot.t_ns,
+                        snapshot.set_index
+                    )
+                };
+                if pulse.is_none() {
+                    pulse = Some(choose_pulse(args.pulse.as_deref(), reader.metadata(), &snapshot, path)?);
+                }
+                let link = match run.links.entry(key) {
+                    std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
+                    std::collections::btree_map::Entry::Vacant(e) => {
+                        let pulse = pulse.as_ref().context("internal: pulse chosen above")?;
+                        let pipeline = MpcPipeline::new(
+                            config.clone(),
+                            pulse,
+                            snapshot.tap_spacing_s,
+                            snapshot.carrier_hz,
+                            threads,
+                        )
+                        .with_context(context)?;
+                        e.insert(LinkRun {
+                            pipeline,
+                            current_set: None,
+                            pending: Vec::new(),
+                            detections: Vec::new(),
+                            tracks: Vec::new(),
+                            gmphd_tracks: Vec::new(),
+                            long_term: Vec::new(),
+                            sets: Vec::new(),
+                        })
+                    }
+                };
+                match link.current_set {
+                    Some(set) if snapshot.set_index < set => bail!(
+                        "{}: set_index {} after set {set} on link tx{}:rx{}; snapshots must come in set order",
+                        context(),
+                        snapshot.set_index,
+                        key.0,
+                        key.1
+                    ),
+                    Some(set) if snapshot.set_index == set => {}
+                    _ => {
+                        link.flush().with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
+                        link.current_set = Some(snapshot.set_index);
+                    }
+                }
+                link.pending.push(snapshot);
+            }
+            RecordingEvent::MpcTruth(truth) => run.truth.push(truth),
+            RecordingEvent::Pose { stream: PoseStream::GroundTruthTx, pose } => run.tx.push(pose),
+            RecordingEvent::Pose { stream: PoseStream::GroundTruthRx, pose } => run.rx.push(pose),
+            _ => {}
+        }
+    }
+    for (key, link) in &mut run.links {
+        link.flush().with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
+    }
+    bar.finish_and_clear();
+    run.sequence_id = reader
+        .metadata()
+        .and_then(RecordingMetadata::from_map)
+        .map(|m| m.sequence_id)
+        .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
+    if run.links.is_empty() {
+        match link_filter {
+            Some((tx, rx)) if run.snapshots == 0 => {
+                bail!("{}: no CIR snapshot of link {tx}:{rx} (topic /channel/cir); nothing written", path.display())
+            }
+            _ => bail!("{}: the recording has no CIR snapshots (topic /channel/cir); nothing written", path.display()),
+        }
+    }
+    Ok(run)
+}
+
+/// Partition name of each link.
+fn partitions(run: &MpcRun, sequence: &str, picked: bool) -> Vec<((u32, u32), String)> {
+    let single = picked || run.links.len() == 1;
+    run.links
+        .keys()
+        .map(|&(tx, rx)| ((tx, rx), if single { sequence.to_string() } else { format!("{sequence}-tx{tx}-rx{rx}") }))
+        .collect()
+}
+
+/// Refuses when any table of `sequence` (or one of its link partitions) exists.
+fn refuse_existing(output: &Path, sequence: &str) -> anyhow::Result<()> {
+    for table in TABLES {
+        let path = table_path(output, table, sequence)?;
+        if path.exists() {
+            bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
+        }
+        let Ok(entries) = std::fs::read_dir(output.join(table)) else { continue };
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let link_part =
+                name.strip_prefix(&format!("sequence={sequence}-tx")).is_some_and(|rest| rest.contains("-rx"));
+            if link_part && entry.path().join("part-0.parquet").exists() {
+                bail!("{}: exists; use --force to replace it (nothing was written)", entry.path().display());
+            }
+        }
+    }
+    Ok(())
+}
+
+pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
+    let mut config = effective_config(args.config.as_deref())?;
+    config.run_gmphd |= args.gmphd;
+    if args.print_config {
+        print!("{}", toml::to_string(&config)?);
+        return Ok(());
+    }
+    if let Some(link) = &args.link {
+        parse_link(link)?;
+    }
+    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
+    // Check the outputs before the work, so a refusal costs nothing.
+    let hinted = match &args.sequence {
+        Some(s) => Some(s.clone()),
+        None => RecordingReader::open(&args.recording).ok().and_then(|mut r| {
+            let _ = r.next_item();
+            r.metadata().and_then(RecordingMetadata::from_map).map(|m| m.sequence_id)
+        }),
+    };
+    if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &hinted) {
+        refuse_existing(&args.output, sequence)?;
+    }
+    let run = read_and_process(args, &config, quiet)?;
+    let sequence = args.sequence.clone().unwrap_or_else(|| run.sequence_id.clone());
+    if overwrite == Overwrite::Refuse {
+        refuse_existing(&args.output, &sequence)?;
+    }
+    let info = RunInfo {
+        config_json: serde_json::json!({
+            "command": "process mpc",
+            "recording": args.recording.display().to_string(),
+            "pulse": args.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
+            "link": args.link,
+            "mpc": config,
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    let mut written = Vec::new();
+    for (key, partition) in partitions(&run, &sequence, args.link.is_some()) {
+        let link = &run.links[&key];
+        written.extend(write_link(&args.output, &partition, link, &run, config.run_gmphd, &info, overwrite)?);
+        if !quiet {
+            println!(
+                "mpc {partition} (link tx{}:rx{}): {} sets, {} detections, {} short-term tracks, {} long-term entries",
+                key.0,
+                key.1,
+                link.sets.len(),
+                link.detections.len(),
+                link.tracks.len(),
+                link.long_term.len()
+            );
+        }
+    }
+    if !quiet {
+        for w in &written {
+            println!("  wrote {} ({} rows)", w.path.display(), w.rows);
+        }
+    }
+    Ok(())
+}
+
+fn write_link(
+    output: &Path,
+    partition: &str,
+    link: &LinkRun,
+    run: &MpcRun,
+    gmphd: bool,
+    info: &RunInfo,
+    overwrite: Overwrite,
+) -> anyhow::Result<Vec<TableWriteSummary>> {
+    let mut written = vec![
+        write_table(output, partition, &link.detections, info, overwrite)?,
+        write_table(output, partition, &link.tracks, info, overwrite)?,
+        write_table(output, partition, &link.long_term, info, overwrite)?,
+        write_table(output, partition, &link.sets, info, overwrite)?,
+    ];
+    if gmphd {
+        let tracks: Vec<GmPhdTrack> = link.gmphd_tracks.iter().cloned().map(GmPhdTrack).collect();
+        written.push(write_table(output, partition, &tracks, info, overwrite)?);
+    }
+    if !run.truth.is_empty() {
+        written.push(write_table(output, partition, &run.truth, info, overwrite)?);
+    }
+    if !run.tx.is_empty() && !run.rx.is_empty() {
+        let tx: Vec<GroundTruthTxPose> = run.tx.iter().cloned().map(GroundTruthTxPose).collect();
+        let rx: Vec<GroundTruthRxPose> = run.rx.iter().cloned().map(GroundTruthRxPose).collect();
+        written.push(write_table(output, partition, &tx, info, overwrite)?);
+        written.push(write_table(output, partition, &rx, info, overwrite)?);
+    }
+    Ok(written)
+}

@@ -1,0 +1,121 @@
+//! `mmtrack process mpc` and `mmtrack analyze` on a short simulated convoy:
+//! the tables and their row counts, refusal without --force, the MPC
+//! statistics of analyze, and a recording without CIRs named in the error.
+
+use std::path::Path;
+
+use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, Se2, StampedPose};
+use mmtrack_io::recording::{PoseStream, TimeBase};
+use mmtrack_io::table::{GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, TableRow, read_table_dir};
+use mmtrack_io::{RecordingEvent, RecordingMetadata, RecordingOptions, RecordingReader, RecordingWriter};
+
+use super::common::{mmtrack, root, text};
+
+const SETS: usize = 8;
+
+fn only<T: TableRow>(tables: &Path) -> (String, Vec<T>) {
+    let mut all = read_table_dir::<T>(tables).unwrap();
+    assert_eq!(all.len(), 1, "one partition of {}", T::SPEC.name);
+    all.pop_first().unwrap()
+}
+
+fn simulate(dir: &Path) {
+    let scenario = root().join("data/sounder/convoy-tunnel.toml");
+    let sets = SETS.to_string();
+    let args = ["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "rec.mcap", "--sets", &sets];
+    let out = mmtrack(dir, &args);
+    assert!(out.status.success(), "{}", text(&out).1);
+}
+
+#[test]
+fn process_mpc_writes_every_table_refuses_to_overwrite_and_analyze_reports_mpc_statistics() {
+    let dir = tempfile::tempdir().unwrap();
+    simulate(dir.path());
+    let truth_in_recording = RecordingReader::open(&dir.path().join("rec.mcap"))
+        .unwrap()
+        .filter(|e| matches!(e.as_ref().unwrap(), RecordingEvent::MpcTruth(_)))
+        .count();
+
+    let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "tables", "--gmphd", "--threads", "2"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains(&format!("{SETS} sets")), "{stdout}");
+
+    let tables = dir.path().join("tables");
+    let (sequence, sets) = only::<MpcSetStats>(&tables);
+    assert_eq!(sets.len(), SETS);
+    assert!(sets.iter().all(|s| s.snapshots == 6), "the paper's set of six snapshots");
+    let (_, detections) = only::<MpcDetection>(&tables);
+    assert_eq!(detections.len() as u64, sets.iter().map(|s| u64::from(s.detections)).sum::<u64>());
+    assert!(!detections.is_empty(), "the convoy has a LOS path and wall bounces");
+    let (_, tracks) = only::<MpcTrack>(&tables);
+    assert_eq!(tracks.len() as u64, sets.iter().map(|s| u64::from(s.short_term_tracks)).sum::<u64>());
+    let (_, long_term) = only::<MpcLongTermEntry>(&tables);
+    assert_eq!(long_term.len() as u64, sets.iter().map(|s| u64::from(s.full_lifetime_tracks)).sum::<u64>());
+    let (_, truth) = only::<MpcTruth>(&tables);
+    assert_eq!(truth.len(), truth_in_recording);
+    let (_, tx) = only::<GroundTruthTxPose>(&tables);
+    let (_, rx) = only::<GroundTruthRxPose>(&tables);
+    assert_eq!((tx.len(), rx.len()), (SETS, SETS), "one pose per set and car");
+    let _ = only::<GmPhdTrack>(&tables);
+
+    // Refused without --force before any work, and the file is untouched.
+    let part = tables.join("mpc_sets").join(format!("sequence={sequence}")).join("part-0.parquet");
+    let before = std::fs::metadata(&part).unwrap().modified().unwrap();
+    let again = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "tables", "--quiet"]);
+    let (_, stderr) = text(&again);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(stderr.contains("exists; use --force"), "{stderr}");
+    assert_eq!(std::fs::metadata(&part).unwrap().modified().unwrap(), before);
+    let forced = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "tables", "--quiet", "--force", "--gmphd"]);
+    assert!(forced.status.success(), "{}", text(&forced).1);
+
+    let analysis = mmtrack(dir.path(), &["analyze", "tables", "-o", "analysis"]);
+    let (stdout, stderr) = text(&analysis);
+    assert!(analysis.status.success(), "{stderr}");
+    assert!(stdout.contains(&format!("{sequence}: {SETS} sets")), "{stdout}");
+    let results = dir.path().join("analysis");
+    let (_, summary) = only::<mmtrack_analysis::mpc::MpcSummary>(&results.join("tables"));
+    let summary = &summary[0];
+    assert_eq!(summary.sets, SETS as u64);
+    assert_eq!(summary.distance_source, "ground_truth_tx+ground_truth_rx");
+    // Both cars drive at tens of km/h for 70 ms: some metres, not zero.
+    assert!(summary.distance_m.is_some_and(|d| d > 0.5 && d < 20.0), "{:?}", summary.distance_m);
+    assert!(summary.precision.is_some() && summary.recall.is_some() && summary.track_purity.is_some());
+    let (_, per_set) = only::<mmtrack_analysis::mpc::SetMetrics>(&results.join("tables"));
+    assert_eq!(per_set.len(), SETS);
+    assert_eq!(per_set.iter().map(|s| s.long_term_mpcs).sum::<u64>(), long_term.len() as u64);
+    let report = std::fs::read_to_string(results.join("report.md")).unwrap();
+    assert!(report.contains("## Multipath components"), "{report}");
+    for (file, _) in mmtrack_analysis::mpc_report::PLOTS {
+        let svg = std::fs::read_to_string(results.join("plots").join(&sequence).join(file)).unwrap();
+        assert!(svg.starts_with("<svg"), "{file}");
+    }
+}
+
+#[test]
+fn a_recording_without_cir_snapshots_is_named_in_the_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let metadata = RecordingMetadata {
+        sequence_id: "no-cir".into(),
+        source: "process mpc test".into(),
+        time_base: TimeBase::UnixEpoch,
+        extra: Default::default(),
+    };
+    let path = dir.path().join("poses.mcap");
+    let mut writer = RecordingWriter::create(&path, &metadata, &RecordingOptions::default()).unwrap();
+    for i in 0..3i64 {
+        let pose = StampedPose { t_ns: i * 1_000_000, parent_from_child: Se2::new(i as f64, 0.0, 0.0) };
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "vehicle").unwrap();
+    }
+    writer.finish().unwrap();
+    let out = mmtrack(dir.path(), &["process", "mpc", "poses.mcap", "-o", "tables"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("poses.mcap") && stderr.contains("no CIR snapshots"), "{stderr}");
+    assert!(!dir.path().join("tables").join("mpc_sets").exists(), "nothing written");
+
+    let bad_link = mmtrack(dir.path(), &["process", "mpc", "poses.mcap", "-o", "tables", "--link", "x"]);
+    assert_eq!(bad_link.status.code(), Some(1));
+    assert!(text(&bad_link).1.contains("--link 'x'"));
+}
