@@ -28,6 +28,8 @@ pub struct BenchArgs {
 
 #[derive(Subcommand)]
 enum Kind {
+    /// MPC detection plus short- and long-term tracking snapshots/s on simulated 2048-tap CIRs; GM-PHD ratio.
+    Mpc(crate::bench_mpc::MpcBenchArgs),
     /// End-to-end radar odometry scans/s on real Oxford scans (PNG decode included), per stage.
     Odometry(crate::bench_odometry::OdometryBenchArgs),
     /// Oxford-folder ingest (PNG bytes carried) in scans/s vs copying the folder; peak memory at two folder sizes.
@@ -413,6 +415,7 @@ struct IngestBench<'a> {
 pub fn run(args: &BenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.kind {
         Kind::Odometry(odometry) => crate::bench_odometry::run(odometry, quiet),
+        Kind::Mpc(mpc) => crate::bench_mpc::run(mpc, quiet),
         Kind::Ingest { scans, repeats, check, dir, readme, from } => ingest(
             &IngestBench {
                 scans: *scans,

@@ -9,6 +9,7 @@
 
 mod analyze;
 mod bench;
+mod bench_mpc;
 mod bench_odometry;
 mod demo;
 mod export;

@@ -5,6 +5,7 @@
 
 mod analyze;
 mod architecture;
+mod bench_mpc;
 mod cli;
 mod common;
 mod fixtures;
