@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::MpcError;
+use crate::{GmPhdConfig, MpcError};
 
 /// How the noise floor of a snapshot is estimated (detection step 1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -141,6 +141,13 @@ pub struct MpcConfig {
     pub short_term: ShortTermConfig,
     /// Tracking across sets.
     pub long_term: LongTermConfig,
+    /// Also run the GM-PHD baseline on each set's detections
+    /// ([`crate::MpcPipeline`]). Off by default: it is the comparison, not
+    /// the method, and costs about ten times the proposed tracker.
+    pub run_gmphd: bool,
+    /// The GM-PHD baseline's parameters (Table I); its `carrier_hz` is
+    /// replaced by the pipeline's carrier.
+    pub gmphd: GmPhdConfig,
 }
 
 fn bad(field: &'static str, value: impl ToString, expected: &'static str) -> MpcError {
@@ -231,6 +238,7 @@ impl MpcConfig {
     pub fn validate(&self) -> Result<(), MpcError> {
         self.detection.validate()?;
         self.short_term.validate()?;
-        self.long_term.validate()
+        self.long_term.validate()?;
+        self.gmphd.validate().map_err(|source| MpcError::GmPhd { source })
     }
 }

@@ -1,5 +1,7 @@
 use thiserror::Error;
 
+use crate::GmPhdError;
+
 /// What can go wrong when configuring or running MPC detection and tracking.
 #[derive(Debug, Error, PartialEq)]
 #[non_exhaustive]
@@ -41,5 +43,17 @@ pub enum MpcError {
         previous_t_ns: i64,
         /// The offending time stamp.
         t_ns: i64,
+    },
+    /// A set without snapshots was given.
+    #[error("empty set after {snapshots_before} snapshots: a set needs at least one snapshot")]
+    EmptySet {
+        /// Snapshots pushed before it.
+        snapshots_before: usize,
+    },
+    /// The GM-PHD baseline refused its config (`gmphd.<field>`) or input.
+    #[error("gmphd: {source}")]
+    GmPhd {
+        /// The baseline's error.
+        source: GmPhdError,
     },
 }

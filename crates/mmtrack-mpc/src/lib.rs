@@ -12,7 +12,9 @@
 //!    initiation, linear prediction, search tolerances, per-track Doppler;
 //!    Sec. III-B);
 //! 3. [`long_term`]: full-lifetime tracks related across sets by two-way delay
-//!    prediction with confidence classes chi (Sec. V).
+//!    prediction with confidence classes chi (Sec. V);
+//! 4. [`MpcPipeline`]: the three above (and optionally the GM-PHD baseline of
+//!    [`gmphd`]) streamed over the sets of one link, with per-set statistics.
 //!
 //! Pure computation on in-memory types: no files, no printing. It sits in the
 //! `process` step: recording -> CIR snapshots -> detections and tracks ->
@@ -23,6 +25,7 @@ pub mod detect;
 mod error;
 pub mod gmphd;
 pub mod long_term;
+mod pipeline;
 mod pulse;
 pub mod short_term;
 
@@ -31,6 +34,7 @@ pub use detect::{Detector, SnapshotDetections, first_path};
 pub use error::MpcError;
 pub use gmphd::{GmPhdConfig, GmPhdError, GmPhdSnapshot, track_gmphd};
 pub use long_term::LongTermTracker;
+pub use pipeline::{MpcPipeline, SetOutput};
 pub use pulse::SounderPulse;
 pub use short_term::short_term_tracks;
 

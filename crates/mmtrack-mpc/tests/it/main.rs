@@ -5,5 +5,6 @@ mod common;
 mod detect;
 mod gmphd;
 mod long_term;
+mod pipeline;
 mod realdata_cir;
 mod short_term;

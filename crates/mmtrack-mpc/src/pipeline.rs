@@ -1,0 +1,293 @@
+//! The streaming MPC pipeline of one TX/RX link: a set of CIR snapshots in,
+//! detections, short-term tracks, optional GM-PHD tracks, long-term entries
+//! and set statistics out (Mahler et al. 2017, Secs. III and V).
+//!
+//! One set at a time: [`MpcPipeline::push_set`] holds the CIRs of the set it
+//! is given and nothing else; between sets it keeps only the previous set's
+//! long-term summaries, the last time stamp and id counters. So a run of any
+//! length streams in memory bounded by one set.
+//!
+//! Per set:
+//! 1. checks: at least one snapshot, strictly increasing `t_ns` (also across
+//!    sets, [`MpcError::NonMonotonicTime`]), one `set_index` and one link
+//!    (TX/RX antenna) in the set, the pipeline's carrier;
+//! 2. detection of each snapshot ([`Detector`]) on `threads` scoped threads,
+//!    each taking a contiguous chunk of the set; results are put back in
+//!    snapshot order and the first error in snapshot order is returned, so
+//!    the output does not depend on the thread count;
+//! 3. short-term tracks ([`short_term_tracks`]) with ids running on across
+//!    sets;
+//! 4. optionally the GM-PHD baseline ([`track_gmphd`]) on the same detections
+//!    of the set, a fresh filter per set (the paper compares the trackers
+//!    within sets); its tracks are renumbered to ids running on across sets,
+//!    in the filter's label order;
+//! 5. long-term entries ([`LongTermTracker`]) of the set's full-lifetime
+//!    tracks, related to the previous set's;
+//! 6. statistics ([`MpcSetStats`]).
+//!
+//! Gains in the statistics are means over the set's measured (not skipped)
+//! snapshots of linear gains, converted to dB (`-inf` when every snapshot was
+//! skipped or nothing was captured). The detected, tracked and full-lifetime
+//! gains are `sum |alpha|^2 (w^H w)` over the respective detections (`w^H w`
+//! = [`Detector::pulse_energy`]), the scale of the detector's
+//! `detected_gain_db`, so each compares directly with the channel gain.
+
+use mmtrack_core::{CirSnapshot, MpcLongTermEntry, MpcSetStats, MpcTrack};
+
+use crate::short_term::is_full_lifetime;
+use crate::{
+    Detector, GmPhdConfig, GmPhdSnapshot, LongTermTracker, MpcConfig, MpcError, SnapshotDetections, SounderPulse,
+    short_term_tracks, track_gmphd,
+};
+
+/// What one set produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetOutput {
+    /// The detector's output per snapshot, in snapshot order.
+    pub per_snapshot: Vec<SnapshotDetections>,
+    /// Short-term tracks of the proposed tracker (Sec. III-B).
+    pub short_term_tracks: Vec<MpcTrack>,
+    /// GM-PHD tracks on the same detections, when
+    /// [`MpcConfig::run_gmphd`] is set.
+    pub gmphd_tracks: Option<Vec<MpcTrack>>,
+    /// Long-term entries of this set's full-lifetime short-term tracks, with
+    /// their links from the previous set (Sec. V).
+    pub long_term_entries: Vec<MpcLongTermEntry>,
+    /// Counts and gains of the set.
+    pub stats: MpcSetStats,
+}
+
+/// Detection and tracking of one link's sets, in time order (see the module
+/// docs).
+#[derive(Debug)]
+pub struct MpcPipeline {
+    config: MpcConfig,
+    detector: Detector,
+    carrier_hz: f64,
+    threads: usize,
+    long_term: LongTermTracker,
+    next_short_id: u64,
+    next_gmphd_id: u64,
+    last_t_ns: Option<i64>,
+    snapshots_seen: usize,
+}
+
+impl MpcPipeline {
+    /// A pipeline for CIRs of `pulse.taps()` taps spaced `tap_spacing_s`
+    /// apart at a carrier of `carrier_hz`, detecting on `threads` threads.
+    ///
+    /// # Errors
+    /// [`MpcError::BadConfig`] for an invalid config, carrier or thread count
+    /// (the field is named), [`MpcError::GmPhd`] for an invalid GM-PHD
+    /// config, [`MpcError::BadPulse`] for an unusable pulse or tap spacing.
+    pub fn new(
+        mut config: MpcConfig,
+        pulse: &SounderPulse,
+        tap_spacing_s: f64,
+        carrier_hz: f64,
+        threads: usize,
+    ) -> Result<Self, MpcError> {
+        if !(carrier_hz.is_finite() && carrier_hz > 0.0) {
+            return Err(MpcError::BadConfig {
+                field: "carrier_hz",
+                value: carrier_hz.to_string(),
+                expected: "a finite positive frequency",
+            });
+        }
+        if threads == 0 {
+            return Err(MpcError::BadConfig { field: "threads", value: "0".into(), expected: "at least 1" });
+        }
+        config.gmphd.carrier_hz = carrier_hz;
+        config.validate()?;
+        let detector = Detector::new(config.detection.clone(), tap_spacing_s, pulse)?;
+        let long_term = LongTermTracker::new(config.long_term.clone(), carrier_hz, 0)?;
+        Ok(Self {
+            config,
+            detector,
+            carrier_hz,
+            threads,
+            long_term,
+            next_short_id: 0,
+            next_gmphd_id: 0,
+            last_t_ns: None,
+            snapshots_seen: 0,
+        })
+    }
+
+    /// The detector in use (its blocked width, pulse energy).
+    #[must_use]
+    pub fn detector(&self) -> &Detector {
+        &self.detector
+    }
+
+    /// Processes one set: its snapshots in time order (one TX/RX link).
+    ///
+    /// # Errors
+    /// [`MpcError::EmptySet`]; [`MpcError::NonMonotonicTime`] when a
+    /// snapshot is not after the previous one (within the set or across
+    /// sets); [`MpcError::BadSnapshot`] for a snapshot of another set, link
+    /// or carrier, or one the detector refuses; [`MpcError::GmPhd`] if the
+    /// baseline fails. Snapshot positions in errors count every snapshot
+    /// pushed so far, from 0. After an error the pipeline is unchanged.
+    pub fn push_set(&mut self, snapshots: &[CirSnapshot]) -> Result<SetOutput, MpcError> {
+        self.check_set(snapshots)?;
+        let per_snapshot = self.detect_all(snapshots)?;
+        let detections: Vec<Vec<_>> = per_snapshot.iter().map(|s| s.detections.clone()).collect();
+        let gmphd_tracks = if self.config.run_gmphd { Some(self.gmphd(snapshots, &detections)?) } else { None };
+
+        let short_term_tracks =
+            short_term_tracks(&detections, self.carrier_hz, &self.config.short_term, self.next_short_id);
+        self.next_short_id += short_term_tracks.len() as u64;
+        let full_lifetime: Vec<MpcTrack> =
+            short_term_tracks.iter().filter(|t| is_full_lifetime(t, snapshots.len())).cloned().collect();
+        let long_term_entries = self.long_term.push_set(&full_lifetime);
+        if let Some(tracks) = &gmphd_tracks {
+            self.next_gmphd_id += tracks.len() as u64;
+        }
+        self.snapshots_seen += snapshots.len();
+        self.last_t_ns = snapshots.last().map(|s| s.t_ns);
+
+        let stats = self.stats(snapshots, &per_snapshot, &short_term_tracks, &full_lifetime);
+        Ok(SetOutput { per_snapshot, short_term_tracks, gmphd_tracks, long_term_entries, stats })
+    }
+
+    /// Step 1 of the module docs; changes nothing.
+    fn check_set(&self, snapshots: &[CirSnapshot]) -> Result<(), MpcError> {
+        let first = snapshots.first().ok_or(MpcError::EmptySet { snapshots_before: self.snapshots_seen })?;
+        let mut previous_t_ns = self.last_t_ns;
+        for (position, snapshot) in snapshots.iter().enumerate() {
+            let index = self.snapshots_seen + position;
+            if let Some(previous_t_ns) = previous_t_ns
+                && snapshot.t_ns <= previous_t_ns
+            {
+                return Err(MpcError::NonMonotonicTime { snapshot: index, previous_t_ns, t_ns: snapshot.t_ns });
+            }
+            previous_t_ns = Some(snapshot.t_ns);
+            let bad = |detail: String| MpcError::BadSnapshot {
+                snapshot: index,
+                set_index: snapshot.set_index,
+                t_ns: snapshot.t_ns,
+                detail,
+            };
+            if snapshot.set_index != first.set_index {
+                return Err(bad(format!("set_index differs from the set's first snapshot ({})", first.set_index)));
+            }
+            if (snapshot.tx_antenna, snapshot.rx_antenna) != (first.tx_antenna, first.rx_antenna) {
+                return Err(bad(format!(
+                    "link tx{}:rx{} differs from the set's first snapshot (tx{}:rx{})",
+                    snapshot.tx_antenna, snapshot.rx_antenna, first.tx_antenna, first.rx_antenna
+                )));
+            }
+            let relative = (snapshot.carrier_hz - self.carrier_hz).abs() / self.carrier_hz;
+            if relative.is_nan() || relative > 1e-9 {
+                return Err(bad(format!(
+                    "carrier {} Hz differs from the pipeline's {} Hz",
+                    snapshot.carrier_hz, self.carrier_hz
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Detection of every snapshot on up to `threads` scoped threads, in
+    /// snapshot order; the first error in snapshot order.
+    fn detect_all(&self, snapshots: &[CirSnapshot]) -> Result<Vec<SnapshotDetections>, MpcError> {
+        let detect_chunk = |offset: usize, chunk: &[CirSnapshot]| -> Result<Vec<SnapshotDetections>, MpcError> {
+            chunk
+                .iter()
+                .enumerate()
+                .map(|(k, snapshot)| self.detector.detect(snapshot, self.snapshots_seen + offset + k))
+                .collect()
+        };
+        let threads = self.threads.min(snapshots.len());
+        if threads <= 1 {
+            return detect_chunk(0, snapshots);
+        }
+        let chunk_len = snapshots.len().div_ceil(threads);
+        let chunk_results: Vec<Result<Vec<SnapshotDetections>, MpcError>> = std::thread::scope(|scope| {
+            let handles: Vec<_> = snapshots
+                .chunks(chunk_len)
+                .enumerate()
+                .map(|(c, chunk)| scope.spawn(move || detect_chunk(c * chunk_len, chunk)))
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect()
+        });
+        let mut per_snapshot = Vec::with_capacity(snapshots.len());
+        for result in chunk_results {
+            per_snapshot.extend(result?);
+        }
+        Ok(per_snapshot)
+    }
+
+    /// The GM-PHD baseline on the set's detections, renumbered from
+    /// `next_gmphd_id` (the counter is advanced by the caller on success).
+    fn gmphd(
+        &self,
+        snapshots: &[CirSnapshot],
+        detections: &[Vec<mmtrack_core::MpcDetection>],
+    ) -> Result<Vec<MpcTrack>, MpcError> {
+        let input: Vec<GmPhdSnapshot> = snapshots
+            .iter()
+            .zip(detections)
+            .map(|(s, d)| GmPhdSnapshot {
+                t_ns: s.t_ns,
+                set_index: s.set_index,
+                snapshot_index: s.snapshot_index,
+                detections: d.clone(),
+            })
+            .collect();
+        let config: &GmPhdConfig = &self.config.gmphd;
+        let mut tracks = track_gmphd(&input, config).map_err(|source| MpcError::GmPhd { source })?;
+        for (k, track) in tracks.iter_mut().enumerate() {
+            track.track_id = self.next_gmphd_id + k as u64;
+        }
+        Ok(tracks)
+    }
+
+    fn stats(
+        &self,
+        snapshots: &[CirSnapshot],
+        per_snapshot: &[SnapshotDetections],
+        tracks: &[MpcTrack],
+        full_lifetime: &[MpcTrack],
+    ) -> MpcSetStats {
+        let measured: Vec<&SnapshotDetections> = per_snapshot.iter().filter(|s| s.skipped.is_none()).collect();
+        let n = measured.len();
+        let energy = self.detector.pulse_energy();
+        let captured = |tracks: &[MpcTrack]| -> f64 {
+            tracks.iter().flat_map(|t| &t.detections).map(|d| d.amplitude.norm_sqr()).sum::<f64>() * energy
+        };
+        let detected: f64 =
+            measured.iter().flat_map(|s| &s.detections).map(|d| d.amplitude.norm_sqr()).sum::<f64>() * energy;
+        let (set_index, t_ns) = snapshots.first().map_or((0, 0), |s| (s.set_index, s.t_ns));
+        MpcSetStats {
+            set_index,
+            t_ns,
+            snapshots: count_u32(snapshots.len()),
+            skipped_snapshots: count_u32(snapshots.len() - n),
+            detections: count_u32(per_snapshot.iter().map(|s| s.detections.len()).sum()),
+            short_term_tracks: count_u32(tracks.len()),
+            full_lifetime_tracks: count_u32(full_lifetime.len()),
+            noise_floor_db: mean_db(measured.iter().map(|s| from_db(s.noise_floor_db)).sum(), n),
+            channel_gain_db: mean_db(measured.iter().map(|s| from_db(s.channel_gain_db)).sum(), n),
+            detected_gain_db: mean_db(detected, n),
+            tracked_gain_db: mean_db(captured(tracks), n),
+            full_lifetime_gain_db: mean_db(captured(full_lifetime), n),
+        }
+    }
+}
+
+fn from_db(db: f64) -> f64 {
+    10f64.powf(db / 10.0)
+}
+
+/// `10 log10(sum / n)`; `-inf` for `n = 0`.
+fn mean_db(sum: f64, n: usize) -> f64 {
+    if n == 0 { f64::NEG_INFINITY } else { 10.0 * (sum / n as f64).log10() }
+}
+
+/// A count as `u32`, saturating (a set of 4 billion snapshots or detections
+/// does not fit in memory anyway).
+fn count_u32(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}
