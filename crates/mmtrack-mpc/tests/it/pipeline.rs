@@ -79,11 +79,14 @@ fn two_mpc_channel_gives_two_full_lifetime_tracks_per_set_linked_across_sets() {
                 // SNR (hundredths of a ns), far below the 20 ns separation.
                 assert!((d.delay_s - truth_s).abs() < 0.2e-9, "set {s}: {} vs {truth_s}", d.delay_s);
             }
-            // Doppler from six points over 3.6 ms: a delay error of 0.05 ns
-            // moves the slope by ~1.5e-8 s/s, i.e. ~90 Hz; 150 Hz bounds it.
+            // Doppler from six points over 3.6 ms: the fit's slope has a
+            // standard deviation of sigma_tau / 3.0 ms, ~95 Hz at the
+            // detector's ~0.05 ns delay noise at 24 dB SNR (seen: up to
+            // 131 Hz with this seed); 300 Hz is ~3 sigma and still tells the
+            // two paths' Dopplers (-285, +171 Hz) apart.
             let nu = track.doppler_hz.unwrap();
             let truth_hz = -RATES[p] * CARRIER_HZ;
-            assert!((nu - truth_hz).abs() < 150.0, "set {s}: {nu} Hz vs {truth_hz} Hz");
+            assert!((nu - truth_hz).abs() < 300.0, "set {s}: {nu} Hz vs {truth_hz} Hz");
         }
         // Long-term: two entries per set, the same two long-term ids
         // throughout (each linked to its predecessor after the first set).
