@@ -18,6 +18,7 @@ mod inspect;
 mod process;
 mod progress;
 mod reproduce;
+mod reproduce_mpc;
 mod simulate;
 mod simulate_sounder;
 
@@ -25,9 +26,6 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-
-/// Exit code for a feature that is planned but not built yet.
-const EXIT_NOT_BUILT: u8 = 3;
 
 #[derive(Parser)]
 #[command(
@@ -38,7 +36,7 @@ const EXIT_NOT_BUILT: u8 = 3;
 ROS 2 bags) into canonical MCAP recordings, runs published algorithms on them (radar odometry, multipath tracking, \
 beam tracking, mmWave SLAM) and writes Parquet tables and plots.\n\n\
 Data flow: raw files --ingest--> recording.mcap --process--> tables (Parquet) --analyze--> metrics + plots.\n\n\
-Exit codes: 0 success, 1 error (one line naming the file and the problem), 2 usage error, 3 feature not built yet.",
+Exit codes: 0 success, 1 error (one line naming the file and the problem) or a missed paper target (reproduce, bench --check), 2 usage error.",
     after_help = "Start with `mmtrack demo`, then `mmtrack inspect out/demo/recording.mcap`."
 )]
 struct Cli {
@@ -79,11 +77,6 @@ enum Command {
     },
     /// Measure throughput against a same-run baseline (no wall-clock assertions).
     Bench(bench::BenchArgs),
-}
-
-fn not_built(what: &str, issue: u32) -> anyhow::Result<ExitCode> {
-    eprintln!("error: `mmtrack {what}` is not built yet (tracked in issue #{issue}); nothing was done");
-    Ok(ExitCode::from(EXIT_NOT_BUILT))
 }
 
 fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyhow::Result<ExitCode> {

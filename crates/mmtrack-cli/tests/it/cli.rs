@@ -13,16 +13,6 @@ fn help_explains_every_subcommand() {
 }
 
 #[test]
-fn unbuilt_subcommands_say_so_and_exit_3() {
-    // `process mpc` is built (issue #5); `reproduce mpc-artificial` is the last planned one.
-    let args = ["reproduce", "mpc-artificial"];
-    let out = mmtrack(&root(), &args);
-    assert_eq!(out.status.code(), Some(3), "{args:?}");
-    let (_, stderr) = text(&out);
-    assert!(stderr.contains("not built yet") && stderr.contains("issue #"), "{stderr}");
-}
-
-#[test]
 fn demo_writes_a_recording_and_a_table_and_says_where() {
     let dir = tempfile::tempdir().unwrap();
     let out = mmtrack(dir.path(), &["demo", "--out", "demo-out"]);
