@@ -39,7 +39,9 @@
 //!
 //! [`ShortTermConfig::min_track_length`] above 3 additionally drops tracks
 //! shorter than it (the next initial candidate is then tried, as for a
-//! failed identification); at 3, the paper's value, it changes nothing.
+//! failed identification); at 3, the paper's value, it changes nothing; below
+//! 3 (refused by [`ShortTermConfig::validate`]) it acts as 3, since a track
+//! is identified by three points in any case.
 //!
 //! Detections with non-finite magnitude or delay (zero amplitude gives
 //! `-inf` dB) never pass a gate, so they can start no track and join none.
