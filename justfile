@@ -37,6 +37,7 @@ bench:
     cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md --from ../shared/realdata/oxford-radar-tiny
     cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md
     cargo run -q --release -p mmtrack-cli -- bench odometry --readme README.md
+    cargo run -q --release -p mmtrack-cli -- bench mpc --readme README.md
 
 # Paper experiments.
 reproduce *args:

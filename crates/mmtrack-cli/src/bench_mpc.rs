@@ -289,6 +289,9 @@ fn time_gmphd(set: &[CirSnapshot], found: Vec<Vec<MpcDetection>>, config: &GmPhd
 }
 
 struct Measured {
+    /// 1-minute load average before and after the run (Linux), to show
+    /// when other work on the machine shared the cores.
+    load: (Option<f64>, Option<f64>),
     snapshots: usize,
     mpcs: usize,
     fft_s: f64,
@@ -298,6 +301,7 @@ struct Measured {
 
 fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
     anyhow::ensure!(args.snapshots > 0, "--snapshots must be at least 1");
+    let load_before = load_average();
     anyhow::ensure!(!args.threads.is_empty() && !args.threads.contains(&0), "--threads: counts of at least 1");
     let channel = Channel::new(args.mpcs)?;
     let config = MpcConfig::default();
@@ -323,7 +327,19 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
             }
         }
     }
-    Ok(Measured { snapshots: args.snapshots, mpcs: args.mpcs, fft_s: fft.total_s, gmphd_s, proposed })
+    Ok(Measured {
+        load: (load_before, load_average()),
+        snapshots: args.snapshots,
+        mpcs: args.mpcs,
+        fft_s: fft.total_s,
+        gmphd_s,
+        proposed,
+    })
+}
+
+/// The 1-minute load average (`/proc/loadavg`, Linux).
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }
 
 /// Seconds for [`MPC_TARGET_SNAPSHOTS`] at the measured rate.
@@ -378,6 +394,13 @@ impl Measured {
                 self.gmphd_s, first.track_s, first.threads,
             ));
         }
+        let load = |l: Option<f64>| l.map_or_else(|| "-".to_string(), |l| format!("{l:.1}"));
+        out.push_str(&format!(
+            "\n1-minute load average before / after the run: {} / {} (on {} cores; above that, other work shared them).\n",
+            load(self.load.0),
+            load(self.load.1),
+            std::thread::available_parallelism().map_or(1, usize::from),
+        ));
         out
     }
 }
