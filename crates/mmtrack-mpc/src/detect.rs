@@ -245,7 +245,7 @@ impl Detector {
             )));
         }
         let relative = (snapshot.tap_spacing_s - self.band.tap_spacing_s()).abs() / self.band.tap_spacing_s();
-        if !(relative < 1e-9) {
+        if relative.is_nan() || relative >= 1e-9 {
             return Err(bad(format!(
                 "tap spacing {} s differs from the detector's {} s",
                 snapshot.tap_spacing_s,

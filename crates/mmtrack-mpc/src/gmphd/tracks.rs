@@ -38,24 +38,8 @@ impl TrackBook {
     }
 }
 
-/// `nu = -f_c m`, with `m` the least-squares slope of delay over time
-/// (eqs. (30)-(31)); `None` for fewer than two distinct times.
-///
-/// Times are taken relative to the first detection so that `t_ns * 1e-9` keeps
-/// its precision.
-pub(super) fn doppler_hz(detections: &[MpcDetection], carrier_hz: f64) -> Option<f64> {
-    let t0 = detections.first()?.t_ns;
-    let n = detections.len() as f64;
-    let ts: Vec<f64> = detections.iter().map(|d| (d.t_ns - t0) as f64 * 1e-9).collect();
-    let t_mean = ts.iter().sum::<f64>() / n;
-    let tau_mean = detections.iter().map(|d| d.delay_s).sum::<f64>() / n;
-    let (mut sxy, mut sxx) = (0.0, 0.0);
-    for (t, d) in ts.iter().zip(detections) {
-        sxy += (t - t_mean) * (d.delay_s - tau_mean);
-        sxx += (t - t_mean) * (t - t_mean);
-    }
-    (sxx > 0.0).then(|| -carrier_hz * sxy / sxx)
-}
+/// The per-track Doppler, shared with the proposed tracker.
+pub(super) use crate::short_term::doppler_hz;
 
 #[cfg(test)]
 mod tests {
