@@ -96,7 +96,8 @@ pub fn score(
         detections.iter().zip(&matched).filter_map(|(d, m)| m.map(|p| (d.set_index, d.snapshot_index, p))).collect();
     let threshold_db: BTreeMap<u64, f64> =
         sets.iter().map(|s| (s.set_index, s.noise_floor_db + FLOOR_MARGIN_DB)).collect();
-    let above = |t: &MpcTruth| threshold_db.get(&t.set_index).is_none_or(|&th| t.power_db() >= th || t.power_db().is_nan());
+    let above =
+        |t: &MpcTruth| threshold_db.get(&t.set_index).is_none_or(|&th| t.power_db() >= th || t.power_db().is_nan());
     let (mut strong, mut strong_found) = (0u64, 0u64);
     for t in truth.iter().filter(|t| above(t)) {
         strong += 1;
