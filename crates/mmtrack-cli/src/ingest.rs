@@ -5,18 +5,22 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
-use mmtrack_ingest::boreas::{BoreasFolder, BoreasOptions, ingest_boreas};
+use mmtrack_ingest::boreas::BoreasOptions;
 use mmtrack_ingest::cir::{CirFormat, ingest_cir};
-use mmtrack_ingest::mulran::{self, MulranFolder, MulranOptions, ingest_mulran};
-use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+use mmtrack_ingest::mulran::{self, MulranOptions};
+use mmtrack_ingest::oxford::{self, OxfordOptions};
 use mmtrack_ingest::poses::{self, Plane};
-use mmtrack_ingest::ros2::{self, Ros2Topics};
-use mmtrack_ingest::sweep::{StampAt, SweepTiming};
+use mmtrack_ingest::ros2::{RadarTopic, Ros2Topics};
 use mmtrack_io::recording::Compression;
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use crate::progress;
+
+mod folders;
+
+pub use folders::oxford_folder;
+use folders::{SweepArgs, boreas_folder, mulran_folder, positive_metres};
 
 /// Options shared by every ingest kind.
 #[derive(Args, Clone)]
@@ -117,41 +121,6 @@ impl CirFormatArg {
             Self::Csv => CirFormat::Csv,
             Self::Decawave => CirFormat::Decawave,
         }
-    }
-}
-
-/// Which azimuth of a sweep an image stamp marks.
-#[derive(Clone, Copy, ValueEnum)]
-pub enum StampAtArg {
-    /// The first azimuth is at the stamp.
-    Start,
-    /// The last azimuth is at the stamp (a sweep is stamped once received).
-    End,
-}
-
-/// Timing of polar images that carry one stamp per sweep.
-#[derive(Args, Clone)]
-pub struct SweepArgs {
-    /// Which azimuth the image stamp marks; the others are spread evenly over the scan period.
-    #[arg(long, value_enum, default_value_t = StampAtArg::End)]
-    stamp_at: StampAtArg,
-    /// Scan period in seconds (Navtech at 4 Hz: 0.25).
-    #[arg(long, default_value_t = 0.25)]
-    scan_period_s: f64,
-}
-
-impl SweepArgs {
-    fn timing(&self) -> anyhow::Result<SweepTiming> {
-        if !(self.scan_period_s.is_finite() && self.scan_period_s > 0.0 && self.scan_period_s < 60.0) {
-            anyhow::bail!("--scan-period-s {}: expected a positive number of seconds below 60", self.scan_period_s);
-        }
-        Ok(SweepTiming {
-            period_ns: (self.scan_period_s * 1e9).round() as i64,
-            stamp_at: match self.stamp_at {
-                StampAtArg::Start => StampAt::Start,
-                StampAtArg::End => StampAt::End,
-            },
-        })
     }
 }
 
@@ -284,7 +253,11 @@ enum Kind {
         #[command(flatten)]
         output: OutputArgs,
     },
-    /// ROS 2 MCAP bag (cdr): poses from nav_msgs/Odometry or PoseWithCovarianceStamped, fixes from NavSatFix.
+    /// ROS 2 MCAP bag (cdr): poses from nav_msgs/Odometry or PoseWithCovarianceStamped, fixes from NavSatFix,
+    /// Navtech polar scans from sensor_msgs/Image.
+    ///
+    /// Radar images carry one stamp per sweep: azimuth times are spread evenly over
+    /// --scan-period-s with header.stamp at the sweep's end (--stamp-at start to change).
     ///
     /// `mmtrack inspect <bag.mcap>` lists the topics a bag holds.
     Ros2 {
@@ -301,6 +274,14 @@ enum Kind {
         /// NavSatFix topic, if any.
         #[arg(long)]
         gnss_topic: Option<String>,
+        /// sensor_msgs/Image topic of Navtech polar scans (mono8, one row per azimuth), if any.
+        #[arg(long, requires = "radar_range_resolution_m")]
+        radar_topic: Option<String>,
+        /// Range bin size of the radar images in metres (CTS350-X: 0.0438, CIR204-H: 0.0596).
+        #[arg(long)]
+        radar_range_resolution_m: Option<f64>,
+        #[command(flatten)]
+        sweep: SweepArgs,
     },
 }
 
@@ -388,96 +369,32 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         Kind::Cir { input, format, sidecar, output } => {
             cir_file(&input, format.format(), sidecar.as_deref(), &output, quiet)
         }
-        Kind::Ros2 { input, output, pose_topic, poses_are_ground_truth, gnss_topic } => {
+        Kind::Ros2 {
+            input,
+            output,
+            pose_topic,
+            poses_are_ground_truth,
+            gnss_topic,
+            radar_topic,
+            radar_range_resolution_m,
+            sweep,
+        } => {
+            let radar = match (radar_topic, radar_range_resolution_m) {
+                (Some(topic), Some(range_resolution_m)) => {
+                    positive_metres("--radar-range-resolution-m", range_resolution_m)?;
+                    Some(RadarTopic { topic, range_resolution_m, timing: sweep.timing()? })
+                }
+                _ => None,
+            };
             let topics = Ros2Topics {
                 pose_topic: (pose_topic != "none").then_some(pose_topic),
                 pose_stream: if poses_are_ground_truth { PoseStream::GroundTruth } else { PoseStream::Estimate },
                 gnss_topic,
+                radar,
             };
-            let bar = progress::bytes_bar("ingest ros2", quiet);
-            let report =
-                ros2::ingest_ros2(&input, &output.output, &topics, &output.recording_options(), &mut |done, total| {
-                    bar.set_length(total);
-                    bar.set_position(done);
-                });
-            bar.finish_and_clear();
-            let report = report?;
-            if !quiet {
-                println!(
-                    "{}: {} poses, {} GNSS fixes ({} NavSatFix without a fix skipped)",
-                    report.output.path.display(),
-                    report.poses,
-                    report.gnss_fixes,
-                    report.no_fix
-                );
-            }
-            Ok(ExitCode::SUCCESS)
+            folders::ros2_bag(&input, &output, &topics, quiet)
         }
     }
-}
-
-/// Checks that a length flag is a positive, finite number of metres.
-fn positive_metres(flag: &str, value: f64) -> anyhow::Result<()> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        anyhow::bail!("{flag} {value}: expected a positive number of metres")
-    }
-}
-
-/// Ingests one Boreas folder, with a progress bar.
-fn boreas_folder(
-    input: &std::path::Path,
-    output: &OutputArgs,
-    options: &BoreasOptions,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
-    let folder = BoreasFolder::open(input)?;
-    let bar = progress::bar(folder.scans.len() as u64, "ingest boreas", "scans", quiet);
-    let report = ingest_boreas(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
-        bar.set_position(done);
-    });
-    bar.finish_and_clear();
-    let report = report?;
-    if !quiet {
-        println!(
-            "{}: {} scans ({} m range bins: {}), {} ground-truth poses ({:.1} MB)",
-            report.output.path.display(),
-            report.scans,
-            report.range_resolution_m,
-            report.range_resolution_source,
-            report.ground_truth_poses,
-            report.output.file_bytes as f64 / 1e6
-        );
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
-/// Ingests one MulRan folder, with a progress bar.
-fn mulran_folder(
-    input: &std::path::Path,
-    output: &OutputArgs,
-    options: &MulranOptions,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
-    let folder = MulranFolder::open(input)?;
-    let bar = progress::bar(folder.scans.len() as u64, "ingest mulran", "scans", quiet);
-    let report = ingest_mulran(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
-        bar.set_position(done);
-    });
-    bar.finish_and_clear();
-    let report = report?;
-    if !quiet {
-        println!(
-            "{}: {} scans (azimuth times: file time at the sweep's {}), {} ground-truth poses ({:.1} MB)",
-            report.output.path.display(),
-            report.scans,
-            options.timing.stamp_at.name(),
-            report.ground_truth_poses,
-            report.output.file_bytes as f64 / 1e6
-        );
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Adding to the output file itself replaces it, once the new one is complete.
@@ -487,47 +404,6 @@ fn allow_in_place(add_to: Option<&std::path::Path>, output: &mut OutputArgs) {
     {
         output.force = true;
     }
-}
-
-/// Ingests one Oxford folder, with a progress bar.
-pub fn oxford_folder(
-    input: &std::path::Path,
-    output: &OutputArgs,
-    options: &OxfordOptions,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
-    let folder = OxfordFolder::open(input)?;
-    let bar = progress::bar(folder.scans.len() as u64, "ingest oxford", "scans", quiet);
-    let report =
-        oxford::ingest_oxford(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
-            bar.set_position(done);
-        })?;
-    bar.finish_and_clear();
-    if !quiet {
-        println!(
-            "{}: {} scans, {} ground-truth poses, {} GNSS fixes{} ({:.1} MB)",
-            report.output.path.display(),
-            report.scans,
-            report.ground_truth_poses,
-            report.gnss_fixes,
-            if report.skipped_invalid_scans > 0 {
-                format!(", {} scans skipped (flagged invalid in radar.timestamps)", report.skipped_invalid_scans)
-            } else {
-                String::new()
-            } + &report
-                .ins_used_as
-                .as_ref()
-                .map(|used| {
-                    format!(
-                        "; gps/ins.csv used as {used} ({} rows not INS_SOLUTION_GOOD skipped)",
-                        report.ins_rows_not_good
-                    )
-                })
-                .unwrap_or_default(),
-            report.output.file_bytes as f64 / 1e6
-        );
-    }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// Ingests one CIR file, with a progress bar.

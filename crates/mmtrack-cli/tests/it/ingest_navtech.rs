@@ -157,3 +157,41 @@ fn bad_boreas_and_mulran_input_is_one_line_naming_the_file_with_no_output() {
     let leftovers = if dir.path().join("out").exists() { files(&dir.path().join("out")) } else { vec![] };
     assert!(leftovers.is_empty(), "partial output left: {leftovers:?}");
 }
+
+#[test]
+fn ros2_radar_topic_needs_a_range_resolution_and_an_image_type() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "ros2", "bag.mcap", "-o", "r.mcap", "--radar-topic", "/radar"]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out).1);
+    assert!(text(&out).1.contains("--radar-range-resolution-m"), "{}", text(&out).1);
+
+    // On the real bag (MichaelGrupp/evo test data, GPL-3.0), /odom is not an image topic.
+    let Some(realdata) = super::common::realdata("ros2_radar_topic") else { return };
+    let bag = realdata.join("ros2-mcap");
+    let bag = std::fs::read_dir(&bag)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "mcap"))
+        .unwrap();
+    let args = [
+        "ingest",
+        "ros2",
+        bag.to_str().unwrap(),
+        "-o",
+        "r.mcap",
+        "--pose-topic",
+        "none",
+        "--radar-topic",
+        "/odom",
+        "--radar-range-resolution-m",
+        "0.0438",
+    ];
+    let out = mmtrack(dir.path(), &args);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("message") && stderr.contains("/odom") && stderr.contains("not sensor_msgs/msg/Image"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("r.mcap").exists());
+}

@@ -1,0 +1,183 @@
+//! The folder and bag kinds of `mmtrack ingest` (Navtech scan folders of
+//! Oxford, Boreas and MulRan, ROS 2 bags): each opens its input, runs the
+//! ingest under a progress bar and prints a one-line summary.
+
+use std::path::Path;
+use std::process::ExitCode;
+
+use clap::{Args, ValueEnum};
+use mmtrack_ingest::boreas::{BoreasFolder, BoreasOptions, ingest_boreas};
+use mmtrack_ingest::mulran::{MulranFolder, MulranOptions, ingest_mulran};
+use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+use mmtrack_ingest::ros2::{self, Ros2Topics};
+use mmtrack_ingest::sweep::{StampAt, SweepTiming};
+
+use super::OutputArgs;
+use crate::progress;
+
+/// Which azimuth of a sweep an image stamp marks.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum StampAtArg {
+    /// The first azimuth is at the stamp.
+    Start,
+    /// The last azimuth is at the stamp (a sweep is stamped once received).
+    End,
+}
+
+/// Timing of polar images that carry one stamp per sweep.
+#[derive(Args, Clone)]
+pub struct SweepArgs {
+    /// Which azimuth the image stamp marks; the others are spread evenly over the scan period.
+    #[arg(long, value_enum, default_value_t = StampAtArg::End)]
+    stamp_at: StampAtArg,
+    /// Scan period in seconds (Navtech at 4 Hz: 0.25).
+    #[arg(long, default_value_t = 0.25)]
+    scan_period_s: f64,
+}
+
+impl SweepArgs {
+    pub(super) fn timing(&self) -> anyhow::Result<SweepTiming> {
+        if !(self.scan_period_s.is_finite() && self.scan_period_s > 0.0 && self.scan_period_s < 60.0) {
+            anyhow::bail!("--scan-period-s {}: expected a positive number of seconds below 60", self.scan_period_s);
+        }
+        Ok(SweepTiming {
+            period_ns: (self.scan_period_s * 1e9).round() as i64,
+            stamp_at: match self.stamp_at {
+                StampAtArg::Start => StampAt::Start,
+                StampAtArg::End => StampAt::End,
+            },
+        })
+    }
+}
+
+/// Checks that a length flag is a positive, finite number of metres.
+pub(super) fn positive_metres(flag: &str, value: f64) -> anyhow::Result<()> {
+    if value.is_finite() && value > 0.0 {
+        Ok(())
+    } else {
+        anyhow::bail!("{flag} {value}: expected a positive number of metres")
+    }
+}
+
+/// Ingests one Boreas folder, with a progress bar.
+pub(super) fn boreas_folder(
+    input: &Path,
+    output: &OutputArgs,
+    options: &BoreasOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let folder = BoreasFolder::open(input)?;
+    let bar = progress::bar(folder.scans.len() as u64, "ingest boreas", "scans", quiet);
+    let report = ingest_boreas(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    if !quiet {
+        println!(
+            "{}: {} scans ({} m range bins: {}), {} ground-truth poses ({:.1} MB)",
+            report.output.path.display(),
+            report.scans,
+            report.range_resolution_m,
+            report.range_resolution_source,
+            report.ground_truth_poses,
+            report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Ingests one MulRan folder, with a progress bar.
+pub(super) fn mulran_folder(
+    input: &Path,
+    output: &OutputArgs,
+    options: &MulranOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let folder = MulranFolder::open(input)?;
+    let bar = progress::bar(folder.scans.len() as u64, "ingest mulran", "scans", quiet);
+    let report = ingest_mulran(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    if !quiet {
+        println!(
+            "{}: {} scans (azimuth times: file time at the sweep's {}), {} ground-truth poses ({:.1} MB)",
+            report.output.path.display(),
+            report.scans,
+            options.timing.stamp_at.name(),
+            report.ground_truth_poses,
+            report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Ingests one Oxford folder, with a progress bar.
+pub fn oxford_folder(
+    input: &Path,
+    output: &OutputArgs,
+    options: &OxfordOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let folder = OxfordFolder::open(input)?;
+    let bar = progress::bar(folder.scans.len() as u64, "ingest oxford", "scans", quiet);
+    let report =
+        oxford::ingest_oxford(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+            bar.set_position(done);
+        })?;
+    bar.finish_and_clear();
+    if !quiet {
+        println!(
+            "{}: {} scans, {} ground-truth poses, {} GNSS fixes{} ({:.1} MB)",
+            report.output.path.display(),
+            report.scans,
+            report.ground_truth_poses,
+            report.gnss_fixes,
+            if report.skipped_invalid_scans > 0 {
+                format!(", {} scans skipped (flagged invalid in radar.timestamps)", report.skipped_invalid_scans)
+            } else {
+                String::new()
+            } + &report
+                .ins_used_as
+                .as_ref()
+                .map(|used| {
+                    format!(
+                        "; gps/ins.csv used as {used} ({} rows not INS_SOLUTION_GOOD skipped)",
+                        report.ins_rows_not_good
+                    )
+                })
+                .unwrap_or_default(),
+            report.output.file_bytes as f64 / 1e6
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Ingests the chosen topics of a ROS 2 bag, with a progress bar.
+pub(super) fn ros2_bag(
+    input: &Path,
+    output: &OutputArgs,
+    topics: &Ros2Topics,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let bar = progress::bytes_bar("ingest ros2", quiet);
+    let report = ros2::ingest_ros2(input, &output.output, topics, &output.recording_options(), &mut |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let report = report?;
+    if !quiet {
+        println!(
+            "{}: {} poses, {} GNSS fixes ({} NavSatFix without a fix skipped), {} radar scans",
+            report.output.path.display(),
+            report.poses,
+            report.gnss_fixes,
+            report.no_fix,
+            report.radar_scans
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
