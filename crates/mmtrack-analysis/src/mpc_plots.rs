@@ -1,8 +1,6 @@
 //! SVG plots of the MPC statistics (Mahler et al. 2017, Figs. 6-9, 12-13),
 //! drawn with plotters' SVG backend. Each returns the SVG document.
 
-use std::ops::Range;
-
 use plotters::prelude::*;
 
 use crate::mpc::MpcResult;
@@ -14,19 +12,7 @@ pub const DELAY_PLOT_SETS: usize = 30;
 /// A labelled line: label, points, colour.
 type Series<'a> = (&'a str, Vec<(f64, f64)>, RGBColor);
 
-fn err(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow::anyhow!("plot: {e}")
-}
-
-fn padded(values: impl Iterator<Item = f64>) -> Range<f64> {
-    let (lo, hi) =
-        values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-    if !lo.is_finite() {
-        return 0.0..1.0;
-    }
-    let pad = if hi > lo { 0.05 * (hi - lo) } else { 1.0 };
-    (lo - pad)..(hi + pad)
-}
+use crate::plots::{err, padded_range as padded};
 
 /// Empirical CDF points (sorted value, share at or below).
 fn ecdf(mut values: Vec<f64>) -> Vec<(f64, f64)> {

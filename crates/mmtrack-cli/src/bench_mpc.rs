@@ -271,16 +271,8 @@ impl FftBaseline {
 
 /// GM-PHD (Table I) per set on the proposed method's detections.
 fn time_gmphd(set: &[CirSnapshot], found: Vec<Vec<MpcDetection>>, config: &GmPhdConfig) -> anyhow::Result<f64> {
-    let snapshots: Vec<GmPhdSnapshot> = set
-        .iter()
-        .zip(found)
-        .map(|(s, detections)| GmPhdSnapshot {
-            t_ns: s.t_ns,
-            set_index: s.set_index,
-            snapshot_index: s.snapshot_index,
-            detections,
-        })
-        .collect();
+    let snapshots: Vec<GmPhdSnapshot> =
+        set.iter().zip(found).map(|(s, detections)| GmPhdSnapshot::of(s, detections)).collect();
     let started = Instant::now();
     let tracks = track_gmphd(&snapshots, config)?;
     let elapsed = started.elapsed().as_secs_f64();

@@ -24,8 +24,7 @@ use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, Mpc
 use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
 use mmtrack_io::recording::{PoseStream, RecordingItem};
 use mmtrack_io::table::{
-    GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM,
-    MPC_SETS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, RunInfo, TableWriteSummary, table_path, write_table,
+    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, RunInfo, TableWriteSummary, table_path, write_table,
 };
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_mpc::{MpcConfig, MpcPipeline, SounderPulse};
@@ -33,16 +32,7 @@ use mmtrack_mpc::{MpcConfig, MpcPipeline, SounderPulse};
 use crate::progress;
 
 /// Every table `process mpc` may write.
-const TABLES: [&str; 8] = [
-    MPC_DETECTIONS.name,
-    MPC_TRACKS.name,
-    MPC_TRACKS_GMPHD.name,
-    MPC_LONG_TERM.name,
-    MPC_SETS.name,
-    MPC_TRUTH.name,
-    GROUND_TRUTH_TX.name,
-    GROUND_TRUTH_RX.name,
-];
+const TABLES: [&str; 8] = mmtrack_analysis::pipeline::MPC_TABLE_NAMES;
 
 #[derive(Args)]
 pub struct MpcArgs {

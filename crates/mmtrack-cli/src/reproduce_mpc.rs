@@ -124,16 +124,8 @@ fn sweep_point(power_db: f64, window: bool, runs: u64) -> anyhow::Result<[Point;
         }
         let proposed =
             mmtrack_mpc::short_term::short_term_tracks(&per_snapshot, carrier_hz, &ShortTermConfig::default(), 0);
-        let phd_input: Vec<GmPhdSnapshot> = snapshots
-            .iter()
-            .zip(&per_snapshot)
-            .map(|(s, d)| GmPhdSnapshot {
-                t_ns: s.t_ns,
-                set_index: s.set_index,
-                snapshot_index: s.snapshot_index,
-                detections: d.clone(),
-            })
-            .collect();
+        let phd_input: Vec<GmPhdSnapshot> =
+            snapshots.iter().zip(&per_snapshot).map(|(s, d)| GmPhdSnapshot::of(s, d.clone())).collect();
         let gmphd = mmtrack_mpc::track_gmphd(&phd_input, &gmphd_config)?;
         tallies[0].add(&proposed, &truth, 3);
         tallies[1].add(&gmphd, &truth, gmphd_config.min_track_detections);

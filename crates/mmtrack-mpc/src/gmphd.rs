@@ -82,6 +82,14 @@ pub struct GmPhdSnapshot {
     pub detections: Vec<MpcDetection>,
 }
 
+impl GmPhdSnapshot {
+    /// The detections of `snapshot`, stamped with its time and indices.
+    #[must_use]
+    pub fn of(snapshot: &mmtrack_core::CirSnapshot, detections: Vec<MpcDetection>) -> Self {
+        Self { t_ns: snapshot.t_ns, set_index: snapshot.set_index, snapshot_index: snapshot.snapshot_index, detections }
+    }
+}
+
 /// Errors of the GM-PHD baseline.
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]

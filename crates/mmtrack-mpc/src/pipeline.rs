@@ -226,16 +226,8 @@ impl MpcPipeline {
         snapshots: &[CirSnapshot],
         detections: &[Vec<mmtrack_core::MpcDetection>],
     ) -> Result<Vec<MpcTrack>, MpcError> {
-        let input: Vec<GmPhdSnapshot> = snapshots
-            .iter()
-            .zip(detections)
-            .map(|(s, d)| GmPhdSnapshot {
-                t_ns: s.t_ns,
-                set_index: s.set_index,
-                snapshot_index: s.snapshot_index,
-                detections: d.clone(),
-            })
-            .collect();
+        let input: Vec<GmPhdSnapshot> =
+            snapshots.iter().zip(detections).map(|(s, d)| GmPhdSnapshot::of(s, d.clone())).collect();
         let config: &GmPhdConfig = &self.config.gmphd;
         let mut tracks = track_gmphd(&input, config).map_err(|source| MpcError::GmPhd { source })?;
         for (k, track) in tracks.iter_mut().enumerate() {
