@@ -9,17 +9,34 @@
 //!    `alpha W exp(-j 2 pi f tau)` with `W = z P`, `P` the sounder pulse;
 //! 3. find the strongest correlation with the sounder pulse outside the
 //!    blocked delay ranges, `c(tau) = p(tau)^H h_w` (eq. (7)): the coarse peak
-//!    on the tap grid (one inverse FFT of `conj(P) H_w`), refined to sub-tap
-//!    delay by Newton steps on `|c(tau)|^2` with
-//!    `c(tau) = (1/U) sum_k conj(P_k) H_w,k exp(j 2 pi f_k tau)` evaluated
-//!    exactly;
+//!    on the tap grid of `c[n]` (one inverse FFT of `conj(P) H_w` per
+//!    snapshot), refined to sub-tap delay as the maximum of `|c(tau)|` by
+//!    band-limited interpolation from the 65 taps around it;
 //! 4. amplitude `alpha = c(tau) / ((1/U) sum_k z_k |P_k|^2)` (eq. (8), with the
 //!    normaliser that makes it unbiased for a windowed path);
 //! 5. block `tau +- width / 2` around it (width: the windowed pulse's width
 //!    10 dB below its peak, 2.47 ns in the paper);
-//! 6. subtract `alpha W exp(-j 2 pi f tau)` from the windowed transfer
-//!    function (eq. (9)) and repeat until the strongest remaining amplitude is
-//!    below the threshold.
+//! 6. subtract the path (eq. (9)) and repeat until the strongest remaining
+//!    amplitude is below the threshold.
+//!
+//! Steps 3-6 run on the tap-domain correlation, as CLEAN does in its minor
+//! cycle (Hogbom 1974): subtracting `alpha W exp(-j 2 pi f tau)` from the
+//! windowed transfer function is subtracting `alpha kappa(n - tau)` from
+//! `c[n]`, with `kappa` the correlation of the template with one windowed
+//! unit path. `kappa` is tabulated at 1/128-tap delays ([`tables`]), and a
+//! path is subtracted over the taps where `|alpha kappa|` exceeds 1 % of the
+//! threshold's amplitude (about 30 taps each side for a path 40 dB above the
+//! threshold with the Kaiser window; every tap without it). This replaces
+//! one inverse FFT and a dozen exact O(U) evaluations of `c(tau)` per found
+//! path, and is what makes 10 000 snapshots of 2048 taps take about a second
+//! (`mmtrack bench mpc`). Precision: the refinement's truncated interpolation
+//! biases a lone path's delay by up to 1.5e-4 taps; that bias depends only
+//! on the fractional delay, is measured on the kernel itself when the
+//! detector is built and removed, leaving 1e-7 taps (3e-5 without the
+//! window). A strong neighbour not yet subtracted, within the 32 taps, moves
+//! an estimate more than it would with exact interpolation (5e-4 instead of
+//! 1e-4 taps for one 6 dB weaker 31 taps away). Noise makes about 0.03 taps
+//! at the paper's operating point, with this and with the exact evaluation.
 //!
 //! Choices where the paper is not explicit: the template of eq. (7) is the
 //! sounder pulse itself, so the data are windowed once. Correlating with the
@@ -30,12 +47,17 @@
 //! paper states eq. (7) with `w^T h` for a real pulse; with a measured,
 //! complex pulse the matched filter uses the conjugate.
 
+mod residual;
+mod tables;
+
 use std::sync::Arc;
 
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{CirSnapshot, Complex64, MpcDetection};
 use rustfft::{Fft, FftPlanner};
 
+use self::residual::Residual;
+use self::tables::{KernelRows, Neighbourhood, PeakInterpolator};
 use crate::config::{DetectionConfig, NoiseFloor};
 use crate::{MpcError, SounderPulse};
 
@@ -82,9 +104,11 @@ pub struct Detector {
     pulse_w: Vec<Complex64>,
     /// The sounder pulse `P`, the matched-filter template.
     template: Vec<Complex64>,
-    /// `conj(P) W = z |P|^2`: the correlation of the template with one
-    /// windowed path, as a spectrum.
-    kernel: Vec<f64>,
+    /// `kappa(m - delta)`, the correlation of the template with one windowed
+    /// unit path (spectrum `conj(P) W = z |P|^2`), tabulated.
+    kernel_rows: KernelRows,
+    /// Sub-tap refinement of correlation peaks.
+    interpolator: PeakInterpolator,
     /// Correlation of a unit path at its own delay, `(1/U) sum z |P|^2`.
     kernel_peak: f64,
     /// Windowed pulse energy `w^H w = (1/U) sum |W|^2`.
@@ -116,8 +140,9 @@ impl Detector {
             None => vec![1.0; band.taps()],
         };
         let pulse_w: Vec<Complex64> = pulse.spectrum().iter().zip(&window).map(|(p, z)| p * z).collect();
-        let kernel: Vec<f64> = pulse.spectrum().iter().zip(&window).map(|(p, z)| p.norm_sqr() * z).collect();
-        let kernel_peak = kernel.iter().sum::<f64>() / band.taps() as f64;
+        let kernel: Vec<Complex64> =
+            pulse.spectrum().iter().zip(&window).map(|(p, z)| Complex64::new(p.norm_sqr() * z, 0.0)).collect();
+        let kernel_peak = kernel.iter().map(|k| k.re).sum::<f64>() / band.taps() as f64;
         let pulse_energy = pulse_w.iter().map(Complex64::norm_sqr).sum::<f64>() / band.taps() as f64;
         if !(pulse_energy.is_finite() && pulse_energy > 0.0 && kernel_peak > 0.0) {
             return Err(MpcError::BadPulse { detail: "the windowed pulse has no energy".into() });
@@ -125,13 +150,16 @@ impl Detector {
         let mut planner = FftPlanner::new();
         let fft = planner.plan_fft_forward(band.taps());
         let ifft = planner.plan_fft_inverse(band.taps());
+        let kernel_rows = KernelRows::new(&band, &mut planner, &kernel);
+        let interpolator = PeakInterpolator::new(&band, &mut planner, &kernel);
         let mut detector = Self {
             config,
             band,
             window,
             pulse_w,
             template: pulse.spectrum().to_vec(),
-            kernel,
+            kernel_rows,
+            interpolator,
             kernel_peak,
             pulse_energy,
             blocked_half_width_s: 0.0,
@@ -150,14 +178,14 @@ impl Detector {
     #[must_use]
     pub fn pulse_width_s(&self, level_db: f64) -> f64 {
         let spectrum: Vec<Complex64> = self.pulse_w.iter().map(|w| w / self.band.taps() as f64).collect();
-        let peak = eval_correlation(&self.band, &spectrum, 0.0).value.norm();
+        let peak = correlation_at(&self.band, &spectrum, 0.0).norm();
         let level = peak * 10f64.powf(level_db / 20.0);
         let half_taps = self.band.taps() as f64 / 2.0;
         let edge = |sign: f64| {
             let mut x = 0.0;
             while x < half_taps {
                 x += 0.01;
-                if eval_correlation(&self.band, &spectrum, sign * x).value.norm() < level {
+                if correlation_at(&self.band, &spectrum, sign * x).norm() < level {
                     return x;
                 }
             }
@@ -208,7 +236,7 @@ impl Detector {
         let u = self.band.taps() as f64;
         let mut channel_gain = 0.0;
         // G = conj(P) z H / U: the correlation spectrum, c = IFFT(G) without further scaling.
-        let mut correlation_spectrum: Vec<Complex64> = spectrum
+        let correlation_spectrum: Vec<Complex64> = spectrum
             .iter()
             .zip(&self.window)
             .zip(&self.template)
@@ -219,7 +247,7 @@ impl Detector {
             })
             .collect();
         channel_gain /= u;
-        let detections = self.search_and_subtract(snapshot, &mut correlation_spectrum, threshold);
+        let detections = self.search_and_subtract(snapshot, correlation_spectrum, threshold);
         let detected_gain: f64 = detections.iter().map(|d| d.amplitude.norm_sqr()).sum::<f64>() * self.pulse_energy;
         Ok(SnapshotDetections {
             detections,
@@ -288,28 +316,33 @@ impl Detector {
     fn search_and_subtract(
         &self,
         snapshot: &CirSnapshot,
-        correlation_spectrum: &mut [Complex64],
+        mut correlation: Vec<Complex64>,
         threshold: f64,
     ) -> Vec<MpcDetection> {
-        let taps = self.band.taps();
+        self.ifft.process(&mut correlation);
+        let mut residual = Residual::new(correlation);
         let spacing_s = self.band.tap_spacing_s();
         let half_block_taps = self.blocked_half_width_s / spacing_s;
-        let mut blocked = vec![false; taps];
-        let mut correlation = vec![Complex64::default(); taps];
+        let threshold_amplitude = threshold.sqrt();
         let mut detections = Vec::new();
+        let mut around = Neighbourhood::default();
         while detections.len() < self.config.max_mpcs {
-            correlation.copy_from_slice(correlation_spectrum);
-            self.ifft.process(&mut correlation);
-            let Some(coarse) = strongest_unblocked(&correlation, &blocked) else { break };
-            let peak = refine_peak(&self.band, correlation_spectrum, &correlation, coarse);
+            let Some(coarse) = residual.strongest() else { break };
+            around.fill(&self.interpolator, residual.correlation(), coarse);
+            let peak = self.interpolator.refine(&around);
             let amplitude = peak.value / self.kernel_peak;
             if amplitude.norm_sqr() < threshold {
                 break;
             }
-            let delay_taps = peak.x_taps;
-            block(&mut blocked, delay_taps, half_block_taps);
-            // Eq. (9) in the frequency domain: H_w -= alpha W exp(-j 2 pi f tau), so G -= alpha z |P|^2 exp(..) / U.
-            subtract_path(&self.band, correlation_spectrum, &self.kernel, delay_taps, amplitude / taps as f64);
+            let delay_taps = coarse as f64 + peak.delta_taps;
+            // Eq. (9) on the correlation: c[n] -= alpha kappa(n - tau).
+            let reach = self.kernel_rows.reach_taps(amplitude.norm() / threshold_amplitude);
+            let changed = self.kernel_rows.subtract(residual.correlation_mut(), delay_taps, amplitude, reach);
+            let blocked = residual.block(delay_taps, half_block_taps);
+            residual.rescan(changed.0, changed.1);
+            if !residual.covers(changed, blocked) {
+                residual.rescan(blocked.0, blocked.1);
+            }
             detections.push(MpcDetection {
                 t_ns: snapshot.t_ns,
                 set_index: snapshot.set_index,
@@ -338,35 +371,6 @@ fn quietest_windows_power(power: &[f64], window_taps: usize) -> f64 {
     windows.sort_by(|a, b| a.0.total_cmp(&b.0));
     let keep = windows.len().div_ceil(4);
     windows[..keep].iter().map(|w| w.1).sum::<f64>() / keep as f64
-}
-
-fn strongest_unblocked(correlation: &[Complex64], blocked: &[bool]) -> Option<usize> {
-    let mut best: Option<(usize, f64)> = None;
-    for (n, (c, b)) in correlation.iter().zip(blocked).enumerate() {
-        let p = c.norm_sqr();
-        if !b && best.is_none_or(|(_, q)| p > q) {
-            best = Some((n, p));
-        }
-    }
-    best.map(|(n, _)| n)
-}
-
-/// Marks the taps within `half_width_taps` of `delay_taps` (circularly) as blocked.
-fn block(blocked: &mut [bool], delay_taps: f64, half_width_taps: f64) {
-    let taps = blocked.len() as i64;
-    let first = (delay_taps - half_width_taps).ceil() as i64;
-    let last = (delay_taps + half_width_taps).floor() as i64;
-    for n in first..=last.min(first + taps - 1) {
-        blocked[n.rem_euclid(taps) as usize] = true;
-    }
-}
-
-/// `G[k] -= scale |W_k|^2 exp(-j 2 pi s_k x / U)`.
-fn subtract_path(band: &SounderBand, spectrum: &mut [Complex64], kernel: &[f64], x_taps: f64, scale: Complex64) {
-    let phasors = Phasors::new(band.taps(), -x_taps);
-    for (k, (g, p)) in spectrum.iter_mut().zip(kernel).enumerate() {
-        *g -= scale * *p * phasors.at(band.signed_bin(k));
-    }
 }
 
 /// `exp(j 2 pi s x / U)` for every signed bin `s`, from one recurrence.
@@ -398,61 +402,8 @@ impl Phasors {
     }
 }
 
-/// The correlation and its first two derivatives at `x` taps.
-struct CorrelationAt {
-    value: Complex64,
-    first: Complex64,
-    second: Complex64,
-}
-
-/// `c(x) = sum_k G_k exp(j 2 pi s_k x / U)` with derivatives in `x`.
-fn eval_correlation(band: &SounderBand, spectrum: &[Complex64], x_taps: f64) -> CorrelationAt {
-    let taps = band.taps();
-    let phasors = Phasors::new(taps, x_taps);
-    let omega = 2.0 * std::f64::consts::PI / taps as f64;
-    let (mut value, mut first, mut second) = (Complex64::default(), Complex64::default(), Complex64::default());
-    for (k, g) in spectrum.iter().enumerate() {
-        let s = band.signed_bin(k);
-        let term = g * phasors.at(s);
-        let w = omega * s as f64;
-        value += term;
-        first += term * Complex64::new(0.0, w);
-        second -= term * (w * w);
-    }
-    CorrelationAt { value, first, second }
-}
-
-/// A refined correlation peak: delay in taps and the correlation there.
-struct Peak {
-    x_taps: f64,
-    value: Complex64,
-}
-
-/// Newton steps on `J(x) = |c(x)|^2` from the coarse peak, kept within one
-/// tap of it: `J' = 2 Re(conj(c) c')`, `J'' = 2 (|c'|^2 + Re(conj(c) c''))`.
-/// Where `J''` is not negative (off the main lobe), a step of a tenth of a tap
-/// uphill is taken instead. Stops when a step is below 1e-9 taps.
-fn refine_peak(band: &SounderBand, spectrum: &[Complex64], correlation: &[Complex64], coarse: usize) -> Peak {
-    let taps = correlation.len();
-    let at = |n: i64| correlation[n.rem_euclid(taps as i64) as usize].norm();
-    let n0 = coarse as i64;
-    let (left, centre, right) = (at(n0 - 1), at(n0), at(n0 + 1));
-    let curvature = left - 2.0 * centre + right;
-    let start = if curvature < 0.0 { (0.5 * (left - right) / curvature).clamp(-0.5, 0.5) } else { 0.0 };
-    let (low, high) = (coarse as f64 - 1.0, coarse as f64 + 1.0);
-    let mut x = coarse as f64 + start;
-    let mut current = eval_correlation(band, spectrum, x);
-    for _ in 0..12 {
-        let slope = 2.0 * (current.value.conj() * current.first).re;
-        let bend = 2.0 * (current.first.norm_sqr() + (current.value.conj() * current.second).re);
-        let step = if bend < 0.0 { (-slope / bend).clamp(-0.25, 0.25) } else { 0.1 * slope.signum() };
-        let next_x = (x + step).clamp(low, high);
-        let moved = (next_x - x).abs();
-        x = next_x;
-        current = eval_correlation(band, spectrum, x);
-        if moved < 1e-9 {
-            break;
-        }
-    }
-    Peak { x_taps: x, value: current.value }
+/// `c(x) = sum_k G_k exp(j 2 pi s_k x / U)`, evaluated exactly (O(U)).
+fn correlation_at(band: &SounderBand, spectrum: &[Complex64], x_taps: f64) -> Complex64 {
+    let phasors = Phasors::new(band.taps(), x_taps);
+    spectrum.iter().enumerate().map(|(k, g)| g * phasors.at(band.signed_bin(k))).sum()
 }

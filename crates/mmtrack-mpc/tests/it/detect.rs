@@ -20,16 +20,32 @@ fn noiseless_off_grid_paths_are_recovered() {
     ];
     for kaiser_beta in [Some(6.0), None] {
         let detector = Detector::new(noiseless_config(kaiser_beta), TAP_S, &pulse).unwrap();
-        // One path: exact up to round-off and the Newton stop (1e-9 taps).
-        let single = detector.detect(&snapshot(&band, &pulse, &paths[..1], None, &mut rng(1), 0), 0).unwrap();
-        let found = &single.detections[0];
-        assert!((found.delay_s - paths[0].delay_s).abs() < 1e-17, "{kaiser_beta:?}: {found:?}");
-        assert!((found.amplitude - paths[0].amplitude()).norm() / paths[0].amplitude().norm() < 1e-9);
+        // One path at fractional delays across a tap: the refinement's
+        // truncated interpolation is calibrated on the kernel (detect.rs), so
+        // what is left is its node spacing and the subtraction table, far
+        // below the noise-limited 0.03 taps of the paper's operating point
+        // (measured: 1.2e-7 taps with the Kaiser window, 2.6e-5 without).
+        let (mut worst_delay_taps, mut worst_amplitude) = (0.0_f64, 0.0_f64);
+        for step in 0..40 {
+            let path = Path { delay_s: (40.0 + 0.0251 * f64::from(step)) * TAP_S, ..paths[0] };
+            let single = detector.detect(&snapshot(&band, &pulse, &[path], None, &mut rng(1), 0), 0).unwrap();
+            let found = &single.detections[0];
+            worst_delay_taps = worst_delay_taps.max((found.delay_s - path.delay_s).abs() / TAP_S);
+            worst_amplitude =
+                worst_amplitude.max((found.amplitude - path.amplitude()).norm() / path.amplitude().norm());
+        }
+        println!(
+            "{kaiser_beta:?}: lone noiseless path, worst delay error {worst_delay_taps:.1e} taps, amplitude {worst_amplitude:.1e}"
+        );
+        assert!(worst_delay_taps < 1e-4 && worst_amplitude < 1e-4, "{kaiser_beta:?}");
         // Three paths: search and subtract estimates one path at a time, so the
-        // others' correlation sidelobes bias each estimate a little: with the
-        // Kaiser window below 1e-4 taps for paths 30+ taps apart; without it
-        // the flat band's sidelobes decay only as 1/n (1.6e-3 taps measured).
-        let bound_taps = if kaiser_beta.is_some() { 1e-4 } else { 1e-2 };
+        // others, not yet subtracted, bias each estimate a little: with the
+        // Kaiser window, 5e-4 taps for the first path, whose 6 dB weaker
+        // neighbour 31 taps away sits at the edge of the refinement's
+        // interpolation window (+-32 taps; exact interpolation over all taps
+        // gave 1e-4); without the window the flat band's sidelobes decay
+        // only as 1/n (1.6e-3 taps measured).
+        let bound_taps = if kaiser_beta.is_some() { 1e-3 } else { 1e-2 };
         let all = detector.detect(&snapshot(&band, &pulse, &paths, None, &mut rng(1), 0), 0).unwrap();
         assert!(all.detections.len() >= 3, "{kaiser_beta:?}: {:?}", all.detections);
         for (path, detection) in paths.iter().zip(&all.detections) {

@@ -1,0 +1,324 @@
+//! Tables precomputed once per detector so that search and subtract works on
+//! the tap-domain correlation with O(1) work per found path (CLEAN's "minor
+//! cycle", Hogbom 1974; Clark 1980), instead of one inverse FFT and O(U)
+//! exact correlation evaluations per path.
+//!
+//! Notation (see [`mmtrack_core::sounder`]): `U` taps, signed bins `s_k`.
+//! For a spectrum `X`, its response at a fractional delay is
+//! `x(t) = (1/U) sum_k X_k exp(j 2 pi s_k t / U)`.
+//!
+//! - [`KernelRows`]: the correlation of the template with one windowed unit
+//!   path, `kappa(t)` (spectrum `z |P|^2`), at every integer tap minus a
+//!   fractional delay on a grid of 1/128 tap, linearly interpolated between
+//!   grid rows (relative error below `|kappa''| / 131072`, about 2e-5).
+//! - [`PeakInterpolator`]: the band-limited interpolation
+//!   `c(n0 + delta) = sum_n c[n] D(n0 + delta - n)` (exact with the Dirichlet
+//!   kernel `D`, spectrum of ones, summed over all taps) truncated to the
+//!   `2 M + 1` taps around the coarse peak, at 1/256-tap nodes, and a
+//!   quadratic in between.
+
+use mmtrack_core::Complex64;
+use mmtrack_core::sounder::SounderBand;
+use rustfft::FftPlanner;
+
+/// Rows of the subtraction table per tap.
+const KERNEL_PHASES: usize = 128;
+/// Interpolation nodes per tap of the peak refinement.
+const PEAK_NODES: usize = 256;
+/// Taps on each side of the coarse peak used by the refinement.
+const PEAK_REACH_TAPS: usize = 32;
+/// Truncation of a subtraction: residues are left only where the path's
+/// response is below this fraction of the detection threshold's amplitude
+/// (-40 dB), far below anything the search can pick up.
+const SUBTRACTION_RESIDUE: f64 = 0.01;
+
+/// `x(n - delta)` for `n = 0..U` (index `n`, i.e. signed tap `n mod U`).
+fn shifted_response(
+    band: &SounderBand,
+    planner: &mut FftPlanner<f64>,
+    spectrum: &[Complex64],
+    delta_taps: f64,
+) -> Vec<Complex64> {
+    let taps = band.taps();
+    let turn = -2.0 * std::f64::consts::PI * delta_taps / taps as f64;
+    let mut buffer: Vec<Complex64> = spectrum
+        .iter()
+        .enumerate()
+        .map(|(k, x)| x * Complex64::from_polar(1.0 / taps as f64, turn * band.signed_bin(k) as f64))
+        .collect();
+    planner.plan_fft_inverse(taps).process(&mut buffer);
+    buffer
+}
+
+/// `|m|` of the signed tap stored at index `n`.
+fn signed_distance(n: usize, taps: usize) -> usize {
+    n.min(taps - n)
+}
+
+/// `kappa(m - delta)` for every tap `m` and `delta` on a 1/128-tap grid in
+/// `[0, 1]`, and how far a path's response matters.
+pub(super) struct KernelRows {
+    taps: usize,
+    /// Row `p` holds `kappa(n - p / 128)` at `p * U + n`.
+    rows: Vec<Complex64>,
+    /// `tail[L]`: the largest `|kappa(m - delta)| / kappa(0)` over `|m| > L`
+    /// and all rows.
+    tail: Vec<f64>,
+}
+
+impl KernelRows {
+    pub(super) fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, kernel: &[Complex64]) -> Self {
+        let taps = band.taps();
+        let mut rows = Vec::with_capacity((KERNEL_PHASES + 1) * taps);
+        let mut largest = vec![0.0_f64; taps / 2 + 1];
+        for p in 0..=KERNEL_PHASES {
+            let row = shifted_response(band, planner, kernel, p as f64 / KERNEL_PHASES as f64);
+            for (n, value) in row.iter().enumerate() {
+                let m = signed_distance(n, taps);
+                largest[m] = largest[m].max(value.norm());
+            }
+            rows.extend(row);
+        }
+        // Relative to the peak kappa(0): a residue r in c reads as an amplitude r / kappa(0).
+        let peak = rows[0].norm();
+        let mut tail = vec![0.0_f64; largest.len()];
+        for l in (0..largest.len() - 1).rev() {
+            tail[l] = tail[l + 1].max(largest[l + 1] / peak);
+        }
+        Self { taps, rows, tail }
+    }
+
+    /// Half-width in taps of the subtraction of a path `amplitude_ratio`
+    /// times the threshold's amplitude: beyond it its response stays below
+    /// [`SUBTRACTION_RESIDUE`] of the threshold.
+    pub(super) fn reach_taps(&self, amplitude_ratio: f64) -> usize {
+        self.tail.partition_point(|t| t * amplitude_ratio >= SUBTRACTION_RESIDUE)
+    }
+
+    /// `c[n] -= amplitude kappa(n - x)` for `|n - x| <= reach` (circularly);
+    /// returns the first tap changed and how many were.
+    pub(super) fn subtract(
+        &self,
+        correlation: &mut [Complex64],
+        x_taps: f64,
+        amplitude: Complex64,
+        reach: usize,
+    ) -> (usize, usize) {
+        let taps = self.taps;
+        let whole = x_taps.floor();
+        let position = (x_taps - whole) * KERNEL_PHASES as f64;
+        let p = (position.floor() as usize).min(KERNEL_PHASES - 1);
+        let weight = position - p as f64;
+        let (low, high) = (&self.rows[p * taps..(p + 1) * taps], &self.rows[(p + 1) * taps..(p + 2) * taps]);
+        // Signed taps -reach..=reach, or every tap once when that covers the CIR.
+        let (first_m, count) =
+            if 2 * reach + 1 >= taps { (-((taps / 2) as i64), taps) } else { (-(reach as i64), 2 * reach + 1) };
+        let mut m = first_m.rem_euclid(taps as i64) as usize;
+        let first_n = (whole as i64 + first_m).rem_euclid(taps as i64) as usize;
+        let mut n = first_n;
+        let (a_low, a_high) = (amplitude * (1.0 - weight), amplitude * weight);
+        for _ in 0..count {
+            correlation[n] -= a_low * low[m] + a_high * high[m];
+            m += 1;
+            if m == taps {
+                m = 0;
+            }
+            n += 1;
+            if n == taps {
+                n = 0;
+            }
+        }
+        (first_n, count)
+    }
+}
+
+/// The refined correlation peak: fractional delay from the coarse tap and
+/// the correlation there.
+pub(super) struct Peak {
+    pub(super) delta_taps: f64,
+    pub(super) value: Complex64,
+}
+
+/// Sub-tap refinement of a correlation peak from the `2 M + 1` taps around
+/// it, with the truncation's bias on a lone path measured at construction
+/// and removed.
+pub(super) struct PeakInterpolator {
+    reach: usize,
+    /// Row length: `2 M + 1` padded with zeros to a multiple of [`LANES`].
+    width: usize,
+    /// Row `q` (node `delta = q / 256 - 1`) holds `D(delta - m)` at `m + M`,
+    /// real and imaginary parts apart (the dot products vectorise).
+    rows_re: Vec<f64>,
+    rows_im: Vec<f64>,
+    /// Per node: refined minus true delay of a lone unit path, taps.
+    bias_taps: Vec<f64>,
+    /// Per node: refined correlation of a lone unit path over `kappa(0)`.
+    gain: Vec<Complex64>,
+}
+
+/// Independent accumulators of the refinement's dot products.
+const LANES: usize = 4;
+
+/// The taps around a coarse peak, `c[n0 - M ..= n0 + M]`, real and
+/// imaginary parts apart, zero-padded like the interpolator's rows.
+#[derive(Default)]
+pub(super) struct Neighbourhood {
+    re: Vec<f64>,
+    im: Vec<f64>,
+}
+
+impl Neighbourhood {
+    /// Fills from `c` around tap `n0` (circularly) for `interpolator`.
+    pub(super) fn fill(&mut self, interpolator: &PeakInterpolator, correlation: &[Complex64], n0: usize) {
+        let taps = correlation.len() as i64;
+        let reach = interpolator.reach as i64;
+        self.re.clear();
+        self.im.clear();
+        for m in -reach..=reach {
+            let c = correlation[(n0 as i64 + m).rem_euclid(taps) as usize];
+            self.re.push(c.re);
+            self.im.push(c.im);
+        }
+        self.re.resize(interpolator.width, 0.0);
+        self.im.resize(interpolator.width, 0.0);
+    }
+
+    fn centre(&self, reach: usize, offset: i64) -> f64 {
+        let i = (reach as i64 + offset) as usize;
+        self.re[i].hypot(self.im[i])
+    }
+}
+
+impl PeakInterpolator {
+    pub(super) fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, kernel: &[Complex64]) -> Self {
+        let taps = band.taps();
+        let reach = PEAK_REACH_TAPS.min((taps - 1) / 2);
+        let width = (2 * reach + 1).next_multiple_of(LANES);
+        let ones = vec![Complex64::new(1.0, 0.0); taps];
+        let nodes = 2 * PEAK_NODES + 1;
+        let (mut rows_re, mut rows_im) = (vec![0.0; nodes * width], vec![0.0; nodes * width]);
+        for q in 0..nodes {
+            // D(delta - m) = d(n + delta) at n = -m, with d the response of a flat spectrum.
+            let d = shifted_response(band, planner, &ones, -node_delta(q));
+            for i in 0..=2 * reach {
+                let value = d[(reach as i64 - i as i64).rem_euclid(taps as i64) as usize];
+                (rows_re[q * width + i], rows_im[q * width + i]) = (value.re, value.im);
+            }
+        }
+        let mut interpolator = Self {
+            reach,
+            width,
+            rows_re,
+            rows_im,
+            bias_taps: vec![0.0; nodes],
+            gain: vec![Complex64::new(1.0, 0.0); nodes],
+        };
+        let peak = shifted_response(band, planner, kernel, 0.0)[0];
+        let mut bias_taps = Vec::with_capacity(nodes);
+        let mut gain = Vec::with_capacity(nodes);
+        let mut around = Neighbourhood::default();
+        for q in 0..nodes {
+            let delta = node_delta(q);
+            let response = shifted_response(band, planner, kernel, delta);
+            // The lone path at delta: c[m] = kappa(m - delta), centred on tap 0.
+            around.fill(&interpolator, &response, 0);
+            let found = interpolator.search(&around);
+            bias_taps.push(found.delta_taps - delta);
+            gain.push(found.value / peak);
+        }
+        interpolator.bias_taps = bias_taps;
+        interpolator.gain = gain;
+        interpolator
+    }
+
+    /// The peak of `|c(n0 + delta)|` for `delta` in `[-1, 1]` from the taps
+    /// around `n0`, with the lone-path bias removed.
+    pub(super) fn refine(&self, local: &Neighbourhood) -> Peak {
+        let found = self.search(local);
+        let position = (found.delta_taps + 1.0) * PEAK_NODES as f64;
+        let q = (position.floor().max(0.0) as usize).min(self.bias_taps.len() - 2);
+        let w = (position - q as f64).clamp(0.0, 1.0);
+        let bias = self.bias_taps[q] * (1.0 - w) + self.bias_taps[q + 1] * w;
+        let gain = self.gain[q] * (1.0 - w) + self.gain[q + 1] * w;
+        Peak { delta_taps: found.delta_taps - bias, value: found.value / gain }
+    }
+
+    /// `c` at node `q`.
+    fn at(&self, local: &Neighbourhood, q: usize) -> Complex64 {
+        let row = q * self.width..(q + 1) * self.width;
+        let (mut re, mut im) = ([0.0; LANES], [0.0; LANES]);
+        let rows = self.rows_re[row.clone()].chunks_exact(LANES).zip(self.rows_im[row].chunks_exact(LANES));
+        let values = local.re.chunks_exact(LANES).zip(local.im.chunks_exact(LANES));
+        for ((d_re, d_im), (c_re, c_im)) in rows.zip(values) {
+            for lane in 0..LANES {
+                re[lane] += d_re[lane] * c_re[lane] - d_im[lane] * c_im[lane];
+                im[lane] += d_re[lane] * c_im[lane] + d_im[lane] * c_re[lane];
+            }
+        }
+        Complex64::new(re.iter().sum(), im.iter().sum())
+    }
+
+    /// The maximum of `|c|^2` from the three-tap parabola's estimate by
+    /// successive quadratic fits of `c` through three nodes: 1/16 tap apart,
+    /// then neighbouring nodes (1/256 tap) around the best, moved until the
+    /// maximum lies within half a node of the middle one. About six
+    /// evaluations of `c` per peak.
+    fn search(&self, local: &Neighbourhood) -> Peak {
+        let reach = self.reach;
+        let (left, middle, right) = (local.centre(reach, -1), local.centre(reach, 0), local.centre(reach, 1));
+        let curvature = left - 2.0 * middle + right;
+        let start = if curvature < 0.0 { (0.5 * (left - right) / curvature).clamp(-0.5, 0.5) } else { 0.0 };
+        let last = 2 * PEAK_NODES;
+        let coarse = PEAK_NODES / 16;
+        let mut q = ((start + 1.0) * PEAK_NODES as f64).round() as usize;
+        for _ in 0..8 {
+            q = q.clamp(coarse, last - coarse);
+            let (t, _) = self.fit(local, q, coarse);
+            q = (q as f64 + t * coarse as f64).round() as usize;
+            if t.abs() < 1.0 {
+                break;
+            }
+        }
+        let mut best = (q, 0.0, Complex64::default());
+        for _ in 0..8 {
+            let q_fit = q.clamp(1, last - 1);
+            let (t, value) = self.fit(local, q_fit, 1);
+            best = (q_fit, t, value);
+            q = (q_fit as f64 + t).round() as usize;
+            if t.abs() <= 0.5 || q == q_fit {
+                break;
+            }
+        }
+        let (q, t, value) = best;
+        Peak { delta_taps: (q as f64 + t) / PEAK_NODES as f64 - 1.0, value }
+    }
+
+    /// Fits `c(t) = c_q + b t + a t^2` through nodes `q - step`, `q`,
+    /// `q + step` (`t` in steps) and returns the `t` in `[-1, 1]` where
+    /// `|c(t)|^2` peaks (Newton steps; the larger end when the fit is not
+    /// concave) and `c` there.
+    fn fit(&self, local: &Neighbourhood, q: usize, step: usize) -> (f64, Complex64) {
+        let (before, here, after) = (self.at(local, q - step), self.at(local, q), self.at(local, q + step));
+        let b = (after - before) * 0.5;
+        let a = (after + before) * 0.5 - here;
+        let at = |t: f64| here + b * t + a * t * t;
+        let mut t = 0.0_f64;
+        for _ in 0..8 {
+            let (value, slope) = (at(t), b + a * (2.0 * t));
+            let j1 = 2.0 * (value.conj() * slope).re;
+            let j2 = 2.0 * (slope.norm_sqr() + (value.conj() * a * 2.0).re);
+            let next = if j2 < 0.0 { (t - j1 / j2).clamp(-1.0, 1.0) } else { j1.signum() };
+            let moved = (next - t).abs();
+            t = next;
+            if moved < 1e-12 {
+                break;
+            }
+        }
+        (t, at(t))
+    }
+}
+
+/// Delay of node `q`, taps: `q / 256 - 1`.
+fn node_delta(q: usize) -> f64 {
+    q as f64 / PEAK_NODES as f64 - 1.0
+}
