@@ -25,7 +25,7 @@ use clap::Args;
 use mmtrack_core::{MpcDetection, MpcTrack, MpcTruth};
 use mmtrack_io::{AtomicFile, Durability, Overwrite};
 use mmtrack_mpc::{DetectionConfig, Detector, GmPhdConfig, GmPhdSnapshot, ShortTermConfig, SounderPulse};
-use mmtrack_sim::sounder::{ArtificialChannelConfig, artificial_channel};
+use mmtrack_sim::sounder::{ArtificialChannelConfig, PulseModel, artificial_channel};
 
 #[derive(Args)]
 pub struct MpcArtificialArgs {
@@ -38,9 +38,30 @@ pub struct MpcArtificialArgs {
     /// Monte Carlo runs per point (different noise and phases).
     #[arg(long, default_value_t = 20)]
     runs: u64,
+    /// Sounder pulse of the artificial channel: `measured-like` (band edges
+    /// rolled off and a small ripple, as a pulse measured through an RF
+    /// cable, which is what the paper used) or `flat` (an ideal band whose
+    /// off-grid paths spread over the whole CIR as a sinc).
+    #[arg(long, value_enum, default_value_t = PulseChoice::MeasuredLike)]
+    pulse: PulseChoice,
     /// The CI version: 3 runs, powers -100..-130 dB in 6 dB steps plus -116 and -126 dB.
     #[arg(long)]
     quick: bool,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum PulseChoice {
+    MeasuredLike,
+    Flat,
+}
+
+impl PulseChoice {
+    fn model(self) -> PulseModel {
+        match self {
+            Self::MeasuredLike => PulseModel::measured_like(),
+            Self::Flat => PulseModel::Flat,
+        }
+    }
 }
 
 /// One point of the sweep.
@@ -73,7 +94,7 @@ pub fn run(args: &MpcArtificialArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let mut points = Vec::new();
     for &power_db in &powers_db {
         for window in [true, false] {
-            let [proposed, gmphd] = sweep_point(power_db, window, runs)?;
+            let [proposed, gmphd] = sweep_point(power_db, window, runs, &args.pulse.model())?;
             points.push(proposed);
             points.push(gmphd);
         }
@@ -102,11 +123,12 @@ fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
 }
 
 /// The proposed tracker and GM-PHD at one power and window setting.
-fn sweep_point(power_db: f64, window: bool, runs: u64) -> anyhow::Result<[Point; 2]> {
+fn sweep_point(power_db: f64, window: bool, runs: u64, pulse_model: &PulseModel) -> anyhow::Result<[Point; 2]> {
     let config = ArtificialChannelConfig {
         mpc_power_db: power_db,
         start_separation_s: 20e-9,
         end_separation_s: 2.5e-9,
+        sounder: mmtrack_sim::sounder::SounderConfig { pulse: pulse_model.clone(), ..Default::default() },
         ..ArtificialChannelConfig::default()
     };
     let band = config.sounder.band()?;
