@@ -23,7 +23,7 @@
 //! cycle (Hogbom 1974): subtracting `alpha W exp(-j 2 pi f tau)` from the
 //! windowed transfer function is subtracting `alpha kappa(n - tau)` from
 //! `c[n]`, with `kappa` the correlation of the template with one windowed
-//! unit path. `kappa` is tabulated at 1/128-tap delays ([`tables`]), and a
+//! unit path. `kappa` is tabulated at 1/256-tap delays ([`tables`]), and a
 //! path is subtracted over the taps where `|alpha kappa|` exceeds 1 % of the
 //! threshold's amplitude (about 30 taps each side for a path 40 dB above the
 //! threshold with the Kaiser window; every tap without it). This replaces
@@ -151,7 +151,7 @@ impl Detector {
         let fft = planner.plan_fft_forward(band.taps());
         let ifft = planner.plan_fft_inverse(band.taps());
         let kernel_rows = KernelRows::new(&band, &mut planner, &kernel);
-        let interpolator = PeakInterpolator::new(&band, &mut planner, &kernel);
+        let interpolator = PeakInterpolator::new(&band, &kernel_rows);
         let mut detector = Self {
             config,
             band,

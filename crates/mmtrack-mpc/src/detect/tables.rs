@@ -8,23 +8,29 @@
 //! `x(t) = (1/U) sum_k X_k exp(j 2 pi s_k t / U)`.
 //!
 //! - [`KernelRows`]: the correlation of the template with one windowed unit
-//!   path, `kappa(t)` (spectrum `z |P|^2`), at every integer tap minus a
-//!   fractional delay on a grid of 1/128 tap, linearly interpolated between
-//!   grid rows (relative error below `|kappa''| / 131072`, about 2e-5).
+//!   path, `kappa(t)` (spectrum `z |P|^2`), at the integer taps `|m| <= 256`
+//!   minus a fractional delay on a grid of 1/256 tap, linearly interpolated
+//!   between grid rows (relative error below `|kappa''| / 524288`, about
+//!   5e-6). A path whose response matters farther out (a path some 70 dB
+//!   above the threshold with the Kaiser window; most paths without it) is
+//!   subtracted exactly over all taps with one inverse FFT.
 //! - [`PeakInterpolator`]: the band-limited interpolation
 //!   `c(n0 + delta) = sum_n c[n] D(n0 + delta - n)` (exact with the Dirichlet
 //!   kernel `D`, spectrum of ones, summed over all taps) truncated to the
 //!   `2 M + 1` taps around the coarse peak, at 1/256-tap nodes, and a
 //!   quadratic in between.
 
+use std::sync::Arc;
+
 use mmtrack_core::Complex64;
 use mmtrack_core::sounder::SounderBand;
-use rustfft::FftPlanner;
+use rustfft::{Fft, FftPlanner};
 
-/// Rows of the subtraction table per tap.
-const KERNEL_PHASES: usize = 128;
-/// Interpolation nodes per tap of the peak refinement.
-const PEAK_NODES: usize = 256;
+/// Grid points per tap of both tables (rows of the subtraction table, nodes
+/// of the refinement).
+const PHASES: usize = 256;
+/// Largest `|m|` the subtraction table holds.
+const TABLE_REACH_TAPS: usize = 256;
 /// Taps on each side of the coarse peak used by the refinement.
 const PEAK_REACH_TAPS: usize = 32;
 /// Truncation of a subtraction: residues are left only where the path's
@@ -35,7 +41,7 @@ const SUBTRACTION_RESIDUE: f64 = 0.01;
 /// `x(n - delta)` for `n = 0..U` (index `n`, i.e. signed tap `n mod U`).
 fn shifted_response(
     band: &SounderBand,
-    planner: &mut FftPlanner<f64>,
+    ifft: &dyn Fft<f64>,
     spectrum: &[Complex64],
     delta_taps: f64,
 ) -> Vec<Complex64> {
@@ -46,7 +52,7 @@ fn shifted_response(
         .enumerate()
         .map(|(k, x)| x * Complex64::from_polar(1.0 / taps as f64, turn * band.signed_bin(k) as f64))
         .collect();
-    planner.plan_fft_inverse(taps).process(&mut buffer);
+    ifft.process(&mut buffer);
     buffer
 }
 
@@ -55,11 +61,15 @@ fn signed_distance(n: usize, taps: usize) -> usize {
     n.min(taps - n)
 }
 
-/// `kappa(m - delta)` for every tap `m` and `delta` on a 1/128-tap grid in
+/// `kappa(m - delta)` for `|m| <= W` and `delta` on a 1/256-tap grid in
 /// `[0, 1]`, and how far a path's response matters.
 pub(super) struct KernelRows {
-    taps: usize,
-    /// Row `p` holds `kappa(n - p / 128)` at `p * U + n`.
+    band: SounderBand,
+    kernel: Vec<Complex64>,
+    ifft: Arc<dyn Fft<f64>>,
+    /// `W`: the table's reach, `min(U / 2, 256)` taps.
+    reach: usize,
+    /// Row `p` holds `kappa(m - p / 256)` for `m = -W..=W` at `p (2W + 1) + m + W`.
     rows: Vec<Complex64>,
     /// `tail[L]`: the largest `|kappa(m - delta)| / kappa(0)` over `|m| > L`
     /// and all rows.
@@ -69,23 +79,40 @@ pub(super) struct KernelRows {
 impl KernelRows {
     pub(super) fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, kernel: &[Complex64]) -> Self {
         let taps = band.taps();
-        let mut rows = Vec::with_capacity((KERNEL_PHASES + 1) * taps);
+        let ifft = planner.plan_fft_inverse(taps);
+        let reach = TABLE_REACH_TAPS.min(taps / 2);
+        let width = 2 * reach + 1;
+        let mut rows = Vec::with_capacity((PHASES + 1) * width);
         let mut largest = vec![0.0_f64; taps / 2 + 1];
-        for p in 0..=KERNEL_PHASES {
-            let row = shifted_response(band, planner, kernel, p as f64 / KERNEL_PHASES as f64);
+        for p in 0..=PHASES {
+            let row = shifted_response(band, ifft.as_ref(), kernel, p as f64 / PHASES as f64);
             for (n, value) in row.iter().enumerate() {
                 let m = signed_distance(n, taps);
                 largest[m] = largest[m].max(value.norm());
             }
-            rows.extend(row);
+            rows.extend((-(reach as i64)..=reach as i64).map(|m| row[m.rem_euclid(taps as i64) as usize]));
         }
         // Relative to the peak kappa(0): a residue r in c reads as an amplitude r / kappa(0).
-        let peak = rows[0].norm();
+        let peak = rows[reach].norm();
         let mut tail = vec![0.0_f64; largest.len()];
         for l in (0..largest.len() - 1).rev() {
             tail[l] = tail[l + 1].max(largest[l + 1] / peak);
         }
-        Self { taps, rows, tail }
+        Self { band: *band, kernel: kernel.to_vec(), ifft, reach, rows, tail }
+    }
+
+    /// `kappa(0)`, the correlation of a unit path at its own delay.
+    pub(super) fn peak(&self) -> Complex64 {
+        self.rows[self.reach]
+    }
+
+    /// `kappa(m - p / 256)` for `p` in `-256..=256` (a node of the
+    /// refinement) and `|m| < W`.
+    fn at_node(&self, m: i64, p: i64) -> Complex64 {
+        // kappa(m - p/256) = kappa((m + 1) - (p + 256)/256) for negative p.
+        let (m, p) = if p < 0 { (m + 1, p + PHASES as i64) } else { (m, p) };
+        let width = 2 * self.reach + 1;
+        self.rows[p as usize * width + (m + self.reach as i64) as usize]
     }
 
     /// Half-width in taps of the subtraction of a path `amplitude_ratio`
@@ -104,25 +131,28 @@ impl KernelRows {
         amplitude: Complex64,
         reach: usize,
     ) -> (usize, usize) {
-        let taps = self.taps;
+        let taps = self.band.taps();
+        if reach > self.reach && 2 * self.reach + 1 < taps {
+            // Beyond the table: exactly, over every tap.
+            let response = shifted_response(&self.band, self.ifft.as_ref(), &self.kernel, x_taps);
+            correlation.iter_mut().zip(&response).for_each(|(c, k)| *c -= amplitude * k);
+            return (0, taps);
+        }
+        let width = 2 * self.reach + 1;
         let whole = x_taps.floor();
-        let position = (x_taps - whole) * KERNEL_PHASES as f64;
-        let p = (position.floor() as usize).min(KERNEL_PHASES - 1);
+        let position = (x_taps - whole) * PHASES as f64;
+        let p = (position.floor() as usize).min(PHASES - 1);
         let weight = position - p as f64;
-        let (low, high) = (&self.rows[p * taps..(p + 1) * taps], &self.rows[(p + 1) * taps..(p + 2) * taps]);
+        let (low, high) = (&self.rows[p * width..(p + 1) * width], &self.rows[(p + 1) * width..(p + 2) * width]);
         // Signed taps -reach..=reach, or every tap once when that covers the CIR.
         let (first_m, count) =
             if 2 * reach + 1 >= taps { (-((taps / 2) as i64), taps) } else { (-(reach as i64), 2 * reach + 1) };
-        let mut m = first_m.rem_euclid(taps as i64) as usize;
         let first_n = (whole as i64 + first_m).rem_euclid(taps as i64) as usize;
         let mut n = first_n;
         let (a_low, a_high) = (amplitude * (1.0 - weight), amplitude * weight);
-        for _ in 0..count {
+        for i in 0..count {
+            let m = (first_m + i as i64 + self.reach as i64) as usize;
             correlation[n] -= a_low * low[m] + a_high * high[m];
-            m += 1;
-            if m == taps {
-                m = 0;
-            }
             n += 1;
             if n == taps {
                 n = 0;
@@ -190,18 +220,17 @@ impl Neighbourhood {
 }
 
 impl PeakInterpolator {
-    pub(super) fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, kernel: &[Complex64]) -> Self {
+    /// The refinement for `band`, calibrated on the kernel of `rows`.
+    pub(super) fn new(band: &SounderBand, rows: &KernelRows) -> Self {
         let taps = band.taps();
-        let reach = PEAK_REACH_TAPS.min((taps - 1) / 2);
+        // The calibration reads kappa at |m| <= M + 1 from the table.
+        let reach = PEAK_REACH_TAPS.min((taps - 1) / 2).min(rows.reach.saturating_sub(1)).max(1);
         let width = (2 * reach + 1).next_multiple_of(LANES);
-        let ones = vec![Complex64::new(1.0, 0.0); taps];
-        let nodes = 2 * PEAK_NODES + 1;
+        let nodes = 2 * PHASES + 1;
         let (mut rows_re, mut rows_im) = (vec![0.0; nodes * width], vec![0.0; nodes * width]);
         for q in 0..nodes {
-            // D(delta - m) = d(n + delta) at n = -m, with d the response of a flat spectrum.
-            let d = shifted_response(band, planner, &ones, -node_delta(q));
             for i in 0..=2 * reach {
-                let value = d[(reach as i64 - i as i64).rem_euclid(taps as i64) as usize];
+                let value = dirichlet(band, node_delta(q) - (i as f64 - reach as f64));
                 (rows_re[q * width + i], rows_im[q * width + i]) = (value.re, value.im);
             }
         }
@@ -213,17 +242,24 @@ impl PeakInterpolator {
             bias_taps: vec![0.0; nodes],
             gain: vec![Complex64::new(1.0, 0.0); nodes],
         };
-        let peak = shifted_response(band, planner, kernel, 0.0)[0];
+        let peak = rows.peak();
         let mut bias_taps = Vec::with_capacity(nodes);
         let mut gain = Vec::with_capacity(nodes);
-        let mut around = Neighbourhood::default();
+        let mut lone = Neighbourhood::default();
         for q in 0..nodes {
-            let delta = node_delta(q);
-            let response = shifted_response(band, planner, kernel, delta);
-            // The lone path at delta: c[m] = kappa(m - delta), centred on tap 0.
-            around.fill(&interpolator, &response, 0);
-            let found = interpolator.search(&around);
-            bias_taps.push(found.delta_taps - delta);
+            // The lone unit path at delta: c[m] = kappa(m - delta) around tap 0.
+            let p = q as i64 - PHASES as i64;
+            lone.re.clear();
+            lone.im.clear();
+            for m in -(reach as i64)..=reach as i64 {
+                let value = rows.at_node(m, p);
+                lone.re.push(value.re);
+                lone.im.push(value.im);
+            }
+            lone.re.resize(width, 0.0);
+            lone.im.resize(width, 0.0);
+            let found = interpolator.search(&lone);
+            bias_taps.push(found.delta_taps - node_delta(q));
             gain.push(found.value / peak);
         }
         interpolator.bias_taps = bias_taps;
@@ -235,7 +271,7 @@ impl PeakInterpolator {
     /// around `n0`, with the lone-path bias removed.
     pub(super) fn refine(&self, local: &Neighbourhood) -> Peak {
         let found = self.search(local);
-        let position = (found.delta_taps + 1.0) * PEAK_NODES as f64;
+        let position = (found.delta_taps + 1.0) * PHASES as f64;
         let q = (position.floor().max(0.0) as usize).min(self.bias_taps.len() - 2);
         let w = (position - q as f64).clamp(0.0, 1.0);
         let bias = self.bias_taps[q] * (1.0 - w) + self.bias_taps[q + 1] * w;
@@ -268,9 +304,9 @@ impl PeakInterpolator {
         let (left, middle, right) = (local.centre(reach, -1), local.centre(reach, 0), local.centre(reach, 1));
         let curvature = left - 2.0 * middle + right;
         let start = if curvature < 0.0 { (0.5 * (left - right) / curvature).clamp(-0.5, 0.5) } else { 0.0 };
-        let last = 2 * PEAK_NODES;
-        let coarse = PEAK_NODES / 16;
-        let mut q = ((start + 1.0) * PEAK_NODES as f64).round() as usize;
+        let last = 2 * PHASES;
+        let coarse = PHASES / 16;
+        let mut q = ((start + 1.0) * PHASES as f64).round() as usize;
         for _ in 0..8 {
             q = q.clamp(coarse, last - coarse);
             let (t, _) = self.fit(local, q, coarse);
@@ -290,7 +326,7 @@ impl PeakInterpolator {
             }
         }
         let (q, t, value) = best;
-        Peak { delta_taps: (q as f64 + t) / PEAK_NODES as f64 - 1.0, value }
+        Peak { delta_taps: (q as f64 + t) / PHASES as f64 - 1.0, value }
     }
 
     /// Fits `c(t) = c_q + b t + a t^2` through nodes `q - step`, `q`,
@@ -320,5 +356,20 @@ impl PeakInterpolator {
 
 /// Delay of node `q`, taps: `q / 256 - 1`.
 fn node_delta(q: usize) -> f64 {
-    q as f64 / PEAK_NODES as f64 - 1.0
+    q as f64 / PHASES as f64 - 1.0
+}
+
+/// The Dirichlet kernel `D(t) = (1/U) sum_k exp(j 2 pi s_k t / U)` in closed
+/// form: `exp(j 2 pi c t / U) sin(pi t) / (U sin(pi t / U))` with `c` the
+/// centre of the signed bins (`-1/2` for even `U`, `0` for odd), for
+/// `|t| < U` (1 at `t = 0`).
+fn dirichlet(band: &SounderBand, t: f64) -> Complex64 {
+    let taps = band.taps() as f64;
+    if t == 0.0 {
+        return Complex64::new(1.0, 0.0);
+    }
+    let centre = if band.taps().is_multiple_of(2) { -0.5 } else { 0.0 };
+    let pi = std::f64::consts::PI;
+    let magnitude = (pi * t).sin() / (taps * (pi * t / taps).sin());
+    Complex64::from_polar(magnitude, 2.0 * pi * centre * t / taps)
 }

@@ -59,6 +59,38 @@ fn noiseless_off_grid_paths_are_recovered() {
 }
 
 #[test]
+fn a_path_stronger_than_the_subtraction_table_reaches_is_removed_exactly() {
+    // 2048 taps: the subtraction table holds +-256 taps, so a path 134 dB above
+    // the threshold (-60 dB over a -200 dB floor) is subtracted over every tap
+    // with one inverse FFT; the -100 dB path 20 taps from it and the -120 dB
+    // path far away are then found as in a CIR of their own.
+    let band = band(2048);
+    let pulse = SounderPulse::flat(&band);
+    let detector = Detector::new(noiseless_config(Some(6.0)), TAP_S, &pulse).unwrap();
+    let paths = [
+        Path { delay_s: 300.3e-9, power_db: -60.0, phase_rad: 0.4 },
+        Path { delay_s: 320.6e-9, power_db: -100.0, phase_rad: 2.0 },
+        Path { delay_s: 1500.7e-9, power_db: -120.0, phase_rad: -1.0 },
+    ];
+    let found = detector.detect(&snapshot(&band, &pulse, &paths, None, &mut rng(1), 0), 0).unwrap();
+    for path in &paths {
+        let nearest = found
+            .detections
+            .iter()
+            .min_by(|a, b| (a.delay_s - path.delay_s).abs().total_cmp(&(b.delay_s - path.delay_s).abs()))
+            .unwrap();
+        let error_taps = (nearest.delay_s - path.delay_s).abs() / TAP_S;
+        println!("{:.1} dB path: {error_taps:.1e} taps, {:.3} dB", path.power_db, nearest.power_db());
+        assert!(error_taps < 1e-3 && (nearest.power_db() - path.power_db).abs() < 0.01, "{nearest:?}");
+    }
+    // Whatever else is found is residue of the three, far below the weakest.
+    let others = found.detections.iter().filter(|d| paths.iter().all(|p| (d.delay_s - p.delay_s).abs() > 1e-9));
+    let strongest_other = others.map(|d| d.power_db()).fold(f64::NEG_INFINITY, f64::max);
+    println!("strongest other detection: {strongest_other:.1} dB ({} detections)", found.detections.len());
+    assert!(strongest_other < -150.0, "{strongest_other}");
+}
+
+#[test]
 fn blocked_width_of_the_kaiser_windowed_flat_pulse() {
     let band = band(1024);
     let detector = Detector::new(DetectionConfig::default(), TAP_S, &SounderPulse::flat(&band)).unwrap();
