@@ -43,6 +43,7 @@ def check_all_types(root):
         ("/gnss/fix", "mmtrack.GnssFix"): 1,
         ("/viz/gnss", "foxglove.LocationFix"): 1,
         ("/channel/cir", "mmtrack.CirSnapshot"): 1,
+        ("/channel/mpc_truth", "mmtrack.MpcTruth"): 1,
     }
     check(dict(counts) == expected, f"channel counts {dict(counts)}")
     poses = [d for t, _, _, d in messages if t == "/ground_truth/pose"]
@@ -58,6 +59,9 @@ def check_all_types(root):
     cir = next(d for t, _, _, d in messages if t == "/channel/cir")
     check(list(cir.taps_re) == [float(k) for k in range(16)] and list(cir.taps_im) == [-float(k) for k in range(16)], "cir taps")
     check(cir.set_index == 3 and cir.snapshot_index == 2 and cir.carrier_hz == 5.7e9, "cir indices")
+    truth = next(d for t, _, _, d in messages if t == "/channel/mpc_truth")
+    check(truth.path_id == 7 and truth.delay_s == 4.25e-9 and truth.doppler_hz == -321.5, "mpc truth fields")
+    check(truth.amplitude_re == 1e-5 and truth.amplitude_im == -2e-5 and truth.snapshot_index == 2, "mpc truth amplitude")
     log_times = [m.log_time for t, _, m, _ in messages if t == "/ground_truth/pose"]
     check(log_times == [1_000_000_000 + i * 100_000_000 for i in range(5)], "log time = t_ns")
     print("mcap (all types): ok")

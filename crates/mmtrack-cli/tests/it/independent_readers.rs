@@ -8,7 +8,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use mmtrack_core::{CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTrack, Se2, StampedPose};
+use mmtrack_core::{CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTrack, MpcTruth, Se2, StampedPose};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::{Overwrite, RecordingOptions, RecordingWriter};
@@ -83,6 +83,17 @@ fn write_samples(dir: &Path) {
         first_path_hint_s: Some(2.5e-9),
     };
     writer.write_cir(&cir).unwrap();
+    writer
+        .write_mpc_truth(&MpcTruth {
+            t_ns: 1_000_000_000,
+            set_index: 3,
+            snapshot_index: 2,
+            path_id: 7,
+            delay_s: 4.25e-9,
+            amplitude: Complex64::new(1e-5, -2e-5),
+            doppler_hz: -321.5,
+        })
+        .unwrap();
     writer.finish().unwrap();
 
     let run = RunInfo { config_json: r#"{"who":"independent reader test"}"#.into() };
