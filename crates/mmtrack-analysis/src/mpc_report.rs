@@ -97,29 +97,41 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
     let with_truth: Vec<&MpcResult> = results.iter().filter(|r| r.summary.truth_mpcs.is_some()).collect();
     if !with_truth.is_empty() {
         out.push_str(
-            "Against the simulator's truth (`mpc_truth`): a detection matches a true MPC of the same snapshot within \
-             0.5 ns, one to one, strongest true MPC first; recall above floor counts true MPCs at least 6 dB above the \
-             set's noise floor; purity is the share of a track's detections on its majority path; true births and \
-             deaths count paths above the floor appearing or vanishing between consecutive sets.\n\n\
-             | sequence | true MPCs | precision | recall | recall above floor | track purity | births est / true | \
-             deaths est / true | birth rate est / true (1/m) | death rate est / true (1/m) |\n\
-             |---|---|---|---|---|---|---|---|---|---|\n",
+            "Against the simulator's truth (`mpc_truth`), made resolvable first (true MPCs of a snapshot within 0.5 \
+             ns of each other count as one, with the complex sum of their amplitudes): a detection matches a true MPC \
+             of the same snapshot within 0.5 ns, one to one, strongest true MPC first; recall above floor counts the \
+             detectable true MPCs, at least 6 dB above the set's noise floor; purity is the share of a track's \
+             detections on its majority path, over tracks with a matched detection; false tracks have none. \
+             Long-term tracks follow the majority path of their detections; births/deaths on true paths count \
+             those that follow one, tracks per path is how many long-term tracks each followed path was split \
+             into. True births and deaths count paths above the floor appearing or vanishing between consecutive \
+             sets.\n\n\
+             | sequence | true MPCs | precision | recall | recall above floor | track purity | false tracks | \
+             false long-term tracks | long-term tracks per path | births est / on true paths / true | \
+             deaths est / on true paths / true | birth rate est / true (1/m) | death rate est / true (1/m) |\n\
+             |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         );
         for r in with_truth {
             let s = &r.summary;
+            let n = |v: Option<u64>| v.map_or_else(|| "n/a".into(), |v| v.to_string());
             let _ = writeln!(
                 out,
-                "| {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {} / {} | {} / {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} / {} / {} | {} / {} / {} | {} / {} | {} / {} |",
                 r.sequence,
                 s.truth_mpcs.unwrap_or(0),
                 opt(s.precision, 3),
                 opt(s.recall, 3),
                 opt(s.recall_above_floor, 3),
                 opt(s.track_purity, 3),
+                pct(s.false_track_share),
+                pct(s.false_long_term_share),
+                opt(s.long_term_tracks_per_path, 1),
                 s.births,
-                s.true_births.map_or_else(|| "n/a".into(), |v| v.to_string()),
+                n(s.births_on_true_paths),
+                n(s.true_births),
                 s.deaths,
-                s.true_deaths.map_or_else(|| "n/a".into(), |v| v.to_string()),
+                n(s.deaths_on_true_paths),
+                n(s.true_deaths),
                 opt(s.birth_rate_per_m, 3),
                 opt(s.true_birth_rate_per_m, 3),
                 opt(s.death_rate_per_m, 3),

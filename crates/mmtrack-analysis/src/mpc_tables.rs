@@ -297,11 +297,21 @@ they are null without one, and the per-second rates always apply. Truth columns 
         opt("all_tracks_std_below_1_5db", Float64, "", "share of all short-term tracks with power std < 1.5 dB"),
         opt("chi_0_1ns_power_share", Float64, "", "share of linked power in classes chi <= 0.1 ns"),
         opt("unrelated_power_share", Float64, "", "share of long-term power in entries related to no adjacent set"),
-        opt("truth_mpcs", UInt64, "", "true MPCs over all snapshots"),
+        opt("truth_mpcs", UInt64, "", "resolvable true MPCs over all snapshots (true MPCs within 0.5 ns merged)"),
         opt("precision", Float64, "", "detections matching a true MPC within 0.5 ns / detections"),
         opt("recall", Float64, "", "true MPCs matched / true MPCs"),
         opt("recall_above_floor", Float64, "", "recall over true MPCs at least 6 dB above the noise floor"),
-        opt("track_purity", Float64, "", "detection-weighted share of track detections on their majority path"),
+        opt(
+            "track_purity",
+            Float64,
+            "",
+            "over tracks with a matched detection: detection-weighted share on their majority path",
+        ),
+        opt("false_track_share", Float64, "", "share of short-term tracks without a matched detection"),
+        opt("false_long_term_share", Float64, "", "share of long-term tracks that follow no true path"),
+        opt("births_on_true_paths", UInt64, "", "births of long-term tracks that follow a true path"),
+        opt("deaths_on_true_paths", UInt64, "", "deaths of long-term tracks that follow a true path"),
+        opt("long_term_tracks_per_path", Float64, "", "long-term tracks following a true path / paths followed"),
         opt("true_births", UInt64, "", "true path births above the floor"),
         opt("true_deaths", UInt64, "", "true path deaths above the floor"),
         opt("true_birth_rate_per_m", Float64, "1/m", "true_births / distance_m"),
@@ -347,6 +357,11 @@ impl TableRow for MpcSummary {
             o(|r| r.recall),
             o(|r| r.recall_above_floor),
             o(|r| r.track_purity),
+            o(|r| r.false_track_share),
+            o(|r| r.false_long_term_share),
+            ou(|r| r.births_on_true_paths),
+            ou(|r| r.deaths_on_true_paths),
+            o(|r| r.long_term_tracks_per_path),
             ou(|r| r.true_births),
             ou(|r| r.true_deaths),
             o(|r| r.true_birth_rate_per_m),
@@ -358,7 +373,7 @@ impl TableRow for MpcSummary {
         let u = |n: &str| c.u64(n);
         let f = |n: &str| c.f64(n);
         let source = c.utf8("distance_source")?;
-        let [sets, det, short, full, long, births, deaths, truth, tb, td] = [
+        let [sets, det, short, full, long, births, deaths, truth, tb, td, bp, dp] = [
             "sets",
             "detections",
             "short_term_tracks",
@@ -369,10 +384,12 @@ impl TableRow for MpcSummary {
             "truth_mpcs",
             "true_births",
             "true_deaths",
+            "births_on_true_paths",
+            "deaths_on_true_paths",
         ]
         .map(u);
-        let (sets, det, short, full, long, births, deaths, truth, tb, td) =
-            (sets?, det?, short?, full?, long?, births?, deaths?, truth?, tb?, td?);
+        let (sets, det, short, full, long, births, deaths, truth, tb, td, bp, dp) =
+            (sets?, det?, short?, full?, long?, births?, deaths?, truth?, tb?, td?, bp?, dp?);
         let floats = [
             "mean_mpcs_per_set",
             "median_mpcs_per_set",
@@ -394,6 +411,9 @@ impl TableRow for MpcSummary {
             "recall",
             "recall_above_floor",
             "track_purity",
+            "false_track_share",
+            "false_long_term_share",
+            "long_term_tracks_per_path",
             "true_birth_rate_per_m",
             "true_death_rate_per_m",
         ]
@@ -404,7 +424,8 @@ impl TableRow for MpcSummary {
             (next()?, next()?, next()?, next()?, next()?, next()?, next()?, next()?);
         let (dl, tl, fl, gl, s1, s15, chi, unrel) =
             (next()?, next()?, next()?, next()?, next()?, next()?, next()?, next()?);
-        let (prec, rec, recf, pur, tbr, tdr) = (next()?, next()?, next()?, next()?, next()?, next()?);
+        let (prec, rec, recf, pur, fts, flt, ltp) = (next()?, next()?, next()?, next()?, next()?, next()?, next()?);
+        let (tbr, tdr) = (next()?, next()?);
         Ok((0..c.num_rows())
             .map(|i| MpcSummary {
                 sets: sets.value(i),
@@ -436,6 +457,11 @@ impl TableRow for MpcSummary {
                 recall: of(rec, i),
                 recall_above_floor: of(recf, i),
                 track_purity: of(pur, i),
+                false_track_share: of(fts, i),
+                false_long_term_share: of(flt, i),
+                births_on_true_paths: ou(bp, i),
+                deaths_on_true_paths: ou(dp, i),
+                long_term_tracks_per_path: of(ltp, i),
                 true_births: ou(tb, i),
                 true_deaths: ou(td, i),
                 true_birth_rate_per_m: of(tbr, i),

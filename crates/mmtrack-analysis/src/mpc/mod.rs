@@ -15,8 +15,11 @@
 //! - share of the long-term link power per confidence class chi (Sec. VI-A:
 //!   72 % at chi <= 0.1 ns in the paper) and the share of full-lifetime power
 //!   related to no adjacent set (5 % in the paper);
-//! - against the simulator's truth ([`truth`]): detection precision and
-//!   recall, track purity, true birth and death rates.
+//! - against the simulator's truth ([`truth`], made resolvable first: true
+//!   MPCs closer than the match tolerance count as one): detection precision
+//!   and recall (also over the detectable truth, above the floor + 6 dB),
+//!   track purity and false tracks, long-term tracks that follow true paths
+//!   (their births and deaths, tracks per path), true birth and death rates.
 
 pub mod truth;
 
@@ -24,7 +27,7 @@ use std::collections::BTreeMap;
 
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
 
-pub use truth::{TruthScores, match_detections};
+pub use truth::{TruthScores, match_detections, resolvable_truth};
 
 /// Where the distance travelled comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -199,6 +202,11 @@ pub struct MpcSummary {
     pub recall: Option<f64>,
     pub recall_above_floor: Option<f64>,
     pub track_purity: Option<f64>,
+    pub false_track_share: Option<f64>,
+    pub false_long_term_share: Option<f64>,
+    pub births_on_true_paths: Option<u64>,
+    pub deaths_on_true_paths: Option<u64>,
+    pub long_term_tracks_per_path: Option<f64>,
     pub true_births: Option<u64>,
     pub true_deaths: Option<u64>,
     pub true_birth_rate_per_m: Option<f64>,
@@ -285,7 +293,8 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
     }
     let spans = long_term_spans(&input.long_term);
     let gmphd_gain = input.gmphd_tracks.as_deref().map(|t| tracks_gain_db(t, &sets));
-    let truth_scores = input.truth.as_deref().map(|t| truth::score(t, &input.detections, &input.tracks, &sets));
+    let truth_scores =
+        input.truth.as_deref().map(|t| truth::score(t, &input.detections, &input.tracks, &input.long_term, &sets));
 
     let mut per_set = Vec::with_capacity(sets.len());
     for (k, s) in sets.iter().enumerate() {
@@ -499,6 +508,11 @@ fn summarise(
         recall: truth.and_then(|t| t.recall),
         recall_above_floor: truth.and_then(|t| t.recall_above_floor),
         track_purity: truth.and_then(|t| t.track_purity),
+        false_track_share: truth.and_then(|t| t.false_track_share),
+        false_long_term_share: truth.and_then(|t| t.false_long_term_share),
+        births_on_true_paths: truth.map(|t| t.births_on_true_paths),
+        deaths_on_true_paths: truth.map(|t| t.deaths_on_true_paths),
+        long_term_tracks_per_path: truth.and_then(|t| t.long_term_tracks_per_path),
         true_births: truth.map(|t| t.transitions.values().map(|v| v.0).sum()),
         true_deaths: truth.map(|t| t.transitions.values().map(|v| v.1).sum()),
         true_birth_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.0).sum())),
