@@ -31,6 +31,12 @@
 //! gains are `sum |alpha|^2 (w^H w)` over the respective detections (`w^H w`
 //! = [`Detector::pulse_energy`]), the scale of the detector's
 //! `detected_gain_db`, so each compares directly with the channel gain.
+//! The channel gain is the windowed CIR's energy and so includes the cross
+//! terms of paths that overlap within the windowed pulse, while the captured
+//! gains sum each path's own energy: where resolved paths interfere
+//! destructively (two paths 1.1 ns apart after the Kaiser window, as a
+//! convoy's LOS and a wall bounce) the detected gain exceeds the channel
+//! gain, and the power loss of Mahler et al.'s Fig. 9 is negative.
 
 use mmtrack_core::{CirSnapshot, MpcLongTermEntry, MpcSetStats, MpcTrack};
 
