@@ -75,12 +75,13 @@ pub(super) fn boreas_folder(
     let report = report?;
     if !quiet {
         println!(
-            "{}: {} scans ({} m range bins: {}), {} ground-truth poses ({:.1} MB)",
+            "{}: {} scans ({} m range bins: {}), {} ground-truth poses, {} GNSS fixes ({:.1} MB)",
             report.output.path.display(),
             report.scans,
             report.range_resolution_m,
             report.range_resolution_source,
             report.ground_truth_poses,
+            report.gnss_fixes,
             report.output.file_bytes as f64 / 1e6
         );
     }
@@ -103,11 +104,12 @@ pub(super) fn mulran_folder(
     let report = report?;
     if !quiet {
         println!(
-            "{}: {} scans (azimuth times: file time at the sweep's {}), {} ground-truth poses ({:.1} MB)",
+            "{}: {} scans (azimuth times: file time at the sweep's {}), {} ground-truth poses, {} GNSS fixes ({:.1} MB)",
             report.output.path.display(),
             report.scans,
             options.timing.stamp_at.name(),
             report.ground_truth_poses,
+            report.gnss_fixes,
             report.output.file_bytes as f64 / 1e6
         );
     }

@@ -4,7 +4,8 @@
 //!
 //! Layout: `boreas-YYYY-MM-DD-HH-MM/radar/<t_us>.png` and, when present,
 //! `applanix/radar_poses.csv` (or another `applanix/<sensor>_poses.csv`; see
-//! [`applanix`]).
+//! [`applanix`]) and `applanix/gps_post_process.csv` (GNSS fixes, see
+//! [`gps`]).
 //!
 //! Scans use the Oxford row header (int64 microseconds, uint16 encoder of 5600
 //! counts per turn, one more byte), so they are read by the Oxford decoder
@@ -28,6 +29,7 @@
 //! reference); each azimuth keeps its own time from the row header.
 
 pub mod applanix;
+pub mod gps;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -60,6 +62,8 @@ pub struct BoreasFolder {
     pub scans: Vec<ScanFile>,
     /// The poses file and its sensor name (`radar` for `radar_poses.csv`).
     pub poses: Option<(PathBuf, String)>,
+    /// `applanix/gps_post_process.csv`, when present (see [`gps`]).
+    pub gps: Option<PathBuf>,
 }
 
 /// `boreas-YYYY-MM-DD-HH-MM` to (year, month, day).
@@ -108,7 +112,8 @@ impl BoreasFolder {
             });
         }
         let scans = list_scan_pngs(&radar_dir, StampUnit::Micros)?;
-        Ok(Self { root: root.to_path_buf(), scans, poses: find_poses(root)? })
+        let gps = root.join("applanix").join("gps_post_process.csv");
+        Ok(Self { root: root.to_path_buf(), scans, poses: find_poses(root)?, gps: gps.is_file().then_some(gps) })
     }
 
     /// Sequence id: the folder name.
@@ -159,6 +164,8 @@ pub struct BoreasReport {
     pub scans: u64,
     /// Ground-truth poses written (those within the scans' time span).
     pub ground_truth_poses: u64,
+    /// GNSS fixes written from `gps_post_process.csv` (within the scans' time span).
+    pub gnss_fixes: u64,
     /// The range resolution used, metres.
     pub range_resolution_m: f64,
     /// Why that resolution.
@@ -210,6 +217,14 @@ pub fn ingest_boreas(
         }
         None => None,
     };
+    let fixes = match &folder.gps {
+        Some(path) => {
+            extra.insert("gnss.source".into(), path.display().to_string());
+            extra.insert("gnss.kind".into(), "Applanix post-processed GNSS/INS solution (200 Hz)".into());
+            gps::read_boreas_gps(path)?
+        }
+        None => Vec::new(),
+    };
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("boreas:{}", folder.root.display()),
@@ -226,9 +241,15 @@ pub fn ingest_boreas(
             ground_truth_poses += 1;
         }
     }
+    let mut gnss_fixes = 0;
+    for fix in fixes.iter().filter(|f| (first..=last).contains(&f.t_ns)) {
+        writer.write_gnss_fix(fix)?;
+        gnss_fixes += 1;
+    }
     Ok(BoreasReport {
         scans: folder.scans.len() as u64,
         ground_truth_poses,
+        gnss_fixes,
         range_resolution_m,
         range_resolution_source: source,
         output: writer.finish()?,

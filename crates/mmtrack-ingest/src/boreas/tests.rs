@@ -46,6 +46,14 @@ fn folder(parent: &Path, name: &str, bins: usize) -> PathBuf {
         csv.push_str(&format!("{t_us},{},4848823.0,154.5,4,0,0,3.14159,0,0.1,0,0,0\n", 623450.0 + i as f64));
     }
     std::fs::write(root.join("applanix/radar_poses.csv"), csv).unwrap();
+    // GNSS at 4 Hz from before the first scan to after the last: 3 of 6 rows in span.
+    let mut gps = String::from(
+        "GPSTime,easting,northing,altitude,vel_east,vel_north,vel_up,roll,pitch,heading,angvel_z,angvel_y,angvel_x,accelz,accely,accelx,latitude,longitude\n",
+    );
+    for t in ["1630597345.3", "1630597345.6", "1630597345.85", "1630597346.05", "1630597346.3", "1630597346.55"] {
+        gps.push_str(&format!("{t},0,0,154.5,0,0,0,0,0,0,0,0,0,0,0,0,0.7641224,-1.3869569\n"));
+    }
+    std::fs::write(root.join("applanix/gps_post_process.csv"), gps).unwrap();
     root
 }
 
@@ -85,7 +93,7 @@ fn folder_gives_scans_with_width_from_file_resolution_by_date_and_local_poses() 
         let root = folder(dir.path(), name, bins);
         let out = dir.path().join(format!("{name}.mcap"));
         let report = ingest(&root, &out, &BoreasOptions::default()).unwrap();
-        assert_eq!((report.scans, report.ground_truth_poses), (3, 3));
+        assert_eq!((report.scans, report.ground_truth_poses, report.gnss_fixes), (3, 3, 3));
         assert_eq!(report.range_resolution_m, resolution_m);
         let (scans, poses, metadata) = read(&out);
         assert_eq!(scans.len(), 3);
@@ -163,6 +171,15 @@ fn bad_input_names_file_record_and_field_and_leaves_no_output() {
     std::fs::write(&poses, text.replacen(",154.5,", ",NaN,", 1)).unwrap();
     let err = ingest(&root, &out, &BoreasOptions::default()).unwrap_err().to_string();
     assert!(err.contains("line 2") && err.contains("altitude"), "{err}");
+    assert!(!out.exists(), "no partial output");
+    std::fs::write(&poses, &text).unwrap();
+
+    // GNSS latitude in degrees instead of radians.
+    let gps = root.join("applanix/gps_post_process.csv");
+    let text = std::fs::read_to_string(&gps).unwrap();
+    std::fs::write(&gps, text.replacen(",0.7641224,", ",43.78,", 1)).unwrap();
+    let err = ingest(&root, &out, &BoreasOptions::default()).unwrap_err().to_string();
+    assert!(err.contains("gps_post_process.csv") && err.contains("line 2") && err.contains("radians"), "{err}");
     assert!(!out.exists(), "no partial output");
 
     // Empty radar folder, and no radar folder.

@@ -3,7 +3,9 @@
 //! its converters read it).
 //!
 //! Layout: `sensor_data/radar/polar/<t_ns>.png` and, when present,
-//! `global_pose.csv` (see [`global_pose`]) at the sequence root.
+//! `global_pose.csv` (see [`global_pose`]) at the sequence root and
+//! `sensor_data/gps.csv` (see [`gps`]); poses and fixes within the scans'
+//! time span are written.
 //!
 //! Scans are plain 8-bit greyscale PNGs with **range along the rows and
 //! azimuth along the columns** (a Navtech CIR204-H: 400 columns of 3360
@@ -18,6 +20,7 @@
 //! recording metadata records the timing policy (`radar.azimuth_times`).
 
 pub mod global_pose;
+pub mod gps;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -43,6 +46,8 @@ pub struct MulranFolder {
     pub scans: Vec<ScanFile>,
     /// `global_pose.csv`, when present.
     pub global_pose: Option<PathBuf>,
+    /// `sensor_data/gps.csv`, when present.
+    pub gps: Option<PathBuf>,
 }
 
 impl MulranFolder {
@@ -59,7 +64,13 @@ impl MulranFolder {
         }
         let scans = list_scan_pngs(&polar, StampUnit::Nanos)?;
         let pose = root.join("global_pose.csv");
-        Ok(Self { root: root.to_path_buf(), scans, global_pose: pose.is_file().then_some(pose) })
+        let gps = root.join("sensor_data").join("gps.csv");
+        Ok(Self {
+            root: root.to_path_buf(),
+            scans,
+            global_pose: pose.is_file().then_some(pose),
+            gps: gps.is_file().then_some(gps),
+        })
     }
 
     /// Sequence id: the folder name.
@@ -160,6 +171,8 @@ pub struct MulranReport {
     pub scans: u64,
     /// Ground-truth poses written (those within the scans' time span).
     pub ground_truth_poses: u64,
+    /// GNSS fixes written (those within the scans' time span).
+    pub gnss_fixes: u64,
     /// The recording.
     pub output: WriteSummary,
 }
@@ -199,7 +212,14 @@ pub fn ingest_mulran(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<MulranReport, IngestError> {
-    let (extra, truth) = metadata(folder, options)?;
+    let (mut extra, truth) = metadata(folder, options)?;
+    let fixes = match &folder.gps {
+        Some(path) => {
+            extra.insert("gnss.source".into(), path.display().to_string());
+            gps::read_mulran_gps(path)?
+        }
+        None => Vec::new(),
+    };
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("mulran:{}", folder.root.display()),
@@ -223,7 +243,12 @@ pub fn ingest_mulran(
         writer.write_pose(PoseStream::GroundTruth, pose, "world", "vehicle")?;
         ground_truth_poses += 1;
     }
-    Ok(MulranReport { scans: total, ground_truth_poses, output: writer.finish()? })
+    let mut gnss_fixes = 0;
+    for fix in fixes.iter().filter(|f| (first..=last).contains(&f.t_ns)) {
+        writer.write_gnss_fix(fix)?;
+        gnss_fixes += 1;
+    }
+    Ok(MulranReport { scans: total, ground_truth_poses, gnss_fixes, output: writer.finish()? })
 }
 
 #[cfg(test)]

@@ -32,6 +32,12 @@ fn folder(parent: &Path) -> PathBuf {
     // A pose outside the scans' span is left out.
     poses.push_str("1561000009000000000,1,0,0,0,0,1,0,0,0,0,1,0\n");
     std::fs::write(root.join("global_pose.csv"), poses).unwrap();
+    // GPS at 4 Hz around the scans: the 3 rows within their span are kept.
+    let gps: String = [-250_000_000i64, 0, 250_000_000, 500_000_000, 750_000_000]
+        .iter()
+        .map(|dt| format!("{},36.37,127.36,80.0,4.0,0,0,0,4.0,0,0,0,16.0\n", STAMPS_NS[0] + dt))
+        .collect();
+    std::fs::write(root.join("sensor_data/gps.csv"), gps).unwrap();
     root
 }
 
@@ -45,7 +51,7 @@ fn folder_gives_transposed_scans_with_spread_times_and_local_poses() {
     let root = folder(dir.path());
     let out = dir.path().join("kaist.mcap");
     let report = ingest(&root, &out, &MulranOptions::default()).unwrap();
-    assert_eq!((report.scans, report.ground_truth_poses), (3, 3));
+    assert_eq!((report.scans, report.ground_truth_poses, report.gnss_fixes), (3, 3, 3));
     let mut reader = RecordingReader::open(&out).unwrap();
     let (mut scans, mut poses) = (Vec::new(), Vec::new());
     for event in reader.by_ref() {
@@ -121,6 +127,15 @@ fn bad_input_names_file_and_field_and_leaves_no_output() {
     std::fs::write(&poses, format!("{}\n{}\n", swapped[1], swapped[0])).unwrap();
     let err = ingest(&root, &out, &MulranOptions::default()).unwrap_err().to_string();
     assert!(err.contains("line 2: t_ns") && err.contains("does not increase"), "{err}");
+    assert!(!out.exists(), "no partial output");
+    std::fs::write(&poses, &text).unwrap();
+
+    // A GPS line cut short.
+    let gps = root.join("sensor_data/gps.csv");
+    let text = std::fs::read_to_string(&gps).unwrap();
+    std::fs::write(&gps, text.replacen(",16.0\n", "\n", 1)).unwrap();
+    let err = ingest(&root, &out, &MulranOptions::default()).unwrap_err().to_string();
+    assert!(err.contains("gps.csv") && err.contains("line 1") && err.contains("12 fields"), "{err}");
     assert!(!out.exists(), "no partial output");
 
     let empty = dir.path().join("empty");
