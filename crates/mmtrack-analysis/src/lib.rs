@@ -12,6 +12,8 @@
 //! - [`mpc`], [`mpc_tables`], [`mpc_plots`], [`mpc_report`]: multipath-component
 //!   statistics of `process mpc` tables (Mahler et al. 2017, Figs. 7-9,
 //!   12-13), their result tables, plots and report section;
+//! - [`mpc_artificial`]: the artificial-channel experiment's results (Sec.
+//!   IV-A, Figs. 4-5) as plain data and their plots;
 //! - [`plots`]: SVG plots (plotters, SVG backend only);
 //! - [`report`]: the Markdown report;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
@@ -33,6 +35,7 @@
 
 pub mod export;
 pub mod mpc;
+pub mod mpc_artificial;
 pub mod mpc_plots;
 pub mod mpc_report;
 pub mod mpc_tables;

@@ -24,7 +24,7 @@ fn ecdf(mut values: Vec<f64>) -> Vec<(f64, f64)> {
 
 /// A five-stop viridis-like colour for `x` in 0..=1 (plotters' colormaps
 /// feature is not enabled in the workspace).
-fn viridis(x: f64) -> RGBColor {
+pub(crate) fn viridis(x: f64) -> RGBColor {
     const STOPS: [(f64, f64, f64); 5] =
         [(68.0, 1.0, 84.0), (59.0, 82.0, 139.0), (33.0, 145.0, 140.0), (94.0, 201.0, 98.0), (253.0, 231.0, 37.0)];
     let x = if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 } * 4.0;

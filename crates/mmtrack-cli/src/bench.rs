@@ -10,7 +10,6 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
 use clap::{Args, Subcommand};
 use mmtrack_core::PolarScan;
 use mmtrack_io::recording::{Compression, RecordingMetadata, TimeBase};
@@ -19,6 +18,8 @@ use mmtrack_sim::radar::{
     ConstantTurn, GeneratorConfig, RadarSimulator, ScanLimits, Sensor, SimOptions, Trajectory, World, generate_world,
 };
 use serde_json::json;
+
+use crate::readme_block::replace_block;
 
 #[derive(Args)]
 pub struct BenchArgs {
@@ -245,18 +246,6 @@ fn markdown(report: &serde_json::Value) -> String {
         ));
     }
     out
-}
-
-/// Replaces the text between `<!-- {name}:begin -->` and `<!-- {name}:end -->`.
-pub fn replace_block(path: &Path, name: &str, body: &str) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    let (begin, end) = (format!("<!-- {name}:begin -->"), format!("<!-- {name}:end -->"));
-    let (Some(start), Some(stop)) = (text.find(&begin), text.find(&end)) else {
-        anyhow::bail!("{}: markers {begin} / {end} not found", path.display());
-    };
-    let updated = format!("{}{begin}\n{body}{}", &text[..start], &text[stop..]);
-    std::fs::write(path, updated).with_context(|| path.display().to_string())?;
-    Ok(())
 }
 
 /// Issue #3: ingest of an Oxford folder, bytes carried, on this 2-core machine.

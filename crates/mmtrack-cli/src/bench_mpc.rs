@@ -29,7 +29,7 @@ use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use rustfft::{Fft, FftPlanner};
 
-use crate::bench::replace_block;
+use crate::readme_block::replace_block;
 
 /// Issue #5: this many snapshots ...
 pub const MPC_TARGET_SNAPSHOTS: usize = 10_000;

@@ -10,9 +10,9 @@ use anyhow::Context;
 use clap::Args;
 use mmtrack_odometry::OdometryConfig;
 
-use crate::bench::replace_block;
 use crate::ingest::{CompressionArg, OutputArgs};
 use crate::process::run_odometry;
+use crate::readme_block::replace_block;
 
 /// Issue #4: end-to-end scans per second on this 2-core machine (CFEAR-1
 /// reports about 160 Hz for filtering and registration alone, without decode).

@@ -17,8 +17,10 @@ mod ingest;
 mod inspect;
 mod process;
 mod progress;
+mod readme_block;
 mod reproduce;
 mod reproduce_mpc;
+mod reproduce_mpc_report;
 mod simulate;
 mod simulate_sounder;
 

@@ -1,0 +1,374 @@
+//! The outputs of `reproduce mpc-artificial` as text: the CSV files, the
+//! targets and verdicts, `reproduce.md` and the README block (the figures
+//! are drawn by `mmtrack_analysis::mpc_artificial`).
+
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+use mmtrack_analysis::mpc_artificial::{ArtificialTracker, SeparationBin, SweepPoint};
+use mmtrack_sim::sounder::ArtificialChannelConfig;
+
+/// The README block `reproduce mpc-artificial --readme` replaces.
+pub const README_BLOCK: &str = "reproduce-mpc-artificial";
+/// Target: mean delay error below this ...
+pub const TARGET_ERROR_NS: f64 = 0.03;
+/// ... at this MPC power (proposed tracker, Kaiser window).
+pub const TARGET_ERROR_POWER_DB: f64 = -116.0;
+/// Target: two tracks in every run from the highest power down to this one.
+pub const TARGET_TWO_TRACKS_DOWN_TO_DB: f64 = -126.0;
+/// The paper's Fig. 4: GM-PHD starts to split at -124 dB.
+const PAPER_GMPHD_SPLITS_AT_DB: f64 = -124.0;
+
+/// The figures written next to results.csv: file name and what it shows.
+pub const FIGURES: [(&str, &str); 3] = [
+    ("tracks_vs_power.svg", "mean number of tracks vs MPC power (Fig. 4)"),
+    ("delay_error_vs_power.svg", "mean delay error of the true tracks vs MPC power, log scale (Fig. 5)"),
+    ("delay_error_vs_separation.svg", "mean delay error vs the MPCs' separation, proposed tracker, Kaiser window"),
+];
+
+/// Everything one run of the experiment measured.
+pub struct Sweep {
+    /// The channel (at the first power; only the power changes).
+    pub channel: ArtificialChannelConfig,
+    pub pulse_name: &'static str,
+    pub runs: u64,
+    pub points: Vec<SweepPoint>,
+    pub bins: Vec<SeparationBin>,
+}
+
+/// Where the README's links to the figures point.
+pub enum FiguresAt {
+    /// The output directory relative to the README's directory.
+    Relative(PathBuf),
+    /// An output directory outside the README's directory (named, not linked).
+    Elsewhere(PathBuf),
+}
+
+impl Sweep {
+    fn point(&self, power_db: f64, window: bool, tracker: ArtificialTracker) -> Option<&SweepPoint> {
+        self.points.iter().find(|p| p.power_db == power_db && p.kaiser_window == window && p.tracker == tracker)
+    }
+
+    /// The swept powers, highest first.
+    fn powers_db(&self) -> Vec<f64> {
+        let mut powers: Vec<f64> = self.points.iter().map(|p| p.power_db).collect();
+        powers.sort_by(|a, b| b.total_cmp(a));
+        powers.dedup();
+        powers
+    }
+
+    /// The lowest power down to which `holds` is true at every power from
+    /// the highest one (`None` when it fails at the highest).
+    fn down_to(&self, window: bool, tracker: ArtificialTracker, holds: impl Fn(&SweepPoint) -> bool) -> Option<f64> {
+        let mut lowest = None;
+        for power_db in self.powers_db() {
+            match self.point(power_db, window, tracker) {
+                Some(p) if holds(p) => lowest = Some(power_db),
+                _ => break,
+            }
+        }
+        lowest
+    }
+
+    fn description(&self) -> String {
+        let c = &self.channel;
+        format!(
+            "Two equal-power MPCs approaching from {:.1} to {:.1} ns over {} snapshots ({:.3} ms apart), noise floor \
+             {} dB, {:.1} GHz carrier, {:.1} GHz band, {} sounder pulse; {} Monte Carlo runs per point. Tracks have \
+             at least 3 detections; a track is true when most of its points lie within 1 ns of a true MPC; delay \
+             errors are those of the true tracks' points against the nearer true MPC.",
+            c.start_separation_s * 1e9,
+            c.end_separation_s * 1e9,
+            c.snapshots,
+            c.snapshot_interval_s * 1e3,
+            c.sounder.noise_floor_db,
+            c.sounder.carrier_hz / 1e9,
+            c.sounder.bandwidth_hz / 1e9,
+            self.pulse_name,
+            self.runs,
+        )
+    }
+}
+
+/// The targets' measured values.
+pub struct Verdicts {
+    /// Mean delay error at the target power (proposed, Kaiser), ns.
+    error_ns: Option<f64>,
+    /// The separation band with the largest mean error there, and that error.
+    worst_band: Option<(String, f64)>,
+    /// Proposed, Kaiser: (power, runs with two tracks, runs) down to the target power.
+    two_tracks: Vec<(f64, u64, u64)>,
+}
+
+impl Verdicts {
+    fn error_met(&self) -> bool {
+        self.error_ns.is_some_and(|e| e < TARGET_ERROR_NS)
+    }
+
+    fn two_tracks_met(&self) -> bool {
+        !self.two_tracks.is_empty() && self.two_tracks.iter().all(|(_, two, runs)| two == runs)
+    }
+
+    pub fn all_met(&self) -> bool {
+        self.error_met() && self.two_tracks_met()
+    }
+}
+
+pub fn verdicts(sweep: &Sweep) -> Verdicts {
+    let proposed = ArtificialTracker::Proposed;
+    let error_ns = sweep.point(TARGET_ERROR_POWER_DB, true, proposed).map(|p| p.mean_delay_error_ns);
+    let worst_band = sweep
+        .bins
+        .iter()
+        .filter(|b| b.power_db == TARGET_ERROR_POWER_DB && b.kaiser_window && b.tracker == proposed)
+        .filter(|b| b.mean_delay_error_ns.is_finite())
+        .max_by(|a, b| a.mean_delay_error_ns.total_cmp(&b.mean_delay_error_ns))
+        .map(|b| (format!("{}-{} ns", b.separation_ns.start, b.separation_ns.end), b.mean_delay_error_ns));
+    let two_tracks = sweep
+        .powers_db()
+        .into_iter()
+        .filter(|&p| p >= TARGET_TWO_TRACKS_DOWN_TO_DB)
+        .filter_map(|p| sweep.point(p, true, proposed))
+        .map(|p| (p.power_db, p.runs_with_two_tracks, p.runs))
+        .collect();
+    Verdicts { error_ns, worst_band, two_tracks }
+}
+
+fn verdict(met: bool) -> &'static str {
+    if met { "met" } else { "**missed**" }
+}
+
+/// "down to P dB", or that it fails already at the highest power.
+fn down_to(power: Option<f64>) -> String {
+    power.map_or_else(|| "at no power (not even the highest)".to_string(), |p| format!("down to {p} dB"))
+}
+
+/// The targets, measured values and verdicts, plus the paper's other
+/// observations for comparison.
+fn verdict_table(sweep: &Sweep) -> String {
+    let v = verdicts(sweep);
+    let (proposed, gmphd, matched) =
+        (ArtificialTracker::Proposed, ArtificialTracker::GmPhd, ArtificialTracker::GmPhdMatched);
+    let every_run_two = |p: &SweepPoint| p.runs_with_two_tracks == p.runs;
+    let best = v.two_tracks.iter().max_by_key(|t| t.1);
+    let at_target = v.two_tracks.iter().find(|t| t.0 == TARGET_TWO_TRACKS_DOWN_TO_DB);
+    let runs = |t: Option<&(f64, u64, u64)>| t.map_or("-".into(), |t| format!("{}/{} runs at {} dB", t.1, t.2, t.0));
+    let error_at = |tracker| {
+        sweep
+            .point(TARGET_ERROR_POWER_DB, true, tracker)
+            .map_or("-".into(), |p| format!("{:.4} ns", p.mean_delay_error_ns))
+    };
+    let mut out = String::from("| target | measured | verdict |\n|---|---|---|\n");
+    let _ = writeln!(
+        out,
+        "| mean delay error below {TARGET_ERROR_NS} ns at {TARGET_ERROR_POWER_DB} dB, separations 20..2.5 ns \
+         (proposed, Kaiser) | {}{} | {} |",
+        v.error_ns.map_or("-".into(), |e| format!("{e:.4} ns")),
+        v.worst_band.as_ref().map_or(String::new(), |(band, e)| format!("; largest in the {band} band: {e:.4} ns")),
+        verdict(v.error_met()),
+    );
+    let _ = writeln!(
+        out,
+        "| two tracks in every run down to {TARGET_TWO_TRACKS_DOWN_TO_DB} dB (proposed, Kaiser) | two tracks in every \
+         run {}; at best {}; {}; exactly two tracks on the true MPCs in every run {} (the other tracks are made of \
+         noise detections) | {} |",
+        down_to(sweep.down_to(true, proposed, every_run_two)),
+        runs(best),
+        runs(at_target),
+        down_to(sweep.down_to(true, proposed, |p| p.runs_with_two_true_tracks == p.runs)),
+        verdict(v.two_tracks_met()),
+    );
+    let _ = writeln!(
+        out,
+        "| for comparison: GM-PHD splits from {PAPER_GMPHD_SPLITS_AT_DB} dB (paper, Fig. 4) | two tracks in every run \
+         (Kaiser): {} with Table I, {} with the matched measurement noise | - |",
+        down_to(sweep.down_to(true, gmphd, every_run_two)),
+        down_to(sweep.down_to(true, matched, every_run_two)),
+    );
+    let _ = writeln!(
+        out,
+        "| for comparison: the proposed tracker's delay error is lower than GM-PHD's (paper, Fig. 5) | at \
+         {TARGET_ERROR_POWER_DB} dB (Kaiser): proposed {}, GM-PHD (Table I) {}, GM-PHD (matched) {} | - |",
+        error_at(proposed),
+        error_at(gmphd),
+        error_at(matched),
+    );
+    out
+}
+
+fn cell(p: Option<&SweepPoint>) -> String {
+    p.map_or("-".into(), |p| format!("{:.2} / {:.4}", p.mean_tracks, p.mean_delay_error_ns))
+}
+
+/// One row per power: tracks / mean delay error for each tracker and window.
+fn compact_table(sweep: &Sweep) -> String {
+    let mut out = String::from(
+        "Each cell: mean number of tracks / mean delay error of the true tracks (ns). `gm-phd-matched` is the \
+         sensitivity variant with sigma_epsilon set to the proposed tracker's rms delay error at the same point.\n\n\
+         | MPC power dB | proposed, Kaiser | runs with 2 tracks (2 true tracks) | proposed, no window | gm-phd, Kaiser \
+         | gm-phd, no window | gm-phd-matched, Kaiser | gm-phd-matched, no window | matched sigma_epsilon mm (Kaiser / none) |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    for power_db in sweep.powers_db() {
+        let at = |window, tracker| sweep.point(power_db, window, tracker);
+        let proposed = at(true, ArtificialTracker::Proposed);
+        let sigma = |window| {
+            at(window, ArtificialTracker::GmPhdMatched)
+                .and_then(|p| p.sigma_measurement_m)
+                .map_or("-".into(), |s| format!("{:.1}", s * 1e3))
+        };
+        let _ = writeln!(
+            out,
+            "| {power_db} | {} | {} | {} | {} | {} | {} | {} | {} / {} |",
+            cell(proposed),
+            proposed.map_or("-".into(), |p| format!(
+                "{}/{} ({}/{})",
+                p.runs_with_two_tracks, p.runs, p.runs_with_two_true_tracks, p.runs
+            )),
+            cell(at(false, ArtificialTracker::Proposed)),
+            cell(at(true, ArtificialTracker::GmPhd)),
+            cell(at(false, ArtificialTracker::GmPhd)),
+            cell(at(true, ArtificialTracker::GmPhdMatched)),
+            cell(at(false, ArtificialTracker::GmPhdMatched)),
+            sigma(true),
+            sigma(false),
+        );
+    }
+    out
+}
+
+/// Mean delay error per separation band (columns) and power (rows) of one
+/// tracker and window setting.
+fn separation_table(sweep: &Sweep, tracker: ArtificialTracker, window: bool) -> String {
+    let mine = |b: &&SeparationBin| b.tracker == tracker && b.kaiser_window == window;
+    let mut bands: Vec<(f64, f64)> =
+        sweep.bins.iter().filter(mine).map(|b| (b.separation_ns.start, b.separation_ns.end)).collect();
+    bands.sort_by(|a, b| b.0.total_cmp(&a.0));
+    bands.dedup();
+    let mut out = String::from("| MPC power dB |");
+    for (lo, hi) in &bands {
+        let _ = write!(out, " {lo}-{hi} ns |");
+    }
+    let _ = write!(out, "\n|---|{}\n", "---|".repeat(bands.len()));
+    for power_db in sweep.powers_db() {
+        let _ = write!(out, "| {power_db} |");
+        for band in &bands {
+            let bin = sweep
+                .bins
+                .iter()
+                .filter(mine)
+                .find(|b| b.power_db == power_db && (b.separation_ns.start, b.separation_ns.end) == *band);
+            let _ = write!(out, " {} |", bin.map_or("-".into(), |b| format!("{:.4}", b.mean_delay_error_ns)));
+        }
+        out.push('\n');
+    }
+    out
+}
+
+/// `reproduce.md`: everything, including the full per-point table.
+pub fn markdown(sweep: &Sweep) -> String {
+    let mut out = format!("# reproduce mpc-artificial\n\n{}\n\n{}\n", sweep.description(), verdict_table(sweep));
+    out.push_str(&compact_table(sweep));
+    out.push_str(
+        "\n## All points\n\n| MPC power dB | window | tracker | mean tracks | on a true MPC | runs with 2 tracks | \
+         runs with 2 true tracks | mean delay error ns | rms delay error ns | GM-PHD sigma_epsilon m |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for p in &sweep.points {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.2} | {:.2} | {}/{} | {}/{} | {:.4} | {:.4} | {} |",
+            p.power_db,
+            if p.kaiser_window { "Kaiser" } else { "none" },
+            p.tracker.name(),
+            p.mean_tracks,
+            p.mean_true_tracks,
+            p.runs_with_two_tracks,
+            p.runs,
+            p.runs_with_two_true_tracks,
+            p.runs,
+            p.mean_delay_error_ns,
+            p.rms_delay_error_ns,
+            p.sigma_measurement_m.map_or("-".into(), |s| format!("{s:.2e}")),
+        );
+    }
+    out.push_str("\n## Mean delay error (ns) per separation band: proposed, Kaiser window\n\n");
+    out.push_str(&separation_table(sweep, ArtificialTracker::Proposed, true));
+    out.push_str("\n## Figures\n\n");
+    for (name, what) in FIGURES {
+        let _ = writeln!(out, "- [{name}]({name}): {what}");
+    }
+    out
+}
+
+/// The README block: description, verdicts, compact table and where the
+/// figures are.
+pub fn readme_summary(sweep: &Sweep, figures: &FiguresAt) -> String {
+    let mut out = format!(
+        "Written by `mmtrack reproduce mpc-artificial --readme README.md`. {}\n\n{}\n",
+        sweep.description(),
+        verdict_table(sweep)
+    );
+    out.push_str(&compact_table(sweep));
+    out.push('\n');
+    match figures {
+        FiguresAt::Relative(dir) => {
+            let dir = dir.to_string_lossy().replace('\\', "/");
+            out.push_str("Figures, written by the run next to its CSV files and reproduce.md (not committed):\n\n");
+            for (name, what) in FIGURES {
+                let _ = writeln!(out, "- [{name}]({dir}/{name}): {what}");
+            }
+        }
+        FiguresAt::Elsewhere(dir) => {
+            let names: Vec<&str> = FIGURES.iter().map(|f| f.0).collect();
+            let _ = writeln!(out, "Figures: {} in `{}` (written by the run).", names.join(", "), dir.display());
+        }
+    }
+    out
+}
+
+pub fn csv(points: &[SweepPoint]) -> String {
+    let mut out = String::from(
+        "mpc_power_db,kaiser_window,tracker,mean_tracks,mean_true_tracks,runs_with_two_tracks,\
+         runs_with_two_true_tracks,runs,mean_delay_error_ns,rms_delay_error_ns,gmphd_sigma_measurement_m\n",
+    );
+    for p in points {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{},{}",
+            p.power_db,
+            p.kaiser_window,
+            p.tracker.name(),
+            p.mean_tracks,
+            p.mean_true_tracks,
+            p.runs_with_two_tracks,
+            p.runs_with_two_true_tracks,
+            p.runs,
+            p.mean_delay_error_ns,
+            p.rms_delay_error_ns,
+            p.sigma_measurement_m.map_or(String::new(), |s| s.to_string()),
+        );
+    }
+    out
+}
+
+pub fn separation_csv(bins: &[SeparationBin]) -> String {
+    let mut out = String::from(
+        "mpc_power_db,kaiser_window,tracker,separation_min_ns,separation_max_ns,points,truth_points,mean_delay_error_ns\n",
+    );
+    for b in bins {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{}",
+            b.power_db,
+            b.kaiser_window,
+            b.tracker.name(),
+            b.separation_ns.start,
+            b.separation_ns.end,
+            b.points,
+            b.truth_points,
+            b.mean_delay_error_ns,
+        );
+    }
+    out
+}
