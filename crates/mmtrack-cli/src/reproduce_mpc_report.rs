@@ -31,6 +31,8 @@ pub struct Sweep {
     /// The channel (at the first power; only the power changes).
     pub channel: ArtificialChannelConfig,
     pub pulse_name: &'static str,
+    /// Whether detection zeroed the taps below floor + 6 dB (the paper's step 1).
+    pub zero_below_threshold: bool,
     pub runs: u64,
     pub points: Vec<SweepPoint>,
     pub bins: Vec<SeparationBin>,
@@ -74,7 +76,7 @@ impl Sweep {
         let c = &self.channel;
         format!(
             "Two equal-power MPCs approaching from {:.1} to {:.1} ns over {} snapshots ({:.3} ms apart), noise floor \
-             {} dB, {:.1} GHz carrier, {:.1} GHz band, {} sounder pulse; {} Monte Carlo runs per point. Tracks have \
+             {} dB, {:.1} GHz carrier, {:.1} GHz band, {} sounder pulse; {}; {} Monte Carlo runs per point. Tracks have \
              at least 3 detections; a track is true when most of its points lie within 1 ns of a true MPC; delay \
              errors are those of the true tracks' points against the nearer true MPC.",
             c.start_separation_s * 1e9,
@@ -85,6 +87,11 @@ impl Sweep {
             c.sounder.carrier_hz / 1e9,
             c.sounder.bandwidth_hz / 1e9,
             self.pulse_name,
+            if self.zero_below_threshold {
+                "taps below floor + 6 dB zeroed before the search (the paper's step 1)"
+            } else {
+                "taps below floor + 6 dB kept (variant: --keep-taps-below-threshold)"
+            },
             self.runs,
         )
     }
