@@ -78,14 +78,35 @@ fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
     parse().with_context(|| format!("--link '{text}': expected TX:RX antenna indices, e.g. 0:1"))
 }
 
-/// The default configuration with the TOML file's fields on top.
+/// The default configuration with the TOML file's fields on top, table by
+/// table: `[long_term]` with only `delay_gate_s` changes that one field. A
+/// table that names a `method` (the noise floor's) replaces the default's
+/// table, since its other fields depend on the method. Unknown fields are
+/// refused by name when the result is read back.
 fn effective_config(path: Option<&Path>) -> anyhow::Result<MpcConfig> {
     let Some(path) = path else { return Ok(MpcConfig::default()) };
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let changes: toml::Table = toml::from_str(&text).with_context(|| format!("{}: not valid TOML", path.display()))?;
+    let mut merged = toml::Table::try_from(MpcConfig::default())?;
+    merge_tables(&mut merged, changes);
     let config: MpcConfig =
-        toml::from_str(&text).with_context(|| format!("{}: not a valid MPC configuration", path.display()))?;
+        merged.try_into().with_context(|| format!("{}: not a valid MPC configuration", path.display()))?;
     config.validate().with_context(|| path.display().to_string())?;
     Ok(config)
+}
+
+/// `changes` on top of `base`, recursing into tables present in both.
+fn merge_tables(base: &mut toml::Table, changes: toml::Table) {
+    for (key, value) in changes {
+        match (base.get_mut(&key), value) {
+            (Some(toml::Value::Table(inner)), toml::Value::Table(more)) if !more.contains_key("method") => {
+                merge_tables(inner, more);
+            }
+            (_, value) => {
+                base.insert(key, value);
+            }
+        }
+    }
 }
 
 /// What one link accumulates.

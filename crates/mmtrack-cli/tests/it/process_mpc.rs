@@ -119,3 +119,30 @@ fn a_recording_without_cir_snapshots_is_named_in_the_error() {
     assert_eq!(bad_link.status.code(), Some(1));
     assert!(text(&bad_link).1.contains("--link 'x'"));
 }
+
+#[test]
+fn config_overrides_single_fields_of_any_table() {
+    let dir = tempfile::tempdir().unwrap();
+    let print = |config: &str| {
+        std::fs::write(dir.path().join("c.toml"), config).unwrap();
+        mmtrack(dir.path(), &["process", "mpc", "x.mcap", "-o", "t", "--config", "c.toml", "--print-config"])
+    };
+    // One field of two sub-tables; everything else keeps the paper's values.
+    let out = print("[long_term]\ndelay_gate_s = 2.5e-9\n[detection]\nkaiser_beta = 0.0\n");
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let config: mmtrack_mpc::MpcConfig = toml::from_str(&stdout).unwrap();
+    let mut expected = mmtrack_mpc::MpcConfig::default();
+    expected.long_term.delay_gate_s = 2.5e-9;
+    expected.detection.kaiser_beta = Some(0.0);
+    assert_eq!(config, expected);
+    // Another noise-floor method replaces the default's table.
+    let out = print("[detection.noise_floor]\nmethod = \"fixed\"\npower_db = -140.0\n");
+    assert!(out.status.success(), "{}", text(&out).1);
+    let config: mmtrack_mpc::MpcConfig = toml::from_str(&text(&out).0).unwrap();
+    assert_eq!(config.detection.noise_floor, mmtrack_mpc::NoiseFloor::Fixed { power_db: -140.0 });
+    // Unknown fields are still refused by name.
+    let out = print("[long_term]\ndelay_gate_ns = 2.5\n");
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("delay_gate_ns"), "{}", text(&out).1);
+}
