@@ -39,6 +39,15 @@ bench:
     cargo run -q --release -p mmtrack-cli -- bench odometry --readme README.md
     cargo run -q --release -p mmtrack-cli -- bench mpc --readme README.md
 
+# Issue #5's convoy evaluation: the paper's 1666 simulated sets, MPC detection
+# and tracking, statistics against the simulator's truth (report:
+# out/convoy/analysis/report.md). Extra arguments go to the simulation, e.g.
+# `just convoy --sets 100`.
+convoy *args:
+    cargo run -q --release -p mmtrack-cli -- simulate sounder --scenario data/sounder/convoy-tunnel.toml -o out/convoy/convoy.mcap --force "$@"
+    cargo run -q --release -p mmtrack-cli -- process mpc out/convoy/convoy.mcap -o out/convoy/tables --force
+    cargo run -q --release -p mmtrack-cli -- analyze out/convoy/tables -o out/convoy/analysis --force
+
 # Paper experiments.
 reproduce *args:
     cargo run -q --release -p mmtrack-cli -- reproduce "$@"
