@@ -27,6 +27,14 @@ demo *args:
 inspect *args:
     cargo run -q -p mmtrack-cli -- inspect "$@"
 
+# The mmtrack binary with HDF5 / MATLAB v7.3 input for `ingest cir` (needs libhdf5: apt-get install libhdf5-dev).
+build-hdf5:
+    cargo build --release -p mmtrack-cli --features hdf5
+
+# Tests of the HDF5 / MATLAB v7.3 reader (needs libhdf5).
+test-hdf5:
+    cargo test -p mmtrack-ingest --features hdf5 -- --show-output
+
 # All tests (the same command CI runs).
 test:
     cargo test --workspace -- --show-output

@@ -101,8 +101,11 @@ pub enum CirFormatArg {
     Npy,
     /// NumPy .npz archive (the sidecar's `variable` picks the array).
     Npz,
-    /// MATLAB v5/v7 .mat (the sidecar's `variable` picks the array).
+    /// MATLAB .mat, v5/v7 (the sidecar's `variable` picks the array); v7.3 (HDF5) in builds with `--features hdf5`.
     Mat,
+    /// HDF5 (the sidecar's `dataset` picks the array: complex {r,i}/{real,imag} or a trailing I/Q axis of 2);
+    /// needs a build with `--features hdf5` (libhdf5).
+    Hdf5,
     /// SigMF .sigmf-meta + .sigmf-data (cf32_le, ci16_le).
     Sigmf,
     /// CSV, one snapshot per row: [t_ns,set_index,snapshot_index,tx_antenna,rx_antenna,]re_0,im_0,re_1,im_1,...
@@ -117,6 +120,7 @@ impl CirFormatArg {
             Self::Npy => CirFormat::Npy,
             Self::Npz => CirFormat::Npz,
             Self::Mat => CirFormat::Mat,
+            Self::Hdf5 => CirFormat::Hdf5,
             Self::Sigmf => CirFormat::Sigmf,
             Self::Csv => CirFormat::Csv,
             Self::Decawave => CirFormat::Decawave,
@@ -236,13 +240,13 @@ enum Kind {
         #[arg(long, value_name = "RECORDING.mcap")]
         add_to: Option<PathBuf>,
     },
-    /// Channel-sounder CIR/CFR file (NumPy, MATLAB, SigMF, CSV, DecaWave log) into a new recording.
+    /// Channel-sounder CIR/CFR file (NumPy, MATLAB, HDF5, SigMF, CSV, DecaWave log) into a new recording.
     ///
     /// A sidecar TOML gives what the file lacks (carrier_hz, tap_spacing_s or
-    /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable);
+    /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable, dataset);
     /// see the mmtrack_ingest::cir::sidecar docs for every key.
     Cir {
-        /// The file (.npy, .npz, .mat, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
+        /// The file (.npy, .npz, .mat, .h5, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
         input: PathBuf,
         /// File format.
         #[arg(long, value_enum)]

@@ -45,6 +45,21 @@ pub enum IngestError {
         /// What is wrong and what was expected.
         detail: String,
     },
+    /// The input needs a cargo feature this build was compiled without.
+    #[error(
+        "{path}: {input} needs mmtrack built with the `{feature}` cargo feature ({needs}): rebuild with \
+         `--features {feature}`, e.g. `cargo build --release -p mmtrack-cli --features {feature}`"
+    )]
+    FeatureMissing {
+        /// The file.
+        path: PathBuf,
+        /// What the file is, e.g. "a MATLAB v7.3 (HDF5) .mat file".
+        input: String,
+        /// The cargo feature (of `mmtrack-ingest` and `mmtrack-cli`).
+        feature: &'static str,
+        /// What the feature needs on the machine.
+        needs: &'static str,
+    },
     /// Writing the recording failed.
     #[error(transparent)]
     Io(#[from] mmtrack_io::IoError),

@@ -135,6 +135,33 @@ fn failed_ingest_leaves_no_partial_output() {
     assert!(leftovers.is_empty(), "partial output left: {leftovers:?}");
 }
 
+/// Default builds (CI's) know HDF5 and MATLAB v7.3 inputs and say how to
+/// rebuild for them, in one line naming the file; no output is written.
+#[cfg(not(feature = "hdf5"))]
+#[test]
+fn hdf5_inputs_without_the_feature_say_how_to_rebuild() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut v73 = format!("{:<116}", "MATLAB 7.3 MAT-file, Platform: GLNXA64").into_bytes();
+    v73.extend_from_slice(&[0, 0, 0, 0, 0, 0, 0, 0, 0, 2, b'I', b'M']);
+    v73.resize(512, 0);
+    v73.extend_from_slice(b"\x89HDF\r\n\x1a\n");
+    std::fs::write(dir.path().join("h.mat"), &v73).unwrap();
+    std::fs::write(dir.path().join("h.h5"), &v73[512..]).unwrap();
+    std::fs::write(dir.path().join("s.toml"), "variable = \"h\"\ncarrier_hz = 1e9\n").unwrap();
+    for (input, format, what) in [("h.mat", "mat", "a MATLAB v7.3 (HDF5) .mat file"), ("h.h5", "hdf5", "an HDF5 file")]
+    {
+        let sidecar: &[&str] = if format == "mat" { &["--sidecar", "s.toml"] } else { &[] };
+        let args = [&["ingest", "cir", input, "--format", format, "-o", "out.mcap"], sidecar].concat();
+        let out = mmtrack(dir.path(), &args);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.starts_with(&format!("error: {input}: {what}")), "{stderr}");
+        assert!(stderr.contains("--features hdf5") && stderr.contains("libhdf5"), "{stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(!dir.path().join("out.mcap").exists());
+    }
+}
+
 #[test]
 fn schema_documents_are_current() {
     let out = mmtrack(&root(), &["schemas", "--check", "schemas"]);

@@ -28,8 +28,10 @@ pub enum CirFormat {
     Npy,
     /// NumPy `.npz` archive.
     Npz,
-    /// MATLAB v5/v7 `.mat`.
+    /// MATLAB `.mat`: v5/v7, and v7.3 (HDF5) with the `hdf5` feature.
     Mat,
+    /// HDF5 dataset (needs the `hdf5` feature).
+    Hdf5,
     /// SigMF meta + data.
     Sigmf,
     /// CSV, one snapshot per row.
@@ -60,6 +62,7 @@ impl CirFormat {
             Self::Npy => "npy",
             Self::Npz => "npz",
             Self::Mat => "mat",
+            Self::Hdf5 => "hdf5",
             Self::Sigmf => "sigmf",
             Self::Csv => "csv",
             Self::Decawave => "decawave",
@@ -72,6 +75,7 @@ impl CirFormat {
             Self::Npy => &["axes"],
             Self::Npz => &["axes", "variable"],
             Self::Mat => &["axes", "variable", "allow_real"],
+            Self::Hdf5 => &["axes", "dataset"],
             Self::Sigmf => &["taps_per_snapshot"],
             Self::Csv => &[],
             Self::Decawave => return vec!["carrier_hz", "tap_spacing_s", "bandwidth_hz", "t0_ns", "snapshot_period_s"],
@@ -128,7 +132,15 @@ pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSideca
             let rate = s.sample_rate_hz.map(|r| 1.0 / r);
             (cut_snapshots(input, &s.array, &filled, "data", rate)?, 0)
         }
-        CirFormat::Npy | CirFormat::Npz | CirFormat::Mat => {
+        CirFormat::Npy | CirFormat::Npz | CirFormat::Mat | CirFormat::Hdf5 => {
+            if format == CirFormat::Mat {
+                let version = if super::hdf5::is_mat73(&super::hdf5::file_head(input)?) {
+                    "7.3 (HDF5; dimensions reversed back to MATLAB's order)"
+                } else {
+                    "5 (v5/v7)"
+                };
+                metadata.insert("cir.mat_version".into(), version.into());
+            }
             let (record, array) = read_array(format, input, sidecar)?;
             let axes = resolve_axes(input, &array, sidecar, &record)?;
             let axes: Vec<&str> = axes.iter().map(|a| a.as_str()).collect();
@@ -141,12 +153,19 @@ pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSideca
 }
 
 fn read_array(format: CirFormat, input: &Path, sidecar: &CirSidecar) -> Result<(String, NdComplex), IngestError> {
-    let bytes = std::fs::read(input).map_err(os_err(input))?;
     match format {
-        CirFormat::Npy => Ok(("array".into(), super::npy::parse_npy(input, "array", &bytes)?)),
+        CirFormat::Npy => {
+            let bytes = std::fs::read(input).map_err(os_err(input))?;
+            Ok(("array".into(), super::npy::parse_npy(input, "array", &bytes)?))
+        }
         CirFormat::Npz => {
+            let bytes = std::fs::read(input).map_err(os_err(input))?;
             let (name, array) = super::npy::parse_npz(input, &bytes, sidecar.variable.as_deref())?;
             Ok((format!("member `{name}.npy`"), array))
+        }
+        CirFormat::Hdf5 => {
+            let (name, array) = super::hdf5::read_hdf5_array(input, sidecar.dataset.as_deref())?;
+            Ok((format!("dataset `{name}`"), array))
         }
         _ => {
             let Some(variable) = sidecar.variable.as_deref() else {
@@ -154,7 +173,7 @@ fn read_array(format: CirFormat, input: &Path, sidecar: &CirSidecar) -> Result<(
                     sidecar.error("variable", format!("required: name the MATLAB variable of {}", input.display()))
                 );
             };
-            let array = super::matlab::read_mat_array(input, &bytes, variable, sidecar.allow_real)?;
+            let array = super::matlab::read_mat_array(input, variable, sidecar.allow_real)?;
             Ok((format!("variable `{variable}`"), array))
         }
     }

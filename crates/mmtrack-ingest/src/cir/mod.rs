@@ -9,6 +9,9 @@
 //! - NumPy `.npy` / `.npz`, SigMF and CSV files, read through
 //!   [`read_cir_file`] with a [`CirSidecar`] (TOML) giving what the file lacks;
 //!   `.mat` files go the same way there.
+//! - HDF5 datasets and MATLAB v7.3 `.mat` files (which are HDF5), in builds
+//!   with the `hdf5` cargo feature (`hdf5.rs`; it links libhdf5); without it,
+//!   they are recognised and refused with an error saying how to rebuild.
 //! - [`ingest_cir`] writes any of them into a recording on `/channel/cir`.
 //!
 //! All are pure parse functions on text or bytes, plus helpers reading the
@@ -17,6 +20,12 @@
 mod array;
 mod csv_cir;
 pub mod decawave;
+mod hdf5;
+#[cfg(feature = "hdf5")]
+mod hdf5_read;
+#[cfg(test)]
+#[cfg(feature = "hdf5")]
+mod hdf5_tests;
 mod inflate;
 mod ingest;
 pub mod matlab;

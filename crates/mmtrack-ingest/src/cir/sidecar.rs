@@ -18,6 +18,7 @@
 //! | `set_period_s` | time between sets, s (default `snapshots_per_set * snapshot_period_s`) |
 //! | `axes` | array formats: role of each array dimension, from `"snapshot"`, `"tx"`, `"rx"`, `"tap"` |
 //! | `variable` | `.mat`: the MATLAB variable; `.npz`: the member (without `.npy`) |
+//! | `dataset` | HDF5: path of the dataset in the file, e.g. `"/sounder/cir"` (default: the file's only dataset) |
 //! | `allow_real` | `.mat`: read a real array as taps with zero imaginary part (default false) |
 //! | `taps_per_snapshot` | SigMF: samples per CIR (the data file is one stream) |
 //!
@@ -137,6 +138,8 @@ pub struct CirSidecar {
     pub axes: Option<Vec<AxisRole>>,
     /// `variable`.
     pub variable: Option<String>,
+    /// `dataset`.
+    pub dataset: Option<String>,
     /// `allow_real`.
     pub allow_real: bool,
     /// `taps_per_snapshot`.
@@ -148,6 +151,7 @@ const KNOWN_KEYS: &[&str] = &[
     "axes",
     "bandwidth_hz",
     "carrier_hz",
+    "dataset",
     "delay_offset_s",
     "domain",
     "set_period_s",
@@ -237,6 +241,9 @@ impl CirSidecar {
             }
             "variable" => {
                 self.variable = Some(value.as_str().ok_or_else(|| format!("{value}, expected a string"))?.to_string());
+            }
+            "dataset" => {
+                self.dataset = Some(value.as_str().ok_or_else(|| format!("{value}, expected a string"))?.to_string());
             }
             "axes" => self.axes = Some(axes(value)?),
             _ => return Err("unknown key".into()),
