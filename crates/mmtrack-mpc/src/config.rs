@@ -34,7 +34,7 @@ pub enum NoiseFloor {
 
 /// Detection per snapshot: search and subtract (Mahler et al. 2017, Sec. III-A).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct DetectionConfig {
     /// How the noise floor is estimated.
     pub noise_floor: NoiseFloor,
@@ -76,7 +76,7 @@ impl Default for DetectionConfig {
 
 /// Short-term tracking within a set of snapshots (Sec. III-B, eqs. (13)-(32)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct ShortTermConfig {
     /// Largest delay change between the first two detections of a track,
     /// seconds (xi_tau of eq. (15)). The paper derives it from "the physical
@@ -111,7 +111,7 @@ impl Default for ShortTermConfig {
 
 /// Long-term tracking across sets (Sec. V, eqs. (33)-(43)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, default)]
 pub struct LongTermConfig {
     /// Largest change of mean delay between sets for a candidate, seconds
     /// (xi_tau of eq. (35); paper: 1 ns).
@@ -240,5 +240,23 @@ impl MpcConfig {
         self.short_term.validate()?;
         self.long_term.validate()?;
         self.gmphd.validate().map_err(|source| MpcError::GmPhd { source })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_partial_config_takes_the_other_fields_from_the_defaults() {
+        let config: MpcConfig =
+            toml::from_str("[long_term]\ndelay_gate_s = 2.5e-9\n[detection]\nkaiser_beta = 4.0\n").unwrap();
+        assert_eq!(config.long_term.delay_gate_s, 2.5e-9);
+        assert_eq!(config.long_term.chi_classes_s, LongTermConfig::default().chi_classes_s);
+        assert_eq!(config.detection.kaiser_beta, Some(4.0));
+        assert_eq!(config.detection.threshold_margin_db, 6.0);
+        assert_eq!(config.short_term, ShortTermConfig::default());
+        let unknown = toml::from_str::<MpcConfig>("[short_term]\ndelay_tolerance = 1e-9\n").unwrap_err().to_string();
+        assert!(unknown.contains("delay_tolerance"), "{unknown}");
     }
 }
