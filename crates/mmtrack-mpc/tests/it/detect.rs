@@ -37,7 +37,9 @@ fn noiseless_off_grid_paths_are_recovered() {
         println!(
             "{kaiser_beta:?}: lone noiseless path, worst delay error {worst_delay_taps:.1e} taps, amplitude {worst_amplitude:.1e}"
         );
-        assert!(worst_delay_taps < 1e-4 && worst_amplitude < 1e-4, "{kaiser_beta:?}");
+        // Bounds a decade above the measured values, per window.
+        let lone_bound = if kaiser_beta.is_some() { 1e-6 } else { 1e-4 };
+        assert!(worst_delay_taps < lone_bound && worst_amplitude < lone_bound, "{kaiser_beta:?}");
         // Three paths: search and subtract estimates one path at a time, so the
         // others, not yet subtracted, bias each estimate a little: with the
         // Kaiser window, 5e-4 taps for the first path, whose 6 dB weaker
