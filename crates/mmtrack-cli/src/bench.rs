@@ -88,7 +88,7 @@ fn oxford_size_scans(count: usize) -> anyhow::Result<Vec<PolarScan>> {
     let world = World::new(&generate_world(&GeneratorConfig::default(), &trajectory, 1)?)?;
     let sensor = Sensor::default();
     let options =
-        SimOptions { seed: 1, limits: ScanLimits { max_scans: Some(count), max_distance_m: None }, threads: 0 };
+        SimOptions { seed: 1, limits: ScanLimits { max_scans: Some(count), max_distance_m: None } };
     Ok(RadarSimulator::new(&world, &sensor, &trajectory, options)?.map(|(scan, _)| scan).collect())
 }
 

@@ -27,6 +27,7 @@ use mmtrack_mpc::{
 };
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
+use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
 
 use crate::readme_block::replace_block;
@@ -153,23 +154,16 @@ impl Channel {
     }
 
     /// Sets `first..first + count` of a run of `total` snapshots, generated on
-    /// `threads` threads.
-    fn sets(&self, first: u64, count: usize, total: usize, threads: usize) -> Vec<Vec<CirSnapshot>> {
-        let mut sets: Vec<Vec<CirSnapshot>> = vec![Vec::new(); count];
-        let per_thread = count.div_ceil(threads.max(1)).max(1);
-        std::thread::scope(|scope| {
-            for (c, part) in sets.chunks_mut(per_thread).enumerate() {
-                scope.spawn(move || {
-                    for (i, set) in part.iter_mut().enumerate() {
-                        let s = first + (c * per_thread + i) as u64;
-                        let start = s as usize * SNAPSHOTS_PER_SET;
-                        let len = total.saturating_sub(start).min(SNAPSHOTS_PER_SET);
-                        *set = (0..len as u32).map(|k| self.snapshot(s, k)).collect();
-                    }
-                });
-            }
-        });
-        sets
+    /// rayon's global pool.
+    fn sets(&self, first: u64, count: usize, total: usize) -> Vec<Vec<CirSnapshot>> {
+        (first..first + count as u64)
+            .into_par_iter()
+            .map(|s| {
+                let start = s as usize * SNAPSHOTS_PER_SET;
+                let len = total.saturating_sub(start).min(SNAPSHOTS_PER_SET);
+                (0..len as u32).map(|k| self.snapshot(s, k)).collect()
+            })
+            .collect()
     }
 }
 
@@ -190,6 +184,8 @@ fn gauss(rng: &mut Pcg64) -> f64 {
 /// that (it includes the set checks and statistics, which are small).
 struct Proposed {
     threads: usize,
+    /// The rayon pool of `threads` threads the pipeline's detection runs on.
+    pool: rayon::ThreadPool,
     pipeline: MpcPipeline,
     config: MpcConfig,
     long_term: LongTermTracker,
@@ -200,9 +196,19 @@ struct Proposed {
 
 impl Proposed {
     fn new(config: &MpcConfig, channel: &Channel, threads: usize) -> anyhow::Result<Self> {
-        let pipeline = MpcPipeline::new(config.clone(), &channel.pulse, TAP_SPACING_S, CARRIER_HZ, threads)?;
+        let pipeline = MpcPipeline::new(config.clone(), &channel.pulse, TAP_SPACING_S, CARRIER_HZ)?;
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
         let long_term = LongTermTracker::new(config.long_term.clone(), CARRIER_HZ, 0)?;
-        Ok(Self { threads, pipeline, config: config.clone(), long_term, total_s: 0.0, track_s: 0.0, detections: 0 })
+        Ok(Self {
+            threads,
+            pool,
+            pipeline,
+            config: config.clone(),
+            long_term,
+            total_s: 0.0,
+            track_s: 0.0,
+            detections: 0,
+        })
     }
 
     fn detect_s(&self) -> f64 {
@@ -212,7 +218,8 @@ impl Proposed {
     /// Processes one set; returns its detections per snapshot.
     fn push_set(&mut self, set: &[CirSnapshot]) -> anyhow::Result<Vec<Vec<MpcDetection>>> {
         let started = Instant::now();
-        let output = self.pipeline.push_set(set)?;
+        let pipeline = &mut self.pipeline;
+        let output = self.pool.install(|| pipeline.push_set(set))?;
         self.total_s += started.elapsed().as_secs_f64();
         let found: Vec<Vec<MpcDetection>> = output.per_snapshot.into_iter().map(|s| s.detections).collect();
         self.detections += found.iter().map(Vec::len).sum::<usize>();
@@ -302,11 +309,10 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
         args.threads.iter().map(|&t| Proposed::new(&config, &channel, t)).collect::<anyhow::Result<Vec<_>>>()?;
     let mut fft = FftBaseline::new();
     let mut gmphd_s = 0.0;
-    let generate_threads = std::thread::available_parallelism().map_or(1, usize::from);
     let total_sets = args.snapshots.div_ceil(SNAPSHOTS_PER_SET);
     for first in (0..total_sets).step_by(CHUNK_SETS) {
         let count = CHUNK_SETS.min(total_sets - first);
-        let sets = channel.sets(first as u64, count, args.snapshots, generate_threads);
+        let sets = channel.sets(first as u64, count, args.snapshots);
         for set in &sets {
             fft.run(set);
         }

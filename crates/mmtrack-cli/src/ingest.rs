@@ -16,6 +16,7 @@ use mmtrack_io::recording::PoseStream;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use crate::progress;
+use crate::threads::ThreadsArg;
 
 mod folders;
 
@@ -151,6 +152,8 @@ enum Kind {
         input: PathBuf,
         #[command(flatten)]
         output: OutputArgs,
+        #[command(flatten)]
+        threads: ThreadsArg,
         /// Range bin size in metres (dataset SDK: 0.0432; CFEAR uses 0.0438).
         #[arg(long, default_value_t = oxford::OXFORD.range_resolution_m)]
         range_resolution_m: f64,
@@ -175,6 +178,8 @@ enum Kind {
         input: PathBuf,
         #[command(flatten)]
         output: OutputArgs,
+        #[command(flatten)]
+        threads: ThreadsArg,
         /// Range bin size in metres (default: chosen by recording date).
         #[arg(long)]
         range_resolution_m: Option<f64>,
@@ -196,6 +201,8 @@ enum Kind {
         input: PathBuf,
         #[command(flatten)]
         output: OutputArgs,
+        #[command(flatten)]
+        threads: ThreadsArg,
         /// Range bin size in metres.
         #[arg(long, default_value_t = mulran::RANGE_RESOLUTION_M)]
         range_resolution_m: f64,
@@ -291,7 +298,7 @@ enum Kind {
 
 pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match args.kind {
-        Kind::Oxford { input, output, range_resolution_m, bins, decode, sequence_id } => {
+        Kind::Oxford { input, output, threads, range_resolution_m, bins, decode, sequence_id } => {
             let expected_bins = match bins.as_str() {
                 "auto" => None,
                 n => Some(n.parse::<usize>().with_context(|| format!("--bins '{n}': expected a number or `auto`"))?),
@@ -302,19 +309,19 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 carry_png: !decode,
                 sequence_id,
             };
-            oxford_folder(&input, &output, &options, quiet)
+            threads.install(|| oxford_folder(&input, &output, &options, quiet))?
         }
-        Kind::Boreas { input, output, range_resolution_m, decode, sequence_id } => {
+        Kind::Boreas { input, output, threads, range_resolution_m, decode, sequence_id } => {
             if let Some(r) = range_resolution_m {
                 positive_metres("--range-resolution-m", r)?;
             }
             let options = BoreasOptions { range_resolution_m, decode, sequence_id };
-            boreas_folder(&input, &output, &options, quiet)
+            threads.install(|| boreas_folder(&input, &output, &options, quiet))?
         }
-        Kind::Mulran { input, output, range_resolution_m, sweep, sequence_id } => {
+        Kind::Mulran { input, output, threads, range_resolution_m, sweep, sequence_id } => {
             positive_metres("--range-resolution-m", range_resolution_m)?;
             let options = MulranOptions { range_resolution_m, timing: sweep.timing()?, sequence_id };
-            mulran_folder(&input, &output, &options, quiet)
+            threads.install(|| mulran_folder(&input, &output, &options, quiet))?
         }
         Kind::Poses { input, format, mut output, add_to, estimate, times, t0_ns, plane } => {
             let plane = match plane {

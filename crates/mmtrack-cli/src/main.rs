@@ -23,6 +23,7 @@ mod reproduce_mpc;
 mod reproduce_mpc_report;
 mod simulate;
 mod simulate_sounder;
+mod threads;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -3,19 +3,19 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::mpsc;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose, path_length_m};
 use mmtrack_io::recording::PoseStream;
-use mmtrack_io::recording::{EncodedScan, RecordingItem};
+use mmtrack_io::recording::RecordingItem;
 use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary, table_path, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 
 use crate::progress;
+use crate::threads::ThreadsArg;
 
 #[path = "process_mpc.rs"]
 mod process_mpc;
@@ -76,6 +76,8 @@ pub struct OdometryArgs {
     /// Replace existing output tables of this sequence.
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
 }
 
 pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
@@ -125,9 +127,8 @@ pub struct OdometryRun {
     pub elapsed_s: f64,
 }
 
-/// Reads the recording on a second thread and decodes its scans on a pool of
-/// workers (one per core), so reading, PNG inflating and the odometry on this
-/// thread overlap.
+/// Reads the recording and decodes its scans on the current rayon pool while
+/// the odometry runs on the previous ones ([`for_each_event`]).
 pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> anyhow::Result<OdometryRun> {
     let started = Instant::now();
     let mut odometry = RadarOdometry::new(config)?;
@@ -162,84 +163,43 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> an
     Ok(OdometryRun { estimates, timings, ground_truth, sequence_id, elapsed_s: started.elapsed().as_secs_f64() })
 }
 
-/// An event, or a scan being decoded by a worker.
-enum Pending {
-    Event(RecordingEvent),
-    Scan(mpsc::Receiver<Result<PolarScan, mmtrack_io::IoError>>),
-}
+/// Scans decoded per thread of the pool while the previous batch is processed.
+const SCANS_PER_THREAD: usize = 2;
 
 /// Calls `f` with every event of the recording in file order (and the bytes
-/// read so far). A reader thread hands the scans to decode workers, one per
-/// core, round robin; each result comes back through its own channel, so the
-/// order is kept, and bounded channels keep at most a few scans in memory.
-/// Returns the recording metadata.
+/// read so far). Radar scans are decoded on the current rayon pool in batches
+/// while `f` takes the previous batch ([`mmtrack_core::parallel::map_in_order`]),
+/// so reading, PNG inflating and `f` overlap, order is kept and at most two
+/// batches are in memory. Reading stops at the first bad record. Returns the
+/// recording metadata.
 pub fn for_each_event(
     recording: &Path,
-    mut f: impl FnMut(RecordingEvent, u64) -> anyhow::Result<()>,
+    mut f: impl FnMut(RecordingEvent, u64) -> anyhow::Result<()> + Send,
 ) -> anyhow::Result<Option<BTreeMap<String, String>>> {
     let mut reader = RecordingReader::open(recording)?;
-    let workers = std::thread::available_parallelism().map_or(2, std::num::NonZero::get).clamp(1, 8);
-    let (sender, receiver) = mpsc::sync_channel::<Result<(Pending, u64), mmtrack_io::IoError>>(workers);
-    let mut outcome = Ok(());
-    let metadata = std::thread::scope(|scope| {
-        let reader_thread = scope.spawn(move || {
-            std::thread::scope(|pool| {
-                let jobs: Vec<_> = (0..workers)
-                    .map(|_| {
-                        type Job = (EncodedScan, mpsc::SyncSender<Result<PolarScan, mmtrack_io::IoError>>);
-                        let (job_sender, job_receiver) = mpsc::sync_channel::<Job>(1);
-                        pool.spawn(move || {
-                            for (scan, reply) in job_receiver {
-                                let _ = reply.send(scan.decode());
-                            }
-                        });
-                        job_sender
-                    })
-                    .collect();
-                let mut next_worker = 0;
-                while let Some(item) = reader.next_item() {
-                    let pending = match item {
-                        Ok(RecordingItem::Event(event)) => Ok(Pending::Event(event)),
-                        Ok(RecordingItem::Scan(scan)) => {
-                            let (reply, result) = mpsc::sync_channel(1);
-                            if jobs[next_worker].send((scan, reply)).is_err() {
-                                break;
-                            }
-                            next_worker = (next_worker + 1) % workers;
-                            Ok(Pending::Scan(result))
-                        }
-                        Err(e) => Err(e),
-                    };
-                    let failed = pending.is_err();
-                    if sender.send(pending.map(|p| (p, reader.bytes_read()))).is_err() || failed {
-                        break;
-                    }
-                }
-                drop(jobs);
-            });
-            reader.metadata().cloned()
-        });
-        for item in receiver.iter() {
-            let step = item.map_err(anyhow::Error::from).and_then(|(pending, bytes_read)| {
-                let event = match pending {
-                    Pending::Event(event) => event,
-                    Pending::Scan(result) => RecordingEvent::RadarScan(
-                        result.recv().map_err(|_| anyhow::anyhow!("a scan decoding worker stopped"))??,
-                    ),
-                };
-                f(event, bytes_read)
-            });
-            if let Err(e) = step {
-                outcome = Err(e);
-                break;
-            }
+    let mut failed = false;
+    let items = std::iter::from_fn(|| {
+        if failed {
+            return None;
         }
-        // Dropping the receiver stops the reader at its next send.
-        drop(receiver);
-        reader_thread.join().map_err(|_| anyhow::anyhow!("the recording reader thread panicked"))
-    })?;
-    outcome?;
-    Ok(metadata)
+        let item = reader.next_item()?;
+        failed = item.is_err();
+        Some((item, reader.bytes_read()))
+    });
+    mmtrack_core::parallel::map_in_order(
+        items,
+        SCANS_PER_THREAD,
+        |(item, bytes_read)| {
+            let event = match item {
+                Ok(RecordingItem::Event(event)) => Ok(event),
+                Ok(RecordingItem::Scan(scan)) => scan.decode().map(RecordingEvent::RadarScan),
+                Err(e) => Err(e),
+            };
+            (event, bytes_read)
+        },
+        |(event, bytes_read)| f(event?, bytes_read),
+    )?;
+    Ok(reader.metadata().cloned())
 }
 
 fn process_scan(
@@ -262,7 +222,9 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &sequence_hint) {
         refuse_existing(&args.output, sequence)?;
     }
-    let run = run_odometry(&args.recording, config.clone(), quiet)
+    let run = args
+        .threads
+        .install(|| run_odometry(&args.recording, config.clone(), quiet))?
         .with_context(|| format!("{}", args.recording.display()))?;
     let sequence = sequence_hint.unwrap_or_else(|| run.sequence_id.clone());
     if overwrite == Overwrite::Refuse {

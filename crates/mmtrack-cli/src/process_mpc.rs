@@ -30,6 +30,7 @@ use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_mpc::{MpcConfig, MpcPipeline, SounderPulse};
 
 use crate::progress;
+use crate::threads::ThreadsArg;
 
 /// Every table `process mpc` may write.
 const TABLES: [&str; 8] = mmtrack_analysis::pipeline::MPC_TABLE_NAMES;
@@ -59,9 +60,8 @@ pub struct MpcArgs {
     /// mpc_tracks_gmphd); the same as `run_gmphd = true` in the configuration.
     #[arg(long)]
     pub gmphd: bool,
-    /// Worker threads for detection [default: one per core].
-    #[arg(long, value_name = "N")]
-    pub threads: Option<usize>,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
     /// Sequence id of the output partitions (default: the recording's).
     #[arg(long)]
     pub sequence: Option<String>,
@@ -193,7 +193,6 @@ fn choose_pulse(
 fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::Result<MpcRun> {
     let path = &args.recording;
     let link_filter = args.link.as_deref().map(parse_link).transpose()?;
-    let threads = args.threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, usize::from)).max(1);
     let mut reader = RecordingReader::open(path)?;
     let bar = progress::bytes_bar("mpc", quiet);
     bar.set_length(std::fs::metadata(path).map(|m| m.len()).unwrap_or(0));
@@ -240,7 +239,6 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
                             pulse,
                             snapshot.tap_spacing_s,
                             snapshot.carrier_hz,
-                            threads,
                         )
                         .with_context(context)?;
                         e.insert(LinkRun {
@@ -348,7 +346,7 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &hinted) {
         refuse_existing(&args.output, sequence)?;
     }
-    let run = read_and_process(args, &config, quiet)?;
+    let run = args.threads.install(|| read_and_process(args, &config, quiet))??;
     let sequence = args.sequence.clone().unwrap_or_else(|| run.sequence_id.clone());
     if overwrite == Overwrite::Refuse {
         refuse_existing(&args.output, &sequence)?;

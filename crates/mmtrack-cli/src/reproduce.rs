@@ -25,6 +25,7 @@ use mmtrack_sim::radar::{RadarSimulator, Trajectory};
 use crate::ingest::PoseFormat;
 use crate::process::{self, OdometryRun};
 use crate::simulate;
+use crate::threads::ThreadsArg;
 
 /// The drive scenario, embedded so the experiment runs from any directory.
 pub const ODOMETRY_DRIVE_SCENARIO: &str = include_str!("../../../data/reproduce/odometry-drive.toml");
@@ -94,14 +95,13 @@ struct OdometryExperimentArgs {
     /// The CI version: a 300 m drive, KITTI segments of 100 and 200 m.
     #[arg(long)]
     quick: bool,
-    /// Simulator threads (0: all cores). Results do not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
+    #[command(flatten)]
+    threads: ThreadsArg,
 }
 
 pub fn run(args: &ReproduceArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.experiment {
-        Experiment::Odometry(a) => odometry(a, quiet),
+        Experiment::Odometry(a) => a.threads.install(|| odometry(a, quiet))?,
         Experiment::MpcArtificial(a) => crate::reproduce_mpc::run(a, quiet),
     }
 }
@@ -180,7 +180,7 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
     let poses = simulate::read_trajectory(&args.trajectory, args.trajectory_format, None, 0)?;
     let trajectory = Trajectory::from_poses(poses).with_context(|| args.trajectory.display().to_string())?;
     let world = scenario.build_world(&trajectory).with_context(|| scenario_name.clone())?;
-    let sim_options = mmtrack_sim::radar::SimOptions { threads: args.threads, ..scenario.options() };
+    let sim_options = scenario.options();
     let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, sim_options)
         .with_context(|| args.trajectory.display().to_string())?;
 

@@ -12,9 +12,10 @@ use mmtrack_ingest::oxford::{self, NavtechLayout};
 use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_io::RecordingWriter;
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
-use mmtrack_sim::radar::{RadarSimulator, Scenario, SimOptions, Trajectory};
+use mmtrack_sim::radar::{RadarSimulator, Scenario, Trajectory};
 
 use crate::ingest::{OutputArgs, PoseFormat};
+use crate::threads::ThreadsArg;
 
 #[derive(Args)]
 pub struct SimulateArgs {
@@ -68,9 +69,8 @@ struct RadarArgs {
     /// Stop after this many metres of path (overrides the scenario's max_distance_m).
     #[arg(long, value_name = "METRES")]
     max_distance_m: Option<f64>,
-    /// Worker threads (0: all cores). The output does not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
+    #[command(flatten)]
+    threads: ThreadsArg,
     /// Output layout: a recording with ground truth, or an Oxford-style folder (to exercise ingest).
     #[arg(long, value_enum, default_value_t = Format::Recording)]
     format: Format,
@@ -223,7 +223,7 @@ fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
         None => scenario.motion_trajectory().with_context(|| args.scenario.display().to_string())?,
     };
     let world = scenario.build_world(&trajectory).with_context(|| args.scenario.display().to_string())?;
-    let options = SimOptions { threads: args.threads, ..scenario.options() };
+    let options = scenario.options();
     let trajectory_source = args.trajectory.as_ref().unwrap_or(&args.scenario);
     let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)
         .with_context(|| trajectory_source.display().to_string())?;
@@ -249,11 +249,11 @@ fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
 pub fn run(args: SimulateArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match args.kind {
         Kind::Radar(radar) => {
-            run_radar(&radar, quiet)?;
+            radar.threads.install(|| run_radar(&radar, quiet))??;
             Ok(ExitCode::SUCCESS)
         }
         Kind::Sounder(sounder) => {
-            crate::simulate_sounder::run_sounder(&sounder, quiet)?;
+            sounder.threads.install(|| crate::simulate_sounder::run_sounder(&sounder, quiet))??;
             Ok(ExitCode::SUCCESS)
         }
     }

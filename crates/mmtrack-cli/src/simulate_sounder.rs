@@ -16,6 +16,7 @@ use mmtrack_sim::sounder::{
 };
 
 use crate::ingest::OutputArgs;
+use crate::threads::ThreadsArg;
 
 #[derive(Args)]
 pub struct SounderArgs {
@@ -25,9 +26,8 @@ pub struct SounderArgs {
     /// Simulate only the first N sets (overrides the scenario's length).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     sets: Option<u64>,
-    /// Worker threads (0: all cores). The output does not depend on it.
-    #[arg(long, default_value_t = 0)]
-    threads: usize,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
     #[command(flatten)]
     output: OutputArgs,
 }
@@ -88,7 +88,7 @@ fn write_convoy(args: &SounderArgs, seed: u64, config: &ConvoyConfig, quiet: boo
         config.sets = config.sets.min(usize::try_from(sets).unwrap_or(usize::MAX));
     }
     let simulator =
-        ConvoySimulator::new(&config, seed, args.threads).with_context(|| args.scenario.display().to_string())?;
+        ConvoySimulator::new(&config, seed).with_context(|| args.scenario.display().to_string())?;
     let mut extra = BTreeMap::from([
         ("sounder.channel".to_string(), "convoy".to_string()),
         ("sounder.road".to_string(), format!("{:?}", config.road)),

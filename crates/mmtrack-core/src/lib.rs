@@ -10,6 +10,7 @@
 //! - [`CirSnapshot`]: one channel impulse response with its tap spacing and its
 //!   position in the sounder's set/snapshot structure;
 //! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`], [`MpcTruth`] and [`OdometryEstimate`];
+//! - [`parallel`]: order-keeping parallel maps on rayon, for every parallel stage;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
 //!
@@ -26,6 +27,7 @@ mod gnss;
 mod mpc;
 mod odometry;
 mod pose;
+pub mod parallel;
 mod radar;
 pub mod sounder;
 

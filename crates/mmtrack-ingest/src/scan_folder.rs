@@ -1,6 +1,6 @@
 //! What the Navtech folder layouts (Oxford, Boreas, MulRan) share: a folder of
 //! `<stamp>.png` scans named by their time, listed in time order, and decoded
-//! on one worker per core while the caller writes them in order.
+//! on the rayon pool while the caller writes them in order.
 
 use std::path::{Path, PathBuf};
 
@@ -83,47 +83,29 @@ pub fn folder_name(root: &Path) -> String {
         .unwrap_or_else(|| "sequence".into())
 }
 
-/// Decoded scans each worker may hold ready ahead of the writer.
-const DECODED_AHEAD: usize = 2;
+/// Scans decoded per thread of the pool in one batch.
+const DECODED_PER_THREAD: usize = 2;
 
-/// Reads and decodes the scans on one worker per core and hands them to
+/// Reads and decodes the scans on the current rayon pool and hands them to
 /// `write` in file order.
 ///
-/// Worker `w` takes scans `w, w + n, w + 2n, ...` and sends each down its own
-/// channel of capacity [`DECODED_AHEAD`]; the caller's thread receives from the
-/// workers round-robin, so order is kept and at most `n * (DECODED_AHEAD + 1)`
-/// scans are in memory whatever the folder size. PNG decoding (inflate and
-/// unfilter, needed to reach the row headers) is most of an ingest's time.
+/// Decoding runs in batches of [`DECODED_PER_THREAD`] scans per thread while
+/// `write` takes the previous batch ([`mmtrack_core::parallel::map_in_order`]),
+/// so at most `2 * DECODED_PER_THREAD * threads` scans are in memory whatever
+/// the folder size, and the output is the same for any thread count. PNG
+/// decoding (inflate and unfilter, needed to reach the row headers) is most of
+/// an ingest's time.
 pub fn decode_in_order<T: Send>(
     scans: &[ScanFile],
     decode: &(dyn Fn(&ScanFile) -> Result<T, IngestError> + Sync),
-    write: &mut dyn FnMut(usize, T) -> Result<(), IngestError>,
+    write: &mut (dyn FnMut(usize, T) -> Result<(), IngestError> + Send),
 ) -> Result<(), IngestError> {
-    let workers = std::thread::available_parallelism().map_or(1, |n| n.get()).min(scans.len().max(1));
-    std::thread::scope(|scope| {
-        let receivers: Vec<_> = (0..workers)
-            .map(|w| {
-                let (sender, receiver) = std::sync::mpsc::sync_channel(DECODED_AHEAD);
-                scope.spawn(move || {
-                    for scan in scans.iter().skip(w).step_by(workers) {
-                        // A closed channel means the writer stopped on an error.
-                        if sender.send(decode(scan)).is_err() {
-                            return;
-                        }
-                    }
-                });
-                receiver
-            })
-            .collect();
-        for (index, scan) in scans.iter().enumerate() {
-            let received = receivers[index % workers].recv().map_err(|_| IngestError::BadLayout {
-                path: scan.path.clone(),
-                detail: "decoder thread stopped unexpectedly".into(),
-            })?;
-            write(index, received?)?;
-        }
-        Ok(())
-    })
+    mmtrack_core::parallel::map_in_order(
+        scans.iter().enumerate(),
+        DECODED_PER_THREAD,
+        |(index, scan)| (index, decode(scan)),
+        |(index, decoded)| write(index, decoded?),
+    )
 }
 
 #[cfg(test)]

@@ -11,10 +11,10 @@
 //! 1. checks: at least one snapshot, strictly increasing `t_ns` (also across
 //!    sets, [`MpcError::NonMonotonicTime`]), one `set_index` and one link
 //!    (TX/RX antenna) in the set, the pipeline's carrier;
-//! 2. detection of each snapshot ([`Detector`]) on `threads` scoped threads,
-//!    each taking a contiguous chunk of the set; results are put back in
-//!    snapshot order and the first error in snapshot order is returned, so
-//!    the output does not depend on the thread count;
+//! 2. detection of each snapshot ([`Detector`]) on the current rayon pool
+//!    (`ThreadPool::install` around the call chooses the threads); results
+//!    are kept in snapshot order and the first error in snapshot order is
+//!    returned, so the output does not depend on the thread count;
 //! 3. short-term tracks ([`short_term_tracks`]) with ids running on across
 //!    sets;
 //! 4. optionally the GM-PHD baseline ([`track_gmphd`]) on the same detections
@@ -39,6 +39,7 @@
 //! gain, and the power loss of Mahler et al.'s Fig. 9 is negative.
 
 use mmtrack_core::{CirSnapshot, MpcLongTermEntry, MpcSetStats, MpcTrack};
+use rayon::prelude::*;
 
 use crate::short_term::is_full_lifetime;
 use crate::{
@@ -70,7 +71,6 @@ pub struct MpcPipeline {
     config: MpcConfig,
     detector: Detector,
     carrier_hz: f64,
-    threads: usize,
     long_term: LongTermTracker,
     next_short_id: u64,
     next_gmphd_id: u64,
@@ -80,10 +80,10 @@ pub struct MpcPipeline {
 
 impl MpcPipeline {
     /// A pipeline for CIRs of `pulse.taps()` taps spaced `tap_spacing_s`
-    /// apart at a carrier of `carrier_hz`, detecting on `threads` threads.
+    /// apart at a carrier of `carrier_hz`.
     ///
     /// # Errors
-    /// [`MpcError::BadConfig`] for an invalid config, carrier or thread count
+    /// [`MpcError::BadConfig`] for an invalid config or carrier
     /// (the field is named), [`MpcError::GmPhd`] for an invalid GM-PHD
     /// config, [`MpcError::BadPulse`] for an unusable pulse or tap spacing.
     pub fn new(
@@ -91,7 +91,6 @@ impl MpcPipeline {
         pulse: &SounderPulse,
         tap_spacing_s: f64,
         carrier_hz: f64,
-        threads: usize,
     ) -> Result<Self, MpcError> {
         if !(carrier_hz.is_finite() && carrier_hz > 0.0) {
             return Err(MpcError::BadConfig {
@@ -99,9 +98,6 @@ impl MpcPipeline {
                 value: carrier_hz.to_string(),
                 expected: "a finite positive frequency",
             });
-        }
-        if threads == 0 {
-            return Err(MpcError::BadConfig { field: "threads", value: "0".into(), expected: "at least 1" });
         }
         config.gmphd.carrier_hz = carrier_hz;
         config.validate()?;
@@ -111,7 +107,6 @@ impl MpcPipeline {
             config,
             detector,
             carrier_hz,
-            threads,
             long_term,
             next_short_id: 0,
             next_gmphd_id: 0,
@@ -195,34 +190,15 @@ impl MpcPipeline {
         Ok(())
     }
 
-    /// Detection of every snapshot on up to `threads` scoped threads, in
-    /// snapshot order; the first error in snapshot order.
+    /// Detection of every snapshot on the current rayon pool, in snapshot
+    /// order; the first error in snapshot order.
     fn detect_all(&self, snapshots: &[CirSnapshot]) -> Result<Vec<SnapshotDetections>, MpcError> {
-        let detect_chunk = |offset: usize, chunk: &[CirSnapshot]| -> Result<Vec<SnapshotDetections>, MpcError> {
-            chunk
-                .iter()
-                .enumerate()
-                .map(|(k, snapshot)| self.detector.detect(snapshot, self.snapshots_seen + offset + k))
-                .collect()
-        };
-        let threads = self.threads.min(snapshots.len());
-        if threads <= 1 {
-            return detect_chunk(0, snapshots);
-        }
-        let chunk_len = snapshots.len().div_ceil(threads);
-        let chunk_results: Vec<Result<Vec<SnapshotDetections>, MpcError>> = std::thread::scope(|scope| {
-            let handles: Vec<_> = snapshots
-                .chunks(chunk_len)
-                .enumerate()
-                .map(|(c, chunk)| scope.spawn(move || detect_chunk(c * chunk_len, chunk)))
-                .collect();
-            handles.into_iter().map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))).collect()
-        });
-        let mut per_snapshot = Vec::with_capacity(snapshots.len());
-        for result in chunk_results {
-            per_snapshot.extend(result?);
-        }
-        Ok(per_snapshot)
+        let results: Vec<Result<SnapshotDetections, MpcError>> = snapshots
+            .par_iter()
+            .enumerate()
+            .map(|(k, snapshot)| self.detector.detect(snapshot, self.snapshots_seen + k))
+            .collect();
+        results.into_iter().collect()
     }
 
     /// The GM-PHD baseline on the set's detections, renumbered from

@@ -10,10 +10,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let sets: usize = args.next().map_or(Ok(1666), |a| a.parse())?;
     let threads: usize = args.next().map_or(Ok(0), |a| a.parse())?;
+    // Rendering runs on rayon's global pool; 0 keeps rayon's default (RAYON_NUM_THREADS or all cores).
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build_global()?;
     let mut config = ConvoyConfig { sets, ..ConvoyConfig::default() };
     config.sounder.pulse = PulseModel::measured_like();
     let start = Instant::now();
-    let simulator = ConvoySimulator::new(&config, 5, threads)?;
+    let simulator = ConvoySimulator::new(&config, 5)?;
     let (cars, scatterers) = (simulator.traffic_cars(), simulator.diffuse_scatterers());
     let mut per_kind: BTreeMap<String, (usize, f64)> = BTreeMap::new();
     let (mut snapshots, mut truth_power, mut cir_power, mut ids) =

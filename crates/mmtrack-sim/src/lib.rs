@@ -23,7 +23,7 @@
 //! // A world: a procedural street along it (plus any explicit `ReflectorSpec`s).
 //! let world = World::new(&generate_world(&GeneratorConfig::default(), &trajectory, 7)?)?;
 //! let sensor = Sensor { bins: 500, ..Sensor::default() };
-//! let options = SimOptions { seed: 7, limits: ScanLimits { max_scans: Some(2), max_distance_m: None }, threads: 0 };
+//! let options = SimOptions { seed: 7, limits: ScanLimits { max_scans: Some(2), max_distance_m: None } };
 //! // Scans stream one by one: a 2 km drive never sits in memory.
 //! for (scan, world_from_vehicle) in RadarSimulator::new(&world, &sensor, &trajectory, options)? {
 //!     assert_eq!(scan.power.len(), 400 * 500);
@@ -55,8 +55,9 @@
 //! - [`radar::World`]: compiled reflectors in uniform grids; a beam visits
 //!   only the cells it crosses, so cost does not grow with world size.
 //! - [`radar::RadarSimulator`]: `Iterator<Item = (PolarScan, StampedPose)>`,
-//!   rendering `threads` sweeps at a time (per-sweep randomness from
-//!   `(seed, sweep index)`), or any single sweep with `render(index)`.
+//!   rendering one sweep per thread of the current rayon pool at a time
+//!   (per-sweep randomness from `(seed, sweep index)`), or any single sweep
+//!   with `render(index)`.
 //!
 //! Speed (release build, this project's 2-core machine, Oxford-size sweeps of
 //! 400 x 3768 in the default generated city, `cargo run --release -p

@@ -183,8 +183,10 @@ impl RecordingWriter {
             .profile("")
             .library(concat!("mmtrack ", env!("CARGO_PKG_VERSION")));
         if level > 0 {
-            // zstd's own worker threads compress chunks on the other cores.
-            let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u32);
+            // zstd's own worker threads compress chunks beside the writer, as
+            // many as the current rayon pool has threads (`--threads`); zstd
+            // writes the same bytes for any worker count of at least one.
+            let threads = u32::try_from(rayon::current_num_threads()).unwrap_or(1).max(1);
             write_options = write_options.compression_level(level).compression_threads(threads);
         }
         let mut mcap = write_options.create(file.writer()?).map_err(|e| write_err(path, e))?;

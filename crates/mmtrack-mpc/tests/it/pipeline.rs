@@ -50,13 +50,19 @@ fn sets(count: u64, seed: u64) -> Vec<Vec<CirSnapshot>> {
     (0..count).map(|s| set(&band, &pulse, s, &mut rng)).collect()
 }
 
-fn pipeline(config: MpcConfig, threads: usize) -> MpcPipeline {
-    MpcPipeline::new(config, &SounderPulse::flat(&band(TAPS)), TAP_S, CARRIER_HZ, threads).unwrap()
+fn pipeline(config: MpcConfig) -> MpcPipeline {
+    MpcPipeline::new(config, &SounderPulse::flat(&band(TAPS)), TAP_S, CARRIER_HZ).unwrap()
+}
+
+/// Runs `f` on a rayon pool of `threads` threads (detection runs on the
+/// current pool).
+fn in_pool<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(f)
 }
 
 #[test]
 fn two_mpc_channel_gives_two_full_lifetime_tracks_per_set_linked_across_sets() {
-    let mut pipeline = pipeline(MpcConfig::default(), 2);
+    let mut pipeline = pipeline(MpcConfig::default());
     let energy = pipeline.detector().pulse_energy();
     let mut long_ids = Vec::new();
     for (s, snapshots) in sets(4, 11).iter().enumerate() {
@@ -111,7 +117,7 @@ fn two_mpc_channel_gives_two_full_lifetime_tracks_per_set_linked_across_sets() {
 #[test]
 fn time_must_increase_within_and_across_sets() {
     let all = sets(3, 5);
-    let mut pipeline = pipeline(MpcConfig::default(), 1);
+    let mut pipeline = pipeline(MpcConfig::default());
     pipeline.push_set(&all[0]).unwrap();
 
     // Across sets: set 1 starting at the last time of set 0.
@@ -138,8 +144,8 @@ fn output_is_identical_for_any_thread_count() {
     let all = sets(3, 23);
     let run = |threads: usize| -> Vec<SetOutput> {
         let config = MpcConfig { run_gmphd: true, ..MpcConfig::default() };
-        let mut pipeline = pipeline(config, threads);
-        all.iter().map(|s| pipeline.push_set(s).unwrap()).collect()
+        let mut pipeline = pipeline(config);
+        in_pool(threads, || all.iter().map(|s| pipeline.push_set(s).unwrap()).collect())
     };
     let one = run(1);
     for threads in [2, 3, 4, 6, 16] {
@@ -161,7 +167,7 @@ fn bad_snapshots_name_the_first_in_order_for_any_thread_count() {
     bad[4].taps[7] = Complex64::new(f64::NAN, 0.0);
     bad[2].taps.truncate(100);
     for threads in [1, 2, 3, 6] {
-        let err = pipeline(MpcConfig::default(), threads).push_set(&bad).unwrap_err();
+        let err = in_pool(threads, || pipeline(MpcConfig::default()).push_set(&bad).unwrap_err());
         assert!(matches!(err, MpcError::BadSnapshot { snapshot: 2, set_index: 0, .. }), "{threads}: {err}");
     }
     // A snapshot of another set, link or carrier.
@@ -172,10 +178,10 @@ fn bad_snapshots_name_the_first_in_order_for_any_thread_count() {
     let mut other_carrier = all[0].clone();
     other_carrier[5].carrier_hz = 60e9;
     for (input, at) in [(other_set, 1), (other_link, 3), (other_carrier, 5)] {
-        let err = pipeline(MpcConfig::default(), 2).push_set(&input).unwrap_err();
+        let err = pipeline(MpcConfig::default()).push_set(&input).unwrap_err();
         assert!(matches!(err, MpcError::BadSnapshot { snapshot, .. } if snapshot == at), "{err}");
     }
-    let err = pipeline(MpcConfig::default(), 2).push_set(&[]).unwrap_err();
+    let err = pipeline(MpcConfig::default()).push_set(&[]).unwrap_err();
     assert_eq!(err, MpcError::EmptySet { snapshots_before: 0 });
 }
 
@@ -185,7 +191,7 @@ fn all_zero_snapshots_are_counted_as_skipped() {
     for tap in &mut all[3].taps {
         *tap = Complex64::default();
     }
-    let out = pipeline(MpcConfig::default(), 2).push_set(&all).unwrap();
+    let out = pipeline(MpcConfig::default()).push_set(&all).unwrap();
     assert_eq!(out.stats.skipped_snapshots, 1);
     assert_eq!(out.stats.snapshots, SNAPSHOTS);
     // The gap ends both paths' tracks at snapshot 2 (snapshots 4-5 are too
@@ -198,17 +204,15 @@ fn all_zero_snapshots_are_counted_as_skipped() {
 #[test]
 fn bad_configs_are_refused_by_name() {
     let pulse = SounderPulse::flat(&band(TAPS));
-    let err = MpcPipeline::new(MpcConfig::default(), &pulse, TAP_S, CARRIER_HZ, 0).unwrap_err();
-    assert!(matches!(err, MpcError::BadConfig { field: "threads", .. }), "{err}");
-    let err = MpcPipeline::new(MpcConfig::default(), &pulse, TAP_S, f64::NAN, 1).unwrap_err();
+    let err = MpcPipeline::new(MpcConfig::default(), &pulse, TAP_S, f64::NAN).unwrap_err();
     assert!(matches!(err, MpcError::BadConfig { field: "carrier_hz", .. }), "{err}");
     let config =
         MpcConfig { gmphd: GmPhdConfig { p_detection: 1.5, ..GmPhdConfig::default() }, ..MpcConfig::default() };
-    let err = MpcPipeline::new(config, &pulse, TAP_S, CARRIER_HZ, 1).unwrap_err();
+    let err = MpcPipeline::new(config, &pulse, TAP_S, CARRIER_HZ).unwrap_err();
     assert!(matches!(err, MpcError::GmPhd { source: GmPhdError::BadConfig { field: "p_detection", .. } }), "{err}");
     let mut config = MpcConfig::default();
     config.long_term.chi_classes_s.clear();
-    let err = MpcPipeline::new(config, &pulse, TAP_S, CARRIER_HZ, 1).unwrap_err();
+    let err = MpcPipeline::new(config, &pulse, TAP_S, CARRIER_HZ).unwrap_err();
     assert!(matches!(err, MpcError::BadConfig { field: "long_term.chi_classes_s", .. }), "{err}");
 }
 
@@ -238,7 +242,7 @@ fn detected_gain_differs_from_channel_gain_by_the_overlap_of_resolved_paths() {
                 CirSnapshot { snapshot_index: n, ..snapshot(&band, &pulse, &two, None, &mut rng, t_ns) }
             })
             .collect();
-        let out = pipeline(MpcConfig::default(), 1).push_set(&snapshots).unwrap();
+        let out = pipeline(MpcConfig::default()).push_set(&snapshots).unwrap();
         // The windowed energy of the two paths alone, sum_k |z_k H_k|^2 / U.
         let mut spectrum = vec![Complex64::default(); TAPS];
         for p in &two {

@@ -113,13 +113,12 @@ impl Scenario {
         World::new(&reflectors)
     }
 
-    /// Run options from the scenario (seed and cuts; threads: all cores).
+    /// Run options from the scenario (seed and cuts).
     #[must_use]
     pub fn options(&self) -> SimOptions {
         SimOptions {
             seed: self.seed,
             limits: ScanLimits { max_scans: self.max_scans, max_distance_m: self.max_distance_m },
-            threads: 0,
         }
     }
 }

@@ -3,6 +3,7 @@
 use std::collections::VecDeque;
 
 use mmtrack_core::{PolarScan, StampedPose};
+use rayon::prelude::*;
 
 use super::render::RenderContext;
 use super::sensor::Prepared;
@@ -14,27 +15,25 @@ use crate::SimError;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SimOptions {
     /// Seed of every random draw (noise, speckle). The output depends on it
-    /// and on the inputs only, never on `threads`.
+    /// and on the inputs only, never on the thread count.
     pub seed: u64,
     /// Which sweeps to render.
     pub limits: ScanLimits,
-    /// Worker threads; 0 = as many as the machine has. Sweeps are rendered
-    /// `threads` at a time, so memory holds at most that many scans.
-    pub threads: usize,
 }
 
 /// Renders the sweeps of a trajectory one after the other, as an iterator of
 /// `(scan, ground truth)`: the truth is `world_from_vehicle` at the scan's
 /// stamp (the time of its first azimuth).
 ///
-/// Each sweep is rendered from `(seed, sweep index)` alone, so the sequence
-/// is bit-identical for any thread count, and [`RadarSimulator::render`]
-/// gives any single sweep without the ones before it.
+/// Sweeps are rendered on the current rayon pool, one per pool thread at a
+/// time (so memory holds about that many scans). Each is rendered from
+/// `(seed, sweep index)` alone, so the sequence is bit-identical for any
+/// thread count, and [`RadarSimulator::render`] gives any single sweep
+/// without the ones before it.
 pub struct RadarSimulator<'a> {
     context: RenderContext<'a>,
     stamps: Vec<i64>,
     next: usize,
-    threads: usize,
     ready: VecDeque<(PolarScan, StampedPose)>,
 }
 
@@ -49,16 +48,11 @@ impl<'a> RadarSimulator<'a> {
     ) -> Result<Self, SimError> {
         sensor.validate()?;
         let stamps = scan_stamps(trajectory, sensor.sweep_ns(), options.limits)?;
-        let threads = match options.threads {
-            0 => std::thread::available_parallelism().map_or(1, std::num::NonZero::get),
-            n => n,
-        };
         let prepared = Prepared::new(sensor, options.seed);
         Ok(Self {
             context: RenderContext { world, sensor, prepared, trajectory, seed: options.seed },
             stamps,
             next: 0,
-            threads,
             ready: VecDeque::new(),
         })
     }
@@ -78,20 +72,10 @@ impl<'a> RadarSimulator<'a> {
     }
 
     fn refill(&mut self) {
-        let end = (self.next + self.threads).min(self.stamps.len());
-        let indices: Vec<usize> = (self.next..end).collect();
+        let end = (self.next + rayon::current_num_threads()).min(self.stamps.len());
+        let rendered: Vec<Option<(PolarScan, StampedPose)>> =
+            (self.next..end).into_par_iter().map(|i| self.render(i)).collect();
         self.next = end;
-        if indices.len() <= 1 {
-            let rendered: Vec<_> = indices.iter().filter_map(|i| self.render(*i)).collect();
-            self.ready.extend(rendered);
-            return;
-        }
-        let this = &*self;
-        let rendered: Vec<Option<(PolarScan, StampedPose)>> = std::thread::scope(|scope| {
-            let handles: Vec<_> = indices.iter().map(|i| scope.spawn(move || this.render(*i))).collect();
-            // A worker panics only on a bug; re-raise it on the caller's thread.
-            handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-        });
         self.ready.extend(rendered.into_iter().flatten());
     }
 }

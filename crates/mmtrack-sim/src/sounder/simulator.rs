@@ -7,6 +7,7 @@ use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{CirSnapshot, Complex64, MpcTruth, Se2, StampedPose};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
+use rayon::prelude::*;
 
 use super::convoy::{ConvoyConfig, RoadKind};
 use super::geometry::{P2, Road, Wall, blocked, cross, dist, dot, reflection_point, sub, unit};
@@ -101,6 +102,9 @@ struct Path {
     phase_rad: f64,
 }
 
+/// Sets rendered per thread of the rayon pool in one batch.
+const SETS_PER_THREAD: usize = 4;
+
 const NOISE_STREAM: u64 = 0x6e6f_6973_6520_636f;
 
 /// Streams the sets of a convoy run (see the [`super`] module docs for the
@@ -120,16 +124,16 @@ pub struct ConvoySimulator {
     tx: LaneMotion,
     snapshot_ns: i64,
     set_ns: i64,
-    threads: usize,
     next: usize,
     ready: VecDeque<SounderSet>,
 }
 
 impl ConvoySimulator {
     /// Checks the configuration and lays out the road, walls, diffuse
-    /// scatterers and traffic. `threads`: sets rendered at a time (0 = all
-    /// cores); the output does not depend on it.
-    pub fn new(config: &ConvoyConfig, seed: u64, threads: usize) -> Result<Self, SimError> {
+    /// scatterers and traffic. Sets are rendered on the current rayon pool,
+    /// four per pool thread at a time; the output does not
+    /// depend on the thread count.
+    pub fn new(config: &ConvoyConfig, seed: u64) -> Result<Self, SimError> {
         config.validate()?;
         let band = config.sounder.band()?;
         let pulse = config.sounder.pulse.spectrum(&band);
@@ -158,10 +162,6 @@ impl ConvoySimulator {
         };
         let scatterers = build_scatterers(&road, config, &walls, seed, s_min, s_max);
         let cars = build_cars(config, seed, duration_s, s_min, s_max);
-        let threads = match threads {
-            0 => std::thread::available_parallelism().map_or(1, std::num::NonZero::get),
-            n => n,
-        };
         Ok(Self {
             config: config.clone(),
             seed,
@@ -175,7 +175,6 @@ impl ConvoySimulator {
             tx,
             snapshot_ns,
             set_ns,
-            threads,
             next: 0,
             ready: VecDeque::new(),
         })
@@ -546,21 +545,11 @@ impl Iterator for ConvoySimulator {
 
     fn next(&mut self) -> Option<SounderSet> {
         if self.ready.is_empty() {
-            let end = (self.next + self.threads).min(self.config.sets);
-            let indices: Vec<u64> = (self.next as u64..end as u64).collect();
+            let end = (self.next + SETS_PER_THREAD * rayon::current_num_threads()).min(self.config.sets);
+            let rendered: Vec<Option<SounderSet>> =
+                (self.next as u64..end as u64).into_par_iter().map(|i| self.render_set(i)).collect();
             self.next = end;
-            if indices.len() <= 1 {
-                let rendered: Vec<SounderSet> = indices.iter().filter_map(|i| self.render_set(*i)).collect();
-                self.ready.extend(rendered);
-            } else {
-                let this = &*self;
-                let rendered: Vec<Option<SounderSet>> = std::thread::scope(|scope| {
-                    let handles: Vec<_> = indices.iter().map(|i| scope.spawn(move || this.render_set(*i))).collect();
-                    // A worker panics only on a bug; re-raise it on the caller's thread.
-                    handles.into_iter().map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e))).collect()
-                });
-                self.ready.extend(rendered.into_iter().flatten());
-            }
+            self.ready.extend(rendered.into_iter().flatten());
         }
         self.ready.pop_front()
     }

@@ -23,7 +23,7 @@ fn render(
     seed: u64,
     scans: usize,
 ) -> Vec<(PolarScan, StampedPose)> {
-    let options = SimOptions { seed, limits: ScanLimits { max_scans: Some(scans), max_distance_m: None }, threads: 1 };
+    let options = SimOptions { seed, limits: ScanLimits { max_scans: Some(scans), max_distance_m: None } };
     RadarSimulator::new(world, sensor, trajectory, options).unwrap().collect()
 }
 
@@ -109,7 +109,8 @@ fn same_seed_same_bytes_for_any_thread_count_and_a_new_seed_differs() {
     let s = Sensor { bins: 400, ..Sensor::default() };
     let run = |seed, threads| -> Vec<(PolarScan, StampedPose)> {
         let limits = ScanLimits { max_scans: Some(5), max_distance_m: None };
-        RadarSimulator::new(&world, &s, &trajectory, SimOptions { seed, limits, threads }).unwrap().collect()
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| RadarSimulator::new(&world, &s, &trajectory, SimOptions { seed, limits }).unwrap().collect())
     };
     let one = run(9, 1);
     assert_eq!(one.len(), 5);

@@ -19,8 +19,14 @@ fn tunnel(sets: usize) -> ConvoyConfig {
     ConvoyConfig { sets, ..ConvoyConfig::default() }
 }
 
-fn run(config: &ConvoyConfig, seed: u64, threads: usize) -> Vec<SounderSet> {
-    ConvoySimulator::new(config, seed, threads).unwrap().collect()
+/// The run on the global rayon pool.
+fn run(config: &ConvoyConfig, seed: u64) -> Vec<SounderSet> {
+    ConvoySimulator::new(config, seed).unwrap().collect()
+}
+
+/// The run on a rayon pool of `threads` threads.
+fn run_on(config: &ConvoyConfig, seed: u64, threads: usize) -> Vec<SounderSet> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| run(config, seed))
 }
 
 fn truth_of(set: &SounderSet, snapshot: u32, id: u64) -> Option<&MpcTruth> {
@@ -29,7 +35,7 @@ fn truth_of(set: &SounderSet, snapshot: u32, id: u64) -> Option<&MpcTruth> {
 
 #[test]
 fn los_delay_is_the_distance_between_the_cars_over_c() {
-    let sets = run(&tunnel(20), 3, 0);
+    let sets = run(&tunnel(20), 3);
     for set in &sets {
         let (tx, rx) = (set.tx_pose.parent_from_child, set.rx_pose.parent_from_child);
         let distance_m = (tx.x_m - rx.x_m).hypot(tx.y_m - rx.y_m);
@@ -43,7 +49,7 @@ fn los_delay_is_the_distance_between_the_cars_over_c() {
 
 #[test]
 fn tunnel_has_los_wall_bounces_in_delay_order_and_stable_ids() {
-    let sets = run(&tunnel(10), 3, 0);
+    let sets = run(&tunnel(10), 3);
     for set in &sets {
         for snapshot in 0..6 {
             let los = truth_of(set, snapshot, 0).unwrap();
@@ -71,7 +77,7 @@ fn doppler_matches_the_delay_slope_for_every_path() {
     let config = tunnel(30);
     let fc = config.sounder.carrier_hz;
     let mut checked = 0;
-    for set in run(&config, 11, 0) {
+    for set in run(&config, 11) {
         for first in set.truth.iter().filter(|t| t.snapshot_index == 0) {
             let Some(last) = truth_of(&set, 5, first.path_id) else { continue };
             let dt_s = (last.t_ns - first.t_ns) as f64 * 1e-9;
@@ -109,7 +115,7 @@ fn straight_convoy(rx_kmh: f64, tx_kmh: f64) -> ConvoyConfig {
 fn approaching_cars_give_positive_doppler_and_falling_delay() {
     for (rx_kmh, tx_kmh, approaching) in [(60.0, 40.0, true), (40.0, 60.0, false)] {
         let config = straight_convoy(rx_kmh, tx_kmh);
-        let sets = run(&config, 1, 1);
+        let sets = run(&config, 1);
         let los: Vec<&MpcTruth> = sets.iter().flat_map(|s| s.truth.iter().filter(|t| t.path_id == 0)).collect();
         assert_eq!(los.len(), 18);
         // Closing speed 20 km/h: |nu| = f_c * 5.556 / c = 105.6 Hz.
@@ -143,7 +149,7 @@ fn noise_floor_power_matches_the_setting() {
     let mut convoy = tunnel(20);
     convoy.sounder.pulse = PulseModel::measured_like();
     convoy.sounder.noise_floor_db = -130.0;
-    let sets = run(&convoy, 2, 0);
+    let sets = run(&convoy, 2);
     let tail: Vec<f64> =
         sets.iter().flat_map(|s| s.snapshots.iter()).flat_map(|c| c.taps[448..].iter().map(|t| t.norm_sqr())).collect();
     let mean_db = 10.0 * (tail.iter().sum::<f64>() / tail.len() as f64).log10();
@@ -216,7 +222,7 @@ fn a_flat_pulse_model_leaves_a_residual_on_a_measured_like_pulse() {
 #[test]
 fn sets_have_the_papers_timing() {
     let config = ConvoyConfig { start_t_ns: 1_000, ..tunnel(4) };
-    let sets = run(&config, 1, 0);
+    let sets = run(&config, 1);
     for (m, set) in sets.iter().enumerate() {
         assert_eq!(set.set_index, m as u64);
         assert_eq!(set.snapshots.len(), 6);
@@ -240,7 +246,7 @@ fn an_oncoming_car_is_born_and_dies_with_the_delay_window() {
     config.traffic.cars = vec![TrafficCar { start_s_m: 200.0, lane_m: 3.5, speed_kmh: -50.0 }];
     // List the car however weak, so only the delay window decides.
     config.truth_min_power_db = -300.0;
-    let sets = run(&config, 4, 0);
+    let sets = run(&config, 4);
     let present: Vec<bool> = sets.iter().map(|s| truth_of(s, 0, PathKind::TRAFFIC_BASE).is_some()).collect();
     let born = present.iter().position(|p| *p).expect("the car appears");
     let died = present.iter().rposition(|p| *p).unwrap() + 1;
@@ -280,7 +286,7 @@ fn a_wall_hides_a_car_behind_the_bend() {
         let mut c = config.clone();
         c.road.kind = kind;
         c.road.double_bounces = false;
-        let sets = run(&c, 4, 0);
+        let sets = run(&c, 4);
         // The LOS between the cars (40 m apart on the bend) stays clear.
         assert!(sets.iter().all(|s| truth_of(s, 0, 0).is_some()));
         sets.iter().position(|s| truth_of(s, 0, PathKind::TRAFFIC_BASE).is_some()).expect("the car appears")
@@ -292,12 +298,12 @@ fn a_wall_hides_a_car_behind_the_bend() {
 #[test]
 fn same_seed_same_bytes_for_any_thread_count() {
     let config = tunnel(5);
-    let one = run(&config, 21, 1);
-    let three = run(&config, 21, 3);
+    let one = run_on(&config, 21, 1);
+    let three = run_on(&config, 21, 3);
     assert_eq!(one, three);
-    let other = run(&config, 22, 1);
+    let other = run_on(&config, 22, 1);
     assert_ne!(one[0].snapshots[0].taps, other[0].snapshots[0].taps);
-    let simulator = ConvoySimulator::new(&config, 21, 1).unwrap();
+    let simulator = ConvoySimulator::new(&config, 21).unwrap();
     assert_eq!(simulator.render_set(3).unwrap(), one[3]);
     assert!(simulator.render_set(5).is_none());
     let config = ArtificialChannelConfig::default();
@@ -338,7 +344,7 @@ fn bad_values_are_named() {
     expect_invalid(a.validate(), "artificial.snapshots");
     let a = ArtificialChannelConfig { centre_delay_s: 5e-9, ..ArtificialChannelConfig::default() };
     expect_invalid(a.validate(), "artificial.centre_delay_s");
-    assert!(ConvoySimulator::new(&ConvoyConfig { sets: 0, ..tunnel(1) }, 1, 1).is_err());
+    assert!(ConvoySimulator::new(&ConvoyConfig { sets: 0, ..tunnel(1) }, 1).is_err());
     // Through TOML: unknown fields are named by serde, values by validate.
     let parse = |text: &str| toml::from_str::<SounderScenario>(text);
     let err = parse("seed = 1\n[convoy.sounder]\nbandwdth_hz = 1e9\n").unwrap_err().to_string();
@@ -374,7 +380,7 @@ fn wall_bounce_delays_are_continuous_across_segment_hand_overs() {
     config.traffic = no_traffic();
     config.sounder.noise_floor_db = f64::NEG_INFINITY;
     let fc = config.sounder.carrier_hz;
-    let sets = run(&config, 8, 0);
+    let sets = run(&config, 8);
     let mut worst = [0.0f64; 2];
     for pair in sets.windows(2) {
         for id in [0, 100, 101, 200, 201] {
