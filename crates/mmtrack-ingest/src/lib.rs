@@ -32,4 +32,5 @@ pub mod target;
 pub use error::IngestError;
 
 /// Progress of a long ingest: `done` of `total` items (scans, lines, ...).
-pub type Progress<'a> = &'a mut dyn FnMut(u64, u64);
+/// `Send`: folder ingests decode on the rayon pool and report from it.
+pub type Progress<'a> = &'a mut (dyn FnMut(u64, u64) + Send);

@@ -54,7 +54,7 @@ fn convoy_recording_holds_what_the_simulator_makes_and_inspect_lists_it() {
     let scenario = scenario("convoy-tunnel.toml");
     let mut config = scenario.convoy.unwrap();
     config.sets = 3;
-    let simulator = ConvoySimulator::new(&config, scenario.seed, 1).unwrap();
+    let simulator = ConvoySimulator::new(&config, scenario.seed).unwrap();
     let pulse = simulator.pulse_spectrum().to_vec();
     let sets: Vec<_> = simulator.collect();
     let cirs: Vec<CirSnapshot> = sets.iter().flat_map(|s| s.snapshots.clone()).collect();
