@@ -19,3 +19,4 @@ mod realdata_ros2;
 mod reproduce;
 mod simulate_radar;
 mod simulate_sounder;
+mod threads;
