@@ -87,8 +87,7 @@ fn oxford_size_scans(count: usize) -> anyhow::Result<Vec<PolarScan>> {
     let trajectory = Trajectory::constant_turn(motion, 1_547_131_046_353_776_000, count as f64 * 0.25 + 1.0)?;
     let world = World::new(&generate_world(&GeneratorConfig::default(), &trajectory, 1)?)?;
     let sensor = Sensor::default();
-    let options =
-        SimOptions { seed: 1, limits: ScanLimits { max_scans: Some(count), max_distance_m: None } };
+    let options = SimOptions { seed: 1, limits: ScanLimits { max_scans: Some(count), max_distance_m: None } };
     Ok(RadarSimulator::new(&world, &sensor, &trajectory, options)?.map(|(scan, _)| scan).collect())
 }
 

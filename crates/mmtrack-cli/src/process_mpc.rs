@@ -234,13 +234,9 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
                     std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
                     std::collections::btree_map::Entry::Vacant(e) => {
                         let pulse = pulse.as_ref().context("internal: pulse chosen above")?;
-                        let pipeline = MpcPipeline::new(
-                            config.clone(),
-                            pulse,
-                            snapshot.tap_spacing_s,
-                            snapshot.carrier_hz,
-                        )
-                        .with_context(context)?;
+                        let pipeline =
+                            MpcPipeline::new(config.clone(), pulse, snapshot.tap_spacing_s, snapshot.carrier_hz)
+                                .with_context(context)?;
                         e.insert(LinkRun {
                             pipeline,
                             current_set: None,

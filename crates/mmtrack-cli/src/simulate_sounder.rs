@@ -87,8 +87,7 @@ fn write_convoy(args: &SounderArgs, seed: u64, config: &ConvoyConfig, quiet: boo
     if let Some(sets) = args.sets {
         config.sets = config.sets.min(usize::try_from(sets).unwrap_or(usize::MAX));
     }
-    let simulator =
-        ConvoySimulator::new(&config, seed).with_context(|| args.scenario.display().to_string())?;
+    let simulator = ConvoySimulator::new(&config, seed).with_context(|| args.scenario.display().to_string())?;
     let mut extra = BTreeMap::from([
         ("sounder.channel".to_string(), "convoy".to_string()),
         ("sounder.road".to_string(), format!("{:?}", config.road)),
