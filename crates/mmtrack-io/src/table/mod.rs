@@ -10,14 +10,20 @@
 //! - `units`: JSON object column -> unit (also on each Arrow field as `unit`);
 //! - `mmtrack.table`, `mmtrack.version`;
 //! - `mmtrack.run_config`: the run's full configuration as JSON.
+//!
+//! Each table is declared once with [`define_table!`](crate::define_table):
+//! its columns (name, Rust type, unit, meaning) give the spec, the writer and
+//! the reader.
 
 mod columns;
+mod define;
 mod io;
 mod mpc_rows;
 mod odometry_rows;
 mod rows;
 
-pub use columns::Columns;
+pub use arrow_array::ArrayRef;
+pub use columns::{ColumnValue, Columns, ListColumn};
 pub use io::{
     RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table, read_table_dir,
     table_path, write_table,
@@ -27,11 +33,10 @@ pub use mpc_rows::{
     MPC_TRACKS_GMPHD, MPC_TRUTH,
 };
 pub use odometry_rows::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, ODOMETRY_TIMING};
-pub use rows::{ALL_TABLES, MPC_DETECTIONS, MPC_TRACKS, POSES};
+pub use rows::{ALL_TABLES, CIR_SNAPSHOTS, GNSS_FIXES, MPC_DETECTIONS, MPC_TRACKS, POSES, RADAR_SCANS};
 
 use std::sync::Arc;
 
-use arrow_array::ArrayRef;
 use arrow_schema::{DataType, Field, Schema};
 
 /// Arrow type of a column, as tables use them.
