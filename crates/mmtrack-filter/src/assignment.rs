@@ -24,7 +24,7 @@
 //! "A shortest augmenting path algorithm for dense and sparse linear assignment
 //! problems", Computing 38, 1987 (the potentials/augmenting-path form).
 
-use nalgebra::DMatrix;
+use faer::{Mat, MatRef};
 
 use crate::error::FilterError;
 
@@ -49,17 +49,17 @@ impl Assignment {
 ///
 /// # Errors
 /// [`FilterError::NotFinite`] if a cost is NaN or infinite.
-pub fn solve(cost: &DMatrix<f64>) -> Result<Assignment, FilterError> {
+pub fn solve(cost: &Mat<f64>) -> Result<Assignment, FilterError> {
     crate::error::ensure_finite_matrix("assignment cost matrix", cost)?;
-    let (n, m) = cost.shape();
+    let (n, m) = (cost.nrows(), cost.ncols());
     if n == 0 || m == 0 {
         return Ok(Assignment { row_to_col: vec![None; n], total_cost: 0.0 });
     }
     let row_to_col = if n <= m {
-        hungarian(cost)?.into_iter().map(Some).collect::<Vec<_>>()
+        hungarian(cost.as_ref())?.into_iter().map(Some).collect::<Vec<_>>()
     } else {
         // Solve the transpose (columns as rows) and invert the pairing.
-        let col_to_row = hungarian(&cost.transpose())?;
+        let col_to_row = hungarian(cost.transpose())?;
         let mut row_to_col = vec![None; n];
         for (c, r) in col_to_row.into_iter().enumerate() {
             if let Some(slot) = row_to_col.get_mut(r) {
@@ -83,23 +83,20 @@ pub fn solve(cost: &DMatrix<f64>) -> Result<Assignment, FilterError> {
 /// # Errors
 /// [`FilterError::NotFinite`] for a NaN or `-inf` cost, or a non-finite
 /// `unassigned_cost`.
-pub fn solve_with_unassigned(cost: &DMatrix<f64>, unassigned_cost: f64) -> Result<Assignment, FilterError> {
+pub fn solve_with_unassigned(cost: &Mat<f64>, unassigned_cost: f64) -> Result<Assignment, FilterError> {
     if !unassigned_cost.is_finite() {
         return Err(FilterError::NotFinite { what: "unassigned cost", row: 0, col: 0, value: unassigned_cost });
     }
-    let (n, m) = cost.shape();
-    if let Some(i) = cost.iter().position(|c| c.is_nan() || *c == f64::NEG_INFINITY) {
-        let rows = n.max(1);
-        return Err(FilterError::NotFinite {
-            what: "assignment cost matrix",
-            row: i % rows,
-            col: i / rows,
-            value: cost[i],
-        });
+    let (n, m) = (cost.nrows(), cost.ncols());
+    // Column-major order, as `ensure_finite_matrix`.
+    for col in 0..m {
+        if let Some(row) = cost.col(col).iter().position(|c| c.is_nan() || *c == f64::NEG_INFINITY) {
+            return Err(FilterError::NotFinite { what: "assignment cost matrix", row, col, value: cost[(row, col)] });
+        }
     }
     // Any value above the unassigned cost is never used by an optimum.
     let forbidden = unassigned_cost + unassigned_cost.abs().max(1.0);
-    let augmented = DMatrix::from_fn(n, m + n, |r, c| {
+    let augmented = Mat::from_fn(n, m + n, |r, c| {
         if c < m {
             let v = cost[(r, c)];
             if v.is_finite() { v.min(forbidden) } else { forbidden }
@@ -110,7 +107,7 @@ pub fn solve_with_unassigned(cost: &DMatrix<f64>, unassigned_cost: f64) -> Resul
     if n == 0 {
         return Ok(Assignment { row_to_col: Vec::new(), total_cost: 0.0 });
     }
-    let cols = hungarian(&augmented)?;
+    let cols = hungarian(augmented.as_ref())?;
     let mut total_cost = 0.0;
     let row_to_col = cols
         .into_iter()
@@ -125,8 +122,8 @@ pub fn solve_with_unassigned(cost: &DMatrix<f64>, unassigned_cost: f64) -> Resul
 }
 
 /// Hungarian method for `n <= m` finite costs; returns the column of each row.
-fn hungarian(a: &DMatrix<f64>) -> Result<Vec<usize>, FilterError> {
-    let (n, m) = a.shape();
+fn hungarian(a: MatRef<'_, f64>) -> Result<Vec<usize>, FilterError> {
+    let (n, m) = (a.nrows(), a.ncols());
     // 1-based rows/columns; index 0 is the virtual source. p[j]: row paired with
     // column j (0 = none); way[j]: previous column on the augmenting path.
     let mut u = vec![0.0_f64; n + 1];
@@ -200,8 +197,8 @@ mod tests {
     use super::*;
 
     /// Brute force over all injections rows -> columns (n <= m).
-    fn brute(cost: &DMatrix<f64>) -> f64 {
-        fn rec(cost: &DMatrix<f64>, r: usize, used: &mut Vec<bool>) -> f64 {
+    fn brute(cost: MatRef<'_, f64>) -> f64 {
+        fn rec(cost: MatRef<'_, f64>, r: usize, used: &mut Vec<bool>) -> f64 {
             if r == cost.nrows() {
                 return 0.0;
             }
@@ -227,9 +224,9 @@ mod tests {
             ((s >> 33) as f64 / (1u64 << 31) as f64) * 20.0 - 5.0
         };
         for (n, m) in [(1, 1), (2, 3), (3, 3), (4, 4), (3, 5), (5, 5), (5, 3)] {
-            let c = DMatrix::from_fn(n, m, |_, _| next());
+            let c = Mat::from_fn(n, m, |_, _| next());
             let a = solve(&c).expect("finite");
-            let best = if n <= m { brute(&c) } else { brute(&c.transpose()) };
+            let best = if n <= m { brute(c.as_ref()) } else { brute(c.transpose()) };
             // Sums of <= 5 terms of magnitude <= 15: round-off well below 1e-9.
             assert!((a.total_cost - best).abs() < 1e-9, "{n}x{m}: {} vs {best}", a.total_cost);
             assert_eq!(a.pairs().count(), n.min(m));

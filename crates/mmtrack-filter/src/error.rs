@@ -3,7 +3,7 @@
 //! Checks run in release builds too: invalid input is an error, never a debug
 //! assertion and never a panic.
 
-use nalgebra::{DMatrix, DVector};
+use faer::{Col, Mat};
 use thiserror::Error;
 
 /// Errors of the estimation building blocks.
@@ -87,7 +87,7 @@ pub enum FilterError {
 }
 
 /// Fails with [`FilterError::DimensionMismatch`] unless `m` is `rows x cols`.
-pub(crate) fn ensure_shape(what: &'static str, m: &DMatrix<f64>, rows: usize, cols: usize) -> Result<(), FilterError> {
+pub(crate) fn ensure_shape(what: &'static str, m: &Mat<f64>, rows: usize, cols: usize) -> Result<(), FilterError> {
     if m.nrows() == rows && m.ncols() == cols {
         Ok(())
     } else {
@@ -102,15 +102,15 @@ pub(crate) fn ensure_shape(what: &'static str, m: &DMatrix<f64>, rows: usize, co
 }
 
 /// Fails with [`FilterError::DimensionMismatch`] unless `v` has `len` rows.
-pub(crate) fn ensure_len(what: &'static str, v: &DVector<f64>, len: usize) -> Result<(), FilterError> {
-    if v.len() == len {
+pub(crate) fn ensure_len(what: &'static str, v: &Col<f64>, len: usize) -> Result<(), FilterError> {
+    if v.nrows() == len {
         Ok(())
     } else {
         Err(FilterError::DimensionMismatch {
             what,
             expected_rows: len,
             expected_cols: 1,
-            found_rows: v.len(),
+            found_rows: v.nrows(),
             found_cols: 1,
         })
     }
@@ -118,16 +118,17 @@ pub(crate) fn ensure_len(what: &'static str, v: &DVector<f64>, len: usize) -> Re
 
 /// Fails with [`FilterError::NotFinite`] at the first non-finite element
 /// (column-major order, so `(row, col)` is exact).
-pub(crate) fn ensure_finite_matrix(what: &'static str, m: &DMatrix<f64>) -> Result<(), FilterError> {
-    let rows = m.nrows().max(1);
-    match m.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(i) => Err(FilterError::NotFinite { what, row: i % rows, col: i / rows, value: m[i] }),
+pub(crate) fn ensure_finite_matrix(what: &'static str, m: &Mat<f64>) -> Result<(), FilterError> {
+    for col in 0..m.ncols() {
+        if let Some(row) = m.col(col).iter().position(|v| !v.is_finite()) {
+            return Err(FilterError::NotFinite { what, row, col, value: m[(row, col)] });
+        }
     }
+    Ok(())
 }
 
 /// Fails with [`FilterError::NotFinite`] at the first non-finite element.
-pub(crate) fn ensure_finite_vector(what: &'static str, v: &DVector<f64>) -> Result<(), FilterError> {
+pub(crate) fn ensure_finite_vector(what: &'static str, v: &Col<f64>) -> Result<(), FilterError> {
     match v.iter().position(|x| !x.is_finite()) {
         None => Ok(()),
         Some(i) => Err(FilterError::NotFinite { what, row: i, col: 0, value: v[i] }),

@@ -6,7 +6,7 @@
 //! which is how the GM-PHD baseline of Mahler et al. 2017 applies its "maximum
 //! delay / magnitude change" limits.
 
-use nalgebra::DVector;
+use faer::Col;
 
 use crate::error::{FilterError, ensure_positive};
 use crate::gaussian::Gaussian;
@@ -22,9 +22,9 @@ pub struct GateCandidate<'a> {
     /// Index of the measurement in the step's measurement set.
     pub measurement_index: usize,
     /// The measurement `z`.
-    pub measurement: &'a DVector<f64>,
+    pub measurement: &'a Col<f64>,
     /// Innovation `z - H m`.
-    pub innovation: &'a DVector<f64>,
+    pub innovation: &'a Col<f64>,
     /// Squared Mahalanobis distance `nu^T S^-1 nu`.
     pub mahalanobis_squared: f64,
 }

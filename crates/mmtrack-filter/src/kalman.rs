@@ -24,10 +24,13 @@
 //! *Filtering for Stochastic Processes with Applications to Guidance*, 1968 (the
 //! Joseph form).
 
-use nalgebra::{Cholesky, DMatrix, DVector, Dyn};
+use faer::linalg::solvers::{Llt, Solve};
+use faer::{Col, Mat};
 
 use crate::error::{FilterError, ensure_finite_vector, ensure_len};
-use crate::gaussian::{Gaussian, cholesky, log_normal_pdf_with, mahalanobis_squared_with, symmetrise};
+use crate::gaussian::{
+    Gaussian, checked_spd, cholesky, log_det, log_normal_pdf_with, mahalanobis_squared_with, symmetrise,
+};
 use crate::models::{LinearMeasurement, TransitionModel};
 
 /// How the posterior covariance is computed.
@@ -105,22 +108,24 @@ impl KalmanUpdater {
         let r = self.model.r();
         ensure_len("prior mean", prior.mean(), self.model.state_dim())?;
         let p = prior.cov();
-        let s = symmetrise(h * p * h.transpose() + r);
+        let hp = h * p;
+        let s = symmetrise(&hp * h.transpose() + r);
         let s_chol = cholesky("innovation covariance S", &s)?;
         // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
-        let gain = s_chol.solve(&(h * p)).transpose();
+        let gain = s_chol.solve(&hp).transpose().to_owned();
         let n = prior.dim();
-        let i_kh = DMatrix::identity(n, n) - &gain * h;
+        let i_kh = Mat::<f64>::identity(n, n) - &gain * h;
         let post = match self.covariance_update {
             CovarianceUpdate::Joseph => &i_kh * p * i_kh.transpose() + &gain * r * gain.transpose(),
             CovarianceUpdate::Standard => &i_kh * p,
         };
-        let posterior_cov = symmetrise(post);
-        // Validate once here so `posterior` only has to check the mean.
-        let posterior_cov = Gaussian::new(prior.mean().clone(), posterior_cov)?.cov().clone();
+        // Validate once here (as `Gaussian::new` would) so that `posterior`
+        // only has to check the mean.
+        let posterior_cov = checked_spd("Gaussian covariance", symmetrise(post), n)?;
         Ok(PreparedUpdate {
             prior_mean: prior.mean().clone(),
             predicted_measurement: h * prior.mean(),
+            log_det_s: log_det(&s_chol),
             s,
             s_chol,
             gain,
@@ -133,7 +138,7 @@ impl KalmanUpdater {
     /// # Errors
     /// As [`KalmanUpdater::prepare`], plus [`FilterError::DimensionMismatch`] /
     /// [`FilterError::NotFinite`] for a bad `z`.
-    pub fn update(&self, prior: &Gaussian, z: &DVector<f64>) -> Result<Gaussian, FilterError> {
+    pub fn update(&self, prior: &Gaussian, z: &Col<f64>) -> Result<Gaussian, FilterError> {
         self.prepare(prior)?.posterior(z)
     }
 }
@@ -141,36 +146,38 @@ impl KalmanUpdater {
 /// The measurement-independent part of a Kalman update (see the module docs).
 #[derive(Debug, Clone)]
 pub struct PreparedUpdate {
-    prior_mean: DVector<f64>,
-    predicted_measurement: DVector<f64>,
-    s: DMatrix<f64>,
-    s_chol: Cholesky<f64, Dyn>,
-    gain: DMatrix<f64>,
-    posterior_cov: DMatrix<f64>,
+    prior_mean: Col<f64>,
+    predicted_measurement: Col<f64>,
+    /// `ln det S`, once per prior rather than once per measurement.
+    log_det_s: f64,
+    s: Mat<f64>,
+    s_chol: Llt<f64>,
+    gain: Mat<f64>,
+    posterior_cov: Mat<f64>,
 }
 
 impl PreparedUpdate {
     /// Predicted measurement `eta = H m`.
     #[must_use]
-    pub fn predicted_measurement(&self) -> &DVector<f64> {
+    pub fn predicted_measurement(&self) -> &Col<f64> {
         &self.predicted_measurement
     }
 
     /// Innovation covariance `S = H P H^T + R`.
     #[must_use]
-    pub fn innovation_cov(&self) -> &DMatrix<f64> {
+    pub fn innovation_cov(&self) -> &Mat<f64> {
         &self.s
     }
 
     /// Gain `K`.
     #[must_use]
-    pub fn gain(&self) -> &DMatrix<f64> {
+    pub fn gain(&self) -> &Mat<f64> {
         &self.gain
     }
 
     /// Posterior covariance `P+` (the same for every `z`).
     #[must_use]
-    pub fn posterior_cov(&self) -> &DMatrix<f64> {
+    pub fn posterior_cov(&self) -> &Mat<f64> {
         &self.posterior_cov
     }
 
@@ -178,8 +185,8 @@ impl PreparedUpdate {
     ///
     /// # Errors
     /// [`FilterError::DimensionMismatch`] / [`FilterError::NotFinite`] for a bad `z`.
-    pub fn innovation(&self, z: &DVector<f64>) -> Result<DVector<f64>, FilterError> {
-        ensure_len("measurement", z, self.predicted_measurement.len())?;
+    pub fn innovation(&self, z: &Col<f64>) -> Result<Col<f64>, FilterError> {
+        ensure_len("measurement", z, self.predicted_measurement.nrows())?;
         ensure_finite_vector("measurement", z)?;
         Ok(z - &self.predicted_measurement)
     }
@@ -188,8 +195,9 @@ impl PreparedUpdate {
     ///
     /// # Errors
     /// As [`PreparedUpdate::innovation`].
-    pub fn mahalanobis_squared(&self, z: &DVector<f64>) -> Result<f64, FilterError> {
-        Ok(mahalanobis_squared_with(&self.s_chol, &self.innovation(z)?))
+    pub fn mahalanobis_squared(&self, z: &Col<f64>) -> Result<f64, FilterError> {
+        let nu = self.innovation(z)?;
+        Ok(mahalanobis_squared_with(&self.s_chol, nu.as_ref(), &mut Col::zeros(nu.nrows())))
     }
 
     /// `ln N(z; eta, S)`, the log measurement likelihood `ln q(z)` of Vo & Ma
@@ -197,34 +205,34 @@ impl PreparedUpdate {
     ///
     /// # Errors
     /// As [`PreparedUpdate::innovation`].
-    pub fn log_likelihood(&self, z: &DVector<f64>) -> Result<f64, FilterError> {
-        Ok(log_normal_pdf_with(&self.s_chol, &self.innovation(z)?))
+    pub fn log_likelihood(&self, z: &Col<f64>) -> Result<f64, FilterError> {
+        Ok(log_normal_pdf_with(&self.s_chol, self.innovation(z)?.as_ref()))
     }
 
     /// `ln N(nu; 0, S)` from `d2 = nu^T S^-1 nu` already computed:
     /// `-(m ln 2 pi + ln det S + d2) / 2`, `ln det S = 2 sum ln L_ii`.
     pub(crate) fn log_likelihood_from_mahalanobis(&self, d2: f64) -> f64 {
-        let m = self.predicted_measurement.len() as f64;
-        let log_det: f64 = 2.0 * self.s_chol.l_dirty().diagonal().iter().map(|d| d.ln()).sum::<f64>();
-        -0.5 * (m * (2.0 * std::f64::consts::PI).ln() + log_det + d2)
+        let m = self.predicted_measurement.nrows() as f64;
+        -0.5 * (m * (2.0 * std::f64::consts::PI).ln() + self.log_det_s + d2)
     }
 
-    /// `nu^T S^-1 nu` for an innovation already computed.
-    pub(crate) fn mahalanobis_squared_of_innovation(&self, nu: &DVector<f64>) -> f64 {
-        mahalanobis_squared_with(&self.s_chol, nu)
+    /// `nu^T S^-1 nu` for an innovation already computed; `scratch` is
+    /// working space (see [`mahalanobis_squared_with`]).
+    pub(crate) fn mahalanobis_squared_of_innovation(&self, nu: &Col<f64>, scratch: &mut Col<f64>) -> f64 {
+        mahalanobis_squared_with(&self.s_chol, nu.as_ref(), scratch)
     }
 
     /// Posterior `N(m + K (z - eta), P+)`.
     ///
     /// # Errors
     /// As [`PreparedUpdate::innovation`].
-    pub fn posterior(&self, z: &DVector<f64>) -> Result<Gaussian, FilterError> {
+    pub fn posterior(&self, z: &Col<f64>) -> Result<Gaussian, FilterError> {
         let nu = self.innovation(z)?;
         self.posterior_of_innovation(&nu)
     }
 
     /// Posterior for an innovation already computed.
-    pub(crate) fn posterior_of_innovation(&self, nu: &DVector<f64>) -> Result<Gaussian, FilterError> {
-        Gaussian::new(&self.prior_mean + &self.gain * nu, self.posterior_cov.clone())
+    pub(crate) fn posterior_of_innovation(&self, nu: &Col<f64>) -> Result<Gaussian, FilterError> {
+        Gaussian::with_checked_cov(&self.prior_mean + &self.gain * nu, self.posterior_cov.clone())
     }
 }

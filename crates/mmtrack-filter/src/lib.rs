@@ -20,9 +20,12 @@
 //! - [`gmphd`]: the labelled GM-PHD filter of Vo & Ma 2006;
 //! - [`metrics`]: OSPA and GOSPA.
 //!
-//! Vectors and matrices are `nalgebra` `DVector`/`DMatrix` (re-exported as
-//! [`nalgebra`]) so one code path serves every state dimension; shapes are
-//! checked at run time and a mismatch is a [`FilterError`], never a panic.
+//! Vectors and matrices are [`faer`] `Col<f64>`/`Mat<f64>` (faer is the
+//! workspace's one linear-algebra crate, re-exported here as [`faer`]) so one
+//! code path serves every state dimension; factorisations are faer's `L L^T`
+//! (Cholesky). Shapes are checked at run time before any faer call (faer
+//! panics on mismatched shapes), so a mismatch is a [`FilterError`], never a
+//! panic.
 
 pub mod assignment;
 mod error;
@@ -34,10 +37,10 @@ pub mod metrics;
 pub mod models;
 
 pub use error::FilterError;
+/// The linear-algebra crate of the public API, so dependants need not pin it.
+pub use faer;
 pub use gating::{Gate, GateCandidate, MahalanobisGate, NoGate};
 pub use gaussian::{Gaussian, SYMMETRY_TOLERANCE};
 pub use gmphd::{GmPhdFilter, GmPhdParams, Label};
 pub use kalman::{CovarianceUpdate, KalmanPredictor, KalmanUpdater, PreparedUpdate};
 pub use models::{ConstantVelocity, FixedTransition, LinearMeasurement, TransitionModel};
-/// The linear-algebra crate of the public API, so dependants need not pin it.
-pub use nalgebra;

@@ -32,7 +32,7 @@
 //! A. S. Rahmathullah, A. F. Garcia-Fernandez, L. Svensson, "Generalized
 //! optimal sub-pattern assignment metric", FUSION 2017.
 
-use nalgebra::{DMatrix, DVector};
+use faer::{Col, Mat};
 
 use crate::assignment::solve;
 use crate::error::FilterError;
@@ -72,14 +72,14 @@ fn check_parameters(c: f64, p: f64) -> Result<(), FilterError> {
 }
 
 /// Checks both sets share one dimension and are finite.
-fn check_sets(x: &[DVector<f64>], y: &[DVector<f64>]) -> Result<(), FilterError> {
-    let dim = x.first().or(y.first()).map(|v| v.len());
+fn check_sets(x: &[Col<f64>], y: &[Col<f64>]) -> Result<(), FilterError> {
+    let dim = x.first().or(y.first()).map(|v| v.nrows());
     for (what, set) in [("first point set", x), ("second point set", y)] {
         for (index, v) in set.iter().enumerate() {
             if let Some(expected) = dim
-                && v.len() != expected
+                && v.nrows() != expected
             {
-                return Err(FilterError::PointDimension { what, index, expected, found: v.len() });
+                return Err(FilterError::PointDimension { what, index, expected, found: v.nrows() });
             }
             // Reported as (row = point index, col = coordinate).
             if let Some(k) = v.iter().position(|e| !e.is_finite()) {
@@ -91,8 +91,8 @@ fn check_sets(x: &[DVector<f64>], y: &[DVector<f64>]) -> Result<(), FilterError>
 }
 
 /// `min(d, c)^p` for every pair, rows = the smaller set.
-fn cut_cost(small: &[DVector<f64>], large: &[DVector<f64>], c: f64, p: f64) -> DMatrix<f64> {
-    DMatrix::from_fn(small.len(), large.len(), |i, j| (&small[i] - &large[j]).norm().min(c).powf(p))
+fn cut_cost(small: &[Col<f64>], large: &[Col<f64>], c: f64, p: f64) -> Mat<f64> {
+    Mat::from_fn(small.len(), large.len(), |i, j| (&small[i] - &large[j]).norm_l2().min(c).powf(p))
 }
 
 /// OSPA distance between `x` and `y` (symmetric in its arguments).
@@ -101,7 +101,7 @@ fn cut_cost(small: &[DVector<f64>], large: &[DVector<f64>], c: f64, p: f64) -> D
 /// [`FilterError::InvalidParameter`] for `c <= 0` or `p < 1`;
 /// [`FilterError::PointDimension`] / [`FilterError::NotFinite`] (row = point,
 /// col = coordinate) for points of mixed dimension or with NaN.
-pub fn ospa(x: &[DVector<f64>], y: &[DVector<f64>], c: f64, p: f64) -> Result<Ospa, FilterError> {
+pub fn ospa(x: &[Col<f64>], y: &[Col<f64>], c: f64, p: f64) -> Result<Ospa, FilterError> {
     check_parameters(c, p)?;
     check_sets(x, y)?;
     let (small, large) = if x.len() <= y.len() { (x, y) } else { (y, x) };
@@ -123,7 +123,7 @@ pub fn ospa(x: &[DVector<f64>], y: &[DVector<f64>], c: f64, p: f64) -> Result<Os
 ///
 /// # Errors
 /// As [`ospa`].
-pub fn gospa(truth: &[DVector<f64>], estimates: &[DVector<f64>], c: f64, p: f64) -> Result<Gospa, FilterError> {
+pub fn gospa(truth: &[Col<f64>], estimates: &[Col<f64>], c: f64, p: f64) -> Result<Gospa, FilterError> {
     check_parameters(c, p)?;
     check_sets(truth, estimates)?;
     let cost = cut_cost(truth, estimates, c, p);
@@ -131,7 +131,7 @@ pub fn gospa(truth: &[DVector<f64>], estimates: &[DVector<f64>], c: f64, p: f64)
     let mut localisation_p = 0.0;
     let mut assigned = 0_usize;
     for (i, j) in assignment.pairs() {
-        let d = (&truth[i] - &estimates[j]).norm();
+        let d = (&truth[i] - &estimates[j]).norm_l2();
         if d < c {
             localisation_p += d.powf(p);
             assigned += 1;

@@ -5,10 +5,10 @@
 //! constant-velocity model is the one of Vo & Ma 2006, Sec. VI (and of the GM-PHD
 //! baseline of Mahler et al. 2017, Table I), for any number of spatial axes.
 
-use nalgebra::DMatrix;
+use faer::Mat;
 
 use crate::error::{FilterError, ensure_finite_matrix, ensure_positive, ensure_shape};
-use crate::gaussian::{SYMMETRY_TOLERANCE, checked_spd};
+use crate::gaussian::{SYMMETRY_TOLERANCE, checked_spd, max_asymmetry};
 
 /// A linear-Gaussian motion model `x_k = F(dt) x_{k-1} + v`, `v ~ N(0, Q(dt))`.
 pub trait TransitionModel {
@@ -21,7 +21,7 @@ pub trait TransitionModel {
     /// # Errors
     /// [`FilterError::InvalidParameter`] for a step the model cannot take (e.g.
     /// negative or non-finite `dt_s`).
-    fn matrices(&self, dt_s: f64) -> Result<(DMatrix<f64>, DMatrix<f64>), FilterError>;
+    fn matrices(&self, dt_s: f64) -> Result<(Mat<f64>, Mat<f64>), FilterError>;
 }
 
 /// Constant velocity (nearly constant, driven by white acceleration) in `k`
@@ -86,15 +86,15 @@ impl TransitionModel for ConstantVelocity {
         2 * self.spatial_dims
     }
 
-    fn matrices(&self, dt_s: f64) -> Result<(DMatrix<f64>, DMatrix<f64>), FilterError> {
+    fn matrices(&self, dt_s: f64) -> Result<(Mat<f64>, Mat<f64>), FilterError> {
         if !(dt_s.is_finite() && dt_s >= 0.0) {
             return Err(FilterError::InvalidParameter { name: "dt_s", value: dt_s, expected: "finite and >= 0" });
         }
         let k = self.spatial_dims;
         let n = 2 * k;
         let s2 = self.sigma_accel * self.sigma_accel;
-        let mut f = DMatrix::identity(n, n);
-        let mut q = DMatrix::zeros(n, n);
+        let mut f = Mat::identity(n, n);
+        let mut q = Mat::zeros(n, n);
         for i in 0..k {
             f[(i, k + i)] = dt_s;
             q[(i, i)] = s2 * dt_s.powi(4) / 4.0;
@@ -110,8 +110,8 @@ impl TransitionModel for ConstantVelocity {
 /// models and known-answer tests).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FixedTransition {
-    f: DMatrix<f64>,
-    q: DMatrix<f64>,
+    f: Mat<f64>,
+    q: Mat<f64>,
 }
 
 impl FixedTransition {
@@ -123,14 +123,14 @@ impl FixedTransition {
     /// [`FilterError::DimensionMismatch`], [`FilterError::NotFinite`] or
     /// [`FilterError::NotPositiveDefinite`] (asymmetric `Q` or a negative
     /// diagonal element).
-    pub fn new(f: DMatrix<f64>, q: DMatrix<f64>) -> Result<Self, FilterError> {
+    pub fn new(f: Mat<f64>, q: Mat<f64>) -> Result<Self, FilterError> {
         let n = f.nrows();
         ensure_shape("transition matrix F", &f, n, n)?;
         ensure_finite_matrix("transition matrix F", &f)?;
         ensure_shape("process covariance Q", &q, n, n)?;
         ensure_finite_matrix("process covariance Q", &q)?;
-        let scale = q.amax().max(1.0);
-        if (&q - q.transpose()).amax() > SYMMETRY_TOLERANCE * scale || q.diagonal().iter().any(|d| *d < 0.0) {
+        let scale = q.norm_max().max(1.0);
+        if max_asymmetry(&q) > SYMMETRY_TOLERANCE * scale || q.diagonal().column_vector().iter().any(|d| *d < 0.0) {
             return Err(FilterError::NotPositiveDefinite { what: "process covariance Q" });
         }
         Ok(Self { f, q })
@@ -142,7 +142,7 @@ impl TransitionModel for FixedTransition {
         self.f.nrows()
     }
 
-    fn matrices(&self, _dt_s: f64) -> Result<(DMatrix<f64>, DMatrix<f64>), FilterError> {
+    fn matrices(&self, _dt_s: f64) -> Result<(Mat<f64>, Mat<f64>), FilterError> {
         Ok((self.f.clone(), self.q.clone()))
     }
 }
@@ -151,8 +151,8 @@ impl TransitionModel for FixedTransition {
 /// `m x n`, `R` is `m x m` symmetric positive definite.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearMeasurement {
-    h: DMatrix<f64>,
-    r: DMatrix<f64>,
+    h: Mat<f64>,
+    r: Mat<f64>,
 }
 
 impl LinearMeasurement {
@@ -161,8 +161,8 @@ impl LinearMeasurement {
     /// # Errors
     /// [`FilterError::DimensionMismatch`], [`FilterError::NotFinite`] or
     /// [`FilterError::NotPositiveDefinite`].
-    pub fn new(h: DMatrix<f64>, r: DMatrix<f64>) -> Result<Self, FilterError> {
-        let (m, n) = h.shape();
+    pub fn new(h: Mat<f64>, r: Mat<f64>) -> Result<Self, FilterError> {
+        let (m, n) = (h.nrows(), h.ncols());
         if m == 0 || n == 0 {
             return Err(FilterError::DimensionMismatch {
                 what: "measurement matrix H",
@@ -192,11 +192,9 @@ impl LinearMeasurement {
         }
         ensure_positive("measurement sigma", sigma)?;
         let k = spatial_dims;
-        let mut h = DMatrix::zeros(k, 2 * k);
-        for i in 0..k {
-            h[(i, i)] = 1.0;
-        }
-        Self::new(h, DMatrix::identity(k, k) * (sigma * sigma))
+        let h = Mat::from_fn(k, 2 * k, |i, j| if i == j { 1.0 } else { 0.0 });
+        let variance = sigma * sigma;
+        Self::new(h, Mat::from_fn(k, k, |i, j| if i == j { variance } else { 0.0 }))
     }
 
     /// Measurement dimension `m`.
@@ -213,13 +211,13 @@ impl LinearMeasurement {
 
     /// `H`.
     #[must_use]
-    pub fn h(&self) -> &DMatrix<f64> {
+    pub fn h(&self) -> &Mat<f64> {
         &self.h
     }
 
     /// `R`.
     #[must_use]
-    pub fn r(&self) -> &DMatrix<f64> {
+    pub fn r(&self) -> &Mat<f64> {
         &self.r
     }
 }

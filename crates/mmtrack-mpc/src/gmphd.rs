@@ -57,8 +57,8 @@ pub use config::GmPhdConfig;
 use std::collections::{BTreeMap, BTreeSet};
 
 use mmtrack_core::{MpcDetection, MpcTrack};
+use mmtrack_filter::faer::{Col, ColRef, Mat, MatRef};
 use mmtrack_filter::gmphd::{MixtureReducer, StateExtractor, WeightedGaussian};
-use mmtrack_filter::nalgebra::{DMatrix, DVector};
 use mmtrack_filter::{
     ConstantVelocity, FilterError, Gate, GateCandidate, Gaussian, GmPhdFilter, GmPhdParams, KalmanPredictor,
     KalmanUpdater, Label, LinearMeasurement,
@@ -179,7 +179,7 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
             last_power_db.insert(*label, power_db);
         }
 
-        let zs: Vec<DVector<f64>> = snap.detections.iter().map(|d| DVector::from_element(1, c * d.delay_s)).collect();
+        let zs: Vec<Col<f64>> = snap.detections.iter().map(|d| Col::full(1, c * d.delay_s)).collect();
         let powers_db: Vec<f64> = snap.detections.iter().map(MpcDetection::power_db).collect();
         let gate = ChangeGate {
             max_innovation_m: c * config.max_delay_change_s,
@@ -199,7 +199,7 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
                 t_ns: snap.t_ns,
                 set_index: snap.set_index,
                 snapshot_index: snap.snapshot_index,
-                delay_s: estimate.density.mean().get(0).copied().unwrap_or(f64::NAN) / c,
+                delay_s: estimate.density.mean().iter().next().copied().unwrap_or(f64::NAN) / c,
                 amplitude: mmtrack_core::Complex64::new(0.0, 0.0),
             };
             book.push(estimate.label, detection, source.map(|d| d.amplitude));
@@ -266,7 +266,7 @@ fn build_filter(config: &GmPhdConfig) -> Result<GmPhdFilter<ConstantVelocity>, F
 /// Builds birth terms from detections of the previous snapshot.
 struct BirthModel {
     predictor: KalmanPredictor<ConstantVelocity>,
-    cov: DMatrix<f64>,
+    cov: Mat<f64>,
     weight: f64,
 }
 
@@ -275,14 +275,14 @@ impl BirthModel {
         let (sd, sv) = (config.sigma_measurement_m, config.birth_sigma_rate_mps);
         Ok(Self {
             predictor: KalmanPredictor::new(ConstantVelocity::new(1, config.sigma_process_mps2)?),
-            cov: DMatrix::from_row_slice(2, 2, &[sd * sd, 0.0, 0.0, sv * sv]),
+            cov: MatRef::from_row_major_slice(&[sd * sd, 0.0, 0.0, sv * sv], 2, 2).to_owned(),
             weight: config.birth_weight,
         })
     }
 
     /// `w_b N([d, 0], diag(sigma_d^2, sigma_rate^2))` predicted over `dt_s`.
     fn at(&self, d_m: f64, dt_s: f64) -> Result<WeightedGaussian, FilterError> {
-        let at_detection = Gaussian::new(DVector::from_column_slice(&[d_m, 0.0]), self.cov.clone())?;
+        let at_detection = Gaussian::new(ColRef::from_slice(&[d_m, 0.0]).to_owned(), self.cov.clone())?;
         Ok(WeightedGaussian { weight: self.weight, density: self.predictor.predict(&at_detection, dt_s)? })
     }
 }

@@ -58,7 +58,7 @@ use crate::gating::Gate;
 use crate::gaussian::Gaussian;
 use crate::kalman::{KalmanPredictor, KalmanUpdater};
 use crate::models::TransitionModel;
-use nalgebra::DVector;
+use faer::Col;
 
 /// Identity of a component lineage; extracted states with the same label form
 /// a track.
@@ -249,7 +249,7 @@ impl<T: TransitionModel> GmPhdFilter<T> {
     /// [`FilterError::Measurement`] for a measurement of the wrong dimension or
     /// with NaN (checked before anything changes); [`FilterError::NotPositiveDefinite`]
     /// if an innovation covariance is not SPD. On error the mixture is unchanged.
-    pub fn update<G: Gate>(&mut self, measurements: &[DVector<f64>], gate: &G) -> Result<UpdateReport, FilterError> {
+    pub fn update<G: Gate>(&mut self, measurements: &[Col<f64>], gate: &G) -> Result<UpdateReport, FilterError> {
         let (mixture, report) = update::update(&self.mixture, measurements, &self.updater, &self.params, gate)?;
         self.mixture = mixture;
         Ok(report)
@@ -289,7 +289,7 @@ impl<T: TransitionModel> GmPhdFilter<T> {
         &mut self,
         dt_s: f64,
         births: Vec<WeightedGaussian>,
-        measurements: &[DVector<f64>],
+        measurements: &[Col<f64>],
         gate: &G,
     ) -> Result<StepReport, FilterError> {
         update::check_measurements(measurements, self.updater.model.measurement_dim())?;

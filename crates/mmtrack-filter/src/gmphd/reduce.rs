@@ -22,10 +22,10 @@
 //! - `P~` is a weighted sum of SPD matrices plus positive semi-definite outer
 //!   products, hence SPD; it is symmetrised against round-off.
 
-use nalgebra::{DMatrix, DVector};
+use faer::{Col, Mat, Scale, unzip, zip};
 
 use super::Component;
-use crate::error::{FilterError, ensure_in_range};
+use crate::error::{FilterError, ensure_in_range, ensure_len};
 use crate::gaussian::{Gaussian, cholesky, mahalanobis_squared_with, symmetrise};
 
 /// The pruning-and-merging role.
@@ -88,14 +88,21 @@ impl MixtureReducer {
     /// merge groups were formed (descending leader weight).
     ///
     /// # Errors
-    /// [`FilterError::NotPositiveDefinite`] if a component covariance cannot be
-    /// factorised.
+    /// [`FilterError::DimensionMismatch`] if the kept components do not share
+    /// one state dimension; [`FilterError::NotPositiveDefinite`] if a component
+    /// covariance cannot be factorised.
     pub fn reduce(&self, mixture: &[Component]) -> Result<(Vec<Component>, ReductionReport), FilterError> {
         let kept: Vec<&Component> = mixture.iter().filter(|c| c.weight > self.truncation_threshold).collect();
+        let n = kept.first().map_or(0, |c| c.density.dim());
+        for c in &kept {
+            ensure_len("component mean (state dimension of the first kept component)", c.density.mean(), n)?;
+        }
         let mut report = ReductionReport { truncated: mixture.len() - kept.len(), ..ReductionReport::default() };
         let chols =
             kept.iter().map(|c| cholesky("component covariance", c.density.cov())).collect::<Result<Vec<_>, _>>()?;
         let mut remaining: Vec<usize> = (0..kept.len()).collect();
+        // Working space of the Mahalanobis tests.
+        let (mut d, mut scratch) = (Col::zeros(n), Col::zeros(n));
         let mut out = Vec::new();
         while !remaining.is_empty() {
             // argmax with ties to the earliest: strict `>` keeps the first.
@@ -107,7 +114,14 @@ impl MixtureReducer {
             }
             let mj = kept[j].density.mean();
             let (group, rest): (Vec<usize>, Vec<usize>) = remaining.iter().partition(|&&i| {
-                i == j || mahalanobis_squared_with(&chols[i], &(kept[i].density.mean() - mj)) <= self.merge_threshold
+                if i == j {
+                    return true;
+                }
+                let mi = kept[i].density.mean();
+                for r in 0..n {
+                    d[r] = mi[r] - mj[r];
+                }
+                mahalanobis_squared_with(&chols[i], d.as_ref(), &mut scratch) <= self.merge_threshold
             });
             remaining = rest;
             report.merged += group.len() - 1;
@@ -130,17 +144,18 @@ fn merge_group(kept: &[&Component], group: &[usize], leader: usize) -> Result<Co
     }
     let n = kept[leader].density.dim();
     let w_total: f64 = group.iter().map(|&i| kept[i].weight).sum();
-    let mut mean = DVector::zeros(n);
+    let mut mean = Col::<f64>::zeros(n);
     for &i in group {
-        mean += kept[i].density.mean() * kept[i].weight;
+        mean += kept[i].density.mean() * Scale(kept[i].weight);
     }
-    mean /= w_total;
-    let mut cov = DMatrix::zeros(n, n);
+    // Divided, not multiplied by the reciprocal: the equation as written.
+    zip!(&mut mean).for_each(|unzip!(x)| *x /= w_total);
+    let mut cov = Mat::<f64>::zeros(n, n);
     for &i in group {
         let d = &mean - kept[i].density.mean();
-        cov += (kept[i].density.cov() + &d * d.transpose()) * kept[i].weight;
+        cov += (kept[i].density.cov() + &d * d.transpose()) * Scale(kept[i].weight);
     }
-    cov /= w_total;
+    zip!(&mut cov).for_each(|unzip!(x)| *x /= w_total);
     Ok(Component {
         label: kept[leader].label,
         weight: w_total,

@@ -19,7 +19,7 @@
 
 use std::collections::BTreeMap;
 
-use nalgebra::DVector;
+use faer::Col;
 
 use super::{Component, GmPhdParams, Label};
 use crate::error::{FilterError, ensure_finite_vector, ensure_len};
@@ -68,7 +68,7 @@ impl UpdateReport {
 }
 
 /// Checks every measurement's dimension and finiteness.
-pub(crate) fn check_measurements(measurements: &[DVector<f64>], dim: usize) -> Result<(), FilterError> {
+pub(crate) fn check_measurements(measurements: &[Col<f64>], dim: usize) -> Result<(), FilterError> {
     for (index, z) in measurements.iter().enumerate() {
         let wrap = |e: FilterError| FilterError::Measurement { index, source: Box::new(e) };
         ensure_len("measurement", z, dim).map_err(wrap)?;
@@ -80,7 +80,7 @@ pub(crate) fn check_measurements(measurements: &[DVector<f64>], dim: usize) -> R
 /// Returns the updated mixture and the report; `predicted` is not modified.
 pub(crate) fn update<G: Gate>(
     predicted: &[Component],
-    measurements: &[DVector<f64>],
+    measurements: &[Col<f64>],
     updater: &KalmanUpdater,
     params: &GmPhdParams,
     gate: &G,
@@ -102,12 +102,21 @@ pub(crate) fn update<G: Gate>(
     let mut measurement_weights = Vec::with_capacity(measurements.len());
     let mut assoc: BTreeMap<(Label, usize), f64> = BTreeMap::new();
 
+    // Working space of the (component, measurement) loop, which otherwise
+    // would allocate two vectors per pair: the innovation, copied into the
+    // terms only for pairs that pass the gate, and the triangular solve's.
+    let dim = updater.model.measurement_dim();
+    let mut nu = Col::zeros(dim);
+    let mut solve_scratch = Col::zeros(dim);
     for (j, z) in measurements.iter().enumerate() {
         // (component index, ln(p_D w q), innovation)
         let mut terms = Vec::new();
         for (i, (c, prep)) in predicted.iter().zip(&prepared).enumerate() {
-            let nu = z - prep.predicted_measurement();
-            let mahalanobis_squared = prep.mahalanobis_squared_of_innovation(&nu);
+            let eta = prep.predicted_measurement();
+            for r in 0..dim {
+                nu[r] = z[r] - eta[r];
+            }
+            let mahalanobis_squared = prep.mahalanobis_squared_of_innovation(&nu, &mut solve_scratch);
             let candidate = GateCandidate {
                 label: c.label,
                 prior: &c.density,
@@ -121,7 +130,7 @@ pub(crate) fn update<G: Gate>(
             }
             let log_numerator = (p_d * c.weight).ln() + prep.log_likelihood_from_mahalanobis(mahalanobis_squared);
             if log_numerator > f64::NEG_INFINITY {
-                terms.push((i, log_numerator, nu));
+                terms.push((i, log_numerator, nu.clone()));
             }
         }
         // ln(kappa + sum exp(ln numerator)) by log-sum-exp: no overflow for

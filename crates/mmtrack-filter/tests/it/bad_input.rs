@@ -1,9 +1,9 @@
 //! Bad input gives errors naming what is wrong, never a panic.
 
-use mmtrack_filter::gmphd::{MixtureReducer, StateExtractor, WeightedGaussian};
+use mmtrack_filter::gmphd::{Component, MixtureReducer, StateExtractor, WeightedGaussian};
 use mmtrack_filter::metrics::{gospa, ospa};
 use mmtrack_filter::{
-    ConstantVelocity, FilterError, Gaussian, GmPhdFilter, GmPhdParams, KalmanPredictor, KalmanUpdater,
+    ConstantVelocity, FilterError, Gaussian, GmPhdFilter, GmPhdParams, KalmanPredictor, KalmanUpdater, Label,
     LinearMeasurement, NoGate,
 };
 use proptest::prelude::*;
@@ -85,6 +85,18 @@ fn filter_rejects_bad_measurements_and_births_and_keeps_its_state() {
 }
 
 #[test]
+fn reducer_rejects_components_of_mixed_dimension() {
+    let component =
+        |label: u64, density: Gaussian| Component { label: Label(label), weight: 0.5, density, measurement: None };
+    let mixture = vec![
+        component(0, Gaussian::new(v(&[0.0, 0.0]), m(2, 2, &[1.0, 0.0, 0.0, 1.0])).expect("valid")),
+        component(1, Gaussian::new(v(&[0.0]), m(1, 1, &[1.0])).expect("valid")),
+    ];
+    let e = MixtureReducer::new(1e-2, 0.1, 10).expect("valid").reduce(&mixture).unwrap_err();
+    assert!(matches!(e, FilterError::DimensionMismatch { expected_rows: 2, found_rows: 1, .. }), "{e}");
+}
+
+#[test]
 fn metrics_reject_mixed_dimensions_and_nan() {
     let e = ospa(&[v(&[0.0, 0.0])], &[v(&[0.0])], 1.0, 1.0).unwrap_err();
     assert!(matches!(e, FilterError::PointDimension { index: 0, expected: 2, found: 1, .. }), "{e}");
@@ -108,7 +120,7 @@ proptest! {
         let mut f = filter();
         for (dt, zs) in steps {
             let zs: Vec<_> = zs.into_iter().map(|z| v(&z)).collect();
-            let births = zs.iter().filter(|z| z.len() == 1 && z[0].is_finite()).map(|z| birth(z[0])).collect();
+            let births = zs.iter().filter(|z| z.nrows() == 1 && z[0].is_finite()).map(|z| birth(z[0])).collect();
             if f.step(dt, births, &zs, &NoGate).is_ok() {
                 prop_assert!(f.mixture().iter().all(|c| c.weight.is_finite() && c.weight >= 0.0));
             }

@@ -2,8 +2,8 @@
 
 use std::collections::BTreeMap;
 
+use mmtrack_filter::faer::Col;
 use mmtrack_filter::gmphd::{Component, Estimate, MixtureReducer, StateExtractor, WeightedGaussian};
-use mmtrack_filter::nalgebra::DVector;
 use mmtrack_filter::{
     ConstantVelocity, Gaussian, GmPhdFilter, GmPhdParams, KalmanPredictor, KalmanUpdater, Label, LinearMeasurement,
     NoGate, TransitionModel,
@@ -29,7 +29,7 @@ fn filter() -> GmPhdFilter<ConstantVelocity> {
 
 /// Births at the measurements no component explained at the previous step:
 /// N([z, 0], diag(sigma_z^2, 2^2)) moved forward by `dt`.
-fn births(prev: &[(DVector<f64>, f64)], dt: f64) -> Vec<WeightedGaussian> {
+fn births(prev: &[(Col<f64>, f64)], dt: f64) -> Vec<WeightedGaussian> {
     let model = ConstantVelocity::new(1, 0.1).expect("valid");
     let (f, q) = model.matrices(dt).expect("valid dt");
     prev.iter()
@@ -50,7 +50,7 @@ fn births(prev: &[(DVector<f64>, f64)], dt: f64) -> Vec<WeightedGaussian> {
 fn two_targets_cardinality_and_labels() {
     let mut f = filter();
     let mut noise = Normal::new(7);
-    let mut prev: Vec<(DVector<f64>, f64)> = Vec::new();
+    let mut prev: Vec<(Col<f64>, f64)> = Vec::new();
     // step -> estimates
     let mut history: Vec<Vec<Estimate>> = Vec::new();
     let mut cardinality = Vec::new();

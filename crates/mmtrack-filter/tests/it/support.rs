@@ -1,15 +1,15 @@
 //! Small deterministic helpers shared by the tests.
 
-use mmtrack_filter::nalgebra::{DMatrix, DVector};
+use mmtrack_filter::faer::{Col, ColRef, Mat, MatRef};
 
 /// Column vector from a slice.
-pub fn v(xs: &[f64]) -> DVector<f64> {
-    DVector::from_column_slice(xs)
+pub fn v(xs: &[f64]) -> Col<f64> {
+    ColRef::from_slice(xs).to_owned()
 }
 
 /// Row-major matrix.
-pub fn m(rows: usize, cols: usize, xs: &[f64]) -> DMatrix<f64> {
-    DMatrix::from_row_slice(rows, cols, xs)
+pub fn m(rows: usize, cols: usize, xs: &[f64]) -> Mat<f64> {
+    MatRef::from_row_major_slice(xs, rows, cols).to_owned()
 }
 
 /// Deterministic standard-normal samples (64-bit LCG + Box-Muller), so the
