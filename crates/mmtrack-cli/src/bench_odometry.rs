@@ -38,7 +38,7 @@ pub struct OdometryBenchArgs {
 }
 
 /// Reads and decodes every scan of the recording through the same reader
-/// and decode workers as `process odometry`: the baseline.
+/// and rayon decoding as `process odometry`: the baseline.
 fn decode_only(recording: &Path) -> anyhow::Result<usize> {
     let mut scans = 0;
     crate::process::for_each_event(recording, |event, _| {
@@ -113,13 +113,14 @@ pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 fn markdown(args: &OdometryBenchArgs, decode_per_s: f64, results: &[PresetResult]) -> String {
     let mut out = format!(
         "`mmtrack bench odometry`: the {} real Oxford scans (400 x 3768) of `{}` in a recording, {} passes per \
-         preset, each a fresh pipeline; a reader thread feeds PNG decoding workers (one per core) beside the odometry. Baseline in \
+         preset, each a fresh pipeline; scans are decoded on the rayon pool ({} threads) in batches beside the odometry. Baseline in \
          the same run: reading and decoding alone, {decode_per_s:.0} scans/s.\n\n\
          | preset | scans | end-to-end scans/s | / decode-only | filter ms | surface points ms | registration ms | \
          target >= {ODOMETRY_TARGET_SCANS_PER_S} scans/s |\n|---|---|---|---|---|---|---|---|\n",
         results.first().map(|r| r.scans / args.passes.max(1)).unwrap_or(0),
         args.from.display(),
         args.passes,
+        rayon::current_num_threads(),
     );
     for r in results {
         out.push_str(&format!(
