@@ -26,8 +26,8 @@ mod error;
 mod gnss;
 mod mpc;
 mod odometry;
-mod pose;
 pub mod parallel;
+mod pose;
 mod radar;
 pub mod sounder;
 

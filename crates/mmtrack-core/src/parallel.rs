@@ -69,10 +69,15 @@ mod tests {
                 let mut seen = Vec::new();
                 pool(threads)
                     .install(|| {
-                        map_in_order(0..103u64, batch, |i| i * i, |v| {
-                            seen.push(v);
-                            Ok::<(), ()>(())
-                        })
+                        map_in_order(
+                            0..103u64,
+                            batch,
+                            |i| i * i,
+                            |v| {
+                                seen.push(v);
+                                Ok::<(), ()>(())
+                            },
+                        )
                     })
                     .unwrap();
                 assert_eq!(seen, expected, "threads {threads}, batch {batch}");
@@ -85,13 +90,18 @@ mod tests {
         for threads in [1, 2, 4] {
             let mut consumed = Vec::new();
             let err = pool(threads).install(|| {
-                map_in_order(0..50u32, 4, |i| i, |v| {
-                    if v == 9 {
-                        return Err(format!("item {v}"));
-                    }
-                    consumed.push(v);
-                    Ok(())
-                })
+                map_in_order(
+                    0..50u32,
+                    4,
+                    |i| i,
+                    |v| {
+                        if v == 9 {
+                            return Err(format!("item {v}"));
+                        }
+                        consumed.push(v);
+                        Ok(())
+                    },
+                )
             });
             assert_eq!(err, Err("item 9".to_string()));
             assert_eq!(consumed, (0..9).collect::<Vec<_>>(), "threads {threads}");
@@ -101,10 +111,15 @@ mod tests {
     #[test]
     fn empty_input_consumes_nothing() {
         let mut calls = 0;
-        map_in_order(std::iter::empty::<u8>(), 4, |i| i, |_| {
-            calls += 1;
-            Ok::<(), ()>(())
-        })
+        map_in_order(
+            std::iter::empty::<u8>(),
+            4,
+            |i| i,
+            |_| {
+                calls += 1;
+                Ok::<(), ()>(())
+            },
+        )
         .unwrap();
         assert_eq!(calls, 0);
     }
