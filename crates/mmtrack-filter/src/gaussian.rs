@@ -1,10 +1,10 @@
 //! Gaussian densities: a validated mean/covariance pair and the small
 //! operations on it (density, squared Mahalanobis distance).
 
-use faer::linalg::solvers::Llt;
-use faer::{Col, ColRef, Mat, Side};
+use faer::{Col, ColRef, Mat};
 
 use crate::error::{FilterError, ensure_finite_matrix, ensure_finite_vector, ensure_len, ensure_shape};
+use crate::linalg::{Cholesky, is_positive_definite, max_asymmetry, symmetrise};
 
 /// Relative asymmetry `max |P - P^T| / max(1, max |P|)` above which a matrix is
 /// rejected as not symmetric. `1e-9` is far above the round-off of the
@@ -74,8 +74,8 @@ impl Gaussian {
     pub fn mahalanobis_squared(&self, x: &Col<f64>) -> Result<f64, FilterError> {
         ensure_len("point", x, self.dim())?;
         ensure_finite_vector("point", x)?;
-        let chol = cholesky("Gaussian covariance", &self.cov)?;
-        Ok(mahalanobis_squared_with(&chol, (x - &self.mean).as_ref(), &mut Col::zeros(x.nrows())))
+        let chol = Cholesky::new("Gaussian covariance", &self.cov)?;
+        Ok(chol.mahalanobis_squared((x - &self.mean).as_ref(), &mut Col::zeros(x.nrows())))
     }
 }
 
@@ -103,86 +103,18 @@ pub(crate) fn checked_spd(what: &'static str, m: Mat<f64>, n: usize) -> Result<M
         return Err(FilterError::NotPositiveDefinite { what });
     }
     let sym = symmetrise(m);
-    cholesky(what, &sym)?;
+    if !is_positive_definite(&sym) {
+        return Err(FilterError::NotPositiveDefinite { what });
+    }
     Ok(sym)
-}
-
-/// `max |P - P^T|` of a square matrix (0 for an empty one).
-pub(crate) fn max_asymmetry(m: &Mat<f64>) -> f64 {
-    let mut worst = 0.0_f64;
-    for j in 0..m.ncols() {
-        for i in 0..j {
-            worst = worst.max((m[(i, j)] - m[(j, i)]).abs());
-        }
-    }
-    worst
-}
-
-/// `(P + P^T) / 2`, in place: element `(i, j)` becomes `(p_ij + p_ji) * 0.5`,
-/// the diagonal included, so the result is the same number for number as
-/// forming `P + P^T` and halving it.
-pub(crate) fn symmetrise(mut m: Mat<f64>) -> Mat<f64> {
-    for j in 0..m.ncols() {
-        for i in 0..=j {
-            let mean = (m[(i, j)] + m[(j, i)]) * 0.5;
-            m[(i, j)] = mean;
-            m[(j, i)] = mean;
-        }
-    }
-    m
-}
-
-/// Cholesky factor `L` of an SPD matrix (`S = L L^T`, faer's `L L^T`
-/// decomposition of the lower triangle), or [`FilterError::NotPositiveDefinite`]
-/// when a pivot is not positive.
-pub(crate) fn cholesky(what: &'static str, m: &Mat<f64>) -> Result<Llt<f64>, FilterError> {
-    m.llt(Side::Lower).map_err(|_| FilterError::NotPositiveDefinite { what })
-}
-
-/// `ln det S = 2 sum ln L_ii` from the Cholesky factor of `S`.
-pub(crate) fn log_det(chol: &Llt<f64>) -> f64 {
-    2.0 * chol.L().diagonal().column_vector().iter().map(|d| d.ln()).sum::<f64>()
-}
-
-/// `v^T S^-1 v` from the Cholesky factor `L` of `S` (`S = L L^T`): solve
-/// `L y = v` by forward substitution, return `|y|^2`. `y` is scratch space
-/// (resized to `v`), so a caller in a loop allocates nothing. `v` must have
-/// the dimension of `S` (every caller has checked it).
-///
-/// The substitution is written out over faer's factor rather than calling
-/// `faer::linalg::triangular_solve` and `squared_norm_l2`: it runs once per
-/// (component, measurement) pair of every GM-PHD update and once per pair of
-/// components in every merge, on vectors of one or two elements, where faer's
-/// SIMD dispatch and blocked/pairwise-sum kernels cost more than the
-/// arithmetic. Measured on the MPC GM-PHD baseline (1-D delay measurements,
-/// sets of 6 snapshots with ~140 detections each, as `mmtrack bench mpc`
-/// feeds it): the whole filter executed 1.46 times the instructions with
-/// faer's kernels here (callgrind). The order of operations is the textbook
-/// one, `y_i = (v_i - sum_{k<i} L_ik y_k) / L_ii`, summed in index order.
-pub(crate) fn mahalanobis_squared_with(chol: &Llt<f64>, v: ColRef<'_, f64>, y: &mut Col<f64>) -> f64 {
-    let l = chol.L();
-    if y.nrows() != v.nrows() {
-        y.resize_with(v.nrows(), |_| 0.0);
-    }
-    let mut d2 = 0.0;
-    for i in 0..v.nrows() {
-        let mut r = v[i];
-        for k in 0..i {
-            r -= l[(i, k)] * y[k];
-        }
-        let yi = r / l[(i, i)];
-        y[i] = yi;
-        d2 += yi * yi;
-    }
-    d2
 }
 
 /// `ln N(v; 0, S)` from the Cholesky factor of `S`:
 /// `-(k ln 2 pi + ln det S + v^T S^-1 v) / 2` with `ln det S = 2 sum ln L_ii`.
-pub(crate) fn log_normal_pdf_with(chol: &Llt<f64>, v: ColRef<'_, f64>) -> f64 {
+pub(crate) fn log_normal_pdf_with(chol: &Cholesky, v: ColRef<'_, f64>) -> f64 {
     let k = v.nrows() as f64;
-    let d2 = mahalanobis_squared_with(chol, v, &mut Col::zeros(v.nrows()));
-    -0.5 * (k * (2.0 * std::f64::consts::PI).ln() + log_det(chol) + d2)
+    let d2 = chol.mahalanobis_squared(v, &mut Col::zeros(v.nrows()));
+    -0.5 * (k * (2.0 * std::f64::consts::PI).ln() + chol.log_det() + d2)
 }
 
 #[cfg(test)]
@@ -202,7 +134,7 @@ mod tests {
 
     #[test]
     fn log_pdf_of_standard_normal_at_zero() {
-        let chol = cholesky("I", &Mat::identity(1, 1)).expect("identity is SPD");
+        let chol = Cholesky::new("I", &Mat::identity(1, 1)).expect("identity is SPD");
         let v = col![0.0];
         // ln(1/sqrt(2 pi)) = -0.918938533204672...; only round-off separates them.
         assert!((log_normal_pdf_with(&chol, v.as_ref()) + 0.918_938_533_204_672_7).abs() < 1e-14);

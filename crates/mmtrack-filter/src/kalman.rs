@@ -24,13 +24,12 @@
 //! *Filtering for Stochastic Processes with Applications to Guidance*, 1968 (the
 //! Joseph form).
 
-use faer::linalg::solvers::{Llt, Solve};
-use faer::{Col, Mat};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Col, Mat, Par};
 
-use crate::error::{FilterError, ensure_finite_vector, ensure_len};
-use crate::gaussian::{
-    Gaussian, checked_spd, cholesky, log_det, log_normal_pdf_with, mahalanobis_squared_with, symmetrise,
-};
+use crate::error::{FilterError, ensure_finite_vector, ensure_len, ensure_shape};
+use crate::gaussian::{Gaussian, checked_spd, log_normal_pdf_with};
+use crate::linalg::{Cholesky, symmetrise};
 use crate::models::{LinearMeasurement, TransitionModel};
 
 /// How the posterior covariance is computed.
@@ -69,17 +68,61 @@ impl<T: TransitionModel> KalmanPredictor<T> {
     ///
     /// # Errors
     /// [`FilterError::DimensionMismatch`] when the prior does not have the
-    /// model's state dimension; the model's own errors for a bad `dt_s`;
+    /// model's state dimension (or the model hands out `F`, `Q` of another);
+    /// the model's own errors for a bad `dt_s`;
     /// [`FilterError::NotPositiveDefinite`] / [`FilterError::NotFinite`] if the
     /// result is not a valid covariance (e.g. overflow).
     pub fn predict(&self, prior: &Gaussian, dt_s: f64) -> Result<Gaussian, FilterError> {
         let n = self.model.state_dim();
         ensure_len("prior mean", prior.mean(), n)?;
-        let (f, q) = self.model.matrices(dt_s)?;
-        let mean = &f * prior.mean();
-        let cov = symmetrise(&f * prior.cov() * f.transpose() + q);
-        Gaussian::new(mean, cov)
+        let (f, q) = self.checked_matrices(dt_s)?;
+        predict_with(prior, &f, &q)
     }
+
+    /// [`KalmanPredictor::predict`] of every prior over the same step of
+    /// `dt_s` seconds, with `(F, Q)` built once (and not at all for no
+    /// priors); the first error ends it.
+    ///
+    /// # Errors
+    /// As [`KalmanPredictor::predict`].
+    pub fn predict_each<'a>(
+        &self,
+        priors: impl IntoIterator<Item = &'a Gaussian>,
+        dt_s: f64,
+    ) -> Result<Vec<Gaussian>, FilterError> {
+        let n = self.model.state_dim();
+        let priors = priors.into_iter();
+        let mut out = Vec::with_capacity(priors.size_hint().0);
+        let mut matrices = None;
+        for prior in priors {
+            ensure_len("prior mean", prior.mean(), n)?;
+            let (f, q) = match &matrices {
+                Some(fq) => fq,
+                None => matrices.insert(self.checked_matrices(dt_s)?),
+            };
+            out.push(predict_with(prior, f, q)?);
+        }
+        Ok(out)
+    }
+
+    /// The model's `(F, Q)`, checked to be `n x n`.
+    fn checked_matrices(&self, dt_s: f64) -> Result<(Mat<f64>, Mat<f64>), FilterError> {
+        let n = self.model.state_dim();
+        let (f, q) = self.model.matrices(dt_s)?;
+        ensure_shape("transition matrix F", &f, n, n)?;
+        ensure_shape("process covariance Q", &q, n, n)?;
+        Ok((f, q))
+    }
+}
+
+/// `N(F m, F P F^T + Q)`, shapes already checked.
+fn predict_with(prior: &Gaussian, f: &Mat<f64>, q: &Mat<f64>) -> Result<Gaussian, FilterError> {
+    let mean = f * prior.mean();
+    let fp = f * prior.cov();
+    // F P F^T + Q, written into a copy of Q.
+    let mut cov = q.clone();
+    matmul(cov.as_mut(), Accum::Add, &fp, f.transpose(), 1.0, Par::Seq);
+    Gaussian::new(mean, symmetrise(cov))
 }
 
 /// The update role: conditions a Gaussian on a linear measurement.
@@ -108,16 +151,28 @@ impl KalmanUpdater {
         let r = self.model.r();
         ensure_len("prior mean", prior.mean(), self.model.state_dim())?;
         let p = prior.cov();
-        let hp = h * p;
-        let s = symmetrise(&hp * h.transpose() + r);
-        let s_chol = cholesky("innovation covariance S", &s)?;
-        // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
-        let gain = s_chol.solve(&hp).transpose().to_owned();
         let n = prior.dim();
-        let i_kh = Mat::<f64>::identity(n, n) - &gain * h;
+        let hp = h * p;
+        // S = H P H^T + R, written into a copy of R.
+        let mut s = r.clone();
+        matmul(s.as_mut(), Accum::Add, &hp, h.transpose(), 1.0, Par::Seq);
+        let s = symmetrise(s);
+        let s_chol = Cholesky::new("innovation covariance S", &s)?;
+        // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
+        let mut gain_t = hp;
+        s_chol.solve_in_place(gain_t.as_mut());
+        let gain = gain_t.transpose().to_owned();
+        // I - K H, written into I.
+        let mut i_kh = Mat::<f64>::identity(n, n);
+        matmul(i_kh.as_mut(), Accum::Add, &gain, h, -1.0, Par::Seq);
+        let i_kh_p = &i_kh * p;
         let post = match self.covariance_update {
-            CovarianceUpdate::Joseph => &i_kh * p * i_kh.transpose() + &gain * r * gain.transpose(),
-            CovarianceUpdate::Standard => &i_kh * p,
+            CovarianceUpdate::Joseph => {
+                let mut post = &i_kh_p * i_kh.transpose();
+                matmul(post.as_mut(), Accum::Add, &gain * r, gain.transpose(), 1.0, Par::Seq);
+                post
+            }
+            CovarianceUpdate::Standard => i_kh_p,
         };
         // Validate once here (as `Gaussian::new` would) so that `posterior`
         // only has to check the mean.
@@ -125,7 +180,7 @@ impl KalmanUpdater {
         Ok(PreparedUpdate {
             prior_mean: prior.mean().clone(),
             predicted_measurement: h * prior.mean(),
-            log_det_s: log_det(&s_chol),
+            log_det_s: s_chol.log_det(),
             s,
             s_chol,
             gain,
@@ -151,7 +206,7 @@ pub struct PreparedUpdate {
     /// `ln det S`, once per prior rather than once per measurement.
     log_det_s: f64,
     s: Mat<f64>,
-    s_chol: Llt<f64>,
+    s_chol: Cholesky,
     gain: Mat<f64>,
     posterior_cov: Mat<f64>,
 }
@@ -197,7 +252,7 @@ impl PreparedUpdate {
     /// As [`PreparedUpdate::innovation`].
     pub fn mahalanobis_squared(&self, z: &Col<f64>) -> Result<f64, FilterError> {
         let nu = self.innovation(z)?;
-        Ok(mahalanobis_squared_with(&self.s_chol, nu.as_ref(), &mut Col::zeros(nu.nrows())))
+        Ok(self.s_chol.mahalanobis_squared(nu.as_ref(), &mut Col::zeros(nu.nrows())))
     }
 
     /// `ln N(z; eta, S)`, the log measurement likelihood `ln q(z)` of Vo & Ma
@@ -217,9 +272,9 @@ impl PreparedUpdate {
     }
 
     /// `nu^T S^-1 nu` for an innovation already computed; `scratch` is
-    /// working space (see [`mahalanobis_squared_with`]).
+    /// working space (see [`Cholesky::mahalanobis_squared`]).
     pub(crate) fn mahalanobis_squared_of_innovation(&self, nu: &Col<f64>, scratch: &mut Col<f64>) -> f64 {
-        mahalanobis_squared_with(&self.s_chol, nu.as_ref(), scratch)
+        self.s_chol.mahalanobis_squared(nu.as_ref(), scratch)
     }
 
     /// Posterior `N(m + K (z - eta), P+)`.
@@ -233,6 +288,9 @@ impl PreparedUpdate {
 
     /// Posterior for an innovation already computed.
     pub(crate) fn posterior_of_innovation(&self, nu: &Col<f64>) -> Result<Gaussian, FilterError> {
-        Gaussian::with_checked_cov(&self.prior_mean + &self.gain * nu, self.posterior_cov.clone())
+        // m + K nu, written into a copy of m.
+        let mut mean = self.prior_mean.clone();
+        matmul(mean.as_mat_mut(), Accum::Add, &self.gain, nu.as_mat(), 1.0, Par::Seq);
+        Gaussian::with_checked_cov(mean, self.posterior_cov.clone())
     }
 }

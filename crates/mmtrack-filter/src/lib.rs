@@ -33,6 +33,7 @@ pub mod gating;
 mod gaussian;
 pub mod gmphd;
 pub mod kalman;
+mod linalg;
 pub mod metrics;
 pub mod models;
 

@@ -8,7 +8,8 @@
 use faer::Mat;
 
 use crate::error::{FilterError, ensure_finite_matrix, ensure_positive, ensure_shape};
-use crate::gaussian::{SYMMETRY_TOLERANCE, checked_spd, max_asymmetry};
+use crate::gaussian::{SYMMETRY_TOLERANCE, checked_spd};
+use crate::linalg::max_asymmetry;
 
 /// A linear-Gaussian motion model `x_k = F(dt) x_{k-1} + v`, `v ~ N(0, Q(dt))`.
 pub trait TransitionModel {

@@ -172,8 +172,7 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
         let dt_s = previous_t_ns.map_or(0.0, |p| (i128::from(snap.t_ns) - i128::from(p)) as f64 * 1e-9);
         previous_t_ns = Some(snap.t_ns);
 
-        let births =
-            unexplained.iter().map(|&(d, _)| birth.at(d, dt_s)).collect::<Result<Vec<_>, _>>().map_err(wrap)?;
+        let births = birth.at_all(unexplained.iter().map(|&(d, _)| d), dt_s).map_err(wrap)?;
         let labels = filter.predict(dt_s, births).map_err(wrap)?;
         for (label, &(_, power_db)) in labels.iter().zip(&unexplained) {
             last_power_db.insert(*label, power_db);
@@ -280,10 +279,14 @@ impl BirthModel {
         })
     }
 
-    /// `w_b N([d, 0], diag(sigma_d^2, sigma_rate^2))` predicted over `dt_s`.
-    fn at(&self, d_m: f64, dt_s: f64) -> Result<WeightedGaussian, FilterError> {
-        let at_detection = Gaussian::new(ColRef::from_slice(&[d_m, 0.0]).to_owned(), self.cov.clone())?;
-        Ok(WeightedGaussian { weight: self.weight, density: self.predictor.predict(&at_detection, dt_s)? })
+    /// `w_b N([d, 0], diag(sigma_d^2, sigma_rate^2))` predicted over `dt_s`,
+    /// for each path length `d` (m).
+    fn at_all(&self, d_m: impl Iterator<Item = f64>, dt_s: f64) -> Result<Vec<WeightedGaussian>, FilterError> {
+        let at_detections = d_m
+            .map(|d| Gaussian::new(ColRef::from_slice(&[d, 0.0]).to_owned(), self.cov.clone()))
+            .collect::<Result<Vec<_>, _>>()?;
+        let predicted = self.predictor.predict_each(&at_detections, dt_s)?;
+        Ok(predicted.into_iter().map(|density| WeightedGaussian { weight: self.weight, density }).collect())
     }
 }
 

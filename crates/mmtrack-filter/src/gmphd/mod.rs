@@ -223,12 +223,13 @@ impl<T: TransitionModel> GmPhdFilter<T> {
             ensure_len("birth mean", b.density.mean(), n).map_err(wrap)?;
             ensure_in_range("birth weight", b.weight, 0.0, f64::MAX, "finite and >= 0").map_err(wrap)?;
         }
+        let densities = self.predictor.predict_each(self.mixture.iter().map(|c| &c.density), dt_s)?;
         let mut predicted = Vec::with_capacity(self.mixture.len() + births.len());
-        for c in &self.mixture {
+        for (c, density) in self.mixture.iter().zip(densities) {
             predicted.push(Component {
                 label: c.label,
                 weight: self.params.p_survival * c.weight,
-                density: self.predictor.predict(&c.density, dt_s)?,
+                density,
                 measurement: None,
             });
         }

@@ -26,7 +26,8 @@ use faer::{Col, Mat, Scale, unzip, zip};
 
 use super::Component;
 use crate::error::{FilterError, ensure_in_range, ensure_len};
-use crate::gaussian::{Gaussian, cholesky, mahalanobis_squared_with, symmetrise};
+use crate::gaussian::Gaussian;
+use crate::linalg::{Cholesky, symmetrise};
 
 /// The pruning-and-merging role.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -98,8 +99,10 @@ impl MixtureReducer {
             ensure_len("component mean (state dimension of the first kept component)", c.density.mean(), n)?;
         }
         let mut report = ReductionReport { truncated: mixture.len() - kept.len(), ..ReductionReport::default() };
-        let chols =
-            kept.iter().map(|c| cholesky("component covariance", c.density.cov())).collect::<Result<Vec<_>, _>>()?;
+        let chols = kept
+            .iter()
+            .map(|c| Cholesky::new("component covariance", c.density.cov()))
+            .collect::<Result<Vec<_>, _>>()?;
         let mut remaining: Vec<usize> = (0..kept.len()).collect();
         // Working space of the Mahalanobis tests.
         let (mut d, mut scratch) = (Col::zeros(n), Col::zeros(n));
@@ -121,7 +124,7 @@ impl MixtureReducer {
                 for r in 0..n {
                     d[r] = mi[r] - mj[r];
                 }
-                mahalanobis_squared_with(&chols[i], d.as_ref(), &mut scratch) <= self.merge_threshold
+                chols[i].mahalanobis_squared(d.as_ref(), &mut scratch) <= self.merge_threshold
             });
             remaining = rest;
             report.merged += group.len() - 1;

@@ -3,7 +3,7 @@ use std::sync::Arc;
 
 use arrow_array::builder::{BooleanBuilder, Float64Builder, Int64Builder, ListBuilder};
 use arrow_array::cast::AsArray;
-use arrow_array::types::{Float64Type, Int64Type, UInt32Type, UInt64Type};
+use arrow_array::types::{Float64Type, Int64Type};
 use arrow_array::{
     Array, ArrayRef, BinaryArray, BooleanArray, Float64Array, Int64Array, ListArray, RecordBatch, StringArray,
     UInt32Array, UInt64Array,
@@ -34,48 +34,9 @@ impl<'a> Columns<'a> {
         self.batch.num_rows()
     }
 
-    fn column(&self, name: &str) -> Result<&'a dyn Array, String> {
-        self.batch.column_by_name(name).map(|c| c.as_ref()).ok_or_else(|| missing(name))
-    }
-
-    /// An `int64` column.
-    pub fn i64(&self, name: &str) -> Result<&'a Int64Array, String> {
-        self.column(name)?.as_primitive_opt::<Int64Type>().ok_or_else(|| missing(name))
-    }
-
-    /// A `uint64` column.
-    pub fn u64(&self, name: &str) -> Result<&'a UInt64Array, String> {
-        self.column(name)?.as_primitive_opt::<UInt64Type>().ok_or_else(|| missing(name))
-    }
-
-    /// A `uint32` column.
-    pub fn u32(&self, name: &str) -> Result<&'a UInt32Array, String> {
-        self.column(name)?.as_primitive_opt::<UInt32Type>().ok_or_else(|| missing(name))
-    }
-
-    /// A `float64` column.
-    pub fn f64(&self, name: &str) -> Result<&'a Float64Array, String> {
-        self.column(name)?.as_primitive_opt::<Float64Type>().ok_or_else(|| missing(name))
-    }
-
-    /// A `bool` column.
-    pub fn bool(&self, name: &str) -> Result<&'a BooleanArray, String> {
-        self.column(name)?.as_boolean_opt().ok_or_else(|| missing(name))
-    }
-
-    /// A `string` column.
-    pub fn utf8(&self, name: &str) -> Result<&'a StringArray, String> {
-        self.column(name)?.as_string_opt::<i32>().ok_or_else(|| missing(name))
-    }
-
-    /// A `binary` column.
-    pub fn binary(&self, name: &str) -> Result<&'a BinaryArray, String> {
-        self.column(name)?.as_binary_opt::<i32>().ok_or_else(|| missing(name))
-    }
-
-    /// A `list<...>` column.
-    pub fn list(&self, name: &str) -> Result<&'a ListArray, String> {
-        self.column(name)?.as_list_opt::<i32>().ok_or_else(|| missing(name))
+    /// Column `name` as its Arrow array type `A` (`Int64Array`, `ListArray`, ...).
+    pub fn array<A: Array + 'static>(&self, name: &str) -> Result<&'a A, String> {
+        self.batch.column_by_name(name).and_then(|c| c.as_any().downcast_ref::<A>()).ok_or_else(|| missing(name))
     }
 }
 
@@ -137,9 +98,9 @@ impl<T: ColumnValue> ColumnValue for Option<T> {
 }
 
 /// `ColumnValue` for a type with an Arrow array of its own: the type, its
-/// column type, array type, `Columns` getter, and value as the array takes it.
+/// column type, array type, and value as the array takes it.
 macro_rules! scalar {
-    ($t:ty, $ty:ident, $array:ty, $get:ident, $to_arrow:expr) => {
+    ($t:ty, $ty:ident, $array:ty, $to_arrow:expr) => {
         impl ColumnValue for $t {
             const TYPE: ColumnType = ColumnType::$ty;
             type Column<'a> = &'a $array;
@@ -147,7 +108,7 @@ macro_rules! scalar {
                 Arc::new(values.iter().map(|v| v.map($to_arrow)).collect::<$array>())
             }
             fn column<'a>(columns: &Columns<'a>, name: &str) -> Result<&'a $array, String> {
-                columns.$get(name)
+                columns.array::<$array>(name)
             }
             fn get(column: &&$array, row: usize, _: &str) -> Result<Option<Self>, String> {
                 Ok(column.is_valid(row).then(|| column.value(row).to_owned()))
@@ -156,13 +117,13 @@ macro_rules! scalar {
     };
 }
 
-scalar!(i64, Int64, Int64Array, i64, |v: &i64| *v);
-scalar!(u64, UInt64, UInt64Array, u64, |v: &u64| *v);
-scalar!(u32, UInt32, UInt32Array, u32, |v: &u32| *v);
-scalar!(f64, Float64, Float64Array, f64, |v: &f64| *v);
-scalar!(bool, Boolean, BooleanArray, bool, |v: &bool| *v);
-scalar!(String, Utf8, StringArray, utf8, String::as_str);
-scalar!(Vec<u8>, Binary, BinaryArray, binary, Vec::as_slice);
+scalar!(i64, Int64, Int64Array, |v: &i64| *v);
+scalar!(u64, UInt64, UInt64Array, |v: &u64| *v);
+scalar!(u32, UInt32, UInt32Array, |v: &u32| *v);
+scalar!(f64, Float64, Float64Array, |v: &f64| *v);
+scalar!(bool, Boolean, BooleanArray, |v: &bool| *v);
+scalar!(String, Utf8, StringArray, String::as_str);
+scalar!(Vec<u8>, Binary, BinaryArray, Vec::as_slice);
 
 /// A `list<...>` column, downcast once: the lists and their items.
 pub struct ListColumn<'a, A> {
@@ -186,7 +147,7 @@ macro_rules! list {
                 Arc::new(builder.finish())
             }
             fn column<'a>(columns: &Columns<'a>, name: &str) -> Result<Self::Column<'a>, String> {
-                let lists = columns.list(name)?;
+                let lists = columns.array::<ListArray>(name)?;
                 let items = lists.values().$downcast$(::<$arrow>)?().ok_or_else(|| missing(name))?;
                 Ok(ListColumn { lists, items })
             }

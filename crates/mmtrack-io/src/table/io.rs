@@ -278,7 +278,7 @@ fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileS
         for batch in builder.with_projection(mask).build().map_err(|e| corrupt(path, e))? {
             let batch = batch.map_err(|e| corrupt(path, e))?;
             let columns = Columns::new(&batch);
-            let t = columns.i64("t_ns").map_err(|d| corrupt(path, d))?;
+            let t = columns.array::<arrow_array::Int64Array>("t_ns").map_err(|d| corrupt(path, d))?;
             for v in t.iter().flatten() {
                 span = Some(span.map_or((v, v), |(a, b)| (a.min(v), b.max(v))));
             }
