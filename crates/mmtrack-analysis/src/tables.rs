@@ -86,3 +86,57 @@ one row per associated frame k >= 1, in time order.";
         yaw_error_rad: f64, "rad", "rotation of E_k, wrapped to (-pi, pi]";
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use mmtrack_io::Overwrite;
+    use mmtrack_io::table::{RunInfo, read_table_dir, write_table};
+
+    use super::*;
+
+    /// The derived writer and reader of a result table with lists and
+    /// nullable integers and floats give back every value, nulls included.
+    #[test]
+    fn trajectory_metrics_round_trip_with_and_without_nulls() {
+        let full = TrajectoryMetrics {
+            estimate_poses: u64::MAX,
+            associated_poses: 7,
+            interpolated_poses: 3,
+            dropped_poses: 0,
+            first_t_ns: i64::MIN,
+            last_t_ns: i64::MAX,
+            path_length_m: 812.5,
+            estimate_path_length_m: -0.0,
+            segment_lengths_m: vec![100.0, 200.0],
+            step_frames: Some(10),
+            step_m: None,
+            kitti_segments: 12,
+            kitti_translational_pct: Some(1.25),
+            kitti_rotational_deg_per_m: Some(0.002),
+            kitti_rotational_deg_per_100m: Some(0.2),
+            ate_rmse_m: 1.0,
+            ate_max_m: 2.0,
+            x_rmse_m: 0.5,
+            y_rmse_m: 0.25,
+            position_rmse_m: f64::INFINITY,
+            yaw_rmse_rad: 1e-300,
+            final_position_error_m: 3.0,
+            rpe_translation_rmse_m: 0.1,
+            rpe_yaw_rmse_rad: 0.01,
+        };
+        let empty = TrajectoryMetrics {
+            segment_lengths_m: Vec::new(),
+            step_frames: None,
+            step_m: Some(5.0),
+            kitti_translational_pct: None,
+            kitti_rotational_deg_per_m: None,
+            kitti_rotational_deg_per_100m: None,
+            ..full.clone()
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let run = RunInfo { config_json: "{}".into() };
+        write_table(dir.path(), "seq", &[full.clone(), empty.clone()], &run, Overwrite::Refuse).unwrap();
+        let read = read_table_dir::<TrajectoryMetrics>(dir.path()).unwrap();
+        assert_eq!(read.get("seq").map(Vec::as_slice), Some(&[full, empty][..]));
+    }
+}
