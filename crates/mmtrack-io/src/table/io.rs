@@ -166,26 +166,24 @@ fn check_schema(path: &Path, spec: &TableSpec, schema: &arrow_schema::Schema) ->
 }
 
 /// Reads all rows of one Parquet file of table `T`, validating the schema.
+///
+/// The file's record batches are joined before rows are built, so a record
+/// that spans several rows (a track's points in `mpc_tracks`) is read whole
+/// wherever the reader's batch boundaries fall, and errors give the row
+/// number within the file.
 pub fn read_table<T: TableRow>(path: &Path) -> Result<Vec<T>> {
     let file = File::open(path).map_err(os_err(path))?;
     let builder = ParquetRecordBatchReaderBuilder::try_new(file).map_err(|e| corrupt(path, e))?;
     check_schema(path, T::SPEC, builder.schema())?;
+    let schema = builder.schema().clone();
     let reader = builder.build().map_err(|e| corrupt(path, e))?;
-    let mut rows = Vec::new();
-    for batch in reader {
-        let batch = batch.map_err(|e| corrupt(path, e))?;
-        for column in T::SPEC.columns.iter().filter(|c| !c.nullable) {
-            check_no_nulls(&batch, column.name)
-                .map_err(|detail| IoError::CorruptTable { path: path.to_path_buf(), detail })?;
-        }
-        let offset = rows.len();
-        let batch_rows = T::from_columns(&Columns::new(&batch)).map_err(|detail| IoError::CorruptTable {
-            path: path.to_path_buf(),
-            detail: format!("{detail} (batch starting at row {offset})"),
-        })?;
-        rows.extend(batch_rows);
+    let batches = reader.collect::<std::result::Result<Vec<_>, _>>().map_err(|e| corrupt(path, e))?;
+    let batch = arrow_select::concat::concat_batches(&schema, &batches).map_err(|e| corrupt(path, e))?;
+    let corrupt_table = |detail| IoError::CorruptTable { path: path.to_path_buf(), detail };
+    for column in T::SPEC.columns.iter().filter(|c| !c.nullable) {
+        check_no_nulls(&batch, column.name).map_err(corrupt_table)?;
     }
-    Ok(rows)
+    T::from_columns(&Columns::new(&batch)).map_err(corrupt_table)
 }
 
 fn partitions(table_dir: &Path) -> Result<Vec<(String, PathBuf)>> {

@@ -220,6 +220,26 @@ fn tables_round_trip_every_type_bit_exactly() {
     let _: Vec<MpcTrack> = table_round_trip(&Vec::new());
 }
 
+/// A track's points are rows of `mpc_tracks`; the Parquet reader hands a
+/// file back in batches of 1024 rows, and a track straddling a batch boundary
+/// must still come back as one track.
+#[test]
+fn records_spanning_reader_batches_come_back_whole() {
+    let detection = |i: u64| MpcDetection {
+        t_ns: i as i64,
+        set_index: i / 6,
+        snapshot_index: (i % 6) as u32,
+        delay_s: 1e-8 + i as f64 * 1e-13,
+        amplitude: mmtrack_core::Complex64::new(1e-6, 0.0),
+    };
+    let tracks = vec![
+        MpcTrack { track_id: 0, doppler_hz: Some(12.5), detections: (0..1000).map(detection).collect() },
+        MpcTrack { track_id: 1, doppler_hz: None, detections: (1000..3100).map(detection).collect() },
+        MpcTrack { track_id: 2, doppler_hz: Some(-3.0), detections: (3100..3105).map(detection).collect() },
+    ];
+    assert_eq!(table_round_trip(&tracks), tracks);
+}
+
 #[test]
 fn parquet_metadata_carries_units_and_run_config() {
     let dir = tempfile::tempdir().unwrap();
