@@ -23,7 +23,7 @@ pub struct SounderArgs {
     /// Scenario file (TOML): seed and one of [artificial] or [convoy] (see data/sounder/).
     #[arg(long, value_name = "SCENARIO.toml")]
     scenario: PathBuf,
-    /// Simulate only the first N sets (overrides the scenario's length).
+    /// Write only the first N sets of the scenario's run (the same sets as the full run's first N).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     sets: Option<u64>,
     #[command(flatten)]
@@ -83,11 +83,11 @@ struct Written {
 }
 
 fn write_convoy(args: &SounderArgs, seed: u64, config: &ConvoyConfig, quiet: bool) -> anyhow::Result<Written> {
-    let mut config = config.clone();
-    if let Some(sets) = args.sets {
-        config.sets = config.sets.min(usize::try_from(sets).unwrap_or(usize::MAX));
-    }
-    let simulator = ConvoySimulator::new(&config, seed).with_context(|| args.scenario.display().to_string())?;
+    // `--sets N` keeps the first N sets of the scenario's run: the world (its
+    // length, traffic and scatterers) is laid out for the scenario's own
+    // number of sets, so a shorter run is a prefix of the full one.
+    let simulator = ConvoySimulator::new(config, seed).with_context(|| args.scenario.display().to_string())?;
+    let sets = args.sets.map_or(config.sets, |n| usize::try_from(n).unwrap_or(usize::MAX).min(config.sets));
     let mut extra = BTreeMap::from([
         ("sounder.channel".to_string(), "convoy".to_string()),
         ("sounder.road".to_string(), format!("{:?}", config.road)),
@@ -108,9 +108,9 @@ fn write_convoy(args: &SounderArgs, seed: u64, config: &ConvoyConfig, quiet: boo
     let output = &args.output;
     let mut writer =
         RecordingWriter::create(&output.output, &metadata(args, seed, extra), &output.recording_options())?;
-    let bar = crate::progress::bar(simulator.len() as u64, "simulate sounder", "sets", quiet);
+    let bar = crate::progress::bar(sets as u64, "simulate sounder", "sets", quiet);
     let mut written = Written { sets: 0, snapshots: 0, truths: 0, detail };
-    for set in simulator {
+    for set in simulator.take(sets) {
         writer.write_pose(PoseStream::GroundTruthTx, &set.tx_pose, "world", "tx")?;
         writer.write_pose(PoseStream::GroundTruthRx, &set.rx_pose, "world", "rx")?;
         for cir in &set.snapshots {
