@@ -9,7 +9,7 @@ use mmtrack_core::{
     MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, OdometryEstimate, Se2, StampedPose,
 };
 use mmtrack_io::table::{
-    GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose,
+    GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose,
     MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, ODOMETRY, TableRow, read_table,
     read_table_dir, table_path,
 };
@@ -334,7 +334,6 @@ pub fn read_mpc(root: &Path, sequence: &str) -> anyhow::Result<MpcInput> {
     Ok(MpcInput {
         detections: read_required::<MpcDetection>(root, sequence)?,
         tracks: read_required::<MpcTrack>(root, sequence)?,
-        gmphd_tracks: read_optional::<GmPhdTrack>(root, sequence)?.map(|t| t.into_iter().map(|t| t.0).collect()),
         long_term: read_required::<MpcLongTermEntry>(root, sequence)?,
         sets: read_required::<MpcSetStats>(root, sequence)?,
         truth: read_optional::<MpcTruth>(root, sequence)?,

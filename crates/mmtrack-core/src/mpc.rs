@@ -123,6 +123,9 @@ pub struct MpcSetStats {
     pub tracked_gain_db: f64,
     /// Mean gain captured by the full-lifetime tracks, dB.
     pub full_lifetime_gain_db: f64,
+    /// Mean gain captured by the GM-PHD baseline's tracks, dB (the same
+    /// definition as `tracked_gain_db`); `None` when GM-PHD did not run.
+    pub gmphd_tracked_gain_db: Option<f64>,
 }
 
 #[cfg(test)]

@@ -28,7 +28,8 @@
 //! Gains in the statistics are means over the set's measured (not skipped)
 //! snapshots of linear gains, converted to dB (`-inf` when every snapshot was
 //! skipped or nothing was captured). The detected, tracked and full-lifetime
-//! gains are `sum |alpha|^2 (w^H w)` over the respective detections (`w^H w`
+//! gains (and the GM-PHD baseline's tracked gain, when it runs) are
+//! `sum |alpha|^2 (w^H w)` over the respective detections (`w^H w`
 //! = [`Detector::pulse_energy`]), the scale of the detector's
 //! `detected_gain_db`, so each compares directly with the channel gain.
 //! The channel gain is the windowed CIR's energy and so includes the cross
@@ -148,7 +149,7 @@ impl MpcPipeline {
         self.snapshots_seen += snapshots.len();
         self.last_t_ns = snapshots.last().map(|s| s.t_ns);
 
-        let stats = self.stats(snapshots, &per_snapshot, &short_term_tracks, &full_lifetime);
+        let stats = self.stats(snapshots, &per_snapshot, &short_term_tracks, &full_lifetime, gmphd_tracks.as_deref());
         Ok(SetOutput { per_snapshot, short_term_tracks, gmphd_tracks, long_term_entries, stats })
     }
 
@@ -224,6 +225,7 @@ impl MpcPipeline {
         per_snapshot: &[SnapshotDetections],
         tracks: &[MpcTrack],
         full_lifetime: &[MpcTrack],
+        gmphd_tracks: Option<&[MpcTrack]>,
     ) -> MpcSetStats {
         let measured: Vec<&SnapshotDetections> = per_snapshot.iter().filter(|s| s.skipped.is_none()).collect();
         let n = measured.len();
@@ -247,6 +249,7 @@ impl MpcPipeline {
             detected_gain_db: mean_db(detected, n),
             tracked_gain_db: mean_db(captured(tracks), n),
             full_lifetime_gain_db: mean_db(captured(full_lifetime), n),
+            gmphd_tracked_gain_db: gmphd_tracks.map(|tracks| mean_db(captured(tracks), n)),
         }
     }
 }

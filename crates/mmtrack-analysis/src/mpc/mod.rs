@@ -100,8 +100,6 @@ pub struct MpcInput {
     pub detections: Vec<MpcDetection>,
     /// `mpc_tracks` (short-term tracks).
     pub tracks: Vec<MpcTrack>,
-    /// `mpc_tracks_gmphd`, when written.
-    pub gmphd_tracks: Option<Vec<MpcTrack>>,
     /// `mpc_long_term`.
     pub long_term: Vec<MpcLongTermEntry>,
     /// `mpc_sets`.
@@ -234,10 +232,6 @@ pub struct MpcResult {
     pub tracks: Vec<MpcTrack>,
 }
 
-fn db(linear: f64) -> f64 {
-    10.0 * linear.log10()
-}
-
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
     let (sum, n) = values.filter(|v| v.is_finite()).fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
     (n > 0).then(|| sum / n as f64)
@@ -267,21 +261,6 @@ fn long_term_spans(entries: &[MpcLongTermEntry]) -> BTreeMap<u64, (u64, u64)> {
     spans
 }
 
-/// Gain captured by `tracks` per set: mean over the set's processed snapshots
-/// of sum |a|^2, dB (the definition of `mpc_sets`).
-fn tracks_gain_db(tracks: &[MpcTrack], sets: &[MpcSetStats]) -> BTreeMap<u64, f64> {
-    let mut power: BTreeMap<u64, f64> = BTreeMap::new();
-    for d in tracks.iter().flat_map(|t| &t.detections) {
-        *power.entry(d.set_index).or_default() += d.amplitude.norm_sqr();
-    }
-    sets.iter()
-        .map(|s| {
-            let n = f64::from(s.snapshots.saturating_sub(s.skipped_snapshots).max(1));
-            (s.set_index, db(power.get(&s.set_index).copied().unwrap_or(0.0) / n))
-        })
-        .collect()
-}
-
 /// All MPC statistics of one sequence.
 #[must_use]
 pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
@@ -292,7 +271,6 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
         *per_set_count.entry(e.set_index).or_default() += 1;
     }
     let spans = long_term_spans(&input.long_term);
-    let gmphd_gain = input.gmphd_tracks.as_deref().map(|t| tracks_gain_db(t, &sets));
     let truth_scores =
         input.truth.as_deref().map(|t| truth::score(t, &input.detections, &input.tracks, &input.long_term, &sets));
 
@@ -304,7 +282,7 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
         let distance_m = previous.and_then(|p| input.distance.distance_m(p.t_ns, s.t_ns));
         let dt_s = previous.map(|p| (s.t_ns - p.t_ns) as f64 * 1e-9);
         let per = |n: Option<u64>, d: Option<f64>| n.zip(d).and_then(|(n, d)| ratio(n, d));
-        let gmphd = gmphd_gain.as_ref().and_then(|g| g.get(&s.set_index).copied());
+        let gmphd = s.gmphd_tracked_gain_db;
         let (true_births, true_deaths) = truth_scores
             .as_ref()
             .and_then(|t| t.transitions.get(&s.set_index))

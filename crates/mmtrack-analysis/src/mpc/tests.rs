@@ -18,6 +18,7 @@ fn set(i: u64) -> MpcSetStats {
         detected_gain_db: -82.0,
         tracked_gain_db: -83.0,
         full_lifetime_gain_db: -84.0,
+        gmphd_tracked_gain_db: None,
     }
 }
 
@@ -62,7 +63,6 @@ fn input(distance: DistanceSource) -> MpcInput {
     MpcInput {
         detections: Vec::new(),
         tracks: Vec::new(),
-        gmphd_tracks: None,
         long_term: long_term(),
         sets: (0..4).map(set).collect(),
         truth: None,
@@ -186,7 +186,6 @@ fn truth_input(sets: u64, detections: Vec<MpcDetection>, tracks: Vec<MpcTrack>, 
     MpcInput {
         detections,
         tracks,
-        gmphd_tracks: None,
         long_term: Vec::new(),
         sets: (0..sets).map(set).collect(), // floor -140 dB: detectable from -134 dB
         truth: Some(truth),

@@ -57,6 +57,8 @@ was captured.";
         detected_gain_db: f64, "dB", "gain captured by the detections";
         tracked_gain_db: f64, "dB", "gain captured by the short-term tracks";
         full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks";
+        gmphd_tracked_gain_db: Option<f64>, "dB",
+            "gain captured by the GM-PHD baseline's tracks (same definition); null when it did not run";
     }
 }
 

@@ -53,6 +53,7 @@ fn set_stats() -> Vec<MpcSetStats> {
             detected_gain_db: -82.0,
             tracked_gain_db: if i == 2 { f64::NEG_INFINITY } else { -82.5 },
             full_lifetime_gain_db: AWKWARD[(i as usize + 3) % 6],
+            gmphd_tracked_gain_db: (i % 2 == 0).then(|| AWKWARD[(i as usize + 4) % 6]),
         })
         .collect()
 }
