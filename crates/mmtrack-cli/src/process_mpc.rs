@@ -167,7 +167,14 @@ fn choose_pulse(
         Some("flat") => flat(),
         Some(file) => {
             let path = Path::new(file);
-            let cir = mmtrack_ingest::cir::read_cir_file(mmtrack_ingest::cir::CirFormat::Npy, path, None)
+            // A back-to-back CIR of this sounder: its carrier and tap spacing
+            // are the recording's (the .npy holds only the taps).
+            let sidecar = mmtrack_ingest::cir::CirSidecar {
+                carrier_hz: Some(first.carrier_hz),
+                tap_spacing: Some(mmtrack_ingest::cir::TapSpacing::Seconds(first.tap_spacing_s)),
+                ..mmtrack_ingest::cir::CirSidecar::empty()
+            };
+            let cir = mmtrack_ingest::cir::read_cir_file(mmtrack_ingest::cir::CirFormat::Npy, path, Some(&sidecar))
                 .with_context(|| format!("--pulse {}: back-to-back CIR", path.display()))?;
             let taps = cir.snapshots.first().map(|s| s.taps.clone()).with_context(|| {
                 format!("--pulse {}: no CIR in the file (expected one back-to-back CIR)", path.display())
