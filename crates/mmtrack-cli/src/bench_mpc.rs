@@ -58,6 +58,8 @@ const MAX_DOPPLER_HZ: f64 = 400.0;
 const DELAY_MARGIN_S: f64 = 16e-9;
 /// Sets generated and held at a time.
 const CHUNK_SETS: usize = 64;
+/// Sets pushed to the pipeline together per thread, as `process mpc` does.
+const SETS_PER_THREAD: usize = 4;
 const SEED: u64 = 5;
 
 #[derive(Args)]
@@ -184,8 +186,9 @@ fn gauss(rng: &mut Pcg64) -> f64 {
 /// that (it includes the set checks and statistics, which are small).
 struct Proposed {
     threads: usize,
-    /// The rayon pool of `threads` threads the pipeline's detection runs on.
-    pool: rayon::ThreadPool,
+    /// The rayon pool of `threads` threads the run happens in (installed
+    /// around each chunk of sets, as `--threads` does around a command).
+    pool: Option<rayon::ThreadPool>,
     pipeline: MpcPipeline,
     config: MpcConfig,
     long_term: LongTermTracker,
@@ -197,7 +200,7 @@ struct Proposed {
 impl Proposed {
     fn new(config: &MpcConfig, channel: &Channel, threads: usize) -> anyhow::Result<Self> {
         let pipeline = MpcPipeline::new(config.clone(), &channel.pulse, TAP_SPACING_S, CARRIER_HZ)?;
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+        let pool = Some(rayon::ThreadPoolBuilder::new().num_threads(threads).build()?);
         let long_term = LongTermTracker::new(config.long_term.clone(), CARRIER_HZ, 0)?;
         Ok(Self {
             threads,
@@ -215,28 +218,32 @@ impl Proposed {
         self.total_s - self.track_s
     }
 
-    /// Processes one set; returns its detections per snapshot.
-    fn push_set(&mut self, set: &[CirSnapshot]) -> anyhow::Result<Vec<Vec<MpcDetection>>> {
+    /// Processes consecutive sets together, as `process mpc` does (four per
+    /// thread); returns each set's detections per snapshot.
+    fn push_sets(&mut self, sets: &[Vec<CirSnapshot>]) -> anyhow::Result<Vec<Vec<Vec<MpcDetection>>>> {
         let started = Instant::now();
-        let pipeline = &mut self.pipeline;
-        let output = self.pool.install(|| pipeline.push_set(set))?;
+        let outputs = self.pipeline.push_sets(sets)?;
         self.total_s += started.elapsed().as_secs_f64();
-        let found: Vec<Vec<MpcDetection>> = output.per_snapshot.into_iter().map(|s| s.detections).collect();
-        self.detections += found.iter().map(Vec::len).sum::<usize>();
+        let mut all_found = Vec::with_capacity(sets.len());
+        for (set, output) in sets.iter().zip(outputs) {
+            let found: Vec<Vec<MpcDetection>> = output.per_snapshot.into_iter().map(|s| s.detections).collect();
+            self.detections += found.iter().map(Vec::len).sum::<usize>();
 
-        let started = Instant::now();
-        let tracks = short_term_tracks(&found, CARRIER_HZ, &self.config.short_term, 0);
-        let full_lifetime: Vec<MpcTrack> = tracks.into_iter().filter(|t| is_full_lifetime(t, set.len())).collect();
-        let entries = self.long_term.push_set(&full_lifetime);
-        self.track_s += started.elapsed().as_secs_f64();
-        anyhow::ensure!(
-            entries.len() == output.long_term_entries.len(),
-            "set {}: the re-timed tracking gave {} long-term entries, the pipeline {}",
-            set.first().map_or(0, |s| s.set_index),
-            entries.len(),
-            output.long_term_entries.len()
-        );
-        Ok(found)
+            let started = Instant::now();
+            let tracks = short_term_tracks(&found, CARRIER_HZ, &self.config.short_term, 0);
+            let full_lifetime: Vec<MpcTrack> = tracks.into_iter().filter(|t| is_full_lifetime(t, set.len())).collect();
+            let entries = self.long_term.push_set(&full_lifetime);
+            self.track_s += started.elapsed().as_secs_f64();
+            anyhow::ensure!(
+                entries.len() == output.long_term_entries.len(),
+                "set {}: the re-timed tracking gave {} long-term entries, the pipeline {}",
+                set.first().map_or(0, |s| s.set_index),
+                entries.len(),
+                output.long_term_entries.len()
+            );
+            all_found.push(found);
+        }
+        Ok(all_found)
     }
 }
 
@@ -317,12 +324,24 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
             fft.run(set);
         }
         for (p, run) in proposed.iter_mut().enumerate() {
-            for set in &sets {
-                let found = run.push_set(set).with_context(|| format!("set {}", set[0].set_index))?;
-                if p == 0 {
-                    gmphd_s += time_gmphd(set, found, &gmphd_config)?;
+            // The chunk runs on a thread of the run's pool, so detection's
+            // parallel loop starts inside the pool rather than handing each
+            // set over from this thread.
+            let pool = run.pool.take().context("internal: the run's pool")?;
+            let batch = SETS_PER_THREAD * run.threads;
+            let chunk = pool.install(|| -> anyhow::Result<()> {
+                for batch in sets.chunks(batch) {
+                    let found = run.push_sets(batch).with_context(|| format!("sets from {}", batch[0][0].set_index))?;
+                    if p == 0 {
+                        for (set, found) in batch.iter().zip(found) {
+                            gmphd_s += time_gmphd(set, found, &gmphd_config)?;
+                        }
+                    }
                 }
-            }
+                Ok(())
+            });
+            run.pool = Some(pool);
+            chunk?;
         }
     }
     Ok(Measured {

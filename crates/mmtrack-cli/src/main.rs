@@ -135,7 +135,10 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match run(cli) {
+    // Every command runs on a thread of a rayon pool of the default size
+    // (RAYON_NUM_THREADS, else one per core); `--threads N` gives a command
+    // a pool of its own.
+    match threads::ThreadsArg::default().install(|| run(cli)).and_then(|result| result) {
         Ok(code) => code,
         Err(error) => {
             eprintln!("error: {error:#}");

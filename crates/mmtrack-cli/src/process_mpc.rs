@@ -109,11 +109,18 @@ fn merge_tables(base: &mut toml::Table, changes: toml::Table) {
     }
 }
 
+/// Complete sets handed to the pipeline together, per thread of the pool:
+/// one set (six snapshots) is too little work to share between threads.
+const SETS_PER_THREAD: usize = 4;
+
 /// What one link accumulates.
 struct LinkRun {
     pipeline: MpcPipeline,
     current_set: Option<u64>,
+    /// Snapshots of the set being read.
     pending: Vec<CirSnapshot>,
+    /// Complete sets not yet processed.
+    complete: Vec<Vec<CirSnapshot>>,
     detections: Vec<MpcDetection>,
     tracks: Vec<MpcTrack>,
     gmphd_tracks: Vec<MpcTrack>,
@@ -122,22 +129,29 @@ struct LinkRun {
 }
 
 impl LinkRun {
-    fn flush(&mut self) -> anyhow::Result<()> {
-        if self.pending.is_empty() {
+    /// Ends the set being read; processes the complete sets once there are
+    /// enough of them, or all of them with `all`.
+    fn end_set(&mut self, all: bool) -> anyhow::Result<()> {
+        if !self.pending.is_empty() {
+            self.complete.push(std::mem::take(&mut self.pending));
+        }
+        if self.complete.is_empty() || (!all && self.complete.len() < SETS_PER_THREAD * rayon::current_num_threads()) {
             return Ok(());
         }
-        let set = self.pending[0].set_index;
-        let out = self.pipeline.push_set(&self.pending).with_context(|| format!("set {set}"))?;
-        for snapshot in out.per_snapshot {
-            self.detections.extend(snapshot.detections);
+        let (first, last) = (self.complete[0][0].set_index, self.complete[self.complete.len() - 1][0].set_index);
+        let outputs = self.pipeline.push_sets(&self.complete).with_context(|| format!("sets {first}..={last}"))?;
+        for out in outputs {
+            for snapshot in out.per_snapshot {
+                self.detections.extend(snapshot.detections);
+            }
+            self.tracks.extend(out.short_term_tracks);
+            if let Some(tracks) = out.gmphd_tracks {
+                self.gmphd_tracks.extend(tracks);
+            }
+            self.long_term.extend(out.long_term_entries);
+            self.sets.push(out.stats);
         }
-        self.tracks.extend(out.short_term_tracks);
-        if let Some(tracks) = out.gmphd_tracks {
-            self.gmphd_tracks.extend(tracks);
-        }
-        self.long_term.extend(out.long_term_entries);
-        self.sets.push(out.stats);
-        self.pending.clear();
+        self.complete.clear();
         Ok(())
     }
 }
@@ -248,6 +262,7 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
                             pipeline,
                             current_set: None,
                             pending: Vec::new(),
+                            complete: Vec::new(),
                             detections: Vec::new(),
                             tracks: Vec::new(),
                             gmphd_tracks: Vec::new(),
@@ -266,7 +281,8 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
                     ),
                     Some(set) if snapshot.set_index == set => {}
                     _ => {
-                        link.flush().with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
+                        link.end_set(false)
+                            .with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
                         link.current_set = Some(snapshot.set_index);
                     }
                 }
@@ -279,7 +295,7 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
         }
     }
     for (key, link) in &mut run.links {
-        link.flush().with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
+        link.end_set(true).with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
     }
     bar.finish_and_clear();
     run.sequence_id = reader

@@ -123,42 +123,107 @@ impl MpcPipeline {
     }
 
     /// Processes one set: its snapshots in time order (one TX/RX link).
+    /// The same as [`MpcPipeline::push_sets`] with one set.
+    ///
+    /// # Errors
+    /// As [`MpcPipeline::push_sets`].
+    pub fn push_set(&mut self, snapshots: &[CirSnapshot]) -> Result<SetOutput, MpcError> {
+        let mut outputs = self.push_sets(std::slice::from_ref(&snapshots))?;
+        outputs.pop().ok_or(MpcError::EmptySet { snapshots_before: self.snapshots_seen })
+    }
+
+    /// Processes consecutive sets, each its snapshots in time order (one
+    /// TX/RX link), with the same output as pushing them one by one: the
+    /// snapshots of all the sets are detected in one parallel loop on the
+    /// current rayon pool (and the GM-PHD baseline, a fresh filter per set,
+    /// runs on the sets in parallel), then tracking runs set by set. A few
+    /// sets at a time keep both cores busy where one set of six snapshots
+    /// is too little work to share.
     ///
     /// # Errors
     /// [`MpcError::EmptySet`]; [`MpcError::NonMonotonicTime`] when a
-    /// snapshot is not after the previous one (within the set or across
+    /// snapshot is not after the previous one (within a set or across
     /// sets); [`MpcError::BadSnapshot`] for a snapshot of another set, link
     /// or carrier, or one the detector refuses; [`MpcError::GmPhd`] if the
-    /// baseline fails. Snapshot positions in errors count every snapshot
-    /// pushed so far, from 0. After an error the pipeline is unchanged.
-    pub fn push_set(&mut self, snapshots: &[CirSnapshot]) -> Result<SetOutput, MpcError> {
-        self.check_set(snapshots)?;
-        let per_snapshot = self.detect_all(snapshots)?;
-        let detections: Vec<Vec<_>> = per_snapshot.iter().map(|s| s.detections.clone()).collect();
-        let gmphd_tracks = if self.config.run_gmphd { Some(self.gmphd(snapshots, &detections)?) } else { None };
+    /// baseline fails. The first error in snapshot order is returned;
+    /// snapshot positions in errors count every snapshot pushed so far, from
+    /// 0. After an error the pipeline is unchanged (no set of the call is
+    /// taken).
+    pub fn push_sets<S: AsRef<[CirSnapshot]> + Sync>(&mut self, sets: &[S]) -> Result<Vec<SetOutput>, MpcError> {
+        // Checks in order; sets after a failing one are not processed.
+        let (mut seen, mut last_t_ns) = (self.snapshots_seen, self.last_t_ns);
+        let mut firsts = Vec::with_capacity(sets.len());
+        let mut check = Ok(());
+        for set in sets {
+            let snapshots = set.as_ref();
+            check = self.check_set(snapshots, seen, last_t_ns);
+            if check.is_err() {
+                break;
+            }
+            firsts.push(seen);
+            seen += snapshots.len();
+            last_t_ns = snapshots.last().map(|s| s.t_ns);
+        }
+        let checked = &sets[..firsts.len()];
+        let detected = self.detect_all(checked, &firsts);
+        let gmphd: Vec<Option<Result<Vec<MpcTrack>, MpcError>>> = checked
+            .par_iter()
+            .zip(&detected)
+            .map(|(set, found)| match found {
+                Ok(found) if self.config.run_gmphd => Some(self.gmphd(set.as_ref(), found)),
+                _ => None,
+            })
+            .collect();
+        // The first error in set order (within a set: detection, then GM-PHD),
+        // then a failed check after the good sets.
+        let mut done = Vec::with_capacity(checked.len());
+        for (found, gmphd_tracks) in detected.into_iter().zip(gmphd) {
+            done.push((found?, gmphd_tracks.transpose()?));
+        }
+        check?;
+        // Nothing below fails: the pipeline changes only now.
+        Ok(checked
+            .iter()
+            .zip(done)
+            .map(|(set, (per_snapshot, gmphd_tracks))| self.track_set(set.as_ref(), per_snapshot, gmphd_tracks))
+            .collect())
+    }
 
+    /// Steps 3-6 of the module docs for one detected set; advances the
+    /// counters.
+    fn track_set(
+        &mut self,
+        snapshots: &[CirSnapshot],
+        per_snapshot: Vec<SnapshotDetections>,
+        mut gmphd_tracks: Option<Vec<MpcTrack>>,
+    ) -> SetOutput {
+        let detections: Vec<Vec<_>> = per_snapshot.iter().map(|s| s.detections.clone()).collect();
         let short_term_tracks =
             short_term_tracks(&detections, self.carrier_hz, &self.config.short_term, self.next_short_id);
         self.next_short_id += short_term_tracks.len() as u64;
         let full_lifetime: Vec<MpcTrack> =
             short_term_tracks.iter().filter(|t| is_full_lifetime(t, snapshots.len())).cloned().collect();
         let long_term_entries = self.long_term.push_set(&full_lifetime);
-        if let Some(tracks) = &gmphd_tracks {
+        if let Some(tracks) = &mut gmphd_tracks {
+            for (k, track) in tracks.iter_mut().enumerate() {
+                track.track_id = self.next_gmphd_id + k as u64;
+            }
             self.next_gmphd_id += tracks.len() as u64;
         }
         self.snapshots_seen += snapshots.len();
         self.last_t_ns = snapshots.last().map(|s| s.t_ns);
 
         let stats = self.stats(snapshots, &per_snapshot, &short_term_tracks, &full_lifetime, gmphd_tracks.as_deref());
-        Ok(SetOutput { per_snapshot, short_term_tracks, gmphd_tracks, long_term_entries, stats })
+        SetOutput { per_snapshot, short_term_tracks, gmphd_tracks, long_term_entries, stats }
     }
 
-    /// Step 1 of the module docs; changes nothing.
-    fn check_set(&self, snapshots: &[CirSnapshot]) -> Result<(), MpcError> {
-        let first = snapshots.first().ok_or(MpcError::EmptySet { snapshots_before: self.snapshots_seen })?;
-        let mut previous_t_ns = self.last_t_ns;
+    /// Step 1 of the module docs for a set after `seen` snapshots, the last
+    /// at `last_t_ns`; changes nothing.
+    fn check_set(&self, snapshots: &[CirSnapshot], seen: usize, last_t_ns: Option<i64>) -> Result<(), MpcError> {
+        let first = snapshots.first().ok_or(MpcError::EmptySet { snapshots_before: seen })?;
+        let mut previous_t_ns = last_t_ns;
         for (position, snapshot) in snapshots.iter().enumerate() {
-            let index = self.snapshots_seen + position;
+            let index = seen + position;
             if let Some(previous_t_ns) = previous_t_ns
                 && snapshot.t_ns <= previous_t_ns
             {
@@ -191,32 +256,35 @@ impl MpcPipeline {
         Ok(())
     }
 
-    /// Detection of every snapshot on the current rayon pool, in snapshot
-    /// order; the first error in snapshot order.
-    fn detect_all(&self, snapshots: &[CirSnapshot]) -> Result<Vec<SnapshotDetections>, MpcError> {
-        let results: Vec<Result<SnapshotDetections, MpcError>> = snapshots
-            .par_iter()
-            .enumerate()
-            .map(|(k, snapshot)| self.detector.detect(snapshot, self.snapshots_seen + k))
+    /// Detection of every snapshot of `sets` on the current rayon pool, in
+    /// one parallel loop; per set, the detections in snapshot order or the
+    /// first error in snapshot order. `firsts`: each set's first snapshot
+    /// position.
+    fn detect_all<S: AsRef<[CirSnapshot]> + Sync>(
+        &self,
+        sets: &[S],
+        firsts: &[usize],
+    ) -> Vec<Result<Vec<SnapshotDetections>, MpcError>> {
+        let snapshots: Vec<(usize, &CirSnapshot)> = sets
+            .iter()
+            .zip(firsts)
+            .flat_map(|(set, &first)| set.as_ref().iter().enumerate().map(move |(k, s)| (first + k, s)))
             .collect();
-        results.into_iter().collect()
+        let mut results = snapshots
+            .par_iter()
+            .map(|&(index, snapshot)| self.detector.detect(snapshot, index))
+            .collect::<Vec<Result<SnapshotDetections, MpcError>>>()
+            .into_iter();
+        sets.iter().map(|set| results.by_ref().take(set.as_ref().len()).collect()).collect()
     }
 
-    /// The GM-PHD baseline on the set's detections, renumbered from
-    /// `next_gmphd_id` (the counter is advanced by the caller on success).
-    fn gmphd(
-        &self,
-        snapshots: &[CirSnapshot],
-        detections: &[Vec<mmtrack_core::MpcDetection>],
-    ) -> Result<Vec<MpcTrack>, MpcError> {
+    /// The GM-PHD baseline on one set's detections, a fresh filter, ids
+    /// from 0 (renumbered by [`MpcPipeline::track_set`]).
+    fn gmphd(&self, snapshots: &[CirSnapshot], found: &[SnapshotDetections]) -> Result<Vec<MpcTrack>, MpcError> {
         let input: Vec<GmPhdSnapshot> =
-            snapshots.iter().zip(detections).map(|(s, d)| GmPhdSnapshot::of(s, d.clone())).collect();
+            snapshots.iter().zip(found).map(|(s, d)| GmPhdSnapshot::of(s, d.detections.clone())).collect();
         let config: &GmPhdConfig = &self.config.gmphd;
-        let mut tracks = track_gmphd(&input, config).map_err(|source| MpcError::GmPhd { source })?;
-        for (k, track) in tracks.iter_mut().enumerate() {
-            track.track_id = self.next_gmphd_id + k as u64;
-        }
-        Ok(tracks)
+        track_gmphd(&input, config).map_err(|source| MpcError::GmPhd { source })
     }
 
     fn stats(

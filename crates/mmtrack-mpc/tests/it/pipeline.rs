@@ -184,6 +184,33 @@ fn output_is_identical_for_any_thread_count() {
 }
 
 #[test]
+fn pushing_sets_together_gives_what_pushing_them_one_by_one_gives() {
+    let all = sets(5, 23);
+    let config = MpcConfig { run_gmphd: true, ..MpcConfig::default() };
+    let mut one_by_one = pipeline(config.clone());
+    let expected: Vec<SetOutput> = all.iter().map(|s| one_by_one.push_set(s).unwrap()).collect();
+    for threads in [1, 2, 3] {
+        let mut together = pipeline(config.clone());
+        let mut got = in_pool(threads, || together.push_sets(&all[..2]).unwrap());
+        got.extend(in_pool(threads, || together.push_sets(&all[2..]).unwrap()));
+        assert_eq!(got, expected, "threads = {threads}");
+    }
+
+    // The first error in snapshot order, and nothing of the call is taken:
+    // set 1 has a bad snapshot, set 2 goes back in time.
+    let mut bad = all.clone();
+    bad[1][4].taps[7] = Complex64::new(f64::NAN, 0.0);
+    bad[2][0].t_ns = bad[0][0].t_ns;
+    let mut pipeline = pipeline(config);
+    let err = pipeline.push_sets(&bad).unwrap_err();
+    assert!(matches!(err, MpcError::BadSnapshot { snapshot: 10, set_index: 1, .. }), "{err}");
+    bad[1] = all[1].clone();
+    let err = pipeline.push_sets(&bad).unwrap_err();
+    assert!(matches!(err, MpcError::NonMonotonicTime { snapshot: 12, .. }), "{err}");
+    assert_eq!(pipeline.push_sets(&all).unwrap(), expected, "the failed calls took nothing");
+}
+
+#[test]
 fn bad_snapshots_name_the_first_in_order_for_any_thread_count() {
     let all = sets(1, 3);
     let mut bad = all[0].clone();
