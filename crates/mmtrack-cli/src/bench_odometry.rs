@@ -113,7 +113,7 @@ pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 fn markdown(args: &OdometryBenchArgs, decode_per_s: f64, results: &[PresetResult]) -> String {
     let mut out = format!(
         "`mmtrack bench odometry`: the {} real Oxford scans (400 x 3768) of `{}` in a recording, {} passes per \
-         preset, each a fresh pipeline; scans are decoded on the rayon pool ({} threads) in batches beside the odometry. Baseline in \
+         preset, each a fresh pipeline; scans are decoded on the rayon pool ({} threads), a few ahead of the odometry. Baseline in \
          the same run: reading and decoding alone, {decode_per_s:.0} scans/s.\n\n\
          | preset | scans | end-to-end scans/s | / decode-only | filter ms | surface points ms | registration ms | \
          target >= {ODOMETRY_TARGET_SCANS_PER_S} scans/s |\n|---|---|---|---|---|---|---|---|\n",

@@ -163,14 +163,14 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> an
     Ok(OdometryRun { estimates, timings, ground_truth, sequence_id, elapsed_s: started.elapsed().as_secs_f64() })
 }
 
-/// Scans decoded per thread of the pool while the previous batch is processed.
+/// Scans decoded ahead of `f`, per thread of the pool.
 const SCANS_PER_THREAD: usize = 2;
 
 /// Calls `f` with every event of the recording in file order (and the bytes
-/// read so far). Radar scans are decoded on the current rayon pool in batches
-/// while `f` takes the previous batch ([`mmtrack_core::parallel::map_in_order`]),
-/// so reading, PNG inflating and `f` overlap, order is kept and at most two
-/// batches are in memory. Reading stops at the first bad record. Returns the
+/// read so far). Radar scans are decoded on the current rayon pool, a few per
+/// thread ahead of `f` ([`mmtrack_core::parallel::map_in_order`]), so
+/// reading, PNG inflating and `f` overlap, order is kept and memory holds a
+/// bounded number of scans. Reading stops at the first bad record. Returns the
 /// recording metadata.
 pub fn for_each_event(
     recording: &Path,

@@ -7,22 +7,25 @@
 //! (`ThreadPool::install`), else rayon's global pool (`RAYON_NUM_THREADS`, or
 //! one thread per core).
 
-use rayon::prelude::*;
+use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
 /// Maps `items` on the current rayon pool and passes the results to
-/// `consume` in input order, one batch (`per_thread` items for each thread of
-/// the pool) while the next batch is mapped, so a sequential consumer
-/// overlaps the parallel map.
+/// `consume` in input order, keeping up to `per_thread` items per pool thread
+/// in flight ahead of the consumer, so a sequential consumer overlaps the
+/// parallel map without a barrier between batches.
 ///
-/// At most two batches are held at once (the one being consumed and the one
-/// being mapped), so memory does not grow with the number of items. `items`
-/// is pulled from one thread at a time. The first error of `consume` stops
-/// the work and is returned; items after it are not consumed (at most one
-/// more batch has been mapped). Because `consume` sees the results in order
-/// and the map is per item, the outcome does not depend on the thread count.
+/// Each item is mapped by its own task ([`rayon::scope_fifo`]); the consumer
+/// takes the results in input order and, while the next one is not ready,
+/// runs pending map tasks itself (`rayon::yield_now`) or sleeps until it is.
+/// At most `per_thread * threads` results wait at once, so memory does not
+/// grow with the number of items. `items` is pulled on the consumer's thread.
+/// The first error of `consume` stops the work and is returned; items after
+/// it are not consumed (the tasks already started finish first). Because
+/// `consume` sees the results in order and the map is per item, the outcome
+/// does not depend on the thread count. A panic in `map` is re-raised.
 ///
-/// `consume` must be `Send`: it runs on a pool thread (with
-/// [`rayon::join`]), not necessarily the caller's.
+/// `consume` must be `Send`: it runs on a pool thread, not necessarily the
+/// caller's.
 ///
 /// # Errors
 /// The first error returned by `consume`.
@@ -38,19 +41,76 @@ where
     U: Send,
     E: Send,
 {
-    let batch_len = per_thread.max(1) * rayon::current_num_threads();
+    let window = per_thread.max(1) * rayon::current_num_threads();
+    let slots: Vec<Slot<U>> = (0..window).map(|_| Slot::default()).collect();
+    let (map, slots) = (&map, &slots);
     let mut items = items;
-    let mut map_next = || -> Vec<U> {
-        let batch: Vec<I::Item> = items.by_ref().take(batch_len).collect();
-        batch.into_par_iter().map(&map).collect()
-    };
-    let mut ready = map_next();
-    while !ready.is_empty() {
-        let (next, consumed) = rayon::join(&mut map_next, || ready.into_iter().try_for_each(&mut consume));
-        consumed?;
-        ready = next;
+    rayon::scope_fifo(move |scope| {
+        let spawn = |index: usize, item: I::Item| {
+            let slot = &slots[index % window];
+            scope.spawn_fifo(move |_| {
+                let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| map(item)));
+                slot.fill(outcome);
+            });
+        };
+        let mut spawned = 0;
+        for item in items.by_ref().take(window) {
+            spawn(spawned, item);
+            spawned += 1;
+        }
+        for next in 0.. {
+            if next == spawned {
+                return Ok(());
+            }
+            consume(slots[next % window].take())?;
+            if let Some(item) = items.next() {
+                spawn(spawned, item);
+                spawned += 1;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// Where a map task leaves its result for the consumer.
+struct Slot<U> {
+    value: Mutex<Option<std::thread::Result<U>>>,
+    filled: Condvar,
+}
+
+impl<U> Default for Slot<U> {
+    fn default() -> Self {
+        Self { value: Mutex::new(None), filled: Condvar::new() }
     }
-    Ok(())
+}
+
+impl<U> Slot<U> {
+    fn lock(&self) -> MutexGuard<'_, Option<std::thread::Result<U>>> {
+        self.value.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    fn fill(&self, outcome: std::thread::Result<U>) {
+        *self.lock() = Some(outcome);
+        self.filled.notify_all();
+    }
+
+    /// The result, once its task has run: meanwhile this thread runs other
+    /// pending tasks, or sleeps when there are none (the task is running on
+    /// another thread).
+    fn take(&self) -> U {
+        loop {
+            if let Some(outcome) = self.lock().take() {
+                return outcome.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+            }
+            if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                let guard = self.lock();
+                if guard.is_none() {
+                    // Filled under the lock, so no notification is lost.
+                    drop(self.filled.wait(guard).unwrap_or_else(PoisonError::into_inner));
+                }
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -122,5 +182,17 @@ mod tests {
         )
         .unwrap();
         assert_eq!(calls, 0);
+    }
+
+    #[test]
+    fn a_panic_in_map_reaches_the_caller() {
+        for threads in [1, 2] {
+            let outcome = std::panic::catch_unwind(|| {
+                pool(threads).install(|| {
+                    map_in_order(0..20u32, 2, |i| if i == 5 { panic!("map of {i}") } else { i }, |_| Ok::<(), ()>(()))
+                })
+            });
+            assert!(outcome.is_err(), "threads {threads}");
+        }
     }
 }

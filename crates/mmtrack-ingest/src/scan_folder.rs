@@ -83,15 +83,15 @@ pub fn folder_name(root: &Path) -> String {
         .unwrap_or_else(|| "sequence".into())
 }
 
-/// Scans decoded per thread of the pool in one batch.
+/// Scans decoded ahead of the writer, per thread of the pool.
 const DECODED_PER_THREAD: usize = 2;
 
 /// Reads and decodes the scans on the current rayon pool and hands them to
 /// `write` in file order.
 ///
-/// Decoding runs in batches of [`DECODED_PER_THREAD`] scans per thread while
-/// `write` takes the previous batch ([`mmtrack_core::parallel::map_in_order`]),
-/// so at most `2 * DECODED_PER_THREAD * threads` scans are in memory whatever
+/// Up to [`DECODED_PER_THREAD`] scans per thread are decoded ahead while
+/// `write` takes them in order ([`mmtrack_core::parallel::map_in_order`]), so
+/// at most `DECODED_PER_THREAD * threads` decoded scans are in memory whatever
 /// the folder size, and the output is the same for any thread count. PNG
 /// decoding (inflate and unfilter, needed to reach the row headers) is most of
 /// an ingest's time.
