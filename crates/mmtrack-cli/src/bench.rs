@@ -91,6 +91,29 @@ fn oxford_size_scans(count: usize) -> anyhow::Result<Vec<PolarScan>> {
     Ok(RadarSimulator::new(&world, &sensor, &trajectory, options)?.map(|(scan, _)| scan).collect())
 }
 
+/// An Oxford folder of `count` Oxford-size scans (400 x 3768) of a simulated
+/// drive through a generated street, written by `mmtrack simulate radar` in a
+/// child process (scenario file in `scratch`).
+fn simulated_oxford_folder(folder: &Path, count: usize, scratch: &Path) -> anyhow::Result<()> {
+    let scenario = scratch.join("bench-scenario.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "seed = 1\nstart_t_ns = 1_547_131_046_353_776_000\nmax_scans = {count}\n[motion]\nspeed_mps = 10.0\n\
+             yaw_rate_radps = 0.02\nduration_s = {}\n[generator]\n",
+            count as f64 * 0.25 + 1.0
+        ),
+    )?;
+    let status = std::process::Command::new(std::env::current_exe()?)
+        .args(["simulate", "radar", "--format", "oxford", "--quiet", "--force", "--scenario"])
+        .arg(&scenario)
+        .arg("-o")
+        .arg(folder)
+        .status()?;
+    anyhow::ensure!(status.success(), "{}: simulating the bench scans failed", folder.display());
+    Ok(())
+}
+
 fn best_of(repeats: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<Duration> {
     let mut best = Duration::MAX;
     for _ in 0..repeats.max(1) {
@@ -295,7 +318,6 @@ fn ingest(args: &IngestBench<'_>, quiet: bool) -> anyhow::Result<ExitCode> {
         Some(d) => tempfile::tempdir_in(d)?,
         None => tempfile::tempdir()?,
     };
-    let layout = mmtrack_ingest::oxford::OXFORD;
     let small_scans = (args.scans / 4).max(1);
     let (large, small) = (temp.path().join("large"), temp.path().join("small"));
     let source = match args.from {
@@ -305,9 +327,11 @@ fn ingest(args: &IngestBench<'_>, quiet: bool) -> anyhow::Result<ExitCode> {
             format!("real PNG bytes of {} repeated", real.display())
         }
         None => {
-            let scans = oxford_size_scans(args.scans)?;
-            mmtrack_ingest::oxford::write_oxford_folder(&large, &scans, &[], &layout)?;
-            mmtrack_ingest::oxford::write_oxford_folder(&small, &scans[..small_scans], &[], &layout)?;
+            // In child processes: scans rendered here would leave their freed
+            // memory with this process's allocator and hide the ingest's
+            // own peak.
+            simulated_oxford_folder(&large, args.scans, temp.path())?;
+            simulated_oxford_folder(&small, small_scans, temp.path())?;
             "simulated scans of the radar simulator in a generated street".to_string()
         }
     };
