@@ -74,11 +74,6 @@ fn write_pair(root: &Path, sequence: &str, estimate: &[OdometryEstimate], truth:
     }
 }
 
-fn python3() -> Option<&'static str> {
-    let ok = Command::new("python3").args(["-c", "import numpy"]).output().is_ok_and(|o| o.status.success());
-    ok.then_some("python3")
-}
-
 fn relative_diff(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(f64::MIN_POSITIVE)
 }
@@ -126,8 +121,8 @@ fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
     assert_eq!(times.lines().count(), estimate.len() - 1);
     assert!(times.starts_with("0.000000000\n"), "{}", &times[..40]);
 
-    let Some(python) = python3() else {
-        eprintln!("skipped: independent KITTI devkit check: python3 with numpy not available");
+    let Some(python) = super::common::venv_python() else {
+        eprintln!("skipped: independent KITTI devkit check: no Python venv (python3 or PyPI unavailable)");
         return;
     };
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/kitti_devkit.py");

@@ -49,3 +49,39 @@ pub fn files(dir: &Path) -> Vec<PathBuf> {
     out.sort();
     out
 }
+
+/// PyPI packages of the independent readers and writers, pinned.
+const REQUIREMENTS: &str =
+    "mcap==1.6.0 mcap-protobuf-support==0.6.0 protobuf==7.36.2 pyarrow==26.0.1 duckdb==2.0.0 numpy==2.4.6";
+
+/// A Python with [`REQUIREMENTS`], in a venv under the target directory
+/// (`$MMTRACK_PY_VENV` to put it elsewhere), made on first use; `None`
+/// where Python or PyPI is unavailable.
+pub fn venv_python() -> Option<PathBuf> {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"));
+    let venv = std::env::var_os("MMTRACK_PY_VENV").map(PathBuf::from).unwrap_or_else(|| target.join("py-venv"));
+    let python = venv.join("bin/python");
+    let stamp = venv.join("requirements.txt");
+    // Tests run in parallel: one makes the venv, the others wait for it.
+    static MADE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _made = MADE.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    if std::fs::read_to_string(&stamp).ok().as_deref() == Some(REQUIREMENTS) && python.is_file() {
+        return Some(python);
+    }
+    let system = ["python3", "python"]
+        .into_iter()
+        .find(|p| Command::new(p).arg("--version").output().is_ok_and(|o| o.status.success()))?;
+    let ok = Command::new(system).args(["-m", "venv"]).arg(&venv).status().is_ok_and(|s| s.success())
+        && Command::new(&python)
+            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
+            .args(REQUIREMENTS.split(' '))
+            .status()
+            .is_ok_and(|s| s.success());
+    if !ok {
+        return None;
+    }
+    std::fs::write(&stamp, REQUIREMENTS).ok()?;
+    Some(python)
+}

@@ -2,10 +2,11 @@
 //! decoding from the embedded descriptors), pyarrow and duckdb check counts,
 //! schema names, values and units metadata. The script lives in
 //! `tests/python/`; its packages are installed from PyPI into a venv under
-//! the target directory. Skips with a visible line where Python or PyPI is
-//! unavailable.
+//! the target directory. NumPy, as an independent writer, makes `.npy` and
+//! `.npz` files that `ingest cir` must read. Skips with a visible line where
+//! Python or PyPI is unavailable.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 use mmtrack_core::{CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTrack, MpcTruth, Se2, StampedPose};
@@ -13,35 +14,7 @@ use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::{Overwrite, RecordingOptions, RecordingWriter};
 
-use super::common::{mmtrack, root};
-
-const REQUIREMENTS: &str = "mcap==1.6.0 mcap-protobuf-support==0.6.0 protobuf==7.36.2 pyarrow==26.0.1 duckdb==2.0.0";
-
-fn venv_python() -> Option<PathBuf> {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"));
-    let venv = std::env::var_os("MMTRACK_PY_VENV").map(PathBuf::from).unwrap_or_else(|| target.join("py-venv"));
-    let python = venv.join("bin/python");
-    let stamp = venv.join("requirements.txt");
-    if std::fs::read_to_string(&stamp).ok().as_deref() == Some(REQUIREMENTS) && python.is_file() {
-        return Some(python);
-    }
-    let system = ["python3", "python"]
-        .into_iter()
-        .find(|p| Command::new(p).arg("--version").output().is_ok_and(|o| o.status.success()))?;
-    let ok = Command::new(system).args(["-m", "venv"]).arg(&venv).status().is_ok_and(|s| s.success())
-        && Command::new(&python)
-            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
-            .args(REQUIREMENTS.split(' '))
-            .status()
-            .is_ok_and(|s| s.success());
-    if !ok {
-        return None;
-    }
-    std::fs::write(&stamp, REQUIREMENTS).ok()?;
-    Some(python)
-}
+use super::common::{mmtrack, root, text, venv_python};
 
 /// A recording and tables holding every canonical type.
 fn write_samples(dir: &Path) {
@@ -133,4 +106,78 @@ fn python_mcap_pyarrow_and_duckdb_read_our_files() {
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(stdout.contains("all checks passed"), "{stdout}");
+}
+
+/// NumPy itself (an independent writer): `np.save` in Fortran order,
+/// `savez_compressed` (deflate, ZIP64 local headers), complex64 and float32
+/// I/Q, read by `mmtrack ingest cir` into the same CIRs; a float64 member is
+/// refused by name and dtype.
+#[test]
+fn numpy_written_files_are_ingested_value_for_value() {
+    let Some(python) = venv_python() else {
+        eprintln!("skipped: NumPy conformance: no Python venv (python3 or PyPI unavailable)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let script = "import numpy as np, sys\n\
+        d = sys.argv[1]\n\
+        h = (np.arange(24).reshape(2, 3, 4) * (1 - 0.5j)).astype(np.complex64)\n\
+        np.save(d + '/f.npy', np.asfortranarray(h.astype(np.complex128)))\n\
+        iq = np.stack([h.real, h.imag], axis=-1).astype(np.float32)\n\
+        np.savez_compressed(d + '/z.npz', cir=h, iq=iq, other=np.zeros(3))\n";
+    let ran = Command::new(python).arg("-c").arg(script).arg(d).output().unwrap();
+    assert!(ran.status.success(), "{}", String::from_utf8_lossy(&ran.stderr));
+    let sidecar = |variable: &str| {
+        let path = d.join(format!("{variable}.toml"));
+        let variable = if variable == "f" { String::new() } else { format!("variable = \"{variable}\"\n") };
+        std::fs::write(
+            &path,
+            format!("{variable}carrier_hz = 5.7e9\ntap_spacing_s = 1e-9\nsnapshot_period_s = 1e-3\naxes = [\"snapshot\", \"rx\", \"tap\"]\n"),
+        )
+        .unwrap();
+        path
+    };
+    // Element (s, r, k) = (12 s + 4 r + k) (1 - 0.5 j), whatever the storage order.
+    let expected = |s: u64, r: u32, k: usize| {
+        let i = (12 * s + 4 * u64::from(r)) as f64 + k as f64;
+        Complex64::new(i, -0.5 * i)
+    };
+    for (file, format, variable) in [("f.npy", "npy", "f"), ("z.npz", "npz", "cir"), ("z.npz", "npz", "iq")] {
+        let side = sidecar(variable);
+        let out = mmtrack(
+            d,
+            &[
+                "ingest",
+                "cir",
+                file,
+                "--format",
+                format,
+                "--sidecar",
+                side.to_str().unwrap(),
+                "-o",
+                "r.mcap",
+                "-q",
+                "--force",
+            ],
+        );
+        assert!(out.status.success(), "{file} {variable}: {}", text(&out).1);
+        let cirs: Vec<CirSnapshot> = mmtrack_io::RecordingReader::open(&d.join("r.mcap"))
+            .unwrap()
+            .filter_map(|e| match e.unwrap() {
+                mmtrack_io::RecordingEvent::Cir(c) => Some(c),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(cirs.len(), 6, "{file} {variable}: two snapshots of three receive antennas");
+        for c in &cirs {
+            let want: Vec<Complex64> = (0..4).map(|k| expected(c.set_index, c.rx_antenna, k)).collect();
+            assert_eq!(c.taps, want, "{file} {variable}: snapshot {} rx {}", c.set_index, c.rx_antenna);
+        }
+    }
+    let side = sidecar("other");
+    let out =
+        mmtrack(d, &["ingest", "cir", "z.npz", "--format", "npz", "--sidecar", side.to_str().unwrap(), "-o", "o.mcap"]);
+    let stderr = text(&out).1;
+    assert!(!out.status.success() && stderr.contains("other.npy") && stderr.contains("<f8"), "{stderr}");
 }

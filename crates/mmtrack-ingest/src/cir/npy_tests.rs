@@ -136,38 +136,3 @@ fn npz_members() {
         assert!(parse_npz(p, &single[..cut], None).is_err(), "cut {cut}");
     }
 }
-
-/// NumPy itself (an independent writer) when Python with numpy is available:
-/// `savez_compressed` (deflate, ZIP64 local headers), Fortran order, complex64
-/// and float32 I/Q.
-#[test]
-fn numpy_written_files() {
-    let dir = tempfile::tempdir().unwrap();
-    let script = "import numpy as np, sys\n\
-        d = sys.argv[1]\n\
-        h = (np.arange(24).reshape(2, 3, 4) * (1 - 0.5j)).astype(np.complex64)\n\
-        np.save(d + '/f.npy', np.asfortranarray(h.astype(np.complex128)))\n\
-        iq = np.stack([h.real, h.imag], axis=-1).astype(np.float32)\n\
-        np.savez_compressed(d + '/z.npz', cir=h, iq=iq, other=np.zeros(3))\n";
-    let ran = std::process::Command::new("python3").arg("-c").arg(script).arg(dir.path()).output();
-    if !matches!(&ran, Ok(o) if o.status.success()) {
-        eprintln!("skipped: python3 with numpy not available for the NumPy conformance test");
-        return;
-    }
-    let expected = |i: usize| Complex64::new(i as f64, -0.5 * i as f64);
-    let f = parse_npy(Path::new("f.npy"), "array", &std::fs::read(dir.path().join("f.npy")).unwrap()).unwrap();
-    assert_eq!(f.dims, [2, 3, 4]);
-    // Element (1, 2, 3) = 12 + 8 + 3 = 23, whatever the storage order.
-    let at = |a: &NdComplex, i: [usize; 3]| a.values[i.iter().zip(&a.strides).map(|(i, s)| i * s).sum::<usize>()];
-    assert_eq!(at(&f, [1, 2, 3]), expected(23));
-    let npz = std::fs::read(dir.path().join("z.npz")).unwrap();
-    let (_, cir) = parse_npz(Path::new("z.npz"), &npz, Some("cir")).unwrap();
-    let (_, iq) = parse_npz(Path::new("z.npz"), &npz, Some("iq")).unwrap();
-    for a in [&cir, &iq] {
-        assert_eq!(a.dims, [2, 3, 4]);
-        assert_eq!(at(a, [1, 2, 3]), expected(23));
-        assert_eq!(at(a, [0, 1, 2]), expected(6));
-    }
-    let e = parse_npz(Path::new("z.npz"), &npz, Some("other")).unwrap_err().to_string();
-    assert!(e.contains("member `other.npy`") && e.contains("dtype `<f8`"), "{e}");
-}
