@@ -98,10 +98,7 @@ pub fn write_all_results(
     let parent = parent_dir(out);
     std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
     let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "results".into());
-    let staging = tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".partial")
-        .tempdir_in(&parent)
+    let staging = mmtrack_io::staging_dir(&parent, &format!(".{name}."))
         .with_context(|| format!("{}: cannot create a staging directory", parent.display()))?;
     let mut files = write_into(staging.path(), results, skipped, options, run)?;
     files += write_mpc_into(staging.path(), mpc, run)?;

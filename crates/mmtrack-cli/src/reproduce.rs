@@ -217,7 +217,7 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
         _ => PathBuf::from("."),
     };
     std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
-    let staging = tempfile::Builder::new().prefix(".reproduce-odometry.").tempdir_in(&parent)?;
+    let staging = mmtrack_io::staging_dir(&parent, ".reproduce-odometry.")?;
     let tables = staging.path().join("tables");
     let mut results = Vec::new();
     for run in runs {

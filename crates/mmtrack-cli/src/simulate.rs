@@ -140,7 +140,7 @@ pub fn write_oxford_streaming(
     }
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
-    let staging = tempfile::Builder::new().prefix(".simulate-").tempdir_in(parent)?;
+    let staging = mmtrack_io::staging_dir(parent, ".simulate-")?;
     let layout = NavtechLayout {
         range_resolution_m: scenario.sensor.range_resolution_m,
         expected_bins: Some(scenario.sensor.bins),

@@ -52,7 +52,7 @@ impl AtomicFile {
         };
         std::fs::create_dir_all(&dir).map_err(os_err(&dir))?;
         let file_name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let temp = tempfile::Builder::new()
+        let temp = with_default_mode(&mut tempfile::Builder::new(), 0o666)
             .prefix(&format!(".{file_name}."))
             .suffix(".partial")
             .tempfile_in(&dir)
@@ -100,10 +100,60 @@ impl AtomicFile {
     }
 }
 
+/// A staging directory beside an output directory (`parent`), renamed over
+/// it when complete. Created with the mode `create_dir` gives (0777 less the
+/// umask), not the private 0700 of temporary directories, so the published
+/// output is readable as any other.
+///
+/// # Errors
+/// The OS error of creating it.
+pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::TempDir> {
+    with_default_mode(&mut tempfile::Builder::new(), 0o777).prefix(prefix).suffix(".partial").tempdir_in(parent)
+}
+
+/// Asks for `mode` less the umask, as `File::create` (0666) and `create_dir`
+/// (0777) do, instead of tempfile's private 0600/0700: temporary outputs are
+/// renamed into place and keep their mode.
+fn with_default_mode<'b, 'p, 's>(
+    builder: &'b mut tempfile::Builder<'p, 's>,
+    mode: u32,
+) -> &'b mut tempfile::Builder<'p, 's> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(mode))
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = mode;
+        builder
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::io::Write;
+
+    /// Outputs get the mode of any new file or directory (umask applied),
+    /// not the temporary file's 0600 / 0700.
+    #[cfg(unix)]
+    #[test]
+    fn published_outputs_have_the_usual_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        let plain = dir.path().join("plain");
+        std::fs::write(&plain, b"x").unwrap();
+        let target = dir.path().join("out.bin");
+        let f = AtomicFile::create(&target, Overwrite::Refuse).unwrap();
+        f.commit(Overwrite::Refuse, Durability::PageCache).unwrap();
+        assert_eq!(mode(&target), mode(&plain));
+        let plain_dir = dir.path().join("plain-dir");
+        std::fs::create_dir(&plain_dir).unwrap();
+        let staged = staging_dir(dir.path(), ".x.").unwrap();
+        assert_eq!(mode(staged.path()), mode(&plain_dir));
+    }
 
     #[test]
     fn dropped_file_leaves_nothing_and_commit_publishes() {

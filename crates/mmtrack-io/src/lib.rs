@@ -22,7 +22,7 @@ pub mod recording;
 pub mod schema_docs;
 pub mod table;
 
-pub use atomic::{AtomicFile, Durability, Overwrite};
+pub use atomic::{AtomicFile, Durability, Overwrite, staging_dir};
 pub use error::{IoError, Result};
 pub use png_gray::decode_gray8;
 pub use recording::{RecordingEvent, RecordingMetadata, RecordingOptions, RecordingReader, RecordingWriter};
