@@ -99,6 +99,10 @@ def check_tables(root):
     check(kv[b"mmtrack.table"] == b"mpc_tracks", "table name")
     schema = pq.read_schema(file)
     check(schema.field("delay_s").metadata[b"unit"] == b"s", "field unit metadata")
+    # pandas/pyarrow users see the table's metadata on the schema they get.
+    meta = pq.read_table(file).schema.metadata or {}
+    check(json.loads(meta.get(b"units", b"{}")).get("delay_s") == "s", f"schema metadata units: {meta}")
+    check(json.loads(meta.get(b"mmtrack.run_config", b"null")) == {"who": "independent reader test"}, "schema run config")
     check(pq.ParquetFile(file).metadata.row_group(0).column(0).compression == "ZSTD", "zstd")
 
     con = duckdb.connect()

@@ -76,12 +76,16 @@ impl TableWriter {
             KeyValue::new("mmtrack.version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
             KeyValue::new("mmtrack.run_config".to_string(), run.config_json.clone()),
         ];
+        // The same pairs on the Arrow schema, where pyarrow and pandas users
+        // look (`pq.read_table(f).schema.metadata`), and in the file footer.
+        let schema_metadata: std::collections::HashMap<String, String> =
+            metadata.iter().map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default())).collect();
         let level = ZstdLevel::try_new(3).map_err(|e| table_write_err(&path, e))?;
         let props = WriterProperties::builder()
             .set_compression(Compression::ZSTD(level))
             .set_key_value_metadata(Some(metadata))
             .build();
-        let schema = Arc::new(spec.arrow_schema());
+        let schema = Arc::new(spec.arrow_schema().with_metadata(schema_metadata));
         let writer =
             ArrowWriter::try_new(file.writer()?, schema.clone(), Some(props)).map_err(|e| table_write_err(&path, e))?;
         Ok(Self { spec, schema, file, overwrite, writer, rows: 0 })
