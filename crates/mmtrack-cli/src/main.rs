@@ -133,7 +133,23 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// Ends the process quietly when stdout is a pipe whose reader has gone
+/// (`mmtrack inspect x.mcap | head -1`): Rust ignores SIGPIPE, so `println!`
+/// panics on the EPIPE error; every other panic keeps the default report.
+fn exit_quietly_on_a_closed_pipe() {
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload.downcast_ref::<String>().map(String::as_str).or(payload.downcast_ref::<&str>().copied());
+        if message.is_some_and(|m| m.contains("failed printing to stdout") && m.contains("Broken pipe")) {
+            std::process::exit(0);
+        }
+        default_hook(info);
+    }));
+}
+
 fn main() -> ExitCode {
+    exit_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
     // Every command runs on a thread of a rayon pool of the default size
     // (RAYON_NUM_THREADS, else one per core); `--threads N` gives a command

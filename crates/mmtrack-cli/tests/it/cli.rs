@@ -202,3 +202,29 @@ fn poses_are_added_to_an_existing_recording_in_place() {
     assert_eq!(std::fs::read(dir.path().join(rec)).unwrap(), before);
     assert_eq!(files(&dir.path().join("d")).iter().filter(|p| p.to_string_lossy().contains("partial")).count(), 0);
 }
+
+/// `mmtrack inspect ... | head -1`: the reader closes the pipe early; the
+/// command ends quietly instead of panicking on the broken pipe.
+#[test]
+fn a_closed_stdout_pipe_ends_the_command_quietly() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = super::common::root().join("data/sounder/artificial.toml");
+    let out = super::common::mmtrack(
+        dir.path(),
+        &["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "a.mcap", "-q"],
+    );
+    assert!(out.status.success());
+    for _ in 0..3 {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mmtrack"))
+            .args(["inspect", "a.mcap"])
+            .current_dir(dir.path())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success() && !stderr.contains("panicked"), "{:?}: {stderr}", out.status);
+    }
+}
