@@ -189,7 +189,12 @@ mod tests {
         for threads in [1, 2] {
             let outcome = std::panic::catch_unwind(|| {
                 pool(threads).install(|| {
-                    map_in_order(0..20u32, 2, |i| if i == 5 { panic!("map of {i}") } else { i }, |_| Ok::<(), ()>(()))
+                    map_in_order(
+                        0..20u32,
+                        2,
+                        |i| if i == 5 { panic!("deliberate test panic: map of item {i}") } else { i },
+                        |_| Ok::<(), ()>(()),
+                    )
                 })
             });
             assert!(outcome.is_err(), "threads {threads}");
