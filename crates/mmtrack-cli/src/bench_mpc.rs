@@ -58,8 +58,6 @@ const MAX_DOPPLER_HZ: f64 = 400.0;
 const DELAY_MARGIN_S: f64 = 16e-9;
 /// Sets generated and held at a time.
 const CHUNK_SETS: usize = 64;
-/// Sets pushed to the pipeline together per thread, as `process mpc` does.
-const SETS_PER_THREAD: usize = 4;
 const SEED: u64 = 5;
 
 #[derive(Args)]
@@ -186,9 +184,6 @@ fn gauss(rng: &mut Pcg64) -> f64 {
 /// that (it includes the set checks and statistics, which are small).
 struct Proposed {
     threads: usize,
-    /// The rayon pool of `threads` threads the run happens in (installed
-    /// around each chunk of sets, as `--threads` does around a command).
-    pool: Option<rayon::ThreadPool>,
     pipeline: MpcPipeline,
     config: MpcConfig,
     long_term: LongTermTracker,
@@ -200,26 +195,17 @@ struct Proposed {
 impl Proposed {
     fn new(config: &MpcConfig, channel: &Channel, threads: usize) -> anyhow::Result<Self> {
         let pipeline = MpcPipeline::new(config.clone(), &channel.pulse, TAP_SPACING_S, CARRIER_HZ)?;
-        let pool = Some(rayon::ThreadPoolBuilder::new().num_threads(threads).build()?);
         let long_term = LongTermTracker::new(config.long_term.clone(), CARRIER_HZ, 0)?;
-        Ok(Self {
-            threads,
-            pool,
-            pipeline,
-            config: config.clone(),
-            long_term,
-            total_s: 0.0,
-            track_s: 0.0,
-            detections: 0,
-        })
+        Ok(Self { threads, pipeline, config: config.clone(), long_term, total_s: 0.0, track_s: 0.0, detections: 0 })
     }
 
     fn detect_s(&self) -> f64 {
         self.total_s - self.track_s
     }
 
-    /// Processes consecutive sets together, as `process mpc` does (four per
-    /// thread); returns each set's detections per snapshot.
+    /// Processes consecutive sets together, as `process mpc` does
+    /// ([`MpcPipeline::SETS_PER_THREAD`] per thread); returns each set's
+    /// detections per snapshot.
     fn push_sets(&mut self, sets: &[Vec<CirSnapshot>]) -> anyhow::Result<Vec<Vec<Vec<MpcDetection>>>> {
         let started = Instant::now();
         let outputs = self.pipeline.push_sets(sets)?;
@@ -314,6 +300,15 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
     let gmphd_config = GmPhdConfig { carrier_hz: CARRIER_HZ, ..GmPhdConfig::default() };
     let mut proposed =
         args.threads.iter().map(|&t| Proposed::new(&config, &channel, t)).collect::<anyhow::Result<Vec<_>>>()?;
+    // Each run happens in a pool of its thread count, installed around each
+    // chunk of sets as `--threads` is around a command, so detection's
+    // parallel loop starts inside the pool rather than handing every batch
+    // over from this thread.
+    let pools = args
+        .threads
+        .iter()
+        .map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build())
+        .collect::<Result<Vec<_>, _>>()?;
     let mut fft = FftBaseline::new();
     let mut gmphd_s = 0.0;
     let total_sets = args.snapshots.div_ceil(SNAPSHOTS_PER_SET);
@@ -323,13 +318,9 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
         for set in &sets {
             fft.run(set);
         }
-        for (p, run) in proposed.iter_mut().enumerate() {
-            // The chunk runs on a thread of the run's pool, so detection's
-            // parallel loop starts inside the pool rather than handing each
-            // set over from this thread.
-            let pool = run.pool.take().context("internal: the run's pool")?;
-            let batch = SETS_PER_THREAD * run.threads;
-            let chunk = pool.install(|| -> anyhow::Result<()> {
+        for (p, (run, pool)) in proposed.iter_mut().zip(&pools).enumerate() {
+            let batch = MpcPipeline::SETS_PER_THREAD * run.threads;
+            pool.install(|| -> anyhow::Result<()> {
                 for batch in sets.chunks(batch) {
                     let found = run.push_sets(batch).with_context(|| format!("sets from {}", batch[0][0].set_index))?;
                     if p == 0 {
@@ -339,9 +330,7 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
                     }
                 }
                 Ok(())
-            });
-            run.pool = Some(pool);
-            chunk?;
+            })?;
         }
     }
     Ok(Measured {

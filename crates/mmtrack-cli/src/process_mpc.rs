@@ -109,10 +109,6 @@ fn merge_tables(base: &mut toml::Table, changes: toml::Table) {
     }
 }
 
-/// Complete sets handed to the pipeline together, per thread of the pool:
-/// one set (six snapshots) is too little work to share between threads.
-const SETS_PER_THREAD: usize = 4;
-
 /// What one link accumulates.
 struct LinkRun {
     pipeline: MpcPipeline,
@@ -135,7 +131,9 @@ impl LinkRun {
         if !self.pending.is_empty() {
             self.complete.push(std::mem::take(&mut self.pending));
         }
-        if self.complete.is_empty() || (!all && self.complete.len() < SETS_PER_THREAD * rayon::current_num_threads()) {
+        if self.complete.is_empty()
+            || (!all && self.complete.len() < MpcPipeline::SETS_PER_THREAD * rayon::current_num_threads())
+        {
             return Ok(());
         }
         let (first, last) = (self.complete[0][0].set_index, self.complete[self.complete.len() - 1][0].set_index);

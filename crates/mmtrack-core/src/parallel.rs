@@ -58,11 +58,10 @@ where
             spawn(spawned, item);
             spawned += 1;
         }
-        for next in 0.. {
-            if next == spawned {
-                return Ok(());
-            }
+        let mut next = 0;
+        while next < spawned {
             consume(slots[next % window].take())?;
+            next += 1;
             if let Some(item) = items.next() {
                 spawn(spawned, item);
                 spawned += 1;

@@ -132,6 +132,11 @@ impl MpcPipeline {
         outputs.pop().ok_or(MpcError::EmptySet { snapshots_before: self.snapshots_seen })
     }
 
+    /// Sets per thread of the rayon pool worth handing to
+    /// [`MpcPipeline::push_sets`] at once: one set (six snapshots) is too
+    /// little work to share between threads.
+    pub const SETS_PER_THREAD: usize = 4;
+
     /// Processes consecutive sets, each its snapshots in time order (one
     /// TX/RX link), with the same output as pushing them one by one: the
     /// snapshots of all the sets are detected in one parallel loop on the
