@@ -10,6 +10,8 @@
 //! - [`CirSnapshot`]: one channel impulse response with its tap spacing and its
 //!   position in the sounder's set/snapshot structure;
 //! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`], [`MpcTruth`] and [`OdometryEstimate`];
+//! - [`array`]: antenna array responses, beamforming gains, beamwidths and
+//!   beam codebooks;
 //! - [`parallel`]: order-keeping parallel maps on rayon, for every parallel stage;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
@@ -21,6 +23,7 @@
 //! Units are SI and named in identifiers (`range_m`, `delay_s`, `azimuth_rad`);
 //! geodetic latitude/longitude are the one exception and are named `_deg`.
 
+pub mod array;
 mod cir;
 mod error;
 mod gnss;

@@ -147,45 +147,9 @@ impl KalmanUpdater {
     /// [`FilterError::DimensionMismatch`] if the prior's dimension is not the
     /// model's; [`FilterError::NotPositiveDefinite`] if `S` or `P+` is not SPD.
     pub fn prepare(&self, prior: &Gaussian) -> Result<PreparedUpdate, FilterError> {
-        let h = self.model.h();
-        let r = self.model.r();
         ensure_len("prior mean", prior.mean(), self.model.state_dim())?;
-        let p = prior.cov();
-        let n = prior.dim();
-        let hp = h * p;
-        // S = H P H^T + R, written into a copy of R.
-        let mut s = r.clone();
-        matmul(s.as_mut(), Accum::Add, &hp, h.transpose(), 1.0, Par::Seq);
-        let s = symmetrise(s);
-        let s_chol = Cholesky::new("innovation covariance S", &s)?;
-        // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
-        let mut gain_t = hp;
-        s_chol.solve_in_place(gain_t.as_mut());
-        let gain = gain_t.transpose().to_owned();
-        // I - K H, written into I.
-        let mut i_kh = Mat::<f64>::identity(n, n);
-        matmul(i_kh.as_mut(), Accum::Add, &gain, h, -1.0, Par::Seq);
-        let i_kh_p = &i_kh * p;
-        let post = match self.covariance_update {
-            CovarianceUpdate::Joseph => {
-                let mut post = &i_kh_p * i_kh.transpose();
-                matmul(post.as_mut(), Accum::Add, &gain * r, gain.transpose(), 1.0, Par::Seq);
-                post
-            }
-            CovarianceUpdate::Standard => i_kh_p,
-        };
-        // Validate once here (as `Gaussian::new` would) so that `posterior`
-        // only has to check the mean.
-        let posterior_cov = checked_spd("Gaussian covariance", symmetrise(post), n)?;
-        Ok(PreparedUpdate {
-            prior_mean: prior.mean().clone(),
-            predicted_measurement: h * prior.mean(),
-            log_det_s: s_chol.log_det(),
-            s,
-            s_chol,
-            gain,
-            posterior_cov,
-        })
+        let h = self.model.h();
+        prepare_linearised(prior, h * prior.mean(), h, self.model.r(), self.covariance_update)
     }
 
     /// One full update of `prior` with measurement `z`.
@@ -196,6 +160,60 @@ impl KalmanUpdater {
     pub fn update(&self, prior: &Gaussian, z: &Col<f64>) -> Result<Gaussian, FilterError> {
         self.prepare(prior)?.posterior(z)
     }
+}
+
+/// The update quantities of the module docs for a measurement model
+/// linearised at the prior mean: predicted measurement `eta` (`H m` for a
+/// linear model, `h(m)` for an extended Kalman filter) and Jacobian `H`.
+/// Shapes: `H` is `m x n` for an `n`-dimensional prior, `eta` has `m` rows,
+/// `R` is `m x m`; checked here.
+pub(crate) fn prepare_linearised(
+    prior: &Gaussian,
+    predicted_measurement: Col<f64>,
+    h: &Mat<f64>,
+    r: &Mat<f64>,
+    covariance_update: CovarianceUpdate,
+) -> Result<PreparedUpdate, FilterError> {
+    let n = prior.dim();
+    let m = predicted_measurement.nrows();
+    ensure_shape("measurement Jacobian H", h, m, n)?;
+    ensure_shape("measurement covariance R", r, m, m)?;
+    ensure_finite_vector("predicted measurement", &predicted_measurement)?;
+    let p = prior.cov();
+    let hp = h * p;
+    // S = H P H^T + R, written into a copy of R.
+    let mut s = r.clone();
+    matmul(s.as_mut(), Accum::Add, &hp, h.transpose(), 1.0, Par::Seq);
+    let s = symmetrise(s);
+    let s_chol = Cholesky::new("innovation covariance S", &s)?;
+    // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
+    let mut gain_t = hp;
+    s_chol.solve_in_place(gain_t.as_mut());
+    let gain = gain_t.transpose().to_owned();
+    // I - K H, written into I.
+    let mut i_kh = Mat::<f64>::identity(n, n);
+    matmul(i_kh.as_mut(), Accum::Add, &gain, h, -1.0, Par::Seq);
+    let i_kh_p = &i_kh * p;
+    let post = match covariance_update {
+        CovarianceUpdate::Joseph => {
+            let mut post = &i_kh_p * i_kh.transpose();
+            matmul(post.as_mut(), Accum::Add, &gain * r, gain.transpose(), 1.0, Par::Seq);
+            post
+        }
+        CovarianceUpdate::Standard => i_kh_p,
+    };
+    // Validate once here (as `Gaussian::new` would) so that `posterior`
+    // only has to check the mean.
+    let posterior_cov = checked_spd("Gaussian covariance", symmetrise(post), n)?;
+    Ok(PreparedUpdate {
+        prior_mean: prior.mean().clone(),
+        predicted_measurement,
+        log_det_s: s_chol.log_det(),
+        s,
+        s_chol,
+        gain,
+        posterior_cov,
+    })
 }
 
 /// The measurement-independent part of a Kalman update (see the module docs).

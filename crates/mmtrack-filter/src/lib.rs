@@ -15,6 +15,8 @@
 //!   transitions, linear measurements;
 //! - [`kalman`]: the predictor and updater roles, with an explicit
 //!   [`CovarianceUpdate`] (Joseph form by default);
+//! - [`ekf`]: the extended Kalman filter for nonlinear models with analytic
+//!   Jacobians (and a finite-difference check for them);
 //! - [`gating`]: the gate role ([`Gate`]) and the Mahalanobis gate;
 //! - [`assignment`]: Kuhn-Munkres on real costs, with forbidden pairs;
 //! - [`gmphd`]: the labelled GM-PHD filter of Vo & Ma 2006;
@@ -28,6 +30,7 @@
 //! panic.
 
 pub mod assignment;
+pub mod ekf;
 mod error;
 pub mod gating;
 mod gaussian;
@@ -37,6 +40,7 @@ mod linalg;
 pub mod metrics;
 pub mod models;
 
+pub use ekf::{ExtendedKalmanUpdater, NonlinearMeasurement, numerical_jacobian, predict_linearised};
 pub use error::FilterError;
 /// The linear-algebra crate of the public API, so dependants need not pin it.
 pub use faer;

@@ -2,6 +2,7 @@
 
 mod assignment;
 mod bad_input;
+mod ekf;
 mod gmphd;
 mod kalman;
 mod metrics;
