@@ -1,6 +1,9 @@
 //! Comma-separated text with a header line, as the Oxford SDK files use:
 //! columns found by name (order does not matter), required ones checked up
-//! front, and every field error naming the file, the line and the column.
+//! front, and every field error naming the file, the line and the column. A
+//! header without a single data row is an error: every such file (ground
+//! truth, GNSS, INS) is a record of something, and an empty one means a
+//! truncated or mis-exported file, not an empty drive.
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -61,7 +64,8 @@ pub struct CsvTable<'a> {
 }
 
 impl<'a> CsvTable<'a> {
-    /// Splits `text` into header and data lines; fails naming a missing column.
+    /// Splits `text` into header and data lines; fails naming a missing
+    /// column, or when there is no data line after the header.
     pub fn parse(path: &'a Path, text: &'a str, required: &[&str]) -> Result<Self, IngestError> {
         let mut lines = text.lines().enumerate();
         let header = lines.next().map(|(_, l)| l).ok_or_else(|| IngestError::BadLayout {
@@ -77,7 +81,13 @@ impl<'a> CsvTable<'a> {
                 detail: format!("missing column; expected {}", required.join(", ")),
             });
         }
-        let body = lines.filter(|(_, l)| !l.trim().is_empty()).map(|(i, l)| (i + 1, l)).collect();
+        let body: Vec<(usize, &str)> = lines.filter(|(_, l)| !l.trim().is_empty()).map(|(i, l)| (i + 1, l)).collect();
+        if body.is_empty() {
+            return Err(IngestError::BadLayout {
+                path: path.to_path_buf(),
+                detail: "no data rows after the header (line 1): the file holds nothing to ingest".into(),
+            });
+        }
         Ok(Self { path, columns, body })
     }
 
@@ -95,5 +105,20 @@ impl<'a> CsvTable<'a> {
             fields: text.split(',').map(str::trim).collect(),
             columns: &self.columns,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_header_without_rows_is_an_error() {
+        let path = Path::new("gt/radar_odometry.csv");
+        for text in ["a,b\n", "a,b\n\n  \n", "a,b"] {
+            let err = CsvTable::parse(path, text, &["a"]).err().map(|e| e.to_string()).unwrap_or_default();
+            assert!(err.contains("gt/radar_odometry.csv") && err.contains("no data rows after the header"), "{err}");
+        }
+        assert_eq!(CsvTable::parse(path, "a,b\n1,2\n", &["a"]).unwrap().rows().count(), 1);
     }
 }

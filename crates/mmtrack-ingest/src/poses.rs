@@ -15,7 +15,13 @@
 //! KITTI's own camera trajectories are x right, y down, z forward, so their
 //! ground plane is x-z: forward z, left -x, and yaw `atan2(-r13, r33)`.
 //! Quaternions are `(x, y, z, w)`; yaw about z is
-//! `atan2(2 (w z + x y), 1 - 2 (y^2 + z^2))`.
+//! `atan2(2 (w z + x y), 1 - 2 (y^2 + z^2))`. A quaternion whose norm is not
+//! 1 within [`QUATERNION_NORM_TOLERANCE`] (a zero quaternion, a column read
+//! from the wrong place) is an error naming the line; within it, the
+//! quaternion is normalised first.
+//!
+//! A file without a single pose is an error, and so is a plane that leaves
+//! the motion on the dropped axis (see [`check_plane`]).
 
 use std::path::Path;
 
@@ -36,6 +42,108 @@ pub enum Plane {
     Xy,
     /// x-z of a camera frame (x right, y down, z forward): KITTI camera poses.
     XzCamera,
+}
+
+impl Plane {
+    /// The axis dropped by the projection (the one taken as vertical): 2 (z)
+    /// for x-y, 1 (y) for a camera's x-z.
+    fn vertical_axis(self) -> usize {
+        match self {
+            Self::Xy => 2,
+            Self::XzCamera => 1,
+        }
+    }
+
+    /// The `--plane` value that names this plane.
+    fn flag(self) -> &'static str {
+        match self {
+            Self::Xy => "xy",
+            Self::XzCamera => "xz-camera",
+        }
+    }
+}
+
+/// How far from 1 the norm of an orientation quaternion may be: printing a
+/// unit quaternion to 4 decimals is off by about 1e-4, and a quaternion
+/// further off than 1 % is not a rotation written out.
+pub const QUATERNION_NORM_TOLERANCE: f64 = 0.01;
+
+/// `(x, y, z, w)` scaled to unit norm, or why it is not a rotation: its norm
+/// differs from 1 by more than [`QUATERNION_NORM_TOLERANCE`] (a zero
+/// quaternion among them).
+pub fn unit_quaternion(q: [f64; 4]) -> Result<[f64; 4], String> {
+    let norm = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+        return Err(format!(
+            "quaternion ({}, {}, {}, {}) has norm {norm:.3}; a rotation has norm 1 (within {QUATERNION_NORM_TOLERANCE})",
+            q[0], q[1], q[2], q[3]
+        ));
+    }
+    Ok(q.map(|c| c / norm))
+}
+
+/// Smallest extent of the dropped axis, metres, for [`check_plane`] to judge:
+/// below it a trajectory is too small for its vertical axis to matter.
+const PLANE_CHECK_MIN_EXTENT_M: f64 = 1.0;
+
+/// Refuses a plane that drops the axis the motion happens along.
+///
+/// With `e_v` the extent (max - min) of the positions along the dropped
+/// (vertical) axis and `e_big`, `e_small` the larger and smaller extents of
+/// the two kept axes, the trajectory is refused when all of
+/// - `e_v >= 1 m` (smaller trajectories are left alone),
+/// - `e_v >= 0.25 e_big`: the dropped axis carries a good share of the motion;
+///   a ground vehicle climbing at a 25 % average grade along a straight road
+///   would be needed to reach it,
+/// - `e_small <= 0.1 e_v`: one kept axis is nearly constant, as the height
+///   of a vehicle is,
+///
+/// hold: then the kept axis that stays constant is the real vertical. KITTI
+/// camera poses (y down) read with `--plane xy` are caught this way (their
+/// z spans hundreds of metres, y a few), as is a z-up trajectory read as a
+/// camera's x-z.
+pub fn check_plane(path: &Path, positions_m: &[[f64; 3]], plane: Plane) -> Result<(), IngestError> {
+    let extent_m: [f64; 3] = std::array::from_fn(|axis| {
+        let values = positions_m.iter().map(|p| p[axis]);
+        values.clone().fold(f64::NEG_INFINITY, f64::max) - values.fold(f64::INFINITY, f64::min)
+    });
+    let vertical = plane.vertical_axis();
+    let [first, second] = match plane {
+        Plane::Xy => [0, 1],
+        Plane::XzCamera => [0, 2],
+    };
+    // Ties go to the second kept axis: y of a camera, y of a z-up frame.
+    let (small, big) = if extent_m[second] <= extent_m[first] { (second, first) } else { (first, second) };
+    let e_v = extent_m[vertical];
+    if !(e_v >= PLANE_CHECK_MIN_EXTENT_M && e_v >= 0.25 * extent_m[big] && extent_m[small] <= 0.1 * e_v) {
+        return Ok(());
+    }
+    let names = ["x", "y", "z"];
+    let suggestion = [Plane::Xy, Plane::XzCamera]
+        .into_iter()
+        .find(|p| p.vertical_axis() == small)
+        .map(|p| format!("use --plane {}", p.flag()))
+        .unwrap_or_else(|| format!("no --plane choice takes {} as vertical", names[small]));
+    Err(IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: format!(
+            "positions span x {:.1} m, y {:.1} m, z {:.1} m: --plane {} drops {}, which carries the motion, \
+             while {} stays within {:.1} m, so {} looks vertical; {suggestion}",
+            extent_m[0],
+            extent_m[1],
+            extent_m[2],
+            plane.flag(),
+            names[vertical],
+            names[small],
+            extent_m[small],
+            names[small],
+        ),
+    })
+}
+
+/// The error for a file without a single pose.
+fn no_poses(path: &Path, what: &str) -> IngestError {
+    IngestError::BadLayout { path: path.to_path_buf(), detail: format!("no poses ({what})") }
 }
 
 fn bad(path: &Path, line: usize, field: &str, detail: String) -> IngestError {
@@ -87,9 +195,11 @@ fn check_increasing(path: &Path, poses: &[StampedPose], line: usize, t_ns: i64) 
     }
 }
 
-/// Parses a TUM trajectory.
+/// Parses a TUM trajectory: at least one pose, unit quaternions, a plane that
+/// keeps the motion ([`check_plane`]).
 pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPose>, IngestError> {
     let mut poses = Vec::new();
+    let mut positions_m = Vec::new();
     for (index, line) in text.lines().enumerate() {
         let line_number = index + 1;
         let line = line.trim();
@@ -102,6 +212,8 @@ pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPos
         let rest = line[stamp.len()..].trim();
         let [tx, ty, tz, qx, qy, qz, qw] =
             numbers(path, line_number, rest, &["tx", "ty", "tz", "qx", "qy", "qz", "qw"])?;
+        let [qx, qy, qz, qw] =
+            unit_quaternion([qx, qy, qz, qw]).map_err(|detail| bad(path, line_number, "qx qy qz qw", detail))?;
         let pose = match plane {
             Plane::Xy => Se2::new(tx, ty, yaw_from_quaternion([qx, qy, qz, qw])),
             Plane::XzCamera => {
@@ -113,7 +225,12 @@ pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPos
         };
         check_increasing(path, &poses, line_number, t_ns)?;
         poses.push(StampedPose { t_ns, parent_from_child: pose });
+        positions_m.push([tx, ty, tz]);
     }
+    if poses.is_empty() {
+        return Err(no_poses(path, "the file is empty or only comments"));
+    }
+    check_plane(path, &positions_m, plane)?;
     Ok(poses)
 }
 
@@ -134,10 +251,12 @@ pub fn parse_times(path: &Path, text: &str, t0_ns: i64) -> Result<Vec<i64>, Inge
     Ok(times)
 }
 
-/// Parses a KITTI pose file with one time per line from `times_ns`.
+/// Parses a KITTI pose file with one time per line from `times_ns`: at
+/// least one pose, a plane that keeps the motion ([`check_plane`]).
 pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> Result<Vec<StampedPose>, IngestError> {
     let names = ["r11", "r12", "r13", "tx", "r21", "r22", "r23", "ty", "r31", "r32", "r33", "tz"];
     let mut poses = Vec::new();
+    let mut positions_m = Vec::new();
     for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let line_number = index + 1;
         let [r11, _r12, r13, tx, r21, _r22, _r23, ty, _r31, _r32, r33, tz] = numbers(path, line_number, line, &names)?;
@@ -150,6 +269,10 @@ pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> R
         };
         check_increasing(path, &poses, line_number, t_ns)?;
         poses.push(StampedPose { t_ns, parent_from_child: pose });
+        positions_m.push([tx, ty, tz]);
+    }
+    if poses.is_empty() {
+        return Err(no_poses(path, "the file is empty"));
     }
     if poses.len() != times_ns.len() {
         return Err(IngestError::BadLayout {
@@ -157,6 +280,7 @@ pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> R
             detail: format!("{} poses but {} times", poses.len(), times_ns.len()),
         });
     }
+    check_plane(path, &positions_m, plane)?;
     Ok(poses)
 }
 
@@ -236,5 +360,98 @@ mod tests {
                 .unwrap_err()
                 .to_string();
         assert!(err.contains("line 2") && err.contains("times file has only 1"), "{err}");
+    }
+
+    #[test]
+    fn empty_trajectories_are_errors() {
+        for text in ["", "# only a comment\n\n"] {
+            let err = parse_tum(Path::new("t.txt"), text, Plane::Xy).unwrap_err().to_string();
+            assert!(err.contains("t.txt") && err.contains("no poses"), "{err}");
+        }
+        let err = parse_kitti(Path::new("p.txt"), "\n", &[], Plane::Xy).unwrap_err().to_string();
+        assert!(err.contains("p.txt") && err.contains("no poses"), "{err}");
+    }
+
+    #[test]
+    fn zero_and_unnormalised_quaternions_are_refused() {
+        let err =
+            parse_tum(Path::new("t.txt"), "1.0 1 2 3 0 0 0 1\n2.0 1 2 3 0 0 0 0\n", Plane::Xy).unwrap_err().to_string();
+        assert!(err.contains("t.txt: line 2: qx qy qz qw") && err.contains("norm 0"), "{err}");
+        let err = parse_tum(Path::new("t.txt"), "1.0 1 2 3 0 0 0.5 0.5\n", Plane::XzCamera).unwrap_err().to_string();
+        assert!(err.contains("line 1") && err.contains("norm 0.707"), "{err}");
+        // Printed to 4 decimals a unit quaternion is off by ~1e-4: accepted,
+        // and its yaw is that of the normalised quaternion.
+        let (s, c) = 0.35f64.sin_cos();
+        let text = format!("1.0 0 0 0 0 0 {s:.4} {c:.4}\n");
+        let yaw = parse_tum(Path::new("t.txt"), &text, Plane::Xy).unwrap()[0].parent_from_child.yaw_rad;
+        assert!((yaw - 0.7).abs() < 1e-3, "{yaw}");
+    }
+
+    /// A KITTI-like camera drive: forward along z, a left turn onto -x, the
+    /// camera height (y) within 0.3 m; as TUM lines with the camera's
+    /// quaternion (x right, y down, z forward).
+    fn camera_drive_tum() -> String {
+        let mut text = String::new();
+        for i in 0..200 {
+            let (x, y, z, turn) = if i < 100 {
+                (0.0, 0.1 * (i as f64 * 0.3).sin(), i as f64 * 2.0, 0.0)
+            } else {
+                (-(i - 100) as f64 * 2.0, -0.2, 200.0, std::f64::consts::FRAC_PI_2)
+            };
+            // Yaw left about the up axis is a rotation about the camera's -y.
+            let (s, c) = (turn / 2.0f64).sin_cos();
+            text += &format!("{}.0 {x} {y} {z} 0 {} 0 {c}\n", 100 + i, -s);
+        }
+        text
+    }
+
+    #[test]
+    fn a_vertical_axis_carrying_the_motion_is_refused() {
+        let path = Path::new("camera.txt");
+        let text = camera_drive_tum();
+        let err = parse_tum(path, &text, Plane::Xy).unwrap_err().to_string();
+        assert!(
+            err.contains("camera.txt")
+                && err.contains("--plane xy")
+                && err.contains("y looks vertical")
+                && err.contains("--plane xz-camera"),
+            "{err}"
+        );
+        let poses = parse_tum(path, &text, Plane::XzCamera).unwrap();
+        let last = poses[199].parent_from_child;
+        assert!((last.x_m - 200.0).abs() < 1e-9 && (last.y_m - 198.0).abs() < 1e-9, "{last:?}");
+        // The same drive written z up (x, y ground; z the height), read as a
+        // camera frame, is refused the other way round.
+        let z_up: String = text
+            .lines()
+            .map(|l| {
+                let f: Vec<&str> = l.split_whitespace().collect();
+                format!("{} {} {} {} 0 0 0 1\n", f[0], f[3], f[1], f[2])
+            })
+            .collect();
+        let err = parse_tum(path, &z_up, Plane::XzCamera).unwrap_err().to_string();
+        assert!(err.contains("z looks vertical") && err.contains("use --plane xy"), "{err}");
+        assert_eq!(parse_tum(path, &z_up, Plane::Xy).unwrap().len(), 200);
+        // A KITTI pose file likewise.
+        let kitti: String = (0..50).map(|i| format!("1 0 0 0.5 0 1 0 1.6 0 0 1 {}\n", i as f64 * 3.0)).collect();
+        let times: Vec<i64> = (0..50).map(|i| i * 100_000_000).collect();
+        let err = parse_kitti(Path::new("00.txt"), &kitti, &times, Plane::Xy).unwrap_err().to_string();
+        assert!(err.contains("00.txt") && err.contains("--plane xz-camera"), "{err}");
+    }
+
+    #[test]
+    fn a_ground_vehicle_climbing_a_hill_is_accepted() {
+        // 1 km east with 10 m of lateral wander while climbing 200 m: the
+        // height spans a fifth of the track, under the quarter that refuses.
+        let text: String = (0..=100)
+            .map(|i| {
+                let x = i as f64 * 10.0;
+                format!("{i}.0 {x} {} {} 0 0 0 1\n", 5.0 * (x / 200.0).sin(), x / 5.0)
+            })
+            .collect();
+        assert_eq!(parse_tum(Path::new("hill.txt"), &text, Plane::Xy).unwrap().len(), 101);
+        // A handheld 0.8 m trajectory is below the 1 m floor of the check.
+        let text: String = (0..10).map(|i| format!("{i}.0 0.5 0.01 {} 0 0 0 1\n", i as f64 * 0.08)).collect();
+        assert_eq!(parse_tum(Path::new("hand.txt"), &text, Plane::Xy).unwrap().len(), 10);
     }
 }

@@ -4,7 +4,9 @@
 //! Header, as the dataset ships it (checked on the pyboreas demo files):
 //! `GPSTime,easting,northing,altitude,vel_east,vel_north,vel_up,roll,pitch,heading,angvel_z,angvel_y,angvel_x`.
 //! `GPSTime` is, despite its name, UNIX time in microseconds and equals the
-//! scan file names. The pyboreas reference describes the same columns as
+//! scan file names; newer files give nanoseconds instead, which pyboreas reads
+//! too. The unit is told by the number of digits (see [`unix_time_ns`]).
+//! The pyboreas reference describes the same columns as
 //! `t, x, y, z, ...` in its fixed ENU frame, so `timestamp`/`t` and `x, y, z`
 //! are accepted as well; columns are found by name.
 //!
@@ -55,6 +57,37 @@ fn missing(path: &Path, field: &str, expected: &str) -> IngestError {
     }
 }
 
+/// A UNIX time in microseconds or nanoseconds, as nanoseconds, told apart by
+/// its number of digits: up to 16 digits is microseconds (16 digits span
+/// 2001-09-09 to 2286-11-20), exactly 19 digits is nanoseconds (the same
+/// years). 17 or 18 digits are refused: as microseconds they would be after
+/// the year 5138, as nanoseconds before 1973-03-03. Only plain positive
+/// integers are accepted.
+#[must_use]
+pub fn unix_time_ns(text: &str) -> Option<i64> {
+    if text.is_empty() || !text.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let value: i64 = text.parse().ok()?;
+    let digits = text.trim_start_matches('0').len();
+    let t_ns = match digits {
+        0..=16 => value.checked_mul(1000)?,
+        19 => value,
+        _ => return None,
+    };
+    (t_ns > 0).then_some(t_ns)
+}
+
+fn row_time_ns(row: &CsvRow<'_>, column: &str) -> Result<i64, IngestError> {
+    let raw = row.text(column)?;
+    unix_time_ns(raw).ok_or_else(|| {
+        row.bad(
+            column,
+            format!("'{raw}' is not a UNIX time in microseconds (up to 16 digits) or nanoseconds (19 digits)"),
+        )
+    })
+}
+
 /// Planar yaw of the sensor's x axis from pyboreas's (roll, pitch, heading);
 /// `None` when the x axis points straight up or down.
 #[must_use]
@@ -82,7 +115,7 @@ pub fn parse_applanix_poses(path: &Path, text: &str) -> Result<ApplanixPoses, In
     let time = *TIME_COLUMNS
         .iter()
         .find(|c| table.has(c))
-        .ok_or_else(|| missing(path, "GPSTime", "GPSTime (or timestamp, t) in UNIX microseconds"))?;
+        .ok_or_else(|| missing(path, "GPSTime", "GPSTime (or timestamp, t) in UNIX microseconds or nanoseconds"))?;
     let (position, position_frame) = if UTM_COLUMNS.iter().all(|c| table.has(c)) {
         (UTM_COLUMNS, "utm")
     } else if ENU_COLUMNS.iter().all(|c| table.has(c)) {
@@ -94,13 +127,11 @@ pub fn parse_applanix_poses(path: &Path, text: &str) -> Result<ApplanixPoses, In
     let mut poses: Vec<StampedPose> = Vec::new();
     let mut origin = None;
     for row in table.rows() {
-        let t_ns = row.micros_ns(time)?;
+        let t_ns = row_time_ns(&row, time)?;
         if let Some(previous) = poses.last()
             && t_ns <= previous.t_ns
         {
-            return Err(
-                row.bad(time, format!("{} us does not increase (previous {} us)", t_ns / 1000, previous.t_ns / 1000))
-            );
+            return Err(row.bad(time, format!("{t_ns} ns does not increase (previous {} ns)", previous.t_ns)));
         }
         let (xyz, yaw_rad) = row_pose(&row, &position)?;
         let origin = *origin.get_or_insert(xyz);
@@ -141,6 +172,22 @@ mod tests {
     }
 
     #[test]
+    fn nanosecond_gps_time_is_read_by_its_magnitude() {
+        let row = ",623450.5,4848823.0,154.5,3.9,0.67,0.1,3.1248,0.029,0.17,0,0,0";
+        let path = Path::new("radar_poses.csv");
+        let parse = |t: &str| parse_applanix_poses(path, &format!("{HEADER}\n{t}{row}\n"));
+        // 16 digits: microseconds; 19 digits: nanoseconds (as pyboreas reads newer files).
+        assert_eq!(parse("1630597345560134").unwrap().poses[0].t_ns, 1_630_597_345_560_134_000);
+        assert_eq!(parse("1630597345560134123").unwrap().poses[0].t_ns, 1_630_597_345_560_134_123);
+        // 17 and 18 digits are neither a microsecond time before the year
+        // 5138 nor a nanosecond time after 1973: refused, naming the rule.
+        for t in ["16305973455601341", "163059734556013412", "-1630597345560134", "1.5e15"] {
+            let err = parse(t).unwrap_err().to_string();
+            assert!(err.contains("line 2: GPSTime") && err.contains("16 digits") && err.contains("19 digits"), "{err}");
+        }
+    }
+
+    #[test]
     fn yaw_follows_the_x_axis_for_either_roll() {
         assert!((planar_yaw_rad(std::f64::consts::PI, 0.0, 0.4).unwrap() - 0.4).abs() < 1e-12);
         assert!((planar_yaw_rad(0.0, 0.0, 0.4).unwrap() + 0.4).abs() < 1e-12);
@@ -154,11 +201,17 @@ mod tests {
     #[test]
     fn bad_rows_are_named() {
         let path = Path::new("radar_poses.csv");
-        let err = parse_applanix_poses(path, &HEADER.replace("heading", "yaw")).unwrap_err().to_string();
+        let err = parse_applanix_poses(path, &format!("{}\n1,2\n", HEADER.replace("heading", "yaw")))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("radar_poses.csv") && err.contains("heading") && err.contains("missing column"), "{err}");
-        let err = parse_applanix_poses(path, &HEADER.replace("northing", "north")).unwrap_err().to_string();
+        let err = parse_applanix_poses(path, &format!("{}\n1,2\n", HEADER.replace("northing", "north")))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("northing") && err.contains("missing column"), "{err}");
-        let err = parse_applanix_poses(path, &HEADER.replace("GPSTime", "time")).unwrap_err().to_string();
+        let err = parse_applanix_poses(path, &format!("{}\n1,2\n", HEADER.replace("GPSTime", "time")))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("GPSTime") && err.contains("missing column"), "{err}");
         let nan = format!("{HEADER}\n10,1,2,3,0,0,0,3.1,0,NaN,0,0,0\n");
         let err = parse_applanix_poses(path, &nan).unwrap_err().to_string();
@@ -167,6 +220,6 @@ mod tests {
         let err = parse_applanix_poses(path, &backwards).unwrap_err().to_string();
         assert!(err.contains("line 3") && err.contains("GPSTime") && err.contains("does not increase"), "{err}");
         let err = parse_applanix_poses(path, &format!("{HEADER}\n")).unwrap_err().to_string();
-        assert!(err.contains("no pose rows"), "{err}");
+        assert!(err.contains("no data rows"), "{err}");
     }
 }

@@ -137,5 +137,8 @@ mod tests {
             .unwrap();
         let err = chain(path, &rows).unwrap_err().to_string();
         assert!(err.contains("line 3") && err.contains("does not continue the chain"), "{err}");
+        // A header alone is not an empty trajectory but an error.
+        let err = parse_radar_odometry(path, &format!("{HEADER}\n")).unwrap_err().to_string();
+        assert!(err.contains("radar_odometry.csv") && err.contains("no data rows"), "{err}");
     }
 }
