@@ -39,6 +39,11 @@
 //! or a two-car convoy through a curved tunnel or on a highway
 //! ([`sounder::ConvoySimulator`]), with the true MPCs and both cars' poses.
 //!
+//! ## Beam links ([`beam`])
+//!
+//! Links measured one pilot at a time through the beams a tracker chooses:
+//! the overpass link of Shaham et al. 2020 ([`beam::overpass`]).
+//!
 //! The radar pieces:
 //!
 //! - [`radar::Scenario`]: the TOML scenario (sensor, `[motion]`,
@@ -64,6 +69,7 @@
 //! mmtrack-sim --example radar_speed`): 340 scans/s on 2 threads, 193 on one;
 //! the CLI writes an Oxford PNG folder of 400 such scans in 3.7 s.
 
+pub mod beam;
 mod error;
 pub mod radar;
 pub mod sounder;

@@ -1,0 +1,7 @@
+//! Beam-tracking scenarios: links whose geometry changes as a vehicle moves,
+//! measured one pilot at a time through the beams a tracker chooses.
+//!
+//! - [`overpass`]: the vehicle-to-infrastructure overpass link of Shaham et
+//!   al. 2020 (base station on an overpass, vehicle on the road below).
+
+pub mod overpass;
