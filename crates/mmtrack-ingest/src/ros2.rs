@@ -131,12 +131,14 @@ fn header(cdr: &mut Cdr<'_>) -> Result<(i64, String), String> {
 }
 
 /// `geometry_msgs/Pose` as a planar transform: yaw of the quaternion,
-/// `atan2(2 (w z + x y), 1 - 2 (y^2 + z^2))`.
+/// `atan2(2 (w z + x y), 1 - 2 (y^2 + z^2))`, after a check that it is a unit
+/// quaternion ([`crate::poses::unit_quaternion`]: a zero quaternion is an error).
 fn planar_pose(cdr: &mut Cdr<'_>) -> Result<Se2, String> {
     let (x, y) = (cdr.f64("pose.position.x")?, cdr.f64("pose.position.y")?);
     let _z = cdr.f64("pose.position.z")?;
     let q =
         [cdr.f64("orientation.x")?, cdr.f64("orientation.y")?, cdr.f64("orientation.z")?, cdr.f64("orientation.w")?];
+    let q = crate::poses::unit_quaternion(q).map_err(|e| format!("pose.orientation: {e}"))?;
     let pose = Se2::new(x, y, (2.0 * (q[3] * q[2] + q[0] * q[1])).atan2(1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2])));
     if pose.is_finite() { Ok(pose) } else { Err("pose is not finite".into()) }
 }
@@ -205,6 +207,13 @@ pub struct RadarTopic {
     pub timing: SweepTiming,
 }
 
+/// Message types a pose topic may have.
+pub const POSE_TYPES: [&str; 2] = ["nav_msgs/msg/Odometry", "geometry_msgs/msg/PoseWithCovarianceStamped"];
+/// Message type of a GNSS topic.
+pub const GNSS_TYPES: [&str; 1] = ["sensor_msgs/msg/NavSatFix"];
+/// Message type of a radar topic.
+pub const RADAR_TYPES: [&str; 1] = ["sensor_msgs/msg/Image"];
+
 /// Which topics to take from a bag, and as what.
 #[derive(Debug, Clone)]
 pub struct Ros2Topics {
@@ -216,6 +225,31 @@ pub struct Ros2Topics {
     pub gnss_topic: Option<String>,
     /// Polar radar image topic.
     pub radar: Option<RadarTopic>,
+}
+
+impl Ros2Topics {
+    /// Each chosen topic with its role and the message types that role takes.
+    fn roles(&self) -> impl Iterator<Item = (&'static str, &str, &'static [&'static str])> {
+        [
+            self.pose_topic.as_deref().map(|t| ("pose", t, &POSE_TYPES[..])),
+            self.gnss_topic.as_deref().map(|t| ("GNSS", t, &GNSS_TYPES[..])),
+            self.radar.as_ref().map(|r| ("radar", r.topic.as_str(), &RADAR_TYPES[..])),
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// Checks that `topic`, whose messages are of type `schema`, suits every
+    /// role it was chosen for, e.g. `radar topic /odom has type
+    /// nav_msgs/msg/Odometry; expected sensor_msgs/msg/Image`.
+    pub fn check_type(&self, topic: &str, schema: &str) -> Result<(), String> {
+        match self.roles().find(|(_, t, types)| *t == topic && !types.contains(&schema)) {
+            Some((role, _, types)) => {
+                Err(format!("{role} topic {topic} has type {schema}; expected {}", types.join(" or ")))
+            }
+            None => Ok(()),
+        }
+    }
 }
 
 impl Default for Ros2Topics {
@@ -267,7 +301,7 @@ impl Sink<'_> {
             let decoded = match schema {
                 "nav_msgs/msg/Odometry" => decode_odometry(data),
                 "geometry_msgs/msg/PoseWithCovarianceStamped" => decode_pose_with_covariance_stamped(data),
-                other => Err(format!("{other} is not a pose type (Odometry or PoseWithCovarianceStamped)")),
+                other => Err(format!("type {other}; expected {}", POSE_TYPES.join(" or "))),
             };
             let decoded = match decoded.and_then(|d| self.increasing(0, d.pose.t_ns).map(|()| d)) {
                 Ok(d) => d,
@@ -277,9 +311,6 @@ impl Sink<'_> {
             self.writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id, child)?;
             self.poses += 1;
         } else if topics.gnss_topic.as_deref() == Some(topic) {
-            if schema != "sensor_msgs/msg/NavSatFix" {
-                return Ok(Err(format!("{schema} is not sensor_msgs/msg/NavSatFix")));
-            }
             match decode_nav_sat_fix(data) {
                 Ok(Some(fix)) => {
                     if let Err(e) = self.increasing(1, fix.t_ns) {
@@ -292,9 +323,6 @@ impl Sink<'_> {
                 Err(e) => return Ok(Err(e)),
             }
         } else if let Some(radar) = topics.radar.as_ref().filter(|r| r.topic == topic) {
-            if schema != "sensor_msgs/msg/Image" {
-                return Ok(Err(format!("{schema} is not sensor_msgs/msg/Image")));
-            }
             let scan = crate::ros2_image::decode_image(data)
                 .and_then(|image| crate::ros2_image::image_to_scan(&image, &radar.timing, radar.range_resolution_m))
                 .and_then(|scan| self.increasing(2, scan.header.t_ns).map(|()| scan));
@@ -337,7 +365,9 @@ fn metadata(bag: &Path, topics: &Ros2Topics) -> RecordingMetadata {
 }
 
 /// Ingests the chosen topics of a ROS 2 bag into a new recording. Messages
-/// must come in increasing header time per topic.
+/// must come in increasing header time per topic; a chosen topic missing
+/// from the bag, or of a message type its role does not take
+/// ([`Ros2Topics::check_type`]), is an error.
 pub fn ingest_ros2(
     bag: &Path,
     out: &Path,
@@ -364,8 +394,13 @@ pub fn ingest_ros2(
             field: channel.schema_name.clone(),
             detail,
         };
-        if wanted.contains(&channel.topic.as_str()) && channel.message_encoding != "cdr" {
-            return Err(bad(format!("message encoding '{}', expected cdr", channel.message_encoding)));
+        if wanted.contains(&channel.topic.as_str()) {
+            topics
+                .check_type(&channel.topic, &channel.schema_name)
+                .map_err(|detail| IngestError::BadLayout { path: bag.to_path_buf(), detail })?;
+            if channel.message_encoding != "cdr" {
+                return Err(bad(format!("message encoding '{}', expected cdr", channel.message_encoding)));
+            }
         }
         sink.handle(&channel.topic, &channel.schema_name, &message.data)?.map_err(bad)?;
         progress(reader.bytes_read(), bag_bytes);
@@ -437,6 +472,16 @@ mod tests {
         let p = decoded.pose.parent_from_child;
         assert_eq!((p.x_m, p.y_m), (1.5, -2.0));
         assert!((p.yaw_rad - 0.75).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_zero_quaternion_is_refused() {
+        let mut w = Writer::new();
+        w.u32(12).u32(500).string("odom").string("base_link");
+        w.f64(1.5).f64(-2.0).f64(0.0);
+        w.f64(0.0).f64(0.0).f64(0.0).f64(0.0);
+        let err = decode_odometry(&w.0).unwrap_err();
+        assert!(err.contains("pose.orientation") && err.contains("norm 0"), "{err}");
     }
 
     #[test]

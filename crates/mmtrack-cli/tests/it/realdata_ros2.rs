@@ -42,3 +42,37 @@ fn ros2_bag_odom_becomes_poses() {
     assert!(stderr.contains("no topic /fix") && stderr.contains("/odom"), "{stderr}");
     assert!(!dir.path().join("x.mcap").exists());
 }
+
+#[test]
+fn ros2_topic_of_the_wrong_type_is_an_error_for_every_option() {
+    let Some(realdata) = super::common::realdata("ros2_wrong_type") else { return };
+    let bag = realdata.join("ros2-mcap/nav2_turtlebot.mcap");
+    let dir = tempfile::tempdir().unwrap();
+    let bag = bag.to_str().unwrap();
+    let radar = ["--radar-topic", "/odom", "--radar-range-resolution-m", "0.0438", "--pose-topic", "none"];
+    for (args, topic, found, expected) in [
+        (&radar[..], "/odom", "nav_msgs/msg/Odometry", "sensor_msgs/msg/Image"),
+        // With the default --pose-topic /odom beside it, the radar option is still checked.
+        (&radar[..4], "/odom", "nav_msgs/msg/Odometry", "sensor_msgs/msg/Image"),
+        (
+            &["--gnss-topic", "/amcl_pose"][..],
+            "/amcl_pose",
+            "geometry_msgs/msg/PoseWithCovarianceStamped",
+            "sensor_msgs/msg/NavSatFix",
+        ),
+        (
+            &["--pose-topic", "/tf"][..],
+            "/tf",
+            "tf2_msgs/msg/TFMessage",
+            "nav_msgs/msg/Odometry or geometry_msgs/msg/PoseWithCovarianceStamped",
+        ),
+    ] {
+        let out = mmtrack(dir.path(), &[&["ingest", "ros2", bag, "-o", "x.mcap"][..], args].concat());
+        let (stdout, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stdout}");
+        assert!(stderr.contains(&format!("topic {topic} has type {found}; expected {expected}")), "{args:?}: {stderr}");
+        // One line, the bag named once.
+        assert_eq!((stderr.trim().lines().count(), stderr.matches("nav2_turtlebot.mcap").count()), (1, 1), "{stderr}");
+        assert!(!dir.path().join("x.mcap").exists());
+    }
+}
