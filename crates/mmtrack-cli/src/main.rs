@@ -29,6 +29,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use mmtrack_core::error::printable;
 
 #[derive(Parser)]
 #[command(
@@ -148,6 +149,36 @@ fn exit_quietly_on_a_closed_pipe() {
     }));
 }
 
+/// The error and its causes as one line, `outer: inner: innermost`, each part
+/// once, with no control characters.
+///
+/// Our error types name only their own part and leave the wrapped error to the
+/// chain, but a context may repeat what the error below it says (a path given
+/// as context to an error that names the path), and other crates' errors may
+/// repeat their source in their message. So, for each cause after the first:
+/// it is left out when the part before it already ends with it (or equals it),
+/// and it replaces the part before it when it starts with that part. Quoted
+/// input was escaped where it was quoted; [`printable`] again here keeps
+/// multi-line messages of other crates (TOML parse errors) on one line.
+fn one_line(error: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in error.chain() {
+        let text = cause.to_string().trim_end().to_string();
+        if text.is_empty() {
+            continue;
+        }
+        match parts.last() {
+            Some(last) if *last == text || last.ends_with(&format!(": {text}")) => continue,
+            Some(last) if text.starts_with(&format!("{last}: ")) => {
+                parts.pop();
+            }
+            _ => {}
+        }
+        parts.push(text);
+    }
+    printable(&parts.join(": ")).into_owned()
+}
+
 fn main() -> ExitCode {
     exit_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
@@ -157,7 +188,7 @@ fn main() -> ExitCode {
     match threads::ThreadsArg::default().install(|| run(cli)).and_then(|result| result) {
         Ok(code) => code,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", one_line(&error));
             ExitCode::FAILURE
         }
     }

@@ -1,3 +1,8 @@
+//! The core error type, and [`printable`]: the one way error text quotes input.
+
+use std::borrow::Cow;
+use std::fmt::Write as _;
+
 use thiserror::Error;
 
 /// Errors raised when a core type is constructed from inconsistent parts.
@@ -57,4 +62,78 @@ pub(crate) fn ensure_finite(field: &'static str, value: f64) -> Result<(), CoreE
 /// Fails with [`CoreError::ShapeMismatch`] unless `found == expected`.
 pub(crate) fn ensure_len(what: &'static str, expected: usize, found: usize) -> Result<(), CoreError> {
     if expected == found { Ok(()) } else { Err(CoreError::ShapeMismatch { what, expected, found }) }
+}
+
+/// `input` as text that is safe to print on one terminal line: control
+/// characters (newlines, escape sequences, NUL, ...) and Unicode
+/// bidirectional-override characters become `\n`, `\r`, `\t`, `\xNN` or
+/// `\u{NNNN}`, bytes that are not UTF-8 become `\xNN`; everything else,
+/// including printable non-ASCII text, is kept. Error messages that quote
+/// input (a line of a log, a field of a CSV, a file name) pass it through
+/// here, so a corrupt file cannot garble the terminal or split one error
+/// over several lines.
+///
+/// Backslashes are kept as they are, so the result is idempotent: printing
+/// it through `printable` again changes nothing.
+///
+/// ```
+/// use mmtrack_core::error::printable;
+/// assert_eq!(printable("1.0 \u{1b}[31mred\n"), "1.0 \\x1b[31mred\\n");
+/// assert_eq!(printable(&b"ok\xff"[..]), "ok\\xff");
+/// assert_eq!(printable("Straße 5 m"), "Straße 5 m");
+/// ```
+pub fn printable<T: AsRef<[u8]> + ?Sized>(input: &T) -> Cow<'_, str> {
+    let bytes = input.as_ref();
+    if let Ok(text) = std::str::from_utf8(bytes)
+        && !text.chars().any(needs_escape)
+    {
+        return Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(bytes.len() + 16);
+    for chunk in bytes.utf8_chunks() {
+        for c in chunk.valid().chars() {
+            match c {
+                '\n' => out.push_str("\\n"),
+                '\r' => out.push_str("\\r"),
+                '\t' => out.push_str("\\t"),
+                c if needs_escape(c) && u32::from(c) < 0x100 => {
+                    let _ = write!(out, "\\x{:02x}", u32::from(c));
+                }
+                c if needs_escape(c) => {
+                    let _ = write!(out, "\\u{{{:04x}}}", u32::from(c));
+                }
+                c => out.push(c),
+            }
+        }
+        for byte in chunk.invalid() {
+            let _ = write!(out, "\\x{byte:02x}");
+        }
+    }
+    Cow::Owned(out)
+}
+
+/// Characters that must not reach a terminal as they are: C0/C1 controls and
+/// DEL, and the bidirectional-text overrides that reorder what is shown.
+fn needs_escape(c: char) -> bool {
+    c.is_control() || matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}')
+}
+
+#[cfg(test)]
+mod tests {
+    use super::printable;
+
+    #[test]
+    fn printable_escapes_controls_and_invalid_bytes_and_keeps_the_rest() {
+        assert_eq!(printable("plain text, 5 m"), "plain text, 5 m");
+        assert!(matches!(printable("plain"), std::borrow::Cow::Borrowed(_)), "nothing to escape: no copy");
+        assert_eq!(printable("a\tb\r\nc\0"), "a\\tb\\r\\nc\\x00");
+        assert_eq!(printable("\u{1b}[2J\u{7f}\u{9b}"), "\\x1b[2J\\x7f\\x9b");
+        assert_eq!(printable("abc\u{202e}def"), "abc\\u{202e}def");
+        assert_eq!(printable(&[b'$', 0x01, 0xff, 0xfe, b'x'][..]), "$\\x01\\xff\\xfex");
+        assert_eq!(printable("Zürich → 北京"), "Zürich → 北京");
+        // Idempotent: nothing left to escape the second time.
+        let once = printable(&b"\x1b[31m\xc3(\n"[..]).into_owned();
+        assert_eq!(printable(&once), once);
+        assert!(once.chars().all(|c| !c.is_control()), "{once}");
+    }
 }

@@ -25,7 +25,7 @@
 
 pub mod array;
 mod cir;
-mod error;
+pub mod error;
 mod gnss;
 mod mpc;
 mod odometry;

@@ -9,7 +9,10 @@ use thiserror::Error;
 /// Errors of the estimation building blocks.
 ///
 /// Every variant names the quantity at fault (`what`) in words a caller can put
-/// in front of a user, e.g. "measurement 3" or "transition covariance Q".
+/// in front of a user, e.g. "measurement 3" or "transition covariance Q". A
+/// variant that wraps another error names only its own part; the wrapped error
+/// is its [`source`](std::error::Error::source), so a report of the chain
+/// (`anyhow`'s `{:#}`) says each part once.
 #[derive(Debug, Error, Clone, PartialEq)]
 #[non_exhaustive]
 pub enum FilterError {
@@ -57,7 +60,7 @@ pub enum FilterError {
         expected: &'static str,
     },
     /// One measurement of a measurement set is bad; `source` says how.
-    #[error("measurement {index}: {source}")]
+    #[error("measurement {index}")]
     Measurement {
         /// Index of the measurement in its set.
         index: usize,
@@ -65,7 +68,7 @@ pub enum FilterError {
         source: Box<FilterError>,
     },
     /// One birth component supplied to a prediction is bad; `source` says how.
-    #[error("birth component {index}: {source}")]
+    #[error("birth component {index}")]
     Birth {
         /// Index of the birth component in the supplied list.
         index: usize,

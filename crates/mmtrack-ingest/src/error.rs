@@ -1,14 +1,18 @@
 use std::path::PathBuf;
 
+use mmtrack_core::error::printable;
 use thiserror::Error;
 
 /// Errors of the ingest adapters. Each names the file, the record (row, line,
-/// scan) and the field, and says what was expected.
+/// scan) and the field, and says what was expected. Text quoted from the
+/// input goes through [`printable`]; a wrapped OS error is the source, not
+/// repeated in the message.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum IngestError {
-    /// An operating-system error on a file.
-    #[error("{path}: {source}")]
+    /// An operating-system error on a file (the message names the file; the
+    /// OS error is the source).
+    #[error("{path}")]
     Os {
         /// The file.
         path: PathBuf,
@@ -16,7 +20,7 @@ pub enum IngestError {
         source: std::io::Error,
     },
     /// The input folder lacks what the format requires.
-    #[error("{path}: {detail}")]
+    #[error("{path}: {}", printable(.detail))]
     BadLayout {
         /// The folder or file.
         path: PathBuf,
@@ -24,7 +28,7 @@ pub enum IngestError {
         detail: String,
     },
     /// A record is malformed.
-    #[error("{path}: {record}: {field}: {detail}")]
+    #[error("{path}: {}: {}: {}", printable(.record), printable(.field), printable(.detail))]
     BadRecord {
         /// The file.
         path: PathBuf,
@@ -36,7 +40,7 @@ pub enum IngestError {
         detail: String,
     },
     /// A sidecar file (TOML) is malformed or inconsistent.
-    #[error("{path}: key `{key}`: {detail}")]
+    #[error("{path}: key `{}`: {}", printable(.key), printable(.detail))]
     BadSidecar {
         /// The sidecar file.
         path: PathBuf,

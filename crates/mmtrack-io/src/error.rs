@@ -1,16 +1,23 @@
 use std::path::PathBuf;
 
+use mmtrack_core::error::printable;
 use thiserror::Error;
 
 /// Everything that can go wrong reading or writing mmtrack's canonical formats.
 ///
 /// Every variant names the file; record-level variants also name the record
 /// (message sequence, row) and the field, so a user can find the bad byte.
+///
+/// Each message says its part once: text quoted from a file goes through
+/// [`printable`] (no raw control bytes), and a wrapped OS error is the
+/// [`source`](std::error::Error::source), not repeated in the message, so
+/// `anyhow`'s `{:#}` prints `file: problem` once.
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum IoError {
-    /// An operating-system error on a file.
-    #[error("{path}: {source}")]
+    /// An operating-system error on a file (the message names the file; the
+    /// OS error is the source).
+    #[error("{path}")]
     Os {
         /// The file.
         path: PathBuf,
@@ -24,7 +31,7 @@ pub enum IoError {
         path: PathBuf,
     },
     /// The MCAP container is malformed or cut short.
-    #[error("{path}: not a readable MCAP recording ({detail}); the file may be truncated or corrupted")]
+    #[error("{path}: not a readable MCAP recording ({}); the file may be truncated or corrupted", printable(.detail))]
     CorruptRecording {
         /// The recording.
         path: PathBuf,
@@ -32,7 +39,7 @@ pub enum IoError {
         detail: String,
     },
     /// An MCAP write failed.
-    #[error("{path}: writing MCAP failed: {detail}")]
+    #[error("{path}: writing MCAP failed: {}", printable(.detail))]
     RecordingWrite {
         /// The recording being written.
         path: PathBuf,
@@ -40,7 +47,7 @@ pub enum IoError {
         detail: String,
     },
     /// A message could not be decoded with its channel's schema.
-    #[error("{path}: message {sequence} on {topic}: {detail}")]
+    #[error("{path}: message {sequence} on {}: {}", printable(.topic), printable(.detail))]
     BadMessage {
         /// The recording.
         path: PathBuf,
@@ -52,7 +59,7 @@ pub enum IoError {
         detail: String,
     },
     /// A value cannot be represented in the canonical format.
-    #[error("{path}: {record}: field {field}: {detail}")]
+    #[error("{path}: {}: field {field}: {}", printable(.record), printable(.detail))]
     BadValue {
         /// The file being written or read.
         path: PathBuf,
@@ -64,7 +71,7 @@ pub enum IoError {
         detail: String,
     },
     /// A Parquet file is unreadable or malformed.
-    #[error("{path}: not a readable Parquet table ({detail})")]
+    #[error("{path}: not a readable Parquet table ({})", printable(.detail))]
     CorruptTable {
         /// The table file.
         path: PathBuf,
@@ -72,7 +79,7 @@ pub enum IoError {
         detail: String,
     },
     /// A Parquet table lacks a column its schema requires.
-    #[error("{path}: table '{table}' has no column '{column}' (expected columns: {expected})")]
+    #[error("{path}: table '{}' has no column '{column}' (expected columns: {expected})", printable(.table))]
     MissingColumn {
         /// The table file.
         path: PathBuf,
@@ -84,7 +91,7 @@ pub enum IoError {
         expected: String,
     },
     /// A Parquet column has the wrong type.
-    #[error("{path}: table '{table}' column '{column}' has type {found}, expected {expected}")]
+    #[error("{path}: table '{}' column '{}' has type {}, expected {expected}", printable(.table), printable(.column), printable(.found))]
     WrongColumnType {
         /// The table file.
         path: PathBuf,
@@ -98,7 +105,7 @@ pub enum IoError {
         found: String,
     },
     /// A Parquet table carries a column its schema does not know.
-    #[error("{path}: table '{table}' has unknown column '{column}' (expected columns: {expected})")]
+    #[error("{path}: table '{}' has unknown column '{}' (expected columns: {expected})", printable(.table), printable(.column))]
     UnknownColumn {
         /// The table file.
         path: PathBuf,
@@ -110,7 +117,7 @@ pub enum IoError {
         expected: String,
     },
     /// A Parquet write failed.
-    #[error("{path}: writing Parquet failed: {detail}")]
+    #[error("{path}: writing Parquet failed: {}", printable(.detail))]
     TableWrite {
         /// The table file.
         path: PathBuf,
@@ -125,4 +132,28 @@ pub type Result<T, E = IoError> = std::result::Result<T, E>;
 /// Attaches a path to an `std::io::Error`.
 pub(crate) fn os_err(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> IoError + '_ {
     move |source| IoError::Os { path: path.to_path_buf(), source }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each part once: the OS error is the source, not also in the message;
+    /// quoted input is escaped.
+    #[test]
+    fn messages_say_each_part_once_and_escape_quoted_input() {
+        let source = std::io::Error::from(std::io::ErrorKind::NotFound);
+        let os = IoError::Os { path: PathBuf::from("x.mcap"), source };
+        let source_text = std::error::Error::source(&os).map(ToString::to_string).unwrap_or_default();
+        assert_eq!(os.to_string(), "x.mcap");
+        assert!(!source_text.is_empty() && !os.to_string().contains(&source_text));
+
+        let bad = IoError::BadMessage {
+            path: PathBuf::from("bag.mcap"),
+            topic: "/odom\u{1b}[2J".into(),
+            sequence: 7,
+            detail: "bytes \u{0}\u{7}".into(),
+        };
+        assert_eq!(bad.to_string(), r"bag.mcap: message 7 on /odom\x1b[2J: bytes \x00\x07");
+    }
 }

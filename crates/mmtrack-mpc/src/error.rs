@@ -50,8 +50,9 @@ pub enum MpcError {
         /// Snapshots pushed before it.
         snapshots_before: usize,
     },
-    /// The GM-PHD baseline refused its config (`gmphd.<field>`) or input.
-    #[error("gmphd: {source}")]
+    /// The GM-PHD baseline refused its config (`gmphd.<field>`) or input; the
+    /// baseline's error is the source (not repeated in this message).
+    #[error("GM-PHD baseline")]
     GmPhd {
         /// The baseline's error.
         source: GmPhdError,

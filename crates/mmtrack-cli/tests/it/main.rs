@@ -8,6 +8,7 @@ mod architecture;
 mod bench_mpc;
 mod cli;
 mod common;
+mod error_lines;
 mod fixtures;
 mod independent_readers;
 mod ingest_navtech;
