@@ -15,7 +15,8 @@
 //! 4. amplitude `alpha = c(tau) / ((1/U) sum_k z_k |P_k|^2)` (eq. (8), with the
 //!    normaliser that makes it unbiased for a windowed path);
 //! 5. block `tau +- width / 2` around it (width: the windowed pulse's width
-//!    10 dB below its peak, 2.47 ns in the paper);
+//!    10 dB below its peak, 2.47 ns in the paper), so that the path is not
+//!    detected again at a neighbouring delay;
 //! 6. subtract the path (eq. (9)) and repeat until the strongest remaining
 //!    amplitude is below the threshold.
 //!
@@ -37,6 +38,25 @@
 //! an estimate more than it would with exact interpolation (5e-4 instead of
 //! 1e-4 taps for one 6 dB weaker 31 taps away). Noise makes about 0.03 taps
 //! at the paper's operating point, with this and with the exact evaluation.
+//!
+//! The blocked ranges hold for the refined delays. The search picks the
+//! strongest *unblocked tap*, but its sub-tap refinement moves it by up to a
+//! tap and may land inside an earlier detection's blocked range: on the
+//! simulated convoy 7 % of adjacent detections were closer than 1.2 ns
+//! (half the blocked width 1.24 ns), 78 pairs closer than 0.5 ns. Such a peak
+//! is the earlier, stronger path found again: its residue (pulse mismatch,
+//! or an estimate biased by an unresolved neighbour) or a second path the
+//! blocked range does not resolve, which the paper's step 3 ("the strongest
+//! peak outside blocked delay range(s)") does not detect. It is therefore
+//! not reported; the earlier, stronger detection is kept. It is still
+//! subtracted, as part of the earlier path, and only its coarse tap is
+//! blocked so the search moves on (each such step blocks one more tap, so
+//! the search ends). Subtracting it is our choice: left in the residual, the
+//! flank of that peak is picked up again from the next tap out, at the edge
+//! of the block. Measured on the artificial channel without the window
+//! (sinc sidelobes), 3.20 instead of 4.55 tracks at -100 dB; on the convoy
+//! precision 0.295 instead of 0.299, otherwise alike. Kept detections are
+//! therefore more than half the blocked width apart.
 //!
 //! Choices where the paper is not explicit: the template of eq. (7) is the
 //! sounder pulse itself, so the data are windowed once. Correlating with the
@@ -324,7 +344,10 @@ impl Detector {
         let spacing_s = self.band.tap_spacing_s();
         let half_block_taps = self.blocked_half_width_s / spacing_s;
         let threshold_amplitude = threshold.sqrt();
+        let taps = self.band.taps() as f64;
         let mut detections = Vec::new();
+        // Delays of the detections so far, taps: the centres of the blocked ranges.
+        let mut detected_taps: Vec<f64> = Vec::new();
         let mut around = Neighbourhood::default();
         while detections.len() < self.config.max_mpcs {
             let Some(coarse) = residual.strongest() else { break };
@@ -335,14 +358,30 @@ impl Detector {
                 break;
             }
             let delay_taps = coarse as f64 + peak.delta_taps;
-            // Eq. (9) on the correlation: c[n] -= alpha kappa(n - tau).
+            // The coarse tap is unblocked, but its refined peak may lie in an
+            // earlier detection's blocked range: that is the earlier path
+            // found again (see the module docs), not a peak outside the
+            // blocked ranges.
+            let found_again = detected_taps.iter().any(|&d| circular_distance(delay_taps, d, taps) <= half_block_taps);
+            // Eq. (9) on the correlation: c[n] -= alpha kappa(n - tau); a
+            // re-detection is subtracted too, as residue of the earlier path.
             let reach = self.kernel_rows.reach_taps(amplitude.norm() / threshold_amplitude);
             let changed = self.kernel_rows.subtract(residual.correlation_mut(), delay_taps, amplitude, reach);
-            let blocked = residual.block(delay_taps, half_block_taps);
+            // A re-detection blocks only its coarse tap (so the search moves
+            // on), not a range of its own.
+            let blocked = if found_again {
+                residual.block(coarse as f64, 0.0)
+            } else {
+                residual.block(delay_taps, half_block_taps)
+            };
             residual.rescan(changed.0, changed.1);
             if !residual.covers(changed, blocked) {
                 residual.rescan(blocked.0, blocked.1);
             }
+            if found_again {
+                continue;
+            }
+            detected_taps.push(delay_taps);
             detections.push(MpcDetection {
                 t_ns: snapshot.t_ns,
                 set_index: snapshot.set_index,
@@ -371,6 +410,12 @@ fn quietest_windows_power(power: &[f64], window_taps: usize) -> f64 {
     windows.sort_by(|a, b| a.0.total_cmp(&b.0));
     let keep = windows.len().div_ceil(4);
     windows[..keep].iter().map(|w| w.1).sum::<f64>() / keep as f64
+}
+
+/// Distance between delays `a` and `b` on the circular delay axis of `taps` taps.
+fn circular_distance(a: f64, b: f64, taps: f64) -> f64 {
+    let d = (a - b).rem_euclid(taps);
+    d.min(taps - d)
 }
 
 /// `exp(j 2 pi s x / U)` for every signed bin `s`, from one recurrence.

@@ -11,6 +11,7 @@
 
 use std::path::PathBuf;
 
+use mmtrack_core::CirSnapshot;
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_ingest::cir::{DecawaveConfig, MatCirLayout, read_decawave_log, read_mat_cir_file};
 use mmtrack_mpc::{DetectionConfig, Detector, NoiseFloor, SounderPulse, first_path};
@@ -101,9 +102,9 @@ fn uwb_first_path_against_the_chips_leading_edge() {
     assert!(percentile(&signed, 0.5).abs() <= 2.0, "median difference {} ns", percentile(&signed, 0.5));
 }
 
-#[test]
-fn mimo_60ghz_mpcs_per_link() {
-    let Some(dir) = realdata("but-60ghz-mimo") else { return };
+/// The 16 links of the 60 GHz MIMO sample, `None` when the data is absent.
+fn mimo_60ghz_links() -> Option<Vec<CirSnapshot>> {
+    let dir = realdata("but-60ghz-mimo")?;
     // 1001 CTF bins 10 MHz apart (55-65 GHz): taps 1 / (1001 x 10 MHz) = 99.9 ps apart.
     let layout = MatCirLayout {
         variable: "CIR_mat".into(),
@@ -118,8 +119,18 @@ fn mimo_60ghz_mpcs_per_link() {
     };
     let cirs = read_mat_cir_file(&dir.join("CIR.mat"), &layout).unwrap();
     assert_eq!(cirs.len(), 16);
-    let band = SounderBand::new(1001, layout.tap_spacing_s).unwrap();
-    let detector = Detector::new(DetectionConfig::default(), band.tap_spacing_s(), &SounderPulse::flat(&band)).unwrap();
+    Some(cirs)
+}
+
+fn mimo_60ghz_detector(cirs: &[CirSnapshot]) -> Detector {
+    let band = SounderBand::new(cirs[0].taps.len(), cirs[0].tap_spacing_s).unwrap();
+    Detector::new(DetectionConfig::default(), band.tap_spacing_s(), &SounderPulse::flat(&band)).unwrap()
+}
+
+#[test]
+fn mimo_60ghz_mpcs_per_link() {
+    let Some(cirs) = mimo_60ghz_links() else { return };
+    let detector = mimo_60ghz_detector(&cirs);
     println!(
         "60 GHz 4x4 MIMO: link (tx, rx): MPCs (within 30 dB of the strongest), strongest path delay and power, floor"
     );
@@ -145,4 +156,28 @@ fn mimo_60ghz_mpcs_per_link() {
         - strongest_delays_ns.iter().copied().fold(f64::INFINITY, f64::min);
     println!("  spread of the strongest path's delay over the 16 links: {spread:.2} ns");
     assert!(spread < 1.0, "{strongest_delays_ns:?}");
+}
+
+#[test]
+fn mimo_60ghz_detections_keep_out_of_each_others_blocked_range() {
+    let Some(cirs) = mimo_60ghz_links() else { return };
+    let detector = mimo_60ghz_detector(&cirs);
+    let half_width_s = detector.blocked_width_s() / 2.0;
+    let (mut closest_s, mut inside, mut pairs) = (f64::INFINITY, 0, 0);
+    for (index, cir) in cirs.iter().enumerate() {
+        let mut delays: Vec<f64> = detector.detect(cir, index).unwrap().detections.iter().map(|d| d.delay_s).collect();
+        delays.sort_by(f64::total_cmp);
+        for gap_s in delays.windows(2).map(|w| w[1] - w[0]) {
+            pairs += 1;
+            inside += usize::from(gap_s <= half_width_s);
+            closest_s = closest_s.min(gap_s);
+        }
+    }
+    println!(
+        "60 GHz 4x4 MIMO: {pairs} adjacent detection pairs, {inside} within half the blocked range ({:.4} ns), closest {:.4} ns",
+        half_width_s * 1e9,
+        closest_s * 1e9
+    );
+    // Exact, as on the synthetic channels (detect.rs).
+    assert!(closest_s > half_width_s, "closest pair {closest_s} s, half blocked width {half_width_s} s");
 }
