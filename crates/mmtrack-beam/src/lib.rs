@@ -1,0 +1,30 @@
+//! # mmtrack-beam
+//!
+//! Beam trackers for mmWave links to moving vehicles: each keeps a state of
+//! the link, points the beams for the next pilot from its prediction, and
+//! updates from the pilot it receives.
+//!
+//! - [`PositionVelocityEkf`]: Shaham et al. 2020, state `[d, v, Re alpha,
+//!   Im alpha]` on the overpass link, linear motion, Jacobian (31);
+//! - [`AngleEkf`]: the angle-state baseline of Va et al. 2016, state `[AoA,
+//!   AoD, Re alpha, Im alpha]` with additive angle noise;
+//! - [`PilotTracker`]: the predict / update roles every such tracker plays,
+//!   so experiments drive them alike;
+//! - [`valid_tracking`]: the paper's metric, blocks until the RMS angle error
+//!   over Monte Carlo runs exceeds half the beamwidth.
+//!
+//! It sits in the *process* stage: pure computation on in-memory types (no
+//! files, no printing); `mmtrack-sim` provides links to run on and
+//! `mmtrack-cli` wires the experiments. Depends on `mmtrack-core` (arrays)
+//! and `mmtrack-filter` (the EKF) only.
+
+mod angle_ekf;
+mod error;
+mod link;
+mod position_velocity_ekf;
+pub mod valid_tracking;
+
+pub use angle_ekf::{AngleEkf, AngleEkfConfig};
+pub use error::BeamError;
+pub use link::{BeamPair, PilotTracker};
+pub use position_velocity_ekf::{PositionVelocityEkf, PositionVelocityEkfConfig, ProcessModel};

@@ -1,0 +1,3 @@
+//! Integration tests of mmtrack-beam (one test binary, one module per topic).
+
+mod overpass;
