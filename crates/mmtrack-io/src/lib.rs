@@ -24,5 +24,5 @@ pub mod table;
 
 pub use atomic::{AtomicFile, Durability, Overwrite, staging_dir};
 pub use error::{IoError, Result};
-pub use png_gray::decode_gray8;
+pub use png_gray::{Gray8Png, MAX_GRAY8_BYTES, decode_gray8};
 pub use recording::{RecordingEvent, RecordingMetadata, RecordingOptions, RecordingReader, RecordingWriter};

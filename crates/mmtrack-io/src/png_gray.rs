@@ -1,27 +1,419 @@
-//! Decoding of 8-bit greyscale PNGs (Navtech polar scans), with errors that say
-//! what was wrong with the image rather than panicking.
+//! Decoding of 8-bit greyscale PNGs (Navtech polar scans), header first, with
+//! errors that say what was wrong with the image rather than panicking.
+//!
+//! [`Gray8Png::open`] reads only the header (and the chunks before the image
+//! data), so a caller checks the dimensions against what it expects before a
+//! single pixel is allocated; [`Gray8Png::decode`] refuses images over
+//! [`MAX_GRAY8_BYTES`] whatever the caller checked.
+//!
+//! The `png` crate parses the signature, the header and the chunks and checks
+//! every chunk CRC. The image data is inflated here with `fdeflate` (the
+//! inflater the `png` crate uses) and unfiltered here, because the `png`
+//! decoder does not verify the zlib stream: it checks the Adler-32 only when
+//! its inflater happens to reach the stream's end before the pixels are full,
+//! and accepts a stream that runs on past them, so a corrupted scan could
+//! decode as a good one. Here the stream must end exactly after the last
+//! pixel row with a matching Adler-32.
 
-/// Decodes an 8-bit greyscale PNG into `(width, height, row-major pixels)`.
-///
-/// Errors name the problem: not a PNG, truncated data, or a colour type/bit
-/// depth other than 8-bit grey.
+use std::io::Cursor;
+
+/// Largest image [`Gray8Png::decode`] decodes, bytes (= pixels): 64 MiB, 16
+/// times a Boreas scan after its 2021 radar upgrade (400 x 6859).
+pub const MAX_GRAY8_BYTES: usize = 64 << 20;
+
+/// Memory the `png` crate may spend on the chunks before the image data
+/// (text, ICC profiles), bytes.
+const MAX_METADATA_BYTES: usize = 8 << 20;
+
+/// An 8-bit greyscale PNG whose header has been read, not yet decoded.
+pub struct Gray8Png<'a> {
+    bytes: &'a [u8],
+    reader: png::Reader<Cursor<&'a [u8]>>,
+    width: usize,
+    height: usize,
+}
+
+impl<'a> Gray8Png<'a> {
+    /// Reads the header and the chunks before the image data, allocating
+    /// nothing in proportion to the image size. Errors name the problem: not
+    /// a PNG, a bad chunk, or a colour type, bit depth or interlacing other
+    /// than plain 8-bit grey.
+    pub fn open(bytes: &'a [u8]) -> Result<Self, String> {
+        let decoder = png::Decoder::new_with_limits(Cursor::new(bytes), png::Limits { bytes: MAX_METADATA_BYTES });
+        let reader = decoder.read_info().map_err(|e| format!("not a readable PNG: {e}"))?;
+        let info = reader.info();
+        if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Eight {
+            return Err(format!(
+                "PNG is {:?} with {}-bit samples, expected 8-bit greyscale",
+                info.color_type, info.bit_depth as u8
+            ));
+        }
+        if info.interlaced {
+            return Err("PNG is interlaced (Adam7); expected a plain, non-interlaced image".into());
+        }
+        let (width, height) = (info.width as usize, info.height as usize);
+        Ok(Self { bytes, reader, width, height })
+    }
+
+    /// Image width from the header, pixels.
+    #[must_use]
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Image height from the header, rows.
+    #[must_use]
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// Decodes the row-major pixels. Fails on an image over
+    /// [`MAX_GRAY8_BYTES`], a bad chunk CRC, a zlib stream that is corrupt,
+    /// ends early, runs past the last row or fails its Adler-32 checksum, and a
+    /// row with an unknown filter type.
+    pub fn decode(mut self) -> Result<Vec<u8>, String> {
+        let (width, height) = (self.width, self.height);
+        let pixels = width.checked_mul(height).filter(|&n| n <= MAX_GRAY8_BYTES).ok_or_else(|| {
+            format!("{width} x {height} pixels is over the {} MiB this reader decodes", MAX_GRAY8_BYTES >> 20)
+        })?;
+        // Every chunk, image data included, up to IEND: structure and CRCs.
+        self.reader.finish().map_err(|e| format!("PNG data is truncated or corrupt: {e}"))?;
+        let mut filtered = vec![0u8; pixels + height];
+        inflate_exact(&image_data(self.bytes), &mut filtered)
+            .map_err(|e| format!("PNG image data ({width} x {height}) is corrupt: {e}"))?;
+        unfilter(&filtered, width)
+    }
+}
+
+/// Decodes an 8-bit greyscale PNG into `(width, height, row-major pixels)`;
+/// [`Gray8Png`] to check the size before decoding.
 pub fn decode_gray8(bytes: &[u8]) -> Result<(usize, usize, Vec<u8>), String> {
-    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
-    let mut reader = decoder.read_info().map_err(|e| format!("not a readable PNG: {e}"))?;
-    let info = reader.info();
-    if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Eight {
+    let image = Gray8Png::open(bytes)?;
+    let (width, height) = (image.width(), image.height());
+    Ok((width, height, image.decode()?))
+}
+
+/// The data of the first run of consecutive IDAT chunks, in order. The chunk
+/// structure has been checked by the `png` crate; a chunk whose length runs
+/// past the end ends the walk.
+fn image_data(png: &[u8]) -> Vec<&[u8]> {
+    let mut chunks = Vec::new();
+    let mut at = 8; // after the signature
+    while let Some(header) = png.get(at..at + 8) {
+        let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;
+        let Some(data) = png.get(at + 8..).and_then(|rest| rest.get(..length)) else { break };
+        if &header[4..8] == b"IDAT" {
+            chunks.push(data);
+        } else if !chunks.is_empty() {
+            break;
+        }
+        at += 12 + length;
+    }
+    chunks
+}
+
+/// Inflates the zlib stream split over `chunks` into `out`, which it must
+/// fill exactly; the stream's Adler-32 is verified.
+fn inflate_exact(chunks: &[&[u8]], out: &mut [u8]) -> Result<(), String> {
+    let mut inflater = fdeflate::Decompressor::new();
+    let mut filled = 0;
+    for (index, chunk) in chunks.iter().enumerate() {
+        let last = index + 1 == chunks.len();
+        let mut input = *chunk;
+        while !input.is_empty() && !inflater.is_done() {
+            let (consumed, produced) =
+                inflater.read(input, out, filled, last).map_err(|e| inflate_error(&e, filled, out.len()))?;
+            if consumed == 0 && produced == 0 {
+                return Err(format!("the zlib stream holds more than the {} bytes of the pixel rows", out.len()));
+            }
+            input = &input[consumed..];
+            filled += produced;
+        }
+    }
+    if !inflater.is_done() {
         return Err(format!(
-            "PNG is {:?} with {}-bit samples, expected 8-bit greyscale",
-            info.color_type, info.bit_depth as u8
+            "the zlib stream ends after {filled} of {} bytes, before its Adler-32 checksum",
+            out.len()
         ));
     }
-    let (width, height) = (info.width as usize, info.height as usize);
-    let size = reader.output_buffer_size().ok_or("PNG dimensions overflow memory")?;
-    let mut pixels = vec![0; size];
-    let frame = reader.next_frame(&mut pixels).map_err(|e| format!("PNG data is truncated or corrupt: {e}"))?;
-    pixels.truncate(frame.buffer_size());
-    if pixels.len() != width * height {
-        return Err(format!("PNG holds {} bytes, expected {width} x {height}", pixels.len()));
+    if filled != out.len() {
+        return Err(format!("the zlib stream holds {filled} bytes, expected {} for the pixel rows", out.len()));
     }
-    Ok((width, height, pixels))
+    Ok(())
+}
+
+fn inflate_error(error: &fdeflate::DecompressionError, filled: usize, expected: usize) -> String {
+    match error {
+        fdeflate::DecompressionError::WrongChecksum => {
+            "the zlib stream's Adler-32 checksum does not match its data".to_string()
+        }
+        fdeflate::DecompressionError::InsufficientInput => {
+            format!("the zlib stream ends after {filled} of {expected} bytes")
+        }
+        other => format!("invalid zlib stream after {filled} bytes ({other:?})"),
+    }
+}
+
+/// Undoes the PNG row filters of 8-bit, one-channel rows (`width + 1` bytes
+/// each: the filter type, then the filtered pixels).
+///
+/// # References
+/// PNG specification (W3C, 3rd ed.), section 7.3 "Filtering" and 9.4 "Filter
+/// types" (Sub, Up, Average, Paeth with one byte per pixel).
+fn unfilter(filtered: &[u8], width: usize) -> Result<Vec<u8>, String> {
+    let mut pixels = vec![0u8; filtered.len() / (width + 1) * width];
+    let zeros = vec![0u8; width];
+    for (row, line) in filtered.chunks_exact(width + 1).enumerate() {
+        let (kind, data) = (line[0], &line[1..]);
+        let (done, rest) = pixels.split_at_mut(row * width);
+        let above = if row == 0 { &zeros[..] } else { &done[(row - 1) * width..] };
+        let out = &mut rest[..width];
+        match kind {
+            0 => out.copy_from_slice(data),
+            1 => {
+                let mut left = 0u8;
+                for (o, &x) in out.iter_mut().zip(data) {
+                    left = x.wrapping_add(left);
+                    *o = left;
+                }
+            }
+            2 => {
+                for ((o, &x), &b) in out.iter_mut().zip(data).zip(above) {
+                    *o = x.wrapping_add(b);
+                }
+            }
+            3 => {
+                let mut left = 0u8;
+                for ((o, &x), &b) in out.iter_mut().zip(data).zip(above) {
+                    left = x.wrapping_add(((u16::from(left) + u16::from(b)) / 2) as u8);
+                    *o = left;
+                }
+            }
+            4 => {
+                let (mut left, mut upper_left) = (0u8, 0u8);
+                for ((o, &x), &b) in out.iter_mut().zip(data).zip(above) {
+                    left = x.wrapping_add(paeth(left, b, upper_left));
+                    upper_left = b;
+                    *o = left;
+                }
+            }
+            other => return Err(format!("PNG row {row}: filter type {other}, expected 0-4")),
+        }
+    }
+    Ok(pixels)
+}
+
+/// The Paeth predictor: of left `a`, above `b` and upper-left `c`, the one
+/// closest to `a + b - c` (ties in that order).
+fn paeth(a: u8, b: u8, c: u8) -> u8 {
+    let p = i16::from(a) + i16::from(b) - i16::from(c);
+    let (pa, pb, pc) = ((p - i16::from(a)).abs(), (p - i16::from(b)).abs(), (p - i16::from(c)).abs());
+    if pa <= pb && pa <= pc {
+        a
+    } else if pb <= pc {
+        b
+    } else {
+        c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn encode(width: u32, height: u32, pixels: &[u8], filter: png::Filter, compression: png::Compression) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_filter(filter);
+        encoder.set_compression(compression);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(pixels).unwrap();
+        writer.finish().unwrap();
+        out
+    }
+
+    /// A PNG with the given header and `idat` as its one IDAT chunk, every
+    /// CRC correct (the `png` writer computes them).
+    fn repack(width: u32, height: u32, idat: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_chunk(png::chunk::IDAT, idat).unwrap();
+        drop(writer); // writes IEND
+        out
+    }
+
+    /// The `png` crate's own full-frame decode: the reference, and the
+    /// decoder this module replaced.
+    fn png_crate_decode(bytes: &[u8]) -> Result<Vec<u8>, String> {
+        let mut reader = png::Decoder::new(Cursor::new(bytes)).read_info().map_err(|e| e.to_string())?;
+        let mut pixels = vec![0; reader.output_buffer_size().ok_or("size")?];
+        reader.next_frame(&mut pixels).map_err(|e| e.to_string())?;
+        Ok(pixels)
+    }
+
+    fn noise(n: usize, seed: u64) -> Vec<u8> {
+        let mut state = seed | 1;
+        (0..n)
+            .map(|i| {
+                state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+                // Smooth ramps with sparse noise, so every filter type gets chosen.
+                ((i % 97) as u8).wrapping_add(((state >> 61) as u8) * u8::from(i % 5 == 0))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_filter_type_decodes_as_the_png_crate_does() {
+        let (width, height) = (37, 23);
+        let pixels = noise(width * height, 7);
+        for filter in [
+            png::Filter::NoFilter,
+            png::Filter::Sub,
+            png::Filter::Up,
+            png::Filter::Avg,
+            png::Filter::Paeth,
+            png::Filter::Adaptive,
+        ] {
+            for compression in [png::Compression::NoCompression, png::Compression::Fast, png::Compression::High] {
+                let bytes = encode(width as u32, height as u32, &pixels, filter, compression);
+                assert_eq!(decode_gray8(&bytes).unwrap(), (width, height, pixels.clone()), "{filter:?}");
+                assert_eq!(png_crate_decode(&bytes).unwrap(), pixels);
+            }
+        }
+    }
+
+    /// Adler-32 of `data` (RFC 1950), written out for the test.
+    fn adler32(data: &[u8]) -> u32 {
+        let (mut a, mut b) = (1u32, 0u32);
+        for &x in data {
+            a = (a + u32::from(x)) % 65_521;
+            b = (b + a) % 65_521;
+        }
+        b << 16 | a
+    }
+
+    /// One bit flipped in the image data, the chunk CRC made right again:
+    /// only the zlib stream's own checks can tell. The `png` crate's decoder
+    /// returned altered pixels without an error for many of these flips
+    /// (every flip of an uncompressed stream, a few near the end of a
+    /// compressed one). Here each is an error, or the true pixels (the flip
+    /// hit bits the stream ignores), or, rarely, a change Adler-32 cannot see
+    /// (a flipped back-reference that permutes bytes so that both of its
+    /// sums are unchanged).
+    #[test]
+    fn image_data_corrupted_under_a_good_crc_is_refused() {
+        let (width, height) = (301u32, 40u32);
+        let pixels = noise((width * height) as usize, 3);
+        let (mut slipped_past_png_crate, mut adler_collisions, mut refused) = (0, 0, 0);
+        for compression in [png::Compression::NoCompression, png::Compression::Fast, png::Compression::Balanced] {
+            let good = encode(width, height, &pixels, png::Filter::Adaptive, compression);
+            let idat: Vec<u8> = image_data(&good).concat();
+            let true_stream = fdeflate::decompress_to_vec(&idat).unwrap();
+            // Every byte of the last 64 and 200 spread over the rest.
+            let positions = (0..idat.len()).filter(|i| i % (idat.len() / 200) == 0 || idat.len() - i <= 64);
+            for position in positions {
+                let mut flipped = idat.clone();
+                flipped[position] ^= 0x10;
+                let bad = repack(width, height, &flipped);
+                if png_crate_decode(&bad).is_ok_and(|p| p != pixels) {
+                    slipped_past_png_crate += 1;
+                }
+                match decode_gray8(&bad) {
+                    Err(e) => {
+                        assert!(e.contains("corrupt"), "{e}");
+                        refused += 1;
+                    }
+                    Ok((_, _, decoded)) if decoded == pixels => {}
+                    Ok(_) => {
+                        let mut inflater = fdeflate::Decompressor::new();
+                        inflater.ignore_adler32();
+                        let mut stream = vec![0; true_stream.len()];
+                        inflater.read(&flipped, &mut stream, 0, true).unwrap();
+                        assert_eq!(adler32(&stream), adler32(&true_stream), "{compression:?}, byte {position}");
+                        adler_collisions += 1;
+                    }
+                }
+            }
+        }
+        assert!(slipped_past_png_crate > 200, "the png crate missed {slipped_past_png_crate} corruptions");
+        assert!(adler_collisions <= 2 && refused > 500, "{adler_collisions} collisions, {refused} refused");
+        let good = encode(width, height, &pixels, png::Filter::Adaptive, png::Compression::NoCompression);
+        let mut idat = image_data(&good).concat();
+        let middle = idat.len() / 2;
+        idat[middle] ^= 1;
+        let err = decode_gray8(&repack(width, height, &idat)).unwrap_err();
+        assert!(err.contains("Adler-32") && err.contains("301 x 40"), "{err}");
+    }
+
+    #[test]
+    fn stream_longer_or_shorter_than_the_header_says_is_refused() {
+        let pixels = noise(30 * 6, 5);
+        let idat = image_data(&encode(30, 6, &pixels, png::Filter::Sub, png::Compression::Fast)).concat();
+        let err = decode_gray8(&repack(30, 5, &idat)).unwrap_err();
+        assert!(err.contains("more than the 155 bytes"), "{err}");
+        let err = decode_gray8(&repack(30, 7, &idat)).unwrap_err();
+        assert!(err.contains("holds 186 bytes, expected 217"), "{err}");
+        // The png crate took the longer stream: it stops at the last row.
+        assert!(png_crate_decode(&repack(30, 5, &idat)).is_ok());
+    }
+
+    #[test]
+    fn huge_header_is_read_without_allocating_and_refused_on_decode() {
+        let idat = image_data(&encode(1, 1, &[0], png::Filter::NoFilter, png::Compression::Fast)).concat();
+        let bytes = repack(100_000, 100_000, &idat);
+        assert!(bytes.len() < 100, "{} bytes", bytes.len());
+        let image = Gray8Png::open(&bytes).unwrap();
+        assert_eq!((image.width(), image.height()), (100_000, 100_000));
+        let err = image.decode().unwrap_err();
+        assert!(err.contains("100000 x 100000") && err.contains("64 MiB"), "{err}");
+    }
+
+    #[test]
+    fn wrong_kinds_of_png_are_named() {
+        let mut sixteen = Vec::new();
+        let mut encoder = png::Encoder::new(&mut sixteen, 2, 2);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        encoder.write_header().unwrap().write_image_data(&[0; 8]).unwrap();
+        let err = decode_gray8(&sixteen).err().unwrap();
+        assert!(err.contains("16-bit") && err.contains("8-bit greyscale"), "{err}");
+
+        // Filter type 7 on the second row.
+        let raw = [0u8, 1, 2, 7, 3, 4];
+        let err = decode_gray8(&repack(2, 2, &fdeflate::compress_to_vec(&raw))).unwrap_err();
+        assert!(err.contains("row 1") && err.contains("filter type 7"), "{err}");
+
+        let good = encode(4, 4, &[9; 16], png::Filter::NoFilter, png::Compression::Fast);
+        let err = decode_gray8(&good[..good.len() - 12]).unwrap_err();
+        assert!(err.contains("truncated or corrupt"), "no IEND: {err}");
+        let err = decode_gray8(b"GIF89a").err().unwrap();
+        assert!(err.contains("not a readable PNG"), "{err}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+        /// Any image, any filter: the same pixels as the png crate; cut or
+        /// arbitrary bytes are an error, never a panic.
+        #[test]
+        fn decodes_like_the_png_crate_and_never_panics(
+            width in 1u32..40, height in 1u32..12, seed in any::<u64>(), filter in 0usize..6,
+            cut in 0usize..2000, junk in proptest::collection::vec(any::<u8>(), 0..200),
+        ) {
+            let filters = [png::Filter::NoFilter, png::Filter::Sub, png::Filter::Up, png::Filter::Avg, png::Filter::Paeth, png::Filter::Adaptive];
+            let pixels = noise((width * height) as usize, seed);
+            let bytes = encode(width, height, &pixels, filters[filter], png::Compression::Fast);
+            prop_assert_eq!(decode_gray8(&bytes).unwrap().2, pixels);
+            let _ = decode_gray8(&bytes[..cut.min(bytes.len())]);
+            let _ = decode_gray8(&junk);
+            let mut spliced = bytes[..33.min(bytes.len())].to_vec();
+            spliced.extend_from_slice(&junk);
+            let _ = decode_gray8(&spliced);
+        }
+    }
 }
