@@ -25,21 +25,68 @@ pub enum StampUnit {
     Nanos,
 }
 
+/// Earliest plausible scan time, ns: 2000-01-01 00:00 UTC.
+const EARLIEST_SCAN_T_NS: i64 = 946_684_800 * 1_000_000_000;
+/// Latest plausible scan time, ns: 2100-01-01 00:00 UTC.
+const LATEST_SCAN_T_NS: i64 = 4_102_444_800 * 1_000_000_000;
+
 impl StampUnit {
-    /// Parses a file-name stamp into positive nanoseconds.
+    /// Parses a file-name stamp into nanoseconds. A stamp outside 2000-2100
+    /// is refused: it is in another unit (or not a time at all, like
+    /// `000001`), and taking it would misplace the scan by decades.
     pub fn parse(self, path: &Path, record: &str, raw: &str) -> Result<i64, IngestError> {
-        let (factor, name) = match self {
-            Self::Micros => (1000, "microsecond"),
-            Self::Nanos => (1, "nanosecond"),
+        let (factor, name, example) = match self {
+            Self::Micros => (1000, "microsecond", "16 digits, e.g. 1547131046353776"),
+            Self::Nanos => (1, "nanosecond", "19 digits, e.g. 1561000000000000000"),
         };
-        raw.parse::<i64>().ok().and_then(|t| t.checked_mul(factor)).filter(|t| *t > 0).ok_or_else(|| {
-            IngestError::BadRecord {
-                path: path.to_path_buf(),
-                record: record.into(),
-                field: "timestamp".into(),
-                detail: format!("'{raw}' is not a {name} UNIX timestamp"),
+        let bad = |detail: String| IngestError::BadRecord {
+            path: path.to_path_buf(),
+            record: record.into(),
+            field: "timestamp".into(),
+            detail,
+        };
+        let t_ns = raw
+            .parse::<i64>()
+            .ok()
+            .and_then(|t| t.checked_mul(factor))
+            .ok_or_else(|| bad(format!("'{raw}' is not a {name} UNIX timestamp")))?;
+        if !(EARLIEST_SCAN_T_NS..LATEST_SCAN_T_NS).contains(&t_ns) {
+            return Err(bad(format!(
+                "'{raw}' is not a plausible {name} UNIX timestamp: expected a time between 2000 and 2100 \
+                 ({example})"
+            )));
+        }
+        Ok(t_ns)
+    }
+}
+
+/// Checks that every scan of a folder has the size of the first one, for
+/// layouts that take the size from the files.
+#[derive(Debug, Default)]
+pub struct SameSize {
+    first: Option<(PathBuf, usize, usize)>,
+}
+
+impl SameSize {
+    /// Records the first scan's azimuth rows and range bins; fails when a
+    /// later scan differs, naming both files.
+    pub fn check(&mut self, path: &Path, azimuths: usize, bins: usize) -> Result<(), IngestError> {
+        match &self.first {
+            None => self.first = Some((path.to_path_buf(), azimuths, bins)),
+            Some((first, a, b)) if (*a, *b) != (azimuths, bins) => {
+                return Err(IngestError::BadRecord {
+                    path: path.to_path_buf(),
+                    record: "image".into(),
+                    field: "size".into(),
+                    detail: format!(
+                        "{azimuths} azimuths x {bins} range bins; the folder's first scan {} has {a} x {b}",
+                        first.display()
+                    ),
+                });
             }
-        })
+            Some(_) => {}
+        }
+        Ok(())
     }
 }
 
@@ -115,13 +162,18 @@ mod tests {
     #[test]
     fn listing_takes_numeric_pngs_in_time_order_and_names_bad_stamps() {
         let dir = tempfile::tempdir().unwrap();
-        for name in ["30.png", "10.png", "20.png", "notes.txt", "cart.png.bak"] {
+        let stamps_ns = ["1561000000500000000", "1561000000000000000", "1561000000250000000"];
+        for name in stamps_ns.iter().map(|s| format!("{s}.png")).chain(["notes.txt".into(), "cart.png.bak".into()]) {
             std::fs::write(dir.path().join(name), b"x").unwrap();
         }
         let scans = list_scan_pngs(dir.path(), StampUnit::Nanos).unwrap();
-        assert_eq!(scans.iter().map(|s| s.t_ns).collect::<Vec<_>>(), vec![10, 20, 30]);
-        let scans = list_scan_pngs(dir.path(), StampUnit::Micros).unwrap();
-        assert_eq!(scans[0].t_ns, 10_000);
+        let t0_ns = 1_561_000_000_000_000_000;
+        assert_eq!(scans.iter().map(|s| s.t_ns - t0_ns).collect::<Vec<_>>(), vec![0, 250_000_000, 500_000_000]);
+
+        let micros = tempfile::tempdir().unwrap();
+        std::fs::write(micros.path().join("1547131046353776.png"), b"x").unwrap();
+        let scans = list_scan_pngs(micros.path(), StampUnit::Micros).unwrap();
+        assert_eq!(scans[0].t_ns, 1_547_131_046_353_776_000);
 
         std::fs::write(dir.path().join("0.png"), b"x").unwrap();
         let err = list_scan_pngs(dir.path(), StampUnit::Nanos).unwrap_err().to_string();
@@ -130,6 +182,39 @@ mod tests {
         let empty = tempfile::tempdir().unwrap();
         let err = list_scan_pngs(empty.path(), StampUnit::Nanos).unwrap_err().to_string();
         assert!(err.contains("no scans found"), "{err}");
+    }
+
+    /// MulRan names scans by 19-digit nanoseconds; `000001.png` is not a
+    /// scan at 1 ns, and microseconds given as nanoseconds (1970) or
+    /// nanoseconds as microseconds (beyond 2100) are refused too.
+    #[test]
+    fn implausible_stamps_are_refused_naming_the_file() {
+        let path = Path::new("polar/000001.png");
+        let err = StampUnit::Nanos.parse(path, "file name", "000001").unwrap_err().to_string();
+        assert!(
+            err.contains("polar/000001.png: file name: timestamp: '000001' is not a plausible nanosecond")
+                && err.contains("19 digits"),
+            "{err}"
+        );
+        assert!(StampUnit::Nanos.parse(path, "file name", "1547131046353776").is_err(), "microseconds as ns");
+        assert!(StampUnit::Micros.parse(path, "line 3", "1561000000000000000").is_err(), "ns as microseconds");
+        assert!(StampUnit::Micros.parse(path, "line 3", "-1547131046353776").is_err());
+        assert_eq!(StampUnit::Nanos.parse(path, "file name", "946684800000000000").unwrap(), 946_684_800_000_000_000);
+        assert!(StampUnit::Nanos.parse(path, "file name", "946684799999999999").is_err(), "1999");
+
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("000001.png"), b"x").unwrap();
+        let err = list_scan_pngs(dir.path(), StampUnit::Nanos).unwrap_err().to_string();
+        assert!(err.contains("000001.png") && err.contains("plausible"), "{err}");
+    }
+
+    #[test]
+    fn a_scan_of_another_size_than_the_first_is_named() {
+        let mut same = SameSize::default();
+        same.check(Path::new("a.png"), 400, 3360).unwrap();
+        same.check(Path::new("b.png"), 400, 3360).unwrap();
+        let err = same.check(Path::new("c.png"), 399, 3360).unwrap_err().to_string();
+        assert!(err.contains("c.png: image: size: 399 azimuths x 3360 range bins") && err.contains("a.png"), "{err}");
     }
 
     #[test]

@@ -10,8 +10,9 @@
 //! Scans use the Oxford row header (int64 microseconds, uint16 encoder of 5600
 //! counts per turn, one more byte), so they are read by the Oxford decoder
 //! with a Boreas [`NavtechLayout`]:
-//! - the number of range bins is taken from each file (the CIR204-H gives 3360
-//!   bins before the 2021 upgrade and more after it);
+//! - the numbers of range bins and of azimuth rows are taken from the files
+//!   (the CIR204-H gives 3360 bins before the 2021 upgrade and more after it);
+//!   every scan of a folder must have the same as the first;
 //! - range resolution by recording date: 0.0596 m per bin before 2021-09-21 and
 //!   0.04381 m from that day on (pyboreas switches at 1632182400 s, 2021-09-21
 //!   00:00 UTC). The date is parsed from the folder name; a folder renamed
@@ -190,6 +191,7 @@ pub fn ingest_boreas(
         range_resolution_m,
         range_offset_m: RANGE_OFFSET_M,
         expected_bins: None,
+        expected_azimuths: None,
         valid_byte_is_flag: false,
         ..OXFORD
     };

@@ -9,8 +9,10 @@
 //!
 //! Scans are plain 8-bit greyscale PNGs with **range along the rows and
 //! azimuth along the columns** (a Navtech CIR204-H: 400 columns of 3360
-//! rows; both are read from each file) and no row header: the only time is
-//! the file name, in nanoseconds. Per-azimuth times are spread evenly over
+//! rows; both are read from the files, and every scan of a folder must have
+//! the size of the first) and no row header: the only time is the file name,
+//! in nanoseconds (19 digits; a name that is not a time between 2000 and 2100
+//! is refused). Per-azimuth times are spread evenly over
 //! one scan period (0.25 s at 4 Hz) ending at the file time by default (see
 //! [`crate::sweep`] for why), and column `a` of `n` is at angle `a * 2 pi / n`.
 //! Range bins are 0.05952 m from 0 m.
@@ -30,7 +32,7 @@ use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummar
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
 use crate::error::os_err;
-use crate::scan_folder::{ScanFile, StampUnit, decode_in_order, folder_name, list_scan_pngs};
+use crate::scan_folder::{SameSize, ScanFile, StampUnit, decode_in_order, folder_name, list_scan_pngs};
 use crate::sweep::SweepTiming;
 use crate::{IngestError, Progress};
 
@@ -102,14 +104,16 @@ fn bad(path: &Path, field: &str, detail: String) -> IngestError {
 }
 
 /// Decodes one MulRan polar PNG (columns = azimuths, rows = range bins) into
-/// a scan with one row per azimuth.
+/// a scan with one row per azimuth. The image's shape is checked from its PNG
+/// header before any pixel is decoded.
 pub fn decode_mulran_png(
     path: &Path,
     png: &[u8],
     scan_t_ns: i64,
     options: &MulranOptions,
 ) -> Result<PolarScan, IngestError> {
-    let (azimuths, bins, pixels) = mmtrack_io::decode_gray8(png).map_err(|detail| bad(path, "PNG data", detail))?;
+    let image = mmtrack_io::Gray8Png::open(png).map_err(|detail| bad(path, "PNG data", detail))?;
+    let (azimuths, bins) = (image.width(), image.height());
     if azimuths == 0 || bins == 0 {
         return Err(bad(path, "width/height", format!("{azimuths} x {bins} image has no pixels")));
     }
@@ -123,6 +127,7 @@ pub fn decode_mulran_png(
             ),
         ));
     }
+    let pixels = image.decode().map_err(|detail| bad(path, "PNG data", detail))?;
     let mut power = vec![0u8; azimuths * bins];
     for (range_bin, row) in pixels.chunks_exact(azimuths).enumerate() {
         for (azimuth, value) in row.iter().enumerate() {
@@ -232,7 +237,9 @@ pub fn ingest_mulran(
         let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
         decode_mulran_png(&scan.path, &bytes, scan.t_ns, options)
     };
+    let mut same_size = SameSize::default();
     decode_in_order(&folder.scans, &decode, &mut |index, scan: PolarScan| {
+        same_size.check(&folder.scans[index].path, scan.header.azimuths.len(), scan.header.bins_per_azimuth)?;
         writer.write_radar_scan(&scan)?;
         progress(index as u64 + 1, total);
         Ok(())

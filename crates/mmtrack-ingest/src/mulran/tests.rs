@@ -143,3 +143,30 @@ fn bad_input_names_file_and_field_and_leaves_no_output() {
     assert!(MulranFolder::open(&empty).unwrap_err().to_string().contains("no scans found"));
     assert!(MulranFolder::open(dir.path()).unwrap_err().to_string().contains("no sensor_data/radar/polar/"));
 }
+
+/// Before, `000001.png` became a scan at t = 1 ns; MulRan names scans by
+/// 19-digit UNIX nanoseconds. A scan of another size than the first is
+/// refused too, naming the file.
+#[test]
+fn implausible_file_stamp_and_odd_scan_size_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = folder(dir.path());
+    let polar = root.join("sensor_data/radar/polar");
+    let odd = polar.join(format!("{}.png", STAMPS_NS[2]));
+    std::fs::write(&odd, polar_png(8, 19)).unwrap();
+    let out = dir.path().join("out.mcap");
+    let err = ingest(&root, &out, &MulranOptions::default()).unwrap_err().to_string();
+    assert!(err.contains(&odd.display().to_string()) && err.contains("8 azimuths x 19 range bins"), "{err}");
+    assert!(!out.exists(), "no partial output");
+    std::fs::write(&odd, polar_png(8, 20)).unwrap();
+
+    let stray = polar.join("000001.png");
+    std::fs::write(&stray, polar_png(8, 20)).unwrap();
+    let err = MulranFolder::open(&root).unwrap_err().to_string();
+    assert!(
+        err.contains(&stray.display().to_string())
+            && err.contains("'000001' is not a plausible nanosecond UNIX timestamp")
+            && err.contains("19 digits"),
+        "{err}"
+    );
+}

@@ -74,7 +74,7 @@ pub fn parse_ins_csv(path: &Path, text: &str) -> Result<InsSolution, IngestError
             t_ns,
             latitude_deg,
             longitude_deg,
-            altitude_m: row.finite("altitude")?,
+            altitude_m: Some(row.finite("altitude")?),
             horizontal_sigma_m: None,
             num_satellites: None,
             quality: GnssFixQuality::Unknown,
@@ -177,7 +177,8 @@ mod tests {
                 PolarScan::new(header, vec![7; 20]).unwrap()
             })
             .collect();
-        let layout = super::super::NavtechLayout { expected_bins: Some(5), ..super::super::OXFORD };
+        let layout =
+            super::super::NavtechLayout { expected_bins: Some(5), expected_azimuths: Some(4), ..super::super::OXFORD };
         super::super::write_oxford_folder(dir.path(), &scans, &[], &layout).unwrap();
         std::fs::create_dir(dir.path().join("gps")).unwrap();
         let mut text = format!("{HEADER}\n");

@@ -1,14 +1,15 @@
 //! Oxford Radar RobotCar sequence folders.
 //!
-//! Layout: `radar/<t_us>.png` (polar scans, see [`png_scan`]),
+//! Layout: `radar/<t_us>.png` (polar scans, see [`png_scan`]; 400 azimuth
+//! rows of 11 + 3768 columns, checked from each PNG header before decoding),
 //! `radar.timestamps` (`<t_us> <valid>` per scan; scans flagged 0 are skipped
-//! and counted), optional `gt/radar_odometry.csv` (see [`odometry`]) and
-//! `gps/gps.csv` (see [`gps`]) and `gps/ins.csv` (see [`ins`]; its poses are the
-//! ground truth when there is no `radar_odometry.csv`, its positions the GNSS
-//! fixes when there is no `gps.csv`). Ground truth and GNSS fixes are kept within the
-//! time span of the scans. Without
-//! `radar.timestamps`, every `radar/*.png` with a numeric name is taken in
-//! time order.
+//! and counted, and so are PNGs in `radar/` that it does not list), optional
+//! `gt/radar_odometry.csv` (see [`odometry`]) and `gps/gps.csv` (see [`gps`])
+//! and `gps/ins.csv` (see [`ins`]; its poses are the ground truth when there
+//! is no `radar_odometry.csv`, its positions the GNSS fixes when there is no
+//! `gps.csv`). Ground truth and GNSS fixes are kept within the time span of
+//! the scans. Without `radar.timestamps`, every `radar/*.png` with a numeric
+//! name is taken in time order. Scan stamps outside 2000-2100 are refused.
 //!
 //! Attribution for the real sample used in tests: Oxford Radar RobotCar
 //! Dataset (Barnes et al., ICRA 2020), CC BY-NC-SA 4.0.
@@ -18,7 +19,7 @@ pub mod ins;
 pub mod odometry;
 pub mod png_scan;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use mmtrack_core::{GnssFix, PolarScan, StampedPose};
@@ -26,7 +27,7 @@ use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummar
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
 use crate::error::os_err;
-use crate::scan_folder::{StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check};
+use crate::scan_folder::{SameSize, StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check};
 use crate::{IngestError, Progress};
 pub use png_scan::{DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
 
@@ -41,6 +42,9 @@ pub struct OxfordFolder {
     pub scans: Vec<ScanFile>,
     /// Scans listed in `radar.timestamps` with valid flag 0 (skipped).
     pub skipped_invalid: u64,
+    /// PNGs in `radar/` that `radar.timestamps` does not list (skipped), in
+    /// name order.
+    pub unlisted_pngs: Vec<PathBuf>,
     /// `gt/radar_odometry.csv`, when present.
     pub ground_truth: Option<PathBuf>,
     /// `gps/gps.csv`, when present.
@@ -68,16 +72,19 @@ impl OxfordFolder {
         let timestamps = root.join("radar.timestamps");
         let mut skipped_invalid = 0;
         let mut scans = Vec::new();
+        let mut unlisted_pngs = Vec::new();
         if timestamps.is_file() {
             let text = std::fs::read_to_string(&timestamps).map_err(os_err(&timestamps))?;
+            let mut listed = BTreeSet::new();
             for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
                 let mut parts = line.split_whitespace();
                 let t_ns = parse_stamp(&timestamps, index + 1, parts.next().unwrap_or(""))?;
+                let path = radar_dir.join(format!("{}.png", t_ns / 1000));
+                listed.insert(path.clone());
                 if parts.next() == Some("0") {
                     skipped_invalid += 1;
                     continue;
                 }
-                let path = radar_dir.join(format!("{}.png", t_ns / 1000));
                 if !path.is_file() {
                     return Err(IngestError::BadLayout {
                         path: timestamps.clone(),
@@ -92,6 +99,7 @@ impl OxfordFolder {
                 scans.push(ScanFile { t_ns, path });
             }
             scans = sort_and_check(&radar_dir, scans)?;
+            unlisted_pngs = png_files(&radar_dir)?.into_iter().filter(|p| !listed.contains(p)).collect();
         } else {
             scans = list_scan_pngs(&radar_dir, StampUnit::Micros)?;
         }
@@ -102,6 +110,7 @@ impl OxfordFolder {
             root: root.to_path_buf(),
             scans,
             skipped_invalid,
+            unlisted_pngs,
             ground_truth: gt.is_file().then_some(gt),
             gps: gps.is_file().then_some(gps),
             ins: ins.is_file().then_some(ins),
@@ -113,6 +122,19 @@ impl OxfordFolder {
     pub fn sequence_id(&self) -> String {
         folder_name(&self.root)
     }
+}
+
+/// Every `*.png` file of `dir`, in name order.
+fn png_files(dir: &Path) -> Result<Vec<PathBuf>, IngestError> {
+    let mut pngs = Vec::new();
+    for entry in std::fs::read_dir(dir).map_err(os_err(dir))? {
+        let path = entry.map_err(os_err(dir))?.path();
+        if path.extension().is_some_and(|e| e == "png") && path.is_file() {
+            pngs.push(path);
+        }
+    }
+    pngs.sort();
+    Ok(pngs)
 }
 
 /// How to ingest an Oxford folder.
@@ -139,6 +161,9 @@ pub struct IngestReport {
     pub scans: u64,
     /// Scans skipped because `radar.timestamps` flags them invalid.
     pub skipped_invalid_scans: u64,
+    /// PNGs in `radar/` skipped because `radar.timestamps` does not list
+    /// them, in name order.
+    pub unlisted_pngs: Vec<PathBuf>,
     /// Ground-truth poses written (those within the scans' time span).
     pub ground_truth_poses: u64,
     /// GNSS fixes written (those within the scans' time span).
@@ -250,6 +275,7 @@ pub fn ingest_oxford(
     Ok(IngestReport {
         scans: total,
         skipped_invalid_scans: folder.skipped_invalid,
+        unlisted_pngs: folder.unlisted_pngs.clone(),
         ground_truth_poses: in_span.len() as u64,
         gnss_fixes: fixes_in_span.len() as u64,
         ins_used_as: aux.ins_used_as,
@@ -259,7 +285,8 @@ pub fn ingest_oxford(
 }
 
 /// Decodes Oxford/Boreas-style scan PNGs (one worker per core) and writes them
-/// in order: the PNG bytes carried unchanged, or decoded mono8 images.
+/// in order: the PNG bytes carried unchanged, or decoded mono8 images. Every
+/// scan must have the size of the first.
 pub(crate) fn write_navtech_scans(
     writer: &mut RecordingWriter,
     scans: &[ScanFile],
@@ -272,7 +299,10 @@ pub(crate) fn write_navtech_scans(
         let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
         Ok((decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?, bytes))
     };
+    let mut same_size = SameSize::default();
     let mut write = |index: usize, (decoded, bytes): (DecodedScanPng, Vec<u8>)| -> Result<(), IngestError> {
+        let path = &scans[index].path;
+        same_size.check(path, decoded.header.azimuths.len(), decoded.header.bins_per_azimuth)?;
         if carry_png {
             writer.write_radar_png(&decoded.header, &bytes, HEADER_COLUMNS as u32)?;
         } else {

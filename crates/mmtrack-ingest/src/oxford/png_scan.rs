@@ -28,19 +28,22 @@ pub struct NavtechLayout {
     pub range_offset_m: f64,
     /// Required number of range bins, or `None` to take it from each file.
     pub expected_bins: Option<usize>,
+    /// Required number of azimuth rows, or `None` to take it from each file.
+    pub expected_azimuths: Option<usize>,
     /// Whether byte 10 flags the row (255 = valid). `false` marks every row
     /// valid: Boreas documents the byte as unused.
     pub valid_byte_is_flag: bool,
 }
 
-/// Oxford Radar RobotCar (Navtech CTS350-X): 3768 bins of 0.0432 m, as the
-/// dataset SDK states (CFEAR's code uses 0.0438 m; `--range-resolution-m`
-/// overrides it).
+/// Oxford Radar RobotCar (Navtech CTS350-X): 400 azimuths of 3768 bins of
+/// 0.0432 m, as the dataset SDK states (CFEAR's code uses 0.0438 m;
+/// `--range-resolution-m` overrides it).
 pub const OXFORD: NavtechLayout = NavtechLayout {
     counts_per_turn: 5600,
     range_resolution_m: 0.0432,
     range_offset_m: 0.0,
     expected_bins: Some(3768),
+    expected_azimuths: Some(400),
     valid_byte_is_flag: true,
 };
 
@@ -68,16 +71,9 @@ fn bad(path: &Path, record: String, field: &str, detail: String) -> IngestError 
     IngestError::BadRecord { path: path.to_path_buf(), record, field: field.to_string(), detail }
 }
 
-/// Decodes one scan PNG and parses its row headers. `scan_t_ns` is the scan's
-/// own stamp (the file name). Errors name the file, the row and the field.
-pub fn decode_scan_png(
-    path: &Path,
-    png: &[u8],
-    scan_t_ns: i64,
-    layout: &NavtechLayout,
-) -> Result<DecodedScanPng, IngestError> {
-    let (width, height, pixels) =
-        mmtrack_io::decode_gray8(png).map_err(|detail| bad(path, "image".into(), "PNG data", detail))?;
+/// Checks an image's size from its PNG header against the layout, before
+/// anything is decoded.
+fn check_size(path: &Path, width: usize, height: usize, layout: &NavtechLayout) -> Result<(), IngestError> {
     if width <= HEADER_COLUMNS {
         return Err(bad(
             path,
@@ -97,9 +93,35 @@ pub fn decode_scan_png(
             format!("{width} columns ({bins} range bins); expected {HEADER_COLUMNS} + {expected} for this dataset"),
         ));
     }
-    if height == 0 {
-        return Err(bad(path, "image".into(), "height", "no azimuth rows".into()));
+    if let Some(expected) = layout.expected_azimuths
+        && height != expected
+    {
+        return Err(bad(
+            path,
+            "image".into(),
+            "height",
+            format!("{height} rows; expected {expected} azimuth rows (one per azimuth) for this dataset"),
+        ));
     }
+    Ok(())
+}
+
+/// Decodes one scan PNG and parses its row headers. `scan_t_ns` is the scan's
+/// own stamp (the file name). The size in the PNG header is checked against
+/// the layout before any pixel is decoded. Errors name the file, the row and
+/// the field.
+pub fn decode_scan_png(
+    path: &Path,
+    png: &[u8],
+    scan_t_ns: i64,
+    layout: &NavtechLayout,
+) -> Result<DecodedScanPng, IngestError> {
+    let png_error = |detail| bad(path, "image".into(), "PNG data", detail);
+    let image = mmtrack_io::Gray8Png::open(png).map_err(png_error)?;
+    let (width, height) = (image.width(), image.height());
+    check_size(path, width, height, layout)?;
+    let bins = width - HEADER_COLUMNS;
+    let pixels = image.decode().map_err(png_error)?;
     let mut azimuths = Vec::with_capacity(height);
     for (row_index, row) in pixels.chunks_exact(width).enumerate() {
         let record = || format!("azimuth row {row_index}");
@@ -196,7 +218,7 @@ mod tests {
     }
 
     fn layout(bins: usize) -> NavtechLayout {
-        NavtechLayout { expected_bins: Some(bins), ..OXFORD }
+        NavtechLayout { expected_bins: Some(bins), expected_azimuths: None, ..OXFORD }
     }
 
     fn gray_png(width: u32, height: u32, depth: png::BitDepth, pixels: &[u8]) -> Vec<u8> {
@@ -248,6 +270,124 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("azimuth row 0") && err.contains("encoder") && err.contains("5600"), "{err}");
+    }
+
+    /// The data of a PNG's IDAT chunks, concatenated (the zlib stream).
+    fn idat(png: &[u8]) -> Vec<u8> {
+        let (mut at, mut data) = (8, Vec::new());
+        while at + 8 <= png.len() {
+            let length = u32::from_be_bytes(png[at..at + 4].try_into().unwrap()) as usize;
+            if &png[at + 4..at + 8] == b"IDAT" {
+                data.extend_from_slice(&png[at + 8..at + 8 + length]);
+            }
+            at += 12 + length;
+        }
+        data
+    }
+
+    /// A greyscale PNG with this header and `zlib` as its image data, every
+    /// chunk CRC correct (the png writer computes them).
+    fn png_with_image_data(width: u32, height: u32, zlib: &[u8]) -> Vec<u8> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_chunk(png::chunk::IDAT, zlib).unwrap();
+        drop(writer);
+        out
+    }
+
+    /// Before: a 74-byte PNG claiming 100000 x 100000 made the decoder ask for
+    /// 10 GB (and abort) before its width was looked at; a 399-row image was
+    /// taken as an Oxford scan. Now the header is checked first.
+    #[test]
+    fn size_is_checked_from_the_header_before_decoding() {
+        let tiny = idat(&gray_png(1, 1, png::BitDepth::Eight, &[0]));
+        let huge = png_with_image_data(100_000, 100_000, &tiny);
+        assert!(huge.len() < 100);
+        let err = decode_scan_png(Path::new("radar/1547131046353776.png"), &huge, 1, &OXFORD).unwrap_err().to_string();
+        assert!(
+            err.contains("radar/1547131046353776.png: image: width: 100000 columns") && err.contains("11 + 3768"),
+            "{err}"
+        );
+        // Right width, 100000 rows: the height is refused, still from the header.
+        let tall = png_with_image_data(3779, 100_000, &tiny);
+        let err = decode_scan_png(Path::new("t.png"), &tall, 1, &OXFORD).unwrap_err().to_string();
+        assert!(err.contains("t.png: image: height: 100000 rows; expected 400 azimuth rows"), "{err}");
+        // A layout that takes the size from the file: the reader's cap.
+        let auto = NavtechLayout { expected_bins: None, expected_azimuths: None, ..OXFORD };
+        let err = decode_scan_png(Path::new("t.png"), &huge, 1, &auto).unwrap_err().to_string();
+        assert!(err.contains("t.png: image: PNG data: 100000 x 100000 pixels is over the 64 MiB"), "{err}");
+
+        let full = NavtechLayout { expected_bins: Some(30), ..OXFORD };
+        let png = encode_scan_png(&scan(399, 30), &full).unwrap();
+        let err = decode_scan_png(Path::new("s.png"), &png, 1, &full).unwrap_err().to_string();
+        assert!(err.contains("s.png: image: height: 399 rows; expected 400 azimuth rows"), "{err}");
+        assert!(
+            decode_scan_png(Path::new("s.png"), &encode_scan_png(&scan(400, 30), &full).unwrap(), 1, &full).is_ok()
+        );
+    }
+
+    /// Before: one flipped byte of image data under a corrected chunk CRC was
+    /// ingested as a good scan (the zlib Adler-32 was not checked).
+    #[test]
+    fn corrupted_image_data_under_a_good_crc_is_refused() {
+        let layout = layout(30);
+        let good = encode_scan_png(&scan(20, 30), &layout).unwrap();
+        let mut zlib = idat(&good);
+        let middle = zlib.len() / 2;
+        zlib[middle] ^= 0x04;
+        let bad = png_with_image_data(41, 20, &zlib);
+        let err = decode_scan_png(Path::new("s.png"), &bad, 1, &layout).unwrap_err().to_string();
+        assert!(err.contains("s.png: image: PNG data") && err.contains("corrupt"), "{err}");
+    }
+
+    /// An Oxford folder: `radar.timestamps` lists 1 of 11 PNGs; the other 10
+    /// are reported, not silently dropped. With `--bins auto`, a scan of
+    /// another size than the first is refused.
+    #[test]
+    fn unlisted_pngs_are_counted_and_sizes_agree() {
+        let dir = tempfile::tempdir().unwrap();
+        let auto = NavtechLayout { expected_bins: None, expected_azimuths: None, ..OXFORD };
+        let scans: Vec<PolarScan> = (0..11)
+            .map(|i| {
+                let mut s = scan(8, 30);
+                let t0_ns = 1_547_131_046_353_776_000 + i * 250_000_000;
+                for (a, azimuth) in s.header.azimuths.iter_mut().enumerate() {
+                    azimuth.t_ns = t0_ns + a as i64 * 625_000;
+                }
+                s.header.t_ns = t0_ns;
+                s
+            })
+            .collect();
+        super::super::write_oxford_folder(dir.path(), &scans, &[], &auto).unwrap();
+        let timestamps = dir.path().join("radar.timestamps");
+        let all = std::fs::read_to_string(&timestamps).unwrap();
+        std::fs::write(&timestamps, all.lines().nth(4).unwrap()).unwrap();
+        let folder = super::super::OxfordFolder::open(dir.path()).unwrap();
+        assert_eq!((folder.scans.len(), folder.unlisted_pngs.len()), (1, 10));
+        assert!(folder.unlisted_pngs[0].ends_with("radar/1547131046353776.png"), "{:?}", folder.unlisted_pngs);
+        let options = super::super::OxfordOptions { layout: auto.clone(), ..Default::default() };
+        let out = dir.path().join("out.mcap");
+        let recording = mmtrack_io::RecordingOptions::default();
+        let report = super::super::ingest_oxford(&folder, &out, &options, &recording, &mut |_, _| {}).unwrap();
+        assert_eq!((report.scans, report.unlisted_pngs.len()), (1, 10));
+
+        // Every scan listed again, the last one a row short.
+        std::fs::write(&timestamps, &all).unwrap();
+        let last = dir.path().join(format!("radar/{}.png", scans[10].header.t_ns / 1000));
+        let mut short = scans[10].clone();
+        short.header.azimuths.pop();
+        short.power.truncate(7 * 30);
+        std::fs::write(&last, encode_scan_png(&short, &auto).unwrap()).unwrap();
+        let folder = super::super::OxfordFolder::open(dir.path()).unwrap();
+        assert!(folder.unlisted_pngs.is_empty());
+        let out = dir.path().join("short.mcap");
+        let err =
+            super::super::ingest_oxford(&folder, &out, &options, &recording, &mut |_, _| {}).unwrap_err().to_string();
+        assert!(err.contains(&last.display().to_string()) && err.contains("7 azimuths x 30 range bins"), "{err}");
+        assert!(!out.exists(), "no partial output");
     }
 
     #[test]
