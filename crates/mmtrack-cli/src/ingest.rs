@@ -364,8 +364,24 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             )?;
             let log = &report.log;
             if !quiet {
+                let without_altitude = log.fixes.iter().filter(|fix| fix.altitude_m.is_none()).count();
+                let partial = if without_altitude > 0 {
+                    format!(" ({} from RMC alone, {without_altitude} without altitude)", log.rmc_only_fixes)
+                } else {
+                    String::new()
+                };
+                let out_of_order = match &log.first_out_of_order {
+                    Some(first) => format!(
+                        ", {} epoch{} out of time order (first at line {}: {})",
+                        log.out_of_order_epochs,
+                        if log.out_of_order_epochs == 1 { "" } else { "s" },
+                        first.line,
+                        first.reason
+                    ),
+                    None => String::new(),
+                };
                 println!(
-                    "{}: {} GNSS fixes; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix; {} other sentences ignored",
+                    "{}: {} GNSS fixes{partial}; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix{out_of_order}; {} other sentences ignored",
                     report.output.path.display(),
                     log.fixes.len(),
                     log.bad_checksum_lines,

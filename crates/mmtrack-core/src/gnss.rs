@@ -59,8 +59,9 @@ pub struct GnssFix {
     /// Geodetic longitude, degrees, east positive.
     pub longitude_deg: f64,
     /// Height, metres (above the ellipsoid when known, else above mean sea level;
-    /// the recording metadata says which).
-    pub altitude_m: f64,
+    /// the recording metadata says which), when the source gives one: `None`
+    /// for e.g. an NMEA RMC without a GGA (NaN is not used for "unknown").
+    pub altitude_m: Option<f64>,
     /// 1-sigma horizontal position uncertainty, metres, when the source gives one
     /// (NaN is not used for "unknown"; `None` is).
     pub horizontal_sigma_m: Option<f64>,

@@ -161,6 +161,8 @@ pub fn decode_pose_with_covariance_stamped(data: &[u8]) -> Result<RosPose, Strin
 }
 
 /// Decodes `sensor_msgs/msg/NavSatFix`; `None` when its status says no fix (-1).
+/// A NaN altitude is "no altitude available", as the message definition
+/// says; an infinite one is an error.
 ///
 /// `horizontal_sigma_m` is `sqrt((C_ee + C_nn) / 2)` from the ENU covariance
 /// when its type is not UNKNOWN (0). ROS status 0/1/2 (fix, SBAS, GBAS) map to
@@ -170,7 +172,7 @@ pub fn decode_nav_sat_fix(data: &[u8]) -> Result<Option<GnssFix>, String> {
     let (t_ns, _) = header(&mut cdr)?;
     let status = cdr.u8("status.status")? as i8;
     let _service = cdr.u16("status.service")?;
-    let (latitude_deg, longitude_deg, altitude_m) = (cdr.f64("latitude")?, cdr.f64("longitude")?, cdr.f64("altitude")?);
+    let (latitude_deg, longitude_deg, altitude) = (cdr.f64("latitude")?, cdr.f64("longitude")?, cdr.f64("altitude")?);
     let mut covariance = [0.0; 9];
     for c in &mut covariance {
         *c = cdr.f64("position_covariance")?;
@@ -179,9 +181,14 @@ pub fn decode_nav_sat_fix(data: &[u8]) -> Result<Option<GnssFix>, String> {
     if status < 0 {
         return Ok(None);
     }
-    if !(latitude_deg.is_finite() && longitude_deg.is_finite() && altitude_m.is_finite()) {
-        return Err("latitude/longitude/altitude not finite".into());
+    if !(latitude_deg.is_finite() && longitude_deg.is_finite()) {
+        return Err(format!("latitude/longitude: ({latitude_deg}, {longitude_deg}) is not finite"));
     }
+    let altitude_m = match altitude {
+        a if a.is_nan() => None,
+        a if a.is_finite() => Some(a),
+        a => return Err(format!("altitude: {a} is not finite (NaN when unknown)")),
+    };
     let sigma =
         (covariance_type != 0).then(|| ((covariance[0] + covariance[4]) / 2.0).sqrt()).filter(|s| s.is_finite());
     Ok(Some(GnssFix {
@@ -472,6 +479,34 @@ mod tests {
         let p = decoded.pose.parent_from_child;
         assert_eq!((p.x_m, p.y_m), (1.5, -2.0));
         assert!((p.yaw_rad - 0.75).abs() < 1e-12);
+    }
+
+    fn nav_sat_fix(altitude: f64) -> Vec<u8> {
+        let mut w = Writer::new();
+        w.u32(12).u32(500).string("gnss");
+        // status.status = 0 (fix) at an odd offset, then status.service = 1
+        // (GPS) on the next even one.
+        assert_eq!(w.0.len() % 2, 1);
+        w.0.push(0);
+        w.0.extend_from_slice(&1u16.to_le_bytes());
+        w.f64(37.4).f64(-122.1).f64(altitude);
+        for _ in 0..9 {
+            w.f64(0.0);
+        }
+        w.0.push(0); // covariance type unknown
+        w.0
+    }
+
+    #[test]
+    fn nav_sat_fix_nan_altitude_is_no_altitude() {
+        let fix = decode_nav_sat_fix(&nav_sat_fix(12.5)).unwrap().unwrap();
+        assert_eq!(
+            (fix.t_ns, fix.latitude_deg, fix.altitude_m, fix.horizontal_sigma_m),
+            (12_000_000_500, 37.4, Some(12.5), None)
+        );
+        assert_eq!(decode_nav_sat_fix(&nav_sat_fix(f64::NAN)).unwrap().unwrap().altitude_m, None);
+        let err = decode_nav_sat_fix(&nav_sat_fix(f64::INFINITY)).unwrap_err();
+        assert!(err.contains("altitude: inf"), "{err}");
     }
 
     #[test]

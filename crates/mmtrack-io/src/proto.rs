@@ -236,8 +236,8 @@ pub struct GnssFix {
     #[prost(double, required, tag = "3")]
     pub longitude_deg: f64,
     /// See [`GNSS_FIX_SPEC`].
-    #[prost(double, required, tag = "4")]
-    pub altitude_m: f64,
+    #[prost(double, optional, tag = "4")]
+    pub altitude_m: Option<f64>,
     /// See [`GNSS_FIX_SPEC`].
     #[prost(double, optional, tag = "5")]
     pub horizontal_sigma_m: Option<f64>,
@@ -257,7 +257,14 @@ pub const GNSS_FIX_SPEC: MessageSpec = MessageSpec {
         field("t_ns", 1, Int64, One, "ns", "fix time, nanoseconds since the UNIX epoch"),
         field("latitude_deg", 2, Double, One, "deg", "geodetic latitude, north positive"),
         field("longitude_deg", 3, Double, One, "deg", "geodetic longitude, east positive"),
-        field("altitude_m", 4, Double, One, "m", "height (datum in the recording metadata key gnss.altitude_datum)"),
+        field(
+            "altitude_m",
+            4,
+            Double,
+            Optional,
+            "m",
+            "height (datum in the recording metadata key gnss.altitude_datum), absent when the source gives none",
+        ),
         field(
             "horizontal_sigma_m",
             5,

@@ -37,7 +37,7 @@ fn write_samples(dir: &Path) {
             t_ns: 1_000_000_000,
             latitude_deg: 51.762042,
             longitude_deg: -1.262751,
-            altitude_m: 65.176138,
+            altitude_m: Some(65.176138),
             horizontal_sigma_m: Some(0.77),
             num_satellites: None,
             quality: GnssFixQuality::Autonomous,

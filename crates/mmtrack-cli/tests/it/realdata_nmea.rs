@@ -32,3 +32,67 @@ fn nmea_drive_gives_1653_fixes_and_reports_bad_checksums() {
     assert_eq!(m["gnss.altitude_datum"], "ellipsoid");
     assert!(m["gnss.enu_origin_latitude_deg"].as_str().unwrap().starts_with("37.4"));
 }
+
+/// `$payload*XX` with the NMEA checksum.
+fn signed(payload: &str) -> String {
+    format!("${payload}*{:02X}", payload.bytes().fold(0u8, |a, b| a ^ b))
+}
+
+/// Each sentence of `text` through `edit` (given its payload; `None` drops
+/// it); changed sentences are re-signed, the others kept byte for byte.
+fn edit_sentences(text: &str, edit: impl Fn(&str) -> Option<String>) -> String {
+    text.lines()
+        .filter_map(|line| match line.strip_prefix('$').and_then(|b| b.rsplit_once('*')) {
+            Some((payload, _)) => {
+                edit(payload).map(|p| if p == payload { format!("{line}\n") } else { signed(&p) + "\n" })
+            }
+            None => Some(format!("{line}\n")),
+        })
+        .collect()
+}
+
+#[test]
+fn nmea_rmc_only_epochs_and_a_backward_step_are_reported_not_lost() {
+    let Some(realdata) = super::common::realdata("nmea_rmc_only") else { return };
+    let log = realdata.join("nmea-ublox-f9k/MTV.Local1.ublox-F9K.20200206-181434.nmea");
+    let nmea = String::from_utf8_lossy(&std::fs::read(log).unwrap()).into_owned();
+    let dir = tempfile::tempdir().unwrap();
+
+    // The first 34 epochs with their GGA sentences gone: 34 RMC fixes, as a
+    // receiver that writes RMC alone logs them.
+    let epoch_34 = nmea.lines().position(|l| l.starts_with("$GNRMC,021451.00,")).unwrap();
+    let head: String = nmea.lines().take(epoch_34).map(|l| format!("{l}\n")).collect();
+    let rmc_only = edit_sentences(&head, |p| (!p.contains("GGA,")).then(|| p.to_string()));
+    std::fs::write(dir.path().join("rmc.nmea"), rmc_only).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "nmea", "rmc.nmea", "-o", "rmc.mcap"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("34 GNSS fixes (34 from RMC alone, 34 without altitude)"), "{stdout}");
+    let fixes: Vec<_> = RecordingReader::open(&dir.path().join("rmc.mcap"))
+        .unwrap()
+        .filter_map(|e| match e.unwrap() {
+            RecordingEvent::Gnss(fix) => Some(fix),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(fixes.len(), 34);
+    assert!(fixes.iter().all(|f| f.altitude_m.is_none() && f.num_satellites.is_none()), "{:?}", fixes[0]);
+    let meta = mmtrack(dir.path(), &["inspect", "--json", "rmc.mcap"]);
+    let summary: serde_json::Value = serde_json::from_slice(&meta.stdout).unwrap();
+    assert_eq!(summary["metadata"]["mmtrack.recording"]["gnss.altitude_datum"], "none (no fix gives an altitude)");
+
+    // The epoch of 02:15:57 stamped 0.3 s before the one of 02:15:56: that
+    // epoch is skipped and reported, the 1652 others kept.
+    let back = edit_sentences(&nmea, |p| Some(p.replace(",021557.00,", ",021555.70,")));
+    std::fs::write(dir.path().join("back.nmea"), back).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "nmea", "back.nmea", "-o", "back.mcap"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("1652 GNSS fixes")
+            && stdout.contains(
+                "1 epoch out of time order (first at line 2892: fix at 021555.700000000 UTC is 0.300000000 s before"
+            ),
+        "{stdout}"
+    );
+}

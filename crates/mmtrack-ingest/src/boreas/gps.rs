@@ -52,7 +52,7 @@ pub fn parse_boreas_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
             t_ns,
             latitude_deg: latitude_rad.to_degrees(),
             longitude_deg: longitude_rad.to_degrees(),
-            altitude_m: row.finite("altitude")?,
+            altitude_m: Some(row.finite("altitude")?),
             horizontal_sigma_m: None,
             num_satellites: None,
             quality: GnssFixQuality::Unknown,
@@ -84,7 +84,7 @@ mod tests {
         assert_eq!(fixes[1].t_ns - fixes[0].t_ns, 5_000_000);
         assert!((fixes[0].latitude_deg - 43.780_988_551).abs() < 1e-8, "{}", fixes[0].latitude_deg);
         assert!((fixes[0].longitude_deg + 79.466_776_737).abs() < 1e-8, "{}", fixes[0].longitude_deg);
-        assert_eq!(fixes[0].altitude_m, 173.2);
+        assert_eq!(fixes[0].altitude_m, Some(173.2));
     }
 
     #[test]

@@ -86,7 +86,7 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
             t_ns,
             latitude_deg,
             longitude_deg,
-            altitude_m,
+            altitude_m: Some(altitude_m),
             horizontal_sigma_m: covariance.iter().any(|c| *c != 0.0).then(|| horizontal.sqrt()),
             num_satellites: None,
             quality: GnssFixQuality::Unknown,
@@ -112,7 +112,7 @@ mod tests {
         let fixes = parse_mulran_gps(Path::new("gps.csv"), &format!("{ROW}\n")).unwrap();
         assert_eq!(fixes.len(), 1);
         assert_eq!(fixes[0].t_ns, 1_566_279_371_523_590_000);
-        assert_eq!((fixes[0].latitude_deg, fixes[0].longitude_deg, fixes[0].altitude_m), (37.4, 127.1, 82.5));
+        assert_eq!((fixes[0].latitude_deg, fixes[0].longitude_deg, fixes[0].altitude_m), (37.4, 127.1, Some(82.5)));
         // sqrt((4 + 2.25) / 2)
         assert!((fixes[0].horizontal_sigma_m.unwrap() - 3.125f64.sqrt()).abs() < 1e-12);
         let unknown = parse_mulran_gps(Path::new("gps.csv"), "5,37.4,127.1,82.5,0,0,0,0,0,0,0,0,0\n").unwrap();

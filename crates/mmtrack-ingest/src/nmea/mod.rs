@@ -9,7 +9,7 @@
 //! - not a sentence at all (blank, binary junk, truncated, a missing `*` or a
 //!   checksum that is not two hex digits), *and* GGA/RMC/GST sentences with a
 //!   valid checksum whose fields do not parse (non-numeric or out-of-range
-//!   latitude, NaN altitude, a bad date, ...): skipped and counted as
+//!   latitude, a NaN altitude, a bad date, ...): skipped and counted as
 //!   [`NmeaLog::unparsable_lines`], the first one described in
 //!   [`NmeaLog::first_unparsable`]. Skipping rather than failing is deliberate:
 //!   an 8-bit checksum lets about one corrupted line in 256 through, and one
@@ -20,8 +20,15 @@
 //! Epochs: consecutive GGA, RMC and GST sentences with the same time of day
 //! form one epoch, whatever their order (u-blox writes RMC before GGA, other
 //! receivers GGA before RMC). The GGA gives time of day, position, quality,
-//! satellites and altitude; the RMC of the same epoch gives the date, and its
-//! status `V` means no fix; the GST gives `horizontal_sigma_m`. An epoch
+//! satellites and altitude (an empty altitude field is a fix without
+//! altitude); the RMC of the same epoch gives the date, and its status `V`
+//! means no fix; the GST gives `horizontal_sigma_m`. An epoch with a valid
+//! RMC but no usable GGA (none, or one that does not parse) is a fix from the
+//! RMC alone, counted in [`NmeaLog::rmc_only_fixes`]: its position, its
+//! quality from the RMC mode indicator (A autonomous, D differential, E dead
+//! reckoning, F RTK float, R RTK fixed, none or other unknown), no altitude
+//! and no satellite count: receivers configured for RMC alone, and logs
+//! whose GGAs lack a height, are not lost. An epoch
 //! without its own RMC is dated from the latest known time (the latest RMC or
 //! fix), taking the day that puts it nearest, so a midnight rollover between
 //! RMCs is handled; GGAs before the first RMC are dated by that RMC the same
@@ -29,20 +36,25 @@
 //! way to give UNIX times. Time is computed from the digits with integers, so
 //! fractional seconds are exact to the nanosecond.
 //!
-//! Epochs whose GGA quality is 0 or whose RMC status is `V` are not fixes:
+//! Epochs whose GGA quality is 0, or whose RMC status is `V` or mode `N`, are not fixes:
 //! they are counted ([`NmeaLog::epochs_without_fix`]), not emitted (u-blox
 //! receivers print `$GPGGA,,,,,,0,...` with no time before their first fix;
 //! that is such an epoch, not an error). Fix quality maps from GGA: 1
 //! autonomous, 2 differential, 4 RTK fixed, 5 RTK float, 6 dead reckoning,
 //! anything else unknown. An epoch seen twice (the same GGA time again, e.g.
 //! `GPGGA` and `GNGGA` of one epoch) is merged into the first and counted in
-//! [`NmeaLog::duplicate_epochs`]; a fix earlier than the previous one is an
-//! error naming the line, as the recording requires increasing time.
+//! [`NmeaLog::duplicate_epochs`]. An epoch earlier than the fix before it (a
+//! receiver stepping its clock back) is skipped and counted in
+//! [`NmeaLog::out_of_order_epochs`], the first one described in
+//! [`NmeaLog::first_out_of_order`]: the recording needs increasing time, and
+//! one such step must not reject the rest of a drive. Lines named for an
+//! epoch are those of its first GGA, RMC or GST sentence.
 //!
 //! `altitude_m` is the height above the WGS-84 ellipsoid (GGA altitude above
-//! mean sea level plus the geoid separation) when every fix gives the geoid
-//! separation, else the altitude above mean sea level for all fixes;
-//! [`NmeaLog::altitude_datum`] says which. HDOP is not a standard deviation
+//! mean sea level plus the geoid separation) when every fix with an altitude
+//! gives the geoid separation, else the altitude above mean sea level for all
+//! fixes; [`NmeaLog::altitude_datum`] says which. Fixes without an altitude
+//! have `altitude_m: None`. HDOP is not a standard deviation
 //! and there is no standard factor from it to metres, so `horizontal_sigma_m`
 //! is `None` unless a GST sentence of the same epoch gives the latitude and
 //! longitude sigmas; it is then their RMS, `sqrt((s_lat^2 + s_lon^2) / 2)`,
@@ -83,6 +95,9 @@ pub struct SkippedLine {
 pub struct NmeaLog {
     /// Fixes in strictly increasing time order.
     pub fixes: Vec<GnssFix>,
+    /// Fixes from an RMC alone (no GGA, or one that did not parse): no
+    /// altitude and no satellite count.
+    pub rmc_only_fixes: u64,
     /// Lines skipped for a wrong checksum.
     pub bad_checksum_lines: u64,
     /// First line (1-based) with a wrong checksum.
@@ -94,41 +109,77 @@ pub struct NmeaLog {
     pub first_unparsable: Option<SkippedLine>,
     /// Valid sentences of other types (GSA, GSV, VTG, GLL, TXT, proprietary, ...).
     pub ignored_sentences: u64,
-    /// Epochs without a fix (GGA quality 0 or RMC status V), not emitted.
+    /// Epochs without a fix (GGA quality 0, RMC status V or mode N), not emitted.
     pub epochs_without_fix: u64,
-    /// Repeated epochs (a GGA time already seen) merged into the first.
+    /// Repeated epochs (a fix time already seen) merged into the first.
     pub duplicate_epochs: u64,
-    /// `ellipsoid` or `mean sea level` (empty when there are no fixes).
+    /// Epochs earlier than the fix before them, skipped.
+    pub out_of_order_epochs: u64,
+    /// The first epoch skipped for its time, and by how much it went back.
+    pub first_out_of_order: Option<SkippedLine>,
+    /// `ellipsoid` or `mean sea level`; empty when no fix has an altitude.
     pub altitude_datum: &'static str,
 }
 
 /// GGA, RMC and GST sentences sharing one time of day.
 struct Epoch {
     time_of_day_ns: i64,
-    /// The first GGA with a fix (or without: quality 0) and its line.
-    gga: Option<(Option<GgaPosition>, GnssFixQuality, usize)>,
-    /// RMC status valid, and its date (days since the epoch).
-    rmc: Option<(bool, Option<i64>)>,
+    /// Line of the epoch's first sentence.
+    line: usize,
+    /// The first GGA: its position (`None`: quality 0, no fix) and quality.
+    gga: Option<(Option<GgaPosition>, GnssFixQuality)>,
+    /// The first RMC.
+    rmc: Option<sentence::Rmc>,
     horizontal_sigma_m: Option<f64>,
 }
 
 impl Epoch {
-    fn new(time_of_day_ns: i64) -> Self {
-        Self { time_of_day_ns, gga: None, rmc: None, horizontal_sigma_m: None }
+    fn new(time_of_day_ns: i64, line: usize) -> Self {
+        Self { time_of_day_ns, line, gga: None, rmc: None, horizontal_sigma_m: None }
     }
 
     /// Adds a sentence of this epoch; the first of each type wins. Returns
     /// whether it was a second GGA (a duplicate epoch).
-    fn join(&mut self, part: Part, line: usize) -> bool {
+    fn join(&mut self, part: Part) -> bool {
         match part {
-            Part::Gga(gga) if self.gga.is_none() => self.gga = Some((gga.position, gga.quality, line)),
+            Part::Gga(gga) if self.gga.is_none() => self.gga = Some((gga.position, gga.quality)),
             Part::Gga(_) => return true,
             Part::Rmc(rmc) => {
-                self.rmc.get_or_insert((rmc.valid, rmc.days));
+                self.rmc.get_or_insert(rmc);
             }
             Part::Gst(gst) => self.horizontal_sigma_m = self.horizontal_sigma_m.or(gst.horizontal_sigma_m),
         }
         false
+    }
+
+    /// The fix this epoch gives: from the GGA when there is one (and the RMC
+    /// does not say no fix), else from a valid RMC. `Err(())` is an epoch
+    /// without a fix, `Ok(None)` one with neither GGA nor RMC (a lone GST).
+    fn fix(&self) -> Result<Option<Candidate>, ()> {
+        let rmc_says_no_fix = self.rmc.as_ref().is_some_and(|rmc| !rmc.valid);
+        let candidate = match (&self.gga, &self.rmc) {
+            (Some((Some(p), quality)), _) if !rmc_says_no_fix => Candidate {
+                latitude_deg: p.latitude_deg,
+                longitude_deg: p.longitude_deg,
+                altitude_msl_m: p.altitude_msl_m,
+                geoid_separation_m: p.geoid_separation_m,
+                num_satellites: p.num_satellites,
+                quality: *quality,
+                rmc_only: false,
+            },
+            (None, Some(sentence::Rmc { position: Some(p), .. })) => Candidate {
+                latitude_deg: p.latitude_deg,
+                longitude_deg: p.longitude_deg,
+                altitude_msl_m: None,
+                geoid_separation_m: None,
+                num_satellites: None,
+                quality: p.quality,
+                rmc_only: true,
+            },
+            (None, None) => return Ok(None),
+            _ => return Err(()),
+        };
+        Ok(Some(candidate))
     }
 }
 
@@ -149,11 +200,22 @@ impl Part {
     }
 }
 
+/// What an epoch's fix is made of, before it has a UNIX time.
+struct Candidate {
+    latitude_deg: f64,
+    longitude_deg: f64,
+    altitude_msl_m: Option<f64>,
+    geoid_separation_m: Option<f64>,
+    num_satellites: Option<u32>,
+    quality: GnssFixQuality,
+    /// From an RMC without a usable GGA.
+    rmc_only: bool,
+}
+
 /// A fix whose date is not known yet (GGAs before the first RMC).
 struct Undated {
     time_of_day_ns: i64,
-    position: GgaPosition,
-    quality: GnssFixQuality,
+    candidate: Candidate,
     horizontal_sigma_m: Option<f64>,
     line: usize,
 }
@@ -175,92 +237,91 @@ fn clock(t_ns: i64) -> String {
     format!("{:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, ns % 1_000_000_000)
 }
 
-struct Assembler<'a> {
-    path: &'a Path,
+#[derive(Default)]
+struct Assembler {
     log: NmeaLog,
     /// Line of each fix, for messages.
     fix_lines: Vec<usize>,
-    /// Geoid separation of each fix.
+    /// Geoid separation of each fix that has an altitude (to pick the datum).
     separations_m: Vec<Option<f64>>,
     /// Latest known UNIX time (an RMC's date and time, or a fix), for dating.
     reference_ns: Option<i64>,
     undated: Vec<Undated>,
 }
 
-impl Assembler<'_> {
-    fn close(&mut self, epoch: Epoch) -> Result<(), IngestError> {
-        let rmc_date = epoch.rmc.and_then(|(_, days)| days);
+impl Assembler {
+    fn close(&mut self, epoch: Epoch) {
+        let rmc_date = epoch.rmc.as_ref().and_then(|rmc| rmc.days);
         if let Some(days) = rmc_date {
             let reference_ns = days * NS_PER_DAY + epoch.time_of_day_ns;
             self.reference_ns = Some(reference_ns);
             for undated in std::mem::take(&mut self.undated) {
                 let t_ns = nearest_ns(reference_ns, undated.time_of_day_ns);
-                self.emit(t_ns, undated.position, undated.quality, undated.horizontal_sigma_m, undated.line)?;
+                self.emit(t_ns, undated.candidate, undated.horizontal_sigma_m, undated.line);
             }
         }
-        let Some((position, quality, line)) = epoch.gga else { return Ok(()) };
-        let rmc_says_no_fix = epoch.rmc.is_some_and(|(valid, _)| !valid);
-        let Some(position) = position.filter(|_| !rmc_says_no_fix) else {
-            self.log.epochs_without_fix += 1;
-            return Ok(());
+        let candidate = match epoch.fix() {
+            Ok(Some(candidate)) => candidate,
+            Ok(None) => return,
+            Err(()) => {
+                self.log.epochs_without_fix += 1;
+                return;
+            }
         };
         let t_ns = match (rmc_date, self.reference_ns) {
             (Some(days), _) => days * NS_PER_DAY + epoch.time_of_day_ns,
             (None, Some(reference_ns)) => nearest_ns(reference_ns, epoch.time_of_day_ns),
             (None, None) => {
-                let time_of_day_ns = epoch.time_of_day_ns;
-                let horizontal_sigma_m = epoch.horizontal_sigma_m;
-                self.undated.push(Undated { time_of_day_ns, position, quality, horizontal_sigma_m, line });
-                return Ok(());
+                let (time_of_day_ns, horizontal_sigma_m, line) =
+                    (epoch.time_of_day_ns, epoch.horizontal_sigma_m, epoch.line);
+                self.undated.push(Undated { time_of_day_ns, candidate, horizontal_sigma_m, line });
+                return;
             }
         };
-        self.emit(t_ns, position, quality, epoch.horizontal_sigma_m, line)?;
-        self.reference_ns = Some(t_ns);
-        Ok(())
+        if self.emit(t_ns, candidate, epoch.horizontal_sigma_m, epoch.line) {
+            self.reference_ns = Some(t_ns);
+        }
     }
 
-    fn emit(
-        &mut self,
-        t_ns: i64,
-        position: GgaPosition,
-        quality: GnssFixQuality,
-        horizontal_sigma_m: Option<f64>,
-        line: usize,
-    ) -> Result<(), IngestError> {
+    /// Appends a fix; returns whether it was kept (not a repeated or
+    /// out-of-order epoch, which are counted instead).
+    fn emit(&mut self, t_ns: i64, candidate: Candidate, horizontal_sigma_m: Option<f64>, line: usize) -> bool {
         if let (Some(last), Some(last_line)) = (self.log.fixes.last(), self.fix_lines.last()) {
             if t_ns == last.t_ns {
                 self.log.duplicate_epochs += 1;
-                return Ok(());
+                return false;
             }
             if t_ns < last.t_ns {
-                let back_ns = last.t_ns - t_ns;
-                return Err(IngestError::BadRecord {
-                    path: self.path.to_path_buf(),
-                    record: format!("line {line}"),
-                    field: "time".into(),
-                    detail: format!(
-                        "fix at {} UTC is {}.{:09} s before the previous fix ({} UTC, line {last_line}); \
-                         fix times must increase",
+                self.log.out_of_order_epochs += 1;
+                if self.log.first_out_of_order.is_none() {
+                    let back_ns = last.t_ns - t_ns;
+                    let reason = format!(
+                        "fix at {} UTC is {}.{:09} s before the previous fix ({} UTC, line {last_line})",
                         clock(t_ns),
                         back_ns / 1_000_000_000,
                         back_ns % 1_000_000_000,
                         clock(last.t_ns),
-                    ),
-                });
+                    );
+                    self.log.first_out_of_order = Some(SkippedLine { line, reason });
+                }
+                return false;
             }
         }
         self.fix_lines.push(line);
-        self.separations_m.push(position.geoid_separation_m);
+        if candidate.altitude_msl_m.is_some() {
+            self.separations_m.push(candidate.geoid_separation_m);
+        }
+        self.log.rmc_only_fixes += u64::from(candidate.rmc_only);
         self.log.fixes.push(GnssFix {
             t_ns,
-            latitude_deg: position.latitude_deg,
-            longitude_deg: position.longitude_deg,
-            altitude_m: position.altitude_msl_m,
+            latitude_deg: candidate.latitude_deg,
+            longitude_deg: candidate.longitude_deg,
+            altitude_m: candidate.altitude_msl_m,
             horizontal_sigma_m,
-            num_satellites: position.num_satellites,
-            quality,
+            num_satellites: candidate.num_satellites,
+            quality: candidate.quality,
         });
-        Ok(())
+        true
     }
 
     fn unparsable(&mut self, line: usize, reason: impl FnOnce() -> String) {
@@ -269,20 +330,30 @@ impl Assembler<'_> {
             self.log.first_unparsable = Some(SkippedLine { line, reason: reason() });
         }
     }
+
+    /// The log, altitudes moved to the ellipsoid when every fix with an
+    /// altitude gives the geoid separation.
+    fn finish(self) -> NmeaLog {
+        let mut log = self.log;
+        if self.separations_m.is_empty() {
+            log.altitude_datum = "";
+        } else if self.separations_m.iter().all(Option::is_some) {
+            let mut separations = self.separations_m.iter().flatten();
+            for altitude_m in log.fixes.iter_mut().filter_map(|fix| fix.altitude_m.as_mut()) {
+                *altitude_m += separations.next().copied().unwrap_or(0.0);
+            }
+            log.altitude_datum = "ellipsoid";
+        } else {
+            log.altitude_datum = "mean sea level";
+        }
+        log
+    }
 }
 
-/// Parses a whole log. Fails only when time goes backwards or when there are
-/// fixes but no date; everything else is skipped and counted (see the module
-/// documentation).
+/// Parses a whole log. Fails only when there are fixes but no date;
+/// everything else is skipped and counted (see the module documentation).
 pub fn parse_nmea(path: &Path, text: &str) -> Result<NmeaLog, IngestError> {
-    let mut assembler = Assembler {
-        path,
-        log: NmeaLog::default(),
-        fix_lines: Vec::new(),
-        separations_m: Vec::new(),
-        reference_ns: None,
-        undated: Vec::new(),
-    };
+    let mut assembler = Assembler::default();
     let mut current: Option<Epoch> = None;
     for (index, raw) in text.lines().enumerate() {
         let line_number = index + 1;
@@ -329,15 +400,15 @@ pub fn parse_nmea(path: &Path, text: &str) -> Result<NmeaLog, IngestError> {
             continue;
         };
         if let Some(epoch) = current.take_if(|epoch| epoch.time_of_day_ns != time_of_day_ns) {
-            assembler.close(epoch)?;
+            assembler.close(epoch);
         }
-        let epoch = current.get_or_insert_with(|| Epoch::new(time_of_day_ns));
-        if epoch.join(part, line_number) {
+        let epoch = current.get_or_insert_with(|| Epoch::new(time_of_day_ns, line_number));
+        if epoch.join(part) {
             assembler.log.duplicate_epochs += 1;
         }
     }
     if let Some(epoch) = current {
-        assembler.close(epoch)?;
+        assembler.close(epoch);
     }
     if let Some(first) = assembler.undated.first() {
         return Err(IngestError::BadLayout {
@@ -350,18 +421,7 @@ pub fn parse_nmea(path: &Path, text: &str) -> Result<NmeaLog, IngestError> {
             ),
         });
     }
-    let mut log = assembler.log;
-    if !log.fixes.is_empty() {
-        if assembler.separations_m.iter().all(Option::is_some) {
-            for (fix, separation_m) in log.fixes.iter_mut().zip(&assembler.separations_m) {
-                fix.altitude_m += separation_m.unwrap_or(0.0);
-            }
-            log.altitude_datum = "ellipsoid";
-        } else {
-            log.altitude_datum = "mean sea level";
-        }
-    }
-    Ok(log)
+    Ok(assembler.finish())
 }
 
 /// Reads and parses a log file. Bytes that are not UTF-8 make their lines
@@ -381,9 +441,11 @@ pub struct NmeaReport {
 }
 
 /// Writes the fixes of an NMEA log into `out` (new, or a copy of `extend` plus
-/// the fixes). The metadata records the altitude datum and the origin of the
-/// local ENU frame (the first fix) that analyses use, e.g. for distance
-/// travelled.
+/// the fixes). The metadata records the altitude datum (`none (no fix gives
+/// an altitude)` when no fix has one) and the origin of the local ENU frame
+/// that analyses use, e.g. for distance travelled: the first fix's latitude
+/// and longitude, and the height of the first fix that has one (the key is
+/// left out when none has).
 pub fn ingest_nmea(
     input: &Path,
     out: &Path,
@@ -405,13 +467,19 @@ pub fn ingest_nmea(
             log.epochs_without_fix
         ),
     })?;
-    let extra = std::collections::BTreeMap::from([
+    let altitude_datum = match log.altitude_datum {
+        "" => "none (no fix gives an altitude)",
+        datum => datum,
+    };
+    let mut extra = std::collections::BTreeMap::from([
         ("gnss.source".to_string(), format!("nmea:{}", input.display())),
-        ("gnss.altitude_datum".to_string(), log.altitude_datum.to_string()),
+        ("gnss.altitude_datum".to_string(), altitude_datum.to_string()),
         ("gnss.enu_origin_latitude_deg".to_string(), first.latitude_deg.to_string()),
         ("gnss.enu_origin_longitude_deg".to_string(), first.longitude_deg.to_string()),
-        ("gnss.enu_origin_altitude_m".to_string(), first.altitude_m.to_string()),
     ]);
+    if let Some(altitude_m) = log.fixes.iter().find_map(|fix| fix.altitude_m) {
+        extra.insert("gnss.enu_origin_altitude_m".to_string(), altitude_m.to_string());
+    }
     let source = format!("nmea:{}", input.display());
     let mut writer = crate::target::open_writer(out, extend, &source, extra, &[GNSS_TOPIC, GNSS_VIZ_TOPIC], recording)?;
     for fix in &log.fixes {

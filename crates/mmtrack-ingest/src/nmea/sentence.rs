@@ -181,8 +181,9 @@ fn finite(text: &str) -> Option<f64> {
 pub(super) struct GgaPosition {
     pub latitude_deg: f64,
     pub longitude_deg: f64,
-    /// Altitude above mean sea level (GGA field 9).
-    pub altitude_msl_m: f64,
+    /// Altitude above mean sea level (GGA field 9); `None` when the field is
+    /// empty.
+    pub altitude_msl_m: Option<f64>,
     /// Geoid separation (GGA field 11), ellipsoid minus mean sea level.
     pub geoid_separation_m: Option<f64>,
     pub num_satellites: Option<u32>,
@@ -234,8 +235,13 @@ pub(super) fn parse_gga(fields: &[&str]) -> Result<Gga, FieldError> {
             format!("'{},{}' is not dddmm.mm,E|W within 180 degrees", get(fields, 4), get(fields, 5)),
         )
     })?;
-    let altitude_msl_m = finite(get(fields, 9))
-        .ok_or_else(|| field_error("altitude", format!("'{}' is not a finite number of metres", get(fields, 9))))?;
+    let altitude_msl_m = match get(fields, 9) {
+        "" => None,
+        text => Some(
+            finite(text)
+                .ok_or_else(|| field_error("altitude", format!("'{text}' is not a finite number of metres")))?,
+        ),
+    };
     let geoid_separation_m = match get(fields, 11) {
         "" => None,
         text => Some(
@@ -256,21 +262,36 @@ pub(super) fn parse_gga(fields: &[&str]) -> Result<Gga, FieldError> {
     })
 }
 
-/// An RMC sentence: only what dating and validity need.
-#[derive(Debug, Clone, PartialEq)]
-pub(super) struct Rmc {
-    /// Time of day; may be empty only with status `V`.
-    pub time_of_day_ns: Option<i64>,
-    /// Status `A` (valid) or `V` (no fix).
-    pub valid: bool,
-    /// Date, days since the UNIX epoch; may be empty only with status `V`.
-    pub days: Option<i64>,
+/// Position part of a valid RMC.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct RmcPosition {
+    pub latitude_deg: f64,
+    pub longitude_deg: f64,
+    /// From the mode indicator (field 12, NMEA 2.3 and later): A autonomous,
+    /// D differential, E dead reckoning, F RTK float, R RTK fixed; anything
+    /// else, or no field, unknown.
+    pub quality: GnssFixQuality,
 }
 
-/// RMC: `time, status, lat, N|S, lon, E|W, speed, course, date, ...`.
+/// An RMC sentence: what dating, validity and a fix without GGA need.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Rmc {
+    /// Time of day; may be empty only without a fix.
+    pub time_of_day_ns: Option<i64>,
+    /// Status `A` (valid) and a mode other than `N` (not valid).
+    pub valid: bool,
+    /// Date, days since the UNIX epoch; may be empty only without a fix.
+    pub days: Option<i64>,
+    /// Where, exactly when `valid`.
+    pub position: Option<RmcPosition>,
+}
+
+/// RMC: `time, status, lat, N|S, lon, E|W, speed, course, date, magnetic
+/// variation, E|W, mode, ...`. Status `A` with mode `N` is no fix.
 pub(super) fn parse_rmc(fields: &[&str]) -> Result<Rmc, FieldError> {
+    let mode = get(fields, 12);
     let valid = match get(fields, 2) {
-        "A" => true,
+        "A" => mode != "N",
         "V" => false,
         other => return Err(field_error("status", format!("'{other}' is not A (valid) or V (no fix)"))),
     };
@@ -287,7 +308,27 @@ pub(super) fn parse_rmc(fields: &[&str]) -> Result<Rmc, FieldError> {
         "" if !valid => None,
         _ => Some(date_days(date_text).ok_or_else(|| field_error("date", format!("'{date_text}' is not ddmmyy")))?),
     };
-    Ok(Rmc { time_of_day_ns, valid, days })
+    if !valid {
+        return Ok(Rmc { time_of_day_ns, valid, days, position: None });
+    }
+    let latitude_deg = coordinate_deg(get(fields, 3), get(fields, 4), 2, 90.0).ok_or_else(|| {
+        field_error("latitude", format!("'{},{}' is not ddmm.mm,N|S within 90 degrees", get(fields, 3), get(fields, 4)))
+    })?;
+    let longitude_deg = coordinate_deg(get(fields, 5), get(fields, 6), 3, 180.0).ok_or_else(|| {
+        field_error(
+            "longitude",
+            format!("'{},{}' is not dddmm.mm,E|W within 180 degrees", get(fields, 5), get(fields, 6)),
+        )
+    })?;
+    let quality = match mode {
+        "A" => GnssFixQuality::Autonomous,
+        "D" => GnssFixQuality::Differential,
+        "E" => GnssFixQuality::DeadReckoning,
+        "F" => GnssFixQuality::RtkFloat,
+        "R" => GnssFixQuality::RtkFixed,
+        _ => GnssFixQuality::Unknown,
+    };
+    Ok(Rmc { time_of_day_ns, valid, days, position: Some(RmcPosition { latitude_deg, longitude_deg, quality }) })
 }
 
 /// A GST sentence (pseudorange error statistics).
@@ -371,7 +412,7 @@ mod tests {
         let gga = parse_gga(&"GPGGA,,,,,,0,00,99.99,,,,,,".split(',').collect::<Vec<_>>()).unwrap();
         assert_eq!((gga.time_of_day_ns, gga.quality, gga.position), (None, GnssFixQuality::NoFix, None));
         let rmc = parse_rmc(&"GPRMC,,V,,,,,,,,,,N".split(',').collect::<Vec<_>>()).unwrap();
-        assert_eq!(rmc, Rmc { time_of_day_ns: None, valid: false, days: None });
+        assert_eq!(rmc, Rmc { time_of_day_ns: None, valid: false, days: None, position: None });
         // A valid RMC must carry its date.
         let err = parse_rmc(&"GPRMC,021417.00,A,3725.5,N,12205.6,W,0,0,,,,A".split(',').collect::<Vec<_>>());
         assert_eq!(err.unwrap_err().field, "date");

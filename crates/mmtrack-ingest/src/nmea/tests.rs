@@ -40,7 +40,7 @@ fn epoch_gives_exact_time_position_and_ellipsoid_height() {
     assert_eq!(fix.t_ns, T0_S * 1_000_000_000 + 250_000_000);
     assert!((fix.latitude_deg - (37.0 + 25.58362 / 60.0)).abs() < 1e-12);
     assert!((fix.longitude_deg + (122.0 + 5.61915 / 60.0)).abs() < 1e-12);
-    assert!((fix.altitude_m - (4.4 - 30.0)).abs() < 1e-12);
+    assert!((fix.altitude_m.unwrap() - (4.4 - 30.0)).abs() < 1e-12);
     assert_eq!((fix.quality, fix.num_satellites, fix.horizontal_sigma_m), (GnssFixQuality::RtkFloat, Some(12), None));
     assert_eq!((log.altitude_datum, log.ignored_sentences), ("ellipsoid", 1));
     // Nanosecond digits are kept exactly (an f64 of seconds would not).
@@ -111,7 +111,9 @@ fn bad_fields_in_a_valid_sentence_skip_the_line_and_name_it() {
     }
     text += &epoch("GN", "021422.00");
     let log = parse(&text).unwrap();
-    assert_eq!((log.fixes.len(), log.unparsable_lines), (1, 5));
+    // The first epoch's GGA does not parse, so its valid RMC gives the fix.
+    assert_eq!((log.fixes.len(), log.unparsable_lines, log.rmc_only_fixes), (2, 5, 1));
+    assert_eq!(log.fixes.iter().map(|f| f.altitude_m.is_some()).collect::<Vec<_>>(), vec![false, true]);
     let first = log.first_unparsable.unwrap();
     assert_eq!(first.line, 2);
     assert!(first.reason.contains("GNGGA: latitude:") && first.reason.contains("'37x5.58,N'"), "{}", first.reason);
@@ -128,17 +130,82 @@ fn gga_without_rmc_is_an_error() {
 }
 
 #[test]
-fn time_going_backwards_names_the_line_and_duplicates_merge() {
-    let text = epoch("GN", "021417.00") + &epoch("GN", "021416.00");
-    let err = parse(&text).unwrap_err().to_string();
+fn an_epoch_earlier_than_the_previous_fix_is_skipped_and_counted() {
+    // 5 Hz, one epoch stamped 0.3 s back (a receiver's clock correction): it
+    // is skipped, the log is not rejected, and the epochs after it are kept.
+    let text = ["021417.00", "021417.20", "021417.40", "021417.10", "021417.60", "021417.80"]
+        .iter()
+        .map(|t| epoch("GN", t))
+        .collect::<String>();
+    let log = parse(&text).unwrap();
+    let t0_ns = T0_S * 1_000_000_000;
+    let times: Vec<i64> = log.fixes.iter().map(|f| (f.t_ns - t0_ns) / 1_000_000).collect();
+    assert_eq!(times, vec![0, 200, 400, 600, 800]);
+    assert_eq!(log.out_of_order_epochs, 1);
+    let first = log.first_out_of_order.as_ref().unwrap();
+    // Lines are those of each epoch's first sentence.
+    assert_eq!(first.line, 10);
     assert!(
-        err.contains("drive.nmea: line 5: time:") && err.contains("1.000000000 s before") && err.contains("line 2"),
-        "{err}"
+        first.reason.contains("021417.100000000 UTC")
+            && first.reason.contains("0.300000000 s before")
+            && first.reason.contains("line 7"),
+        "{}",
+        first.reason
     );
-    // The same epoch twice (and a GPGGA beside the GNGGA) is merged, not an error.
+    // The same epoch twice (and a GPGGA beside the GNGGA) is merged, not counted as out of order.
     let text = epoch("GN", "021417.00") + &gga("GP", "021417.00", "5") + "\n" + &epoch("GN", "021417.00");
     let log = parse(&text).unwrap();
-    assert_eq!((log.fixes.len(), log.duplicate_epochs), (1, 2));
+    assert_eq!((log.fixes.len(), log.duplicate_epochs, log.out_of_order_epochs), (1, 2, 0));
+}
+
+#[test]
+fn an_rmc_without_a_usable_gga_is_a_fix_without_altitude() {
+    let t0_ns = T0_S * 1_000_000_000;
+    // RMC alone: position, date and the mode indicator's quality; no height
+    // and no satellite count.
+    let log = parse(&(rmc("GN", "021417.00", "A", "070220") + "\n")).unwrap();
+    assert_eq!(log.fixes.len(), 1);
+    let fix = &log.fixes[0];
+    assert_eq!((fix.t_ns, fix.altitude_m, fix.num_satellites), (t0_ns, None, None));
+    assert!((fix.latitude_deg - (37.0 + 25.58362 / 60.0)).abs() < 1e-12);
+    assert!((fix.longitude_deg + (122.0 + 5.61915 / 60.0)).abs() < 1e-12);
+    assert_eq!((fix.quality, log.rmc_only_fixes, log.altitude_datum), (GnssFixQuality::RtkFloat, 1, ""));
+    // Mode indicators map like GGA qualities; N (not valid) and status V are no fix.
+    for (mode, expected) in [
+        ("A", Some(GnssFixQuality::Autonomous)),
+        ("D", Some(GnssFixQuality::Differential)),
+        ("E", Some(GnssFixQuality::DeadReckoning)),
+        ("R", Some(GnssFixQuality::RtkFixed)),
+        ("", Some(GnssFixQuality::Unknown)),
+        ("N", None),
+    ] {
+        let line = sentence(&format!("GNRMC,021417.00,A,3725.58362,N,12205.61915,W,0.0,0.0,070220,,,{mode}"));
+        let log = parse(&line).unwrap();
+        assert_eq!(log.fixes.first().map(|f| f.quality), expected, "mode {mode}");
+        assert_eq!(log.epochs_without_fix, u64::from(expected.is_none()), "mode {mode}");
+    }
+    let log = parse(&rmc("GN", "021417.00", "V", "070220")).unwrap();
+    assert_eq!((log.fixes.len(), log.epochs_without_fix), (0, 1));
+    // A GGA with an empty altitude still gives its position and satellites.
+    let no_height = sentence("GNGGA,021418.00,3725.58362,N,12205.61915,W,1,12,0.76,,M,,M,,");
+    let text = epoch("GN", "021417.00") + &rmc("GN", "021418.00", "A", "070220") + "\n" + &no_height + "\n";
+    let log = parse(&text).unwrap();
+    assert_eq!(log.fixes.iter().map(|f| f.altitude_m.is_some()).collect::<Vec<_>>(), vec![true, false]);
+    assert_eq!((log.fixes[1].num_satellites, log.fixes[1].quality), (Some(12), GnssFixQuality::Autonomous));
+    assert_eq!((log.unparsable_lines, log.rmc_only_fixes, log.altitude_datum), (0, 0, "ellipsoid"));
+    // A GGA that does not parse leaves its epoch to the RMC (and is counted).
+    let bad_gga = gga("GN", "021418.00", "4").replace("3725.58362", "37x5.58362");
+    let text = epoch("GN", "021417.00")
+        + &rmc("GN", "021418.00", "A", "070220")
+        + "\n"
+        + &sentence(&bad_gga[1..bad_gga.len() - 3]);
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.unparsable_lines, log.rmc_only_fixes), (2, 1, 1));
+    assert_eq!(log.fixes[1].altitude_m, None);
+    // A valid RMC must say where.
+    let err = parse(&sentence("GNRMC,021417.00,A,,,,,0.0,0.0,070220,,,A")).unwrap();
+    assert_eq!((err.fixes.len(), err.unparsable_lines), (0, 1));
+    assert!(err.first_unparsable.unwrap().reason.contains("GNRMC: latitude"));
 }
 
 #[test]
@@ -160,11 +227,13 @@ fn gga_before_rmc_and_midnight_rollover_are_dated_right() {
     let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000_000 - midnight_s).collect();
     assert_eq!(times, vec![-2, 0, 1]);
     assert_eq!(log.epochs_without_fix, 1);
-    // GGAs before the first RMC, across midnight, dated by that RMC.
+    // GGAs before the first RMC, across midnight, dated by that RMC (which
+    // is a fix of its own, without altitude).
     let lines = [gga("GN", "235959.00", "1"), gga("GN", "000000.00", "1"), rmc("GN", "000001.00", "A", "010220")];
     let log = parse(&lines.join("\n")).unwrap();
     let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000_000 - midnight_s).collect();
-    assert_eq!(times, vec![-1, 0]);
+    assert_eq!(times, vec![-1, 0, 1]);
+    assert_eq!((log.rmc_only_fixes, log.fixes[2].altitude_m), (1, None));
 }
 
 #[test]
@@ -190,7 +259,7 @@ fn altitude_is_above_mean_sea_level_unless_every_fix_gives_the_geoid() {
     let text = epoch("GN", "021417.00") + &rmc("GN", "021418.00", "A", "070220") + "\n" + &without_geoid;
     let log = parse(&text).unwrap();
     assert_eq!(log.altitude_datum, "mean sea level");
-    assert!(log.fixes.iter().all(|f| (f.altitude_m - 4.4).abs() < 1e-12));
+    assert!(log.fixes.iter().all(|f| (f.altitude_m.unwrap() - 4.4).abs() < 1e-12));
     assert_eq!(parse("").unwrap(), NmeaLog::default());
 }
 
@@ -230,6 +299,71 @@ fn real_ublox_drive_gives_1653_fixes() {
         (count(GnssFixQuality::RtkFixed), count(GnssFixQuality::RtkFloat), count(GnssFixQuality::Differential)),
         (967, 632, 54)
     );
+}
+
+fn real_log() -> Option<String> {
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/realdata/nmea-ublox-f9k/MTV.Local1.ublox-F9K.20200206-181434.nmea"
+    ));
+    if !path.is_file() {
+        eprintln!("skipped: real data not found at {}", path.display());
+        return None;
+    }
+    Some(String::from_utf8_lossy(&std::fs::read(path).unwrap()).into_owned())
+}
+
+#[test]
+fn real_drive_without_usable_gga_still_gives_every_fix() {
+    let Some(text) = real_log() else { return };
+    let with_gga = parse(&text).unwrap();
+    // Every GGA dropped: the 1653 RMCs (status A) give the same times and
+    // positions, the quality from the RMC mode (it matches the GGA quality
+    // in every epoch of this log), no altitude.
+    let rmc_only: String = text.lines().filter(|l| !l.contains("GGA,")).map(|l| format!("{l}\n")).collect();
+    let log = parse(&rmc_only).unwrap();
+    assert_eq!((log.fixes.len(), log.rmc_only_fixes, log.altitude_datum), (1653, 1653, ""));
+    for (a, b) in log.fixes.iter().zip(&with_gga.fixes) {
+        assert_eq!(
+            (a.t_ns, a.latitude_deg, a.longitude_deg, a.quality),
+            (b.t_ns, b.latitude_deg, b.longitude_deg, b.quality)
+        );
+        assert_eq!((a.altitude_m, a.num_satellites), (None, None));
+    }
+    // Every GGA's altitude emptied (and re-signed): counted as fixes, not unparsable lines.
+    let no_height: String = text
+        .lines()
+        .map(|l| match l.strip_prefix('$').and_then(|b| b.rsplit_once('*')) {
+            Some((payload, _)) if payload.contains("GGA,") => {
+                let mut fields: Vec<&str> = payload.split(',').collect();
+                fields[9] = "";
+                sentence(&fields.join(",")) + "\n"
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    let log = parse(&no_height).unwrap();
+    assert_eq!((log.fixes.len(), log.unparsable_lines, log.rmc_only_fixes), (1653, 0, 0));
+    assert!(log.fixes.iter().all(|f| f.altitude_m.is_none() && f.num_satellites.is_some()));
+}
+
+#[test]
+fn real_drive_with_one_epoch_stamped_back_keeps_the_rest() {
+    let Some(text) = real_log() else { return };
+    // The epoch of 02:15:57 restamped 0.3 s before the one of 02:15:56 (its
+    // sentences re-signed).
+    let text: String = text
+        .lines()
+        .map(|l| match l.strip_prefix('$').and_then(|b| b.rsplit_once('*')) {
+            Some((payload, _)) if payload.contains(",021557.00,") => {
+                sentence(&payload.replace(",021557.00,", ",021555.70,")) + "\n"
+            }
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.out_of_order_epochs), (1652, 1));
+    assert!(log.first_out_of_order.unwrap().reason.contains("0.300000000 s before"));
 }
 
 /// A valid multi-epoch log to mutate.
@@ -279,7 +413,7 @@ proptest! {
         };
         if let Ok(log) = parse(&text) {
             prop_assert!(log.fixes.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
-            prop_assert!(log.fixes.iter().all(|f| f.latitude_deg.abs() <= 90.0 && f.altitude_m.is_finite()));
+            prop_assert!(log.fixes.iter().all(|f| f.latitude_deg.abs() <= 90.0 && f.altitude_m.is_none_or(f64::is_finite)));
         }
     }
 
@@ -331,6 +465,6 @@ proptest! {
         // 7 decimals of a minute round by at most 5e-8 min = 8.3e-10 deg.
         prop_assert!((fix.latitude_deg - lat_deg).abs() < 1e-9, "{} vs {}", fix.latitude_deg, lat_deg);
         prop_assert!((fix.longitude_deg - lon_deg).abs() < 1e-9, "{} vs {}", fix.longitude_deg, lon_deg);
-        prop_assert!((fix.altitude_m - altitude_m).abs() < 1e-9);
+        prop_assert!((fix.altitude_m.unwrap() - altitude_m).abs() < 1e-9);
     }
 }

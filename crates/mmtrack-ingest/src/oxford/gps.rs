@@ -71,7 +71,7 @@ pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, Inges
                 t_ns,
                 latitude_deg,
                 longitude_deg,
-                altitude_m: row.finite("altitude")?,
+                altitude_m: Some(row.finite("altitude")?),
                 horizontal_sigma_m: Some(((sigma_lat_m * sigma_lat_m + sigma_lon_m * sigma_lon_m) / 2.0).sqrt()),
                 num_satellites: Some(
                     satellites

@@ -429,7 +429,9 @@ impl RecordingWriter {
                 frame_id: "gnss".into(),
                 latitude: fix.latitude_deg,
                 longitude: fix.longitude_deg,
-                altitude: fix.altitude_m,
+                // As sensor_msgs/NavSatFix, which LocationFix mirrors: NaN
+                // when no altitude is available.
+                altitude: fix.altitude_m.unwrap_or(f64::NAN),
                 position_covariance: covariance,
                 position_covariance_type: covariance_type,
                 ..Default::default()

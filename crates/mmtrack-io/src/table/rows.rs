@@ -26,7 +26,7 @@ crate::define_table! {
         t_ns: i64, "ns", "fix time";
         latitude_deg: f64, "deg", "geodetic latitude, north positive";
         longitude_deg: f64, "deg", "geodetic longitude, east positive";
-        altitude_m: f64, "m", "height";
+        altitude_m: Option<f64>, "m", "height; null when not reported (an NMEA RMC without GGA)";
         horizontal_sigma_m: Option<f64>, "m", "1-sigma horizontal uncertainty; null when not reported";
         num_satellites: Option<u32>, "", "satellites used; null when not reported";
         quality: u32, "",

@@ -94,7 +94,7 @@ fn descriptors_match_prost_encoding() {
         t_ns: 1,
         latitude_deg: 1.0,
         longitude_deg: 2.0,
-        altitude_m: 3.0,
+        altitude_m: Some(3.0),
         horizontal_sigma_m: Some(0.5),
         num_satellites: Some(3),
         quality: 2,
