@@ -25,7 +25,8 @@ fn bad(path: &Path, line: usize, field: &str, detail: String) -> IngestError {
     IngestError::BadRecord { path: path.to_path_buf(), record: format!("line {line}"), field: field.into(), detail }
 }
 
-/// Parses `gps.csv` text. Times must increase strictly.
+/// Parses `gps.csv` text. Times must increase strictly; an empty file is an
+/// error.
 pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestError> {
     let mut fixes: Vec<GnssFix> = Vec::new();
     for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
@@ -92,6 +93,9 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
             quality: GnssFixQuality::Unknown,
         });
     }
+    if fixes.is_empty() {
+        return Err(IngestError::BadLayout { path: path.to_path_buf(), detail: "no fixes (empty file)".into() });
+    }
     Ok(fixes)
 }
 
@@ -130,5 +134,9 @@ mod tests {
         assert!(backwards.contains("line 2") && backwards.contains("does not increase"), "{backwards}");
         let radians = err("5,0.65,2.2,82.5,0,0,0,0,0,0,0,0,0\n6,91,2.2,82.5,0,0,0,0,0,0,0,0,0\n");
         assert!(radians.contains("line 2") && radians.contains("not a geodetic position"), "{radians}");
+        for empty in ["", "\n \n"] {
+            let message = err(empty);
+            assert!(message.contains("gps.csv") && message.contains("no fixes"), "{message}");
+        }
     }
 }
