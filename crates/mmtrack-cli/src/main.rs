@@ -179,9 +179,40 @@ fn one_line(error: &anyhow::Error) -> String {
     printable(&parts.join(": ")).into_owned()
 }
 
+/// On SIGINT or SIGTERM: removes the partial outputs this run is writing
+/// (`mmtrack_io::atomic`), says so on stderr (unless `quiet`; failures
+/// always) and exits with 128 + the signal (130, 143), as a shell reports a
+/// process the signal killed. Partials of runs killed outright (SIGKILL, an
+/// aborted allocation) are removed by the next run that writes the same
+/// output.
+fn remove_partial_outputs_on_interrupt(quiet: bool) {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    // Without the handler (it could not be installed) the signals keep
+    // their default action; the next run still removes the partials.
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else { return };
+    std::thread::spawn(move || {
+        let Some(signal) = signals.forever().next() else { return };
+        let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
+        // Holds the registry until the exit: no new partial starts meanwhile.
+        let cleanup = mmtrack_io::atomic::remove_partial_outputs();
+        for (path, error) in &cleanup.failed {
+            eprintln!(
+                "error: {}: cannot remove this partial output: {error}",
+                printable(path.as_os_str().as_encoded_bytes())
+            );
+        }
+        if !quiet && cleanup.removed > 0 {
+            let plural = if cleanup.removed == 1 { "" } else { "s" };
+            eprintln!("\ninterrupted ({name}): removed {} partial output{plural}", cleanup.removed);
+        }
+        std::process::exit(128 + signal);
+    });
+}
+
 fn main() -> ExitCode {
     exit_quietly_on_a_closed_pipe();
     let cli = Cli::parse();
+    remove_partial_outputs_on_interrupt(cli.quiet);
     // Every command runs on a thread of a rayon pool of the default size
     // (RAYON_NUM_THREADS, else one per core); `--threads N` gives a command
     // a pool of its own.

@@ -1,10 +1,34 @@
 //! Atomic output files: write to a temporary file beside the target, then
-//! rename over it. A crash, an error or a dropped writer leaves the previous
-//! output (if any) untouched and no partial file behind.
+//! rename over it. An error or a dropped writer leaves the previous output (if
+//! any) untouched and no partial file behind.
+//!
+//! # Partial outputs and interruptions
+//!
+//! A partial output is named `.<name>.<pid>.<random>.partial` beside its
+//! target `<name>` (a staging directory: `<prefix><pid>.<random>.partial`),
+//! where `<pid>` is the writing process. Two mechanisms keep them from piling
+//! up when a run cannot clean up after itself:
+//!
+//! - every partial this process is writing is in a registry, and
+//!   [`remove_partial_outputs`] removes them all: the CLI calls it when
+//!   SIGINT or SIGTERM arrives, then exits;
+//! - a run that starts writing `<name>` (or a staging directory with a given
+//!   prefix) first removes the partials of that same name left by earlier
+//!   runs that were killed outright (SIGKILL, an aborted allocation, a power
+//!   cut). A partial is left alone while the process named by its `<pid>` is
+//!   alive, so two runs writing the same output at once do not delete each
+//!   other's work; one of this process's own pid that it is not writing is
+//!   stale (an earlier process that had the same pid, as in containers).
+//!   Liveness is read from `/proc`, so it holds for writers in the same PID
+//!   namespace (one machine, one container); where there is no `/proc`, only
+//!   partials of this process's own pid are removed. Files that do not match
+//!   the pattern exactly are never touched.
 
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use tempfile::NamedTempFile;
 
@@ -35,13 +59,17 @@ pub enum Durability {
 #[derive(Debug)]
 pub struct AtomicFile {
     target: PathBuf,
+    // Dropped before `registration`: the file is gone before it leaves the registry.
     temp: NamedTempFile,
+    registration: Registration,
 }
 
 impl AtomicFile {
     /// Starts writing `target`: checks the overwrite policy, creates the parent
-    /// directories and a hidden temporary file in the same directory (so the
-    /// final rename never crosses file systems).
+    /// directories, removes stale partials of `target` left by killed runs
+    /// (see the module docs) and creates a hidden temporary file
+    /// `.<name>.<pid>.<random>.partial` in the same directory (so the final
+    /// rename never crosses file systems).
     pub fn create(target: &Path, overwrite: Overwrite) -> Result<Self> {
         if overwrite == Overwrite::Refuse && target.exists() {
             return Err(IoError::OutputExists { path: target.to_path_buf() });
@@ -52,12 +80,20 @@ impl AtomicFile {
         };
         std::fs::create_dir_all(&dir).map_err(os_err(&dir))?;
         let file_name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let prefix = format!(".{file_name}.");
+        // Registered under the lock it was created under: an interruption
+        // either finds it in the registry or stops this before it exists.
+        let mut live = live_partials();
+        remove_stale_partials(&dir, &prefix, &live);
         let temp = with_default_mode(&mut tempfile::Builder::new(), 0o666)
-            .prefix(&format!(".{file_name}."))
-            .suffix(".partial")
+            .prefix(&format!("{prefix}{}.", std::process::id()))
+            .suffix(PARTIAL_SUFFIX)
             .tempfile_in(&dir)
             .map_err(os_err(&dir))?;
-        Ok(Self { target: target.to_path_buf(), temp })
+        live.insert(temp.path().to_path_buf(), PartialKind::File);
+        drop(live);
+        let registration = Registration(temp.path().to_path_buf());
+        Ok(Self { target: target.to_path_buf(), temp, registration })
     }
 
     /// The final path.
@@ -78,7 +114,7 @@ impl AtomicFile {
     /// the disk before the rename, so a power cut cannot leave an empty file
     /// in place of the old one.
     pub fn commit(self, overwrite: Overwrite, durability: Durability) -> Result<PathBuf> {
-        let Self { target, temp } = self;
+        let Self { target, temp, registration } = self;
         if durability == Durability::Fsync {
             temp.as_file().sync_all().map_err(os_err(temp.path()))?;
         }
@@ -96,6 +132,7 @@ impl AtomicFile {
                 })?;
             }
         }
+        drop(registration);
         Ok(target)
     }
 }
@@ -107,8 +144,127 @@ impl AtomicFile {
 ///
 /// # Errors
 /// The OS error of creating it.
+///
+/// Named `<prefix><pid>.<random>.partial`; stale ones of the same prefix
+/// left by killed runs are removed first, and the directory is removed by
+/// [`remove_partial_outputs`] while it exists (see the module docs).
 pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::TempDir> {
-    with_default_mode(&mut tempfile::Builder::new(), 0o777).prefix(prefix).suffix(".partial").tempdir_in(parent)
+    let mut live = live_partials();
+    // Staging directories are renamed into place (or dropped) by their
+    // callers; forget those that are gone.
+    live.retain(|path, kind| *kind == PartialKind::File || path.exists());
+    remove_stale_partials(parent, prefix, &live);
+    let dir = with_default_mode(&mut tempfile::Builder::new(), 0o777)
+        .prefix(&format!("{prefix}{}.", std::process::id()))
+        .suffix(PARTIAL_SUFFIX)
+        .tempdir_in(parent)?;
+    live.insert(dir.path().to_path_buf(), PartialKind::Directory);
+    Ok(dir)
+}
+
+/// The end of every partial output's name.
+const PARTIAL_SUFFIX: &str = ".partial";
+
+/// What a registered partial output is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PartialKind {
+    File,
+    Directory,
+}
+
+/// The partial outputs this process is writing.
+static LIVE_PARTIALS: Mutex<BTreeMap<PathBuf, PartialKind>> = Mutex::new(BTreeMap::new());
+
+/// The registry, also after a panic elsewhere (it holds plain paths).
+fn live_partials() -> MutexGuard<'static, BTreeMap<PathBuf, PartialKind>> {
+    LIVE_PARTIALS.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Takes an [`AtomicFile`]'s partial out of the registry when it is committed
+/// or dropped.
+#[derive(Debug)]
+struct Registration(PathBuf);
+
+impl Drop for Registration {
+    fn drop(&mut self) {
+        live_partials().remove(&self.0);
+    }
+}
+
+/// What [`remove_partial_outputs`] did; holds the registry until dropped.
+#[must_use = "drop it only after the process has decided to exit"]
+pub struct PartialOutputsRemoved {
+    /// How many partial files and staging directories were removed.
+    pub removed: usize,
+    /// Partials that could not be removed, with the reason.
+    pub failed: Vec<(PathBuf, std::io::Error)>,
+    _registry: MutexGuard<'static, BTreeMap<PathBuf, PartialKind>>,
+}
+
+/// Removes every partial output this process is writing, for a process that
+/// is being interrupted (SIGINT, SIGTERM). The result keeps the registry
+/// locked, so no new partial output can start (its writer waits) while the
+/// caller exits: keep it alive until `std::process::exit`.
+pub fn remove_partial_outputs() -> PartialOutputsRemoved {
+    let registry = live_partials();
+    let mut removed = 0;
+    let mut failed = Vec::new();
+    for (path, kind) in registry.iter() {
+        let result = match kind {
+            PartialKind::File => std::fs::remove_file(path),
+            PartialKind::Directory => std::fs::remove_dir_all(path),
+        };
+        match result {
+            Ok(()) => removed += 1,
+            // Committed, or dropped, in the meantime.
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => failed.push((path.clone(), e)),
+        }
+    }
+    PartialOutputsRemoved { removed, failed, _registry: registry }
+}
+
+/// Removes the partial outputs in `dir` named `<prefix><pid>.<random>.partial`
+/// whose writer is gone: the process `<pid>` is not running, or it is this
+/// process and `live` (this process's registry) does not hold it. Best
+/// effort: what cannot be read or removed is left. Returns how many went.
+fn remove_stale_partials(dir: &Path, prefix: &str, live: &BTreeMap<PathBuf, PartialKind>) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else { return 0 };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(|n| partial_writer_pid(n, prefix)) else { continue };
+        let path = entry.path();
+        if live.contains_key(&path) || (pid != std::process::id() && process_may_be_running(pid)) {
+            continue;
+        }
+        let result = match entry.file_type() {
+            Ok(t) if t.is_file() => std::fs::remove_file(&path),
+            Ok(t) if t.is_dir() => std::fs::remove_dir_all(&path),
+            _ => continue,
+        };
+        if result.is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// The writer's pid of a partial output named `<prefix><pid>.<random>.partial`
+/// (`<random>`: ASCII letters and digits), `None` for any other name.
+fn partial_writer_pid(name: &str, prefix: &str) -> Option<u32> {
+    let middle = name.strip_prefix(prefix)?.strip_suffix(PARTIAL_SUFFIX)?;
+    let (pid, random) = middle.split_once('.')?;
+    let all_digits = !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit());
+    let random_ok = !random.is_empty() && random.bytes().all(|b| b.is_ascii_alphanumeric());
+    if all_digits && random_ok { pid.parse().ok() } else { None }
+}
+
+/// Whether process `pid` may be running: `/proc/<pid>` exists, or there is
+/// no `/proc` to tell (then every other process is assumed alive).
+fn process_may_be_running(pid: u32) -> bool {
+    let proc = Path::new("/proc");
+    !proc.join("self").exists() || proc.join(pid.to_string()).exists()
 }
 
 /// Asks for `mode` less the umask, as `File::create` (0666) and `create_dir`
@@ -173,6 +329,58 @@ mod tests {
         drop(w);
         f.commit(Overwrite::Refuse, Durability::Fsync).unwrap();
         assert_eq!(std::fs::read(&target).unwrap(), b"whole");
+    }
+
+    #[test]
+    fn partial_names_carry_the_writer_pid() {
+        let prefix = ".out.mcap.";
+        assert_eq!(partial_writer_pid(".out.mcap.123.AbC9x1.partial", prefix), Some(123));
+        for other in [
+            ".out.mcap.AbC9x1.partial",       // no pid (older mmtrack): not ours to judge
+            ".out.mcap.1.123.abc.partial",    // `.out.mcap.1`'s partial
+            ".out.mcap.12x.abc.partial",      // not a pid
+            ".out.mcap.123..partial",         // no random part
+            ".out.mcap.123.abc.partial.keep", // not a partial
+            ".other.mcap.123.abc.partial",    // another output's
+        ] {
+            assert_eq!(partial_writer_pid(other, prefix), None, "{other}");
+        }
+    }
+
+    /// Partials of killed runs are removed when the next run starts writing
+    /// the same output; those of running writers and other names stay.
+    #[test]
+    fn stale_partials_of_the_same_output_are_removed_by_the_next_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("out.bin");
+        let plant = |name: &str| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, b"partial").unwrap();
+            path
+        };
+        // No process has pid u32::MAX (Linux pids stop at 2^22).
+        let dead_writer = plant(&format!(".out.bin.{}.AbC123.partial", u32::MAX));
+        // This process's pid, not in its registry: an earlier process's.
+        let earlier_same_pid = plant(&format!(".out.bin.{}.xyz789.partial", std::process::id()));
+        let staged_dir = dir.path().join(format!(".out.bin.{}.dir001.partial", u32::MAX));
+        std::fs::create_dir(&staged_dir).unwrap();
+        std::fs::write(staged_dir.join("inner"), b"x").unwrap();
+        // Pid 1 is always running: a concurrent writer's.
+        let running_writer = plant(".out.bin.1.QQQ111.partial");
+        let others = [plant(".out.bin.AbC123.partial"), plant(".other.bin.99999999.abc.partial"), plant("notes.txt")];
+
+        let first = AtomicFile::create(&target, Overwrite::Refuse).unwrap();
+        assert!(!dead_writer.exists() && !earlier_same_pid.exists() && !staged_dir.exists());
+        assert!(running_writer.exists() && others.iter().all(|p| p.exists()));
+        let first_partial = first.temp.path().to_path_buf();
+        assert!(partial_writer_pid(&first_partial.file_name().unwrap().to_string_lossy(), ".out.bin.").is_some());
+
+        // A second writer of the same output in this process keeps the first's partial.
+        let second = AtomicFile::create(&target, Overwrite::Replace).unwrap();
+        assert!(first_partial.exists());
+        drop(second);
+        first.commit(Overwrite::Refuse, Durability::PageCache).unwrap();
+        assert!(!first_partial.exists() && target.exists());
     }
 
     #[test]

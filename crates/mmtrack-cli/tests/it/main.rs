@@ -11,6 +11,7 @@ mod common;
 mod error_lines;
 mod fixtures;
 mod independent_readers;
+mod interrupt;
 mod ingest_navtech;
 mod process_mpc;
 mod process_odometry;

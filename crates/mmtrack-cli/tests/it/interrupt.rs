@@ -1,0 +1,118 @@
+//! An interrupted run leaves no partial output: SIGINT / SIGTERM remove it
+//! on the way out (exit 130 / 143), and the partial of a run killed outright
+//! is removed by the next run writing the same output.
+
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use super::common::{files, mmtrack, root, text};
+
+/// A radar drive far longer than the tests wait for (1600 scans of Oxford
+/// size, 3768 bins), so the recording's partial file grows from the start.
+const LONG_DRIVE: &str = "seed = 7\nstart_t_ns = 1_700_000_000_000_000_000\n\n[sensor]\nbins = 3768\n\n\
+[motion]\nspeed_mps = 8.0\nyaw_rate_radps = 0.0\nduration_s = 400.0\n\n[generator]\n";
+
+/// A running `mmtrack`, killed if a test fails before it ends.
+struct Running(Child);
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// Starts `mmtrack simulate radar` on [`LONG_DRIVE`] writing `out.mcap` in `dir`.
+fn start_long_simulation(dir: &Path) -> Running {
+    std::fs::write(dir.join("long.toml"), LONG_DRIVE).unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_mmtrack"))
+        .args(["simulate", "radar", "--scenario", "long.toml", "-o", "out.mcap"])
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    Running(child)
+}
+
+/// Waits for the end of `run`: its exit status and stderr.
+fn finish(mut run: Running) -> (std::process::ExitStatus, String) {
+    let status = run.0.wait().unwrap();
+    let mut stderr = String::new();
+    if let Some(mut pipe) = run.0.stderr.take() {
+        std::io::Read::read_to_string(&mut pipe, &mut stderr).unwrap();
+    }
+    (status, stderr)
+}
+
+/// The hidden partial files in `dir`.
+fn partials(dir: &Path) -> Vec<String> {
+    files(dir).iter().map(|p| p.to_string_lossy().into_owned()).filter(|n| n.ends_with(".partial")).collect()
+}
+
+/// Waits until `run` has written a megabyte into its partial output. The
+/// bound is a timeout, not a measurement: generous for a loaded machine.
+fn wait_for_a_growing_partial(run: &mut Running, dir: &Path) {
+    for _ in 0..1200 {
+        let has_data = partials(dir).iter().any(|n| std::fs::metadata(dir.join(n)).is_ok_and(|m| m.len() > 1 << 20));
+        if has_data {
+            return;
+        }
+        if let Some(status) = run.0.try_wait().unwrap() {
+            panic!("the run ended ({status}) before it wrote a partial output");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    panic!("no partial output appeared in {}", dir.display());
+}
+
+/// `kill -<signal> <pid>`.
+fn send(signal: &str, run: &Running) {
+    let status = Command::new("kill").args([&format!("-{signal}"), &run.0.id().to_string()]).status().unwrap();
+    assert!(status.success(), "kill -{signal}");
+}
+
+#[test]
+fn sigint_and_sigterm_remove_the_partial_output_and_exit_130_143() {
+    for (signal, code) in [("INT", 130), ("TERM", 143)] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut run = start_long_simulation(dir.path());
+        wait_for_a_growing_partial(&mut run, dir.path());
+        send(signal, &run);
+        let (status, stderr) = finish(run);
+        assert_eq!(status.code(), Some(code), "SIG{signal}: {status:?} {stderr}");
+        assert!(stderr.contains(&format!("interrupted (SIG{signal}): removed 1 partial output")), "{stderr}");
+        assert_eq!(partials(dir.path()), Vec::<String>::new(), "SIG{signal} left a partial output");
+        assert!(!dir.path().join("out.mcap").exists());
+    }
+}
+
+#[test]
+fn the_next_run_removes_stale_partials_of_its_output_only() {
+    let dir = tempfile::tempdir().unwrap();
+    // A run killed outright (as by an out-of-memory abort) cannot clean up.
+    let mut run = start_long_simulation(dir.path());
+    wait_for_a_growing_partial(&mut run, dir.path());
+    send("KILL", &run);
+    finish(run);
+    let killed = partials(dir.path());
+    assert_eq!(killed.len(), 1, "{killed:?}");
+
+    // Planted beside it: a partial of a writer that is still running (this
+    // test process), one without a pid (not ours to judge), another output's.
+    let running = format!(".out.mcap.{}.RunNin.partial", std::process::id());
+    let kept = [running.as_str(), ".out.mcap.AbC123.partial", ".other.mcap.4194305.AbC123.partial"];
+    for name in kept {
+        std::fs::write(dir.path().join(name), b"partial").unwrap();
+    }
+    let scenario = root().join("data/sounder/artificial.toml");
+    let out = mmtrack(dir.path(), &["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "out.mcap"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    assert!(!dir.path().join(&killed[0]).exists(), "the killed run's partial is still there");
+    let mut left = partials(dir.path());
+    left.sort();
+    let mut expected: Vec<String> = kept.iter().map(|s| s.to_string()).collect();
+    expected.sort();
+    assert_eq!(left, expected);
+}
