@@ -18,10 +18,15 @@ use crate::readme_block::replace_block;
 /// reports about 160 Hz for filtering and registration alone, without decode).
 pub const ODOMETRY_TARGET_SCANS_PER_S: f64 = 150.0;
 
+/// Default `--from`: the Oxford sample beside the repository.
+const DEFAULT_FROM: &str = "../shared/realdata/oxford-radar-tiny";
+
 #[derive(Args)]
 pub struct OdometryBenchArgs {
-    /// Oxford folder whose real scans are used.
-    #[arg(long, value_name = "OXFORD_FOLDER", default_value = "../shared/realdata/oxford-radar-tiny")]
+    /// Oxford folder whose real scans are used. The default is the Oxford sample among the
+    /// real-data samples beside the repository, a path relative to the current directory: run
+    /// from the repository root, or pass --from.
+    #[arg(long, value_name = "OXFORD_FOLDER", default_value = DEFAULT_FROM)]
     from: PathBuf,
     /// Passes over the sequence per preset (each pass starts a fresh pipeline).
     #[arg(long, default_value_t = 20)]
@@ -60,6 +65,12 @@ struct PresetResult {
 }
 
 pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    if args.from == Path::new(DEFAULT_FROM) && !args.from.exists() {
+        anyhow::bail!(
+            "default {DEFAULT_FROM} not found (the Oxford sample among the real-data samples beside the \
+             repository; run from the repository root); pass --from PATH"
+        );
+    }
     let dir = tempfile::tempdir()?;
     let recording = dir.path().join("bench.mcap");
     ingest_quietly(&args.from, &recording)

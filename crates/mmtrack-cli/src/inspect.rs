@@ -1,9 +1,11 @@
 //! `mmtrack inspect <recording.mcap | table dir>`.
 
+use std::borrow::Cow;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
+use mmtrack_core::error::printable;
 use mmtrack_io::recording::{RecordingSummary, inspect_recording_with_progress};
 use mmtrack_io::table::{TableFileSummary, inspect_table_dir};
 use serde_json::json;
@@ -12,7 +14,7 @@ use serde_json::json;
 pub struct InspectArgs {
     /// An MCAP file (ours or any other, e.g. a ROS 2 bag) or a directory of Parquet tables.
     path: PathBuf,
-    /// Print JSON instead of text.
+    /// Print JSON instead of text (metadata values whole; the text output shortens long ones).
     #[arg(long)]
     json: bool,
 }
@@ -22,6 +24,25 @@ impl InspectArgs {
     pub fn new(path: PathBuf) -> Self {
         Self { path, json: false }
     }
+}
+
+/// Metadata values longer than this (in characters) are shortened in the
+/// text output: a recording's `sounder.pulse_spectrum` runs to kilobytes.
+const MAX_SHOWN_VALUE_CHARS: usize = 120;
+
+/// Characters kept of a shortened metadata value.
+const SHORTENED_VALUE_CHARS: usize = 80;
+
+/// A metadata value as the text output shows it: control characters
+/// escaped, and a long value cut to its first [`SHORTENED_VALUE_CHARS`]
+/// characters with its length and where to get it whole.
+fn shown_value(value: &str) -> Cow<'_, str> {
+    let shown = printable(value);
+    if shown.chars().count() <= MAX_SHOWN_VALUE_CHARS {
+        return shown;
+    }
+    let head: String = shown.chars().take(SHORTENED_VALUE_CHARS).collect();
+    Cow::Owned(format!("{head}… ({} bytes; `--json` prints it whole)", value.len()))
 }
 
 fn seconds(ns: u64) -> f64 {
@@ -46,9 +67,9 @@ fn recording_json(summary: &RecordingSummary) -> serde_json::Value {
 fn print_recording(summary: &RecordingSummary) {
     println!("recording {}", summary.path.display());
     for (name, map) in &summary.metadata {
-        println!("  metadata {name}:");
+        println!("  metadata {}:", printable(name));
         for (k, v) in map {
-            println!("    {k} = {v}");
+            println!("    {} = {}", printable(k), shown_value(v));
         }
     }
     let start = summary.channels.iter().map(|c| c.start_ns).min();
@@ -62,8 +83,8 @@ fn print_recording(summary: &RecordingSummary) {
     for c in &summary.channels {
         println!(
             "  {:<topic_width$} {:<schema_width$} {:>9} {:>12.3}",
-            c.topic,
-            c.schema_name,
+            printable(&c.topic),
+            printable(&c.schema_name),
             c.message_count,
             seconds(c.end_ns - c.start_ns)
         );

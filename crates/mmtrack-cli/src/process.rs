@@ -55,11 +55,12 @@ enum Pipeline {
 
 #[derive(Args)]
 pub struct OdometryArgs {
-    /// Recording with radar scans (from `mmtrack ingest` or `mmtrack simulate`).
-    pub recording: PathBuf,
-    /// Output table directory (created if missing).
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// Recording with radar scans (from `mmtrack ingest` or `mmtrack simulate`); not needed with `--print-config`.
+    #[arg(required_unless_present = "print_config")]
+    pub recording: Option<PathBuf>,
+    /// Output table directory (created if missing); not needed with `--print-config`.
+    #[arg(short, long, required_unless_present = "print_config")]
+    pub output: Option<PathBuf>,
     /// Parameter preset: `fast-cfear` (Liu et al., SPEBT Table I: scan-to-scan) or
     /// `cfear` (CFEAR-3: keyframe submap, motion compensation, re-association).
     #[arg(long, default_value = "cfear", value_parser = clap::builder::PossibleValuesParser::new(OdometryConfig::PRESETS))]
@@ -67,7 +68,7 @@ pub struct OdometryArgs {
     /// TOML file overriding single fields of the preset (see `--print-config`).
     #[arg(long, value_name = "TOML")]
     pub config: Option<PathBuf>,
-    /// Print the effective configuration as TOML and exit.
+    /// Print the effective configuration (the preset with `--config` on top) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
     /// Sequence id of the output partitions (default: the recording's).
@@ -216,21 +217,25 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
         print!("{}", toml::to_string(&config)?);
         return Ok(());
     }
+    // clap requires both unless --print-config.
+    let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
+        bail!("a recording and --output are required (unless --print-config)");
+    };
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
     // Check the outputs before the work, so a refusal costs nothing.
     let sequence_hint = args.sequence.clone();
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &sequence_hint) {
-        refuse_existing(&args.output, sequence)?;
+        refuse_existing(output, sequence)?;
     }
     let run = args
         .threads
-        .install(|| run_odometry(&args.recording, config.clone(), quiet))?
-        .with_context(|| format!("{}", args.recording.display()))?;
+        .install(|| run_odometry(recording, config.clone(), quiet))?
+        .with_context(|| format!("{}", recording.display()))?;
     let sequence = sequence_hint.unwrap_or_else(|| run.sequence_id.clone());
     if overwrite == Overwrite::Refuse {
-        refuse_existing(&args.output, &sequence)?;
+        refuse_existing(output, &sequence)?;
     }
-    let written = write_outputs(&args.output, &sequence, &run, &config, &args.preset, &args.recording, overwrite)?;
+    let written = write_outputs(output, &sequence, &run, &config, &args.preset, recording, overwrite)?;
     if !quiet {
         print_summary(&run, &args.preset, &written);
     }

@@ -37,15 +37,17 @@ const TABLES: [&str; 8] = mmtrack_analysis::pipeline::MPC_TABLE_NAMES;
 
 #[derive(Args)]
 pub struct MpcArgs {
-    /// Recording with CIR snapshots on /channel/cir (from `mmtrack ingest cir` or `mmtrack simulate sounder`).
-    pub recording: PathBuf,
-    /// Output table directory (created if missing).
-    #[arg(short, long)]
-    pub output: PathBuf,
+    /// Recording with CIR snapshots on /channel/cir (from `mmtrack ingest cir` or `mmtrack simulate sounder`); not
+    /// needed with `--print-config`.
+    #[arg(required_unless_present = "print_config")]
+    pub recording: Option<PathBuf>,
+    /// Output table directory (created if missing); not needed with `--print-config`.
+    #[arg(short, long, required_unless_present = "print_config")]
+    pub output: Option<PathBuf>,
     /// TOML file overriding single fields of the default configuration (see `--print-config`).
     #[arg(long, value_name = "TOML")]
     pub config: Option<PathBuf>,
-    /// Print the effective configuration as TOML and exit.
+    /// Print the effective configuration (the defaults with `--config` and `--gmphd` on top) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
     /// Sounder pulse: `flat` (the band's flat spectrum), or a `.npy` file holding a back-to-back calibration CIR
@@ -210,7 +212,7 @@ fn choose_pulse(
 }
 
 fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::Result<MpcRun> {
-    let path = &args.recording;
+    let Some(path) = &args.recording else { bail!("a recording is required (unless --print-config)") };
     let link_filter = args.link.as_deref().map(parse_link).transpose()?;
     let mut reader = RecordingReader::open(path)?;
     let bar = progress::bytes_bar("mpc", quiet);
@@ -348,6 +350,10 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
         print!("{}", toml::to_string(&config)?);
         return Ok(());
     }
+    // clap requires both unless --print-config.
+    let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
+        bail!("a recording and --output are required (unless --print-config)");
+    };
     if let Some(link) = &args.link {
         parse_link(link)?;
     }
@@ -355,23 +361,23 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     // Check the outputs before the work, so a refusal costs nothing.
     let hinted = match &args.sequence {
         Some(s) => Some(s.clone()),
-        None => RecordingReader::open(&args.recording).ok().and_then(|mut r| {
+        None => RecordingReader::open(recording).ok().and_then(|mut r| {
             let _ = r.next_item();
             r.metadata().and_then(RecordingMetadata::from_map).map(|m| m.sequence_id)
         }),
     };
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &hinted) {
-        refuse_existing(&args.output, sequence)?;
+        refuse_existing(output, sequence)?;
     }
     let run = args.threads.install(|| read_and_process(args, &config, quiet))??;
     let sequence = args.sequence.clone().unwrap_or_else(|| run.sequence_id.clone());
     if overwrite == Overwrite::Refuse {
-        refuse_existing(&args.output, &sequence)?;
+        refuse_existing(output, &sequence)?;
     }
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process mpc",
-            "recording": args.recording.display().to_string(),
+            "recording": recording.display().to_string(),
             "pulse": args.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
             "link": args.link,
             "mpc": config,
@@ -382,7 +388,7 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     let mut written = Vec::new();
     for (key, partition) in partitions(&run, &sequence, args.link.is_some()) {
         let link = &run.links[&key];
-        written.extend(write_link(&args.output, &partition, link, &run, config.run_gmphd, &info, overwrite)?);
+        written.extend(write_link(output, &partition, link, &run, config.run_gmphd, &info, overwrite)?);
         if !quiet {
             println!(
                 "mpc {partition} (link tx{}:rx{}): {} sets, {} detections, {} short-term tracks, {} long-term entries",
@@ -397,10 +403,26 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     }
     if !quiet {
         for w in &written {
-            println!("  wrote {} ({} rows)", w.path.display(), w.rows);
+            println!("  wrote {} ({} {})", w.path.display(), w.rows, record_noun(&w.path));
         }
     }
     Ok(())
+}
+
+/// What the records counted in a table's [`TableWriteSummary::rows`] are,
+/// from the table's directory in `<output>/<table>/sequence=<id>/part-0.parquet`:
+/// one record of `mpc_tracks` is a whole track (one row per point).
+fn record_noun(path: &Path) -> &'static str {
+    let table = path.parent().and_then(Path::parent).and_then(Path::file_name).and_then(|n| n.to_str());
+    match table {
+        Some("mpc_detections") => "detections",
+        Some("mpc_tracks" | "mpc_tracks_gmphd") => "tracks",
+        Some("mpc_long_term") => "long-term entries",
+        Some("mpc_sets") => "sets",
+        Some("mpc_snapshots") => "snapshots",
+        Some("ground_truth_tx" | "ground_truth_rx") => "poses",
+        _ => "rows",
+    }
 }
 
 fn write_link(

@@ -83,7 +83,9 @@ struct OdometryExperimentArgs {
     /// Drive scenario (TOML; default: the embedded data/reproduce/odometry-drive.toml).
     #[arg(long, value_name = "SCENARIO.toml")]
     scenario: Option<PathBuf>,
-    /// Trajectory to drive along (Oxford gt/radar_odometry.csv by default).
+    /// Trajectory to drive along. The default is the Oxford full-sequence ground truth
+    /// (gt/radar_odometry.csv) among the real-data samples beside the repository, a path
+    /// relative to the current directory: run from the repository root, or pass --trajectory.
     #[arg(long, value_name = "FILE", default_value = DEFAULT_TRAJECTORY)]
     trajectory: PathBuf,
     /// Format of --trajectory.
@@ -171,11 +173,13 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
         step: FirstFrameStep::Frames(10),
     };
     if !args.trajectory.exists() {
-        bail!(
-            "{}: trajectory not found (the default is the Oxford full-sequence ground truth in ../shared/realdata; \
-             run from the repository root or pass --trajectory)",
-            args.trajectory.display()
-        );
+        if args.trajectory == Path::new(DEFAULT_TRAJECTORY) {
+            bail!(
+                "default {DEFAULT_TRAJECTORY} not found (the Oxford full-sequence ground truth among the real-data \
+                 samples beside the repository; run from the repository root); pass --trajectory PATH"
+            );
+        }
+        bail!("{}: trajectory not found", args.trajectory.display());
     }
     let poses = simulate::read_trajectory(&args.trajectory, args.trajectory_format, None, 0)?;
     let trajectory = Trajectory::from_poses(poses).with_context(|| args.trajectory.display().to_string())?;

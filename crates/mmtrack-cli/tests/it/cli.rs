@@ -228,3 +228,89 @@ fn a_closed_stdout_pipe_ends_the_command_quietly() {
         assert!(out.status.success() && !stderr.contains("panicked"), "{:?}: {stderr}", out.status);
     }
 }
+
+/// `--print-config` needs neither a recording nor `-o`.
+#[test]
+fn print_config_needs_no_recording_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    for (pipeline, key) in [("odometry", "k_strongest"), ("mpc", "[detection]")] {
+        let out = mmtrack(dir.path(), &["process", pipeline, "--print-config"]);
+        let (stdout, stderr) = text(&out);
+        assert!(out.status.success(), "process {pipeline} --print-config: {stderr}");
+        assert!(stdout.parse::<toml::Table>().is_ok(), "not TOML:\n{stdout}");
+        assert!(stdout.contains(key), "process {pipeline} --print-config lacks {key}:\n{stdout}");
+        // Without it, both stay required.
+        let out = mmtrack(dir.path(), &["process", pipeline]);
+        assert_eq!(out.status.code(), Some(2), "{}", text(&out).1);
+    }
+    assert!(files(dir.path()).is_empty(), "--print-config wrote files");
+}
+
+/// Defaults that point beside the repository say so in `--help` and name
+/// the missing default and the option to pass when run elsewhere.
+#[test]
+fn defaults_beside_the_repository_say_so_and_fail_clearly_elsewhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            ["reproduce", "odometry", "--quick"],
+            "../shared/realdata/oxford-gt-full-seq/radar_odometry.csv",
+            "--trajectory",
+        ),
+        (["bench", "odometry", "--check"], "../shared/realdata/oxford-radar-tiny", "--from"),
+    ];
+    for (command, default, option) in cases {
+        let help = mmtrack(dir.path(), &[command[0], command[1], "--help"]);
+        let (stdout, _) = text(&help);
+        let flat = stdout.split_whitespace().collect::<Vec<_>>().join(" ");
+        assert!(flat.contains(default) && flat.contains("beside the repository"), "{command:?} --help:\n{stdout}");
+        let out = mmtrack(dir.path(), &command);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{command:?}: {stderr}");
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        assert!(
+            stderr.contains(&format!("default {default} not found")) && stderr.contains(&format!("pass {option} PATH")),
+            "{command:?}: {stderr}"
+        );
+    }
+}
+
+/// `process mpc` counts tracks as tracks: one record of `mpc_tracks` is a
+/// whole track (a row per point), so "65 rows" misread the table.
+#[test]
+fn process_mpc_summary_names_what_it_counts() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = root().join("data/sounder/artificial.toml");
+    let sim = mmtrack(dir.path(), &["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "a.mcap"]);
+    assert!(sim.status.success(), "{}", text(&sim).1);
+    let out = mmtrack(dir.path(), &["process", "mpc", "a.mcap", "-o", "tables", "--gmphd"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let summary = stdout.lines().next().unwrap();
+    let tracks = summary.split(", ").find_map(|p| p.strip_suffix(" short-term tracks")).unwrap();
+    let line = |table: &str| stdout.lines().find(|l| l.contains(&format!("/{table}/"))).unwrap().to_string();
+    assert!(line("mpc_tracks").ends_with(&format!("({tracks} tracks)")), "{stdout}");
+    assert!(line("mpc_tracks_gmphd").ends_with(" tracks)"), "{stdout}");
+    assert!(line("mpc_detections").ends_with(" detections)") && line("mpc_sets").ends_with(" sets)"), "{stdout}");
+}
+
+/// `inspect` shortens long metadata values (a sounder recording's pulse
+/// spectrum runs to kilobytes) and says how to get them whole.
+#[test]
+fn inspect_shortens_long_metadata_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = root().join("data/sounder/artificial.toml");
+    let sim = mmtrack(dir.path(), &["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "a.mcap"]);
+    assert!(sim.status.success(), "{}", text(&sim).1);
+    let out = mmtrack(dir.path(), &["inspect", "a.mcap"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let line = stdout.lines().find(|l| l.trim_start().starts_with("sounder.pulse_spectrum = ")).unwrap();
+    let json = mmtrack(dir.path(), &["inspect", "--json", "a.mcap"]);
+    let summary: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let whole = summary["metadata"]["mmtrack.recording"]["sounder.pulse_spectrum"].as_str().unwrap();
+    assert!(whole.len() > 1000, "the JSON keeps the value whole ({} bytes)", whole.len());
+    assert!(line.chars().count() < 200, "{line}");
+    assert!(line.contains(&whole[..40]) && line.contains(&format!("({} bytes; `--json`", whole.len())), "{line}");
+    assert!(stdout.lines().all(|l| l.chars().count() < 200), "{stdout}");
+}
