@@ -188,3 +188,31 @@ fn bad_input_names_file_record_and_field_and_leaves_no_output() {
     assert!(BoreasFolder::open(&empty).unwrap_err().to_string().contains("no scans found"));
     assert!(BoreasFolder::open(dir.path()).unwrap_err().to_string().contains("no radar/ folder"));
 }
+
+#[test]
+fn nanosecond_radar_poses_match_the_microsecond_scan_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = folder(dir.path(), "boreas-2021-09-02-11-42", 20);
+    let (_, micro_poses, _) = {
+        let out = dir.path().join("us.mcap");
+        ingest(&root, &out, &BoreasOptions::default()).unwrap();
+        read(&out)
+    };
+    // The same file with GPSTime in nanoseconds (19 digits), as newer Boreas
+    // releases write it.
+    let poses = root.join("applanix/radar_poses.csv");
+    let text = std::fs::read_to_string(&poses).unwrap();
+    let nanos: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| match l.split_once(',') {
+            Some((t, rest)) if i > 0 => format!("{t}000,{rest}\n"),
+            _ => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&poses, nanos).unwrap();
+    let out = dir.path().join("ns.mcap");
+    let report = ingest(&root, &out, &BoreasOptions::default()).unwrap();
+    assert_eq!(report.ground_truth_poses, 3);
+    assert_eq!(read(&out).1, micro_poses);
+}
