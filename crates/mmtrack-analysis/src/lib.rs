@@ -14,6 +14,8 @@
 //!   12-13), their result tables, plots and report section;
 //! - [`mpc_artificial`]: the artificial-channel experiment's results (Sec.
 //!   IV-A, Figs. 4-5) as plain data and their plots;
+//! - [`beam`]: beam-tracking results (valid tracking, Shaham et al. 2020) as
+//!   tables and figures;
 //! - [`plots`]: SVG plots (plotters, SVG backend only);
 //! - [`report`]: the Markdown report;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
@@ -33,6 +35,7 @@
 //! workspace on small machines for nothing we need. Campaign-wide queries run
 //! on the Hive-partitioned output with DuckDB or polars outside the binary.
 
+pub mod beam;
 pub mod export;
 pub mod mpc;
 pub mod mpc_artificial;

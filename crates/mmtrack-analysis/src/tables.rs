@@ -15,6 +15,8 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::mpc_tables::MPC_COUNT_DISTRIBUTION,
     &crate::mpc_tables::MPC_TRACK_POWER_STD,
     &crate::mpc_tables::MPC_CHI_CLASSES,
+    &crate::beam::tables::BEAM_RMS_PER_BLOCK,
+    &crate::beam::tables::BEAM_VALID_TRACKING,
 ];
 
 mmtrack_io::define_table! {

@@ -8,6 +8,7 @@
 //! built yet (the message names the issue that will build it).
 
 mod analyze;
+mod beam;
 mod bench;
 mod bench_mpc;
 mod bench_odometry;

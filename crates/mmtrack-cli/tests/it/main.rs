@@ -19,6 +19,7 @@ mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;
 mod reproduce;
+mod reproduce_shaham;
 mod simulate_radar;
 mod simulate_sounder;
 mod threads;
