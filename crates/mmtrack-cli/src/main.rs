@@ -5,7 +5,8 @@
 //!
 //! Exit codes: 0 success; 1 error (bad input, I/O; one line on stderr naming
 //! the file and the problem); 2 usage error; 3 the requested feature is not
-//! built yet (the message names the issue that will build it).
+//! built yet (the message names the issue that will build it); 130 / 143
+//! interrupted by SIGINT / SIGTERM (the partial outputs removed first).
 
 mod analyze;
 mod beam;
@@ -41,7 +42,9 @@ use mmtrack_core::error::printable;
 ROS 2 bags) into canonical MCAP recordings, runs published algorithms on them (radar odometry, multipath tracking, \
 beam tracking, mmWave SLAM) and writes Parquet tables and plots.\n\n\
 Data flow: raw files --ingest--> recording.mcap --process--> tables (Parquet) --analyze--> metrics + plots.\n\n\
-Exit codes: 0 success, 1 error (one line naming the file and the problem) or a missed paper target (reproduce, bench --check), 2 usage error.",
+Exit codes: 0 success, 1 error (one line naming the file and the problem) or a missed paper target (reproduce, bench --check), 2 usage error, \
+130/143 interrupted by SIGINT/SIGTERM (partial outputs are removed; a run killed outright leaves a hidden \
+.<name>.<pid>.<random>.partial file that the next run writing the same output removes).",
     after_help = "Start with `mmtrack demo`, then `mmtrack inspect out/demo/recording.mcap`."
 )]
 struct Cli {
