@@ -153,8 +153,34 @@ pub fn oxford_folder(
                 .unwrap_or_default(),
             report.output.file_bytes as f64 / 1e6
         );
+        if let Some(warning) = unlisted_warning(&folder.root, &report.unlisted_pngs) {
+            eprintln!("{warning}");
+        }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// How many PNGs of `radar/` were skipped because `radar.timestamps` does not
+/// list them, with the first few names (escaped); `None` when there were none.
+fn unlisted_warning(root: &Path, unlisted: &[std::path::PathBuf]) -> Option<String> {
+    const SHOWN: usize = 3;
+    let names: Vec<String> = unlisted
+        .iter()
+        .take(SHOWN)
+        .map(|p| {
+            let name = p.file_name().unwrap_or(p.as_os_str());
+            mmtrack_core::error::printable(name.as_encoded_bytes()).into_owned()
+        })
+        .collect();
+    (!unlisted.is_empty()).then(|| {
+        format!(
+            "warning: {}: {} PNGs in radar/ are not listed in radar.timestamps and were skipped: {}{}",
+            root.display(),
+            unlisted.len(),
+            names.join(", "),
+            if unlisted.len() > SHOWN { ", ..." } else { "" }
+        )
+    })
 }
 
 /// Ingests the chosen topics of a ROS 2 bag, with a progress bar.

@@ -5,6 +5,7 @@
 
 mod analyze;
 mod architecture;
+mod bad_png;
 mod bench_mpc;
 mod cli;
 mod common;
