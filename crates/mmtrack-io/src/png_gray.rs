@@ -17,7 +17,7 @@
 
 use std::io::Cursor;
 
-/// Largest image [`Gray8Png::decode`] decodes, bytes (= pixels): 64 MiB, 16
+/// Largest image [`Gray8Png::decode`] decodes, bytes (= pixels): 64 MiB, 24
 /// times a Boreas scan after its 2021 radar upgrade (400 x 6859).
 pub const MAX_GRAY8_BYTES: usize = 64 << 20;
 
