@@ -55,7 +55,7 @@ impl RmsPerBlock {
 /// the channel estimate), or `None` when it never does.
 #[must_use]
 pub fn valid_tracking_blocks(rms_rad: &[f64], threshold_rad: f64) -> Option<usize> {
-    rms_rad.iter().position(|&e| !(e <= threshold_rad))
+    rms_rad.iter().position(|&e| e.is_nan() || e > threshold_rad)
 }
 
 #[cfg(test)]

@@ -227,9 +227,9 @@ impl Codebook {
         Self::new((0..beams).map(|i| u_from_broadside_angle(-0.5 * fov_rad + (i as f64 + 0.5) * step)).collect())
     }
 
-    /// The DFT codebook of an `element_count`-element array: `u_i = -1 + (2 i
-    /// + 1) / N` in the visible region (orthogonal beams for half-wavelength
-    /// spacing).
+    /// The DFT codebook of an `element_count`-element array:
+    /// `u_i = -1 + (2 i + 1) / N` in the visible region (orthogonal beams for
+    /// half-wavelength spacing).
     ///
     /// # Errors
     /// [`CoreError::OutOfRange`] for zero elements.

@@ -1,3 +1,5 @@
 //! Integration tests of mmtrack-beam (one test binary, one module per topic).
 
+#![allow(clippy::unwrap_used)]
+
 mod overpass;

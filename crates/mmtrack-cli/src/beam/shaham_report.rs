@@ -14,7 +14,7 @@ pub struct Verdict {
     pub met: bool,
 }
 
-fn point<'a>(results: &'a [PointResult], snr_db: f64, speed_kmh: f64) -> Option<&'a PointResult> {
+fn point(results: &[PointResult], snr_db: f64, speed_kmh: f64) -> Option<&PointResult> {
     results.iter().find(|p| p.snr_db == snr_db && p.speed_kmh == speed_kmh)
 }
 
