@@ -36,7 +36,7 @@ pub fn one_line(r: &MpcResult) -> String {
     let s = &r.summary;
     let (b, d, unit) = rates(r);
     format!(
-        "{}: {} sets, {:.1} MPCs per set, births {b} / deaths {d} {unit} (distance: {}), detection loss {} dB, tracking loss {} dB{}",
+        "{}: {} sets, {:.1} MPCs per set, births {b} / deaths {d} {unit} (distance: {}), detection loss {} dB, tracking loss {} dB{}{}",
         r.sequence,
         s.sets,
         s.mean_mpcs_per_set,
@@ -46,8 +46,48 @@ pub fn one_line(r: &MpcResult) -> String {
         match (s.precision, s.recall) {
             (Some(p), Some(rc)) => format!(", precision {:.3} recall {:.3}", p, rc),
             _ => String::new(),
+        },
+        match (s.first_path_hint_abs_median_s, s.first_path_hint_abs_p90_s) {
+            (Some(median), Some(p90)) => format!(
+                ", first path vs the receiver's estimate: median |difference| {:.3} ns, 90th percentile {:.3} ns",
+                median * 1e9,
+                p90 * 1e9
+            ),
+            _ => String::new(),
         }
     )
+}
+
+fn ns(v: Option<f64>) -> String {
+    v.map_or_else(|| "n/a".to_string(), |v| format!("{:+.3}", v * 1e9))
+}
+
+/// The first-path table: every sequence, its rule and, where the recording
+/// carries the receiver's own first-path estimate, the differences.
+fn first_path_section(out: &mut String, results: &[MpcResult]) {
+    let _ = write!(
+        out,
+        "First path (table `mpc_first_path`): per snapshot, the earliest detection at most the dynamic range below the \
+         snapshot's strongest detection. Where the recording carries the receiver's own first-path estimate (e.g. the \
+         DW1000's leading edge HLP, `mpc_snapshots.first_path_hint_s`), first path minus that estimate, in ns.\n\n\
+         | sequence | dynamic range (dB) | snapshots with a first path | with the receiver's estimate | median difference \
+         | median absolute difference | 90th percentile of the absolute difference |\n|---|---|---|---|---|---|---|\n"
+    );
+    for r in results {
+        let s = &r.summary;
+        let _ = writeln!(
+            out,
+            "| {} | {:.1} | {} | {} | {} | {} | {} |",
+            r.sequence,
+            s.first_path_dynamic_range_db,
+            s.first_path_snapshots,
+            s.first_path_hint_snapshots,
+            ns(s.first_path_minus_hint_median_s),
+            ns(s.first_path_hint_abs_median_s).trim_start_matches('+'),
+            ns(s.first_path_hint_abs_p90_s).trim_start_matches('+'),
+        );
+    }
+    out.push('\n');
 }
 
 /// Appends the section for `results` (nothing when empty).
@@ -140,6 +180,7 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
         }
         out.push('\n');
     }
+    first_path_section(out, results);
     for r in results {
         let _ = writeln!(out, "### `{}` (MPC)\n", r.sequence);
         for (file, title) in PLOTS {

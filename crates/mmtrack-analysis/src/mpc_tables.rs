@@ -1,6 +1,6 @@
 //! Result tables of the MPC statistics (see [`crate::mpc`]), with units.
 
-use crate::mpc::{ChiClassShare, CountBin, MpcSummary, SetMetrics, TrackPowerStd};
+use crate::mpc::{ChiClassShare, CountBin, FirstPathRow, MpcSummary, SetMetrics, TrackPowerStd};
 
 mmtrack_io::define_table! {
     /// `mpc_set_metrics`: one row per set.
@@ -119,5 +119,36 @@ they are null without one, and the per-second rates always apply. Truth columns 
         true_deaths: Option<u64>, "", "true path deaths above the floor";
         true_birth_rate_per_m: Option<f64>, "1/m", "true_births / distance_m";
         true_death_rate_per_m: Option<f64>, "1/m", "true_deaths / distance_m";
+        first_path_dynamic_range_db: f64, "dB",
+            "a snapshot's first path is its earliest detection at most this far below its strongest (mpc_first_path)";
+        first_path_snapshots: u64, "", "snapshots with a first path (at least one detection)";
+        first_path_hint_snapshots: u64, "", "of those, snapshots carrying the receiver's own first-path estimate";
+        first_path_minus_hint_median_s: Option<f64>, "s",
+            "median of first path minus the receiver's estimate; null without estimates";
+        first_path_hint_abs_median_s: Option<f64>, "s",
+            "median of |first path - the receiver's estimate|; null without estimates";
+        first_path_hint_abs_p90_s: Option<f64>, "s",
+            "90th percentile of |first path - the receiver's estimate| (linear between order statistics)";
+    }
+}
+
+mmtrack_io::define_table! {
+    /// `mpc_first_path`: one row per snapshot.
+    pub const MPC_FIRST_PATH = "mpc_first_path",
+        "The first path of each CIR snapshot, in the order of mpc_snapshots (or of set and snapshot \
+without it): the earliest detection at most first_path_dynamic_range_db (mpc_summary) below the snapshot's \
+strongest detection, and its distance from the receiver's own first-path estimate when the recording carries one \
+(e.g. the DW1000's leading edge HLP). Delay columns are null for a snapshot without detections.";
+    FirstPathRow {
+        t_ns: i64, "ns", "time of the snapshot";
+        set_index: u64, "", "sounder set";
+        snapshot_index: u32, "", "snapshot within the set";
+        detections: u64, "", "detections of the snapshot";
+        strongest_delay_s: Option<f64>, "s", "delay of the strongest detection";
+        strongest_power_db: Option<f64>, "dB", "power of the strongest detection";
+        first_path_delay_s: Option<f64>, "s", "delay of the first path";
+        first_path_power_db: Option<f64>, "dB", "power of the first path";
+        first_path_hint_s: Option<f64>, "s", "the receiver's own first-path estimate (mpc_snapshots); null when not given";
+        first_path_minus_hint_s: Option<f64>, "s", "first_path_delay_s - first_path_hint_s";
     }
 }

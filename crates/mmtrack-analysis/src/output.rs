@@ -163,6 +163,7 @@ fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::R
         write_table(&tables, seq, &r.counts, run, Overwrite::Refuse)?;
         write_table(&tables, seq, &r.power_std, run, Overwrite::Refuse)?;
         write_table(&tables, seq, &r.chi, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.first_path, run, Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
         std::fs::create_dir_all(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let svgs = [
@@ -177,7 +178,7 @@ fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::R
             let svg = svg.with_context(|| format!("sequence {seq}: {file}"))?;
             std::fs::write(&path, svg).with_context(|| path.display().to_string())?;
         }
-        files += 5 + mpc_report::PLOTS.len();
+        files += 6 + mpc_report::PLOTS.len();
     }
     Ok(files)
 }

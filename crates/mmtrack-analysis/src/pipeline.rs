@@ -10,11 +10,11 @@ use mmtrack_core::{
 };
 use mmtrack_io::table::{
     GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose,
-    MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, ODOMETRY, TableRow, read_table,
-    read_table_dir, table_path,
+    MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_SNAPSHOTS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats,
+    ODOMETRY, TableRow, read_table, read_table_dir, table_path,
 };
 
-use crate::mpc::{DistanceSource, MpcInput, MpcResult, analyze_mpc};
+use crate::mpc::{DistanceSource, MpcInput, MpcOptions, MpcResult, analyze_mpc};
 
 use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
 use crate::trajectory::{
@@ -336,29 +336,31 @@ pub fn read_mpc(root: &Path, sequence: &str) -> anyhow::Result<MpcInput> {
         tracks: read_required::<MpcTrack>(root, sequence)?,
         long_term: read_required::<MpcLongTermEntry>(root, sequence)?,
         sets: read_required::<MpcSetStats>(root, sequence)?,
+        snapshots: read_optional::<MpcSnapshotStats>(root, sequence)?,
         truth: read_optional::<MpcTruth>(root, sequence)?,
         distance: read_distance(root, sequence)?,
     })
 }
 
 /// MPC statistics of every sequence of `plan`.
-pub fn analyze_mpc_all(root: &Path, plan: &Plan) -> anyhow::Result<Vec<MpcResult>> {
+pub fn analyze_mpc_all(root: &Path, plan: &Plan, options: &MpcOptions) -> anyhow::Result<Vec<MpcResult>> {
     plan.mpc
         .iter()
         .map(|sequence| {
             let input = read_mpc(root, sequence).with_context(|| format!("sequence {sequence}: MPC tables"))?;
-            Ok(analyze_mpc(sequence, input))
+            Ok(analyze_mpc(sequence, input, options))
         })
         .collect()
 }
 
 /// Table names `process mpc` writes, for messages.
-pub const MPC_TABLE_NAMES: [&str; 8] = [
+pub const MPC_TABLE_NAMES: [&str; 9] = [
     MPC_DETECTIONS.name,
     MPC_TRACKS.name,
     MPC_TRACKS_GMPHD.name,
     MPC_LONG_TERM.name,
     MPC_SETS.name,
+    MPC_SNAPSHOTS.name,
     MPC_TRUTH.name,
     GROUND_TRUTH_TX.name,
     GROUND_TRUTH_RX.name,

@@ -15,6 +15,7 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::mpc_tables::MPC_COUNT_DISTRIBUTION,
     &crate::mpc_tables::MPC_TRACK_POWER_STD,
     &crate::mpc_tables::MPC_CHI_CLASSES,
+    &crate::mpc_tables::MPC_FIRST_PATH,
     &crate::beam::tables::BEAM_RMS_PER_BLOCK,
     &crate::beam::tables::BEAM_VALID_TRACKING,
 ];

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::Args;
+use mmtrack_analysis::mpc::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, MpcOptions};
 use mmtrack_analysis::output::{check_output, write_all_results};
 use mmtrack_analysis::pipeline::{analyze_all, analyze_mpc_all, inventory, plan};
 use mmtrack_analysis::report::one_line;
@@ -27,9 +28,11 @@ Tables of `mmtrack process mpc` (mpc_sets, mpc_detections, mpc_tracks, mpc_long_
 statistics after Mahler et al. 2017: number of MPCs per set and its CDF, birth and death rates per metre travelled by \
 both vehicles (ground_truth_tx + ground_truth_rx; else ground_truth or odometry; else per second, and the report says \
 which), detection and tracking power loss, per-track power standard deviation, long-term link power per chi class, \
-and with mpc_truth: detection precision/recall (0.5 ns), track purity, true birth/death rates.\n\n\
+and with mpc_truth: detection precision/recall (0.5 ns), track purity, true birth/death rates. First path of each \
+snapshot: the earliest detection within --first-path-range-db of its strongest; where the recording carried the \
+receiver's own first-path estimate (e.g. DW1000 HLP), the median and 90th percentile of the difference.\n\n\
 Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
-mpc_count_distribution,mpc_track_power_std,mpc_chi_classes}/sequence=<id>/part-0.parquet, \
+mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path}/sequence=<id>/part-0.parquet, \
 <OUT>/plots/<id>/*.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.",
     after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
@@ -53,6 +56,9 @@ pub struct AnalyzeArgs {
     /// Start a KITTI segment every X metres of ground-truth path instead (independent of the frame rate).
     #[arg(long, value_name = "M")]
     step_m: Option<f64>,
+    /// MPC first path: the earliest detection of a snapshot at most this far below its strongest detection, dB.
+    #[arg(long, value_name = "DB", default_value_t = DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB)]
+    first_path_range_db: f64,
 }
 
 fn drift_options(args: &AnalyzeArgs) -> DriftOptions {
@@ -84,6 +90,9 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let options = drift_options(args);
     // Options are checked by the metric too, but a usage error should not wait for the tables to load.
     mmtrack_analysis::trajectory::kitti_drift(&[], &[], &options).context("--segment-lengths-m / --step-*")?;
+    if !(args.first_path_range_db.is_finite() && args.first_path_range_db >= 0.0) {
+        bail!("--first-path-range-db {}: expected a finite, non-negative number of dB", args.first_path_range_db);
+    }
 
     let found = inventory(&args.tables)?;
     let plan = plan(&found);
@@ -103,13 +112,15 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         );
     }
     let results = analyze_all(&args.tables, &plan, &options)?;
-    let mpc_results = analyze_mpc_all(&args.tables, &plan)?;
+    let mpc_options = MpcOptions { first_path_dynamic_range_db: args.first_path_range_db };
+    let mpc_results = analyze_mpc_all(&args.tables, &plan, &mpc_options)?;
     let run = RunInfo {
         config_json: serde_json::json!({
             "command": "analyze",
             "tables": args.tables.display().to_string(),
             "segment_lengths_m": options.segment_lengths_m,
             "step": format!("{:?}", options.step),
+            "first_path_range_db": args.first_path_range_db,
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),

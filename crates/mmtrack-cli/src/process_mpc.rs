@@ -24,16 +24,17 @@ use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, Mpc
 use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
 use mmtrack_io::recording::{PoseStream, RecordingItem};
 use mmtrack_io::table::{
-    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, RunInfo, TableWriteSummary, table_path, write_table,
+    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MpcSnapshotStats, RunInfo, TableWriteSummary, table_path,
+    write_table,
 };
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
-use mmtrack_mpc::{MpcConfig, MpcPipeline, SounderPulse};
+use mmtrack_mpc::{MpcConfig, MpcPipeline, SnapshotDetections, SounderPulse};
 
 use crate::progress;
 use crate::threads::ThreadsArg;
 
 /// Every table `process mpc` may write.
-const TABLES: [&str; 8] = mmtrack_analysis::pipeline::MPC_TABLE_NAMES;
+const TABLES: [&str; 9] = mmtrack_analysis::pipeline::MPC_TABLE_NAMES;
 
 #[derive(Args)]
 pub struct MpcArgs {
@@ -124,6 +125,8 @@ struct LinkRun {
     gmphd_tracks: Vec<MpcTrack>,
     long_term: Vec<MpcLongTermEntry>,
     sets: Vec<MpcSetStats>,
+    /// Per snapshot: what detection found, and the receiver's first-path hint.
+    snapshots: Vec<MpcSnapshotStats>,
 }
 
 impl LinkRun {
@@ -140,9 +143,10 @@ impl LinkRun {
         }
         let (first, last) = (self.complete[0][0].set_index, self.complete[self.complete.len() - 1][0].set_index);
         let outputs = self.pipeline.push_sets(&self.complete).with_context(|| format!("sets {first}..={last}"))?;
-        for out in outputs {
-            for snapshot in out.per_snapshot {
-                self.detections.extend(snapshot.detections);
+        for (set, out) in self.complete.iter().zip(outputs) {
+            for (cir, found) in set.iter().zip(out.per_snapshot) {
+                self.snapshots.push(snapshot_stats(cir, &found));
+                self.detections.extend(found.detections);
             }
             self.tracks.extend(out.short_term_tracks);
             if let Some(tracks) = out.gmphd_tracks {
@@ -153,6 +157,21 @@ impl LinkRun {
         }
         self.complete.clear();
         Ok(())
+    }
+}
+
+/// The `mpc_snapshots` row of one detected snapshot.
+fn snapshot_stats(cir: &CirSnapshot, found: &SnapshotDetections) -> MpcSnapshotStats {
+    MpcSnapshotStats {
+        t_ns: cir.t_ns,
+        set_index: cir.set_index,
+        snapshot_index: cir.snapshot_index,
+        detections: u32::try_from(found.detections.len()).unwrap_or(u32::MAX),
+        skipped: found.skipped.is_some(),
+        noise_floor_db: found.noise_floor_db,
+        channel_gain_db: found.channel_gain_db,
+        detected_gain_db: found.detected_gain_db,
+        first_path_hint_s: cir.first_path_hint_s,
     }
 }
 
@@ -268,6 +287,7 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
                             gmphd_tracks: Vec::new(),
                             long_term: Vec::new(),
                             sets: Vec::new(),
+                            snapshots: Vec::new(),
                         })
                     }
                 };
@@ -439,6 +459,7 @@ fn write_link(
         write_table(output, partition, &link.tracks, info, overwrite)?,
         write_table(output, partition, &link.long_term, info, overwrite)?,
         write_table(output, partition, &link.sets, info, overwrite)?,
+        write_table(output, partition, &link.snapshots, info, overwrite)?,
     ];
     if gmphd {
         let tracks: Vec<GmPhdTrack> = link.gmphd_tracks.iter().cloned().map(GmPhdTrack).collect();

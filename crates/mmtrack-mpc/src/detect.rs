@@ -99,20 +99,6 @@ pub struct SnapshotDetections {
     pub skipped: Option<&'static str>,
 }
 
-/// The first (earliest) path of a snapshot: the earliest detection at least
-/// `margin_db` above the noise floor. Search and subtract also picks up noise
-/// peaks a little above its floor + 6 dB threshold; a leading-edge estimate
-/// needs a margin that such peaks rarely reach (a 1000-tap CIR of white noise
-/// has its largest tap about 8.4 dB above the mean).
-#[must_use]
-pub fn first_path(found: &SnapshotDetections, margin_db: f64) -> Option<&MpcDetection> {
-    found
-        .detections
-        .iter()
-        .filter(|d| d.power_db() >= found.noise_floor_db + margin_db)
-        .min_by(|a, b| a.delay_s.total_cmp(&b.delay_s))
-}
-
 /// Detects MPCs in snapshots of one sounder (fixed band and pulse).
 pub struct Detector {
     config: DetectionConfig,

@@ -30,7 +30,7 @@ mod pulse;
 pub mod short_term;
 
 pub use config::{DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig};
-pub use detect::{Detector, SnapshotDetections, first_path};
+pub use detect::{Detector, SnapshotDetections};
 pub use error::MpcError;
 pub use gmphd::{GmPhdConfig, GmPhdError, GmPhdSnapshot, track_gmphd};
 pub use long_term::LongTermTracker;

@@ -19,15 +19,35 @@
 //!   MPCs closer than the match tolerance count as one): detection precision
 //!   and recall (also over the detectable truth, above the floor + 6 dB),
 //!   track purity and false tracks, long-term tracks that follow true paths
-//!   (their births and deaths, tracks per path), true birth and death rates.
+//!   (their births and deaths, tracks per path), true birth and death rates;
+//! - the first path of each snapshot ([`first_path`]): the earliest detection
+//!   within a dynamic range (20 dB) of the strongest, against the receiver's
+//!   own first-path estimate when the recording carries one.
 
+pub mod first_path;
 pub mod truth;
 
 use std::collections::BTreeMap;
 
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
+use mmtrack_io::table::MpcSnapshotStats;
 
+pub use first_path::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, FirstPathRow, FirstPathSummary};
 pub use truth::{TruthScores, match_detections, resolvable_truth};
+
+/// Choices of the MPC statistics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcOptions {
+    /// Dynamic range below a snapshot's strongest detection within which the
+    /// earliest detection is its first path, dB.
+    pub first_path_dynamic_range_db: f64,
+}
+
+impl Default for MpcOptions {
+    fn default() -> Self {
+        Self { first_path_dynamic_range_db: DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB }
+    }
+}
 
 /// Where the distance travelled comes from.
 #[derive(Debug, Clone, PartialEq)]
@@ -104,6 +124,8 @@ pub struct MpcInput {
     pub long_term: Vec<MpcLongTermEntry>,
     /// `mpc_sets`.
     pub sets: Vec<MpcSetStats>,
+    /// `mpc_snapshots`, when present (tables of older versions lack it).
+    pub snapshots: Option<Vec<MpcSnapshotStats>>,
     /// `mpc_truth`, when the recording had truth.
     pub truth: Option<Vec<MpcTruth>>,
     /// Trajectories for the distance travelled.
@@ -209,6 +231,12 @@ pub struct MpcSummary {
     pub true_deaths: Option<u64>,
     pub true_birth_rate_per_m: Option<f64>,
     pub true_death_rate_per_m: Option<f64>,
+    pub first_path_dynamic_range_db: f64,
+    pub first_path_snapshots: u64,
+    pub first_path_hint_snapshots: u64,
+    pub first_path_minus_hint_median_s: Option<f64>,
+    pub first_path_hint_abs_median_s: Option<f64>,
+    pub first_path_hint_abs_p90_s: Option<f64>,
 }
 
 /// Everything computed for one sequence.
@@ -224,6 +252,8 @@ pub struct MpcResult {
     pub chi: Vec<ChiClassShare>,
     /// Distribution of the number of MPCs per set.
     pub counts: Vec<CountBin>,
+    /// Per snapshot: its first path.
+    pub first_path: Vec<FirstPathRow>,
     /// Summary.
     pub summary: MpcSummary,
     /// Detections and short-term tracks for the delay-vs-time plot.
@@ -263,7 +293,7 @@ fn long_term_spans(entries: &[MpcLongTermEntry]) -> BTreeMap<u64, (u64, u64)> {
 
 /// All MPC statistics of one sequence.
 #[must_use]
-pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
+pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> MpcResult {
     let mut sets = input.sets.clone();
     sets.sort_by_key(|s| s.set_index);
     let mut per_set_count: BTreeMap<u64, u64> = sets.iter().map(|s| (s.set_index, 0)).collect();
@@ -316,13 +346,23 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput) -> MpcResult {
     let power_std = track_power_std(&input.tracks, &sets);
     let chi = chi_shares(&input.long_term);
     let counts = count_distribution(per_set.iter().map(|s| s.long_term_mpcs));
-    let summary = summarise(&input, &per_set, &power_std, &chi, &spans, truth_scores.as_ref());
+    let range_db = options.first_path_dynamic_range_db;
+    let first_path = first_path::first_paths(&input.detections, input.snapshots.as_deref(), range_db);
+    let mut summary = summarise(&input, &per_set, &power_std, &chi, &spans, truth_scores.as_ref());
+    let first = first_path::summarise_first_paths(&first_path);
+    summary.first_path_dynamic_range_db = range_db;
+    summary.first_path_snapshots = first.snapshots;
+    summary.first_path_hint_snapshots = first.with_hint;
+    summary.first_path_minus_hint_median_s = first.median_minus_hint_s;
+    summary.first_path_hint_abs_median_s = first.median_abs_minus_hint_s;
+    summary.first_path_hint_abs_p90_s = first.p90_abs_minus_hint_s;
     MpcResult {
         sequence: sequence.to_string(),
         per_set,
         power_std,
         chi,
         counts,
+        first_path,
         summary,
         detections: input.detections,
         tracks: input.tracks,
@@ -495,6 +535,13 @@ fn summarise(
         true_deaths: truth.map(|t| t.transitions.values().map(|v| v.1).sum()),
         true_birth_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.0).sum())),
         true_death_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.1).sum())),
+        // Filled by analyze_mpc from the first paths.
+        first_path_dynamic_range_db: DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB,
+        first_path_snapshots: 0,
+        first_path_hint_snapshots: 0,
+        first_path_minus_hint_median_s: None,
+        first_path_hint_abs_median_s: None,
+        first_path_hint_abs_p90_s: None,
     }
 }
 

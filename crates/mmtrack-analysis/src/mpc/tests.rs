@@ -65,6 +65,7 @@ fn input(distance: DistanceSource) -> MpcInput {
         tracks: Vec::new(),
         long_term: long_term(),
         sets: (0..4).map(set).collect(),
+        snapshots: None,
         truth: None,
         distance,
     }
@@ -72,7 +73,11 @@ fn input(distance: DistanceSource) -> MpcInput {
 
 #[test]
 fn births_deaths_and_counts_follow_the_long_term_tracks() {
-    let r = analyze_mpc("s", input(DistanceSource::BothVehicles { tx: straight(50.0), rx: straight(0.0) }));
+    let r = analyze_mpc(
+        "s",
+        input(DistanceSource::BothVehicles { tx: straight(50.0), rx: straight(0.0) }),
+        &MpcOptions::default(),
+    );
     let counts: Vec<u64> = r.per_set.iter().map(|s| s.long_term_mpcs).collect();
     assert_eq!(counts, vec![2, 2, 3, 2]);
     let births: Vec<Option<u64>> = r.per_set.iter().map(|s| s.births).collect();
@@ -97,7 +102,7 @@ fn births_deaths_and_counts_follow_the_long_term_tracks() {
 
 #[test]
 fn chi_shares_and_unrelated_power() {
-    let r = analyze_mpc("s", input(DistanceSource::None));
+    let r = analyze_mpc("s", input(DistanceSource::None), &MpcOptions::default());
     // Equal powers: three links at 0.1 ns and one at 0.5 ns; C, D, E (3 of 9 entries) are unrelated.
     assert_eq!(r.chi.len(), 3);
     assert!((r.chi[0].chi_class_s.unwrap() - 0.1e-9).abs() < 1e-24);
@@ -188,6 +193,7 @@ fn truth_input(sets: u64, detections: Vec<MpcDetection>, tracks: Vec<MpcTrack>, 
         tracks,
         long_term: Vec::new(),
         sets: (0..sets).map(set).collect(), // floor -140 dB: detectable from -134 dB
+        snapshots: None,
         truth: Some(truth),
         distance: DistanceSource::None,
     }
@@ -218,7 +224,7 @@ fn true_mpcs_closer_than_the_tolerance_are_one_resolvable_mpc() {
     assert_eq!(merged[1].amplitude.norm(), 0.0);
     assert!((merged[2].amplitude.re - 2e-6).abs() < 1e-18);
     assert!((merged[2].delay_s - 140.00005e-9).abs() < 1e-18);
-    let s = analyze_mpc("s", truth_input(1, detections, Vec::new(), truth)).summary;
+    let s = analyze_mpc("s", truth_input(1, detections, Vec::new(), truth), &MpcOptions::default()).summary;
     // 3 resolvable MPCs in each of 6 snapshots; the cancelled pair is below
     // the floor, so both detectable MPCs are found every time.
     assert_eq!(s.truth_mpcs, Some(18));
@@ -238,7 +244,7 @@ fn purity_counts_tracks_on_true_paths_and_false_tracks_apart() {
         MpcTrack { track_id: 0, doppler_hz: None, detections: on_path.clone() },
         MpcTrack { track_id: 1, doppler_hz: None, detections: noise.clone() },
     ];
-    let s = analyze_mpc("s", truth_input(1, [on_path, noise].concat(), tracks, truth)).summary;
+    let s = analyze_mpc("s", truth_input(1, [on_path, noise].concat(), tracks, truth), &MpcOptions::default()).summary;
     assert_eq!(s.track_purity, Some(1.0), "the one track on a true path never leaves it");
     assert_eq!(s.false_track_share, Some(0.5));
     assert!((s.precision.unwrap() - 6.0 / 9.0).abs() < 1e-12, "the noise shows in precision");
@@ -275,7 +281,7 @@ fn long_term_tracks_are_scored_by_the_path_they_follow() {
     }
     let mut input = truth_input(4, detections, tracks, truth);
     input.long_term = long_term;
-    let s = analyze_mpc("s", input).summary;
+    let s = analyze_mpc("s", input, &MpcOptions::default()).summary;
     assert_eq!((s.births, s.deaths), (2, 2), "tracks 2 and 3 are born in set 2; 1 and 3 die before the end");
     assert_eq!((s.births_on_true_paths, s.deaths_on_true_paths), (Some(1), Some(1)), "the split of path 2");
     assert_eq!((s.true_births, s.true_deaths), (Some(0), Some(0)));

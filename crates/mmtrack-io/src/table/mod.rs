@@ -30,7 +30,7 @@ pub use io::{
 };
 pub use mpc_rows::{
     GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_LONG_TERM, MPC_SETS,
-    MPC_TRACKS_GMPHD, MPC_TRUTH,
+    MPC_SNAPSHOTS, MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats,
 };
 pub use odometry_rows::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, ODOMETRY_TIMING};
 pub use rows::{ALL_TABLES, CIR_SNAPSHOTS, GNSS_FIXES, MPC_DETECTIONS, MPC_TRACKS, POSES, RADAR_SCANS};

@@ -1,6 +1,6 @@
 //! Tables of the multipath-component pipeline beyond detections and tracks
-//! (those are in `rows.rs`): GM-PHD tracks, long-term tracks, per-set
-//! statistics, the simulator's true MPCs and both sounder vehicles' ground
+//! (those are in `rows.rs`): GM-PHD tracks, long-term tracks, per-set and
+//! per-snapshot statistics, the simulator's true MPCs and both sounder vehicles' ground
 //! truth (Mahler et al. 2017, Secs. III-VI).
 
 use mmtrack_core::{Complex64, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
@@ -59,6 +59,27 @@ was captured.";
         full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks";
         gmphd_tracked_gain_db: Option<f64>, "dB",
             "gain captured by the GM-PHD baseline's tracks (same definition); null when it did not run";
+    }
+}
+
+crate::define_table! {
+    /// `mpc_snapshots`: per-snapshot detection statistics.
+    pub const MPC_SNAPSHOTS = "mpc_snapshots",
+        "One CIR snapshot per row, in recording order: what detection found in it (Mahler et al. 2017, \
+Sec. III-A) and the receiver's own first-path estimate carried in the recording, for comparing first paths.";
+    /// One row of [`MPC_SNAPSHOTS`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct MpcSnapshotStats {
+        t_ns: i64, "ns", "time of the snapshot";
+        set_index: u64, "", "sounder set";
+        snapshot_index: u32, "", "snapshot within the set";
+        detections: u32, "", "detected MPCs (rows of mpc_detections of this snapshot)";
+        skipped: bool, "", "true when detection skipped the snapshot (all taps zero)";
+        noise_floor_db: f64, "dB", "estimated noise floor (mean tap power); -inf when skipped";
+        channel_gain_db: f64, "dB", "channel gain after thresholding and windowing; -inf when skipped";
+        detected_gain_db: f64, "dB", "gain captured by the detections; -inf when none";
+        first_path_hint_s: Option<f64>, "s",
+            "the receiver's own first-path estimate on the delay axis (e.g. DW1000 HLP); null when not given";
     }
 }
 

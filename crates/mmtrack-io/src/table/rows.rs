@@ -189,6 +189,7 @@ pub const ALL_TABLES: &[&TableSpec] = &[
     &super::MPC_TRACKS_GMPHD,
     &super::MPC_LONG_TERM,
     &super::MPC_SETS,
+    &super::MPC_SNAPSHOTS,
     &super::MPC_TRUTH,
     &super::GROUND_TRUTH_TX,
     &super::GROUND_TRUTH_RX,
