@@ -9,6 +9,7 @@
 //! - [`PolarScan`]: a spinning-radar sweep with per-azimuth time, angle and validity;
 //! - [`CirSnapshot`]: one channel impulse response with its tap spacing and its
 //!   position in the sounder's set/snapshot structure;
+//! - [`BeamSweep`]: received power per measured beam of one codebook sweep;
 //! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`], [`MpcTruth`] and [`OdometryEstimate`];
 //! - [`array`]: antenna array responses, beamforming gains, beamwidths and
 //!   beam codebooks;
@@ -24,6 +25,7 @@
 //! geodetic latitude/longitude are the one exception and are named `_deg`.
 
 pub mod array;
+mod beam_sweep;
 mod cir;
 pub mod error;
 mod gnss;
@@ -34,6 +36,7 @@ mod pose;
 mod radar;
 pub mod sounder;
 
+pub use beam_sweep::BeamSweep;
 pub use cir::CirSnapshot;
 pub use error::CoreError;
 pub use gnss::{GnssFix, GnssFixQuality};
