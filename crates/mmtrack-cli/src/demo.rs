@@ -124,7 +124,7 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             analysis.out_dir.display(),
             analysis.report.display()
         );
-        println!("\nNot in the demo yet: mpc, beam and slam pipelines (issue #5 and later).");
+        println!("\nNot in the demo yet: the mpc, beam and slam pipelines.");
     }
     Ok(ExitCode::SUCCESS)
 }

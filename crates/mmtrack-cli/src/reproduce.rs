@@ -40,7 +40,7 @@ pub struct ReproduceArgs {
 
 #[derive(Subcommand)]
 enum Experiment {
-    /// Radar odometry drift on a simulated drive along a real trajectory (issue #4)
+    /// Radar odometry drift on a simulated drive along a real trajectory
     ///
     /// Renders Oxford-size Navtech scans (400 x 3768) along the trajectory
     /// through a generated street scene, runs the `fast-cfear` and `cfear`
@@ -53,7 +53,7 @@ enum Experiment {
     /// missed. `--quick` is the CI version: 300 m, segments of 100 and 200 m.
     #[command(verbatim_doc_comment)]
     Odometry(OdometryExperimentArgs),
-    /// The artificial two-MPC channel of Mahler et al. 2017, Figs. 4-5 (issue #5)
+    /// The artificial two-MPC channel of Mahler et al. 2017, Figs. 4-5
     ///
     /// Two equal-power MPCs approach in delay from 20 to 2.5 ns over a
     /// -140 dB noise floor; the MPC power is swept from -100 to -132 dB. With
