@@ -56,6 +56,11 @@ convoy *args:
     cargo run -q --release -p mmtrack-cli -- process mpc out/convoy/convoy.mcap -o out/convoy/tables --force
     cargo run -q --release -p mmtrack-cli -- analyze out/convoy/tables -o out/convoy/analysis --force
 
+# Fuzz the byte-level readers offline, e.g. `just fuzz all --seconds 600` or
+# `just fuzz npy --seconds 60`; findings go to target/fuzz-findings/<target>/.
+fuzz *args:
+    cargo run -q --release -p mmtrack-fuzz -- "$@"
+
 # Paper experiments.
 reproduce *args:
     cargo run -q --release -p mmtrack-cli -- reproduce "$@"

@@ -14,6 +14,8 @@ fn allowed_internal(name: &str) -> Option<&'static [&'static str]> {
         "mmtrack-sim" => &["mmtrack-core"],
         "mmtrack-analysis" => &["mmtrack-core", "mmtrack-io"],
         "mmtrack-cli" => ANY,
+        // Dev-only fuzzing of the readers (publish = false).
+        "mmtrack-fuzz" => &["mmtrack-core", "mmtrack-io", "mmtrack-ingest"],
         _ => return None,
     })
 }

@@ -1,0 +1,35 @@
+//! # mmtrack-fuzz
+//!
+//! Bounded-time mutation fuzzing of mmtrack's byte-level readers, on stable
+//! Rust and without libFuzzer: a deterministic mutator ([`mutate`]) seeded
+//! from the real samples and from small inputs our own writers make
+//! ([`seeds`], [`writers`]), one target per reader ([`targets`]), and a loop
+//! ([`runner`]) that runs each input under `catch_unwind` with an allocator
+//! that notes any single allocation above a cap ([`alloc`]).
+//!
+//! Two uses: CI runs every target for a fixed number of executions
+//! (`tests/it`, deterministic, asserts no findings); `cargo run --release -p
+//! mmtrack-fuzz -- <target>|all --seconds N` runs as long as wanted and saves
+//! findings under `target/fuzz-findings/<target>/`.
+//!
+//! A dev-only crate (`publish = false`): it depends on the readers
+//! (`mmtrack-ingest`, `mmtrack-io`, `mmtrack-core`) and nothing depends on
+//! it. Linking it installs its global allocator.
+
+pub mod alloc;
+pub mod mutate;
+pub mod runner;
+pub mod seeds;
+pub mod targets;
+pub mod writers;
+
+use std::path::PathBuf;
+
+/// Where findings go: `$CARGO_TARGET_DIR/fuzz-findings`, else the
+/// workspace's `target/fuzz-findings`.
+#[must_use]
+pub fn findings_dir() -> PathBuf {
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"), PathBuf::from);
+    target.join("fuzz-findings")
+}
