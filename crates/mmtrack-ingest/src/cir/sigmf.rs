@@ -128,19 +128,26 @@ fn samples(data_path: &Path, datatype: &str, data: &[u8]) -> Result<Vec<Complex6
         .collect())
 }
 
-/// `YYYY-MM-DDTHH:MM:SS[.fraction]Z` -> ns since the UNIX epoch.
+/// Exactly `n` ASCII digits as a number.
+fn digits(text: &str, n: usize) -> Option<i64> {
+    (text.len() == n && text.bytes().all(|b| b.is_ascii_digit())).then(|| text.parse().ok()).flatten()
+}
+
+/// `YYYY-MM-DDTHH:MM:SS[.fraction]Z` (RFC 3339 in UTC: fixed-width fields,
+/// years 0000-9999) -> ns since the UNIX epoch; `None` when malformed or
+/// beyond the i64 nanosecond range (years before 1677 or after 2262).
 fn parse_datetime_ns(text: &str) -> Option<i64> {
     let text = text.strip_suffix('Z')?;
     let (date, time) = text.split_once('T')?;
     let mut d = date.split('-');
-    let (y, m, day): (i64, i64, i64) = (d.next()?.parse().ok()?, d.next()?.parse().ok()?, d.next()?.parse().ok()?);
+    let (y, m, day) = (digits(d.next()?, 4)?, digits(d.next()?, 2)?, digits(d.next()?, 2)?);
     let (hms, frac) = time.split_once('.').unwrap_or((time, ""));
     let mut t = hms.split(':');
-    let (hh, mm, ss): (i64, i64, i64) = (t.next()?.parse().ok()?, t.next()?.parse().ok()?, t.next()?.parse().ok()?);
-    if !(1..=12).contains(&m) || !(1..=31).contains(&day) || hh > 23 || mm > 59 || ss > 60 || d.next().is_some() {
+    let (hh, mm, ss) = (digits(t.next()?, 2)?, digits(t.next()?, 2)?, digits(t.next()?, 2)?);
+    if !(1..=12).contains(&m) || !(1..=31).contains(&day) || hh > 23 || mm > 59 || ss > 60 {
         return None;
     }
-    if frac.len() > 9 || !frac.bytes().all(|b| b.is_ascii_digit()) {
+    if d.next().is_some() || t.next().is_some() || frac.len() > 9 || !frac.bytes().all(|b| b.is_ascii_digit()) {
         return None;
     }
     let frac_ns: i64 = if frac.is_empty() { 0 } else { format!("{frac:0<9}").parse().ok()? };
@@ -209,5 +216,27 @@ mod tests {
         assert!(e.contains("core:sample_rate: -1"), "{e}");
         assert_eq!(parse_datetime_ns("1970-01-01T00:00:00Z"), Some(0));
         assert_eq!(parse_datetime_ns("2000-03-01T00:00:00.000000001Z"), Some(951_868_800_000_000_001));
+    }
+
+    /// Found by fuzzing: a year of 11 digits overflowed the day arithmetic
+    /// (a panic in debug builds); signs and short fields were accepted.
+    #[test]
+    fn datetimes_out_of_range_or_malformed_are_refused() {
+        for text in [
+            "99999999999-01-01T00:00:00Z",
+            "-9223372036854775808-01-01T00:00:00Z",
+            "9999-12-31T23:59:59Z",
+            "1000-01-01T00:00:00Z",
+            "2021-09-21T-1:00:00Z",
+            "2021-09-21T+1:00:00Z",
+            "2021-9-21T00:00:00Z",
+            "2021-09-21T00:00:00:00Z",
+        ] {
+            assert_eq!(parse_datetime_ns(text), None, "{text}");
+        }
+        // The ends of the i64 nanosecond range.
+        assert_eq!(parse_datetime_ns("2262-04-11T23:47:16.854775807Z"), Some(i64::MAX));
+        assert_eq!(parse_datetime_ns("2262-04-11T23:47:17Z"), None);
+        assert_eq!(parse_datetime_ns("1677-09-21T00:12:44Z"), Some(-9_223_372_036_000_000_000));
     }
 }
