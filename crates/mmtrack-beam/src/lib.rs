@@ -11,7 +11,10 @@
 //! - [`PilotTracker`]: the predict / update roles every such tracker plays,
 //!   so experiments drive them alike;
 //! - [`valid_tracking`]: the paper's metric, blocks until the RMS angle error
-//!   over Monte Carlo runs exceeds half the beamwidth.
+//!   over Monte Carlo runs exceeds half the beamwidth;
+//! - [`sweep`]: beam-sweep trackers for measured codebooks (a window around
+//!   the predicted beam, from the beams alone or driven by the car's GNSS
+//!   through a fitted beam map), their baselines and accounting.
 //!
 //! It sits in the *process* stage: pure computation on in-memory types (no
 //! files, no printing); `mmtrack-sim` provides links to run on and
@@ -22,6 +25,7 @@ mod angle_ekf;
 mod error;
 mod link;
 mod position_velocity_ekf;
+pub mod sweep;
 pub mod valid_tracking;
 
 pub use angle_ekf::{AngleEkf, AngleEkfConfig};
