@@ -197,7 +197,7 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
                  samples beside the repository; run from the repository root); pass --trajectory PATH"
             );
         }
-        bail!("{}: trajectory not found", args.trajectory.display());
+        bail!("{}: not found (--trajectory)", args.trajectory.display());
     }
     let poses = simulate::read_trajectory(&args.trajectory, args.trajectory_format, None, 0)?;
     let trajectory = Trajectory::from_poses(poses).with_context(|| args.trajectory.display().to_string())?;
