@@ -83,9 +83,9 @@ pub struct BeamMapConfig {
 }
 
 impl Default for BeamMapConfig {
-    /// -1.5 s to 1.5 s in 0.1 s steps (one sweep at 10 Hz).
+    /// -3 s to 3 s in 0.1 s steps (one sweep at 10 Hz).
     fn default() -> Self {
-        Self { time_offsets_s: (-15..=15).map(|k| f64::from(k) * 0.1).collect() }
+        Self { time_offsets_s: (-30..=30).map(|k| f64::from(k) * 0.1).collect() }
     }
 }
 

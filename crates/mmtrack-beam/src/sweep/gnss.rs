@@ -2,7 +2,7 @@
 //! beam map, moves the window; the measurements correct the map's offset.
 
 use super::error::{SweepError, check};
-use super::search::{BeamProbe, PowerHold, SearchConfig, search_sweep};
+use super::search::{BeamProbe, PowerHold, SearchConfig, Window, search_sweep};
 use super::{SweepDecision, SweepTracker, dt_s};
 
 /// Settings of [`GnssWindowTracker`].
@@ -119,18 +119,24 @@ impl SweepTracker for GnssWindowTracker {
         };
         let config = &self.config;
         let r2 = config.measurement_sigma_beams.powi(2);
-        let (offset, variance, half) = match self.offset {
+        let (offset, variance, window) = match self.offset {
             None => {
                 let sigma0 = config.initial_offset_sigma_beams;
                 let half = (config.initial_window_sigmas * sigma0).ceil().min(probe.beam_count() as f64) as usize;
-                (0.0, sigma0 * sigma0, half.max(config.search.half_window_beams))
+                let half = half.max(config.search.half_window_beams);
+                // Contiguous, not strided like a coarse re-acquisition: far
+                // from the array the beam pattern is flat (3.5 dB from the
+                // best beam to the median on DeepSense scenario 3), and a
+                // strided search then climbs onto a bump.
+                (0.0, sigma0 * sigma0, Window { center: gnss_beam, half })
             }
             Some((offset, variance, previous_t_ns)) => {
                 let dt = dt_s(previous_t_ns, t_ns)?;
-                (offset, variance + config.offset_walk_beams_per_sqrt_s.powi(2) * dt, config.search.half_window_beams)
+                let variance = variance + config.offset_walk_beams_per_sqrt_s.powi(2) * dt;
+                (offset, variance, Window { center: gnss_beam + offset, half: config.search.half_window_beams })
             }
         };
-        let outcome = search_sweep(probe, gnss_beam + offset, half, &config.search, &mut self.hold)?;
+        let outcome = search_sweep(probe, window, &config.search, &mut self.hold)?;
         let z = outcome.subbeam - gnss_beam;
         let (offset, variance) = if outcome.reacquired {
             (z, r2)

@@ -208,12 +208,20 @@ pub(crate) fn climb(probe: &mut BeamProbe<'_>, max_extra: usize) -> Result<Peak,
     }
 }
 
-/// Measures the `2 half + 1` beams around the beam nearest to `center`
-/// (shifted to stay inside the codebook; the whole codebook if it is
-/// smaller). A `center` outside the codebook points at its nearest edge
-/// beam.
-pub(crate) fn measure_window(probe: &mut BeamProbe<'_>, center: f64, half: usize) -> Result<(), SweepError> {
+/// Where a tracker looks in one sweep: the beams within `half` of the beam
+/// nearest to `center`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Window {
+    pub center: f64,
+    pub half: usize,
+}
+
+/// Measures `window`: the `2 half + 1` beams around the beam nearest to its
+/// center (shifted to stay inside the codebook; the whole codebook if it is
+/// smaller). A center outside the codebook points at its nearest edge beam.
+pub(crate) fn measure_window(probe: &mut BeamProbe<'_>, window: Window) -> Result<(), SweepError> {
     let count = probe.beam_count();
+    let Window { center, half } = window;
     let width = (2 * half + 1).min(count);
     let nearest = if center.is_nan() { 0 } else { center.round().clamp(0.0, (count - 1) as f64) as usize };
     let start = nearest.saturating_sub(half).min(count - width);
@@ -311,19 +319,18 @@ pub(crate) struct SearchOutcome {
     pub reacquired: bool,
 }
 
-/// One sweep of a window tracker: measures the window around `center`,
-/// climbs, applies the loss rule (the climb ran out at the window's edge,
+/// One sweep of a window tracker: measures `window`, climbs (up to
+/// `max_extension_beams` new beams), applies the loss rule (the climb ran out at the window's edge,
 /// or the power fell `drop_db` below the hold) and re-acquires when lost;
 /// updates the power hold with the chosen beam's power (restarting it after
 /// a re-acquisition, so a blocked link does not trigger one every sweep).
 pub(crate) fn search_sweep(
     probe: &mut BeamProbe<'_>,
-    center: f64,
-    half_window: usize,
+    window: Window,
     config: &SearchConfig,
     hold: &mut PowerHold,
 ) -> Result<SearchOutcome, SweepError> {
-    measure_window(probe, center, half_window)?;
+    measure_window(probe, window)?;
     let peak = climb(probe, config.max_extension_beams)?;
     let t_ns = probe.t_ns();
     let faded = hold.level_db(t_ns).is_some_and(|level| peak.power_db < level - config.drop_db);
@@ -353,7 +360,7 @@ mod tests {
     fn window_climb_and_subbeam_find_an_offset_peak() {
         let sweep = parabola_sweep(64, 20.3, 0.5);
         let mut probe = BeamProbe::new(&sweep);
-        measure_window(&mut probe, 17.0, 1).unwrap();
+        measure_window(&mut probe, Window { center: 17.0, half: 1 }).unwrap();
         assert_eq!(probe.measured_count(), 3);
         let peak = climb(&mut probe, 4).unwrap();
         assert_eq!(peak.beam, 20);
@@ -368,7 +375,7 @@ mod tests {
     fn climb_stops_at_its_budget_and_reports_the_edge() {
         let sweep = parabola_sweep(64, 40.0, 0.1);
         let mut probe = BeamProbe::new(&sweep);
-        measure_window(&mut probe, 30.0, 1).unwrap();
+        measure_window(&mut probe, Window { center: 30.0, half: 1 }).unwrap();
         let peak = climb(&mut probe, 4).unwrap();
         assert_eq!((peak.beam, peak.at_edge), (35, true));
         assert_eq!(probe.measured_count(), 7);
@@ -378,10 +385,10 @@ mod tests {
     fn window_stays_inside_the_codebook() {
         let sweep = parabola_sweep(8, 0.0, 0.5);
         let mut probe = BeamProbe::new(&sweep);
-        measure_window(&mut probe, -3.0, 2).unwrap();
+        measure_window(&mut probe, Window { center: -3.0, half: 2 }).unwrap();
         assert_eq!((0..5).map(|b| probe.measured(b).is_some()).filter(|&m| m).count(), 5);
         let mut probe = BeamProbe::new(&sweep);
-        measure_window(&mut probe, 1e9, 20).unwrap();
+        measure_window(&mut probe, Window { center: 1e9, half: 20 }).unwrap();
         assert_eq!(probe.measured_count(), 8, "a window wider than the codebook is the codebook");
     }
 

@@ -5,7 +5,7 @@ use mmtrack_filter::faer::{Col, Mat};
 use mmtrack_filter::{ConstantVelocity, Gaussian, KalmanPredictor, KalmanUpdater, LinearMeasurement};
 
 use super::error::{SweepError, check};
-use super::search::{BeamProbe, PowerHold, SearchConfig, acquire, search_sweep, subbeam_peak};
+use super::search::{BeamProbe, PowerHold, SearchConfig, Window, acquire, search_sweep, subbeam_peak};
 use super::{SweepDecision, SweepTracker, dt_s};
 
 /// Settings of [`WindowTracker`].
@@ -141,8 +141,12 @@ impl SweepTracker for WindowTracker {
         let filter_error = |source| SweepError::Filter { t_ns, source };
         let predicted = self.predictor.predict(&prior, dt_s(previous_t_ns, t_ns)?).map_err(filter_error)?;
         let center = predicted.mean()[0];
-        let outcome =
-            search_sweep(probe, center, self.config.search.half_window_beams, &self.config.search, &mut self.hold)?;
+        let outcome = search_sweep(
+            probe,
+            Window { center, half: self.config.search.half_window_beams },
+            &self.config.search,
+            &mut self.hold,
+        )?;
         let posterior = if outcome.reacquired {
             self.restart(outcome.subbeam, predicted.mean()[1], t_ns)?
         } else {
