@@ -250,7 +250,10 @@ fn print_config_needs_no_recording_and_no_output() {
 /// the missing default and the option to pass when run elsewhere.
 #[test]
 fn defaults_beside_the_repository_say_so_and_fail_clearly_elsewhere() {
-    let dir = tempfile::tempdir().unwrap();
+    // A directory whose parent certainly holds no `shared/` (a temporary
+    // directory's parent may: a CI clone in /tmp has ../shared beside it).
+    let top = tempfile::tempdir().unwrap();
+    let dir = tempfile::tempdir_in(top.path()).unwrap();
     let cases = [
         (
             ["reproduce", "odometry", "--quick"],
