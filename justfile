@@ -58,8 +58,9 @@ convoy *args:
 
 # Fuzz the byte-level readers offline, e.g. `just fuzz all --seconds 600` or
 # `just fuzz npy --seconds 60`; findings go to target/fuzz-findings/<target>/.
+# The fuzz profile is release with overflow checks and debug assertions.
 fuzz *args:
-    cargo run -q --release -p mmtrack-fuzz -- "$@"
+    cargo run -q --profile fuzz -p mmtrack-fuzz -- "$@"
 
 # Paper experiments.
 reproduce *args:

@@ -8,9 +8,11 @@
 //! that notes any single allocation above a cap ([`alloc`]).
 //!
 //! Two uses: CI runs every target for a fixed number of executions
-//! (`tests/it`, deterministic, asserts no findings); `cargo run --release -p
-//! mmtrack-fuzz -- <target>|all --seconds N` runs as long as wanted and saves
-//! findings under `target/fuzz-findings/<target>/`.
+//! (`tests/it`, deterministic, asserts no findings); `cargo run --profile
+//! fuzz -p mmtrack-fuzz -- <target>|all --seconds N` runs as long as wanted
+//! and saves findings under `target/fuzz-findings/<target>/` (the `fuzz`
+//! profile is release with overflow checks and debug assertions, so an
+//! integer overflow panics as in the tests instead of wrapping).
 //!
 //! A dev-only crate (`publish = false`): it depends on the readers
 //! (`mmtrack-ingest`, `mmtrack-io`, `mmtrack-core`) and nothing depends on

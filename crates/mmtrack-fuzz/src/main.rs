@@ -1,7 +1,7 @@
 //! `mmtrack-fuzz`: runs the fuzz targets offline.
 //!
 //! ```text
-//! cargo run --release -p mmtrack-fuzz -- <target>|all [--seconds N] [--executions N] [--seed S] [--slow-s X]
+//! cargo run --profile fuzz -p mmtrack-fuzz -- <target>|all [--seconds N] [--executions N] [--seed S] [--slow-s X]
 //! cargo run -p mmtrack-fuzz -- <target> --replay FILE...
 //! ```
 //!
