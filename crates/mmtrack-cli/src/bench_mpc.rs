@@ -344,7 +344,7 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
 }
 
 /// The 1-minute load average (`/proc/loadavg`, Linux).
-fn load_average() -> Option<f64> {
+pub(crate) fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }
 

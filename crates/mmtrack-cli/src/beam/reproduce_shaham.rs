@@ -105,7 +105,8 @@ pub(super) struct PointResult {
     pub rms_rad: [Vec<f64>; 3],
     /// Valid-tracking blocks per tracker.
     pub valid_blocks: [Option<usize>; 3],
-    /// CPU seconds spent in each tracker (summed over threads).
+    /// Seconds spent in each tracker, summed over threads (wall time inside
+    /// each run: other load on the machine inflates it).
     pub tracker_cpu_s: [f64; 3],
 }
 
@@ -133,6 +134,7 @@ pub fn run(args: &ShahamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let points = scenario_points(&experiment);
     let threshold_rad = threshold_rad(&experiment.scenario).with_context(|| source.clone())?;
 
+    let load_before = crate::bench_mpc::load_average();
     let started = Instant::now();
     let (results, threads) = args.threads.install(|| -> anyhow::Result<(Vec<PointResult>, usize)> {
         let chunks = runs.div_ceil(RUNS_PER_CHUNK);
@@ -169,9 +171,10 @@ pub fn run(args: &ShahamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         Ok((results, rayon::current_num_threads()))
     })??;
     let elapsed_s = started.elapsed().as_secs_f64();
+    let load = (load_before, crate::bench_mpc::load_average());
 
     let verdicts = report::verdicts(&experiment, &results);
-    let summary = report::summary(&experiment, &results, &verdicts, runs, threshold_rad, elapsed_s, threads);
+    let summary = report::summary(&experiment, &results, &verdicts, runs, threshold_rad, (elapsed_s, threads, load));
     write_outputs(args, &experiment, &source, &results, runs, threshold_rad, &summary)?;
     if let Some(readme) = &args.readme {
         crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;

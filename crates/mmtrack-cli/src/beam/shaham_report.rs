@@ -87,8 +87,7 @@ pub fn summary(
     verdicts: &[Verdict],
     runs: u64,
     threshold_rad: f64,
-    elapsed_s: f64,
-    threads: usize,
+    (elapsed_s, threads, load): (f64, usize, (Option<f64>, Option<f64>)),
 ) -> String {
     let s = &experiment.scenario;
     let mut out = format!(
@@ -134,11 +133,18 @@ pub fn summary(
         })
         .collect();
     out.push_str(&format!(
-        "\n{} points x {runs} runs x 3 trackers in {elapsed_s:.1} s on {threads} threads; runs per CPU-second of \
+        "\n{} points x {runs} runs x 3 trackers in {elapsed_s:.1} s on {threads} threads; runs per thread-second of \
          {} blocks: {}.\n",
         results.len(),
         experiment.blocks,
         speeds.join(", ")
+    ));
+    let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+    out.push_str(&format!(
+        "1-minute load average before / after the run: {} / {} (on {threads} threads; above that, other work shared \
+         the cores and the times are longer).\n",
+        fmt(load.0),
+        fmt(load.1)
     ));
     out
 }
