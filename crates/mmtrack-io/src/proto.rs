@@ -484,6 +484,65 @@ impl SpecMessage for MpcTruth {
     const SPEC: &'static MessageSpec = &MPC_TRUTH_SPEC;
 }
 
+/// One sweep of a measured beam codebook (`mmtrack.BeamSweep`).
+#[derive(Clone, PartialEq, Message)]
+pub struct BeamSweep {
+    /// See [`BEAM_SWEEP_SPEC`].
+    #[prost(int64, required, tag = "1")]
+    pub t_ns: i64,
+    /// See [`BEAM_SWEEP_SPEC`].
+    #[prost(uint32, required, tag = "2")]
+    pub beam_count: u32,
+    /// See [`BEAM_SWEEP_SPEC`].
+    #[prost(double, repeated, tag = "3")]
+    pub power_linear: Vec<f64>,
+    /// See [`BEAM_SWEEP_SPEC`].
+    #[prost(bool, repeated, tag = "4")]
+    pub measured: Vec<bool>,
+    /// See [`BEAM_SWEEP_SPEC`].
+    #[prost(string, optional, tag = "5")]
+    pub codebook: Option<String>,
+}
+
+/// Schema of [`BeamSweep`].
+pub const BEAM_SWEEP_SPEC: MessageSpec = MessageSpec {
+    full_name: "mmtrack.BeamSweep",
+    description: "One sweep of a measured beam codebook (e.g. a roadside 60 GHz phased array's 64 beams): the received \
+power of each beam that was measured, in codebook order.",
+    fields: &[
+        field("t_ns", 1, Int64, One, "ns", "sweep time (the recording metadata says what it counts from)"),
+        field(
+            "beam_count",
+            2,
+            Uint32,
+            One,
+            "",
+            "beams of the codebook, at least one; power_linear and measured have this length",
+        ),
+        field(
+            "power_linear",
+            3,
+            Double,
+            Repeated,
+            "",
+            "received power of each beam, linear, on the source's scale (e.g. normalised); finite and >= 0; 0 for a beam not measured",
+        ),
+        field("measured", 4, Bool, Repeated, "", "whether each beam was measured in this sweep; at least one is"),
+        field(
+            "codebook",
+            5,
+            Str,
+            Optional,
+            "",
+            "codebook identifier, e.g. deepsense-60ghz-64 (beam index i is the same beam in every sweep of one codebook); absent when the source names none",
+        ),
+    ],
+};
+
+impl SpecMessage for BeamSweep {
+    const SPEC: &'static MessageSpec = &BEAM_SWEEP_SPEC;
+}
+
 /// All mmtrack message schemas, for documentation and tests.
 pub const ALL_SPECS: &[&MessageSpec] =
-    &[&POSE2D_SPEC, &GNSS_FIX_SPEC, &RADAR_SCAN_META_SPEC, &CIR_SNAPSHOT_SPEC, &MPC_TRUTH_SPEC];
+    &[&POSE2D_SPEC, &GNSS_FIX_SPEC, &RADAR_SCAN_META_SPEC, &CIR_SNAPSHOT_SPEC, &MPC_TRUTH_SPEC, &BEAM_SWEEP_SPEC];

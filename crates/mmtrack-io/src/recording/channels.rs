@@ -25,6 +25,13 @@ pub const GNSS_VIZ_TOPIC: &str = "/viz/gnss";
 pub const CIR_TOPIC: &str = "/channel/cir";
 /// Topic of the true multipath components of simulated CIRs.
 pub const MPC_TRUTH_TOPIC: &str = "/channel/mpc_truth";
+/// Topic of beam sweeps of a measured codebook.
+pub const BEAM_SWEEP_TOPIC: &str = "/beam/sweeps";
+/// Topic of GNSS fixes of the beam-sweeping array (e.g. a roadside unit);
+/// the vehicle's own fixes stay on [`GNSS_TOPIC`].
+pub const GNSS_ARRAY_TOPIC: &str = "/gnss/array";
+/// Display view of the array's GNSS fixes.
+pub const GNSS_ARRAY_VIZ_TOPIC: &str = "/viz/gnss_array";
 
 /// Which trajectory a pose belongs to.
 ///
@@ -143,6 +150,19 @@ pub const CHANNELS: &[ChannelSpec] = &[
                   a snapshot has as many as it has true paths, possibly none",
     },
     ChannelSpec {
+        topic: BEAM_SWEEP_TOPIC,
+        schema_names: &["mmtrack.BeamSweep"],
+        canonical: true,
+        meaning: "one sweep of a measured beam codebook: received power of each measured beam (the array that sweeps \
+                  is located by /gnss/array, the vehicle by /gnss/fix)",
+    },
+    ChannelSpec {
+        topic: GNSS_ARRAY_TOPIC,
+        schema_names: &["mmtrack.GnssFix"],
+        canonical: true,
+        meaning: "GNSS position fix of the beam-sweeping array (e.g. a roadside unit); the vehicle's fixes are on /gnss/fix",
+    },
+    ChannelSpec {
         topic: "/viz/ground_truth",
         schema_names: &["foxglove.PoseInFrame"],
         canonical: false,
@@ -171,5 +191,11 @@ pub const CHANNELS: &[ChannelSpec] = &[
         schema_names: &["foxglove.LocationFix"],
         canonical: false,
         meaning: "display copy of /gnss/fix for Foxglove's map panel",
+    },
+    ChannelSpec {
+        topic: GNSS_ARRAY_VIZ_TOPIC,
+        schema_names: &["foxglove.LocationFix"],
+        canonical: false,
+        meaning: "display copy of /gnss/array for Foxglove's map panel",
     },
 ];

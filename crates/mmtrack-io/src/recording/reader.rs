@@ -8,13 +8,16 @@ use foxglove::schemas::{CompressedImage, RawImage};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
 use mmtrack_core::{
-    AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTruth, PolarScan, PolarScanHeader, Se2,
-    StampedPose,
+    AzimuthSample, BeamSweep, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTruth, PolarScan, PolarScanHeader,
+    Se2, StampedPose,
 };
 use prost::Message;
 
 use super::METADATA_NAME;
-use super::channels::{CIR_TOPIC, GNSS_TOPIC, MPC_TRUTH_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC};
+use super::channels::{
+    BEAM_SWEEP_TOPIC, CIR_TOPIC, GNSS_ARRAY_TOPIC, GNSS_TOPIC, MPC_TRUTH_TOPIC, PoseStream, RADAR_IMAGE_TOPIC,
+    RADAR_META_TOPIC,
+};
 use crate::error::{IoError, Result, os_err};
 use crate::proto;
 
@@ -170,8 +173,18 @@ pub enum RecordingEvent {
         /// The pose.
         pose: StampedPose,
     },
-    /// A GNSS fix.
+    /// A GNSS fix of the vehicle (`/gnss/fix`).
     Gnss(GnssFix),
+    /// A GNSS fix of the beam-sweeping array, e.g. a roadside unit
+    /// (`/gnss/array`).
+    ArrayGnss(GnssFix),
+    /// A beam sweep of a measured codebook (`/beam/sweeps`).
+    BeamSweep {
+        /// The sweep (unmeasured beams hold power 0).
+        sweep: BeamSweep,
+        /// The codebook's identifier, when the recording names one.
+        codebook: Option<String>,
+    },
     /// A channel impulse response.
     Cir(CirSnapshot),
     /// A true multipath component of a simulated CIR snapshot.
@@ -240,18 +253,24 @@ impl RecordingReader {
                 let pose = StampedPose { t_ns: p.t_ns, parent_from_child: Se2::new(p.x_m, p.y_m, p.yaw_rad) };
                 return Ok(Some(RecordingItem::Event(RecordingEvent::Pose { stream, pose })));
             } else if topic == GNSS_TOPIC {
-                let f: proto::GnssFix = self.decode(&m)?;
-                let quality = GnssFixQuality::from_code(f.quality)
-                    .ok_or_else(|| self.bad(&m, format!("unknown fix quality code {}", f.quality)))?;
-                return Ok(Some(RecordingItem::Event(RecordingEvent::Gnss(GnssFix {
-                    t_ns: f.t_ns,
-                    latitude_deg: f.latitude_deg,
-                    longitude_deg: f.longitude_deg,
-                    altitude_m: f.altitude_m,
-                    horizontal_sigma_m: f.horizontal_sigma_m,
-                    num_satellites: f.num_satellites,
-                    quality,
-                }))));
+                return Ok(Some(RecordingItem::Event(RecordingEvent::Gnss(self.decode_fix(&m)?))));
+            } else if topic == GNSS_ARRAY_TOPIC {
+                return Ok(Some(RecordingItem::Event(RecordingEvent::ArrayGnss(self.decode_fix(&m)?))));
+            } else if topic == BEAM_SWEEP_TOPIC {
+                let b: proto::BeamSweep = self.decode(&m)?;
+                let beams = b.beam_count as usize;
+                if b.power_linear.len() != beams || b.measured.len() != beams {
+                    return Err(self.bad(
+                        &m,
+                        format!(
+                            "beam_count {beams} but {} power_linear values and {} measured flags",
+                            b.power_linear.len(),
+                            b.measured.len()
+                        ),
+                    ));
+                }
+                let sweep = BeamSweep::new(b.t_ns, b.power_linear, b.measured).map_err(|e| self.bad(&m, e))?;
+                return Ok(Some(RecordingItem::Event(RecordingEvent::BeamSweep { sweep, codebook: b.codebook })));
             } else if topic == CIR_TOPIC {
                 let c: proto::CirSnapshot = self.decode(&m)?;
                 if c.taps_re.len() != c.taps_im.len() {
@@ -287,6 +306,21 @@ impl RecordingReader {
             }
         }
         Ok(None)
+    }
+
+    fn decode_fix(&self, m: &RawMessage) -> Result<GnssFix> {
+        let f: proto::GnssFix = self.decode(m)?;
+        let quality = GnssFixQuality::from_code(f.quality)
+            .ok_or_else(|| self.bad(m, format!("unknown fix quality code {}", f.quality)))?;
+        Ok(GnssFix {
+            t_ns: f.t_ns,
+            latitude_deg: f.latitude_deg,
+            longitude_deg: f.longitude_deg,
+            altitude_m: f.altitude_m,
+            horizontal_sigma_m: f.horizontal_sigma_m,
+            num_satellites: f.num_satellites,
+            quality,
+        })
     }
 
     /// Joins a radar image with the metadata of the same sequence number.

@@ -5,12 +5,13 @@ use std::path::{Path, PathBuf};
 
 use foxglove::Encode;
 use foxglove::schemas::{CompressedImage, LocationFix, Pose, PoseInFrame, Quaternion, RawImage, Timestamp, Vector3};
-use mmtrack_core::{CirSnapshot, GnssFix, MpcTruth, PolarScan, PolarScanHeader, StampedPose};
+use mmtrack_core::{BeamSweep, CirSnapshot, GnssFix, MpcTruth, PolarScan, PolarScanHeader, StampedPose};
 use prost::Message;
 
 use super::METADATA_NAME;
 use super::channels::{
-    CIR_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC, PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
+    BEAM_SWEEP_TOPIC, CIR_TOPIC, GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC,
+    PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
 };
 use super::reader::RawMessage;
 use crate::atomic::{AtomicFile, Durability, Overwrite};
@@ -404,8 +405,18 @@ impl RecordingWriter {
         Ok(())
     }
 
-    /// Writes a GNSS fix (and its Foxglove display copy).
+    /// Writes a GNSS fix of the vehicle (and its Foxglove display copy).
     pub fn write_gnss_fix(&mut self, fix: &GnssFix) -> Result<()> {
+        self.write_fix(GNSS_TOPIC, GNSS_VIZ_TOPIC, "gnss", fix)
+    }
+
+    /// Writes a GNSS fix of the beam-sweeping array, e.g. a roadside unit
+    /// (`/gnss/array`, and its Foxglove display copy).
+    pub fn write_array_gnss_fix(&mut self, fix: &GnssFix) -> Result<()> {
+        self.write_fix(GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, "gnss_array", fix)
+    }
+
+    fn write_fix(&mut self, topic: &'static str, viz_topic: &'static str, frame_id: &str, fix: &GnssFix) -> Result<()> {
         let message = proto::GnssFix {
             t_ns: fix.t_ns,
             latitude_deg: fix.latitude_deg,
@@ -415,7 +426,7 @@ impl RecordingWriter {
             num_satellites: fix.num_satellites,
             quality: fix.quality.code(),
         };
-        self.write_spec(GNSS_TOPIC, fix.t_ns, &message, None)?;
+        self.write_spec(topic, fix.t_ns, &message, None)?;
         if self.foxglove_views {
             let (covariance, covariance_type) = match fix.horizontal_sigma_m {
                 Some(sigma_m) => {
@@ -426,7 +437,7 @@ impl RecordingWriter {
             };
             let view = LocationFix {
                 timestamp: timestamp(fix.t_ns),
-                frame_id: "gnss".into(),
+                frame_id: frame_id.into(),
                 latitude: fix.latitude_deg,
                 longitude: fix.longitude_deg,
                 // As sensor_msgs/NavSatFix, which LocationFix mirrors: NaN
@@ -436,7 +447,7 @@ impl RecordingWriter {
                 position_covariance_type: covariance_type,
                 ..Default::default()
             };
-            self.write_foxglove(GNSS_VIZ_TOPIC, fix.t_ns, &view, None)?;
+            self.write_foxglove(viz_topic, fix.t_ns, &view, None)?;
         }
         Ok(())
     }
@@ -474,6 +485,27 @@ impl RecordingWriter {
             doppler_hz: truth.doppler_hz,
         };
         self.write_spec(MPC_TRUTH_TOPIC, truth.t_ns, &message, None)?;
+        Ok(())
+    }
+
+    /// Writes a beam sweep (`mmtrack.BeamSweep` on `/beam/sweeps`), with the
+    /// codebook's identifier when the source names one.
+    pub fn write_beam_sweep(&mut self, sweep: &BeamSweep, codebook: Option<&str>) -> Result<()> {
+        let beams = sweep.beam_count();
+        let beam_count = u32::try_from(beams).map_err(|_| IoError::BadValue {
+            path: self.path().to_path_buf(),
+            record: format!("beam sweep at {} ns", sweep.t_ns()),
+            field: "beam_count",
+            detail: format!("{beams} beams do not fit in 32 bits"),
+        })?;
+        let message = proto::BeamSweep {
+            t_ns: sweep.t_ns(),
+            beam_count,
+            power_linear: (0..beams).map(|b| sweep.power(b).unwrap_or(0.0)).collect(),
+            measured: (0..beams).map(|b| sweep.is_measured(b)).collect(),
+            codebook: codebook.map(str::to_string),
+        };
+        self.write_spec(BEAM_SWEEP_TOPIC, sweep.t_ns(), &message, None)?;
         Ok(())
     }
 

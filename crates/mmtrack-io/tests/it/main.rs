@@ -4,6 +4,7 @@
 
 mod bad_input;
 mod roundtrip;
+mod roundtrip_beam;
 mod roundtrip_mpc;
 mod samples;
 mod schemas;

@@ -132,5 +132,12 @@ fn descriptors_match_prost_encoding() {
         amplitude_im: 1.0,
         doppler_hz: 1.0,
     });
-    assert_eq!(ALL_SPECS.len(), 5, "a new message needs a sample above");
+    check(&proto::BeamSweep {
+        t_ns: 1,
+        beam_count: 2,
+        power_linear: vec![1.0, 2.0],
+        measured: vec![true, false],
+        codebook: Some("c".into()),
+    });
+    assert_eq!(ALL_SPECS.len(), 6, "a new message needs a sample above");
 }
