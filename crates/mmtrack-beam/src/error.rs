@@ -23,6 +23,15 @@ pub enum BeamError {
         /// The pilot, as text.
         value: String,
     },
+    /// A pose estimate that drives a tracker is unusable (not finite, on the
+    /// base station).
+    #[error("pose estimate of slot {slot}: {detail}")]
+    BadPose {
+        /// Slot index since the tracker started.
+        slot: usize,
+        /// What is wrong with it.
+        detail: String,
+    },
     /// `update` without a `predict` before it.
     #[error("update of block {block} without a prediction: call predict first")]
     UpdateWithoutPrediction {

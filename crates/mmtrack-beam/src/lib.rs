@@ -8,6 +8,9 @@
 //!   Im alpha]` on the overpass link, linear motion, Jacobian (31);
 //! - [`AngleEkf`]: the angle-state baseline of Va et al. 2016, state `[AoA,
 //!   AoD, Re alpha, Im alpha]` with additive angle noise;
+//! - [`SpebtEkf`]: the SPEBT beam tracker of Liu et al. 2024, state
+//!   `[|alpha|, AoD, AoA]` driven by estimated vehicle poses (Proposition 2),
+//!   measured by the pilot's power, re-initialised on large deviations;
 //! - [`PilotTracker`]: the predict / update roles every such tracker plays,
 //!   so experiments drive them alike;
 //! - [`valid_tracking`]: the paper's metric, blocks until the RMS angle error
@@ -25,6 +28,7 @@ mod angle_ekf;
 mod error;
 mod link;
 mod position_velocity_ekf;
+pub mod spebt;
 pub mod sweep;
 pub mod valid_tracking;
 
@@ -32,3 +36,4 @@ pub use angle_ekf::{AngleEkf, AngleEkfConfig};
 pub use error::BeamError;
 pub use link::{BeamPair, PilotTracker};
 pub use position_velocity_ekf::{PositionVelocityEkf, PositionVelocityEkfConfig, ProcessModel};
+pub use spebt::{Deviation, SpebtConfig, SpebtEkf, SpebtState};
