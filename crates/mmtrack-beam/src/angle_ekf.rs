@@ -19,11 +19,11 @@
 use mmtrack_core::Complex64;
 use mmtrack_core::array::UniformLinearArray;
 use mmtrack_filter::faer::{Col, Mat};
-use mmtrack_filter::{ExtendedKalmanUpdater, FilterError, Gaussian, NonlinearMeasurement, predict_linearised};
+use mmtrack_filter::{FilterError, Gaussian, NonlinearMeasurement};
 use serde::{Deserialize, Serialize};
 
 use crate::error::check;
-use crate::link::{check_pilot, set_complex_column, stacked, stacked_noise_cov};
+use crate::link::{PilotEkf, set_complex_column, stacked, stacked_noise_cov};
 use crate::{BeamError, BeamPair, PilotTracker};
 
 /// Parameters of [`AngleEkf`].
@@ -43,12 +43,8 @@ pub struct AngleEkfConfig {
 #[derive(Debug, Clone)]
 pub struct AngleEkf {
     array: UniformLinearArray,
-    transition: Mat<f64>,
-    process_cov: Mat<f64>,
     noise_cov: Mat<f64>,
-    state: Gaussian,
-    block: usize,
-    beams: Option<BeamPair>,
+    ekf: PilotEkf,
 }
 
 impl AngleEkf {
@@ -72,54 +68,28 @@ impl AngleEkf {
         })?;
         let (angle_var, alpha_var) = (c.angle_sigma_rad * c.angle_sigma_rad, 0.5 * (1.0 - c.rho * c.rho));
         let process_cov = diagonal(&[angle_var, angle_var, alpha_var, alpha_var]);
-        let mean = Col::from_fn(4, |i| [aoa_rad, aod_rad, alpha.re, alpha.im][i]);
-        let state =
-            Gaussian::new(mean, process_cov.clone()).map_err(|source| BeamError::Filter { block: 0, source })?;
-        Ok(Self {
-            array,
-            transition: diagonal(&[1.0, 1.0, c.rho, c.rho]),
-            process_cov,
-            noise_cov: stacked_noise_cov(c.noise_variance),
-            state,
-            block: 0,
-            beams: None,
-        })
+        let start = Col::from_fn(4, |i| [aoa_rad, aod_rad, alpha.re, alpha.im][i]);
+        let transition = diagonal(&[1.0, 1.0, c.rho, c.rho]);
+        // P[1|0] = Q: the start covariance is the process noise.
+        let ekf = PilotEkf::new(start, transition, process_cov.clone(), process_cov)?;
+        Ok(Self { array, noise_cov: stacked_noise_cov(c.noise_variance), ekf })
     }
 
     /// The current estimate (after the last predict or update).
     #[must_use]
     pub fn state(&self) -> &Gaussian {
-        &self.state
+        self.ekf.state()
     }
 }
 
 impl PilotTracker for AngleEkf {
     fn predict(&mut self) -> Result<BeamPair, BeamError> {
-        let block = self.block + 1;
-        let mean = &self.transition * self.state.mean();
-        let predicted = if self.block == 0 {
-            // P[1|0] = Q: the start covariance is already the process noise.
-            Gaussian::new(mean, self.process_cov.clone())
-        } else {
-            predict_linearised(&self.state, mean, &self.transition, &self.process_cov)
-        };
-        self.state = predicted.map_err(|source| BeamError::Filter { block, source })?;
-        self.block = block;
-        let x = self.state.mean();
-        let beams = BeamPair { rx_steer_u: x[0].cos(), tx_steer_u: x[1].cos() };
-        self.beams = Some(beams);
-        Ok(beams)
+        self.ekf.predict(|x| BeamPair { rx_steer_u: x[0].cos(), tx_steer_u: x[1].cos() })
     }
 
     fn update(&mut self, pilot: Complex64) -> Result<(), BeamError> {
-        let block = self.block;
-        let beams = self.beams.take().ok_or(BeamError::UpdateWithoutPrediction { block })?;
-        check_pilot(block, pilot)?;
-        let model = AnglePilot { array: self.array, beams, noise_cov: &self.noise_cov };
-        self.state = ExtendedKalmanUpdater::default()
-            .update(&self.state, &model, &stacked(pilot))
-            .map_err(|source| BeamError::Filter { block, source })?;
-        Ok(())
+        let array = self.array;
+        self.ekf.update(pilot, |beams| AnglePilot { array, beams, noise_cov: &self.noise_cov })
     }
 }
 

@@ -4,6 +4,7 @@
 
 use mmtrack_core::Complex64;
 use mmtrack_filter::faer::{Col, Mat};
+use mmtrack_filter::{ExtendedKalmanUpdater, Gaussian, NonlinearMeasurement, predict_linearised};
 
 use crate::BeamError;
 
@@ -74,5 +75,73 @@ pub(crate) fn check_pilot(block: usize, pilot: Complex64) -> Result<(), BeamErro
         Ok(())
     } else {
         Err(BeamError::BadPilot { block, value: pilot.to_string() })
+    }
+}
+
+/// The recursion the pilot EKFs share: linear motion `x[k+1] = A x[k] + u`,
+/// `u ~ N(0, Q)`, started at the channel estimate with `P[1|0]` given; an
+/// EKF update per pilot through the beams pointed from the prediction. It
+/// keeps the block count and the beams in flight, so a tracker only says
+/// how a state points the beams and what pilot it predicts.
+#[derive(Debug, Clone)]
+pub(crate) struct PilotEkf {
+    transition: Mat<f64>,
+    process_cov: Mat<f64>,
+    initial_cov: Mat<f64>,
+    state: Gaussian,
+    block: usize,
+    beams: Option<BeamPair>,
+}
+
+impl PilotEkf {
+    /// Starts at `start` (block 0); `initial_cov` is `P[1|0]`.
+    pub(crate) fn new(
+        start: Col<f64>,
+        transition: Mat<f64>,
+        process_cov: Mat<f64>,
+        initial_cov: Mat<f64>,
+    ) -> Result<Self, BeamError> {
+        let state =
+            Gaussian::new(start, initial_cov.clone()).map_err(|source| BeamError::Filter { block: 0, source })?;
+        Ok(Self { transition, process_cov, initial_cov, state, block: 0, beams: None })
+    }
+
+    /// The current estimate (after the last predict or update).
+    pub(crate) fn state(&self) -> &Gaussian {
+        &self.state
+    }
+
+    /// Predicts the next block (`P[1|0]` for the first) and points the beams
+    /// from the predicted mean with `point`.
+    pub(crate) fn predict(&mut self, point: impl FnOnce(&Col<f64>) -> BeamPair) -> Result<BeamPair, BeamError> {
+        let block = self.block + 1;
+        let mean = &self.transition * self.state.mean();
+        let predicted = if self.block == 0 {
+            Gaussian::new(mean, self.initial_cov.clone())
+        } else {
+            predict_linearised(&self.state, mean, &self.transition, &self.process_cov)
+        };
+        self.state = predicted.map_err(|source| BeamError::Filter { block, source })?;
+        self.block = block;
+        let beams = point(self.state.mean());
+        self.beams = Some(beams);
+        Ok(beams)
+    }
+
+    /// Updates with the pilot received through the beams of the last
+    /// prediction; `model` gives the measurement for those beams.
+    pub(crate) fn update<M: NonlinearMeasurement>(
+        &mut self,
+        pilot: Complex64,
+        model: impl FnOnce(BeamPair) -> M,
+    ) -> Result<(), BeamError> {
+        let block = self.block;
+        let beams = self.beams.take().ok_or(BeamError::UpdateWithoutPrediction { block })?;
+        check_pilot(block, pilot)?;
+        let model = model(beams);
+        self.state = ExtendedKalmanUpdater::default()
+            .update(&self.state, &model, &stacked(pilot))
+            .map_err(|source| BeamError::Filter { block, source })?;
+        Ok(())
     }
 }

@@ -41,11 +41,11 @@
 use mmtrack_core::Complex64;
 use mmtrack_core::array::UniformLinearArray;
 use mmtrack_filter::faer::{Col, Mat};
-use mmtrack_filter::{ExtendedKalmanUpdater, FilterError, Gaussian, NonlinearMeasurement, predict_linearised};
+use mmtrack_filter::{FilterError, Gaussian, NonlinearMeasurement};
 use serde::{Deserialize, Serialize};
 
 use crate::error::check;
-use crate::link::{check_pilot, set_complex_column, stacked, stacked_noise_cov};
+use crate::link::{PilotEkf, set_complex_column, stacked, stacked_noise_cov};
 use crate::{BeamError, BeamPair, PilotTracker};
 
 /// Which process model the filter assumes (module docs).
@@ -83,13 +83,8 @@ pub struct PositionVelocityEkfConfig {
 pub struct PositionVelocityEkf {
     height_m: f64,
     array: UniformLinearArray,
-    transition: Mat<f64>,
-    process_cov: Mat<f64>,
-    initial_cov: Mat<f64>,
     noise_cov: Mat<f64>,
-    state: Gaussian,
-    block: usize,
-    beams: Option<BeamPair>,
+    ekf: PilotEkf,
 }
 
 impl PositionVelocityEkf {
@@ -136,67 +131,42 @@ impl PositionVelocityEkf {
                 (transition(dt, 1.0), q.clone(), q)
             }
         };
-        let mean = Col::from_fn(4, |i| [distance_m, speed_mps, alpha.re, alpha.im][i]);
-        let state =
-            Gaussian::new(mean, initial_cov.clone()).map_err(|source| BeamError::Filter { block: 0, source })?;
-        Ok(Self {
-            height_m: c.height_m,
-            array,
-            transition,
-            process_cov,
-            initial_cov,
-            noise_cov: stacked_noise_cov(c.noise_variance),
-            state,
-            block: 0,
-            beams: None,
-        })
+        let start = Col::from_fn(4, |i| [distance_m, speed_mps, alpha.re, alpha.im][i]);
+        let ekf = PilotEkf::new(start, transition, process_cov, initial_cov)?;
+        Ok(Self { height_m: c.height_m, array, noise_cov: stacked_noise_cov(c.noise_variance), ekf })
     }
 
     /// The current estimate (after the last predict or update).
     #[must_use]
     pub fn state(&self) -> &Gaussian {
-        &self.state
+        self.ekf.state()
     }
 
     /// Estimated distance from the overpass, metres.
     #[must_use]
     pub fn distance_m(&self) -> f64 {
-        self.state.mean()[0]
+        self.ekf.state().mean()[0]
     }
 
     /// Estimated speed, m/s.
     #[must_use]
     pub fn speed_mps(&self) -> f64 {
-        self.state.mean()[1]
+        self.ekf.state().mean()[1]
     }
 }
 
 impl PilotTracker for PositionVelocityEkf {
     fn predict(&mut self) -> Result<BeamPair, BeamError> {
-        let block = self.block + 1;
-        let mean = &self.transition * self.state.mean();
-        let predicted = if self.block == 0 {
-            Gaussian::new(mean, self.initial_cov.clone())
-        } else {
-            predict_linearised(&self.state, mean, &self.transition, &self.process_cov)
-        };
-        self.state = predicted.map_err(|source| BeamError::Filter { block, source })?;
-        self.block = block;
-        let (rx_steer_u, tx_steer_u) = direction_cosines(self.height_m, self.distance_m());
-        let beams = BeamPair { rx_steer_u, tx_steer_u };
-        self.beams = Some(beams);
-        Ok(beams)
+        let height_m = self.height_m;
+        self.ekf.predict(|x| {
+            let (rx_steer_u, tx_steer_u) = direction_cosines(height_m, x[0]);
+            BeamPair { rx_steer_u, tx_steer_u }
+        })
     }
 
     fn update(&mut self, pilot: Complex64) -> Result<(), BeamError> {
-        let block = self.block;
-        let beams = self.beams.take().ok_or(BeamError::UpdateWithoutPrediction { block })?;
-        check_pilot(block, pilot)?;
-        let model = OverpassPilot { height_m: self.height_m, array: self.array, beams, noise_cov: &self.noise_cov };
-        self.state = ExtendedKalmanUpdater::default()
-            .update(&self.state, &model, &stacked(pilot))
-            .map_err(|source| BeamError::Filter { block, source })?;
-        Ok(())
+        let (height_m, array) = (self.height_m, self.array);
+        self.ekf.update(pilot, |beams| OverpassPilot { height_m, array, beams, noise_cov: &self.noise_cov })
     }
 }
 
