@@ -2,6 +2,9 @@
 //! measured one pilot at a time through the beams a tracker chooses.
 //!
 //! - [`overpass`]: the vehicle-to-infrastructure overpass link of Shaham et
-//!   al. 2020 (base station on an overpass, vehicle on the road below).
+//!   al. 2020 (base station on an overpass, vehicle on the road below);
+//! - [`spebt_link`]: the SPEBT link of Liu et al. 2024 along any trajectory,
+//!   with the paper's pose-error model.
 
 pub mod overpass;
+pub mod spebt_link;
