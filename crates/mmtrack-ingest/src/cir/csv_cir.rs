@@ -64,7 +64,11 @@ pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Re
             ok.map(Some).ok_or_else(|| bad(line, name, format!("`{}`, expected an integer >= 0", fields[k])))
         };
         let ordinal = match (int("set_index")?, int("snapshot_index")?) {
-            (Some(set), Some(k)) => set as u64 * per_set + k as u64,
+            (Some(set), Some(k)) => {
+                (set as u64).checked_mul(per_set).and_then(|o| o.checked_add(k as u64)).ok_or_else(|| {
+                    bad(line, "set_index", format!("set {set}, snapshot {k}: the snapshot's ordinal overflows u64"))
+                })?
+            }
             _ => row as u64,
         };
         let set_index = int("set_index")?.map_or(ordinal / per_set, |v| v as u64);
@@ -196,5 +200,21 @@ mod tests {
         assert!(err("re_0,im_0\n").contains("no snapshot rows"));
         let e = parse_cir_csv(Path::new("c.csv"), "re_0,im_0\n1,2\n", &sidecar("tap_spacing_s = 1e-9"));
         assert!(e.unwrap_err().to_string().contains("key `carrier_hz`"));
+    }
+
+    /// Seen while adding the CSV fuzz target: with two snapshots per set, a
+    /// huge set index overflowed the snapshot's ordinal (a panic in debug
+    /// builds, a wrapped ordinal in release).
+    #[test]
+    fn huge_set_index_is_an_error() {
+        // 2 (i64::MAX) + 2 = 2^64.
+        let text = "set_index,snapshot_index,re_0,im_0\n9223372036854775807,2,1,2\n";
+        let e = parse_cir_csv(Path::new("c.csv"), text, &sidecar(SIDECAR)).unwrap_err().to_string();
+        assert!(
+            e.contains(
+                "c.csv: line 2: set_index: set 9223372036854775807, snapshot 2: the snapshot's ordinal overflows"
+            ),
+            "{e}"
+        );
     }
 }
