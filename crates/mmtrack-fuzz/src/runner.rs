@@ -12,7 +12,8 @@
 //!
 //! Inputs that give an outcome not seen before (see [`crate::targets`]) join
 //! the corpus, a cheap stand-in for coverage feedback that leads the
-//! mutations past the first checks of a format.
+//! mutations past the first checks of a format. Half of the inputs start
+//! from a seed, half from any corpus entry.
 
 use std::cell::{Cell, RefCell};
 use std::collections::{BTreeMap, BTreeSet};
@@ -237,7 +238,10 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
         if let Some(seed) = seeds.get(executions as usize) {
             input.clone_from(seed);
         } else {
-            let base = mutator.below(corpus.len());
+            // Half the time a seed: grown entries are mostly inputs some check
+            // refused, and mutating only those rarely reaches the end of a reader.
+            let from = if mutator.below(2) == 0 { seeds.len().max(1) } else { corpus.len() };
+            let base = mutator.below(from);
             let other = mutator.below(corpus.len());
             mutator.mutate(&corpus[base], &corpus[other], &mut input);
             (target.fixup)(&mut input);

@@ -333,3 +333,37 @@ pub fn sigmf(realdata: Option<&Path>) -> Vec<Vec<u8>> {
     out.push(record("taps_per_snapshot = 16\n", &meta("ci16_le"), &ci16));
     out
 }
+
+/// CIR CSV files with their sidecars: written rows with and without index
+/// columns, and the first 8 taps of the real DecaWave log's first frames.
+#[must_use]
+pub fn csv(realdata: Option<&Path>) -> Vec<Vec<u8>> {
+    let sidecar = "carrier_hz = 3993.6e6\ntap_spacing_s = 1.0016e-9\nsnapshot_period_s = 0.001\n\
+                   snapshots_per_set = 2\nset_period_s = 0.01\nt0_ns = 100\n";
+    let mut out = vec![
+        with_sidecar(sidecar, b"# exported\nre_0,im_0,re_1,im_1\n1,2,3,4\n5,6,7,8\n\n-1,0,0,1e-3\n"),
+        with_sidecar(
+            sidecar,
+            b"t_ns,set_index,snapshot_index,tx_antenna,rx_antenna,re_0,im_0,re_1,im_1\n5,3,1,2,1,1,0,0.5,-0.5\n\
+              6,4,0,0,0,2,1,1,2\n",
+        ),
+        with_sidecar(
+            "carrier_hz = 60e9\ndomain = \"cfr\"\nsubcarrier_spacing_hz = 10e6\n",
+            b"set_index,snapshot_index,re_0,im_0,re_1,im_1,re_2,im_2\n0,0,1,0,0,1,-1,0\n",
+        ),
+    ];
+    let Some(log) = realdata.and_then(|dir| head(&dir.join("uwb-cirs-2018/1.log"), 40_000, true)) else {
+        return out;
+    };
+    let mut text = "re_0,im_0,re_1,im_1,re_2,im_2,re_3,im_3,re_4,im_4,re_5,im_5,re_6,im_6,re_7,im_7\n".to_string();
+    let log = String::from_utf8_lossy(&log);
+    let mut lines = log.lines();
+    while lines.by_ref().any(|l| l.starts_with("Accum Len")) {
+        let row: Vec<&str> =
+            lines.by_ref().take(8).filter_map(|l| l.split_once(',')).flat_map(|(i, q)| [i.trim(), q.trim()]).collect();
+        text += &row.join(",");
+        text.push('\n');
+    }
+    out.push(with_sidecar(sidecar, text.as_bytes()));
+    out
+}

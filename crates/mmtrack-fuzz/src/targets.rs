@@ -10,6 +10,7 @@
 //! | `npy` | `cir::read_cir_file` as `npy`, or as `npz` when the file starts with `PK` |
 //! | `mat` | `cir::read_cir_file` as `mat`, and `cir::read_mat_cir` on the bytes |
 //! | `sigmf` | `cir::read_cir_file` as `sigmf` |
+//! | `csv` | `cir::read_cir_file` as `csv` (CIRs one snapshot per row) |
 //!
 //! The CIR targets parse a sidecar first: their input is `sidecar TOML, NUL,
 //! file` (SigMF: `sidecar, NUL, meta, NUL, data`), split at the first NUL(s).
@@ -50,7 +51,7 @@ pub struct Target {
 }
 
 /// Every target, in the order `all` runs them.
-pub const TARGETS: [Target; 7] = [
+pub const TARGETS: [Target; 8] = [
     Target {
         name: "png",
         reader: "Navtech polar PNG (Oxford/Boreas row header)",
@@ -64,6 +65,7 @@ pub const TARGETS: [Target; 7] = [
     Target { name: "npy", reader: "NumPy .npy / .npz", run: npy, seeds: seeds::npy_files, fixup: keep },
     Target { name: "mat", reader: "MATLAB v5 .mat", run: mat, seeds: seeds::mat, fixup: keep },
     Target { name: "sigmf", reader: "SigMF meta + data", run: sigmf, seeds: seeds::sigmf, fixup: keep },
+    Target { name: "csv", reader: "CIR CSV", run: csv, seeds: seeds::csv, fixup: keep },
 ];
 
 /// The target called `name`.
@@ -242,6 +244,17 @@ fn sigmf(scratch: &Scratch, input: &[u8]) -> String {
         scratch.write("fuzz.sigmf-meta", meta).and_then(|meta| Ok((meta, scratch.write("fuzz.sigmf-data", data)?)));
     match written {
         Ok((meta, _)) => outcome(&read_cir_file(CirFormat::Sigmf, &meta, sidecar.as_ref())),
+        Err(e) => e,
+    }
+}
+
+fn csv(scratch: &Scratch, input: &[u8]) -> String {
+    let (sidecar, file) = match split_sidecar(input) {
+        Ok(split) => split,
+        Err(outcome) => return outcome,
+    };
+    match scratch.write("fuzz.csv", file) {
+        Ok(path) => outcome(&read_cir_file(CirFormat::Csv, &path, sidecar.as_ref())),
         Err(e) => e,
     }
 }
