@@ -5,6 +5,7 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
+use mmtrack_ingest::beams::{DeepsenseOptions, VehiclePositions};
 use mmtrack_ingest::boreas::BoreasOptions;
 use mmtrack_ingest::cir::{CirFormat, ingest_cir};
 use mmtrack_ingest::mulran::{self, MulranOptions};
@@ -21,7 +22,7 @@ use crate::threads::ThreadsArg;
 mod folders;
 
 pub use folders::oxford_folder;
-use folders::{SweepArgs, boreas_folder, mulran_folder, positive_metres};
+use folders::{RecordingDirArgs, SweepArgs, boreas_folder, deepsense_folder, mulran_folder, positive_metres};
 
 /// Options shared by every ingest kind.
 #[derive(Args, Clone)]
@@ -127,6 +128,25 @@ impl CirFormatArg {
             Self::Decawave => CirFormat::Decawave,
         }
     }
+}
+
+/// Beam-sweep array formats.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum BeamFormatArg {
+    /// DeepSense 6G 60 GHz arrays: scenarioS_unit1_pwr_60ghz_1-N.npy (power per beam), scenarioS_unit1_loc_...,
+    /// scenarioS_unit2_loc_... (roadside unit, car), scenarioS_seq_index_... (pass per sweep).
+    Deepsense,
+}
+
+/// Which of the car's positions to carry.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum PositionsArg {
+    /// As the GPS gave them (unit2_loc).
+    Raw,
+    /// The calibrated ones (unit2_loc_cal); an error for a scenario without them.
+    Calibrated,
+    /// Calibrated where the scenario has them, raw otherwise.
+    Auto,
 }
 
 /// Ground planes.
@@ -264,6 +284,33 @@ enum Kind {
         #[command(flatten)]
         output: OutputArgs,
     },
+    /// Measured beam sweeps with both units' positions (DeepSense 6G 60 GHz arrays) into one recording per pass.
+    ///
+    /// Writes <DIR>/scenario<S>-pass<PP>.mcap for every pass (sequence id the
+    /// same): beam sweeps on /beam/sweeps, the car's positions on /gnss/fix,
+    /// the roadside unit's on /gnss/array. The arrays carry no timestamps:
+    /// sweep r of a scenario is at r x --sweep-period-s. Every array is
+    /// checked first (equal row counts, finite non-negative power,
+    /// consecutive passes); nothing is written on an error.
+    #[command(verbatim_doc_comment)]
+    Beams {
+        /// The folder holding the arrays.
+        input: PathBuf,
+        /// Array format.
+        #[arg(long, value_enum)]
+        format: BeamFormatArg,
+        /// Only this scenario (default: every scenario in the folder).
+        #[arg(long, value_name = "S")]
+        scenario: Option<u32>,
+        /// The car's positions: raw, calibrated, or calibrated where present.
+        #[arg(long, value_enum, default_value_t = PositionsArg::Auto)]
+        positions: PositionsArg,
+        /// Time between consecutive sweeps, seconds.
+        #[arg(long, default_value_t = 0.1, value_name = "S")]
+        sweep_period_s: f64,
+        #[command(flatten)]
+        output: RecordingDirArgs,
+    },
     /// ROS 2 MCAP bag (cdr): poses from nav_msgs/Odometry or PoseWithCovarianceStamped, fixes from NavSatFix,
     /// Navtech polar scans from sensor_msgs/Image.
     ///
@@ -395,6 +442,21 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         }
         Kind::Cir { input, format, sidecar, output } => {
             cir_file(&input, format.format(), sidecar.as_deref(), &output, quiet)
+        }
+        Kind::Beams { input, format: BeamFormatArg::Deepsense, scenario, positions, sweep_period_s, output } => {
+            if !(sweep_period_s.is_finite() && sweep_period_s > 0.0 && sweep_period_s < 3600.0) {
+                anyhow::bail!("--sweep-period-s {sweep_period_s}: expected a positive number of seconds below 3600");
+            }
+            let options = DeepsenseOptions {
+                scenario,
+                positions: match positions {
+                    PositionsArg::Raw => VehiclePositions::Raw,
+                    PositionsArg::Calibrated => VehiclePositions::Calibrated,
+                    PositionsArg::Auto => VehiclePositions::Auto,
+                },
+                sweep_period_ns: (sweep_period_s * 1e9).round() as i64,
+            };
+            deepsense_folder(&input, &output, &options, quiet)
         }
         Kind::Ros2 {
             input,

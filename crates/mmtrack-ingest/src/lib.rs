@@ -13,8 +13,10 @@
 //! ([`oxford`], with ground truth, GPS and INS), Boreas ([`boreas`], with the
 //! Applanix poses) and MulRan ([`mulran`], with its global poses); ROS 2 bags
 //! ([`ros2`]); trajectory files ([`poses`]); NMEA 0183 logs ([`nmea`]);
-//! channel-sounder CIR/CFR files ([`cir`]).
+//! channel-sounder CIR/CFR files ([`cir`]); measured beam sweeps with both
+//! units' positions ([`beams`]: DeepSense 6G 60 GHz).
 
+pub mod beams;
 pub mod boreas;
 pub mod cir;
 mod csv;

@@ -1,11 +1,12 @@
 //! The folder and bag kinds of `mmtrack ingest` (Navtech scan folders of
-//! Oxford, Boreas and MulRan, ROS 2 bags): each opens its input, runs the
-//! ingest under a progress bar and prints a one-line summary.
+//! Oxford, Boreas and MulRan, ROS 2 bags, DeepSense beam arrays): each opens
+//! its input, runs the ingest under a progress bar and prints a summary.
 
 use std::path::Path;
 use std::process::ExitCode;
 
 use clap::{Args, ValueEnum};
+use mmtrack_ingest::beams::{DeepsenseOptions, ingest_deepsense};
 use mmtrack_ingest::boreas::{BoreasFolder, BoreasOptions, ingest_boreas};
 use mmtrack_ingest::mulran::{MulranFolder, MulranOptions, ingest_mulran};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
@@ -206,6 +207,70 @@ pub(super) fn ros2_bag(
             report.no_fix,
             report.radar_scans
         );
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Where `ingest beams` writes: a directory of recordings, one per pass.
+#[derive(Args, Clone)]
+pub struct RecordingDirArgs {
+    /// Output directory; one recording per pass is written into it (created if missing).
+    #[arg(short, long, value_name = "DIR")]
+    pub output: std::path::PathBuf,
+    /// Replace existing recordings of the same passes (each atomically, once complete).
+    #[arg(long)]
+    pub force: bool,
+    /// Omit the Foxglove display channels (/viz/...).
+    #[arg(long)]
+    pub no_foxglove_views: bool,
+    /// Skip the fsync before each final rename.
+    #[arg(long)]
+    pub no_sync: bool,
+}
+
+impl RecordingDirArgs {
+    fn recording_options(&self) -> mmtrack_io::RecordingOptions {
+        mmtrack_io::RecordingOptions {
+            overwrite: if self.force { mmtrack_io::Overwrite::Replace } else { mmtrack_io::Overwrite::Refuse },
+            foxglove_views: !self.no_foxglove_views,
+            durability: if self.no_sync { mmtrack_io::Durability::PageCache } else { mmtrack_io::Durability::Fsync },
+            ..mmtrack_io::RecordingOptions::default()
+        }
+    }
+}
+
+/// Ingests the DeepSense beam arrays of a folder (one recording per pass),
+/// with a progress bar and one summary line per scenario.
+pub(super) fn deepsense_folder(
+    input: &Path,
+    output: &RecordingDirArgs,
+    options: &DeepsenseOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let bar = progress::bar(0, "ingest beams", "sweeps", quiet);
+    let written = ingest_deepsense(input, &output.output, options, &output.recording_options(), &mut |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let written = written?;
+    if !quiet {
+        let mut scenarios: Vec<u32> = written.iter().map(|w| w.scenario).collect();
+        scenarios.dedup();
+        for scenario in scenarios {
+            let passes: Vec<_> = written.iter().filter(|w| w.scenario == scenario).collect();
+            let (Some(first), Some(last)) = (passes.first(), passes.last()) else { continue };
+            println!(
+                "scenario {scenario}: {} passes, {} sweeps of {} beams, {} car positions -> {} .. {} ({:.1} MB)",
+                passes.len(),
+                passes.iter().map(|w| w.sweeps).sum::<usize>(),
+                first.beams,
+                if first.calibrated { "calibrated" } else { "raw" },
+                first.output.path.display(),
+                last.output.path.display(),
+                passes.iter().map(|w| w.output.file_bytes).sum::<u64>() as f64 / 1e6
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -16,6 +16,7 @@ mod interrupt;
 mod ingest_navtech;
 mod process_mpc;
 mod process_odometry;
+mod realdata_beams;
 mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;

@@ -39,4 +39,5 @@ pub use decawave::{
 };
 pub use ingest::{CirFile, CirFormat, CirIngestReport, ingest_cir, read_cir_file};
 pub use matlab::{MatCirLayout, read_mat_cir, read_mat_cir_file};
+pub use npy::{NpyMatrix, NpyValues, parse_npy_matrix, read_npy_matrix};
 pub use sidecar::{AxisRole, CirSidecar, Domain, TapSpacing};

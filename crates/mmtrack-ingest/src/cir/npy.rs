@@ -28,8 +28,16 @@ fn bad(path: &Path, record: &str, field: &str, detail: String) -> IngestError {
     IngestError::BadRecord { path: path.to_path_buf(), record: record.into(), field: field.into(), detail }
 }
 
-/// Parses the bytes of a `.npy` file. `record` names it in messages (e.g. the npz member).
-pub(crate) fn parse_npy(path: &Path, record: &str, bytes: &[u8]) -> Result<NdComplex, IngestError> {
+/// The header fields of a `.npy` file and the bytes after the header.
+struct NpyHeader<'a> {
+    descr: String,
+    fortran: bool,
+    dims: Vec<usize>,
+    data: &'a [u8],
+}
+
+/// Parses the magic, version and header dict of a `.npy` file.
+fn parse_header<'a>(path: &Path, record: &str, bytes: &'a [u8]) -> Result<NpyHeader<'a>, IngestError> {
     let bad = |field: &str, detail: String| bad(path, record, field, detail);
     if !bytes.starts_with(b"\x93NUMPY") {
         return Err(bad("magic", "expected `\\x93NUMPY` at byte 0 (not a .npy file)".into()));
@@ -52,7 +60,113 @@ pub(crate) fn parse_npy(path: &Path, record: &str, bytes: &[u8]) -> Result<NdCom
     };
     let shape = dict_value(&header, "shape").ok_or_else(|| bad("shape", format!("missing in header `{header}`")))?;
     let dims = parse_shape(shape).ok_or_else(|| bad("shape", format!("`{shape}`, expected a tuple of sizes")))?;
-    decode(descr, &dims, fortran, data).map_err(|(field, detail)| bad(field, detail))
+    Ok(NpyHeader { descr: descr.to_string(), fortran, dims, data })
+}
+
+/// Parses the bytes of a `.npy` file. `record` names it in messages (e.g. the npz member).
+pub(crate) fn parse_npy(path: &Path, record: &str, bytes: &[u8]) -> Result<NdComplex, IngestError> {
+    let header = parse_header(path, record, bytes)?;
+    decode(&header.descr, &header.dims, header.fortran, header.data)
+        .map_err(|(field, detail)| bad(path, record, field, detail))
+}
+
+/// Values of a real `.npy` matrix, in the file's dtype.
+#[derive(Debug, Clone, PartialEq)]
+pub enum NpyValues {
+    /// float64 (`f8`).
+    F64(Vec<f64>),
+    /// int64 (`i8`).
+    I64(Vec<i64>),
+}
+
+/// A real 2-D array from a `.npy` file, row-major whatever the file's order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NpyMatrix {
+    /// Rows (the first dimension).
+    pub rows: usize,
+    /// Columns (1 for a one-dimensional array).
+    pub columns: usize,
+    /// `rows * columns` values, row-major.
+    pub values: NpyValues,
+}
+
+/// Reads a `.npy` file holding a float64 or int64 array of one dimension
+/// (`(N,)`, read as `N x 1`) or two (`(N, M)`), either byte order, C or
+/// Fortran order. Other dtypes and shapes are errors naming the file and the
+/// header field.
+///
+/// # Errors
+/// [`IngestError::Os`] when the file cannot be read; [`IngestError::BadRecord`]
+/// for a bad magic, header, dtype, shape or truncated data.
+pub fn read_npy_matrix(path: &Path) -> Result<NpyMatrix, IngestError> {
+    let bytes = std::fs::read(path).map_err(|source| IngestError::Os { path: path.to_path_buf(), source })?;
+    parse_npy_matrix(path, &bytes)
+}
+
+/// [`read_npy_matrix`] on the bytes of a file already read.
+///
+/// # Errors
+/// As [`read_npy_matrix`].
+pub fn parse_npy_matrix(path: &Path, bytes: &[u8]) -> Result<NpyMatrix, IngestError> {
+    let header = parse_header(path, "header", bytes)?;
+    let bad = |field: &str, detail: String| bad(path, "header", field, detail);
+    let (big, kind) = match header.descr.as_bytes().first() {
+        Some(b'<' | b'|' | b'=') => (false, &header.descr[1..]),
+        Some(b'>') => (true, &header.descr[1..]),
+        _ => (false, header.descr.as_str()),
+    };
+    if kind != "f8" && kind != "i8" {
+        return Err(bad("descr", format!("dtype `{}`, expected float64 (`<f8`) or int64 (`<i8`)", header.descr)));
+    }
+    let (rows, columns) = match header.dims.as_slice() {
+        [n] => (*n, 1),
+        [n, m] => (*n, *m),
+        other => return Err(bad("shape", format!("{other:?}, expected one or two dimensions"))),
+    };
+    let count = rows.checked_mul(columns).ok_or_else(|| bad("shape", format!("{:?} overflows", header.dims)))?;
+    let needed = count.checked_mul(8).ok_or_else(|| bad("shape", format!("{:?} overflows", header.dims)))?;
+    let Some(data) = header.data.get(..needed) else {
+        return Err(bad_data(path, &header, needed));
+    };
+    let words = data.chunks_exact(8).map(|chunk| {
+        let mut raw = [0u8; 8];
+        raw.copy_from_slice(chunk);
+        if big {
+            raw.reverse();
+        }
+        raw
+    });
+    let fortran = header.fortran;
+    let values = if kind == "f8" {
+        NpyValues::F64(row_major(words.map(f64::from_le_bytes).collect(), rows, columns, fortran))
+    } else {
+        NpyValues::I64(row_major(words.map(i64::from_le_bytes).collect(), rows, columns, fortran))
+    };
+    Ok(NpyMatrix { rows, columns, values })
+}
+
+/// `values` of a `rows x columns` array in row-major order. Fortran order
+/// stores columns first: position `k` of the file is row `k % rows`, column
+/// `k / rows`.
+fn row_major<T: Copy>(values: Vec<T>, rows: usize, columns: usize, fortran: bool) -> Vec<T> {
+    if !fortran || columns == 1 || rows == 1 {
+        return values;
+    }
+    (0..values.len()).map(|i| values[(i % columns) * rows + i / columns]).collect()
+}
+
+fn bad_data(path: &Path, header: &NpyHeader<'_>, needed: usize) -> IngestError {
+    bad(
+        path,
+        "data",
+        "data",
+        format!(
+            "truncated: shape {:?} of `{}` needs {needed} bytes of data, the file has {}",
+            header.dims,
+            header.descr,
+            header.data.len()
+        ),
+    )
 }
 
 /// The value text of `'key': value` in a Python dict literal (tuples kept whole).

@@ -32,6 +32,11 @@ pub const BEAM_SWEEP_TOPIC: &str = "/beam/sweeps";
 pub const GNSS_ARRAY_TOPIC: &str = "/gnss/array";
 /// Display view of the array's GNSS fixes.
 pub const GNSS_ARRAY_VIZ_TOPIC: &str = "/viz/gnss_array";
+/// Recording metadata key naming the site of a beam-sweep recording: one
+/// array at one place (e.g. `deepsense-scenario1`). Recordings of one site
+/// share the array's boresight and codebook, so a beam map fitted on some of
+/// them applies to the others.
+pub const BEAM_SITE_KEY: &str = "beam.site";
 
 /// Which trajectory a pose belongs to.
 ///

@@ -16,7 +16,7 @@ pub mod pulse;
 mod reader;
 mod writer;
 
-pub use channels::{CHANNELS, ChannelSpec, PoseStream};
+pub use channels::{BEAM_SITE_KEY, CHANNELS, ChannelSpec, PoseStream};
 pub use reader::{
     ChannelInfo, ChannelSummary, EncodedScan, RawMessage, RawReader, RecordingEvent, RecordingItem, RecordingReader,
     RecordingSummary, inspect_recording, inspect_recording_with_progress,
