@@ -98,7 +98,7 @@ pub struct Report {
     pub corpus: usize,
     /// Distinct outcomes seen.
     pub outcomes: usize,
-    /// Inputs some entry point of the target accepted (outcome "ok"): a
+    /// Inputs some entry point of the target accepted (outcome "ok..."): a
     /// check that mutations still reach the end of the readers.
     pub accepted: u64,
     /// The slowest input's time.
@@ -252,7 +252,7 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
         let mut found = Vec::new();
         match outcome {
             Ok(outcome) => {
-                accepted += u64::from(outcome.split(" | ").any(|part| part == "ok"));
+                accepted += u64::from(outcome.split(" | ").any(|part| part.starts_with("ok")));
                 if outcomes.insert(signature(&outcome)) && executions as usize > seeds.len() {
                     if corpus.len() < seeds.len() + MAX_GROWN_CORPUS {
                         corpus.push(input.clone());

@@ -19,7 +19,8 @@
 //! `mmtrack ingest cir` goes, sidecar checks and snapshot cutting included.
 //!
 //! A target returns a short outcome ("ok", or the record and field of the
-//! error) that the fuzz loop uses to grow its corpus.
+//! error; one per entry point, joined by ` | `) that the fuzz loop uses to
+//! grow its corpus; an outcome starting with "ok" is an accepted input.
 
 use std::path::{Path, PathBuf};
 
@@ -107,9 +108,7 @@ fn outcome<T>(result: &Result<T, IngestError>) -> String {
     match result {
         Ok(_) => "ok".into(),
         Err(IngestError::BadRecord { record, field, detail, .. }) => {
-            // Up to the first quote: what follows often echoes the input.
-            let detail: String = detail.chars().take_while(|c| !matches!(c, '`' | '"' | '\'')).take(32).collect();
-            format!("{record}/{field}/{detail}")
+            format!("{record}/{field}/{}", unquoted(detail))
         }
         Err(IngestError::BadSidecar { key, .. }) => format!("sidecar {key}"),
         Err(e) => e.to_string().chars().take(48).collect(),
@@ -153,8 +152,29 @@ fn png(_: &Scratch, input: &[u8]) -> String {
     format!("{} | {}", outcome(&any), outcome(&oxford))
 }
 
+/// The text before the first quote (what follows often echoes the input).
+fn unquoted(text: &str) -> String {
+    text.chars().take_while(|c| !matches!(c, '`' | '"' | '\'')).take(32).collect()
+}
+
+/// NMEA: a log with bad lines is still read (they are counted), so the
+/// outcome of an accepted log says what was skipped and why.
 fn nmea(_: &Scratch, input: &[u8]) -> String {
-    outcome(&parse_nmea(Path::new("fuzz.nmea"), &String::from_utf8_lossy(input)))
+    match parse_nmea(Path::new("fuzz.nmea"), &String::from_utf8_lossy(input)) {
+        Ok(log) => {
+            let flags = [
+                log.fixes.is_empty(),
+                log.rmc_only_fixes > 0,
+                log.first_out_of_order.is_some(),
+                log.duplicate_epochs > 0,
+                log.epochs_without_fix > 0,
+            ];
+            let flags: String = flags.iter().map(|&f| if f { 'x' } else { '-' }).collect();
+            let skipped = log.first_unparsable.map(|s| unquoted(&s.reason)).unwrap_or_default();
+            format!("ok {flags} {skipped}")
+        }
+        Err(e) => outcome(&Err::<(), _>(e)),
+    }
 }
 
 fn cdr(_: &Scratch, input: &[u8]) -> String {

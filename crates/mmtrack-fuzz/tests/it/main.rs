@@ -75,7 +75,7 @@ fn fuzz_cdr() {
 
 #[test]
 fn fuzz_decawave() {
-    fuzz("decawave", 100_000);
+    fuzz("decawave", 60_000);
 }
 
 #[test]
@@ -85,7 +85,7 @@ fn fuzz_npy() {
 
 #[test]
 fn fuzz_mat() {
-    fuzz("mat", 1_500);
+    fuzz("mat", 1_000);
 }
 
 #[test]
@@ -106,7 +106,7 @@ fn written_seeds_are_accepted() {
     for target in &TARGETS {
         for (i, seed) in (target.seeds)(None).iter().enumerate() {
             let outcome = (target.run)(&scratch, seed);
-            assert!(outcome.split(" | ").any(|o| o == "ok"), "{} written seed {i}: {outcome}", target.name);
+            assert!(outcome.split(" | ").any(|o| o.starts_with("ok")), "{} written seed {i}: {outcome}", target.name);
         }
         if let Some(realdata) = realdata_dir() {
             for (i, seed) in (target.seeds)(Some(&realdata)).iter().enumerate() {
