@@ -51,6 +51,16 @@ enum Pipeline {
     /// unless `--link T:R` picks one. Then run `mmtrack analyze <out>`.
     #[command(verbatim_doc_comment)]
     Mpc(process_mpc::MpcArgs),
+    /// Beam-sweep trackers and their baselines on measured beam sweeps (e.g. from `mmtrack ingest beams`).
+    ///
+    /// Writes `beam_sweeps_tracked/sequence=<id>/part-0.parquet` per
+    /// recording: per sweep and tracker the chosen and best beam, beams
+    /// measured, re-initialisation and received-power loss. The GNSS policies
+    /// (gnss-window, gnss-map) fit the beam map leave-one-pass-out over the
+    /// recordings of each site given together (at least two). Then run
+    /// `mmtrack analyze <out>`.
+    #[command(verbatim_doc_comment)]
+    Beam(crate::beam::process::BeamArgs),
 }
 
 #[derive(Args)]
@@ -91,6 +101,7 @@ pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             process_mpc::run(mpc_args, quiet)?;
             Ok(ExitCode::SUCCESS)
         }
+        Pipeline::Beam(beam_args) => crate::beam::process::run(beam_args, quiet),
     }
 }
 

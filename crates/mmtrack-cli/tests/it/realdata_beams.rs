@@ -1,9 +1,14 @@
 //! Real 60 GHz vehicle beam sweeps (DeepSense 6G scenarios 1 and 3, arrays
 //! as packaged by Morais and Alkhateeb, ICC 2023) through `mmtrack ingest
-//! beams`, and a bad array through the same command.
+//! beams`, `process beam` and `analyze`, checked against `mmtrack_beam`'s
+//! evaluation run straight on the arrays; bad input through the same
+//! commands.
 
 use std::path::Path;
 
+use mmtrack_beam::sweep::{SweepPass, SweepRecord, WindowTracker, WindowTrackerConfig, evaluate};
+use mmtrack_core::BeamSweep;
+use mmtrack_io::table::{BeamSweepTracked, read_table_dir};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 
 use super::common::{mmtrack, text};
@@ -151,4 +156,107 @@ fn a_bad_beam_array_is_one_error_line_naming_file_row_and_field() {
         "{stderr}"
     );
     assert!(!dir.path().join("rec").exists(), "nothing written");
+}
+
+/// The window tracker run straight on the arrays of scenario 1 (no
+/// recording, no table): the records of each pass, as `mmtrack_beam`
+/// computes them (the DeepSense test of that crate drives it the same way).
+fn window_on_arrays(arrays: &Path) -> Vec<Vec<SweepRecord>> {
+    let file = |array: &str| arrays.join(format!("scenario1_{array}_1-2422.npy"));
+    let power = npy_values(&file("unit1_pwr_60ghz"));
+    let pass_index = npy_values(&file("seq_index"));
+    let mut passes: Vec<Vec<BeamSweep>> = Vec::new();
+    for (row, &pass) in pass_index.iter().enumerate() {
+        if row == 0 || pass != pass_index[row - 1] {
+            passes.push(Vec::new());
+        }
+        let sweep = BeamSweep::full(row as i64 * 100_000_000, power[row * 64..(row + 1) * 64].to_vec()).unwrap();
+        passes.last_mut().unwrap().push(sweep);
+    }
+    passes
+        .iter()
+        .map(|sweeps| {
+            let mut tracker = WindowTracker::new(WindowTrackerConfig::default()).unwrap();
+            evaluate(&mut tracker, &[SweepPass { sweeps, gnss_beam: None }]).unwrap()
+        })
+        .collect()
+}
+
+/// `mmtrack ingest beams --scenario 1` then `process beam --tracker window`
+/// into `dir/tables`; returns the arrays' folder.
+fn ingest_and_process(dir: &Path, realdata: &Path) -> std::path::PathBuf {
+    let arrays = realdata.join("deepsense-60ghz-beams");
+    let a = arrays.to_str().unwrap();
+    let out = mmtrack(dir, &["ingest", "beams", a, "--format", "deepsense", "--scenario", "1", "-o", "rec", "--quiet"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(dir, &["process", "beam", "rec", "-o", "tables", "--tracker", "window"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("deepsense-scenario1: 29 passes, 2422 sweeps"), "{stdout}");
+    arrays
+}
+
+#[test]
+fn process_beam_writes_what_evaluate_gives_on_the_raw_arrays_row_for_row() {
+    let Some(realdata) = super::common::realdata("deepsense_process") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let arrays = ingest_and_process(dir.path(), &realdata);
+    let expected = window_on_arrays(&arrays);
+    let tables = read_table_dir::<BeamSweepTracked>(&dir.path().join("tables")).unwrap();
+    assert_eq!(tables.len(), 29);
+    for (pass, records) in expected.iter().enumerate() {
+        let rows = &tables[&format!("scenario1-pass{:02}", pass + 1)];
+        assert_eq!(rows.len(), records.len(), "pass {}", pass + 1);
+        for (row, r) in rows.iter().zip(records) {
+            let got = (row.t_ns, row.sweep, row.chosen_beam, row.best_beam, row.beams_measured, row.reinitialised);
+            let want = (
+                r.t_ns,
+                r.sweep as u64,
+                r.chosen_beam as u32,
+                r.best_beam as u32,
+                r.beams_measured as u32,
+                r.reinitialised,
+            );
+            assert_eq!(got, want, "pass {} sweep {}", pass + 1, r.sweep);
+            assert_eq!(row.loss_db.to_bits(), r.loss_db.to_bits(), "pass {} sweep {}", pass + 1, r.sweep);
+            assert_eq!(
+                (row.tracker.as_str(), row.site.as_str(), row.beam_count),
+                ("window", "deepsense-scenario1", 64)
+            );
+            assert_eq!(row.gnss_beam, None);
+        }
+    }
+}
+
+#[test]
+fn process_beam_refuses_gnss_policies_without_two_passes_and_recordings_without_sweeps() {
+    let dir = tempfile::tempdir().unwrap();
+    let arrays = dir.path().join("arrays");
+    std::fs::create_dir(&arrays).unwrap();
+    let write = |name: &str, bytes: Vec<u8>| std::fs::write(arrays.join(name), bytes).unwrap();
+    write("scenario2_unit1_pwr_60ghz_1-3.npy", npy_f8("(3, 4)", &[0.1, 0.2, 0.9, 0.3].repeat(3)));
+    let place = [33.4, -111.9].repeat(3);
+    write("scenario2_unit1_loc_1-3.npy", npy_f8("(3, 2)", &place));
+    write("scenario2_unit2_loc_1-3.npy", npy_f8("(3, 2)", &[33.4001, -111.9002, 33.4001, -111.9001, 33.4001, -111.9]));
+    write("scenario2_seq_index_1-3.npy", npy("<i8", "(3,)", [1i64, 1, 1].iter().map(|v| v.to_le_bytes())));
+    let out = mmtrack(dir.path(), &["ingest", "beams", "arrays", "--format", "deepsense", "-o", "rec", "--quiet"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", "window,gnss-window"]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(stderr.contains("site deepsense-scenario2") && stderr.contains("at least two recordings"), "{stderr}");
+    assert!(!dir.path().join("tables").exists(), "nothing written");
+    // The window tracker alone needs no map: the best beam (2) every sweep.
+    let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", "window"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let rows = &read_table_dir::<BeamSweepTracked>(&dir.path().join("tables")).unwrap()["scenario2-pass01"];
+    assert!(rows.iter().all(|r| r.chosen_beam == 2 && r.loss_db == 0.0), "{rows:?}");
+    // Again: refused without --force.
+    let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", "window"]);
+    assert!(!out.status.success() && text(&out).1.contains("--force"));
+    // A recording without sweeps.
+    assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
+    let out = mmtrack(dir.path(), &["process", "beam", "d/recording.mcap", "-o", "t2", "--tracker", "window"]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success() && stderr.contains("recording.mcap: no beam sweeps"), "{stderr}");
 }

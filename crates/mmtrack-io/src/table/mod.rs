@@ -15,6 +15,7 @@
 //! its columns (name, Rust type, unit, meaning) give the spec, the writer and
 //! the reader.
 
+mod beam_rows;
 mod columns;
 mod define;
 mod io;
@@ -23,6 +24,7 @@ mod odometry_rows;
 mod rows;
 
 pub use arrow_array::ArrayRef;
+pub use beam_rows::{BEAM_SWEEPS_TRACKED, BeamSweepTracked};
 pub use columns::{ColumnValue, Columns, ListColumn};
 pub use io::{
     RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table, read_table_dir,

@@ -193,4 +193,5 @@ pub const ALL_TABLES: &[&TableSpec] = &[
     &super::MPC_TRUTH,
     &super::GROUND_TRUTH_TX,
     &super::GROUND_TRUTH_RX,
+    &super::BEAM_SWEEPS_TRACKED,
 ];

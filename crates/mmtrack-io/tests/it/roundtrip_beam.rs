@@ -144,3 +144,35 @@ fn malformed_beam_sweeps_are_errors_naming_topic_message_and_problem() {
         assert!(text.contains("bad.mcap") && text.contains("/beam/sweeps") && text.contains(expected), "{text}");
     }
 }
+
+#[test]
+fn beam_sweeps_tracked_table_round_trips_with_and_without_gnss_beam() {
+    use mmtrack_io::Overwrite;
+    use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, read_table, write_table};
+    let rows: Vec<BeamSweepTracked> = (0..6u32)
+        .map(|k| BeamSweepTracked {
+            tracker: if k < 3 { "window".into() } else { "gnss-map".into() },
+            site: "deepsense-scenario1".into(),
+            t_ns: i64::from(k) * 100_000_000 - 1,
+            sweep: u64::from(k % 3),
+            beam_count: 64,
+            chosen_beam: 63 - k,
+            best_beam: k,
+            beams_measured: [64, 3, 0, u32::MAX, 5, 1][k as usize],
+            reinitialised: k == 0,
+            loss_db: AWKWARD[k as usize],
+            gnss_beam: (k >= 3).then(|| -AWKWARD[k as usize] - 1.5),
+        })
+        .collect();
+    let dir = tempfile::tempdir().unwrap();
+    let run = RunInfo { config_json: r#"{"test":"beam"}"#.into() };
+    let summary = write_table(dir.path(), "scenario1-pass01", &rows, &run, Overwrite::Refuse).unwrap();
+    assert!(summary.path.ends_with("beam_sweeps_tracked/sequence=scenario1-pass01/part-0.parquet"));
+    let back = read_table::<BeamSweepTracked>(&summary.path).unwrap();
+    assert_eq!(back, rows);
+    let bits = |r: &[BeamSweepTracked]| {
+        r.iter().map(|r| (r.loss_db.to_bits(), r.gnss_beam.map(f64::to_bits))).collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&back), bits(&rows));
+    assert_eq!(BEAM_SWEEPS_TRACKED.columns.iter().find(|c| c.name == "loss_db").unwrap().unit, "dB");
+}

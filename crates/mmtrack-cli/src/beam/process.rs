@@ -1,0 +1,457 @@
+//! `mmtrack process beam`: the beam-sweep trackers and their baselines on
+//! recordings of measured beam sweeps (e.g. from `mmtrack ingest beams`),
+//! one `beam_sweeps_tracked` partition per recording (sequence).
+//!
+//! Every recording must hold full sweeps (every beam measured): a tracker
+//! sees only the beams it asks for through `mmtrack_beam::sweep::BeamProbe`,
+//! and the full sweep scores its choice (`mmtrack_beam::sweep::evaluate`).
+//!
+//! The GNSS-driven policies (`gnss-window`, `gnss-map`) need the beam map
+//! (beam index against the car's bearing from the array, with the array's
+//! boresight, beam spacing and GNSS time offset fitted from data). It is
+//! fitted leave-one-pass-out over the recordings given on the command line:
+//! each recording is predicted by a map fitted on the other recordings of the
+//! same site (metadata `beam.site`; a recording without it is a site of its
+//! own), so a map is never scored on the sweeps it was fitted to. Those
+//! policies therefore need at least two recordings per site, and their
+//! numbers depend on which recordings are given together.
+//!
+//! The car's position at each sweep is its `/gnss/fix` track, and the
+//! array's its `/gnss/array` track, each interpolated linearly in latitude
+//! and longitude at the sweep's time (exact where a fix has the sweep's
+//! time, as `ingest beams` writes them); east/north metres from the array
+//! come from the WGS-84 local tangent plane.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail};
+use clap::{Args, ValueEnum};
+use mmtrack_beam::sweep::{
+    BeamMap, BeamMapConfig, GnssMapOnly, GnssPass, GnssTrackerConfig, GnssWindowTracker, LastFullSweep, MapPass,
+    Reacquisition, SearchConfig, SweepPass, SweepRecord, SweepSummary, SweepTracker, WindowTracker,
+    WindowTrackerConfig, evaluate,
+};
+use mmtrack_core::{BeamSweep, GnssFix};
+use mmtrack_ingest::nmea::{EnuOrigin, geodetic_to_enu_m};
+use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata};
+use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, table_path, write_table};
+use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
+
+/// The policies `process beam` runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
+pub enum TrackerArg {
+    /// Constant-velocity Kalman filter on the beam index, from the measured beams alone.
+    Window,
+    /// The car's GNSS position through the beam map moves the window (SPEBT with GNSS for radar odometry).
+    GnssWindow,
+    /// Baseline: every sweep measures all beams and uses the previous sweep's best beam.
+    LastFullSweep,
+    /// Baseline: the beam nearest the GNSS prediction of the beam map, no beam measured.
+    GnssMap,
+}
+
+impl TrackerArg {
+    /// Name in tables and messages.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Window => "window",
+            Self::GnssWindow => "gnss-window",
+            Self::LastFullSweep => "last-full-sweep",
+            Self::GnssMap => "gnss-map",
+        }
+    }
+
+    fn needs_map(self) -> bool {
+        matches!(self, Self::GnssWindow | Self::GnssMap)
+    }
+}
+
+/// How the window trackers find the beam at a pass start and after a loss.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ReacquireArg {
+    /// Every 4th beam, then a climb to the local peak.
+    Coarse,
+    /// A full sweep (every beam).
+    Full,
+}
+
+#[derive(Args)]
+pub struct BeamArgs {
+    /// Recordings with beam sweeps (files, or directories whose .mcap files are all read), e.g. from
+    /// `mmtrack ingest beams`; one sequence each.
+    #[arg(required = true, value_name = "RECORDING")]
+    recordings: Vec<PathBuf>,
+    /// Output table directory (created if missing).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Policies to run, comma-separated; all write into the same table, told apart by its `tracker` column.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "window,gnss-window,last-full-sweep,gnss-map")]
+    tracker: Vec<TrackerArg>,
+    /// Re-acquisition of the window trackers (window, gnss-window).
+    #[arg(long, value_enum, default_value_t = ReacquireArg::Coarse)]
+    reacquire: ReacquireArg,
+    /// Replace existing output tables of these sequences.
+    #[arg(long)]
+    force: bool,
+}
+
+/// One recording, read: its full sweeps and both units' positions.
+#[derive(Debug, Clone)]
+pub struct BeamRecording {
+    /// The file.
+    pub path: PathBuf,
+    /// Sequence id (recording metadata).
+    pub sequence_id: String,
+    /// Site (metadata `beam.site`, else the sequence id).
+    pub site: String,
+    /// Full sweeps in time order.
+    pub sweeps: Vec<BeamSweep>,
+    /// The car's GNSS fixes (`/gnss/fix`).
+    pub vehicle: Vec<GnssFix>,
+    /// The array's GNSS fixes (`/gnss/array`).
+    pub array: Vec<GnssFix>,
+}
+
+/// The `.mcap` files of `inputs` (directories expanded, sorted), in order.
+fn expand(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(input)
+                .with_context(|| format!("{}: cannot list", input.display()))?
+                .map(|e| e.map(|e| e.path()))
+                .collect::<Result<_, _>>()
+                .with_context(|| format!("{}: cannot list", input.display()))?;
+            found.retain(|p| p.extension().is_some_and(|e| e == "mcap") && p.is_file());
+            if found.is_empty() {
+                bail!("{}: no .mcap recordings in this directory", input.display());
+            }
+            found.sort();
+            out.extend(found);
+        } else {
+            out.push(input.clone());
+        }
+    }
+    Ok(out)
+}
+
+/// Reads a recording's sweeps and fixes; errors name the file.
+pub fn read_beam_recording(path: &Path) -> anyhow::Result<BeamRecording> {
+    let mut reader = RecordingReader::open(path)?;
+    let (mut sweeps, mut vehicle, mut array) = (Vec::new(), Vec::new(), Vec::new());
+    for event in reader.by_ref() {
+        match event? {
+            RecordingEvent::BeamSweep { sweep, .. } => sweeps.push(sweep),
+            RecordingEvent::Gnss(fix) => vehicle.push(fix),
+            RecordingEvent::ArrayGnss(fix) => array.push(fix),
+            _ => {}
+        }
+    }
+    let metadata = reader.metadata().cloned().unwrap_or_default();
+    let sequence_id = RecordingMetadata::from_map(&metadata)
+        .map(|m| m.sequence_id)
+        .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
+    if sweeps.is_empty() {
+        bail!("{}: no beam sweeps (topic /beam/sweeps); nothing to track", path.display());
+    }
+    let site = metadata.get(BEAM_SITE_KEY).cloned().unwrap_or_else(|| sequence_id.clone());
+    Ok(BeamRecording { path: path.to_path_buf(), sequence_id, site, sweeps, vehicle, array })
+}
+
+/// Latitude and longitude of `fixes` (time order) at `t_ns`: the fix at
+/// that time, else linear between its neighbours; `None` outside their span.
+fn lat_lon_at(fixes: &[GnssFix], t_ns: i64) -> Option<[f64; 2]> {
+    let after = fixes.partition_point(|f| f.t_ns < t_ns);
+    let b = fixes.get(after)?;
+    if b.t_ns == t_ns {
+        return Some([b.latitude_deg, b.longitude_deg]);
+    }
+    let a = fixes.get(after.checked_sub(1)?)?;
+    let w = (t_ns - a.t_ns) as f64 / (b.t_ns - a.t_ns) as f64;
+    Some([
+        a.latitude_deg + w * (b.latitude_deg - a.latitude_deg),
+        a.longitude_deg + w * (b.longitude_deg - a.longitude_deg),
+    ])
+}
+
+/// The car's east/north metres from the array at each sweep.
+fn east_north_m(recording: &BeamRecording) -> anyhow::Result<Vec<[f64; 2]>> {
+    let sorted = |fixes: &[GnssFix], topic: &str| -> anyhow::Result<()> {
+        if fixes.is_empty() {
+            bail!(
+                "{}: no {topic} fixes; the GNSS policies need the car (/gnss/fix) and the array (/gnss/array)",
+                recording.path.display()
+            );
+        }
+        if let Some(pair) = fixes.windows(2).find(|p| p[1].t_ns <= p[0].t_ns) {
+            bail!(
+                "{}: {topic} fix times do not increase ({} ns then {} ns)",
+                recording.path.display(),
+                pair[0].t_ns,
+                pair[1].t_ns
+            );
+        }
+        Ok(())
+    };
+    sorted(&recording.vehicle, "/gnss/fix")?;
+    sorted(&recording.array, "/gnss/array")?;
+    recording
+        .sweeps
+        .iter()
+        .map(|sweep| {
+            let t_ns = sweep.t_ns();
+            let position = |fixes: &[GnssFix], topic: &str| {
+                lat_lon_at(fixes, t_ns).with_context(|| {
+                    format!(
+                        "{}: sweep at {t_ns} ns lies outside the {topic} fixes' time span",
+                        recording.path.display()
+                    )
+                })
+            };
+            let [car_lat, car_lon] = position(&recording.vehicle, "/gnss/fix")?;
+            let [lat, lon] = position(&recording.array, "/gnss/array")?;
+            let origin = EnuOrigin { latitude_deg: lat, longitude_deg: lon, altitude_m: 0.0 };
+            let enu = geodetic_to_enu_m(&origin, car_lat, car_lon, 0.0);
+            Ok([enu[0], enu[1]])
+        })
+        .collect()
+}
+
+/// The recordings of one site with, when a GNSS policy runs, their GNSS
+/// beam predictions from leave-one-pass-out maps.
+struct Site<'a> {
+    name: String,
+    passes: Vec<&'a BeamRecording>,
+    maps: Option<SiteMaps>,
+}
+
+struct SiteMaps {
+    /// Map of each pass (fitted on the others).
+    per_pass: Vec<BeamMap>,
+    /// GNSS beam prediction of each sweep of each pass.
+    gnss_beam: Vec<Vec<f64>>,
+    /// The map fitted on every pass, for the summary.
+    all: BeamMap,
+}
+
+fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
+    if passes.len() < 2 {
+        bail!(
+            "site {site}: the GNSS policies need a beam map fitted leave-one-pass-out, so at least two recordings of \
+             the site ({} given: {}); give more passes, or choose --tracker window,last-full-sweep",
+            passes.len(),
+            passes.iter().map(|p| p.path.display().to_string()).collect::<Vec<_>>().join(", ")
+        );
+    }
+    let beam_count = passes[0].sweeps[0].beam_count();
+    let t_ns: Vec<Vec<i64>> = passes.iter().map(|p| p.sweeps.iter().map(BeamSweep::t_ns).collect()).collect();
+    let positions: Vec<Vec<[f64; 2]>> = passes.iter().map(|p| east_north_m(p)).collect::<Result<_, _>>()?;
+    let best: Vec<Vec<usize>> =
+        passes.iter().map(|p| p.sweeps.iter().map(BeamSweep::best_measured_beam).collect()).collect();
+    let gnss = |i: usize| GnssPass { t_ns: &t_ns[i], east_north_m: &positions[i] };
+    let map_passes: Vec<MapPass<'_>> =
+        (0..passes.len()).map(|i| MapPass { gnss: gnss(i), best_beam: &best[i] }).collect();
+    let config = BeamMapConfig::default();
+    let per_pass = BeamMap::fit_leave_one_pass_out(&map_passes, beam_count, &config)
+        .with_context(|| format!("site {site}: beam map"))?;
+    let all = BeamMap::fit(&map_passes, beam_count, &config).with_context(|| format!("site {site}: beam map"))?;
+    let gnss_beam = per_pass
+        .iter()
+        .enumerate()
+        .map(|(i, map)| {
+            map.predict_pass(&gnss(i)).with_context(|| format!("{}: beam map prediction", passes[i].path.display()))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    Ok(SiteMaps { per_pass, gnss_beam, all })
+}
+
+fn search(reacquire: ReacquireArg) -> SearchConfig {
+    let reacquisition = match reacquire {
+        ReacquireArg::Coarse => Reacquisition::Coarse { stride: 4 },
+        ReacquireArg::Full => Reacquisition::FullSweep,
+    };
+    SearchConfig { reacquisition, ..SearchConfig::default() }
+}
+
+/// A fresh tracker of `kind` for a pass whose map is `map`.
+fn tracker(kind: TrackerArg, reacquire: ReacquireArg, map: Option<&BeamMap>) -> anyhow::Result<Box<dyn SweepTracker>> {
+    Ok(match kind {
+        TrackerArg::Window => {
+            Box::new(WindowTracker::new(WindowTrackerConfig { search: search(reacquire), ..Default::default() })?)
+        }
+        TrackerArg::GnssWindow => {
+            let map = map.context("gnss-window without a beam map")?;
+            Box::new(GnssWindowTracker::new(GnssTrackerConfig {
+                search: search(reacquire),
+                // The pass's map residual (fitted on the other passes) sets
+                // the first window.
+                initial_offset_sigma_beams: map.rms_residual_beams(),
+                ..Default::default()
+            })?)
+        }
+        TrackerArg::LastFullSweep => Box::new(LastFullSweep::new()),
+        TrackerArg::GnssMap => Box::new(GnssMapOnly),
+    })
+}
+
+/// Every pass of `site` through `kind`: the records of each pass.
+fn run_tracker(site: &Site<'_>, kind: TrackerArg, reacquire: ReacquireArg) -> anyhow::Result<Vec<Vec<SweepRecord>>> {
+    site.passes
+        .iter()
+        .enumerate()
+        .map(|(i, pass)| {
+            let map = site.maps.as_ref().map(|m| &m.per_pass[i]);
+            let gnss_beam = site.maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
+            let mut policy = tracker(kind, reacquire, map)?;
+            evaluate(policy.as_mut(), &[SweepPass { sweeps: &pass.sweeps, gnss_beam }])
+                .with_context(|| format!("{}: {}", pass.path.display(), kind.name()))
+        })
+        .collect()
+}
+
+fn rows(
+    kind: TrackerArg,
+    site: &str,
+    sweeps: &[BeamSweep],
+    records: &[SweepRecord],
+    gnss: Option<&[f64]>,
+) -> Vec<BeamSweepTracked> {
+    let as_u32 = |v: usize| u32::try_from(v).unwrap_or(u32::MAX);
+    records
+        .iter()
+        .map(|r| BeamSweepTracked {
+            tracker: kind.name().to_string(),
+            site: site.to_string(),
+            t_ns: r.t_ns,
+            sweep: r.sweep as u64,
+            beam_count: as_u32(sweeps.get(r.sweep).map_or(0, BeamSweep::beam_count)),
+            chosen_beam: as_u32(r.chosen_beam),
+            best_beam: as_u32(r.best_beam),
+            beams_measured: as_u32(r.beams_measured),
+            reinitialised: r.reinitialised,
+            loss_db: r.loss_db,
+            gnss_beam: if kind.needs_map() { gnss.and_then(|g| g.get(r.sweep).copied()) } else { None },
+        })
+        .collect()
+}
+
+pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
+    let mut kinds = args.tracker.clone();
+    kinds.sort();
+    kinds.dedup();
+    let files = expand(&args.recordings)?;
+    let recordings = files.iter().map(|f| read_beam_recording(f)).collect::<anyhow::Result<Vec<_>>>()?;
+    let mut by_sequence: BTreeMap<&str, &Path> = BTreeMap::new();
+    for r in &recordings {
+        if let Some(other) = by_sequence.insert(&r.sequence_id, &r.path) {
+            bail!(
+                "{} and {}: both are sequence {}; give each sequence once",
+                other.display(),
+                r.path.display(),
+                r.sequence_id
+            );
+        }
+        if overwrite == Overwrite::Refuse {
+            let path = table_path(&args.output, BEAM_SWEEPS_TRACKED.name, &r.sequence_id)?;
+            if path.exists() {
+                bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
+            }
+        }
+    }
+    let mut sites: BTreeMap<&str, Vec<&BeamRecording>> = BTreeMap::new();
+    for r in &recordings {
+        sites.entry(&r.site).or_default().push(r);
+    }
+    let needs_map = kinds.iter().any(|k| k.needs_map());
+    let sites: Vec<Site<'_>> = sites
+        .into_iter()
+        .map(|(name, mut passes)| {
+            // Sequence order, so the maps do not depend on the order of the arguments.
+            passes.sort_by(|a, b| a.sequence_id.cmp(&b.sequence_id));
+            let maps = if needs_map { Some(fit_maps(name, &passes)?) } else { None };
+            Ok(Site { name: name.to_string(), passes, maps })
+        })
+        .collect::<anyhow::Result<_>>()?;
+
+    let mut tables: BTreeMap<String, Vec<BeamSweepTracked>> = BTreeMap::new();
+    let mut summaries = Vec::new();
+    for site in &sites {
+        for &kind in &kinds {
+            let per_pass = run_tracker(site, kind, args.reacquire)?;
+            for (i, (pass, records)) in site.passes.iter().zip(&per_pass).enumerate() {
+                let gnss = site.maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
+                tables.entry(pass.sequence_id.clone()).or_default().extend(rows(
+                    kind,
+                    &site.name,
+                    &pass.sweeps,
+                    records,
+                    gnss,
+                ));
+            }
+            let summary = SweepSummary::from_records(per_pass.iter().flatten()).context("no sweeps")?;
+            summaries.push((site.name.clone(), site.passes.len(), kind, summary));
+        }
+    }
+    let info = RunInfo {
+        config_json: serde_json::json!({
+            "command": "process beam",
+            "recordings": files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+            "trackers": kinds.iter().map(|k| k.name()).collect::<Vec<_>>(),
+            "reacquire": format!("{:?}", search(args.reacquire).reacquisition),
+            "search": format!("{:?}", search(args.reacquire)),
+            "window": format!("{:?}", WindowTrackerConfig { search: search(args.reacquire), ..Default::default() }),
+            "gnss_window": format!("{:?} (initial_offset_sigma_beams: each pass's map residual)", GnssTrackerConfig { search: search(args.reacquire), ..Default::default() }),
+            "beam_map": "fitted leave-one-pass-out over the recordings of each site given together",
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    let mut written = Vec::new();
+    for (sequence, rows) in &tables {
+        written.push(write_table(&args.output, sequence, rows, &info, overwrite)?);
+    }
+    if !quiet {
+        print_summary(&sites, &summaries);
+        println!("wrote {} {} partitions under {}", written.len(), BEAM_SWEEPS_TRACKED.name, args.output.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_summary(sites: &[Site<'_>], summaries: &[(String, usize, TrackerArg, SweepSummary)]) {
+    for site in sites {
+        let sweeps: usize = site.passes.iter().map(|p| p.sweeps.len()).sum();
+        println!("{}: {} passes, {sweeps} sweeps", site.name, site.passes.len());
+        if let Some(maps) = &site.maps {
+            let m = &maps.all;
+            println!(
+                "  beam map (all passes): boresight {:.1} deg from north, {:.3} deg per beam ({}), GNSS offset {:+.1} s, \
+                 RMS residual {:.2} beams",
+                m.boresight_bearing_rad().to_degrees(),
+                m.beam_spacing_rad().to_degrees(),
+                if m.beams_per_rad() < 0.0 { "index falls clockwise" } else { "index rises clockwise" },
+                m.gnss_time_offset_s(),
+                m.rms_residual_beams()
+            );
+        }
+        println!(
+            "  {:<16} {:>9} {:>9} {:>6} {:>6} {:>6} {:>6}",
+            "tracker", "mean dB", "median dB", "top1", "+-1", "beams", "reinit"
+        );
+        for (_, _, kind, s) in summaries.iter().filter(|(name, ..)| *name == site.name) {
+            println!(
+                "  {:<16} {:>9.3} {:>9.3} {:>6.3} {:>6.3} {:>6.2} {:>6}",
+                kind.name(),
+                s.mean_loss_db,
+                s.median_loss_db,
+                s.top1,
+                s.within_one,
+                s.mean_beams_per_sweep,
+                s.reinitialisations
+            );
+        }
+    }
+}
