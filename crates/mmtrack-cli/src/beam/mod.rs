@@ -1,6 +1,9 @@
 //! The beam-tracking pipeline's commands: `reproduce shaham` (the valid-tracking
-//! experiment of Shaham et al. 2020).
+//! experiment of Shaham et al. 2020) and `reproduce spebt` (the SPEBT beam
+//! tracking of Liu et al. 2024).
 
 pub mod process;
 pub mod reproduce_shaham;
+pub mod reproduce_spebt;
 mod shaham_report;
+mod spebt_report;

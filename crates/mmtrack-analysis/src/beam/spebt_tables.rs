@@ -1,0 +1,63 @@
+//! Result tables of the SPEBT beam-tracking experiment (Liu et al. 2024,
+//! Sec. IV, Table III and Fig. 5), written by `mmtrack reproduce spebt`.
+
+mmtrack_io::define_table! {
+    /// `spebt_summary`: one row per experiment.
+    pub const SPEBT_SUMMARY = "spebt_summary",
+        "Beam-tracking accuracy of the SPEBT EKF over the Monte Carlo runs of one experiment (Liu et al. 2024, \
+Table III): RMSE over every tracked slot (1..slots-1) of every run of the estimate after the slot's update (after a re-initialisation \
+where one happened) against the true channel, the re-initialisations per run (Algorithm 1 steps 14-15) and the \
+paper's numbers beside them.";
+    /// One row of [`SPEBT_SUMMARY`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SpebtSummaryRow {
+        experiment: String, "", "experiment name (pose-error-model: ground truth plus the paper's pose-error model)";
+        trajectory: String, "", "trajectory file the vehicle drives along";
+        slots: u64, "", "slots per run (one per pose); slot 0 is the initial access";
+        runs: u64, "", "Monte Carlo runs";
+        seed: u64, "", "seed of the runs";
+        rmse_gain_pct: f64, "%", "RMS of the relative error of abs(alpha): (estimate - truth) / truth";
+        rmse_aod_deg: f64, "deg", "RMS of the wrapped AoD error";
+        rmse_aoa_deg: f64, "deg", "RMS of the wrapped AoA error";
+        reinitialisations_mean: f64, "", "re-initialisations per run, mean over runs";
+        reinitialisations_min: u64, "", "fewest re-initialisations of a run";
+        reinitialisations_max: u64, "", "most re-initialisations of a run";
+        reinitialisation_share_pct: f64, "%", "mean re-initialisations per run over the tracked slots (slots - 1)";
+        reinit_gain_pct: f64, "%", "share of re-initialisations where the abs(alpha) test fired (tests may fire together)";
+        reinit_aod_pct: f64, "%", "share of re-initialisations where the AoD test fired";
+        reinit_aoa_pct: f64, "%", "share of re-initialisations where the AoA test fired";
+        paper_rmse_gain_pct: f64, "%", "the paper's RMSE of abs(alpha) (Table III)";
+        paper_rmse_aod_deg: f64, "deg", "the paper's AoD RMSE (Table III)";
+        paper_rmse_aoa_deg: f64, "deg", "the paper's AoA RMSE (Table III)";
+        paper_reinitialisation_share_pct: f64, "%",
+            "the paper's re-initialisation share (fewer than 300 of 6388 slots, Sec. IV)";
+    }
+}
+
+mmtrack_io::define_table! {
+    /// `spebt_per_slot`: truth, one run's estimate and the RMSE over runs per slot.
+    pub const SPEBT_PER_SLOT = "spebt_per_slot",
+        "Per slot of one SPEBT experiment: the true pose and channel, the estimate of run 0 (the realisation of \
+Liu et al. 2024, Fig. 5) and the RMSE over all runs at that slot.";
+    /// One row of [`SPEBT_PER_SLOT`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SpebtSlotRow {
+        slot: u64, "", "slot index (one pose each); 0 is the initial access";
+        t_s: f64, "s", "time since slot 0";
+        x_m: f64, "m", "true vehicle x, relative to its first position";
+        y_m: f64, "m", "true vehicle y, relative to its first position";
+        yaw_deg: f64, "deg", "true vehicle yaw";
+        range_m: f64, "m", "distance to the base station";
+        true_gain: f64, "", "true path-gain magnitude abs(alpha) (linear amplitude)";
+        true_aod_deg: f64, "deg", "true AoD, from the base-station array axis (world x)";
+        true_aoa_deg: f64, "deg", "true AoA, from the vehicle's heading";
+        run0_gain: f64, "", "run 0: estimated abs(alpha) after the slot's update (or re-initialisation)";
+        run0_aod_deg: f64, "deg", "run 0: estimated AoD, wrapped to (-180, 180]";
+        run0_aoa_deg: f64, "deg", "run 0: estimated AoA, wrapped to (-180, 180]";
+        run0_reinitialised: bool, "", "run 0: the slot ended in a re-initialisation";
+        rmse_gain_pct: f64, "%", "RMS over runs of the relative abs(alpha) error at this slot";
+        rmse_aod_deg: f64, "deg", "RMS over runs of the AoD error at this slot";
+        rmse_aoa_deg: f64, "deg", "RMS over runs of the AoA error at this slot";
+        reinitialisation_rate: f64, "", "fraction of runs re-initialised at this slot";
+    }
+}

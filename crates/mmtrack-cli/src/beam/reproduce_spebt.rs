@@ -1,0 +1,498 @@
+//! `mmtrack reproduce spebt`: the beam-tracking experiment of Liu et al.
+//! 2024 (SPEBT), Sec. IV, Table III and Fig. 5 (PAPERS.md section 1).
+//!
+//! The vehicle drives a real trajectory (default: the first 6388 poses of
+//! the Oxford full-sequence ground truth, one slot per pose) past a base
+//! station; the SPEBT EKF (`mmtrack_beam::spebt`) tracks `[|alpha|, AoD,
+//! AoA]` from pose estimates that are the truth plus the paper's pose-error
+//! model (`mmtrack_sim::beam::spebt_link`), one pilot per slot, and
+//! re-initialises from initial access (the true channel) when its estimate
+//! leaves the thresholds around the last initial access. Reported: RMSE of
+//! `|alpha|` (%), AoD and AoA (deg), re-initialisations per run, against
+//! Table III. The experiment, its published numbers and targets are one TOML
+//! file (`data/reproduce/spebt.toml`, embedded).
+//!
+//! Runs are split into fixed chunks computed on rayon and merged in chunk
+//! order, so the numbers do not depend on the thread count.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use mmtrack_analysis::beam::spebt_plots::{SpebtTrackingSeries, spebt_tracking_svg};
+use mmtrack_analysis::beam::spebt_tables::{SpebtSlotRow, SpebtSummaryRow};
+use mmtrack_beam::{Deviation, SpebtConfig, SpebtEkf, SpebtState};
+use mmtrack_core::wrap_angle_rad;
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{RunInfo, write_table};
+use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtScenario, SpebtSlot};
+use rayon::prelude::*;
+use serde::Deserialize;
+
+use super::spebt_report::{self as report, README_BLOCK};
+use crate::ingest::PoseFormat;
+use crate::simulate;
+use crate::threads::ThreadsArg;
+
+/// The experiment, embedded so it runs from any directory.
+pub const SPEBT_EXPERIMENT: &str = include_str!("../../../../data/reproduce/spebt.toml");
+/// Default trajectory: the Oxford full-sequence ground truth beside the repository.
+const DEFAULT_TRAJECTORY: &str = "../shared/realdata/oxford-gt-full-seq/radar_odometry.csv";
+/// The experiment's name: the sequence partition of its tables.
+pub(super) const POSE_ERROR_MODEL: &str = "pose-error-model";
+
+#[derive(Args)]
+pub struct SpebtArgs {
+    /// Output directory (tables/, fig5_tracking.svg, reproduce.md).
+    #[arg(short, long, default_value = "out/reproduce/spebt")]
+    output: PathBuf,
+    /// Replace a previous run's output directory.
+    #[arg(long)]
+    force: bool,
+    /// Experiment file (TOML; default: the embedded data/reproduce/spebt.toml).
+    #[arg(long, value_name = "EXPERIMENT.toml")]
+    experiment: Option<PathBuf>,
+    /// Monte Carlo runs (default: the experiment's, 3000).
+    #[arg(long)]
+    runs: Option<u64>,
+    /// The CI version: the experiment's quick_runs (8) runs.
+    #[arg(long)]
+    quick: bool,
+    /// Trajectory to drive along (its first `slots` poses, one slot each). The default is
+    /// the Oxford full-sequence ground truth (gt/radar_odometry.csv) among the real-data
+    /// samples beside the repository, a path relative to the current directory: run from
+    /// the repository root, or pass --trajectory.
+    #[arg(long, value_name = "FILE", default_value = DEFAULT_TRAJECTORY)]
+    trajectory: PathBuf,
+    /// Format of --trajectory.
+    #[arg(long, value_enum, default_value_t = PoseFormat::Oxford)]
+    trajectory_format: PoseFormat,
+    /// Replace the block `<!-- reproduce-spebt:begin -->` ... `end` in this
+    /// file with the summary (checked before the run).
+    #[arg(long, value_name = "README.md")]
+    readme: Option<PathBuf>,
+    #[command(flatten)]
+    threads: ThreadsArg,
+}
+
+/// The experiment file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Experiment {
+    pub seed: u64,
+    pub runs: u64,
+    pub quick_runs: u64,
+    pub slots: usize,
+    #[serde(default)]
+    pub scenario: SpebtScenario,
+    pub tracker: TrackerParams,
+    pub paper: Paper,
+    pub targets: Targets,
+}
+
+/// The filter's model and thresholds.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TrackerParams {
+    pub position_sigma_m: f64,
+    pub yaw_sigma_deg: f64,
+    pub gain_threshold: f64,
+    pub angle_threshold_deg: f64,
+}
+
+/// The paper's numbers.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Paper {
+    pub rmse_gain_pct: f64,
+    pub rmse_aod_deg: f64,
+    pub rmse_aoa_deg: f64,
+    pub reinitialisations: u64,
+    pub slots: u64,
+}
+
+/// The bounds the verdicts check.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Targets {
+    pub max_rmse_aod_deg: f64,
+    pub max_rmse_aoa_deg: f64,
+    pub max_reinitialisation_share_pct: f64,
+}
+
+/// Runs per rayon task: fixed, so partial sums merge in the same order on
+/// any number of threads.
+const RUNS_PER_CHUNK: u64 = 4;
+/// Chunks computed before their partial sums are merged (bounds the memory
+/// of per-slot partial sums; the merge order stays the chunk order).
+const CHUNKS_PER_BATCH: u64 = 32;
+
+/// What the Monte Carlo runs of one experiment measured.
+pub(super) struct ExperimentResult {
+    pub runs: u64,
+    /// Per slot, per component (|alpha| relative, AoD, AoA): sum over runs
+    /// of the squared error.
+    pub sum_squared: [Vec<f64>; 3],
+    /// Per slot: runs re-initialised there.
+    pub reinitialised_runs: Vec<u64>,
+    /// Re-initialisations of each run, run order.
+    pub reinitialisations: Vec<u64>,
+    /// Re-initialisations where the |alpha|, AoD, AoA test fired.
+    pub causes: [u64; 3],
+    /// Run 0's estimates per slot and whether the slot re-initialised.
+    pub run0: Vec<(SpebtState, bool)>,
+    /// CPU seconds in the tracker (summed over threads).
+    pub tracker_cpu_s: f64,
+}
+
+impl ExperimentResult {
+    fn new(slots: usize) -> Self {
+        Self {
+            runs: 0,
+            sum_squared: std::array::from_fn(|_| vec![0.0; slots]),
+            reinitialised_runs: vec![0; slots],
+            reinitialisations: Vec::new(),
+            causes: [0; 3],
+            run0: Vec::new(),
+            tracker_cpu_s: 0.0,
+        }
+    }
+
+    fn merge(&mut self, other: ExperimentResult) {
+        for (mine, theirs) in self.sum_squared.iter_mut().zip(&other.sum_squared) {
+            for (a, b) in mine.iter_mut().zip(theirs) {
+                *a += b;
+            }
+        }
+        for (a, b) in self.reinitialised_runs.iter_mut().zip(&other.reinitialised_runs) {
+            *a += b;
+        }
+        self.runs += other.runs;
+        self.reinitialisations.extend(other.reinitialisations);
+        for (a, b) in self.causes.iter_mut().zip(other.causes) {
+            *a += b;
+        }
+        if self.run0.is_empty() {
+            self.run0 = other.run0;
+        }
+        self.tracker_cpu_s += other.tracker_cpu_s;
+    }
+
+    /// Tracked slots per run (slot 0 is the initial access).
+    pub fn tracked_slots(&self) -> usize {
+        self.sum_squared[0].len().saturating_sub(1)
+    }
+
+    /// RMSE over every tracked slot and run, per component (relative for
+    /// |alpha|, radians for the angles).
+    pub fn rmse(&self) -> [f64; 3] {
+        let n = (self.tracked_slots() as f64 * self.runs as f64).max(1.0);
+        self.sum_squared.each_ref().map(|sums| (sums.iter().skip(1).sum::<f64>() / n).sqrt())
+    }
+
+    /// Mean re-initialisations per run.
+    pub fn mean_reinitialisations(&self) -> f64 {
+        self.reinitialisations.iter().sum::<u64>() as f64 / self.reinitialisations.len().max(1) as f64
+    }
+}
+
+pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    if args.output.exists() && !args.force {
+        bail!("{}: exists; use --force to replace it (nothing was done)", args.output.display());
+    }
+    if let Some(readme) = &args.readme {
+        crate::readme_block::check_block(readme, README_BLOCK)?;
+    }
+    let (source, text) = match &args.experiment {
+        Some(path) => {
+            (path.display().to_string(), std::fs::read_to_string(path).with_context(|| path.display().to_string())?)
+        }
+        None => ("embedded data/reproduce/spebt.toml".to_string(), SPEBT_EXPERIMENT.to_string()),
+    };
+    let experiment: Experiment = toml::from_str(&text).with_context(|| source.clone())?;
+    let runs = match (args.runs, args.quick) {
+        (Some(n), _) => n,
+        (None, true) => experiment.quick_runs,
+        (None, false) => experiment.runs,
+    };
+    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    anyhow::ensure!(experiment.slots >= 2, "{source}: slots = {} (need at least 2)", experiment.slots);
+    let link = load_link(args, &experiment).with_context(|| format!("{source}: [scenario]"))?;
+    let config = tracker_config(&experiment);
+
+    let started = Instant::now();
+    let (result, threads) = args.threads.install(|| -> anyhow::Result<(ExperimentResult, usize)> {
+        let chunks = runs.div_ceil(RUNS_PER_CHUNK);
+        let bar = crate::progress::bar(runs, "reproduce spebt", "runs", quiet);
+        let mut total = ExperimentResult::new(link.len());
+        for batch in (0..chunks).step_by(CHUNKS_PER_BATCH as usize) {
+            let partials: Vec<ExperimentResult> = (batch..(batch + CHUNKS_PER_BATCH).min(chunks))
+                .into_par_iter()
+                .map(|c| {
+                    let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
+                    let count = range.end - range.start;
+                    let chunk = run_chunk(&link, &config, experiment.seed, range);
+                    bar.inc(count);
+                    chunk
+                })
+                .collect::<anyhow::Result<_>>()?;
+            for part in partials {
+                total.merge(part);
+            }
+        }
+        bar.finish_and_clear();
+        Ok((total, rayon::current_num_threads()))
+    })??;
+    let elapsed_s = started.elapsed().as_secs_f64();
+
+    let context =
+        report::Context { experiment: &experiment, trajectory: &args.trajectory, link: &link, elapsed_s, threads };
+    let verdicts = report::verdicts(&experiment, &result);
+    let summary = report::summary(&context, &result, &verdicts);
+    write_outputs(args, &experiment, &source, &link, &result, &summary)?;
+    if let Some(readme) = &args.readme {
+        crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;
+    }
+    if !quiet {
+        print!("{summary}");
+        println!("\noutputs: {}", args.output.display());
+    }
+    Ok(if verdicts.iter().all(|v| v.met) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+/// The link along the first `slots` poses of `--trajectory`.
+fn load_link(args: &SpebtArgs, experiment: &Experiment) -> anyhow::Result<SpebtLink> {
+    if !args.trajectory.exists() {
+        if args.trajectory == Path::new(DEFAULT_TRAJECTORY) {
+            bail!(
+                "default {DEFAULT_TRAJECTORY} not found (the Oxford full-sequence ground truth among the real-data \
+                 samples beside the repository; run from the repository root); pass --trajectory PATH"
+            );
+        }
+        bail!("{}: not found (--trajectory)", args.trajectory.display());
+    }
+    let mut poses = simulate::read_trajectory(&args.trajectory, args.trajectory_format, None, 0)?;
+    poses.truncate(experiment.slots);
+    SpebtLink::new(&experiment.scenario, &poses).with_context(|| args.trajectory.display().to_string())
+}
+
+/// The filter's parameters: the link's Table I values and the [tracker] table.
+fn tracker_config(experiment: &Experiment) -> SpebtConfig {
+    let (s, t) = (&experiment.scenario, &experiment.tracker);
+    SpebtConfig {
+        bs_elements: s.bs_elements,
+        vehicle_elements: s.vehicle_elements,
+        spacing_wavelengths: s.spacing_wavelengths,
+        path_loss_exponent: s.path_loss_exponent,
+        bs_x_m: s.bs_x_m,
+        bs_y_m: s.bs_y_m,
+        pilot_power_w: s.pilot_power_w(),
+        noise_variance_w: s.noise_variance_w(),
+        position_sigma_m: t.position_sigma_m,
+        yaw_sigma_rad: t.yaw_sigma_deg.to_radians(),
+        gain_threshold: t.gain_threshold,
+        aod_threshold_rad: t.angle_threshold_deg.to_radians(),
+        aoa_threshold_rad: t.angle_threshold_deg.to_radians(),
+    }
+}
+
+/// Initial access: the true channel of a slot.
+fn initial_access(slot: &SpebtSlot) -> SpebtState {
+    SpebtState { gain_magnitude: slot.gain.norm(), aod_rad: slot.aod_rad, aoa_rad: slot.aoa_rad }
+}
+
+fn run_chunk(
+    link: &SpebtLink,
+    config: &SpebtConfig,
+    seed: u64,
+    runs: std::ops::Range<u64>,
+) -> anyhow::Result<ExperimentResult> {
+    let mut chunk = ExperimentResult::new(link.len());
+    for run_index in runs {
+        let realisation = link.realise(seed, run_index);
+        let started = Instant::now();
+        let truth = link.slots();
+        let mut ekf = SpebtEkf::new(config, initial_access(&truth[0]), &realisation.pose_estimates[0])
+            .with_context(|| format!("run {run_index}"))?;
+        let keep = run_index == 0;
+        if keep {
+            chunk.run0.push((ekf.estimate(), false));
+        }
+        let mut reinitialisations = 0;
+        for (k, slot) in truth.iter().enumerate().skip(1) {
+            let beams = ekf.predict(&realisation.pose_estimates[k]).with_context(|| format!("run {run_index}"))?;
+            let pilot = link.pilot(k, beams.rx_steer_u, beams.tx_steer_u, realisation.noise[k]);
+            let deviation = ekf.update(pilot).with_context(|| format!("run {run_index}"))?;
+            let reinitialised = if let Deviation::Exceeded { gain, aod, aoa } = deviation {
+                ekf.reinitialise(initial_access(slot))?;
+                for (count, fired) in chunk.causes.iter_mut().zip([gain, aod, aoa]) {
+                    *count += u64::from(fired);
+                }
+                chunk.reinitialised_runs[k] += 1;
+                reinitialisations += 1;
+                true
+            } else {
+                false
+            };
+            let estimate = ekf.estimate();
+            let true_gain = slot.gain.norm();
+            let errors = [
+                (estimate.gain_magnitude - true_gain) / true_gain,
+                wrap_angle_rad(estimate.aod_rad - slot.aod_rad),
+                wrap_angle_rad(estimate.aoa_rad - slot.aoa_rad),
+            ];
+            for (sums, e) in chunk.sum_squared.iter_mut().zip(errors) {
+                sums[k] += e * e;
+            }
+            if keep {
+                chunk.run0.push((estimate, reinitialised));
+            }
+        }
+        chunk.tracker_cpu_s += started.elapsed().as_secs_f64();
+        chunk.reinitialisations.push(reinitialisations);
+        chunk.runs += 1;
+    }
+    Ok(chunk)
+}
+
+fn write_outputs(
+    args: &SpebtArgs,
+    experiment: &Experiment,
+    source: &str,
+    link: &SpebtLink,
+    result: &ExperimentResult,
+    summary: &str,
+) -> anyhow::Result<()> {
+    let parent = match args.output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
+    let staging = mmtrack_io::staging_dir(&parent, ".reproduce-spebt.")?;
+    let tables = staging.path().join("tables");
+    let info = RunInfo {
+        config_json: serde_json::json!({
+            "command": "reproduce spebt",
+            "experiment": source,
+            "trajectory": args.trajectory.display().to_string(),
+            "runs": result.runs,
+            "seed": experiment.seed,
+            "slots": link.len(),
+            "scenario": experiment.scenario,
+            "tracker": {
+                "position_sigma_m": experiment.tracker.position_sigma_m,
+                "yaw_sigma_deg": experiment.tracker.yaw_sigma_deg,
+                "gain_threshold": experiment.tracker.gain_threshold,
+                "angle_threshold_deg": experiment.tracker.angle_threshold_deg,
+            },
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    let summary_row = summary_row(experiment, &args.trajectory, link, result);
+    write_table(&tables, POSE_ERROR_MODEL, &[summary_row], &info, Overwrite::Refuse)?;
+    write_table(&tables, POSE_ERROR_MODEL, &slot_rows(link, result), &info, Overwrite::Refuse)?;
+    let svg = spebt_tracking_svg(
+        "SPEBT, run 0 against the truth (Liu et al. Fig. 5): pose-error model, Oxford trajectory",
+        &tracking_series(link, result),
+    )?;
+    std::fs::write(staging.path().join("fig5_tracking.svg"), svg).context("fig5_tracking.svg")?;
+    std::fs::write(staging.path().join("reproduce.md"), summary)?;
+    if args.output.exists() {
+        std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
+    }
+    let staged = staging.keep();
+    std::fs::rename(&staged, &args.output).with_context(|| args.output.display().to_string())?;
+    Ok(())
+}
+
+fn summary_row(experiment: &Experiment, trajectory: &Path, link: &SpebtLink, r: &ExperimentResult) -> SpebtSummaryRow {
+    let [gain, aod, aoa] = r.rmse();
+    let total: u64 = r.reinitialisations.iter().sum();
+    let cause = |i: usize| 100.0 * r.causes[i] as f64 / total.max(1) as f64;
+    let paper = &experiment.paper;
+    SpebtSummaryRow {
+        experiment: POSE_ERROR_MODEL.into(),
+        trajectory: trajectory.display().to_string(),
+        slots: link.len() as u64,
+        runs: r.runs,
+        seed: experiment.seed,
+        rmse_gain_pct: 100.0 * gain,
+        rmse_aod_deg: aod.to_degrees(),
+        rmse_aoa_deg: aoa.to_degrees(),
+        reinitialisations_mean: r.mean_reinitialisations(),
+        reinitialisations_min: r.reinitialisations.iter().copied().min().unwrap_or(0),
+        reinitialisations_max: r.reinitialisations.iter().copied().max().unwrap_or(0),
+        reinitialisation_share_pct: 100.0 * r.mean_reinitialisations() / r.tracked_slots().max(1) as f64,
+        reinit_gain_pct: cause(0),
+        reinit_aod_pct: cause(1),
+        reinit_aoa_pct: cause(2),
+        paper_rmse_gain_pct: paper.rmse_gain_pct,
+        paper_rmse_aod_deg: paper.rmse_aod_deg,
+        paper_rmse_aoa_deg: paper.rmse_aoa_deg,
+        paper_reinitialisation_share_pct: 100.0 * paper.reinitialisations as f64 / paper.slots as f64,
+    }
+}
+
+fn slot_rows(link: &SpebtLink, r: &ExperimentResult) -> Vec<SpebtSlotRow> {
+    let t0 = link.slots()[0].t_ns;
+    let runs = r.runs.max(1) as f64;
+    link.slots()
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            let (estimate, reinitialised) = r.run0.get(k).copied().unwrap_or((initial_access(s), false));
+            let rms = |i: usize| (r.sum_squared[i][k] / runs).sqrt();
+            SpebtSlotRow {
+                slot: k as u64,
+                t_s: (s.t_ns - t0) as f64 * 1e-9,
+                x_m: s.pose.x_m,
+                y_m: s.pose.y_m,
+                yaw_deg: wrap_angle_rad(s.pose.yaw_rad).to_degrees(),
+                range_m: s.range_m,
+                true_gain: s.gain.norm(),
+                true_aod_deg: s.aod_rad.to_degrees(),
+                true_aoa_deg: s.aoa_rad.to_degrees(),
+                run0_gain: estimate.gain_magnitude,
+                run0_aod_deg: estimate.aod_rad.to_degrees(),
+                run0_aoa_deg: estimate.aoa_rad.to_degrees(),
+                run0_reinitialised: reinitialised,
+                rmse_gain_pct: 100.0 * rms(0),
+                rmse_aod_deg: rms(1).to_degrees(),
+                rmse_aoa_deg: rms(2).to_degrees(),
+                reinitialisation_rate: r.reinitialised_runs[k] as f64 / runs,
+            }
+        })
+        .collect()
+}
+
+fn tracking_series(link: &SpebtLink, r: &ExperimentResult) -> SpebtTrackingSeries {
+    let mut series = SpebtTrackingSeries::default();
+    for (s, (estimate, reinitialised)) in link.slots().iter().zip(&r.run0) {
+        series.true_gain.push(s.gain.norm());
+        series.true_aod_deg.push(s.aod_rad.to_degrees());
+        series.true_aoa_deg.push(s.aoa_rad.to_degrees());
+        series.estimate_gain.push(estimate.gain_magnitude);
+        series.estimate_aod_deg.push(estimate.aod_rad.to_degrees());
+        series.estimate_aoa_deg.push(estimate.aoa_rad.to_degrees());
+        series.reinitialised.push(*reinitialised);
+    }
+    series
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_embedded_experiment_parses_with_table_i() {
+        let experiment: Experiment = toml::from_str(SPEBT_EXPERIMENT).unwrap();
+        assert_eq!(experiment.scenario, SpebtScenario::default(), "[scenario] spells out Table I");
+        assert_eq!((experiment.slots, experiment.paper.slots), (6388, 6388));
+        let config = tracker_config(&experiment);
+        assert!((config.noise_variance_w - 1e-12).abs() < 1e-24);
+        assert!((config.aoa_threshold_rad.to_degrees() - 7.5).abs() < 1e-12);
+    }
+}

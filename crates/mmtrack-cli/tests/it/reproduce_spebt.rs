@@ -1,0 +1,150 @@
+//! `mmtrack reproduce spebt`: the CI version on the real Oxford trajectory
+//! (8 runs instead of 3000), determinism across thread counts and the bad
+//! trajectories of the issue, on small synthetic drives.
+
+use std::path::Path;
+
+use mmtrack_analysis::beam::spebt_tables::{SpebtSlotRow, SpebtSummaryRow};
+use mmtrack_io::table::read_table;
+
+use super::common::{mmtrack, realdata, text};
+
+const README_BEFORE: &str = "# R\n\n<!-- reproduce-spebt:begin -->\nstale\n<!-- reproduce-spebt:end -->\n";
+const SUMMARY: &str = "tables/spebt_summary/sequence=pose-error-model/part-0.parquet";
+const PER_SLOT: &str = "tables/spebt_per_slot/sequence=pose-error-model/part-0.parquet";
+
+#[test]
+fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
+    let Some(realdata) = realdata("reproduce_spebt_quick") else { return };
+    let trajectory = realdata.join("oxford-gt-full-seq/radar_odometry.csv");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("README.md"), README_BEFORE).unwrap();
+    let args = ["reproduce", "spebt", "--quick", "--trajectory", trajectory.to_str().unwrap()];
+    let out = mmtrack(dir.path(), &[&args[..], &["-o", "out", "--readme", "README.md"]].concat());
+    let (stdout, stderr) = text(&out);
+    let report = std::fs::read_to_string(dir.path().join("out/reproduce.md"))
+        .unwrap_or_else(|e| panic!("no report ({e}):\n{stdout}\n{stderr}"));
+    println!("{report}");
+    let missed = report.matches("| **missed** |").count();
+    assert_eq!(out.status.success(), missed == 0, "exit status must follow the verdicts:\n{stderr}");
+    // Three targets: AoD, AoA, re-initialisation share; |alpha| is reported only.
+    assert_eq!(report.matches("| met |").count() + missed, 3, "{report}");
+    assert!(report.contains("| RMSE abs(alpha) (%) | 1.580 |") && report.contains("| reported |"), "{report}");
+
+    let summary: Vec<SpebtSummaryRow> = read_table(&dir.path().join("out").join(SUMMARY)).unwrap();
+    assert_eq!(summary.len(), 1);
+    let row = &summary[0];
+    assert_eq!((row.runs, row.slots), (8, 6388), "{row:?}");
+    let share = 100.0 * row.reinitialisations_mean / 6387.0;
+    assert!((row.reinitialisation_share_pct - share).abs() < 1e-9, "{row:?}");
+    assert!(row.reinitialisations_min <= row.reinitialisations_max);
+    // Each re-initialisation has at least one test that fired.
+    assert!(row.reinit_gain_pct + row.reinit_aod_pct + row.reinit_aoa_pct >= 100.0 - 1e-9, "{row:?}");
+    let slots: Vec<SpebtSlotRow> = read_table(&dir.path().join("out").join(PER_SLOT)).unwrap();
+    assert_eq!(slots.len(), 6388);
+    // Slot 0 is the initial access: the estimate is the truth.
+    assert_eq!((slots[0].run0_gain, slots[0].run0_aod_deg), (slots[0].true_gain, slots[0].true_aod_deg));
+    assert_eq!(slots[0].rmse_aod_deg, 0.0);
+    // The vehicle starts at (0, 0), 128.5 m from the base station at (-30, -125) m.
+    assert!((slots[0].range_m - 30f64.hypot(125.0)).abs() < 1e-9 && slots[0].x_m == 0.0);
+    // A slot re-initialised in run 0 ends on the true channel.
+    let reset = slots.iter().find(|s| s.run0_reinitialised).expect("run 0 re-initialises somewhere");
+    assert_eq!((reset.run0_gain, reset.run0_aoa_deg), (reset.true_gain, reset.true_aoa_deg));
+
+    let svg = std::fs::read_to_string(dir.path().join("out/fig5_tracking.svg")).unwrap();
+    let doc = roxmltree::Document::parse(&svg).unwrap();
+    assert_eq!(doc.root_element().tag_name().name(), "svg");
+    let readme = std::fs::read_to_string(dir.path().join("README.md")).unwrap();
+    assert!(!readme.contains("stale") && readme.contains("| claim | paper (Table III, 10^5 runs) |"), "{readme}");
+}
+
+/// A TUM file of a drive at 10 m/s, 4 Hz: `poses` poses along `heading_rad`
+/// from `(x0, y0)`; `edit` may change a line.
+fn tum_drive(path: &Path, poses: usize, heading_rad: f64, edit: impl Fn(usize, String) -> String) {
+    let (qz, qw) = ((0.5 * heading_rad).sin(), (0.5 * heading_rad).cos());
+    let lines: Vec<String> = (0..poses)
+        .map(|k| {
+            let d = 2.5 * k as f64;
+            let line = format!(
+                "{:.6} {:.4} {:.4} 0 0 0 {qz:.9} {qw:.9}",
+                0.25 * k as f64,
+                d * heading_rad.cos(),
+                d * heading_rad.sin()
+            );
+            edit(k, line)
+        })
+        .collect();
+    std::fs::write(path, lines.join("\n") + "\n").unwrap();
+}
+
+/// The same tables on 1 and 2 threads (runs are summed in fixed chunks).
+#[test]
+fn spebt_tables_do_not_depend_on_the_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    tum_drive(&dir.path().join("drive.tum"), 300, 0.3, |_, line| line);
+    for threads in ["1", "2"] {
+        let out = mmtrack(
+            dir.path(),
+            &[
+                "reproduce",
+                "spebt",
+                "--trajectory",
+                "drive.tum",
+                "--trajectory-format",
+                "tum",
+                "--runs",
+                "22",
+                "--threads",
+                threads,
+                "-o",
+                threads,
+            ],
+        );
+        assert!(out.status.code().is_some_and(|c| c <= 1), "{}", text(&out).1);
+    }
+    for part in [SUMMARY, PER_SLOT] {
+        let one = std::fs::read(dir.path().join("1").join(part)).unwrap();
+        let two = std::fs::read(dir.path().join("2").join(part)).unwrap();
+        assert!(one == two, "{part} differs between 1 and 2 threads");
+    }
+    let summary: Vec<SpebtSummaryRow> = read_table(&dir.path().join("1").join(SUMMARY)).unwrap();
+    assert_eq!((summary[0].runs, summary[0].slots), (22, 300));
+}
+
+/// A trajectory through the base station, a NaN pose and a gap: a clear
+/// error naming the file and the pose, and nothing written.
+#[test]
+fn bad_trajectories_are_refused_before_any_run() {
+    let dir = tempfile::tempdir().unwrap();
+    // Heading towards the base station at (-30, -125) m: the drive passes through it at 128.5 m.
+    let towards_bs = (-125f64).atan2(-30.0);
+    tum_drive(&dir.path().join("through.tum"), 100, towards_bs, |_, line| line);
+    tum_drive(
+        &dir.path().join("nan.tum"),
+        100,
+        0.3,
+        |k, line| if k == 7 { line.replace("0 0 0", "NaN 0 0") } else { line },
+    );
+    tum_drive(
+        &dir.path().join("gap.tum"),
+        100,
+        0.3,
+        |k, line| if (40..43).contains(&k) { String::new() } else { line },
+    );
+    for (file, expected) in [
+        ("through.tum", vec!["through.tum", "base station", "reference distance"]),
+        ("nan.tum", vec!["nan.tum", "line 8"]),
+        ("gap.tum", vec!["gap.tum", "pose 40", "gap of 1.000 s"]),
+    ] {
+        let out = mmtrack(
+            dir.path(),
+            &["reproduce", "spebt", "--trajectory", file, "--trajectory-format", "tum", "--runs", "2", "-o", "out"],
+        );
+        let (_, stderr) = text(&out);
+        assert!(!out.status.success() && stderr.starts_with("error: "), "{file}: {stderr}");
+        for needle in expected {
+            assert!(stderr.contains(needle), "{file}: `{needle}` not in:\n{stderr}");
+        }
+        assert!(!dir.path().join("out").exists(), "{file}: nothing is written");
+    }
+}
