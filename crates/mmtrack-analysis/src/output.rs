@@ -9,6 +9,8 @@ use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
 
+use crate::beam::sweeps::{self, BeamSweepResults};
+use crate::beam::{plots as beam_plots, tables::BeamSweepPooledRow};
 use crate::mpc::MpcResult;
 use crate::pipeline::TrajectoryResult;
 use crate::trajectory::DriftOptions;
@@ -81,14 +83,17 @@ pub fn write_results(
     run: &RunInfo,
     overwrite: Overwrite,
 ) -> anyhow::Result<WrittenResults> {
-    write_all_results(out, results, &[], skipped, options, run, overwrite)
+    write_all_results(out, results, &[], &BeamSweepResults::default(), skipped, options, run, overwrite)
 }
 
-/// Writes tables, plots and the report for trajectory and MPC results into `out`.
+/// Writes tables, plots and the report for trajectory, MPC and beam-sweep
+/// results into `out`.
+#[allow(clippy::too_many_arguments)] // one per kind of result, plus where and how
 pub fn write_all_results(
     out: &Path,
     results: &[TrajectoryResult],
     mpc: &[MpcResult],
+    beam: &BeamSweepResults,
     skipped: &[(String, String)],
     options: &DriftOptions,
     run: &RunInfo,
@@ -102,10 +107,16 @@ pub fn write_all_results(
         .with_context(|| format!("{}: cannot create a staging directory", parent.display()))?;
     let mut files = write_into(staging.path(), results, skipped, options, run)?;
     files += write_mpc_into(staging.path(), mpc, run)?;
-    if !mpc.is_empty() {
+    files += write_beam_into(staging.path(), beam, run)?;
+    if !mpc.is_empty() || !beam.is_empty() {
         let report_path = staging.path().join("report.md");
         let mut text = report::markdown(results, &[], options);
-        mpc_report::section(&mut text, mpc);
+        if !mpc.is_empty() {
+            mpc_report::section(&mut text, mpc);
+        }
+        if !beam.is_empty() {
+            sweeps::section(&mut text, beam);
+        }
         text.push_str(&report::not_analyzed(skipped));
         std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
     }
@@ -181,6 +192,55 @@ fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::R
         files += 6 + mpc_report::PLOTS.len();
     }
     Ok(files)
+}
+
+fn write_svg(path: &Path, svg: anyhow::Result<String>, what: &str) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    }
+    let svg = svg.with_context(|| what.to_string())?;
+    std::fs::write(path, svg).with_context(|| path.display().to_string())
+}
+
+fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &RunInfo) -> anyhow::Result<usize> {
+    if results.is_empty() {
+        return Ok(0);
+    }
+    let tables = dir.join("tables");
+    let plots = dir.join("plots");
+    let mut files = 0;
+    for r in &results.sequences {
+        let seq = &r.sequence;
+        write_table(&tables, seq, &r.summary, run, Overwrite::Refuse)?;
+        let (best, chosen) = sweeps::beam_index_series(r);
+        let beam_count = r.rows.iter().map(|row| row.beam_count).max().unwrap_or(1);
+        let [(index_file, _), (cdf_file, _)] = sweeps::SEQUENCE_PLOTS;
+        write_svg(
+            &plots.join(seq).join(index_file),
+            beam_plots::beam_index_svg(&format!("{seq}: beam index"), &best, &chosen, beam_count),
+            &format!("sequence {seq}: {index_file}"),
+        )?;
+        write_svg(
+            &plots.join(seq).join(cdf_file),
+            beam_plots::loss_cdf_svg(&format!("{seq}: received-power loss"), &sweeps::loss_curves(r.rows.iter())),
+            &format!("sequence {seq}: {cdf_file}"),
+        )?;
+        files += 1 + sweeps::SEQUENCE_PLOTS.len();
+    }
+    write_table(&tables, "all", &results.pooled, run, Overwrite::Refuse)?;
+    let mut sites: Vec<&str> = results.pooled.iter().map(|BeamSweepPooledRow(p)| p.site.as_str()).collect();
+    sites.dedup();
+    for site in sites {
+        let rows = results.sequences.iter().filter(|s| s.site == site).flat_map(|s| s.rows.iter());
+        let (file, _) = sweeps::SITE_PLOT;
+        write_svg(
+            &plots.join(sweeps::site_plot_dir(site)).join(file),
+            beam_plots::loss_cdf_svg(&format!("{site}: received-power loss, every pass"), &sweeps::loss_curves(rows)),
+            &format!("site {site}: {file}"),
+        )?;
+        files += 1;
+    }
+    Ok(files + 1)
 }
 
 /// Moves the complete `staged` directory to `out`. An existing `out` is

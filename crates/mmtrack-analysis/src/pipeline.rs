@@ -9,11 +9,12 @@ use mmtrack_core::{
     MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, OdometryEstimate, Se2, StampedPose,
 };
 use mmtrack_io::table::{
-    GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose,
-    MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_SNAPSHOTS, MPC_TRACKS, MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats,
-    ODOMETRY, TableRow, read_table, read_table_dir, table_path,
+    BEAM_SWEEPS_TRACKED, BeamSweepTracked, GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GroundTruthPose,
+    GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_SNAPSHOTS, MPC_TRACKS,
+    MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats, ODOMETRY, TableRow, read_table, read_table_dir, table_path,
 };
 
+use crate::beam::sweeps::{BeamSweepResults, analyze_beam_sweeps};
 use crate::mpc::{DistanceSource, MpcInput, MpcOptions, MpcResult, analyze_mpc};
 
 use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
@@ -89,16 +90,20 @@ pub struct Plan {
     /// Sequences with MPC tables (`mpc_sets` and the others of `process mpc`):
     /// MPC statistics.
     pub mpc: Vec<String>,
+    /// Sequences with a `beam_sweeps_tracked` table (`process beam`):
+    /// beam-sweep accounting.
+    pub beam: Vec<String>,
     /// Sequences that have tables but no metric applies, with the reason.
     pub skipped: Vec<(String, String)>,
 }
 
 /// Picks the metrics that apply: `odometry` + `ground_truth` of the same
 /// sequence -> trajectory metrics; `mpc_sets` (with the other tables of
-/// `process mpc`) -> MPC statistics.
+/// `process mpc`) -> MPC statistics; `beam_sweeps_tracked` -> beam-sweep
+/// accounting.
 #[must_use]
 pub fn plan(inventory: &Inventory) -> Plan {
-    let mut plan = Plan::default();
+    let mut plan = Plan { beam: inventory.sequences(BEAM_SWEEPS_TRACKED.name).to_vec(), ..Plan::default() };
     for seq in inventory.sequences(MPC_SETS.name) {
         let missing: Vec<&str> = [MPC_DETECTIONS.name, MPC_TRACKS.name, MPC_LONG_TERM.name]
             .into_iter()
@@ -351,6 +356,16 @@ pub fn analyze_mpc_all(root: &Path, plan: &Plan, options: &MpcOptions) -> anyhow
             Ok(analyze_mpc(sequence, input, options))
         })
         .collect()
+}
+
+/// Beam-sweep accounting of every sequence of `plan` (table
+/// `beam_sweeps_tracked`), per sequence and pooled per site.
+pub fn analyze_beam_all(root: &Path, plan: &Plan) -> anyhow::Result<BeamSweepResults> {
+    let mut tables = BTreeMap::new();
+    for sequence in &plan.beam {
+        tables.insert(sequence.clone(), read_required::<BeamSweepTracked>(root, sequence)?);
+    }
+    analyze_beam_sweeps(tables).map_err(|e| anyhow::anyhow!("{}: {e}", root.join(BEAM_SWEEPS_TRACKED.name).display()))
 }
 
 /// Table names `process mpc` writes, for messages.

@@ -18,6 +18,8 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::mpc_tables::MPC_FIRST_PATH,
     &crate::beam::tables::BEAM_RMS_PER_BLOCK,
     &crate::beam::tables::BEAM_VALID_TRACKING,
+    &crate::beam::tables::BEAM_SWEEP_SUMMARY,
+    &crate::beam::tables::BEAM_SWEEP_POOLED,
     &crate::beam::spebt_tables::SPEBT_SUMMARY,
     &crate::beam::spebt_tables::SPEBT_PER_SLOT,
 ];

@@ -9,11 +9,13 @@ use anyhow::{Context, bail};
 use clap::Args;
 use mmtrack_analysis::mpc::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, MpcOptions};
 use mmtrack_analysis::output::{check_output, write_all_results};
-use mmtrack_analysis::pipeline::{analyze_all, analyze_mpc_all, inventory, plan};
+use mmtrack_analysis::pipeline::{analyze_all, analyze_beam_all, analyze_mpc_all, inventory, plan};
 use mmtrack_analysis::report::one_line;
 use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{GROUND_TRUTH, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, ODOMETRY, RunInfo};
+use mmtrack_io::table::{
+    BEAM_SWEEPS_TRACKED, GROUND_TRUTH, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, ODOMETRY, RunInfo,
+};
 
 #[derive(Args)]
 #[command(
@@ -31,9 +33,14 @@ which), detection and tracking power loss, per-track power standard deviation, l
 and with mpc_truth: detection precision/recall (0.5 ns), track purity, true birth/death rates. First path of each \
 snapshot: the earliest detection within --first-path-range-db of its strongest; where the recording carried the \
 receiver's own first-path estimate (e.g. DW1000 HLP), the median and 90th percentile of the difference.\n\n\
+Table beam_sweeps_tracked of `mmtrack process beam` -> per sequence and pooled per site, for each tracker: mean, \
+median and 90th-percentile received-power loss against each full sweep's best beam, top-1 and within-one-beam \
+accuracy, beams measured per sweep and re-initialisations; plots of the beam index over time (best vs chosen) and \
+of the loss CDF.\n\n\
 Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
-mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path}/sequence=<id>/part-0.parquet, \
-<OUT>/plots/<id>/*.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
+mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary}/sequence=<id>/part-0.parquet, \
+<OUT>/tables/beam_sweep_pooled/sequence=all/part-0.parquet, \
+<OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.",
     after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
 )]
@@ -96,11 +103,11 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     let found = inventory(&args.tables)?;
     let plan = plan(&found);
-    if plan.trajectory.is_empty() && plan.mpc.is_empty() {
+    if plan.trajectory.is_empty() && plan.mpc.is_empty() && plan.beam.is_empty() {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         bail!(
-            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics) and {} with \
-             {}, {}, {} (MPC statistics); found {}{reasons}",
+            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
+             {}, {}, {} (MPC statistics) and {} (beam sweeps); found {}{reasons}",
             args.tables.display(),
             ODOMETRY.name,
             GROUND_TRUTH.name,
@@ -108,12 +115,14 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             MPC_DETECTIONS.name,
             MPC_TRACKS.name,
             MPC_LONG_TERM.name,
+            BEAM_SWEEPS_TRACKED.name,
             found.describe()
         );
     }
     let results = analyze_all(&args.tables, &plan, &options)?;
     let mpc_options = MpcOptions { first_path_dynamic_range_db: args.first_path_range_db };
     let mpc_results = analyze_mpc_all(&args.tables, &plan, &mpc_options)?;
+    let beam_results = analyze_beam_all(&args.tables, &plan)?;
     let run = RunInfo {
         config_json: serde_json::json!({
             "command": "analyze",
@@ -125,13 +134,25 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         })
         .to_string(),
     };
-    let written = write_all_results(&args.output, &results, &mpc_results, &plan.skipped, &options, &run, overwrite)?;
+    let written = write_all_results(
+        &args.output,
+        &results,
+        &mpc_results,
+        &beam_results,
+        &plan.skipped,
+        &options,
+        &run,
+        overwrite,
+    )?;
     if !quiet {
         for r in &results {
             println!("{}", one_line(r));
         }
         for r in &mpc_results {
             println!("{}", mmtrack_analysis::mpc_report::one_line(r));
+        }
+        for line in mmtrack_analysis::beam::sweeps::one_lines(&beam_results) {
+            println!("{line}");
         }
         for (sequence, reason) in &plan.skipped {
             println!("{sequence}: not analyzed: {reason}");

@@ -1,5 +1,7 @@
 //! Beam-tracking results: the valid-tracking experiment of Shaham et al.
-//! 2020 as result tables ([`tables`]) and figures ([`plots`]).
+//! 2020 as result tables ([`tables`]) and figures ([`plots`]); measured beam
+//! sweeps (`mmtrack process beam`) summarised per sequence and pooled per
+//! site ([`sweeps`]).
 //!
 //! Pure data in, tables and SVG documents out; the experiment itself runs in
 //! the CLI (`mmtrack reproduce shaham`), which owns the Monte Carlo loop.
@@ -9,4 +11,5 @@
 pub mod plots;
 pub mod spebt_plots;
 pub mod spebt_tables;
+pub mod sweeps;
 pub mod tables;

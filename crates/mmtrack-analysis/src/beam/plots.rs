@@ -86,3 +86,163 @@ mod tests {
         assert!(svg.matches("<polyline").count() >= 6, "{svg}");
     }
 }
+
+/// A beam index over time: one tracker's chosen beam, or each sweep's best.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeamIndexSeries {
+    /// Legend text.
+    pub label: String,
+    /// Sweep times, seconds from the sequence's first sweep.
+    pub t_s: Vec<f64>,
+    /// Beam index at each time.
+    pub beam: Vec<f64>,
+}
+
+/// Beam index against time: each sweep's best beam as dots, each tracker's
+/// chosen beam as a step line, over the codebook's `beam_count` beams.
+///
+/// # Errors
+/// When plotters fails to draw (not expected for finite input).
+pub fn beam_index_svg(
+    title: &str,
+    best: &BeamIndexSeries,
+    chosen: &[BeamIndexSeries],
+    beam_count: u32,
+) -> anyhow::Result<String> {
+    let all_t = || best.t_s.iter().chain(chosen.iter().flat_map(|c| c.t_s.iter())).copied();
+    let t_end = all_t().filter(|t| t.is_finite()).fold(0.0, f64::max).max(0.1);
+    let beams = f64::from(beam_count.max(1)) - 1.0;
+    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, RGBColor(230, 140, 0)];
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 520)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0f64..t_end, -0.5..beams + 0.5)
+            .map_err(err)?;
+        chart.configure_mesh().x_desc("time (s)").y_desc("beam index").draw().map_err(err)?;
+        let dots = best.t_s.iter().zip(&best.beam).map(|(&t, &b)| Circle::new((t, b), 3, BLACK.filled()));
+        chart
+            .draw_series(dots)
+            .map_err(err)?
+            .label(best.label.clone())
+            .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.filled()));
+        for (k, (series, color)) in chosen.iter().zip(palette.iter().cycle()).enumerate() {
+            // A step line: the chosen beam holds from its sweep to the next.
+            // Earlier trackers are drawn wider, so one that agrees with a
+            // later one still shows beside it.
+            let mut points = Vec::with_capacity(2 * series.t_s.len());
+            for (k, (&t, &b)) in series.t_s.iter().zip(&series.beam).enumerate() {
+                if k > 0 {
+                    points.push((t, series.beam[k - 1]));
+                }
+                points.push((t, b));
+            }
+            let style = color.stroke_width(4u32.saturating_sub(k as u32).max(1));
+            chart
+                .draw_series(LineSeries::new(points, style))
+                .map_err(err)?
+                .label(series.label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .draw()
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    Ok(svg)
+}
+
+/// One empirical loss distribution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LossCurve {
+    /// Legend text.
+    pub label: String,
+    /// Received-power loss of each sweep, dB.
+    pub loss_db: Vec<f64>,
+}
+
+/// Empirical CDF of the received-power loss, one line per curve, from 0 dB
+/// to the largest finite loss.
+///
+/// # Errors
+/// When plotters fails to draw (not expected for finite input).
+pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String> {
+    let finite = || curves.iter().flat_map(|c| c.loss_db.iter().copied()).filter(|v| v.is_finite());
+    let x_end = finite().fold(0.0, f64::max).max(0.5) * 1.02;
+    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, RGBColor(230, 140, 0)];
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (760, 520)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(55)
+            .build_cartesian_2d(0f64..x_end, 0f64..1.0)
+            .map_err(err)?;
+        chart.configure_mesh().x_desc("received-power loss (dB)").y_desc("CDF").draw().map_err(err)?;
+        for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
+            let mut sorted: Vec<f64> = curve.loss_db.iter().copied().filter(|v| v.is_finite()).collect();
+            sorted.sort_by(f64::total_cmp);
+            let n = sorted.len().max(1) as f64;
+            // Steps: the CDF jumps at each loss value.
+            let mut points = vec![(0.0, 0.0)];
+            for (k, &loss) in sorted.iter().enumerate() {
+                points.push((loss, k as f64 / n));
+                points.push((loss, (k + 1) as f64 / n));
+            }
+            points.push((x_end, if sorted.is_empty() { 0.0 } else { 1.0 }));
+            let style = color.stroke_width(2);
+            chart
+                .draw_series(LineSeries::new(points, style))
+                .map_err(err)?
+                .label(curve.label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.85))
+            .draw()
+            .map_err(err)?;
+        root.present().map_err(err)?;
+    }
+    Ok(svg)
+}
+
+#[cfg(test)]
+mod sweep_plot_tests {
+    use super::*;
+
+    #[test]
+    fn beam_index_and_loss_cdf_draw_every_series() {
+        let series = |label: &str, offset: f64| BeamIndexSeries {
+            label: label.into(),
+            t_s: (0..20).map(|k| 0.1 * f64::from(k)).collect(),
+            beam: (0..20).map(|k| 10.0 + f64::from(k) + offset).collect(),
+        };
+        let svg =
+            beam_index_svg("pass", &series("best", 0.0), &[series("window", 1.0), series("gnss", -1.0)], 64).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("window") && svg.contains("best"), "{svg}");
+        // Two step lines and their legend samples.
+        assert!(svg.matches("<polyline").count() >= 4, "{svg}");
+        let curves = [
+            LossCurve { label: "window".into(), loss_db: vec![0.0, 0.0, 1.5, 3.0] },
+            LossCurve { label: "empty".into(), loss_db: vec![] },
+        ];
+        let svg = loss_cdf_svg("loss", &curves).unwrap();
+        assert!(svg.contains("received-power loss (dB)") && svg.contains("empty"), "{svg}");
+        assert!(svg.matches("<polyline").count() >= 4, "{svg}");
+    }
+}

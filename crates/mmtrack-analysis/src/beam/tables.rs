@@ -36,3 +36,39 @@ where it gives one.";
         paper_blocks: Option<u64>, "", "the paper's number for this point and tracker; null where it gives none";
     }
 }
+
+mmtrack_io::define_table! {
+    /// `beam_sweep_summary`: per sequence, one row per beam-sweep tracker.
+    pub const BEAM_SWEEP_SUMMARY = "beam_sweep_summary",
+        "Beam-training accounting of one sequence (a vehicle pass) per tracker, from table beam_sweeps_tracked: \
+received-power loss of the chosen beam against each full sweep's best beam, how often the chosen beam is the best or \
+its neighbour, beams measured per sweep (a full sweep counts all beams) and re-initialisations.";
+    /// One row of [`BEAM_SWEEP_SUMMARY`] (and of [`BEAM_SWEEP_POOLED`]).
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct BeamSweepSummaryRow {
+        tracker: String, "", "policy (beam_sweeps_tracked.tracker)";
+        site: String, "", "array and place (beam_sweeps_tracked.site)";
+        passes: u64, "", "sequences summarised (1 per sequence; the site's passes when pooled)";
+        sweeps: u64, "", "sweeps summarised";
+        beam_count: u32, "", "beams of the codebook (what a full sweep measures)";
+        mean_loss_db: f64, "dB", "mean received-power loss against the best beam, 10 log10(P_best / P_chosen)";
+        median_loss_db: f64, "dB", "median loss (mean of the two middle values for an even count)";
+        p90_loss_db: f64, "dB", "90th percentile of the loss (nearest rank)";
+        top1: f64, "", "share of sweeps whose chosen beam is the best beam";
+        within_one: f64, "", "share of sweeps whose chosen beam is the best beam or its neighbour";
+        mean_beams_per_sweep: f64, "", "mean beams measured per sweep, re-acquisitions included";
+        reinitialisations: u64, "", "sweeps with a (re-)acquisition, pass starts included";
+    }
+}
+
+/// A pooled summary: the columns of [`BEAM_SWEEP_SUMMARY`], in its own table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BeamSweepPooledRow(pub BeamSweepSummaryRow);
+
+mmtrack_io::define_table! {
+    /// `beam_sweep_pooled`: per site and tracker, every sequence pooled.
+    pub const BEAM_SWEEP_POOLED = "beam_sweep_pooled",
+        "Beam-training accounting pooled over every sequence of a site, one row per site and tracker (partition \
+sequence=all): the columns of beam_sweep_summary, each sweep weighted once.";
+    BeamSweepPooledRow(BeamSweepSummaryRow);
+}

@@ -6,7 +6,8 @@
 
 use std::path::Path;
 
-use mmtrack_beam::sweep::{SweepPass, SweepRecord, WindowTracker, WindowTrackerConfig, evaluate};
+use mmtrack_analysis::beam::tables::{BeamSweepPooledRow, BeamSweepSummaryRow};
+use mmtrack_beam::sweep::{SweepPass, SweepRecord, SweepSummary, WindowTracker, WindowTrackerConfig, evaluate};
 use mmtrack_core::BeamSweep;
 use mmtrack_io::table::{BeamSweepTracked, read_table_dir};
 use mmtrack_io::{RecordingEvent, RecordingReader};
@@ -196,13 +197,21 @@ fn ingest_and_process(dir: &Path, realdata: &Path) -> std::path::PathBuf {
     arrays
 }
 
+/// Ingest, process and analyze scenario 1 with the window tracker: the
+/// table equals `mmtrack_beam::evaluate` on the raw arrays row for row, and
+/// analyze's per-sequence and pooled numbers equal its `SweepSummary`.
 #[test]
-fn process_beam_writes_what_evaluate_gives_on_the_raw_arrays_row_for_row() {
+fn ingest_process_analyze_scenario_1_equals_evaluate_on_the_raw_arrays() {
     let Some(realdata) = super::common::realdata("deepsense_process") else { return };
     let dir = tempfile::tempdir().unwrap();
     let arrays = ingest_and_process(dir.path(), &realdata);
     let expected = window_on_arrays(&arrays);
-    let tables = read_table_dir::<BeamSweepTracked>(&dir.path().join("tables")).unwrap();
+    check_table(dir.path(), &expected);
+    check_analysis(dir.path(), &expected);
+}
+
+fn check_table(dir: &Path, expected: &[Vec<SweepRecord>]) {
+    let tables = read_table_dir::<BeamSweepTracked>(&dir.join("tables")).unwrap();
     assert_eq!(tables.len(), 29);
     for (pass, records) in expected.iter().enumerate() {
         let rows = &tables[&format!("scenario1-pass{:02}", pass + 1)];
@@ -226,6 +235,64 @@ fn process_beam_writes_what_evaluate_gives_on_the_raw_arrays_row_for_row() {
             assert_eq!(row.gnss_beam, None);
         }
     }
+}
+
+/// The summary columns of a result row against `mmtrack_beam`'s summary.
+/// Equal to the bit: the same formulas, losses summed in ascending order.
+fn assert_same(row: &BeamSweepSummaryRow, want: &SweepSummary, what: &str) {
+    let got = (row.sweeps, row.mean_loss_db, row.median_loss_db, row.top1, row.within_one, row.mean_beams_per_sweep);
+    let expected = (
+        want.sweeps as u64,
+        want.mean_loss_db,
+        want.median_loss_db,
+        want.top1,
+        want.within_one,
+        want.mean_beams_per_sweep,
+    );
+    assert_eq!(got, expected, "{what}");
+    assert_eq!(row.reinitialisations, want.reinitialisations as u64, "{what}");
+}
+
+fn check_analysis(dir: &Path, expected: &[Vec<SweepRecord>]) {
+    let out = mmtrack(dir, &["analyze", "tables", "-o", "analysis"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let pooled = SweepSummary::from_records(expected.iter().flatten()).unwrap();
+    // What the beam crate's DeepSense test prints for scenario 1 (rounded).
+    assert_eq!(
+        (format!("{:.3}", pooled.mean_loss_db), format!("{:.2}", pooled.mean_beams_per_sweep)),
+        ("0.289".into(), "4.14".into())
+    );
+    assert!(stdout.contains("deepsense-scenario1 (29 passes, 2422 sweeps) window: mean loss 0.289 dB"), "{stdout}");
+    let analysis = dir.join("analysis");
+    let rows = read_table_dir::<BeamSweepPooledRow>(&analysis.join("tables")).unwrap();
+    let all = &rows["all"];
+    assert_eq!(all.len(), 1);
+    let BeamSweepPooledRow(row) = &all[0];
+    assert_eq!(
+        (row.tracker.as_str(), row.site.as_str(), row.passes, row.beam_count),
+        ("window", "deepsense-scenario1", 29, 64)
+    );
+    assert_same(row, &pooled, "pooled");
+    let per_sequence = read_table_dir::<BeamSweepSummaryRow>(&analysis.join("tables")).unwrap();
+    assert_eq!(per_sequence.len(), 29);
+    for (pass, records) in expected.iter().enumerate() {
+        let sequence = format!("scenario1-pass{:02}", pass + 1);
+        let want = SweepSummary::from_records(records).unwrap();
+        assert_same(&per_sequence[&sequence][0], &want, &sequence);
+        for file in ["beam_index.svg", "loss_cdf.svg"] {
+            let svg = std::fs::read_to_string(analysis.join("plots").join(&sequence).join(file)).unwrap();
+            roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{sequence}/{file}: {e}"));
+        }
+    }
+    let site_plot = std::fs::read_to_string(analysis.join("plots/site=deepsense-scenario1/loss_cdf.svg")).unwrap();
+    roxmltree::Document::parse(&site_plot).unwrap();
+    let report = std::fs::read_to_string(analysis.join("report.md")).unwrap();
+    let line = format!(
+        "| deepsense-scenario1 | window | 29 | 2422 | {:.3} | {:.3} |",
+        pooled.mean_loss_db, pooled.median_loss_db
+    );
+    assert!(report.contains("## Beam sweeps") && report.contains(&line), "{report}");
 }
 
 #[test]
