@@ -96,13 +96,16 @@ enum Experiment {
     /// from pose estimates (ground truth plus the paper's pose-error model,
     /// sigma_r = 1 m, sigma_theta = 3 deg) and the power of one pilot per
     /// slot, and re-initialises from initial access when its estimate leaves
-    /// 5e-7 / 7.5 deg of the last one. Reported: RMSE of |alpha| (%), AoD
-    /// and AoA (deg) and re-initialisations per run beside the paper's
-    /// 1.580 % / 0.220 / 4.616 deg and < 300 of 6388. Targets (PAPERS.md
-    /// section 1): AoD <= 0.22 deg, AoA <= 4.6 deg, re-initialisations
-    /// < 5 % of slots. Writes Parquet tables (summary, per slot), the Fig. 5
-    /// figure and reproduce.md; `--readme` rewrites the README's block;
-    /// exits 1 when a target is missed. `--quick` is the CI version.
+    /// 5e-7 / 7.5 deg of the last one. A second experiment drives the
+    /// tracker with our radar odometry (fast-cfear) on Navtech scans
+    /// simulated along the same trajectory (`--skip-odometry` leaves it
+    /// out). Reported per experiment: RMSE of |alpha| (%), AoD and AoA (deg)
+    /// and re-initialisations per run beside the paper's 1.580 % / 0.220 /
+    /// 4.616 deg and < 300 of 6388. Targets (PAPERS.md section 1): AoD <=
+    /// 0.22 deg, AoA <= 4.6 deg, re-initialisations < 5 % of slots. Writes
+    /// Parquet tables (summary, per slot), Fig. 5-style figures and
+    /// reproduce.md; `--readme` rewrites the README's block; exits 1 when a
+    /// target is missed. `--quick` is the CI version.
     #[command(verbatim_doc_comment)]
     Spebt(crate::beam::reproduce_spebt::SpebtArgs),
 }

@@ -6,4 +6,6 @@ pub mod process;
 pub mod reproduce_shaham;
 pub mod reproduce_spebt;
 mod shaham_report;
+mod spebt_odometry;
+mod spebt_output;
 mod spebt_report;

@@ -9,8 +9,11 @@
 //! re-initialises from initial access (the true channel) when its estimate
 //! leaves the thresholds around the last initial access. Reported: RMSE of
 //! `|alpha|` (%), AoD and AoA (deg), re-initialisations per run, against
-//! Table III. The experiment, its published numbers and targets are one TOML
-//! file (`data/reproduce/spebt.toml`, embedded).
+//! Table III. That is experiment (a), `pose-error-model`; experiment (b),
+//! `radar-odometry`, drives the tracker with our own radar odometry on
+//! scans simulated along the same trajectory (`spebt_odometry`), as the
+//! paper's pipeline does. The experiment, its published numbers and targets
+//! are one TOML file (`data/reproduce/spebt.toml`, embedded).
 //!
 //! Runs are split into fixed chunks computed on rayon and merged in chunk
 //! order, so the numbers do not depend on the thread count.
@@ -21,16 +24,17 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use mmtrack_analysis::beam::spebt_plots::{SpebtTrackingSeries, spebt_tracking_svg};
-use mmtrack_analysis::beam::spebt_tables::{SpebtSlotRow, SpebtSummaryRow};
+use mmtrack_analysis::beam::spebt_plots::spebt_tracking_svg;
 use mmtrack_beam::{Deviation, SpebtConfig, SpebtEkf, SpebtState};
-use mmtrack_core::wrap_angle_rad;
+use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtScenario, SpebtSlot};
 use rayon::prelude::*;
 use serde::Deserialize;
 
+use super::spebt_odometry::{self, OdometryDrive};
+use super::spebt_output as output;
 use super::spebt_report::{self as report, README_BLOCK};
 use crate::ingest::PoseFormat;
 use crate::simulate;
@@ -40,12 +44,14 @@ use crate::threads::ThreadsArg;
 pub const SPEBT_EXPERIMENT: &str = include_str!("../../../../data/reproduce/spebt.toml");
 /// Default trajectory: the Oxford full-sequence ground truth beside the repository.
 const DEFAULT_TRAJECTORY: &str = "../shared/realdata/oxford-gt-full-seq/radar_odometry.csv";
-/// The experiment's name: the sequence partition of its tables.
+/// Experiment (a): the sequence partition of its tables.
 pub(super) const POSE_ERROR_MODEL: &str = "pose-error-model";
+/// Experiment (b): the sequence partition of its tables.
+pub(super) const RADAR_ODOMETRY: &str = "radar-odometry";
 
 #[derive(Args)]
 pub struct SpebtArgs {
-    /// Output directory (tables/, fig5_tracking.svg, reproduce.md).
+    /// Output directory (tables/, fig5_*.svg, reproduce.md).
     #[arg(short, long, default_value = "out/reproduce/spebt")]
     output: PathBuf,
     /// Replace a previous run's output directory.
@@ -54,12 +60,19 @@ pub struct SpebtArgs {
     /// Experiment file (TOML; default: the embedded data/reproduce/spebt.toml).
     #[arg(long, value_name = "EXPERIMENT.toml")]
     experiment: Option<PathBuf>,
-    /// Monte Carlo runs (default: the experiment's, 3000).
+    /// Monte Carlo runs of each experiment (default: the experiment file's, 2000 with the
+    /// pose-error model and 100 with radar odometry, whose pose estimates are the same in
+    /// every run).
     #[arg(long)]
     runs: Option<u64>,
-    /// The CI version: the experiment's quick_runs (8) runs.
+    /// The CI version: 8 runs with the pose-error model, 4 with radar odometry on the
+    /// first 480 slots (two minutes of
+    /// driving, the first 70 s standing).
     #[arg(long)]
     quick: bool,
+    /// Run only experiment (a), the pose-error model (no radar simulation).
+    #[arg(long)]
+    skip_odometry: bool,
     /// Trajectory to drive along (its first `slots` poses, one slot each). The default is
     /// the Oxford full-sequence ground truth (gt/radar_odometry.csv) among the real-data
     /// samples beside the repository, a path relative to the current directory: run from
@@ -88,6 +101,7 @@ pub(super) struct Experiment {
     #[serde(default)]
     pub scenario: SpebtScenario,
     pub tracker: TrackerParams,
+    pub odometry: OdometryParams,
     pub paper: Paper,
     pub targets: Targets,
 }
@@ -100,6 +114,16 @@ pub(super) struct TrackerParams {
     pub yaw_sigma_deg: f64,
     pub gain_threshold: f64,
     pub angle_threshold_deg: f64,
+}
+
+/// Experiment (b): radar odometry on simulated scans.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OdometryParams {
+    pub preset: String,
+    pub runs: u64,
+    pub quick_runs: u64,
+    pub quick_slots: usize,
 }
 
 /// The paper's numbers.
@@ -198,6 +222,27 @@ impl ExperimentResult {
     }
 }
 
+/// One experiment: its link, where its pose estimates come from, and what
+/// its runs measured.
+pub(super) struct Outcome {
+    /// Sequence partition of its tables (`pose-error-model`, `radar-odometry`).
+    pub name: &'static str,
+    pub link: SpebtLink,
+    /// Experiment (b)'s drive; `None` for the pose-error model.
+    pub drive: Option<OdometryDrive>,
+    pub result: ExperimentResult,
+    pub verdicts: Vec<report::Verdict>,
+}
+
+/// Where the tracker's pose estimates come from.
+#[derive(Clone, Copy)]
+enum PoseSource<'a> {
+    /// Each run's own draw of the pose-error model.
+    ErrorModel,
+    /// The same estimates in every run (radar odometry), one per slot.
+    Fixed(&'a [Se2]),
+}
+
 pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if args.output.exists() && !args.force {
         bail!("{}: exists; use --force to replace it (nothing was done)", args.output.display());
@@ -212,46 +257,36 @@ pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         None => ("embedded data/reproduce/spebt.toml".to_string(), SPEBT_EXPERIMENT.to_string()),
     };
     let experiment: Experiment = toml::from_str(&text).with_context(|| source.clone())?;
-    let runs = match (args.runs, args.quick) {
+    let runs = |full: u64, quick: u64| match (args.runs, args.quick) {
         (Some(n), _) => n,
-        (None, true) => experiment.quick_runs,
-        (None, false) => experiment.runs,
+        (None, true) => quick,
+        (None, false) => full,
     };
-    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    let (runs_a, runs_b) =
+        (runs(experiment.runs, experiment.quick_runs), runs(experiment.odometry.runs, experiment.odometry.quick_runs));
+    anyhow::ensure!(runs_a >= 1 && runs_b >= 1, "--runs must be at least 1 (nothing was done)");
     anyhow::ensure!(experiment.slots >= 2, "{source}: slots = {} (need at least 2)", experiment.slots);
-    let link = load_link(args, &experiment).with_context(|| format!("{source}: [scenario]"))?;
+    let poses = load_poses(args, &experiment)?;
+    let link = SpebtLink::new(&experiment.scenario, &poses)
+        .with_context(|| args.trajectory.display().to_string())
+        .with_context(|| format!("{source}: [scenario]"))?;
     let config = tracker_config(&experiment);
 
     let started = Instant::now();
-    let (result, threads) = args.threads.install(|| -> anyhow::Result<(ExperimentResult, usize)> {
-        let chunks = runs.div_ceil(RUNS_PER_CHUNK);
-        let bar = crate::progress::bar(runs, "reproduce spebt", "runs", quiet);
-        let mut total = ExperimentResult::new(link.len());
-        for batch in (0..chunks).step_by(CHUNKS_PER_BATCH as usize) {
-            let partials: Vec<ExperimentResult> = (batch..(batch + CHUNKS_PER_BATCH).min(chunks))
-                .into_par_iter()
-                .map(|c| {
-                    let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
-                    let count = range.end - range.start;
-                    let chunk = run_chunk(&link, &config, experiment.seed, range);
-                    bar.inc(count);
-                    chunk
-                })
-                .collect::<anyhow::Result<_>>()?;
-            for part in partials {
-                total.merge(part);
-            }
+    let (outcomes, threads) = args.threads.install(|| -> anyhow::Result<(Vec<Outcome>, usize)> {
+        let result = monte_carlo(&link, &config, experiment.seed, runs_a, PoseSource::ErrorModel, quiet)?;
+        let verdicts = report::verdicts(&experiment, &result);
+        let mut outcomes = vec![Outcome { name: POSE_ERROR_MODEL, link, drive: None, result, verdicts }];
+        if !args.skip_odometry {
+            outcomes.push(radar_odometry(args, &experiment, &config, poses, runs_b, quiet)?);
         }
-        bar.finish_and_clear();
-        Ok((total, rayon::current_num_threads()))
+        Ok((outcomes, rayon::current_num_threads()))
     })??;
     let elapsed_s = started.elapsed().as_secs_f64();
 
-    let context =
-        report::Context { experiment: &experiment, trajectory: &args.trajectory, link: &link, elapsed_s, threads };
-    let verdicts = report::verdicts(&experiment, &result);
-    let summary = report::summary(&context, &result, &verdicts);
-    write_outputs(args, &experiment, &source, &link, &result, &summary)?;
+    let context = report::Context { experiment: &experiment, trajectory: &args.trajectory, elapsed_s, threads };
+    let summary = report::summary(&context, &outcomes);
+    write_outputs(args, &experiment, &source, &outcomes, &summary)?;
     if let Some(readme) = &args.readme {
         crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;
     }
@@ -259,11 +294,74 @@ pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         print!("{summary}");
         println!("\noutputs: {}", args.output.display());
     }
-    Ok(if verdicts.iter().all(|v| v.met) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    let met = outcomes.iter().flat_map(|o| &o.verdicts).all(|v| v.met);
+    Ok(if met { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-/// The link along the first `slots` poses of `--trajectory`.
-fn load_link(args: &SpebtArgs, experiment: &Experiment) -> anyhow::Result<SpebtLink> {
+/// Experiment (b): radar odometry along the first slots of the trajectory
+/// (`quick_slots` with `--quick`), then the Monte Carlo runs on its link.
+fn radar_odometry(
+    args: &SpebtArgs,
+    experiment: &Experiment,
+    config: &SpebtConfig,
+    mut poses: Vec<StampedPose>,
+    runs: u64,
+    quiet: bool,
+) -> anyhow::Result<Outcome> {
+    if args.quick {
+        poses.truncate(experiment.odometry.quick_slots);
+    }
+    let drive = spebt_odometry::drive(poses, &experiment.odometry.preset, quiet)
+        .with_context(|| format!("radar odometry along {}", args.trajectory.display()))?;
+    let link = SpebtLink::new(&experiment.scenario, &drive.ground_truth)
+        .with_context(|| format!("the simulated drive along {}", args.trajectory.display()))?;
+    // The link's positions are relative to the first true position: so are the estimates'.
+    let origin = drive.ground_truth[0].parent_from_child;
+    let estimates: Vec<Se2> =
+        drive.estimates.iter().map(|e| Se2::new(e.x_m - origin.x_m, e.y_m - origin.y_m, e.yaw_rad)).collect();
+    let result = monte_carlo(&link, config, experiment.seed, runs, PoseSource::Fixed(&estimates), quiet)?;
+    let verdicts = report::verdicts(experiment, &result);
+    Ok(Outcome { name: RADAR_ODOMETRY, link, drive: Some(drive), result, verdicts })
+}
+
+/// `runs` Monte Carlo runs on `link` in fixed chunks on rayon, merged in
+/// chunk order.
+fn monte_carlo(
+    link: &SpebtLink,
+    config: &SpebtConfig,
+    seed: u64,
+    runs: u64,
+    source: PoseSource<'_>,
+    quiet: bool,
+) -> anyhow::Result<ExperimentResult> {
+    let chunks = runs.div_ceil(RUNS_PER_CHUNK);
+    let label = match source {
+        PoseSource::ErrorModel => "reproduce spebt: pose-error model",
+        PoseSource::Fixed(_) => "reproduce spebt: tracking on radar odometry",
+    };
+    let bar = crate::progress::bar(runs, label, "runs", quiet);
+    let mut total = ExperimentResult::new(link.len());
+    for batch in (0..chunks).step_by(CHUNKS_PER_BATCH as usize) {
+        let partials: Vec<ExperimentResult> = (batch..(batch + CHUNKS_PER_BATCH).min(chunks))
+            .into_par_iter()
+            .map(|c| {
+                let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
+                let count = range.end - range.start;
+                let chunk = run_chunk(link, config, seed, range, source);
+                bar.inc(count);
+                chunk
+            })
+            .collect::<anyhow::Result<_>>()?;
+        for part in partials {
+            total.merge(part);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(total)
+}
+
+/// The first `slots` poses of `--trajectory`.
+fn load_poses(args: &SpebtArgs, experiment: &Experiment) -> anyhow::Result<Vec<StampedPose>> {
     if !args.trajectory.exists() {
         if args.trajectory == Path::new(DEFAULT_TRAJECTORY) {
             bail!(
@@ -275,7 +373,7 @@ fn load_link(args: &SpebtArgs, experiment: &Experiment) -> anyhow::Result<SpebtL
     }
     let mut poses = simulate::read_trajectory(&args.trajectory, args.trajectory_format, None, 0)?;
     poses.truncate(experiment.slots);
-    SpebtLink::new(&experiment.scenario, &poses).with_context(|| args.trajectory.display().to_string())
+    Ok(poses)
 }
 
 /// The filter's parameters: the link's Table I values and the [tracker] table.
@@ -299,7 +397,7 @@ fn tracker_config(experiment: &Experiment) -> SpebtConfig {
 }
 
 /// Initial access: the true channel of a slot.
-fn initial_access(slot: &SpebtSlot) -> SpebtState {
+pub(super) fn initial_access(slot: &SpebtSlot) -> SpebtState {
     SpebtState { gain_magnitude: slot.gain.norm(), aod_rad: slot.aod_rad, aoa_rad: slot.aoa_rad }
 }
 
@@ -308,21 +406,27 @@ fn run_chunk(
     config: &SpebtConfig,
     seed: u64,
     runs: std::ops::Range<u64>,
+    source: PoseSource<'_>,
 ) -> anyhow::Result<ExperimentResult> {
     let mut chunk = ExperimentResult::new(link.len());
     for run_index in runs {
         let realisation = link.realise(seed, run_index);
+        let poses = match source {
+            PoseSource::ErrorModel => &realisation.pose_estimates[..],
+            PoseSource::Fixed(poses) => poses,
+        };
+        anyhow::ensure!(poses.len() == link.len(), "{} pose estimates for {} slots", poses.len(), link.len());
         let started = Instant::now();
         let truth = link.slots();
-        let mut ekf = SpebtEkf::new(config, initial_access(&truth[0]), &realisation.pose_estimates[0])
-            .with_context(|| format!("run {run_index}"))?;
+        let mut ekf =
+            SpebtEkf::new(config, initial_access(&truth[0]), &poses[0]).with_context(|| format!("run {run_index}"))?;
         let keep = run_index == 0;
         if keep {
             chunk.run0.push((ekf.estimate(), false));
         }
         let mut reinitialisations = 0;
         for (k, slot) in truth.iter().enumerate().skip(1) {
-            let beams = ekf.predict(&realisation.pose_estimates[k]).with_context(|| format!("run {run_index}"))?;
+            let beams = ekf.predict(&poses[k]).with_context(|| format!("run {run_index}"))?;
             let pilot = link.pilot(k, beams.rx_steer_u, beams.tx_steer_u, realisation.noise[k]);
             let deviation = ekf.update(pilot).with_context(|| format!("run {run_index}"))?;
             let reinitialised = if let Deviation::Exceeded { gain, aod, aoa } = deviation {
@@ -361,8 +465,7 @@ fn write_outputs(
     args: &SpebtArgs,
     experiment: &Experiment,
     source: &str,
-    link: &SpebtLink,
-    result: &ExperimentResult,
+    outcomes: &[Outcome],
     summary: &str,
 ) -> anyhow::Result<()> {
     let parent = match args.output.parent() {
@@ -372,33 +475,38 @@ fn write_outputs(
     std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
     let staging = mmtrack_io::staging_dir(&parent, ".reproduce-spebt.")?;
     let tables = staging.path().join("tables");
-    let info = RunInfo {
-        config_json: serde_json::json!({
-            "command": "reproduce spebt",
-            "experiment": source,
-            "trajectory": args.trajectory.display().to_string(),
-            "runs": result.runs,
-            "seed": experiment.seed,
-            "slots": link.len(),
-            "scenario": experiment.scenario,
-            "tracker": {
-                "position_sigma_m": experiment.tracker.position_sigma_m,
-                "yaw_sigma_deg": experiment.tracker.yaw_sigma_deg,
-                "gain_threshold": experiment.tracker.gain_threshold,
-                "angle_threshold_deg": experiment.tracker.angle_threshold_deg,
-            },
-            "mmtrack_version": env!("CARGO_PKG_VERSION"),
-        })
-        .to_string(),
-    };
-    let summary_row = summary_row(experiment, &args.trajectory, link, result);
-    write_table(&tables, POSE_ERROR_MODEL, &[summary_row], &info, Overwrite::Refuse)?;
-    write_table(&tables, POSE_ERROR_MODEL, &slot_rows(link, result), &info, Overwrite::Refuse)?;
-    let svg = spebt_tracking_svg(
-        "SPEBT, run 0 against the truth (Liu et al. Fig. 5): pose-error model, Oxford trajectory",
-        &tracking_series(link, result),
-    )?;
-    std::fs::write(staging.path().join("fig5_tracking.svg"), svg).context("fig5_tracking.svg")?;
+    for outcome in outcomes {
+        let info = RunInfo {
+            config_json: serde_json::json!({
+                "command": "reproduce spebt",
+                "experiment_file": source,
+                "experiment": outcome.name,
+                "trajectory": args.trajectory.display().to_string(),
+                "runs": outcome.result.runs,
+                "seed": experiment.seed,
+                "slots": outcome.link.len(),
+                "scenario": experiment.scenario,
+                "odometry_preset": outcome.drive.as_ref().map(|d| d.preset.clone()),
+                "tracker": {
+                    "position_sigma_m": experiment.tracker.position_sigma_m,
+                    "yaw_sigma_deg": experiment.tracker.yaw_sigma_deg,
+                    "gain_threshold": experiment.tracker.gain_threshold,
+                    "angle_threshold_deg": experiment.tracker.angle_threshold_deg,
+                },
+                "mmtrack_version": env!("CARGO_PKG_VERSION"),
+            })
+            .to_string(),
+        };
+        let summary_row = output::summary_row(experiment, &args.trajectory, outcome);
+        write_table(&tables, outcome.name, &[summary_row], &info, Overwrite::Refuse)?;
+        write_table(&tables, outcome.name, &output::slot_rows(outcome), &info, Overwrite::Refuse)?;
+        let (file, title) = match outcome.drive {
+            None => ("fig5_tracking.svg", "SPEBT run 0 against the truth (Liu et al. Fig. 5): pose-error model"),
+            Some(_) => ("fig5_tracking_odometry.svg", "SPEBT run 0 against the truth: poses from radar odometry"),
+        };
+        let svg = spebt_tracking_svg(title, &output::tracking_series(outcome))?;
+        std::fs::write(staging.path().join(file), svg).context(file)?;
+    }
     std::fs::write(staging.path().join("reproduce.md"), summary)?;
     if args.output.exists() {
         std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
@@ -406,80 +514,6 @@ fn write_outputs(
     let staged = staging.keep();
     std::fs::rename(&staged, &args.output).with_context(|| args.output.display().to_string())?;
     Ok(())
-}
-
-fn summary_row(experiment: &Experiment, trajectory: &Path, link: &SpebtLink, r: &ExperimentResult) -> SpebtSummaryRow {
-    let [gain, aod, aoa] = r.rmse();
-    let total: u64 = r.reinitialisations.iter().sum();
-    let cause = |i: usize| 100.0 * r.causes[i] as f64 / total.max(1) as f64;
-    let paper = &experiment.paper;
-    SpebtSummaryRow {
-        experiment: POSE_ERROR_MODEL.into(),
-        trajectory: trajectory.display().to_string(),
-        slots: link.len() as u64,
-        runs: r.runs,
-        seed: experiment.seed,
-        rmse_gain_pct: 100.0 * gain,
-        rmse_aod_deg: aod.to_degrees(),
-        rmse_aoa_deg: aoa.to_degrees(),
-        reinitialisations_mean: r.mean_reinitialisations(),
-        reinitialisations_min: r.reinitialisations.iter().copied().min().unwrap_or(0),
-        reinitialisations_max: r.reinitialisations.iter().copied().max().unwrap_or(0),
-        reinitialisation_share_pct: 100.0 * r.mean_reinitialisations() / r.tracked_slots().max(1) as f64,
-        reinit_gain_pct: cause(0),
-        reinit_aod_pct: cause(1),
-        reinit_aoa_pct: cause(2),
-        paper_rmse_gain_pct: paper.rmse_gain_pct,
-        paper_rmse_aod_deg: paper.rmse_aod_deg,
-        paper_rmse_aoa_deg: paper.rmse_aoa_deg,
-        paper_reinitialisation_share_pct: 100.0 * paper.reinitialisations as f64 / paper.slots as f64,
-    }
-}
-
-fn slot_rows(link: &SpebtLink, r: &ExperimentResult) -> Vec<SpebtSlotRow> {
-    let t0 = link.slots()[0].t_ns;
-    let runs = r.runs.max(1) as f64;
-    link.slots()
-        .iter()
-        .enumerate()
-        .map(|(k, s)| {
-            let (estimate, reinitialised) = r.run0.get(k).copied().unwrap_or((initial_access(s), false));
-            let rms = |i: usize| (r.sum_squared[i][k] / runs).sqrt();
-            SpebtSlotRow {
-                slot: k as u64,
-                t_s: (s.t_ns - t0) as f64 * 1e-9,
-                x_m: s.pose.x_m,
-                y_m: s.pose.y_m,
-                yaw_deg: wrap_angle_rad(s.pose.yaw_rad).to_degrees(),
-                range_m: s.range_m,
-                true_gain: s.gain.norm(),
-                true_aod_deg: s.aod_rad.to_degrees(),
-                true_aoa_deg: s.aoa_rad.to_degrees(),
-                run0_gain: estimate.gain_magnitude,
-                run0_aod_deg: estimate.aod_rad.to_degrees(),
-                run0_aoa_deg: estimate.aoa_rad.to_degrees(),
-                run0_reinitialised: reinitialised,
-                rmse_gain_pct: 100.0 * rms(0),
-                rmse_aod_deg: rms(1).to_degrees(),
-                rmse_aoa_deg: rms(2).to_degrees(),
-                reinitialisation_rate: r.reinitialised_runs[k] as f64 / runs,
-            }
-        })
-        .collect()
-}
-
-fn tracking_series(link: &SpebtLink, r: &ExperimentResult) -> SpebtTrackingSeries {
-    let mut series = SpebtTrackingSeries::default();
-    for (s, (estimate, reinitialised)) in link.slots().iter().zip(&r.run0) {
-        series.true_gain.push(s.gain.norm());
-        series.true_aod_deg.push(s.aod_rad.to_degrees());
-        series.true_aoa_deg.push(s.aoa_rad.to_degrees());
-        series.estimate_gain.push(estimate.gain_magnitude);
-        series.estimate_aod_deg.push(estimate.aod_rad.to_degrees());
-        series.estimate_aoa_deg.push(estimate.aoa_rad.to_degrees());
-        series.reinitialised.push(*reinitialised);
-    }
-    series
 }
 
 #[cfg(test)]

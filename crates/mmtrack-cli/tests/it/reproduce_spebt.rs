@@ -1,5 +1,6 @@
 //! `mmtrack reproduce spebt`: the CI version on the real Oxford trajectory
-//! (8 runs instead of 3000), determinism across thread counts and the bad
+//! (8 runs instead of 2000 with the pose-error model; radar odometry on the
+//! first 480 slots), determinism across thread counts and the bad
 //! trajectories of the issue, on small synthetic drives.
 
 use std::path::Path;
@@ -10,8 +11,15 @@ use mmtrack_io::table::read_table;
 use super::common::{mmtrack, realdata, text};
 
 const README_BEFORE: &str = "# R\n\n<!-- reproduce-spebt:begin -->\nstale\n<!-- reproduce-spebt:end -->\n";
-const SUMMARY: &str = "tables/spebt_summary/sequence=pose-error-model/part-0.parquet";
-const PER_SLOT: &str = "tables/spebt_per_slot/sequence=pose-error-model/part-0.parquet";
+const EXPERIMENTS: [&str; 2] = ["pose-error-model", "radar-odometry"];
+
+fn summary(experiment: &str) -> String {
+    format!("tables/spebt_summary/sequence={experiment}/part-0.parquet")
+}
+
+fn per_slot(experiment: &str) -> String {
+    format!("tables/spebt_per_slot/sequence={experiment}/part-0.parquet")
+}
 
 #[test]
 fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
@@ -27,21 +35,28 @@ fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
     println!("{report}");
     let missed = report.matches("| **missed** |").count();
     assert_eq!(out.status.success(), missed == 0, "exit status must follow the verdicts:\n{stderr}");
-    // Three targets: AoD, AoA, re-initialisation share; |alpha| is reported only.
-    assert_eq!(report.matches("| met |").count() + missed, 3, "{report}");
-    assert!(report.contains("| RMSE abs(alpha) (%) | 1.580 |") && report.contains("| reported |"), "{report}");
+    // Three targets per experiment: AoD, AoA, re-initialisation share; |alpha| is reported only.
+    assert_eq!(report.matches("| met |").count() + missed, 2 * 3, "{report}");
+    assert_eq!(report.matches("| RMSE abs(alpha) (%) | 1.580 |").count(), 2, "{report}");
 
-    let summary: Vec<SpebtSummaryRow> = read_table(&dir.path().join("out").join(SUMMARY)).unwrap();
-    assert_eq!(summary.len(), 1);
-    let row = &summary[0];
-    assert_eq!((row.runs, row.slots), (8, 6388), "{row:?}");
-    let share = 100.0 * row.reinitialisations_mean / 6387.0;
-    assert!((row.reinitialisation_share_pct - share).abs() < 1e-9, "{row:?}");
-    assert!(row.reinitialisations_min <= row.reinitialisations_max);
-    // Each re-initialisation has at least one test that fired.
-    assert!(row.reinit_gain_pct + row.reinit_aod_pct + row.reinit_aoa_pct >= 100.0 - 1e-9, "{row:?}");
-    let slots: Vec<SpebtSlotRow> = read_table(&dir.path().join("out").join(PER_SLOT)).unwrap();
-    assert_eq!(slots.len(), 6388);
+    // (a) on the 6388 Oxford slots, 8 runs; (b) on the simulator's scans along the first 480 poses, 4 runs.
+    for (experiment, runs, slots) in [("pose-error-model", 8, 6388..=6388), ("radar-odometry", 4, 470..=480)] {
+        let rows: Vec<SpebtSummaryRow> = read_table(&dir.path().join("out").join(summary(experiment))).unwrap();
+        assert_eq!(rows.len(), 1);
+        let row = &rows[0];
+        assert_eq!((row.experiment.as_str(), row.runs), (experiment, runs), "{row:?}");
+        assert!(slots.contains(&row.slots), "{row:?}");
+        let share = 100.0 * row.reinitialisations_mean / (row.slots - 1) as f64;
+        assert!((row.reinitialisation_share_pct - share).abs() < 1e-9, "{row:?}");
+        assert!(row.reinitialisations_min <= row.reinitialisations_max);
+        // Each re-initialisation has at least one test that fired.
+        if row.reinitialisations_max > 0 {
+            assert!(row.reinit_gain_pct + row.reinit_aod_pct + row.reinit_aoa_pct >= 100.0 - 1e-9, "{row:?}");
+        }
+        let per_slot: Vec<SpebtSlotRow> = read_table(&dir.path().join("out").join(per_slot(experiment))).unwrap();
+        assert_eq!(per_slot.len() as u64, row.slots);
+    }
+    let slots: Vec<SpebtSlotRow> = read_table(&dir.path().join("out").join(per_slot(EXPERIMENTS[0]))).unwrap();
     // Slot 0 is the initial access: the estimate is the truth.
     assert_eq!((slots[0].run0_gain, slots[0].run0_aod_deg), (slots[0].true_gain, slots[0].true_aod_deg));
     assert_eq!(slots[0].rmse_aod_deg, 0.0);
@@ -51,9 +66,11 @@ fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
     let reset = slots.iter().find(|s| s.run0_reinitialised).expect("run 0 re-initialises somewhere");
     assert_eq!((reset.run0_gain, reset.run0_aoa_deg), (reset.true_gain, reset.true_aoa_deg));
 
-    let svg = std::fs::read_to_string(dir.path().join("out/fig5_tracking.svg")).unwrap();
-    let doc = roxmltree::Document::parse(&svg).unwrap();
-    assert_eq!(doc.root_element().tag_name().name(), "svg");
+    for figure in ["fig5_tracking.svg", "fig5_tracking_odometry.svg"] {
+        let svg = std::fs::read_to_string(dir.path().join("out").join(figure)).unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        assert_eq!(doc.root_element().tag_name().name(), "svg");
+    }
     let readme = std::fs::read_to_string(dir.path().join("README.md")).unwrap();
     assert!(!readme.contains("stale") && readme.contains("| claim | paper (Table III, 10^5 runs) |"), "{readme}");
 }
@@ -77,11 +94,12 @@ fn tum_drive(path: &Path, poses: usize, heading_rad: f64, edit: impl Fn(usize, S
     std::fs::write(path, lines.join("\n") + "\n").unwrap();
 }
 
-/// The same tables on 1 and 2 threads (runs are summed in fixed chunks).
+/// The same tables on 1 and 2 threads (runs are summed in fixed chunks;
+/// the radar simulation and odometry are deterministic).
 #[test]
 fn spebt_tables_do_not_depend_on_the_thread_count() {
     let dir = tempfile::tempdir().unwrap();
-    tum_drive(&dir.path().join("drive.tum"), 300, 0.3, |_, line| line);
+    tum_drive(&dir.path().join("drive.tum"), 120, 0.3, |_, line| line);
     for threads in ["1", "2"] {
         let out = mmtrack(
             dir.path(),
@@ -102,13 +120,13 @@ fn spebt_tables_do_not_depend_on_the_thread_count() {
         );
         assert!(out.status.code().is_some_and(|c| c <= 1), "{}", text(&out).1);
     }
-    for part in [SUMMARY, PER_SLOT] {
-        let one = std::fs::read(dir.path().join("1").join(part)).unwrap();
-        let two = std::fs::read(dir.path().join("2").join(part)).unwrap();
+    for part in EXPERIMENTS.iter().flat_map(|e| [summary(e), per_slot(e)]) {
+        let one = std::fs::read(dir.path().join("1").join(&part)).unwrap();
+        let two = std::fs::read(dir.path().join("2").join(&part)).unwrap();
         assert!(one == two, "{part} differs between 1 and 2 threads");
     }
-    let summary: Vec<SpebtSummaryRow> = read_table(&dir.path().join("1").join(SUMMARY)).unwrap();
-    assert_eq!((summary[0].runs, summary[0].slots), (22, 300));
+    let rows: Vec<SpebtSummaryRow> = read_table(&dir.path().join("1").join(summary(EXPERIMENTS[0]))).unwrap();
+    assert_eq!((rows[0].runs, rows[0].slots), (22, 120));
 }
 
 /// A trajectory through the base station, a NaN pose and a gap: a clear
