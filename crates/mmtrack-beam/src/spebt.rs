@@ -23,7 +23,8 @@
 //!
 //! ```text
 //! s_k|k-1 = F_k s_k-1|k-1 + u_k,   F_k = diag(rho^_k, 1, 1),   rho^_k = (|r^_k-1| / |r^_k|)^(gamma/2)
-//! u_k     = [0, u3, u3 - dtheta^_k],   u3 = wrap(bearing(r^_k) - bearing(r^_k-1)),   dtheta^_k = wrap(theta^_k - theta^_k-1)
+//! u_k     = [0, u3, u3 - dtheta^_k],   u3 = wrap(bearing(r^_k) - bearing(r^_k-1)),
+//!           dtheta^_k = wrap(theta^_k - theta^_k-1)
 //! P_k|k-1 = F_k P_k-1|k-1 F_k^T + Q_k
 //! Q_k     = [[(gamma/2 rho^_k |alpha_k-1|)^2 beta_k sigma_r^2, 0, 0],
 //!            [0, beta_k sigma_r^2, beta_k sigma_r^2],

@@ -11,8 +11,11 @@ paper's numbers beside them.";
     /// One row of [`SPEBT_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SpebtSummaryRow {
-        experiment: String, "", "experiment name (pose-error-model: ground truth plus the paper's pose-error model)";
-        trajectory: String, "", "trajectory file the vehicle drives along";
+        experiment: String, "",
+            "pose-error-model (ground truth plus the paper's pose-error model) or radar-odometry (our radar odometry \
+on scans simulated along the trajectory)";
+        trajectory: String, "",
+            "trajectory file the vehicle drives along (radar-odometry: the simulator's poses along it)";
         slots: u64, "", "slots per run (one per pose); slot 0 is the initial access";
         runs: u64, "", "Monte Carlo runs";
         seed: u64, "", "seed of the runs";

@@ -10,7 +10,8 @@
 //! alpha_k = |alpha_ref| (d0 / |r_k|)^(gamma/2) exp(j 2 pi / lambda (|r_k| - d0))     (22)
 //! phi_k   = atan2(r_k.y, r_k.x)             AoD from the BS array axis (world x)
 //! psi_k   = wrap(phi_k + pi - theta_k)      AoA from the vehicle's heading (Appendix A)
-//! z_k     = g^H H_k f b_k + v_k = b alpha_k AF_r(g, cos psi_k) conj(AF_t(f, cos phi_k)) + v_k,  v ~ CN(0, sigma_v^2)   (4)-(5)
+//! z_k     = g^H H_k f b_k + v_k = b alpha_k AF_r(g, cos psi_k) conj(AF_t(f, cos phi_k)) + v_k     (4)-(5)
+//! v_k     ~ CN(0, sigma_v^2)
 //! ```
 //!
 //! (`AF` the array factor of `mmtrack_core::array`; `g` and `f` the beams
