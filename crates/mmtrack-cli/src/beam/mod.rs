@@ -3,6 +3,7 @@
 //! tracking of Liu et al. 2024).
 
 pub mod process;
+mod process_spebt;
 pub mod reproduce_shaham;
 pub mod reproduce_spebt;
 mod shaham_report;

@@ -21,6 +21,10 @@
 //! and longitude at the sweep's time (exact where a fix has the sweep's
 //! time, as `ingest beams` writes them); east/north metres from the array
 //! come from the WGS-84 local tangent plane.
+//!
+//! `--tracker spebt` is another kind of tracker: the SPEBT EKF on a
+//! simulated link along a recording's ground truth, driven by an `odometry`
+//! table or by the pose-error model (`process_spebt`); it runs alone.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -50,6 +54,9 @@ pub enum TrackerArg {
     LastFullSweep,
     /// Baseline: the beam nearest the GNSS prediction of the beam map, no beam measured.
     GnssMap,
+    /// SPEBT (Liu et al. 2024) on a simulated link along the recording's ground truth, driven by
+    /// --odometry or by the pose-error model; runs alone (spebt_per_slot, spebt_summary tables).
+    Spebt,
 }
 
 impl TrackerArg {
@@ -61,6 +68,7 @@ impl TrackerArg {
             Self::GnssWindow => "gnss-window",
             Self::LastFullSweep => "last-full-sweep",
             Self::GnssMap => "gnss-map",
+            Self::Spebt => "spebt",
         }
     }
 
@@ -96,6 +104,8 @@ pub struct BeamArgs {
     /// Replace existing output tables of these sequences.
     #[arg(long)]
     force: bool,
+    #[command(flatten)]
+    spebt: super::process_spebt::SpebtOptions,
 }
 
 /// One recording, read: its full sweeps and both units' positions.
@@ -294,6 +304,7 @@ fn tracker(kind: TrackerArg, reacquire: ReacquireArg, map: Option<&BeamMap>) -> 
         }
         TrackerArg::LastFullSweep => Box::new(LastFullSweep::new()),
         TrackerArg::GnssMap => Box::new(GnssMapOnly),
+        TrackerArg::Spebt => bail!("spebt is not a beam-sweep tracker (it runs alone, process_spebt)"),
     })
 }
 
@@ -344,6 +355,18 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     kinds.sort();
     kinds.dedup();
     let files = expand(&args.recordings)?;
+    if kinds.contains(&TrackerArg::Spebt) {
+        if kinds.len() > 1 {
+            bail!(
+                "--tracker spebt runs alone (it tracks a simulated link along the ground truth, not measured sweeps); \
+                 give the sweep trackers in another call"
+            );
+        }
+        return super::process_spebt::run(&files, &args.output, args.force, &args.spebt, quiet);
+    }
+    if let Some(flag) = args.spebt.given().first() {
+        bail!("{flag} is an option of --tracker spebt only");
+    }
     let recordings = files.iter().map(|f| read_beam_recording(f)).collect::<anyhow::Result<Vec<_>>>()?;
     let mut by_sequence: BTreeMap<&str, &Path> = BTreeMap::new();
     for r in &recordings {

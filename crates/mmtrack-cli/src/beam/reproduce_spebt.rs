@@ -236,7 +236,7 @@ pub(super) struct Outcome {
 
 /// Where the tracker's pose estimates come from.
 #[derive(Clone, Copy)]
-enum PoseSource<'a> {
+pub(super) enum PoseSource<'a> {
     /// Each run's own draw of the pose-error model.
     ErrorModel,
     /// The same estimates in every run (radar odometry), one per slot.
@@ -316,9 +316,7 @@ fn radar_odometry(
     let link = SpebtLink::new(&experiment.scenario, &drive.ground_truth)
         .with_context(|| format!("the simulated drive along {}", args.trajectory.display()))?;
     // The link's positions are relative to the first true position: so are the estimates'.
-    let origin = drive.ground_truth[0].parent_from_child;
-    let estimates: Vec<Se2> =
-        drive.estimates.iter().map(|e| Se2::new(e.x_m - origin.x_m, e.y_m - origin.y_m, e.yaw_rad)).collect();
+    let estimates = spebt_odometry::into_link_frame(drive.ground_truth[0].parent_from_child, &drive.estimates);
     let result = monte_carlo(&link, config, experiment.seed, runs, PoseSource::Fixed(&estimates), quiet)?;
     let verdicts = report::verdicts(experiment, &result);
     Ok(Outcome { name: RADAR_ODOMETRY, link, drive: Some(drive), result, verdicts })
@@ -326,7 +324,7 @@ fn radar_odometry(
 
 /// `runs` Monte Carlo runs on `link` in fixed chunks on rayon, merged in
 /// chunk order.
-fn monte_carlo(
+pub(super) fn monte_carlo(
     link: &SpebtLink,
     config: &SpebtConfig,
     seed: u64,
@@ -336,8 +334,8 @@ fn monte_carlo(
 ) -> anyhow::Result<ExperimentResult> {
     let chunks = runs.div_ceil(RUNS_PER_CHUNK);
     let label = match source {
-        PoseSource::ErrorModel => "reproduce spebt: pose-error model",
-        PoseSource::Fixed(_) => "reproduce spebt: tracking on radar odometry",
+        PoseSource::ErrorModel => "spebt: tracking, pose-error model",
+        PoseSource::Fixed(_) => "spebt: tracking on radar odometry",
     };
     let bar = crate::progress::bar(runs, label, "runs", quiet);
     let mut total = ExperimentResult::new(link.len());
@@ -377,7 +375,7 @@ fn load_poses(args: &SpebtArgs, experiment: &Experiment) -> anyhow::Result<Vec<S
 }
 
 /// The filter's parameters: the link's Table I values and the [tracker] table.
-fn tracker_config(experiment: &Experiment) -> SpebtConfig {
+pub(super) fn tracker_config(experiment: &Experiment) -> SpebtConfig {
     let (s, t) = (&experiment.scenario, &experiment.tracker);
     SpebtConfig {
         bs_elements: s.bs_elements,

@@ -75,8 +75,7 @@ pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyho
     }
     bar.finish_and_clear();
     anyhow::ensure!(ground_truth.len() >= 2, "the simulated drive gave {} scans; nothing to track", ground_truth.len());
-    let truth_from_estimate = ground_truth[0].parent_from_child * raw[0].inverse();
-    let estimates = raw.iter().map(|e| truth_from_estimate * *e).collect();
+    let estimates = into_truth_frame(ground_truth[0].parent_from_child, &raw);
     Ok(OdometryDrive {
         preset: preset.to_string(),
         ground_truth,
@@ -84,4 +83,21 @@ pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyho
         low_confidence,
         elapsed_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// Odometry estimates (their world frame is the first scan's pose) moved
+/// into the ground truth's frame at the first pose:
+/// `world_from_first_truth * first_estimate^-1 * estimate`. Empty for no
+/// estimates.
+pub(super) fn into_truth_frame(first_truth: Se2, raw: &[Se2]) -> Vec<Se2> {
+    let Some(first) = raw.first() else { return Vec::new() };
+    let truth_from_estimate = first_truth * first.inverse();
+    raw.iter().map(|e| truth_from_estimate * *e).collect()
+}
+
+/// Estimates in the ground truth's frame moved into the link's frame, whose
+/// positions are relative to the first true position (headings kept;
+/// `mmtrack_sim::beam::spebt_link` module docs).
+pub(super) fn into_link_frame(first_truth: Se2, estimates: &[Se2]) -> Vec<Se2> {
+    estimates.iter().map(|e| Se2::new(e.x_m - first_truth.x_m, e.y_m - first_truth.y_m, e.yaw_rad)).collect()
 }

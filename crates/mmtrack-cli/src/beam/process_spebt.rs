@@ -1,0 +1,346 @@
+//! `mmtrack process beam --tracker spebt`: the SPEBT beam tracker (Liu et
+//! al. 2024) along a recording's ground-truth trajectory, driven by pose
+//! estimates.
+//!
+//! The link (`mmtrack_sim::beam::spebt_link`, the paper's Table I unless
+//! `--link` says otherwise) needs the true trajectory: the pilots are
+//! simulated along the recording's ground truth. The tracker predicts its
+//! beams from pose estimates, which are either
+//!
+//! - `--odometry <tables>`: the recording's sequence in an `odometry` table
+//!   (from `mmtrack process odometry`), one slot per estimate, the ground
+//!   truth interpolated at the estimates' times, the estimates moved into the
+//!   ground truth's frame at the first slot (as `reproduce spebt` experiment
+//!   (b) does, `spebt_odometry`); or
+//! - without `--odometry`: the ground truth plus the paper's pose-error model
+//!   (eq. (23), `--sigma-r-m`, `--sigma-theta-deg`, drawn per `--seed` and run),
+//!   one slot per ground-truth pose (`reproduce spebt` experiment (a)).
+//!
+//! Both go through `reproduce spebt`'s Monte Carlo (`--runs` realisations of
+//! the receiver noise, and of the pose errors without `--odometry`) with the
+//! paper's re-initialisation rule, and write that command's tables, one
+//! partition per recording: `spebt_per_slot` (truth, run 0's estimate, RMSE
+//! over runs per slot) and `spebt_summary` (RMSE of |alpha|, AoD and AoA,
+//! re-initialisations).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, bail, ensure};
+use clap::Args;
+use mmtrack_analysis::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY};
+use mmtrack_analysis::trajectory::interpolate_pose;
+use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
+use mmtrack_io::recording::{PoseStream, RecordingMetadata};
+use mmtrack_io::table::{ODOMETRY, RunInfo, read_table, table_path, write_table};
+use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
+use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtScenario};
+use serde::Deserialize;
+
+use super::reproduce_spebt::{
+    Experiment, Outcome, POSE_ERROR_MODEL, PoseSource, RADAR_ODOMETRY, SPEBT_EXPERIMENT, TrackerParams, monte_carlo,
+    tracker_config,
+};
+use super::spebt_odometry::{into_link_frame, into_truth_frame};
+use super::spebt_output as output;
+
+/// The options of `--tracker spebt` (refused with the sweep trackers).
+#[derive(Args, Debug, Clone, Default)]
+pub struct SpebtOptions {
+    /// spebt: table directory of `mmtrack process odometry` whose `odometry` table (the
+    /// recording's sequence) drives the tracker; without it, the ground truth plus the
+    /// pose-error model (--sigma-r-m, --sigma-theta-deg) does.
+    #[arg(long, value_name = "TABLES")]
+    pub odometry: Option<PathBuf>,
+    /// spebt: the link and tracker, a TOML file with a `[scenario]` table (Table I's
+    /// fields, e.g. bs_x_m, carrier_hz, bs_elements) and a `[tracker]` table, as in
+    /// data/reproduce/spebt.toml (default: that file's values, the paper's Table I).
+    #[arg(long, value_name = "LINK.toml")]
+    pub link: Option<PathBuf>,
+    /// spebt: pose-error model sigma_r, metres per coordinate (eq. (23)); drawn without
+    /// --odometry, and the filter's Q in both modes (default: the link file's, 1 m).
+    #[arg(long)]
+    pub sigma_r_m: Option<f64>,
+    /// spebt: pose-error model sigma_theta, degrees (default: the link file's, 3 deg).
+    #[arg(long)]
+    pub sigma_theta_deg: Option<f64>,
+    /// spebt: seed of the receiver noise and the pose errors (default: 2024).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// spebt: Monte Carlo runs (noise and pose-error realisations; default 1).
+    #[arg(long)]
+    pub runs: Option<u64>,
+}
+
+impl SpebtOptions {
+    /// The options given, by flag name (the sweep trackers refuse them).
+    pub fn given(&self) -> Vec<&'static str> {
+        [
+            ("--odometry", self.odometry.is_some()),
+            ("--link", self.link.is_some()),
+            ("--sigma-r-m", self.sigma_r_m.is_some()),
+            ("--sigma-theta-deg", self.sigma_theta_deg.is_some()),
+            ("--seed", self.seed.is_some()),
+            ("--runs", self.runs.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(flag, given)| given.then_some(flag))
+        .collect()
+    }
+}
+
+/// The `--link` file: `[scenario]` and `[tracker]` of the experiment file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LinkFile {
+    scenario: Option<SpebtScenario>,
+    tracker: Option<TrackerParams>,
+}
+
+/// A recording's sequence id and ground truth.
+struct TruthRecording {
+    path: PathBuf,
+    sequence_id: String,
+    ground_truth: Vec<StampedPose>,
+}
+
+fn read_truth(path: &Path) -> anyhow::Result<TruthRecording> {
+    let mut reader = RecordingReader::open(path)?;
+    let mut ground_truth = Vec::new();
+    for event in reader.by_ref() {
+        if let RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } = event? {
+            ground_truth.push(pose);
+        }
+    }
+    let metadata = reader.metadata().cloned().unwrap_or_default();
+    let sequence_id = RecordingMetadata::from_map(&metadata)
+        .map(|m| m.sequence_id)
+        .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
+    if ground_truth.len() < 2 {
+        bail!(
+            "{}: {} ground-truth poses; spebt simulates the link along the true trajectory and needs the recording's \
+             ground truth (e.g. from `mmtrack simulate radar` or `mmtrack ingest oxford`)",
+            path.display(),
+            ground_truth.len()
+        );
+    }
+    if let Some(i) = ground_truth.windows(2).position(|p| p[1].t_ns <= p[0].t_ns) {
+        bail!(
+            "{}: ground-truth pose {}: time {} ns does not increase (previous {} ns)",
+            path.display(),
+            i + 1,
+            ground_truth[i + 1].t_ns,
+            ground_truth[i].t_ns
+        );
+    }
+    Ok(TruthRecording { path: path.to_path_buf(), sequence_id, ground_truth })
+}
+
+/// The recording's sequence of the `odometry` table under `dir`, checked:
+/// finite rows, increasing times without gaps (a step above `max_step_ratio`
+/// times the median), inside the ground truth's time span.
+fn read_estimates(
+    dir: &Path,
+    recording: &TruthRecording,
+    max_step_ratio: f64,
+) -> anyhow::Result<(PathBuf, Vec<OdometryEstimate>)> {
+    let file = table_path(dir, ODOMETRY.name, &recording.sequence_id)?;
+    if !file.exists() {
+        bail!(
+            "{}: not found; --odometry needs the `{}` table of sequence {} (the recording {}), as written by \
+             `mmtrack process odometry`",
+            file.display(),
+            ODOMETRY.name,
+            recording.sequence_id,
+            recording.path.display()
+        );
+    }
+    let rows = read_table::<OdometryEstimate>(&file)?;
+    let name = file.display();
+    ensure!(rows.len() >= 2, "{name}: {} rows; need at least 2 estimates to track", rows.len());
+    for (row, e) in rows.iter().enumerate() {
+        let p = &e.world_from_vehicle;
+        for (field, value) in [("x_m", p.x_m), ("y_m", p.y_m), ("yaw_rad", p.yaw_rad)] {
+            ensure!(
+                value.is_finite(),
+                "{name}: row {row} (t_ns {}): {field} is {value}; estimates must be finite",
+                e.t_ns
+            );
+        }
+        if row > 0 && e.t_ns <= rows[row - 1].t_ns {
+            bail!("{name}: row {row}: t_ns {} does not increase (previous row {} ns)", e.t_ns, rows[row - 1].t_ns);
+        }
+    }
+    let mut steps: Vec<i64> = rows.windows(2).map(|w| w[1].t_ns - w[0].t_ns).collect();
+    steps.sort_unstable();
+    let median_ns = steps[steps.len() / 2] as f64;
+    for (i, pair) in rows.windows(2).enumerate() {
+        let step_ns = (pair[1].t_ns - pair[0].t_ns) as f64;
+        ensure!(
+            step_ns <= max_step_ratio * median_ns,
+            "{name}: row {}: t_ns gap of {:.3} s after the previous row, {:.1} times the median step of {:.3} s (more \
+             than max_step_ratio = {max_step_ratio}); the tracker has one slot per estimate and cannot span a gap",
+            i + 1,
+            step_ns * 1e-9,
+            step_ns / median_ns,
+            median_ns * 1e-9
+        );
+    }
+    let truth = &recording.ground_truth;
+    let (first, last) = (truth[0].t_ns, truth[truth.len() - 1].t_ns);
+    if let Some((row, e)) = rows.iter().enumerate().find(|(_, e)| e.t_ns < first || e.t_ns > last) {
+        bail!(
+            "{name}: row {row}: t_ns {} lies outside the ground truth's time span [{first}, {last}] ns of {}; the \
+             link needs the true pose at every estimate",
+            e.t_ns,
+            recording.path.display()
+        );
+    }
+    Ok((file, rows))
+}
+
+/// The ground truth at `t_ns` (inside its span): the pose with that time,
+/// else interpolated between its neighbours.
+fn truth_at(truth: &[StampedPose], t_ns: i64) -> StampedPose {
+    let after = truth.partition_point(|p| p.t_ns < t_ns).min(truth.len() - 1);
+    let parent_from_child = if truth[after].t_ns == t_ns || after == 0 {
+        truth[after].parent_from_child
+    } else {
+        interpolate_pose(&truth[after - 1], &truth[after], t_ns)
+    };
+    StampedPose { t_ns, parent_from_child }
+}
+
+/// The experiment: the embedded `reproduce spebt` file with the `--link`
+/// file's tables and the flags over it.
+fn experiment(options: &SpebtOptions) -> anyhow::Result<(Experiment, String)> {
+    let mut experiment: Experiment = toml::from_str(SPEBT_EXPERIMENT).context("embedded data/reproduce/spebt.toml")?;
+    let mut source = "embedded data/reproduce/spebt.toml".to_string();
+    if let Some(path) = &options.link {
+        let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+        let link: LinkFile = toml::from_str(&text).with_context(|| path.display().to_string())?;
+        if let Some(scenario) = link.scenario {
+            experiment.scenario = scenario;
+        }
+        if let Some(tracker) = link.tracker {
+            experiment.tracker = tracker;
+        }
+        source = path.display().to_string();
+    }
+    if let Some(sigma_r_m) = options.sigma_r_m {
+        ensure!(sigma_r_m.is_finite() && sigma_r_m >= 0.0, "--sigma-r-m {sigma_r_m}: need a finite value >= 0");
+        experiment.scenario.position_sigma_m = sigma_r_m;
+        experiment.tracker.position_sigma_m = sigma_r_m;
+    }
+    if let Some(sigma_theta_deg) = options.sigma_theta_deg {
+        ensure!(
+            sigma_theta_deg.is_finite() && sigma_theta_deg >= 0.0,
+            "--sigma-theta-deg {sigma_theta_deg}: need a finite value >= 0"
+        );
+        experiment.scenario.yaw_sigma_deg = sigma_theta_deg;
+        experiment.tracker.yaw_sigma_deg = sigma_theta_deg;
+    }
+    experiment.scenario.validate().with_context(|| format!("{source}: [scenario]"))?;
+    if let Some(seed) = options.seed {
+        experiment.seed = seed;
+    }
+    Ok((experiment, source))
+}
+
+/// Runs SPEBT on each recording; one partition of each table per recording.
+pub fn run(
+    recordings: &[PathBuf],
+    output_dir: &Path,
+    force: bool,
+    options: &SpebtOptions,
+    quiet: bool,
+) -> anyhow::Result<ExitCode> {
+    let overwrite = if force { Overwrite::Replace } else { Overwrite::Refuse };
+    let (experiment, link_source) = experiment(options)?;
+    let runs = options.runs.unwrap_or(1);
+    ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    let config = tracker_config(&experiment);
+    let recordings = recordings.iter().map(|p| read_truth(p)).collect::<anyhow::Result<Vec<_>>>()?;
+    if overwrite == Overwrite::Refuse {
+        for r in &recordings {
+            for table in [SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name] {
+                let path = table_path(output_dir, table, &r.sequence_id)?;
+                ensure!(!path.exists(), "{}: exists; use --force to replace it (nothing was written)", path.display());
+            }
+        }
+    }
+    let mut outcomes = Vec::new();
+    for recording in &recordings {
+        let (name, slots, estimates, odometry_file) = match &options.odometry {
+            Some(dir) => {
+                let (file, rows) = read_estimates(dir, recording, experiment.scenario.max_step_ratio)?;
+                let slots: Vec<StampedPose> = rows.iter().map(|e| truth_at(&recording.ground_truth, e.t_ns)).collect();
+                let first_truth = slots[0].parent_from_child;
+                let raw: Vec<Se2> = rows.iter().map(|e| e.world_from_vehicle).collect();
+                let estimates = into_link_frame(first_truth, &into_truth_frame(first_truth, &raw));
+                (RADAR_ODOMETRY, slots, Some(estimates), Some(file))
+            }
+            None => (POSE_ERROR_MODEL, recording.ground_truth.clone(), None, None),
+        };
+        let link = SpebtLink::new(&experiment.scenario, &slots)
+            .with_context(|| format!("{}: ground truth", recording.path.display()))
+            .with_context(|| format!("{link_source}: [scenario]"))?;
+        let source = estimates.as_deref().map_or(PoseSource::ErrorModel, PoseSource::Fixed);
+        let result = monte_carlo(&link, &config, experiment.seed, runs, source, quiet)
+            .with_context(|| recording.path.display().to_string())?;
+        outcomes.push((recording, odometry_file, Outcome { name, link, drive: None, result, verdicts: Vec::new() }));
+    }
+    for (recording, odometry_file, outcome) in &outcomes {
+        let info = RunInfo {
+            config_json: serde_json::json!({
+                "command": "process beam",
+                "tracker": "spebt",
+                "recording": recording.path.display().to_string(),
+                "odometry": odometry_file.as_ref().map(|f| f.display().to_string()),
+                "pose_source": outcome.name,
+                "link_file": link_source,
+                "runs": outcome.result.runs,
+                "seed": experiment.seed,
+                "slots": outcome.link.len(),
+                "scenario": experiment.scenario,
+                "tracker_params": {
+                    "position_sigma_m": experiment.tracker.position_sigma_m,
+                    "yaw_sigma_deg": experiment.tracker.yaw_sigma_deg,
+                    "gain_threshold": experiment.tracker.gain_threshold,
+                    "angle_threshold_deg": experiment.tracker.angle_threshold_deg,
+                },
+                "mmtrack_version": env!("CARGO_PKG_VERSION"),
+            })
+            .to_string(),
+        };
+        let summary = output::summary_row(&experiment, &recording.path, outcome);
+        write_table(output_dir, &recording.sequence_id, &[summary.clone()], &info, overwrite)?;
+        write_table(output_dir, &recording.sequence_id, &output::slot_rows(outcome), &info, overwrite)?;
+        if !quiet {
+            println!(
+                "{} ({}, {} slots, {} run{}): RMSE |alpha| {:.3} %, AoD {:.3} deg, AoA {:.3} deg; \
+                 re-initialisations {:.1} per run ({:.2} % of slots)",
+                recording.sequence_id,
+                outcome.name,
+                summary.slots,
+                summary.runs,
+                if summary.runs == 1 { "" } else { "s" },
+                summary.rmse_gain_pct,
+                summary.rmse_aod_deg,
+                summary.rmse_aoa_deg,
+                summary.reinitialisations_mean,
+                summary.reinitialisation_share_pct
+            );
+        }
+    }
+    if !quiet {
+        println!(
+            "wrote {} {} and {} partitions under {}",
+            outcomes.len(),
+            SPEBT_PER_SLOT.name,
+            SPEBT_SUMMARY.name,
+            output_dir.display()
+        );
+    }
+    Ok(ExitCode::SUCCESS)
+}
