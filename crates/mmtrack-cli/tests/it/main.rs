@@ -14,6 +14,7 @@ mod fixtures;
 mod independent_readers;
 mod interrupt;
 mod ingest_navtech;
+mod process_beam_spebt;
 mod process_mpc;
 mod process_odometry;
 mod realdata_beams;

@@ -1,0 +1,134 @@
+//! `mmtrack process beam --tracker spebt`: SPEBT on a simulated radar drive,
+//! driven by the `odometry` table of `process odometry` or by the ground
+//! truth plus the pose-error model; bad odometry tables and recordings
+//! without ground truth are named.
+
+use std::path::Path;
+
+use mmtrack_analysis::beam::spebt_tables::{SpebtSlotRow, SpebtSummaryRow};
+use mmtrack_core::OdometryEstimate;
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{RunInfo, read_table, write_table};
+
+use super::common::{mmtrack, text};
+
+/// 6 s at 8 m/s, 4 Hz: 24 scans.
+const DRIVE: &str = r#"
+seed = 3
+[sensor]
+bins = 300
+[motion]
+speed_mps = 8.0
+yaw_rate_radps = 0.05
+duration_s = 6.0
+[generator]
+"#;
+
+fn run(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = mmtrack(dir, args);
+    let (stdout, stderr) = text(&out);
+    (out.status.success(), stdout, stderr)
+}
+
+fn tables(dir: &Path, out: &str) -> (SpebtSummaryRow, Vec<SpebtSlotRow>) {
+    let root = dir.join(out);
+    let summary = read_table::<SpebtSummaryRow>(&root.join("spebt_summary/sequence=drive/part-0.parquet")).unwrap();
+    let slots = read_table::<SpebtSlotRow>(&root.join("spebt_per_slot/sequence=drive/part-0.parquet")).unwrap();
+    assert_eq!(summary.len(), 1);
+    (summary[0].clone(), slots)
+}
+
+const ODOMETRY: &str = "tables/odometry/sequence=drive/part-0.parquet";
+
+/// Rewrites the drive's odometry table after `edit`.
+fn corrupt(dir: &Path, edit: impl FnOnce(&mut Vec<OdometryEstimate>)) {
+    let mut rows = read_table::<OdometryEstimate>(&dir.join(ODOMETRY)).unwrap();
+    edit(&mut rows);
+    let info = RunInfo { config_json: "{}".into() };
+    write_table(&dir.join("bad"), "drive", &rows, &info, Overwrite::Replace).unwrap();
+}
+
+#[test]
+fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), DRIVE).unwrap();
+    let (ok, _, stderr) = run(d, &["simulate", "radar", "--scenario", "s.toml", "-o", "drive.mcap", "-q"]);
+    assert!(ok, "{stderr}");
+    let (ok, _, stderr) = run(d, &["process", "odometry", "drive.mcap", "-o", "tables", "-q"]);
+    assert!(ok, "{stderr}");
+
+    // Driven by the odometry table.
+    let spebt = ["process", "beam", "drive.mcap", "--tracker", "spebt"];
+    let (ok, stdout, stderr) = run(d, &[&spebt[..], &["--odometry", "tables", "-o", "out"]].concat());
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("drive (radar-odometry, 24 slots, 1 run)"), "{stdout}");
+    let (summary, slots) = tables(d, "out");
+    assert_eq!((summary.experiment.as_str(), summary.slots, summary.runs), ("radar-odometry", 24, 1));
+    for value in [summary.rmse_gain_pct, summary.rmse_aod_deg, summary.rmse_aoa_deg] {
+        assert!(value.is_finite() && value >= 0.0, "{summary:?}");
+    }
+    // A short straight-ish drive 130 m from the BS: the AoD moves little;
+    // the AoA error is the odometry's heading error plus the filter's.
+    assert!(summary.rmse_aod_deg < 2.0 && summary.rmse_aoa_deg < 15.0, "{summary:?}");
+    assert_eq!(slots.len(), 24);
+    assert!(slots.iter().enumerate().all(|(k, s)| s.slot == k as u64 && s.run0_aoa_deg.is_finite()));
+    assert!(slots.windows(2).all(|w| w[1].t_s > w[0].t_s) && slots[0].t_s == 0.0);
+    // Again without --force: refused.
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "tables", "-o", "out"]].concat());
+    assert!(!ok && stderr.contains("--force"), "{stderr}");
+
+    // The estimates drive the tracker: a heading 30 degrees off at row 12
+    // changes run 0's estimate from slot 12 on, and nothing before it.
+    corrupt(d, |rows| rows[12].world_from_vehicle.yaw_rad += 30f64.to_radians());
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "bad", "-o", "turned"]].concat());
+    assert!(ok, "{stderr}");
+    let (_, turned) = tables(d, "turned");
+    assert!(turned[..12].iter().zip(&slots[..12]).all(|(a, b)| a == b));
+    assert!((turned[12].run0_aoa_deg - slots[12].run0_aoa_deg).abs() > 1.0 || turned[12].run0_reinitialised);
+
+    // Bad odometry tables: NaN, a gap, estimates outside the ground truth's span.
+    corrupt(d, |rows| rows[7].world_from_vehicle.y_m = f64::NAN);
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "bad", "-o", "nan"]].concat());
+    assert!(!ok, "{stderr}");
+    assert!(stderr.contains("bad/odometry/sequence=drive/part-0.parquet: row 7") && stderr.contains("y_m is NaN"));
+    corrupt(d, |rows| {
+        rows.remove(10);
+    });
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "bad", "-o", "gap"]].concat());
+    assert!(!ok && stderr.contains("row 10: t_ns gap of 0.500 s") && stderr.contains("2.0 times"), "{stderr}");
+    corrupt(d, |rows| rows.iter_mut().for_each(|r| r.t_ns += 100_000_000));
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "bad", "-o", "late"]].concat());
+    assert!(!ok && stderr.contains("row 23") && stderr.contains("outside the ground truth's time span"), "{stderr}");
+    assert!(!d.join("nan").exists() && !d.join("gap").exists() && !d.join("late").exists());
+
+    // Ground truth plus the pose-error model, deterministic per seed.
+    let model = [&spebt[..], &["--sigma-r-m", "0.5", "--sigma-theta-deg", "1", "--runs", "4", "--seed", "7"]].concat();
+    let (ok, stdout, stderr) = run(d, &[&model[..], &["-o", "model"]].concat());
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("drive (pose-error-model, 24 slots, 4 runs)"), "{stdout}");
+    let (summary, slots) = tables(d, "model");
+    assert_eq!((summary.experiment.as_str(), summary.runs, summary.seed, slots.len()), ("pose-error-model", 4, 7, 24));
+    assert!(summary.rmse_aod_deg.is_finite() && summary.rmse_aoa_deg.is_finite() && summary.rmse_aoa_deg < 15.0);
+    let (ok, _, stderr) = run(d, &[&model[..], &["-o", "model2"]].concat());
+    assert!(ok, "{stderr}");
+    assert_eq!(tables(d, "model2"), (summary, slots));
+
+    // Options that need spebt, spebt with the sweep trackers.
+    let (ok, _, stderr) = run(d, &["process", "beam", "drive.mcap", "--odometry", "tables", "-o", "x"]);
+    assert!(!ok && stderr.contains("--odometry is an option of --tracker spebt only"), "{stderr}");
+    let (ok, _, stderr) = run(d, &["process", "beam", "drive.mcap", "--tracker", "spebt,window", "-o", "x"]);
+    assert!(!ok && stderr.contains("spebt runs alone"), "{stderr}");
+}
+
+#[test]
+fn a_recording_without_ground_truth_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = super::common::root().join("data/sounder/artificial.toml");
+    let args = ["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "a.mcap", "-q", "--sets", "2"];
+    let (ok, _, stderr) = run(dir.path(), &args);
+    assert!(ok, "{stderr}");
+    let (ok, _, stderr) = run(dir.path(), &["process", "beam", "a.mcap", "--tracker", "spebt", "-o", "out"]);
+    assert!(!ok && stderr.contains("a.mcap: 0 ground-truth poses") && stderr.contains("ground truth"), "{stderr}");
+    assert!(!dir.path().join("out").exists());
+}
