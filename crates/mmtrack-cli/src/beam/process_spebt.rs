@@ -314,7 +314,7 @@ pub fn run(
             .to_string(),
         };
         let summary = output::summary_row(&experiment, &recording.path, outcome);
-        write_table(output_dir, &recording.sequence_id, &[summary.clone()], &info, overwrite)?;
+        write_table(output_dir, &recording.sequence_id, std::slice::from_ref(&summary), &info, overwrite)?;
         write_table(output_dir, &recording.sequence_id, &output::slot_rows(outcome), &info, overwrite)?;
         if !quiet {
             println!(
