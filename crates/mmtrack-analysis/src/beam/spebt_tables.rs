@@ -1,21 +1,25 @@
 //! Result tables of the SPEBT beam-tracking experiment (Liu et al. 2024,
-//! Sec. IV, Table III and Fig. 5), written by `mmtrack reproduce spebt`.
+//! Sec. IV, Table III and Fig. 5), written by `mmtrack reproduce spebt`
+//! (partitions named by experiment) and by `mmtrack process beam --tracker
+//! spebt` (partitions named by the recording's sequence).
 
 mmtrack_io::define_table! {
-    /// `spebt_summary`: one row per experiment.
+    /// `spebt_summary`: one row per experiment (or recording).
     pub const SPEBT_SUMMARY = "spebt_summary",
         "Beam-tracking accuracy of the SPEBT EKF over the Monte Carlo runs of one experiment (Liu et al. 2024, \
 Table III): RMSE over every tracked slot (1..slots-1) of every run of the estimate after the slot's update (after a re-initialisation \
 where one happened) against the true channel, the re-initialisations per run (Algorithm 1 steps 14-15) and the \
-paper's numbers beside them.";
+paper's numbers beside them. Written by `reproduce spebt` (one partition per experiment) and `process beam --tracker \
+spebt` (one per recording).";
     /// One row of [`SPEBT_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SpebtSummaryRow {
         experiment: String, "",
-            "pose-error-model (ground truth plus the paper's pose-error model) or radar-odometry (our radar odometry \
-on scans simulated along the trajectory)";
+            "pose-error-model (ground truth plus the paper's pose-error model) or radar-odometry (our radar odometry: \
+on scans simulated along the trajectory in reproduce spebt, the --odometry table in process beam)";
         trajectory: String, "",
-            "trajectory file the vehicle drives along (radar-odometry: the simulator's poses along it)";
+            "trajectory file the vehicle drives along (reproduce spebt radar-odometry: the simulator's poses along it; \
+process beam: the recording, whose ground truth it is)";
         slots: u64, "", "slots per run (one per pose); slot 0 is the initial access";
         runs: u64, "", "Monte Carlo runs";
         seed: u64, "", "seed of the runs";
