@@ -114,6 +114,18 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert!(ok, "{stderr}");
     assert_eq!(tables(d, "model2"), (summary, slots));
 
+    // The link from --link: a base station elsewhere; one on the path is refused.
+    std::fs::write(d.join("far.toml"), "[scenario]\nbs_x_m = -300.0\n").unwrap();
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--link", "far.toml", "-o", "far"]].concat());
+    assert!(ok, "{stderr}");
+    let (_, far) = tables(d, "far");
+    // The vehicle starts at (0, 0): AoD atan2(0 + 125, 0 + 300).
+    let expected = 125f64.atan2(300.0).to_degrees();
+    assert!((far[0].true_aod_deg - expected).abs() < 1e-9, "{}", far[0].true_aod_deg);
+    std::fs::write(d.join("on.toml"), "[scenario]\nbs_x_m = 0.0\nbs_y_m = 0.5\n").unwrap();
+    let (ok, _, stderr) = run(d, &[&spebt[..], &["--link", "on.toml", "-o", "on"]].concat());
+    assert!(!ok && stderr.contains("on.toml") && stderr.contains("passes 0.500 m from the base station"), "{stderr}");
+
     // Options that need spebt, spebt with the sweep trackers.
     let (ok, _, stderr) = run(d, &["process", "beam", "drive.mcap", "--odometry", "tables", "-o", "x"]);
     assert!(!ok && stderr.contains("--odometry is an option of --tracker spebt only"), "{stderr}");
