@@ -51,14 +51,20 @@ enum Pipeline {
     /// unless `--link T:R` picks one. Then run `mmtrack analyze <out>`.
     #[command(verbatim_doc_comment)]
     Mpc(process_mpc::MpcArgs),
-    /// Beam-sweep trackers and their baselines on measured beam sweeps (e.g. from `mmtrack ingest beams`).
+    /// Beam trackers: sweep trackers on measured beam sweeps, or SPEBT on a recording with ground truth.
     ///
-    /// Writes `beam_sweeps_tracked/sequence=<id>/part-0.parquet` per
+    /// Sweep trackers (window, gnss-window, last-full-sweep, gnss-map) on
+    /// recordings of measured beam sweeps (e.g. from `mmtrack ingest beams`)
+    /// write `beam_sweeps_tracked/sequence=<id>/part-0.parquet` per
     /// recording: per sweep and tracker the chosen and best beam, beams
     /// measured, re-initialisation and received-power loss. The GNSS policies
     /// (gnss-window, gnss-map) fit the beam map leave-one-pass-out over the
     /// recordings of each site given together (at least two). Then run
     /// `mmtrack analyze <out>`.
+    /// `--tracker spebt` simulates the SPEBT link along a recording's ground
+    /// truth and tracks it with poses from `--odometry <tables>` (from
+    /// `mmtrack process odometry`) or from the ground truth plus the
+    /// pose-error model; it writes `spebt_per_slot` and `spebt_summary`.
     #[command(verbatim_doc_comment)]
     Beam(crate::beam::process::BeamArgs),
 }
