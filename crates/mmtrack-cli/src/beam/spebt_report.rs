@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use mmtrack_core::{StampedPose, wrap_angle_rad};
 use mmtrack_core::path_length_m;
+use mmtrack_core::{StampedPose, wrap_angle_rad};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtSlot};
 
 use super::reproduce_spebt::{Experiment, ExperimentResult, Outcome};
