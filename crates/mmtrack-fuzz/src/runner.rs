@@ -202,9 +202,21 @@ fn save(dir: &Path, input: &[u8], message: &str) -> PathBuf {
 }
 
 /// Digits removed: two findings or outcomes that differ only in numbers are one.
-fn signature(text: &str) -> String {
-    text.chars().filter(|c| !c.is_ascii_digit()).collect()
+fn signature(text: &str) -> u64 {
+    use std::hash::{Hash, Hasher};
+    // SipHash with fixed keys: the same signature in every run.
+    let mut hasher = std::hash::DefaultHasher::new();
+    for c in text.chars().filter(|c| !c.is_ascii_digit()) {
+        c.hash(&mut hasher);
+    }
+    hasher.finish()
 }
+
+/// Outcome signatures remembered at most. Error texts quote escaped input,
+/// so the set of distinct signatures has no bound; keeping every one (as
+/// strings) grew a 10-minute run to 6-24 GB resident. When full, the set is
+/// forgotten and starts again: the corpus keeps growing by replacement.
+const MAX_OUTCOMES: usize = 1 << 20;
 
 /// Runs `target` from `seeds` until the budget is spent. Fails only when
 /// the scratch directory cannot be made.
@@ -255,6 +267,9 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
         match outcome {
             Ok(outcome) => {
                 accepted += u64::from(outcome.split(" | ").any(|part| part.starts_with("ok")));
+                if outcomes.len() >= MAX_OUTCOMES {
+                    outcomes.clear();
+                }
                 if outcomes.insert(signature(&outcome)) && executions as usize > seeds.len() {
                     if corpus.len() < seeds.len() + MAX_GROWN_CORPUS {
                         corpus.push(input.clone());
