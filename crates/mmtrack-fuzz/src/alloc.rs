@@ -6,10 +6,11 @@
 //! An over-cap request is still passed to the system allocator: on Linux a
 //! large block is mapped lazily, so asking costs nothing until it is written,
 //! and the fuzz loop reports the request after the input ran
-//! ([`take_largest_over_cap`]). Only when the system refuses (more than the
-//! machine can map) is the process lost: Rust aborts on a failed allocation
-//! and stable Rust offers no hook to prevent it, so the allocator first calls
-//! the hook set with [`set_failed_allocation_hook`], which saves the input.
+//! ([`take_usage`]). The allocator also adds up all requests of an input
+//! ([`TOTAL_CAP_BYTES`]). When a cap is crossed it calls the hook set with
+//! [`set_alarm_hook`] at once, which saves the input: the process may not
+//! survive what follows (the kernel's OOM killer, or a refused allocation,
+//! on which Rust aborts and stable Rust offers no hook to prevent it).
 //!
 //! Requests are counted per thread: the readers under test allocate on the
 //! thread that calls them.
@@ -29,44 +30,82 @@ use std::sync::OnceLock;
 /// most a few MiB).
 pub const ALLOCATION_CAP_BYTES: usize = 512 << 20;
 
+/// All the bytes one input may ask for, freed or not, before it is a finding
+/// (8 GiB): a reader that makes millions of small allocations never trips
+/// the single-allocation cap but can still exhaust the machine.
+pub const TOTAL_CAP_BYTES: u64 = 8 << 30;
+
 /// The system allocator, noting over-cap requests (see the module docs).
 pub struct CappedAllocator;
 
 #[global_allocator]
 static GLOBAL: CappedAllocator = CappedAllocator;
 
+/// What the allocator reports to the alarm hook while an input runs, so the
+/// input is saved even if the process does not survive it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Alarm {
+    /// A single request above [`ALLOCATION_CAP_BYTES`] (given, lazily mapped).
+    OverCap(usize),
+    /// The input's requests passed [`TOTAL_CAP_BYTES`] in all.
+    Total(u64),
+    /// An over-cap request the system refused: the process aborts next.
+    Failed(usize),
+}
+
+/// What this thread asked for since the previous [`take_usage`].
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Usage {
+    /// The largest single request above [`ALLOCATION_CAP_BYTES`] (0: none).
+    pub largest_over_cap: usize,
+    /// All bytes requested (reallocations count their new size).
+    pub total_bytes: u64,
+}
+
 thread_local! {
-    /// The largest over-cap request of this thread since the last take.
-    static LARGEST_OVER_CAP: Cell<usize> = const { Cell::new(0) };
-    /// Set while the failed-allocation hook runs, so its own allocations pass.
+    static USAGE: Cell<Usage> = const { Cell::new(Usage { largest_over_cap: 0, total_bytes: 0 }) };
+    /// Set while the alarm hook runs, so its own allocations pass unnoted.
     static IN_HOOK: Cell<bool> = const { Cell::new(false) };
 }
 
-static FAILED_ALLOCATION_HOOK: OnceLock<fn(usize)> = OnceLock::new();
+static ALARM_HOOK: OnceLock<fn(Alarm)> = OnceLock::new();
 
-/// Sets the function called with the size when an over-cap request fails,
-/// just before the process aborts. Only the first call has an effect.
-pub fn set_failed_allocation_hook(hook: fn(usize)) {
-    let _ = FAILED_ALLOCATION_HOOK.set(hook);
+/// Sets the function called when an allocation crosses a cap (before the
+/// process aborts, for [`Alarm::Failed`]). Only the first call has an effect.
+pub fn set_alarm_hook(hook: fn(Alarm)) {
+    let _ = ALARM_HOOK.set(hook);
 }
 
-/// The largest single request above [`ALLOCATION_CAP_BYTES`] made by this
-/// thread since the previous call (0 for none), and resets it.
+/// What this thread asked for since the previous call, and resets it.
 #[must_use]
-pub fn take_largest_over_cap() -> usize {
-    LARGEST_OVER_CAP.try_with(|c| c.replace(0)).unwrap_or(0)
+pub fn take_usage() -> Usage {
+    USAGE.try_with(|u| u.replace(Usage::default())).unwrap_or_default()
 }
 
 /// Notes a request of `size` bytes whose result is `ptr`.
 fn note(size: usize, ptr: *mut u8) {
-    if size <= ALLOCATION_CAP_BYTES {
+    if IN_HOOK.try_with(Cell::get).unwrap_or(true) {
         return;
     }
-    let _ = LARGEST_OVER_CAP.try_with(|c| c.set(c.get().max(size)));
-    if ptr.is_null() && IN_HOOK.try_with(|h| !h.replace(true)).unwrap_or(false) {
-        if let Some(hook) = FAILED_ALLOCATION_HOOK.get() {
-            hook(size);
-        }
+    let Ok(before) = USAGE.try_with(Cell::get) else { return };
+    let mut after = before;
+    after.total_bytes = before.total_bytes.saturating_add(size as u64);
+    if size > ALLOCATION_CAP_BYTES {
+        after.largest_over_cap = before.largest_over_cap.max(size);
+    }
+    let _ = USAGE.try_with(|u| u.set(after));
+    let alarm = if ptr.is_null() && size > ALLOCATION_CAP_BYTES {
+        Some(Alarm::Failed(size))
+    } else if size > ALLOCATION_CAP_BYTES {
+        Some(Alarm::OverCap(size))
+    } else if before.total_bytes <= TOTAL_CAP_BYTES && after.total_bytes > TOTAL_CAP_BYTES {
+        Some(Alarm::Total(after.total_bytes))
+    } else {
+        None
+    };
+    if let (Some(alarm), Some(hook)) = (alarm, ALARM_HOOK.get()) {
+        let _ = IN_HOOK.try_with(|h| h.set(true));
+        hook(alarm);
         let _ = IN_HOOK.try_with(|h| h.set(false));
     }
 }

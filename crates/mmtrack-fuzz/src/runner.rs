@@ -2,7 +2,8 @@
 //! cap and the time, save findings.
 //!
 //! A finding is a panic, a single allocation above
-//! [`crate::alloc::ALLOCATION_CAP_BYTES`], or (when [`RunConfig::slow_is_finding`])
+//! [`crate::alloc::ALLOCATION_CAP_BYTES`], allocations adding up to more than
+//! [`crate::alloc::TOTAL_CAP_BYTES`] for one input, or (when [`RunConfig::slow_is_finding`])
 //! an input that took longer than [`RunConfig::slow_limit`] twice in a row. Each distinct
 //! finding (a panic by its location, other kinds by kind) is saved once, as
 //! `<findings_dir>/<target>/<hash>.bin` (the input) and `<hash>.txt` (the
@@ -24,7 +25,7 @@ use std::sync::{Mutex, MutexGuard, Once};
 use std::thread::ThreadId;
 use std::time::{Duration, Instant};
 
-use crate::alloc::{ALLOCATION_CAP_BYTES, set_failed_allocation_hook, take_largest_over_cap};
+use crate::alloc::{ALLOCATION_CAP_BYTES, Alarm, TOTAL_CAP_BYTES, Usage, set_alarm_hook, take_usage};
 use crate::mutate::Mutator;
 use crate::targets::{Scratch, Target};
 
@@ -67,6 +68,8 @@ pub enum FindingKind {
     Panic,
     /// The reader asked for one allocation above the cap.
     OverCapAllocation,
+    /// The reader's allocations for one input added up to more than the total cap.
+    OverCapTotal,
     /// The input took longer than the slow limit.
     Slow,
 }
@@ -116,13 +119,15 @@ impl Report {
     }
 }
 
-/// The input a thread is running, for the watchdog and the failed-allocation hook.
+/// The input a thread is running, for the watchdog and the allocator's alarms.
 struct InFlight {
     thread: ThreadId,
     target: &'static str,
     dir: PathBuf,
     input: Vec<u8>,
     started: Option<Instant>,
+    /// Kinds of alarm already saved in this run (each kind is saved once).
+    alarms_saved: Vec<FindingKind>,
 }
 
 static IN_FLIGHT: Mutex<Vec<InFlight>> = Mutex::new(Vec::new());
@@ -138,7 +143,7 @@ fn in_flight() -> MutexGuard<'static, Vec<InFlight>> {
     IN_FLIGHT.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
-/// Installs, once per process, the panic hook, the failed-allocation hook and the watchdog.
+/// Installs, once per process, the panic hook, the allocator's alarm hook and the watchdog.
 fn install() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
@@ -150,23 +155,40 @@ fn install() {
                 previous(info);
             }
         }));
-        set_failed_allocation_hook(on_failed_allocation);
+        set_alarm_hook(on_alarm);
         std::thread::spawn(watchdog);
     });
 }
 
-/// Saves the in-flight input of this thread before the process aborts.
-fn on_failed_allocation(size: usize) {
-    let Ok(all) = IN_FLIGHT.try_lock() else { return };
+/// Saves the in-flight input of this thread when the allocator raises an
+/// alarm, before the input goes on (the OOM killer may end the process) or
+/// the process aborts (a refused allocation).
+fn on_alarm(alarm: Alarm) {
+    let Ok(mut all) = IN_FLIGHT.try_lock() else { return };
     let me = std::thread::current().id();
-    if let Some(f) = all.iter().find(|f| f.thread == me && f.started.is_some()) {
-        let message = format!(
-            "allocation of {size} bytes (cap {ALLOCATION_CAP_BYTES}) failed: the process aborts; {} bytes of input",
-            f.input.len()
-        );
-        let path = save(&f.dir, &f.input, &message);
-        eprintln!("fuzz {}: FINDING over-cap allocation: {message}\n  input: {}", f.target, path.display());
+    let Some(f) = all.iter_mut().find(|f| f.thread == me && f.started.is_some()) else { return };
+    let (kind, message) = match alarm {
+        Alarm::OverCap(size) => (FindingKind::OverCapAllocation, over_cap_message(size)),
+        Alarm::Total(bytes) => (FindingKind::OverCapTotal, total_message(bytes)),
+        Alarm::Failed(size) => (
+            FindingKind::OverCapAllocation,
+            format!("allocation of {size} bytes (cap {ALLOCATION_CAP_BYTES}) failed: the process aborts"),
+        ),
+    };
+    if f.alarms_saved.contains(&kind) && !matches!(alarm, Alarm::Failed(_)) {
+        return;
     }
+    f.alarms_saved.push(kind);
+    let path = save(&f.dir, &f.input, &format!("{kind:?}: {message} (saved while running)"));
+    eprintln!("fuzz {}: FINDING {kind:?} (while running): {message}\n  input: {}", f.target, path.display());
+}
+
+fn over_cap_message(size: usize) -> String {
+    format!("one allocation of {size} bytes, above the cap of {ALLOCATION_CAP_BYTES}")
+}
+
+fn total_message(bytes: u64) -> String {
+    format!("allocations of {bytes} bytes in all for one input, above the cap of {TOTAL_CAP_BYTES}")
 }
 
 /// Ends the process when an input runs longer than [`HANG_EXIT`], saving it first.
@@ -228,7 +250,14 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
     {
         let mut all = in_flight();
         all.retain(|f| f.thread != me);
-        all.push(InFlight { thread: me, target: target.name, dir: dir.clone(), input: Vec::new(), started: None });
+        all.push(InFlight {
+            thread: me,
+            target: target.name,
+            dir: dir.clone(),
+            input: Vec::new(),
+            started: None,
+            alarms_saved: Vec::new(),
+        });
     }
     let mut mutator = Mutator::new(config.seed, config.max_input_bytes);
     let mut corpus: Vec<Vec<u8>> = seeds.to_vec();
@@ -261,7 +290,7 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
             (target.fixup)(&mut input);
         }
         executions += 1;
-        let (outcome, took, over_cap) = run_one(target, &scratch, &input, me);
+        let (outcome, took, usage) = run_one(target, &scratch, &input, me);
         slowest = slowest.max(took);
         let mut found = Vec::new();
         match outcome {
@@ -281,9 +310,11 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
             }
             Err(panic) => found.push((FindingKind::Panic, panic)),
         }
-        if over_cap > 0 {
-            let message = format!("one allocation of {over_cap} bytes, above the cap of {ALLOCATION_CAP_BYTES}");
-            found.push((FindingKind::OverCapAllocation, message));
+        if usage.largest_over_cap > 0 {
+            found.push((FindingKind::OverCapAllocation, over_cap_message(usage.largest_over_cap)));
+        }
+        if usage.total_bytes > TOTAL_CAP_BYTES {
+            found.push((FindingKind::OverCapTotal, total_message(usage.total_bytes)));
         }
         if config.slow_is_finding && took > config.slow_limit {
             // Once more: on a busy machine a single slow run may be the
@@ -339,26 +370,26 @@ pub fn run(target: &Target, seeds: &[Vec<u8>], config: &RunConfig) -> std::io::R
     })
 }
 
-/// Runs one input: its outcome (or the panic message), its time and the
-/// largest over-cap allocation it asked for (0: none).
+/// Runs one input: its outcome (or the panic message), its time and what it
+/// asked the allocator for.
 fn run_one(
     target: &Target,
     scratch: &Scratch,
     input: &[u8],
     me: ThreadId,
-) -> (Result<String, String>, Duration, usize) {
+) -> (Result<String, String>, Duration, Usage) {
     if let Some(f) = in_flight().iter_mut().find(|f| f.thread == me) {
         f.input.clear();
         f.input.extend_from_slice(input);
         f.started = Some(Instant::now());
     }
-    let _ = take_largest_over_cap();
+    let _ = take_usage();
     FUZZING.with(|f| f.set(true));
     let started = Instant::now();
     let result = catch_unwind(AssertUnwindSafe(|| (target.run)(scratch, input)));
     let took = started.elapsed();
     FUZZING.with(|f| f.set(false));
-    let over_cap = take_largest_over_cap();
+    let usage = take_usage();
     if let Some(f) = in_flight().iter_mut().find(|f| f.thread == me) {
         f.started = None;
     }
@@ -372,5 +403,5 @@ fn run_one(
                 .unwrap_or_else(|| "panic with a non-text payload".into())
         })
     });
-    (result, took, over_cap)
+    (result, took, usage)
 }

@@ -9,7 +9,7 @@
 use std::path::Path;
 use std::time::Duration;
 
-use mmtrack_fuzz::alloc::ALLOCATION_CAP_BYTES;
+use mmtrack_fuzz::alloc::{ALLOCATION_CAP_BYTES, TOTAL_CAP_BYTES};
 use mmtrack_fuzz::runner::{Budget, FindingKind, RunConfig, run};
 use mmtrack_fuzz::seeds::realdata_dir;
 use mmtrack_fuzz::targets::{Scratch, TARGETS, Target, find, png_chunk_crcs};
@@ -116,7 +116,8 @@ fn written_seeds_are_accepted() {
     }
 }
 
-/// A panic and an over-cap allocation are findings, saved with their message.
+/// A panic, an over-cap allocation and too many allocations in all are
+/// findings, saved with their message.
 #[test]
 fn harness_catches_panics_and_over_cap_allocations() {
     fn misbehave(_: &Scratch, input: &[u8]) -> String {
@@ -128,25 +129,32 @@ fn harness_catches_panics_and_over_cap_allocations() {
                 std::hint::black_box(&block);
                 "ok".into()
             }
+            b"churn" => {
+                // 1 MiB at a time, each freed: only the sum passes a cap.
+                for _ in 0..(TOTAL_CAP_BYTES >> 20) + 1 {
+                    let block: Vec<u8> = Vec::with_capacity(1 << 20);
+                    std::hint::black_box(&block);
+                }
+                "ok".into()
+            }
             _ => "ok".into(),
         }
     }
     fn seeds(_: Option<&Path>) -> Vec<Vec<u8>> {
-        vec![b"fine".to_vec(), b"panic".to_vec(), b"allocate".to_vec()]
+        vec![b"fine".to_vec(), b"panic".to_vec(), b"allocate".to_vec(), b"churn".to_vec()]
     }
     let target = Target { name: "misbehave", reader: "test", run: misbehave, seeds, fixup: |_| {} };
     let dir = tempfile::tempdir().unwrap();
     let report = run(&target, &seeds(None), &config(200, dir.path())).unwrap();
     let kinds: Vec<FindingKind> = report.findings.iter().map(|f| f.kind).collect();
-    assert_eq!(kinds, [FindingKind::Panic, FindingKind::OverCapAllocation], "{:?}", report.findings);
+    let expected = [FindingKind::Panic, FindingKind::OverCapAllocation, FindingKind::OverCapTotal];
+    assert_eq!(kinds, expected, "{:?}", report.findings);
     assert!(report.findings[0].message.contains("deliberate panic"), "{}", report.findings[0].message);
     assert!(report.findings[0].message.contains("main.rs"), "location: {}", report.findings[0].message);
     assert!(report.findings[1].message.contains(&(ALLOCATION_CAP_BYTES + 1).to_string()));
-    for f in &report.findings {
-        assert_eq!(
-            std::fs::read(&f.input).unwrap(),
-            if f.kind == FindingKind::Panic { &b"panic"[..] } else { b"allocate" }
-        );
+    assert!(report.findings[2].message.contains("in all for one input"), "{}", report.findings[2].message);
+    for (f, input) in report.findings.iter().zip([&b"panic"[..], b"allocate", b"churn"]) {
+        assert_eq!(std::fs::read(&f.input).unwrap(), input);
         assert!(f.input.with_extension("txt").is_file());
         assert!(f.input.starts_with(dir.path().join("misbehave")));
     }
