@@ -7,7 +7,7 @@
 //! | `nmea` | `nmea::parse_nmea` (bytes made UTF-8 as `read_nmea` does) |
 //! | `cdr` | `ros2::decode_odometry`, `decode_pose_with_covariance_stamped`, `decode_nav_sat_fix`, `ros2_image::decode_image` + `image_to_scan` |
 //! | `decawave` | `cir::parse_decawave_log_detailed`, timed by the RX timestamp and by a frame period |
-//! | `npy` | `cir::read_cir_file` as `npy`, or as `npz` when the file starts with `PK` |
+//! | `npy` | `cir::read_cir_file` as `npy`, or as `npz` when the file starts with `PK`; `cir::parse_npy_matrix` (DeepSense beam arrays) |
 //! | `mat` | `cir::read_cir_file` as `mat`, and `cir::read_mat_cir` on the bytes |
 //! | `sigmf` | `cir::read_cir_file` as `sigmf` |
 //! | `csv` | `cir::read_cir_file` as `csv` (CIRs one snapshot per row) |
@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 use mmtrack_ingest::IngestError;
 use mmtrack_ingest::cir::{
     CirFormat, CirSidecar, DecawaveConfig, DecawaveDelayReference, DecawaveTimeBase, MatCirLayout,
-    parse_decawave_log_detailed, read_cir_file, read_mat_cir,
+    parse_decawave_log_detailed, parse_npy_matrix, read_cir_file, read_mat_cir,
 };
 use mmtrack_ingest::nmea::parse_nmea;
 use mmtrack_ingest::oxford::{NavtechLayout, OXFORD, decode_scan_png};
@@ -103,7 +103,8 @@ impl Scratch {
 }
 
 /// The outcome of a reader: "ok", or where the error is (record, field and
-/// the start of the detail).
+/// the start of the detail). Never a path: outcomes steer the corpus, and
+/// the same seed must give the same inputs in every run.
 fn outcome<T>(result: &Result<T, IngestError>) -> String {
     match result {
         Ok(_) => "ok".into(),
@@ -111,7 +112,11 @@ fn outcome<T>(result: &Result<T, IngestError>) -> String {
             format!("{record}/{field}/{}", unquoted(detail))
         }
         Err(IngestError::BadSidecar { key, .. }) => format!("sidecar {key}"),
-        Err(e) => e.to_string().chars().take(48).collect(),
+        Err(IngestError::BadLayout { detail, .. }) => format!("layout {}", unquoted(detail)),
+        Err(IngestError::Os { source, .. }) => format!("os {:?}", source.kind()),
+        // Never the message: it starts with the scratch file's path, which
+        // differs from run to run and would make runs differ.
+        Err(_) => "other error".into(),
     }
 }
 
@@ -221,10 +226,12 @@ fn npy(scratch: &Scratch, input: &[u8]) -> String {
     };
     let (format, name) =
         if file.starts_with(b"PK") { (CirFormat::Npz, "fuzz.npz") } else { (CirFormat::Npy, "fuzz.npy") };
-    match scratch.write(name, file) {
+    let cir = match scratch.write(name, file) {
         Ok(path) => outcome(&read_cir_file(format, &path, sidecar.as_ref())),
         Err(e) => e,
-    }
+    };
+    let matrix = parse_npy_matrix(Path::new("fuzz.npy"), file);
+    format!("{cir} | {}", outcome(&matrix))
 }
 
 fn mat(scratch: &Scratch, input: &[u8]) -> String {

@@ -176,3 +176,17 @@ fn png_chunk_crcs_are_repaired() {
     png_chunk_crcs(&mut same);
     assert_eq!(same, png);
 }
+
+/// The same seed gives the same run (inputs, outcomes and corpus), so a CI
+/// failure reproduces.
+#[test]
+fn same_seed_same_run() {
+    let target = find("npy").unwrap();
+    let seeds = (target.seeds)(realdata_dir().as_deref());
+    let dir = tempfile::tempdir().unwrap();
+    let summary = || {
+        let r = run(target, &seeds, &config(20_000, dir.path())).unwrap();
+        (r.executions, r.accepted, r.corpus, r.outcomes)
+    };
+    assert_eq!(summary(), summary());
+}
