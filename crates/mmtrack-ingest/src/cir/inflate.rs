@@ -29,6 +29,25 @@ const DIST_EXTRA: [u8; 30] =
 /// Order in which the code-length code lengths are sent.
 const CODE_LENGTH_ORDER: [usize; 19] = [16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15];
 
+/// A compressed stream may inflate to at most this many times its size...
+pub(crate) const MAX_INFLATE_RATIO: usize = 100;
+/// ...beyond this allowance (small inputs of constant data compress far more).
+pub(crate) const INFLATE_ALLOWANCE_BYTES: usize = 16 << 20;
+
+/// The most a stream of `compressed_len` bytes may inflate to:
+/// [`INFLATE_ALLOWANCE_BYTES`] + [`MAX_INFLATE_RATIO`] x its size, and at
+/// most `hard_cap`. Measured channel data compresses 1- to 3-fold; DEFLATE
+/// reaches about 1000-fold on constant bytes, so without this bound a 1 MiB
+/// file (a decompression bomb, or an array of zeros) would become a 1 GiB
+/// buffer and, cut into one-tap snapshots, tens of GB of memory.
+pub(crate) fn inflate_limit(compressed_len: usize, hard_cap: usize) -> usize {
+    INFLATE_ALLOWANCE_BYTES.saturating_add(compressed_len.saturating_mul(MAX_INFLATE_RATIO)).min(hard_cap)
+}
+
+/// What to say when a stream inflates past [`inflate_limit`].
+pub(crate) const INFLATE_LIMIT_HINT: &str = "more than 100 times its compressed size beyond the first 16 MiB: \
+     a decompression bomb or an array of constants; store such an array uncompressed";
+
 /// Decompresses a zlib stream. `max_output` bounds the decompressed size
 /// (the caller knows how much a sane variable can hold). Errors are plain
 /// sentences; the caller adds the file and the record.
@@ -319,6 +338,37 @@ fn codes(
     }
 }
 
+/// A raw DEFLATE stream of `1 + 258 * matches` zero bytes in one fixed
+/// Huffman block (a literal 0, then matches of length 258 at distance 1):
+/// about 160-fold compression, for tests of [`inflate_limit`].
+#[cfg(test)]
+pub(crate) fn zeros_deflated(matches: usize) -> Vec<u8> {
+    let (mut out, mut acc, mut n) = (Vec::new(), 0u64, 0u32);
+    // Appends `count` bits of `value`, most significant first (Huffman codes)
+    // or least significant first (header fields).
+    let mut push = |value: u32, count: u32, msb_first: bool| {
+        for i in 0..count {
+            let bit = if msb_first { value >> (count - 1 - i) } else { value >> i } & 1;
+            acc |= u64::from(bit) << n;
+            n += 1;
+            if n == 8 {
+                out.push(acc as u8);
+                (acc, n) = (0, 0);
+            }
+        }
+    };
+    push(1, 1, false); // BFINAL
+    push(1, 2, false); // BTYPE fixed
+    push(0x30, 8, true); // literal 0
+    for _ in 0..matches {
+        push(0xc5, 8, true); // length symbol 285: 258
+        push(0, 5, true); // distance symbol 0: 1
+    }
+    push(0, 7, true); // end of block
+    push(0, 7, false); // pad to a byte
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -364,6 +414,9 @@ mod tests {
         bad_sum[last] ^= 1;
         assert!(zlib_decompress(&bad_sum, 1 << 20).unwrap_err().contains("Adler-32"));
         assert!(zlib_decompress(&fixed, 5).unwrap_err().contains("more than 5 bytes"));
+        assert_eq!(inflate_raw(&zeros_deflated(3), 1 << 20).unwrap(), vec![0; 1 + 3 * 258]);
+        assert_eq!(inflate_limit(1000, usize::MAX), (16 << 20) + 100_000);
+        assert_eq!(inflate_limit(usize::MAX, 1 << 31), 1 << 31);
         assert!(zlib_decompress(&hex("7801"), 1 << 20).is_err());
         assert!(zlib_decompress(&hex("78da"), 1 << 20).unwrap_err().contains("ends"));
         assert!(zlib_decompress(&hex("7802"), 1 << 20).unwrap_err().contains("check bits"));

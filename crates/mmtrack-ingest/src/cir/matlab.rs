@@ -57,7 +57,7 @@ use std::path::Path;
 
 use mmtrack_core::{CirSnapshot, Complex64};
 
-use super::inflate::zlib_decompress;
+use super::inflate::{INFLATE_LIMIT_HINT, inflate_limit, zlib_decompress};
 use crate::IngestError;
 use crate::error::os_err;
 
@@ -89,7 +89,8 @@ const MI_MATRIX: u32 = 14;
 /// `miCOMPRESSED`: a zlib stream holding one element.
 const MI_COMPRESSED: u32 = 15;
 /// Decompressed variables larger than this are refused (bounds memory on
-/// hostile input; far above any CIR file).
+/// hostile input; far above any CIR file). Below it, a variable may inflate
+/// to 16 MiB plus 100 times its compressed size (`inflate::inflate_limit`).
 const MAX_VARIABLE_BYTES: usize = 1 << 31;
 
 /// Reads the CIRs of `layout.variable` from the bytes of a `.mat` file.
@@ -301,8 +302,15 @@ fn find_variable(path: &Path, bytes: &[u8], variable: &str) -> Result<MatArray, 
         let matrix_body = match top.data_type {
             MI_MATRIX => top.data,
             MI_COMPRESSED => {
-                decompressed = zlib_decompress(top.data, MAX_VARIABLE_BYTES)
-                    .map_err(|detail| bad(record.clone(), format!("compressed variable: {detail}")))?;
+                let limit = inflate_limit(top.data.len(), MAX_VARIABLE_BYTES);
+                decompressed = zlib_decompress(top.data, limit).map_err(|detail| {
+                    let hint = if detail.contains("more than") {
+                        format!(" ({INFLATE_LIMIT_HINT}, save -v6)")
+                    } else {
+                        String::new()
+                    };
+                    bad(record.clone(), format!("compressed variable: {detail}{hint}"))
+                })?;
                 let inner = element(&decompressed, 0, endian)
                     .map_err(|detail| bad(record.clone(), format!("inside the compressed variable: {detail}")))?;
                 if inner.data_type != MI_MATRIX {

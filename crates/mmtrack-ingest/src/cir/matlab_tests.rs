@@ -302,3 +302,22 @@ proptest! {
         let _ = read_mat_cir(path, &bytes, &MatCirLayout { tx_axis: None, allow_real: true, ..layout("h") });
     }
 }
+
+/// As for npz: a compressed variable may inflate to 16 MiB plus 100 times
+/// its compressed size (found by fuzzing the npy reader, which shares the
+/// decoder; a 1 MiB `.mat` could otherwise become a 2 GiB buffer).
+#[test]
+fn compressed_variable_bomb_is_refused() {
+    // 64.5 MB of zeros from about 400 kB: 160-fold.
+    let deflated = super::super::inflate::zeros_deflated(250_000);
+    let mut z = vec![0x78, 0x01];
+    z.extend_from_slice(&deflated);
+    z.extend_from_slice(&[0; 4]);
+    let mut element = MI_COMPRESSED.to_le_bytes().to_vec();
+    element.extend_from_slice(&(z.len() as u32).to_le_bytes());
+    element.extend(z);
+    let file = mat_file(&[element]);
+    let e = read_mat_cir(Path::new("b.mat"), &file, &layout("h")).unwrap_err().to_string();
+    assert!(e.contains("compressed variable: decompresses to more than"), "{e}");
+    assert!(e.contains("more than 100 times its compressed size") && e.contains("save -v6"), "{e}");
+}

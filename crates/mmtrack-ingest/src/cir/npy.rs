@@ -12,12 +12,14 @@
 //! `np.savez_compressed` deflates them). The ZIP reader is ours, using the
 //! crate's DEFLATE decoder (`inflate.rs`) rather than adding a ZIP crate for
 //! one member of one archive; it checks each member's CRC-32 and reads ZIP64
-//! sizes, which NumPy writes.
+//! sizes, which NumPy writes. A deflated member may inflate to 16 MiB plus
+//! 100 times its compressed size (`inflate::inflate_limit`: decompression
+//! bombs), and is refused before inflating when it declares more.
 
 use std::path::Path;
 
 use super::array::NdComplex;
-use super::inflate::inflate_raw;
+use super::inflate::{INFLATE_LIMIT_HINT, inflate_limit, inflate_raw};
 use crate::IngestError;
 use mmtrack_core::Complex64;
 
@@ -358,7 +360,17 @@ fn member_data(b: &[u8], m: &Member) -> Result<Vec<u8>, String> {
         .ok_or_else(|| format!("truncated: {size} bytes of data at byte {start}, the file has {}", b.len()))?;
     let data = match m.method {
         0 => raw.to_vec(),
-        8 => inflate_raw(raw, MAX_MEMBER_BYTES.min(usize::try_from(m.uncompressed).unwrap_or(usize::MAX)))?,
+        8 => {
+            let limit = inflate_limit(raw.len(), MAX_MEMBER_BYTES);
+            if m.uncompressed > limit as u64 {
+                return Err(format!(
+                    "{} bytes when inflated from {} compressed bytes: {INFLATE_LIMIT_HINT} (np.savez)",
+                    m.uncompressed,
+                    raw.len()
+                ));
+            }
+            inflate_raw(raw, limit.min(m.uncompressed as usize))?
+        }
         other => return Err(format!("compression method {other}, expected stored (0) or deflate (8)")),
     };
     if data.len() as u64 != m.uncompressed {

@@ -136,3 +136,35 @@ fn npz_members() {
         assert!(parse_npz(p, &single[..cut], None).is_err(), "cut {cut}");
     }
 }
+
+/// Found by fuzzing (the npy target was killed at 24 GB of memory): a small
+/// npz could declare and inflate to 4 GiB, which cut into one-tap snapshots
+/// takes about 35 times as much. A member may inflate to 16 MiB plus 100
+/// times its compressed size.
+#[test]
+fn npz_decompression_bomb_is_refused() {
+    let p = Path::new("a.npz");
+    // `data` as a deflated member (stored DEFLATE blocks) declaring `declared` bytes.
+    let deflated_zip = |data: &[u8], declared: u32| {
+        let mut stream = vec![1];
+        stream.extend_from_slice(&(data.len() as u16).to_le_bytes());
+        stream.extend_from_slice(&(!(data.len() as u16)).to_le_bytes());
+        stream.extend_from_slice(data);
+        let mut zip = stored_zip(&[("h.npy", stream)]);
+        let directory = u32::from_le_bytes(zip[zip.len() - 6..zip.len() - 2].try_into().unwrap()) as usize;
+        zip[directory + 10..directory + 12].copy_from_slice(&8u16.to_le_bytes());
+        zip[directory + 16..directory + 20].copy_from_slice(&crc32(data).to_le_bytes());
+        zip[directory + 24..directory + 28].copy_from_slice(&declared.to_le_bytes());
+        zip
+    };
+    let h = npy("<c16", false, "(3,)", &c16(&[(1.0, 2.0), (3.0, 4.0), (5.0, 6.0)]));
+    let (_, a) = parse_npz(p, &deflated_zip(&h, h.len() as u32), None).unwrap();
+    assert_eq!(a.values[2], Complex64::new(5.0, 6.0));
+    // Declaring 200 MB from a few hundred bytes: refused before inflating.
+    let e = parse_npz(p, &deflated_zip(&h, 200_000_000), None).unwrap_err().to_string();
+    let compressed = h.len() + 5;
+    assert!(
+        e.contains(&format!("200000000 bytes when inflated from {compressed} compressed bytes: more than 100 times")),
+        "{e}"
+    );
+}
