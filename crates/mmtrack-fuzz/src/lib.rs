@@ -25,13 +25,14 @@ pub mod seeds;
 pub mod targets;
 pub mod writers;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Where findings go: `$CARGO_TARGET_DIR/fuzz-findings`, else the
 /// workspace's `target/fuzz-findings`.
 #[must_use]
 pub fn findings_dir() -> PathBuf {
-    let target = std::env::var_os("CARGO_TARGET_DIR")
-        .map_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target"), PathBuf::from);
+    // The workspace root is two levels above this crate's manifest directory.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).ancestors().nth(2).unwrap_or(Path::new("."));
+    let target = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| root.join("target"), PathBuf::from);
     target.join("fuzz-findings")
 }
