@@ -9,8 +9,9 @@ use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
 
+use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::sweeps::{self, BeamSweepResults};
-use crate::beam::{plots as beam_plots, tables::BeamSweepPooledRow};
+use crate::beam::{BeamResults, plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
 use crate::mpc::MpcResult;
 use crate::pipeline::TrajectoryResult;
 use crate::trajectory::DriftOptions;
@@ -83,17 +84,17 @@ pub fn write_results(
     run: &RunInfo,
     overwrite: Overwrite,
 ) -> anyhow::Result<WrittenResults> {
-    write_all_results(out, results, &[], &BeamSweepResults::default(), skipped, options, run, overwrite)
+    write_all_results(out, results, &[], &BeamResults::default(), skipped, options, run, overwrite)
 }
 
-/// Writes tables, plots and the report for trajectory, MPC and beam-sweep
-/// results into `out`.
+/// Writes tables, plots and the report for trajectory, MPC and beam-tracking
+/// (sweeps, SPEBT) results into `out`.
 #[allow(clippy::too_many_arguments)] // one per kind of result, plus where and how
 pub fn write_all_results(
     out: &Path,
     results: &[TrajectoryResult],
     mpc: &[MpcResult],
-    beam: &BeamSweepResults,
+    beam: &BeamResults,
     skipped: &[(String, String)],
     options: &DriftOptions,
     run: &RunInfo,
@@ -107,15 +108,19 @@ pub fn write_all_results(
         .with_context(|| format!("{}: cannot create a staging directory", parent.display()))?;
     let mut files = write_into(staging.path(), results, skipped, options, run)?;
     files += write_mpc_into(staging.path(), mpc, run)?;
-    files += write_beam_into(staging.path(), beam, run)?;
+    files += write_beam_into(staging.path(), &beam.sweeps, run)?;
+    files += write_spebt_into(staging.path(), &beam.spebt, run)?;
     if !mpc.is_empty() || !beam.is_empty() {
         let report_path = staging.path().join("report.md");
         let mut text = report::markdown(results, &[], options);
         if !mpc.is_empty() {
             mpc_report::section(&mut text, mpc);
         }
-        if !beam.is_empty() {
-            sweeps::section(&mut text, beam);
+        if !beam.sweeps.is_empty() {
+            sweeps::section(&mut text, &beam.sweeps);
+        }
+        if !beam.spebt.is_empty() {
+            spebt_analysis::section(&mut text, &beam.spebt);
         }
         text.push_str(&report::not_analyzed(skipped));
         std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
@@ -240,6 +245,28 @@ fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &RunInfo) -> any
         )?;
         files += 1;
     }
+    Ok(files + 1)
+}
+
+fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &RunInfo) -> anyhow::Result<usize> {
+    if results.is_empty() {
+        return Ok(0);
+    }
+    let tables = dir.join("tables");
+    let mut files = 0;
+    for r in &results.sequences {
+        let seq = &r.sequence;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
+        let (file, _) = spebt_analysis::SEQUENCE_PLOT;
+        let title = format!("{seq}: SPEBT {} run 0 against the truth", r.summary.experiment);
+        write_svg(
+            &dir.join("plots").join(seq).join(file),
+            spebt_plots::spebt_tracking_svg(&title, &r.tracking_series()),
+            &format!("sequence {seq}: {file}"),
+        )?;
+        files += 2;
+    }
+    write_table(&tables, "all", &results.pooled, run, Overwrite::Refuse)?;
     Ok(files + 1)
 }
 

@@ -14,7 +14,10 @@ use mmtrack_io::table::{
     MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats, ODOMETRY, TableRow, read_table, read_table_dir, table_path,
 };
 
-use crate::beam::sweeps::{BeamSweepResults, analyze_beam_sweeps};
+use crate::beam::BeamResults;
+use crate::beam::spebt_analysis::{self, SpebtResults};
+use crate::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow, SpebtSummaryRow};
+use crate::beam::sweeps::analyze_beam_sweeps;
 use crate::mpc::{DistanceSource, MpcInput, MpcOptions, MpcResult, analyze_mpc};
 
 use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
@@ -93,6 +96,9 @@ pub struct Plan {
     /// Sequences with a `beam_sweeps_tracked` table (`process beam`):
     /// beam-sweep accounting.
     pub beam: Vec<String>,
+    /// Sequences with `spebt_summary` and `spebt_per_slot` tables (`process
+    /// beam --tracker spebt`): SPEBT accuracy.
+    pub spebt: Vec<String>,
     /// Sequences that have tables but no metric applies, with the reason.
     pub skipped: Vec<(String, String)>,
 }
@@ -104,6 +110,19 @@ pub struct Plan {
 #[must_use]
 pub fn plan(inventory: &Inventory) -> Plan {
     let mut plan = Plan { beam: inventory.sequences(BEAM_SWEEPS_TRACKED.name).to_vec(), ..Plan::default() };
+    for seq in inventory.sequences(SPEBT_SUMMARY.name) {
+        if inventory.sequences(SPEBT_PER_SLOT.name).contains(seq) {
+            plan.spebt.push(seq.clone());
+        } else {
+            plan.skipped.push((
+                seq.clone(),
+                format!(
+                    "has an {} table but no {} table: SPEBT accuracy needs both",
+                    SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name
+                ),
+            ));
+        }
+    }
     for seq in inventory.sequences(MPC_SETS.name) {
         let missing: Vec<&str> = [MPC_DETECTIONS.name, MPC_TRACKS.name, MPC_LONG_TERM.name]
             .into_iter()
@@ -358,14 +377,27 @@ pub fn analyze_mpc_all(root: &Path, plan: &Plan, options: &MpcOptions) -> anyhow
         .collect()
 }
 
-/// Beam-sweep accounting of every sequence of `plan` (table
-/// `beam_sweeps_tracked`), per sequence and pooled per site.
-pub fn analyze_beam_all(root: &Path, plan: &Plan) -> anyhow::Result<BeamSweepResults> {
+/// Beam-tracking results of every sequence of `plan`: beam-sweep accounting
+/// (table `beam_sweeps_tracked`) per sequence and pooled per site, and SPEBT
+/// accuracy (tables `spebt_summary`, `spebt_per_slot`) per sequence and
+/// pooled per experiment kind.
+pub fn analyze_beam_all(root: &Path, plan: &Plan) -> anyhow::Result<BeamResults> {
     let mut tables = BTreeMap::new();
     for sequence in &plan.beam {
         tables.insert(sequence.clone(), read_required::<BeamSweepTracked>(root, sequence)?);
     }
-    analyze_beam_sweeps(tables).map_err(|e| anyhow::anyhow!("{}: {e}", root.join(BEAM_SWEEPS_TRACKED.name).display()))
+    let sweeps = analyze_beam_sweeps(tables)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", root.join(BEAM_SWEEPS_TRACKED.name).display()))?;
+    let mut spebt = SpebtResults::default();
+    for sequence in &plan.spebt {
+        let summary = read_required::<SpebtSummaryRow>(root, sequence)?;
+        let per_slot = read_required::<SpebtSlotRow>(root, sequence)?;
+        let result = spebt_analysis::sequence_result(sequence, summary, per_slot)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", root.display()))?;
+        spebt.sequences.push(result);
+    }
+    spebt.pooled = spebt_analysis::pool(&spebt.sequences);
+    Ok(BeamResults { sweeps, spebt })
 }
 
 /// Table names `process mpc` writes, for messages.

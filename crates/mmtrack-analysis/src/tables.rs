@@ -22,6 +22,7 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::beam::tables::BEAM_SWEEP_POOLED,
     &crate::beam::spebt_tables::SPEBT_SUMMARY,
     &crate::beam::spebt_tables::SPEBT_PER_SLOT,
+    &crate::beam::spebt_tables::SPEBT_POOLED,
 ];
 
 mmtrack_io::define_table! {

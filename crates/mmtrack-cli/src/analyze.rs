@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::Args;
+use mmtrack_analysis::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY};
 use mmtrack_analysis::mpc::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, MpcOptions};
 use mmtrack_analysis::output::{check_output, write_all_results};
 use mmtrack_analysis::pipeline::{analyze_all, analyze_beam_all, analyze_mpc_all, inventory, plan};
@@ -37,9 +38,13 @@ Table beam_sweeps_tracked of `mmtrack process beam` -> per sequence and pooled p
 median and 90th-percentile received-power loss against each full sweep's best beam, top-1 and within-one-beam \
 accuracy, beams measured per sweep and re-initialisations; plots of the beam index over time (best vs chosen) and \
 of the loss CDF.\n\n\
+Tables spebt_summary + spebt_per_slot of `mmtrack process beam --tracker spebt` (or `mmtrack reproduce spebt`) -> \
+per sequence the RMSE of abs(alpha), AoD and AoA and the re-initialisation share (the summary is checked against the \
+per-slot RMSEs), pooled per experiment kind weighting each sequence by its (slots - 1) x runs estimates; a plot of \
+run 0 against the truth (Liu et al. Fig. 5).\n\n\
 Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
-mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary}/sequence=<id>/part-0.parquet, \
-<OUT>/tables/beam_sweep_pooled/sequence=all/part-0.parquet, \
+mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary,spebt_summary}/sequence=<id>/part-0.parquet, \
+<OUT>/tables/{beam_sweep_pooled,spebt_pooled}/sequence=all/part-0.parquet, \
 <OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.",
     after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
@@ -103,11 +108,11 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     let found = inventory(&args.tables)?;
     let plan = plan(&found);
-    if plan.trajectory.is_empty() && plan.mpc.is_empty() && plan.beam.is_empty() {
+    if plan.trajectory.is_empty() && plan.mpc.is_empty() && plan.beam.is_empty() && plan.spebt.is_empty() {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         bail!(
             "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
-             {}, {}, {} (MPC statistics) and {} (beam sweeps); found {}{reasons}",
+             {}, {}, {} (MPC statistics), {} (beam sweeps) and {} with {} (SPEBT); found {}{reasons}",
             args.tables.display(),
             ODOMETRY.name,
             GROUND_TRUTH.name,
@@ -116,6 +121,8 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             MPC_TRACKS.name,
             MPC_LONG_TERM.name,
             BEAM_SWEEPS_TRACKED.name,
+            SPEBT_SUMMARY.name,
+            SPEBT_PER_SLOT.name,
             found.describe()
         );
     }
@@ -151,7 +158,10 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         for r in &mpc_results {
             println!("{}", mmtrack_analysis::mpc_report::one_line(r));
         }
-        for line in mmtrack_analysis::beam::sweeps::one_lines(&beam_results) {
+        for line in mmtrack_analysis::beam::sweeps::one_lines(&beam_results.sweeps) {
+            println!("{line}");
+        }
+        for line in mmtrack_analysis::beam::spebt_analysis::one_lines(&beam_results.spebt) {
             println!("{line}");
         }
         for (sequence, reason) in &plan.skipped {

@@ -6,10 +6,30 @@
 //! Pure data in, tables and SVG documents out; the experiment itself runs in
 //! the CLI (`mmtrack reproduce shaham`), which owns the Monte Carlo loop.
 //! The SPEBT experiment of Liu et al. 2024 (`mmtrack reproduce spebt`) has
-//! its own tables ([`spebt_tables`]) and figure ([`spebt_plots`]).
+//! its own tables ([`spebt_tables`]) and figure ([`spebt_plots`]); `mmtrack
+//! analyze` checks and pools the tables `process beam --tracker spebt`
+//! writes ([`spebt_analysis`]).
 
 pub mod plots;
+pub mod spebt_analysis;
 pub mod spebt_plots;
 pub mod spebt_tables;
 pub mod sweeps;
 pub mod tables;
+
+/// What `mmtrack analyze` computed from beam-tracking tables.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct BeamResults {
+    /// Measured beam sweeps (`beam_sweeps_tracked`).
+    pub sweeps: sweeps::BeamSweepResults,
+    /// SPEBT runs (`spebt_summary` + `spebt_per_slot`).
+    pub spebt: spebt_analysis::SpebtResults,
+}
+
+impl BeamResults {
+    /// Whether there is nothing.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.sweeps.is_empty() && self.spebt.is_empty()
+    }
+}

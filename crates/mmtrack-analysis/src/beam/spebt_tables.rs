@@ -68,3 +68,27 @@ Liu et al. 2024, Fig. 5) and the RMSE over all runs at that slot.";
         reinitialisation_rate: f64, "", "fraction of runs re-initialised at this slot";
     }
 }
+
+mmtrack_io::define_table! {
+    /// `spebt_pooled`: per experiment kind, every sequence pooled.
+    pub const SPEBT_POOLED = "spebt_pooled",
+        "SPEBT accuracy pooled over every sequence analysed (partition sequence=all), one row per experiment kind: \
+each sequence's RMSE weighted by its tracked estimates ((slots - 1) x runs), so the pooled RMSE is the RMS over every \
+estimate of every sequence; the re-initialisation share is every re-initialisation over every tracked slot. Written \
+by `mmtrack analyze` from spebt_summary.";
+    /// One row of [`SPEBT_POOLED`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SpebtPooledRow {
+        experiment: String, "", "pose-error-model or radar-odometry (spebt_summary.experiment)";
+        sequences: u64, "", "sequences pooled";
+        tracked_estimates: u64, "", "sum over sequences of (slots - 1) x runs";
+        rmse_gain_pct: f64, "%", "RMS relative abs(alpha) error over every pooled estimate";
+        rmse_aod_deg: f64, "deg", "RMS AoD error over every pooled estimate";
+        rmse_aoa_deg: f64, "deg", "RMS AoA error over every pooled estimate";
+        reinitialisation_share_pct: f64, "%", "re-initialisations over every pooled tracked slot";
+        paper_rmse_gain_pct: f64, "%", "the paper's RMSE of abs(alpha) (Table III)";
+        paper_rmse_aod_deg: f64, "deg", "the paper's AoD RMSE (Table III)";
+        paper_rmse_aoa_deg: f64, "deg", "the paper's AoA RMSE (Table III)";
+        paper_reinitialisation_share_pct: f64, "%", "the paper's re-initialisation share";
+    }
+}

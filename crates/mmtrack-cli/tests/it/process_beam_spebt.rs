@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use mmtrack_analysis::beam::spebt_tables::{SpebtSlotRow, SpebtSummaryRow};
+use mmtrack_analysis::beam::spebt_tables::{SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
 use mmtrack_core::OdometryEstimate;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, read_table, write_table};
@@ -112,7 +112,32 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert!(summary.rmse_aod_deg.is_finite() && summary.rmse_aoa_deg.is_finite() && summary.rmse_aoa_deg < 15.0);
     let (ok, _, stderr) = run(d, &[&model[..], &["-o", "model2"]].concat());
     assert!(ok, "{stderr}");
-    assert_eq!(tables(d, "model2"), (summary, slots));
+    assert_eq!(tables(d, "model2"), (summary.clone(), slots));
+
+    // `analyze` checks the two tables against each other, pools and plots.
+    let (ok, stdout, stderr) = run(d, &["analyze", "model", "-o", "analysis"]);
+    assert!(ok, "{stderr}");
+    assert!(stdout.contains("spebt pose-error-model (1 sequences, 92 estimates)"), "{stdout}");
+    let analysis = d.join("analysis");
+    let pooled =
+        read_table::<SpebtPooledRow>(&analysis.join("tables/spebt_pooled/sequence=all/part-0.parquet")).unwrap();
+    assert_eq!((pooled.len(), pooled[0].tracked_estimates), (1, 23 * 4));
+    assert!((pooled[0].rmse_aod_deg - summary.rmse_aod_deg).abs() <= 1e-12 * summary.rmse_aod_deg, "{pooled:?}");
+    let copied = read_table::<SpebtSummaryRow>(&analysis.join("tables/spebt_summary/sequence=drive/part-0.parquet"));
+    assert_eq!(copied.unwrap(), vec![summary]);
+    let svg = std::fs::read_to_string(analysis.join("plots/drive/spebt_tracking.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("AoA (deg)"));
+    let report = std::fs::read_to_string(analysis.join("report.md")).unwrap();
+    assert!(report.contains("## SPEBT beam tracking") && report.contains("plots/drive/spebt_tracking.svg"), "{report}");
+    // A summary that does not belong to its per-slot table is named.
+    let mut other =
+        read_table::<SpebtSummaryRow>(&d.join("model/spebt_summary/sequence=drive/part-0.parquet")).unwrap();
+    other[0].rmse_aod_deg += 1.0;
+    let info = RunInfo { config_json: "{}".into() };
+    write_table(&d.join("model"), "drive", &other, &info, Overwrite::Replace).unwrap();
+    let (ok, _, stderr) = run(d, &["analyze", "model", "-o", "mixed"]);
+    assert!(!ok && stderr.contains("sequence drive: spebt_summary.rmse_aod_deg is"), "{stderr}");
+    assert!(stderr.contains("not from the same run") && !d.join("mixed").exists(), "{stderr}");
 
     // The link from --link: a base station elsewhere; one on the path is refused.
     std::fs::write(d.join("far.toml"), "[scenario]\nbs_x_m = -300.0\n").unwrap();

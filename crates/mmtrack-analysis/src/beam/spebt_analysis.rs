@@ -1,0 +1,364 @@
+//! SPEBT beam tracking (Liu et al. 2024) in `mmtrack analyze`: the tables
+//! `spebt_summary` and `spebt_per_slot` that `mmtrack process beam --tracker
+//! spebt` (or `mmtrack reproduce spebt`) wrote, checked against each other,
+//! pooled over sequences, with the paper's Fig. 5 figure per sequence.
+//!
+//! Pooling rule: each sequence's RMSE covers its `(slots - 1) x runs`
+//! tracked estimates (slot 0 is the initial access), so the pooled RMSE is
+//! `sqrt(sum_i n_i RMSE_i^2 / sum_i n_i)`, the RMS over every estimate of
+//! every sequence; the re-initialisation share is every re-initialisation
+//! over every tracked slot of every run. One row per experiment kind
+//! (`pose-error-model`, `radar-odometry`): they are different inputs and are
+//! never pooled together.
+
+use std::fmt::Write;
+
+use super::spebt_plots::SpebtTrackingSeries;
+use super::spebt_tables::{SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
+
+/// The figure of one sequence, with its caption.
+pub const SEQUENCE_PLOT: (&str, &str) = ("spebt_tracking.svg", "run 0 against the truth (Liu et al. Fig. 5)");
+
+/// Relative tolerance between `spebt_summary`'s RMSE and the one
+/// recomputed from `spebt_per_slot` (both are f64 sums of the same squares
+/// in a different order).
+const CONSISTENCY_TOLERANCE: f64 = 1e-6;
+
+/// One sequence: its summary row and slots.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpebtSequenceResult {
+    /// Sequence id (the partition).
+    pub sequence: String,
+    /// The sequence's `spebt_summary` row.
+    pub summary: SpebtSummaryRow,
+    /// The sequence's `spebt_per_slot` rows, slot 0 first.
+    pub per_slot: Vec<SpebtSlotRow>,
+}
+
+impl SpebtSequenceResult {
+    /// Run 0 against the truth, for [`super::spebt_plots::spebt_tracking_svg`].
+    #[must_use]
+    pub fn tracking_series(&self) -> SpebtTrackingSeries {
+        let mut s = SpebtTrackingSeries::default();
+        for r in &self.per_slot {
+            s.true_gain.push(r.true_gain);
+            s.true_aod_deg.push(r.true_aod_deg);
+            s.true_aoa_deg.push(r.true_aoa_deg);
+            s.estimate_gain.push(r.run0_gain);
+            s.estimate_aod_deg.push(r.run0_aod_deg);
+            s.estimate_aoa_deg.push(r.run0_aoa_deg);
+            s.reinitialised.push(r.run0_reinitialised);
+        }
+        s
+    }
+}
+
+/// Everything computed from the SPEBT tables.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SpebtResults {
+    /// Per sequence, in sequence order.
+    pub sequences: Vec<SpebtSequenceResult>,
+    /// Per experiment kind, in order of first appearance.
+    pub pooled: Vec<SpebtPooledRow>,
+}
+
+impl SpebtResults {
+    /// Whether there is nothing.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.sequences.is_empty()
+    }
+}
+
+/// Checks one sequence's tables and builds its result.
+///
+/// # Errors
+/// A message naming the sequence (and slot and column) when the summary is
+/// not exactly one row, a slot is missing or out of order, a value is not
+/// finite, or the summary's RMSE differs from the one the slots give.
+pub fn sequence_result(
+    sequence: &str,
+    summary: Vec<SpebtSummaryRow>,
+    per_slot: Vec<SpebtSlotRow>,
+) -> Result<SpebtSequenceResult, String> {
+    let [summary]: [SpebtSummaryRow; 1] = summary.try_into().map_err(|rows: Vec<SpebtSummaryRow>| {
+        format!("sequence {sequence}: table spebt_summary has {} rows, expected one per sequence", rows.len())
+    })?;
+    if summary.slots < 2 || summary.runs == 0 {
+        return Err(format!(
+            "sequence {sequence}: spebt_summary has slots {} and runs {}; expected at least 2 slots and 1 run",
+            summary.slots, summary.runs
+        ));
+    }
+    if per_slot.len() as u64 != summary.slots {
+        return Err(format!(
+            "sequence {sequence}: spebt_per_slot has {} rows but spebt_summary says {} slots",
+            per_slot.len(),
+            summary.slots
+        ));
+    }
+    for (k, r) in per_slot.iter().enumerate() {
+        if r.slot != k as u64 {
+            return Err(format!("sequence {sequence}: spebt_per_slot row {k} is slot {}; expected slot {k}", r.slot));
+        }
+        let columns = [
+            ("t_s", r.t_s),
+            ("true_gain", r.true_gain),
+            ("true_aod_deg", r.true_aod_deg),
+            ("true_aoa_deg", r.true_aoa_deg),
+            ("run0_gain", r.run0_gain),
+            ("run0_aod_deg", r.run0_aod_deg),
+            ("run0_aoa_deg", r.run0_aoa_deg),
+            ("rmse_gain_pct", r.rmse_gain_pct),
+            ("rmse_aod_deg", r.rmse_aod_deg),
+            ("rmse_aoa_deg", r.rmse_aoa_deg),
+            ("reinitialisation_rate", r.reinitialisation_rate),
+        ];
+        if let Some((name, value)) = columns.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(format!("sequence {sequence}: spebt_per_slot slot {k}: {name} is {value}, expected finite"));
+        }
+    }
+    // The summary's RMSE over the tracked slots equals the RMS of the
+    // per-slot RMSEs (every slot holds the same runs).
+    let tracked = &per_slot[1..];
+    let rms =
+        |f: fn(&SpebtSlotRow) -> f64| (tracked.iter().map(|r| f(r) * f(r)).sum::<f64>() / tracked.len() as f64).sqrt();
+    let checks = [
+        ("rmse_gain_pct", summary.rmse_gain_pct, rms(|r| r.rmse_gain_pct)),
+        ("rmse_aod_deg", summary.rmse_aod_deg, rms(|r| r.rmse_aod_deg)),
+        ("rmse_aoa_deg", summary.rmse_aoa_deg, rms(|r| r.rmse_aoa_deg)),
+    ];
+    for (name, stated, from_slots) in checks {
+        let scale = stated.abs().max(from_slots.abs()).max(1e-12);
+        if !stated.is_finite() || (stated - from_slots).abs() > CONSISTENCY_TOLERANCE * scale {
+            return Err(format!(
+                "sequence {sequence}: spebt_summary.{name} is {stated} but spebt_per_slot gives {from_slots}: the two \
+                 tables are not from the same run"
+            ));
+        }
+    }
+    Ok(SpebtSequenceResult { sequence: sequence.to_string(), summary, per_slot })
+}
+
+/// Pools `sequences` per experiment kind (module docs).
+#[must_use]
+pub fn pool(sequences: &[SpebtSequenceResult]) -> Vec<SpebtPooledRow> {
+    let mut kinds: Vec<&str> = Vec::new();
+    for s in sequences {
+        if !kinds.contains(&s.summary.experiment.as_str()) {
+            kinds.push(&s.summary.experiment);
+        }
+    }
+    kinds
+        .into_iter()
+        .map(|kind| {
+            let members: Vec<&SpebtSummaryRow> =
+                sequences.iter().map(|s| &s.summary).filter(|s| s.experiment == kind).collect();
+            let weight = |s: &SpebtSummaryRow| (s.slots - 1) * s.runs;
+            let estimates: u64 = members.iter().map(|s| weight(s)).sum();
+            let pooled = |f: fn(&SpebtSummaryRow) -> f64| {
+                (members.iter().map(|s| weight(s) as f64 * f(s) * f(s)).sum::<f64>() / estimates as f64).sqrt()
+            };
+            let reinitialisations: f64 = members.iter().map(|s| s.reinitialisations_mean * s.runs as f64).sum();
+            let first = members[0];
+            SpebtPooledRow {
+                experiment: kind.to_string(),
+                sequences: members.len() as u64,
+                tracked_estimates: estimates,
+                rmse_gain_pct: pooled(|s| s.rmse_gain_pct),
+                rmse_aod_deg: pooled(|s| s.rmse_aod_deg),
+                rmse_aoa_deg: pooled(|s| s.rmse_aoa_deg),
+                reinitialisation_share_pct: 100.0 * reinitialisations / estimates as f64,
+                paper_rmse_gain_pct: first.paper_rmse_gain_pct,
+                paper_rmse_aod_deg: first.paper_rmse_aod_deg,
+                paper_rmse_aoa_deg: first.paper_rmse_aoa_deg,
+                paper_reinitialisation_share_pct: first.paper_reinitialisation_share_pct,
+            }
+        })
+        .collect()
+}
+
+/// The report section.
+pub fn section(out: &mut String, results: &SpebtResults) {
+    out.push_str(
+        "## SPEBT beam tracking (tables `spebt_summary`, `spebt_per_slot`)\n\n\
+         RMSE over every tracked slot (slot 0, the initial access, excluded) of every run, against the simulated \
+         link's true channel (Liu et al. 2024, Table III); re-initialisations per tracked slot (Algorithm 1). Pooled \
+         rows weight each sequence by its (slots - 1) x runs estimates; the paper's numbers in brackets.\n\n\
+         ### Pooled\n\n\
+         | experiment | sequences | estimates | abs(alpha) RMSE (%) | AoD RMSE (deg) | AoA RMSE (deg) | \
+         re-initialisations (%) |\n|---|---|---|---|---|---|---|\n",
+    );
+    for p in &results.pooled {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {:.2} [{}] | {:.3} [{}] | {:.2} [{}] | {:.2} [{:.1}] |",
+            p.experiment,
+            p.sequences,
+            p.tracked_estimates,
+            p.rmse_gain_pct,
+            p.paper_rmse_gain_pct,
+            p.rmse_aod_deg,
+            p.paper_rmse_aod_deg,
+            p.rmse_aoa_deg,
+            p.paper_rmse_aoa_deg,
+            p.reinitialisation_share_pct,
+            p.paper_reinitialisation_share_pct
+        );
+    }
+    out.push_str(
+        "\n### Per sequence\n\n| sequence | experiment | slots | runs | abs(alpha) RMSE (%) | AoD RMSE (deg) | \
+         AoA RMSE (deg) | re-initialisations (%) | plot |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in &results.sequences {
+        let s = &r.summary;
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {:.2} | {:.3} | {:.2} | {:.2} | [{}](plots/{}/{}) |",
+            r.sequence,
+            s.experiment,
+            s.slots,
+            s.runs,
+            s.rmse_gain_pct,
+            s.rmse_aod_deg,
+            s.rmse_aoa_deg,
+            s.reinitialisation_share_pct,
+            SEQUENCE_PLOT.1,
+            r.sequence,
+            SEQUENCE_PLOT.0
+        );
+    }
+    out.push('\n');
+}
+
+/// One line per experiment kind, as the CLI prints it.
+#[must_use]
+pub fn one_lines(results: &SpebtResults) -> Vec<String> {
+    results
+        .pooled
+        .iter()
+        .map(|p| {
+            format!(
+                "spebt {} ({} sequences, {} estimates): RMSE abs(alpha) {:.2} %, AoD {:.3} deg, AoA {:.2} deg, \
+                 re-initialisations {:.2} % of slots (paper {} %, {} deg, {} deg, {:.1} %)",
+                p.experiment,
+                p.sequences,
+                p.tracked_estimates,
+                p.rmse_gain_pct,
+                p.rmse_aod_deg,
+                p.rmse_aoa_deg,
+                p.reinitialisation_share_pct,
+                p.paper_rmse_gain_pct,
+                p.paper_rmse_aod_deg,
+                p.paper_rmse_aoa_deg,
+                p.paper_reinitialisation_share_pct
+            )
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary(experiment: &str, slots: u64, runs: u64, rmse: [f64; 3], reinit_mean: f64) -> SpebtSummaryRow {
+        SpebtSummaryRow {
+            experiment: experiment.into(),
+            trajectory: "t".into(),
+            slots,
+            runs,
+            seed: 1,
+            rmse_gain_pct: rmse[0],
+            rmse_aod_deg: rmse[1],
+            rmse_aoa_deg: rmse[2],
+            reinitialisations_mean: reinit_mean,
+            reinitialisations_min: 0,
+            reinitialisations_max: 1,
+            reinitialisation_share_pct: 100.0 * reinit_mean / (slots - 1) as f64,
+            reinit_gain_pct: 0.0,
+            reinit_aod_pct: 100.0,
+            reinit_aoa_pct: 0.0,
+            paper_rmse_gain_pct: 0.3,
+            paper_rmse_aod_deg: 0.22,
+            paper_rmse_aoa_deg: 4.6,
+            paper_reinitialisation_share_pct: 4.7,
+        }
+    }
+
+    fn slot(k: u64, rmse: [f64; 3]) -> SpebtSlotRow {
+        SpebtSlotRow {
+            slot: k,
+            t_s: 0.25 * k as f64,
+            x_m: 0.0,
+            y_m: 0.0,
+            yaw_deg: 0.0,
+            range_m: 100.0,
+            true_gain: 1e-6,
+            true_aod_deg: 10.0,
+            true_aoa_deg: -20.0,
+            run0_gain: 1.1e-6,
+            run0_aod_deg: 10.1,
+            run0_aoa_deg: -21.0,
+            run0_reinitialised: false,
+            rmse_gain_pct: rmse[0],
+            rmse_aod_deg: rmse[1],
+            rmse_aoa_deg: rmse[2],
+            reinitialisation_rate: 0.0,
+        }
+    }
+
+    #[test]
+    fn pooled_rmse_weights_each_estimate_once_by_hand() {
+        // Sequence a: 3 slots, 2 runs (4 estimates), slot RMSEs 1 and 3 deg
+        // -> RMSE sqrt(5). Sequence b: 2 slots, 4 runs (4 estimates), 2 deg.
+        let a = sequence_result(
+            "a",
+            vec![summary("radar-odometry", 3, 2, [1.0, 5f64.sqrt(), 2.0], 1.0)],
+            vec![slot(0, [9.0; 3]), slot(1, [1.0, 1.0, 2.0]), slot(2, [1.0, 3.0, 2.0])],
+        )
+        .unwrap();
+        let b = sequence_result(
+            "b",
+            vec![summary("radar-odometry", 2, 4, [1.0, 2.0, 2.0], 0.5)],
+            vec![slot(0, [0.0; 3]), slot(1, [1.0, 2.0, 2.0])],
+        )
+        .unwrap();
+        let other = sequence_result(
+            "c",
+            vec![summary("pose-error-model", 2, 1, [7.0; 3], 0.0)],
+            vec![slot(0, [0.0; 3]), slot(1, [7.0; 3])],
+        )
+        .unwrap();
+        let pooled = pool(&[a, b, other]);
+        assert_eq!(pooled.len(), 2, "experiment kinds are never pooled together");
+        let p = &pooled[0];
+        assert_eq!((p.experiment.as_str(), p.sequences, p.tracked_estimates), ("radar-odometry", 2, 8));
+        // (4 x 5 + 4 x 4) / 8 = 4.5.
+        assert!((p.rmse_aod_deg - 4.5f64.sqrt()).abs() < 1e-12, "{}", p.rmse_aod_deg);
+        // Re-initialisations: 1 x 2 runs + 0.5 x 4 runs = 4 over 8 tracked slots.
+        assert!((p.reinitialisation_share_pct - 50.0).abs() < 1e-12);
+        assert_eq!(pooled[1].rmse_aod_deg, 7.0);
+        let mut text = String::new();
+        section(&mut text, &SpebtResults { sequences: Vec::new(), pooled });
+        assert!(text.contains("| radar-odometry | 2 | 8 | 1.00 [0.3] | 2.121 [0.22] |"), "{text}");
+    }
+
+    #[test]
+    fn inconsistent_or_bad_tables_are_named() {
+        let good = || vec![slot(0, [0.0; 3]), slot(1, [1.0, 2.0, 3.0])];
+        let err = sequence_result("p", vec![summary("x", 2, 1, [1.0, 2.5, 3.0], 0.0)], good()).unwrap_err();
+        assert!(err.contains("sequence p: spebt_summary.rmse_aod_deg is 2.5 but spebt_per_slot gives 2"), "{err}");
+        let err = sequence_result("p", Vec::new(), good()).unwrap_err();
+        assert!(err.contains("has 0 rows, expected one"), "{err}");
+        let mut slots = good();
+        slots[1].run0_aoa_deg = f64::NAN;
+        let err = sequence_result("p", vec![summary("x", 2, 1, [1.0, 2.0, 3.0], 0.0)], slots).unwrap_err();
+        assert!(err.contains("slot 1: run0_aoa_deg is NaN"), "{err}");
+        let mut slots = good();
+        slots[1].slot = 5;
+        let err = sequence_result("p", vec![summary("x", 2, 1, [1.0, 2.0, 3.0], 0.0)], slots).unwrap_err();
+        assert!(err.contains("row 1 is slot 5"), "{err}");
+        let err = sequence_result("p", vec![summary("x", 3, 1, [1.0, 2.0, 3.0], 0.0)], good()).unwrap_err();
+        assert!(err.contains("2 rows but spebt_summary says 3 slots"), "{err}");
+    }
+}
