@@ -247,3 +247,113 @@ fn trackers_beat_the_last_full_sweep_with_at_most_five_beams_per_sweep() {
     // Scenario 3's raw car positions, for comparison (not asserted).
     scenario_table("scenario 3 (raw car positions)", &load(&dir, 3, false));
 }
+
+/// One setting of the grid of [`defaults_chosen_on_one_scenario_hold_on_the_other`].
+#[derive(Debug, Clone, Copy)]
+struct Setting {
+    half_window_beams: usize,
+    max_extension_beams: usize,
+    drop_db: f64,
+    /// Window tracker: acceleration noise, beams/s^2; GNSS tracker: offset
+    /// random walk, beams/sqrt(s).
+    motion_noise: f64,
+}
+
+fn grid(motion_noise: [f64; 3]) -> Vec<Setting> {
+    let mut out = Vec::new();
+    for half_window_beams in [1, 2] {
+        for max_extension_beams in [2, 4, 6] {
+            for drop_db in [3.0, 6.0, 9.0] {
+                for noise in motion_noise {
+                    out.push(Setting { half_window_beams, max_extension_beams, drop_db, motion_noise: noise });
+                }
+            }
+        }
+    }
+    out
+}
+
+fn search(s: &Setting) -> SearchConfig {
+    SearchConfig {
+        half_window_beams: s.half_window_beams,
+        max_extension_beams: s.max_extension_beams,
+        drop_db: s.drop_db,
+        ..SearchConfig::default()
+    }
+}
+
+/// Held-out check of the defaults. They were picked after a small grid on
+/// both scenarios together, so the main test's margins are in-sample. Here
+/// each tracker's setting is chosen on one scenario alone (lowest mean loss
+/// among the grid's settings with at most 5 beams per sweep) and evaluated
+/// on the other, against that scenario's last-full-sweep baseline. Printed
+/// in both directions; the README reports it.
+#[test]
+fn defaults_chosen_on_one_scenario_hold_on_the_other() {
+    let Some(dir) = realdata("deepsense-60ghz-beams") else { return };
+    let scenarios = [("scenario 1", load(&dir, 1, false)), ("scenario 3", load(&dir, 3, true))];
+    let maps: Vec<Vec<BeamMap>> = scenarios.iter().map(|(_, s)| beam_maps(s).0).collect();
+    let summary = |records: &[SweepRecord]| SweepSummary::from_records(records).unwrap();
+    let window_of = |s: &Setting| WindowTrackerConfig {
+        search: search(s),
+        sigma_accel_beams_per_s2: s.motion_noise,
+        ..WindowTrackerConfig::default()
+    };
+    let gnss_of = |s: &Setting, map: &BeamMap| GnssTrackerConfig {
+        search: search(s),
+        offset_walk_beams_per_sqrt_s: s.motion_noise,
+        initial_offset_sigma_beams: map.rms_residual_beams(),
+        ..GnssTrackerConfig::default()
+    };
+    let evaluate_setting = |tracker: &str, k: usize, s: &Setting| -> SweepSummary {
+        let scenario = &scenarios[k].1;
+        match tracker {
+            "window" => summary(&run(scenario, &maps[k], &|_| Box::new(WindowTracker::new(window_of(s)).unwrap()))),
+            _ => summary(&run(scenario, &maps[k], &|m| Box::new(GnssWindowTracker::new(gnss_of(s, m)).unwrap()))),
+        }
+    };
+    let last: Vec<SweepSummary> =
+        (0..2).map(|k| summary(&run(&scenarios[k].1, &maps[k], &|_| Box::new(LastFullSweep::new())))).collect();
+    println!("\nHeld-out settings (chosen on one scenario, evaluated on the other):");
+    let mut over_budget = Vec::new();
+    for (tracker, noise) in [("window", [10.0, 30.0, 60.0]), ("gnss-window", [1.0, 2.0, 4.0])] {
+        for (tune, test) in [(0, 1), (1, 0)] {
+            let settings = grid(noise);
+            let chosen = settings
+                .iter()
+                .map(|s| (s, evaluate_setting(tracker, tune, s)))
+                .filter(|(_, r)| r.mean_beams_per_sweep <= 5.0)
+                .min_by(|a, b| a.1.mean_loss_db.total_cmp(&b.1.mean_loss_db))
+                .expect("some setting measures at most 5 beams per sweep");
+            let held_out = evaluate_setting(tracker, test, chosen.0);
+            println!(
+                "  {tracker:<11} chosen on {}: {:?} ({:.3} dB, {:.2} beams there) -> {}: {:.3} dB mean loss at {:.2} \
+                 beams per sweep (last full sweep {:.3} dB)",
+                scenarios[tune].0,
+                chosen.0,
+                chosen.1.mean_loss_db,
+                chosen.1.mean_beams_per_sweep,
+                scenarios[test].0,
+                held_out.mean_loss_db,
+                held_out.mean_beams_per_sweep,
+                last[test].mean_loss_db
+            );
+            // Asserted: the loss half of the target holds out of sample.
+            assert!(
+                held_out.mean_loss_db < last[test].mean_loss_db,
+                "{tracker} chosen on {}: {:.3} dB on {}, last full sweep {:.3} dB",
+                scenarios[tune].0,
+                held_out.mean_loss_db,
+                scenarios[test].0,
+                last[test].mean_loss_db
+            );
+            if held_out.mean_beams_per_sweep > 5.0 {
+                over_budget.push(format!("{tracker} chosen on {} on {}", scenarios[tune].0, scenarios[test].0));
+            }
+        }
+    }
+    // Reported, not asserted (README): the beam budget does not always
+    // transfer (measured: the window tracker tuned on scenario 1 reads 5.74
+    // beams per sweep on scenario 3).
+    println!("  over the 5-beam budget out of sample: {over_budget:?}");
+}
