@@ -34,6 +34,7 @@ mod odometry;
 pub mod parallel;
 mod pose;
 mod radar;
+pub mod slam;
 pub mod sounder;
 
 pub use beam_sweep::BeamSweep;
