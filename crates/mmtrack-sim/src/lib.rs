@@ -72,6 +72,7 @@
 pub mod beam;
 mod error;
 pub mod radar;
+pub mod slam;
 pub mod sounder;
 
 pub use error::SimError;
