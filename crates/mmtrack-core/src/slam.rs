@@ -202,7 +202,7 @@ pub fn virtual_anchor(bs_m: [f64; 3], wall_point_m: [f64; 3], wall_normal: [f64;
 pub fn incidence_point(va_m: [f64; 3], bs_m: [f64; 3], ue_m: [f64; 3]) -> Option<[f64; 3]> {
     let to_bs = sub3(bs_m, va_m);
     let len = norm3(to_bs);
-    if !(len > 0.0) {
+    if len.is_nan() || len <= 0.0 {
         return None;
     }
     let u = [to_bs[0] / len, to_bs[1] / len, to_bs[2] / len];
@@ -224,7 +224,7 @@ pub fn incidence_point(va_m: [f64; 3], bs_m: [f64; 3], ue_m: [f64; 3]) -> Option
 pub fn va_from_incidence(ue_m: [f64; 3], incidence_m: [f64; 3], bs_m: [f64; 3]) -> Option<[f64; 3]> {
     let dir = sub3(incidence_m, ue_m);
     let r = norm3(dir);
-    if !(r > 0.0) {
+    if r.is_nan() || r <= 0.0 {
         return None;
     }
     let total = r + norm3(sub3(bs_m, incidence_m));
@@ -236,7 +236,7 @@ pub fn va_from_incidence(ue_m: [f64; 3], incidence_m: [f64; 3], bs_m: [f64; 3]) 
 #[must_use]
 pub fn azimuth_elevation_rad(d: [f64; 3]) -> Option<(f64, f64)> {
     let r = norm3(d);
-    if !(r > 0.0) {
+    if r.is_nan() || r <= 0.0 {
         return None;
     }
     Some((d[1].atan2(d[0]), (d[2] / r).clamp(-1.0, 1.0).asin()))
