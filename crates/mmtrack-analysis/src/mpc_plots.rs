@@ -228,7 +228,16 @@ pub fn power_std_svg(result: &MpcResult) -> anyhow::Result<String> {
     Ok(svg)
 }
 
-/// Delay against time over the first [`DELAY_PLOT_SETS`] sets: detections
+/// What the delay plot leaves out: `Some("first 30 of 412 sets")` when the
+/// sequence has more than [`DELAY_PLOT_SETS`] sets, else `None`.
+#[must_use]
+pub fn delay_plot_subset(result: &MpcResult) -> Option<String> {
+    let sets = result.per_set.len();
+    (sets > DELAY_PLOT_SETS).then(|| format!("first {DELAY_PLOT_SETS} of {sets} sets"))
+}
+
+/// Delay against time over the first [`DELAY_PLOT_SETS`] sets (the caption
+/// says so when there are more): detections
 /// coloured by power (dark weak, yellow strong), short-term tracks as lines.
 pub fn delay_tracks_svg(result: &MpcResult) -> anyhow::Result<String> {
     let t0 = t0(result);
@@ -249,8 +258,9 @@ pub fn delay_tracks_svg(result: &MpcResult) -> anyhow::Result<String> {
             .margin(12)
             .caption(
                 format!(
-                    "{}: detections by power ({p_lo:.0}..{p_hi:.0} dB, dark to yellow), short-term tracks",
-                    result.sequence
+                    "{}: detections by power ({p_lo:.0}..{p_hi:.0} dB, dark to yellow), short-term tracks{}",
+                    result.sequence,
+                    delay_plot_subset(result).map_or_else(String::new, |note| format!("; {note}"))
                 ),
                 ("sans-serif", 16),
             )

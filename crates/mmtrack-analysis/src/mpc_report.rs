@@ -134,6 +134,11 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
         );
     }
     out.push('\n');
+    for r in results {
+        for note in &r.notes {
+            let _ = writeln!(out, "`{}`: {note}.\n", r.sequence);
+        }
+    }
     let with_truth: Vec<&MpcResult> = results.iter().filter(|r| r.summary.truth_mpcs.is_some()).collect();
     if !with_truth.is_empty() {
         out.push_str(
@@ -184,7 +189,11 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
     for r in results {
         let _ = writeln!(out, "### `{}` (MPC)\n", r.sequence);
         for (file, title) in PLOTS {
-            let _ = writeln!(out, "![{title}](plots/{}/{file})", r.sequence);
+            let subset = match crate::mpc_plots::delay_plot_subset(r) {
+                Some(note) if file == PLOTS[0].0 => format!(" ({note})"),
+                _ => String::new(),
+            };
+            let _ = writeln!(out, "![{title}{subset}](plots/{}/{file})", r.sequence);
         }
         out.push('\n');
     }

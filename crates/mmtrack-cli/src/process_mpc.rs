@@ -419,6 +419,15 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
                 link.tracks.len(),
                 link.long_term.len()
             );
+            let most = link.sets.iter().map(|s| s.snapshots.saturating_sub(s.skipped_snapshots)).max().unwrap_or(0);
+            let needed = config.short_term.min_track_length;
+            if link.tracks.is_empty() && !link.detections.is_empty() && (most as usize) < needed {
+                println!(
+                    "  no short-term tracks: sets hold at most {most} snapshot(s) and a track follows one path over at \
+                     least short_term.min_track_length = {needed} snapshots of one set (Mahler et al. Sec. III-B); \
+                     this source gives detections and first paths only"
+                );
+            }
         }
     }
     if !quiet {

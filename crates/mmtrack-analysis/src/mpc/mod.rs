@@ -260,6 +260,8 @@ pub struct MpcResult {
     pub detections: Vec<MpcDetection>,
     /// Short-term tracks (for the plot).
     pub tracks: Vec<MpcTrack>,
+    /// Plain sentences on metrics left empty and why (for the report).
+    pub notes: Vec<String>,
 }
 
 fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
@@ -356,7 +358,9 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> Mpc
     summary.first_path_minus_hint_median_s = first.median_minus_hint_s;
     summary.first_path_hint_abs_median_s = first.median_abs_minus_hint_s;
     summary.first_path_hint_abs_p90_s = first.p90_abs_minus_hint_s;
+    let notes = empty_metric_notes(&sets, &input.detections, &input.tracks);
     MpcResult {
+        notes,
         sequence: sequence.to_string(),
         per_set,
         power_std,
@@ -368,6 +372,44 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> Mpc
         tracks: input.tracks,
     }
 }
+
+/// Why whole groups of metrics are empty: no detections at all, or no
+/// short-term tracks (a track follows one path over at least
+/// `short_term.min_track_length` >= 3 snapshots of one set, Mahler et al.
+/// Sec. III-B, so sets of fewer snapshots cannot hold one).
+fn empty_metric_notes(sets: &[MpcSetStats], detections: &[MpcDetection], tracks: &[MpcTrack]) -> Vec<String> {
+    if detections.is_empty() {
+        return vec![
+            "no detections in any snapshot (no tap rose the threshold margin above the noise floor), so every MPC \
+             metric is empty"
+                .to_string(),
+        ];
+    }
+    if !tracks.is_empty() {
+        return Vec::new();
+    }
+    let most = sets.iter().map(|s| s.snapshots.saturating_sub(s.skipped_snapshots)).max().unwrap_or(0);
+    let what = "tracking and full-lifetime losses, power standard deviations, long-term tracks, births, deaths and chi \
+                shares are empty";
+    if most < MIN_SHORT_TERM_TRACK_SNAPSHOTS {
+        vec![format!(
+            "no short-term tracks, so {what}: its sets hold at most {most} snapshot(s) each, and a short-term track \
+             follows one path over at least {MIN_SHORT_TERM_TRACK_SNAPSHOTS} snapshots of one set \
+             (`short_term.min_track_length`, Mahler et al. Sec. III-B). Sources that record one CIR per set (e.g. \
+             DecaWave logs) give detections and first paths only."
+        )]
+    } else {
+        vec![format!(
+            "no short-term tracks, so {what}: its sets hold up to {most} snapshots, but no path stayed within the \
+             short-term gates (`short_term.delay_tolerance_s`, `short_term.magnitude_tolerance_db`) for \
+             `short_term.min_track_length` snapshots"
+        )]
+    }
+}
+
+/// The fewest snapshots a short-term track can span (the tracker refuses a
+/// smaller `short_term.min_track_length`).
+const MIN_SHORT_TERM_TRACK_SNAPSHOTS: u32 = 3;
 
 fn track_power_std(tracks: &[MpcTrack], sets: &[MpcSetStats]) -> Vec<TrackPowerStd> {
     let lengths: BTreeMap<u64, u32> =
