@@ -1,31 +1,36 @@
 //! `mmtrack demo`: the whole chain on embedded data, no files needed.
 //!
-//! Simulate the demo radar scenario as an Oxford-layout folder, ingest it into
-//! a recording, write its ground truth as a Parquet table, run radar odometry
-//! (the `cfear` preset) on it, compute trajectory metrics and plots against
-//! the ground truth, and show where everything is.
+//! The demo runs the same commands a user types, printed before each runs
+//! (copy any of them to run it again):
+//!
+//! 1. radar: simulate the embedded demo drive as an Oxford-layout folder,
+//!    ingest it, run radar odometry (`cfear`);
+//! 2. multipath: simulate a short stretch (40 sets) of the embedded convoy
+//!    sounder scenario and detect and track its multipath components
+//!    (GM-PHD baseline included);
+//! 3. beam: SPEBT beam tracking along the radar drive, driven by the
+//!    odometry of step 1;
+//! 4. analyze every table together: trajectory metrics, MPC statistics,
+//!    SPEBT accuracy, plots and `report.md`.
+//!
+//! SLAM joins when its pipeline lands (issue #16).
 
-use std::path::PathBuf;
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::Context;
-use clap::Args;
-use mmtrack_analysis::output::write_results;
-use mmtrack_analysis::pipeline::analyze_trajectory;
-use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep};
-use mmtrack_core::StampedPose;
-use mmtrack_ingest::oxford::{self, OxfordOptions};
-use mmtrack_io::recording::PoseStream;
-use mmtrack_io::table::{RunInfo, write_table};
-use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
-use mmtrack_odometry::OdometryConfig;
+use anyhow::{Context, bail};
+use clap::{Args, Parser};
 
-use crate::ingest::{CompressionArg, OutputArgs};
-use crate::{inspect, process, simulate};
+use crate::inspect;
 
-/// The demo scenario, embedded so the demo runs from any directory.
+/// The demo radar scenario, embedded so the demo runs from any directory.
 pub const DEMO_SCENARIO: &str = include_str!("../../../data/demo/radar-scenario.toml");
-/// Sequence id of the demo data (the folder name, as for real Oxford data).
+/// The sounder scenario the demo cuts to [`DEMO_SOUNDER_SETS`] sets.
+pub const DEMO_SOUNDER_SCENARIO: &str = include_str!("../../../data/sounder/convoy-tunnel.toml");
+/// Sets of the sounder scenario the demo simulates (0.4 s of driving).
+pub const DEMO_SOUNDER_SETS: usize = 40;
+/// Sequence id of the demo radar data (the folder name, as for real Oxford data).
 pub const DEMO_SEQUENCE: &str = "oxford-demo";
 
 #[derive(Args)]
@@ -35,96 +40,79 @@ pub struct DemoArgs {
     out: PathBuf,
 }
 
-pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let scenario = simulate::parse_scenario(DEMO_SCENARIO).context("embedded demo scenario")?;
-    let input = args.out.join("input").join(DEMO_SEQUENCE);
-    simulate::write_oxford(&scenario, &input, true)?;
+/// A path as a command-line argument.
+fn arg(path: &Path) -> anyhow::Result<String> {
+    path.to_str().map(str::to_string).with_context(|| format!("{}: the demo needs a UTF-8 path", path.display()))
+}
 
-    let recording = args.out.join("recording.mcap");
-    let output = OutputArgs {
-        output: recording.clone(),
-        force: true,
-        compression: CompressionArg::Zstd,
-        zstd_level: 1,
-        no_foxglove_views: false,
-        no_sync: false,
-    };
-    let options = OxfordOptions {
-        layout: oxford::NavtechLayout {
-            range_resolution_m: scenario.sensor.range_resolution_m,
-            expected_bins: Some(scenario.sensor.bins),
-            ..oxford::OXFORD
-        },
-        ..OxfordOptions::default()
-    };
-    crate::ingest::oxford_folder(&input, &output, &options, quiet)?;
-
-    let mut ground_truth: Vec<StampedPose> = Vec::new();
-    for event in RecordingReader::open(&recording)? {
-        if let RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } = event? {
-            ground_truth.push(pose);
-        }
+/// Runs one `mmtrack` command line, printing it first.
+fn step(args: &[String], quiet: bool) -> anyhow::Result<()> {
+    if !quiet {
+        println!("\n$ mmtrack {}", args.join(" "));
     }
-    let tables = args.out.join("tables");
-    let run = RunInfo {
-        config_json: serde_json::json!({"command": "demo", "table": "ground truth of the recording"}).to_string(),
-    };
-    write_table(&tables, DEMO_SEQUENCE, &ground_truth, &run, Overwrite::Replace)?;
+    let mut argv: Vec<OsString> = vec!["mmtrack".into()];
+    argv.extend(args.iter().map(OsString::from));
+    if quiet {
+        argv.push("--quiet".into());
+    }
+    let cli = crate::Cli::try_parse_from(argv).with_context(|| format!("demo step `mmtrack {}`", args.join(" ")))?;
+    let code = crate::run(cli).with_context(|| format!("demo step `mmtrack {}`", args.join(" ")))?;
+    if code != ExitCode::SUCCESS {
+        bail!("demo step `mmtrack {}` failed", args.join(" "));
+    }
+    Ok(())
+}
 
-    let preset = "cfear";
-    let config = OdometryConfig::cfear();
-    let odometry = process::run_odometry(&recording, config.clone(), quiet)?;
-    let written =
-        process::write_outputs(&tables, DEMO_SEQUENCE, &odometry, &config, preset, &recording, Overwrite::Replace)?;
+/// `words` as owned arguments.
+fn line(words: &[&str]) -> Vec<String> {
+    words.iter().map(|w| (*w).to_string()).collect()
+}
 
-    // Trajectory metrics and plots. The demo drive is 14 m, so the KITTI
-    // segments are scaled down from the devkit's 100..800 m.
-    let options = DriftOptions { segment_lengths_m: vec![4.0, 8.0, 12.0], step: FirstFrameStep::Frames(1) };
-    let estimate: Vec<StampedPose> = odometry
-        .estimates
-        .iter()
-        .map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle })
-        .collect();
-    let result = analyze_trajectory(DEMO_SEQUENCE, &estimate, &odometry.ground_truth, &options)?;
-    let info = RunInfo {
-        config_json: serde_json::json!({"command": "demo", "segment_lengths_m": options.segment_lengths_m}).to_string(),
-    };
-    let analysis = write_results(&args.out.join("analysis"), &[result], &[], &options, &info, Overwrite::Replace)?;
+pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    let out = &args.out;
+    let input = out.join("input");
+    std::fs::create_dir_all(&input).with_context(|| input.display().to_string())?;
+    let radar_scenario = input.join("radar-scenario.toml");
+    let sounder_scenario = input.join("sounder-scenario.toml");
+    std::fs::write(&radar_scenario, DEMO_SCENARIO).with_context(|| radar_scenario.display().to_string())?;
+    std::fs::write(&sounder_scenario, DEMO_SOUNDER_SCENARIO).with_context(|| sounder_scenario.display().to_string())?;
+    let folder = arg(&input.join(DEMO_SEQUENCE))?;
+    let recording = arg(&out.join("recording.mcap"))?;
+    let sounder = arg(&out.join("sounder.mcap"))?;
+    let tables = arg(&out.join("tables"))?;
+    let analysis = arg(&out.join("analysis"))?;
+    let sets = DEMO_SOUNDER_SETS.to_string();
+    let radar_scenario = arg(&radar_scenario)?;
+    let sounder_scenario = arg(&sounder_scenario)?;
+
+    if !quiet {
+        println!("mmtrack demo: radar odometry, multipath tracking and SPEBT beam tracking on simulated data");
+    }
+    let steps: [Vec<String>; 7] = [
+        line(&["simulate", "radar", "--scenario", &radar_scenario, "--format", "oxford", "-o", &folder, "--force"]),
+        line(&["ingest", "oxford", &folder, "-o", &recording, "--bins", "auto", "--force"]),
+        line(&["process", "odometry", &recording, "-o", &tables, "--preset", "cfear", "--force"]),
+        line(&["simulate", "sounder", "--scenario", &sounder_scenario, "--sets", &sets, "-o", &sounder, "--force"]),
+        line(&["process", "mpc", &sounder, "-o", &tables, "--gmphd", "--force"]),
+        line(&["process", "beam", &recording, "--tracker", "spebt", "--odometry", &tables, "-o", &tables, "--force"]),
+        // The demo drive is 14 m: KITTI segments scaled down from the
+        // devkit's 100..800 m, a first frame at every scan.
+        line(&["analyze", &tables, "-o", &analysis, "--segment-lengths-m", "4,8,12", "--step-frames", "1", "--force"]),
+    ];
+    for args in &steps {
+        step(args, quiet)?;
+    }
 
     if !quiet {
         println!();
-        inspect::run(&inspect::InspectArgs::new(recording.clone()), quiet)?;
-        println!();
-        inspect::run(&inspect::InspectArgs::new(tables.clone()), quiet)?;
+        inspect::run(&inspect::InspectArgs::new(PathBuf::from(&recording)), quiet)?;
         println!("\nOutputs:");
-        println!("  input folder (Oxford layout): {}", input.display());
-        println!("  recording (open in Foxglove):  {}", recording.display());
-        println!("  tables (Parquet, Hive layout): {}", tables.display());
-        let last = odometry.estimates.last().map(|e| e.world_from_vehicle);
-        let truth_end = odometry
-            .ground_truth
-            .first()
-            .zip(odometry.ground_truth.last())
-            .map(|(a, b)| a.parent_from_child.inverse() * b.parent_from_child);
-        if let (Some(estimate), Some(truth)) = (last, truth_end) {
-            println!(
-                "  radar odometry ({preset}, {} scans, {} low-confidence): end point {:.2} m from the ground truth's after {:.1} m",
-                odometry.estimates.len(),
-                odometry.estimates.iter().filter(|e| e.low_confidence).count(),
-                (truth.inverse() * estimate).translation_norm_m(),
-                truth.translation_norm_m()
-            );
-        }
-        println!(
-            "  odometry tables: {}",
-            written.iter().map(|w| w.path.display().to_string()).collect::<Vec<_>>().join(", ")
-        );
-        println!(
-            "  analysis (metrics, plots):    {} (report {})",
-            analysis.out_dir.display(),
-            analysis.report.display()
-        );
-        println!("\nNot in the demo yet: the mpc, beam and slam pipelines.");
+        println!("  input folder (Oxford layout): {folder}");
+        println!("  radar recording (Foxglove):    {recording}");
+        println!("  sounder recording:             {sounder}");
+        println!("  tables (Parquet, Hive layout): {tables}");
+        println!("  analysis (metrics, plots):     {analysis} (report {analysis}/report.md)");
+        println!("\nNot in the demo yet: the SLAM pipeline (issue #16).");
     }
     Ok(ExitCode::SUCCESS)
 }

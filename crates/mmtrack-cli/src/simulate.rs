@@ -118,16 +118,8 @@ pub fn read_trajectory(
     Ok(poses)
 }
 
-/// Writes the scenario's own drive as an Oxford folder at `dir` (replaced
+/// Streams `simulator`'s scans into an Oxford folder at `dir` (replaced
 /// atomically: built beside it, then renamed).
-pub fn write_oxford(scenario: &Scenario, dir: &Path, force: bool) -> anyhow::Result<()> {
-    let trajectory = scenario.motion_trajectory()?;
-    let world = scenario.build_world(&trajectory)?;
-    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, scenario.options())?;
-    write_oxford_streaming(scenario, simulator, dir, force, &|| {})
-}
-
-/// Streams `simulator`'s scans into an Oxford folder at `dir` (see [`write_oxford`]).
 pub fn write_oxford_streaming(
     scenario: &Scenario,
     simulator: RadarSimulator<'_>,

@@ -32,6 +32,46 @@ fn demo_writes_a_recording_and_a_table_and_says_where() {
     assert_eq!(scans["messages"], 8);
 }
 
+/// The demo from a clean directory: every pipeline's tables, the analysis
+/// report and every plot it links exist and are non-empty, and each table
+/// reads back in pyarrow and DuckDB with its documented schema
+/// (`tests/python/demo_tables.py` against `schemas/tables/`).
+#[test]
+fn demo_runs_every_pipeline_and_its_tables_read_back_as_documented() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["demo", "--out", "d"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    for command in
+        ["$ mmtrack process odometry", "$ mmtrack process mpc", "$ mmtrack process beam", "$ mmtrack analyze"]
+    {
+        assert!(stdout.contains(command), "{command}: {stdout}");
+    }
+    let d = dir.path().join("d");
+    for table in ["odometry", "ground_truth", "mpc_detections", "mpc_tracks", "mpc_tracks_gmphd", "spebt_summary"] {
+        let tables = d.join("tables").join(table);
+        let part = std::fs::read_dir(&tables).unwrap().next().unwrap().unwrap().path().join("part-0.parquet");
+        assert!(std::fs::metadata(&part).unwrap().len() > 0, "{}", part.display());
+    }
+    let report = std::fs::read_to_string(d.join("analysis/report.md")).unwrap();
+    for section in ["KITTI", "## Multipath components", "## SPEBT beam tracking"] {
+        assert!(report.contains(section), "{section}: {report}");
+    }
+    let plots: Vec<&str> = report.split("](plots/").skip(1).map(|rest| rest.split(')').next().unwrap()).collect();
+    assert!(plots.len() >= 8, "{plots:?}");
+    for plot in plots {
+        let svg = std::fs::read_to_string(d.join("analysis/plots").join(plot)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.len() > 1000, "{plot}");
+    }
+    let Some(python) = super::common::venv_python() else { panic!("the Python venv (pyarrow, duckdb) is required") };
+    let script = root().join("tests/python/demo_tables.py");
+    let checked = std::process::Command::new(python).arg(script).arg(&d).arg(root().join("schemas/tables")).output();
+    let checked = checked.unwrap();
+    let (stdout, stderr) = text(&checked);
+    assert!(checked.status.success(), "{stdout}{stderr}");
+    assert!(stdout.contains("tables/spebt_pooled: 1 rows") && stdout.contains("checked 25 tables"), "{stdout}");
+}
+
 #[test]
 fn corrupt_recording_is_one_line_naming_the_file_exit_1() {
     let dir = tempfile::tempdir().unwrap();
@@ -66,9 +106,10 @@ fn table_with_a_missing_column_is_one_line_exit_1() {
 fn known_table_with_a_missing_column_is_one_line_exit_1() {
     let dir = tempfile::tempdir().unwrap();
     assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
-    // Rewrite the demo's poses table without its y_m column, with pyarrow-free
-    // tooling: read it with parquet's Arrow reader and write a projection.
-    let file = dir.path().join("d/tables/poses/sequence=oxford-demo/part-0.parquet");
+    // Rewrite the demo's ground-truth table without its y_m column, with
+    // pyarrow-free tooling: read it with parquet's Arrow reader and write a
+    // projection.
+    let file = dir.path().join("d/tables/ground_truth/sequence=oxford-demo/part-0.parquet");
     let batch = {
         let reader =
             parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(std::fs::File::open(&file).unwrap())
