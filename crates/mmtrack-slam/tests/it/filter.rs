@@ -43,3 +43,79 @@ fn diagnostic_paper_run() {
     println!("true SPs {:?}", r.world.scattering_points_m);
     let _ = PathOrigin::Clutter;
 }
+
+#[test]
+fn same_seed_same_run_for_any_thread_count() {
+    let r = SlamScenario { epochs: 25, ..SlamScenario::default() }.realise(5, 0).unwrap();
+    let config = SlamConfig { particles: 600, chunk_size: 64, ..SlamConfig::default() };
+    let in_pool = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let mut filter = SlamFilter::new(config.clone(), r.truth[0].ue, 9).unwrap();
+            let reports: Vec<_> = r.epochs.iter().map(|e| filter.step(e).unwrap()).collect();
+            (reports, filter.sources().to_vec())
+        })
+    };
+    let one = in_pool(1);
+    assert_eq!(one, in_pool(2));
+    assert_eq!(one, in_pool(3));
+    // A different seed gives a different run.
+    let mut other = SlamFilter::new(config.clone(), r.truth[0].ue, 10).unwrap();
+    let reports: Vec<_> = r.epochs.iter().map(|e| other.step(e).unwrap()).collect();
+    assert_ne!(one.0, reports);
+}
+
+#[test]
+fn bad_input_is_skipped_and_counted_or_refused() {
+    let r = SlamScenario { epochs: 4, ..SlamScenario::default() }.realise(2, 0).unwrap();
+    let config = SlamConfig { particles: 300, ..SlamConfig::default() };
+    let mut filter = SlamFilter::new(config.clone(), r.truth[0].ue, 1).unwrap();
+    filter.step(&r.epochs[0]).unwrap();
+    // A NaN TOA and an elevation beyond the pole: both skipped and counted.
+    let mut bad = r.epochs[1].clone();
+    bad.paths[0].toa_m = f64::NAN;
+    bad.paths[1].doa_el_rad = 2.0;
+    let report = filter.step(&bad).unwrap();
+    assert_eq!(report.skipped_paths, 2);
+    assert_eq!(report.associations.len(), r.epochs[1].paths.len() - 2);
+    // An empty epoch only predicts.
+    let empty = mmtrack_core::slam::SlamEpoch { t_ns: r.epochs[2].t_ns, paths: Vec::new() };
+    let report = filter.step(&empty).unwrap();
+    assert!(report.associations.is_empty() && report.paths_in_update == 0 && report.skipped_paths == 0);
+    // Time that does not advance is an error naming the epoch.
+    let err = filter.step(&r.epochs[2]).unwrap_err();
+    assert!(matches!(err, mmtrack_slam::SlamError::TimeNotIncreasing { epoch: 3, .. }), "{err}");
+    // Strict mode refuses the NaN, naming epoch and path.
+    let mut strict = SlamFilter::new(SlamConfig { strict: true, ..config }, r.truth[0].ue, 1).unwrap();
+    let err = strict.step(&bad).unwrap_err();
+    assert!(matches!(err, mmtrack_slam::SlamError::BadPath { epoch: 0, path: 0, .. }), "{err}");
+    assert!(err.to_string().contains("toa_m"), "{err}");
+    // A bad configuration is named.
+    let err = SlamFilter::new(SlamConfig { particles: 1, ..SlamConfig::default() }, r.truth[0].ue, 1).unwrap_err();
+    assert!(err.to_string().contains("particles"), "{err}");
+}
+
+#[test]
+fn maps_the_paper_world_and_tracks_the_ue() {
+    // 40 epochs, 500 particles: a fifth of the paper's particles, enough to
+    // find every VA and track within the paper's 0.5 m (measured: 0.3-0.5 m).
+    let r = SlamScenario { epochs: 40, ..SlamScenario::default() }.realise(3, 0).unwrap();
+    let (errors, filter) = run(&r, SlamConfig { particles: 500, ..SlamConfig::default() }, 3);
+    let mean_pos = errors.iter().map(|e| e[0]).sum::<f64>() / errors.len() as f64;
+    let mean_heading = errors.iter().map(|e| e[1]).sum::<f64>() / errors.len() as f64;
+    assert!(mean_pos < 1.0, "mean position error {mean_pos} m");
+    assert!(mean_heading < 0.02, "mean heading error {mean_heading} rad");
+    let vas: Vec<_> = filter.sources().iter().filter(|s| s.status == SourceStatus::VirtualAnchor).collect();
+    assert_eq!(vas.len(), 4, "{vas:?}");
+    for va in vas {
+        let nearest =
+            r.world.virtual_anchors_m.iter().map(|t| norm3(sub3(*t, va.belief.mean_m))).fold(f64::MAX, f64::min);
+        assert!(nearest < 2.0, "VA {:?} is {nearest} m from the nearest true VA", va.belief.mean_m);
+    }
+    // Every confirmed SP is a real one (within 2 m).
+    for sp in filter.sources().iter().filter(|s| s.status == SourceStatus::ScatteringPoint) {
+        let nearest =
+            r.world.scattering_points_m.iter().map(|t| norm3(sub3(*t, sp.belief.mean_m))).fold(f64::MAX, f64::min);
+        assert!(nearest < 2.0, "SP {:?} is {nearest} m from the nearest true SP", sp.belief.mean_m);
+    }
+}
