@@ -12,7 +12,8 @@
 //! - [`BeamSweep`]: received power per measured beam of one codebook sweep;
 //! - [`GnssFix`], [`MpcDetection`], [`MpcTrack`], [`MpcTruth`] and [`OdometryEstimate`];
 //! - [`array`]: antenna array responses, beamforming gains, beamwidths and
-//!   beam codebooks;
+//!   beam codebooks; [`array_uca`]: uniform circular arrays and their
+//!   phase-quantised codebooks;
 //! - [`parallel`]: order-keeping parallel maps on rayon, for every parallel stage;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
@@ -25,6 +26,7 @@
 //! geodetic latitude/longitude are the one exception and are named `_deg`.
 
 pub mod array;
+pub mod array_uca;
 mod beam_sweep;
 mod cir;
 pub mod error;
