@@ -6,6 +6,9 @@ use plotters::prelude::*;
 
 use crate::plots::{err, padded_range};
 
+/// Points, legend, colour, filled, small.
+type Markers<'a> = (&'a [[f64; 2]], &'static str, RGBColor, bool, bool);
+
 /// What the map figure shows, horizontal coordinates in metres.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct MapFigure {
@@ -68,7 +71,7 @@ pub fn map_svg(title: &str, figure: &MapFigure) -> anyhow::Result<String> {
             .map_err(err)?
             .label("estimated track")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(1)));
-        let markers: [(&[[f64; 2]], &str, RGBColor, bool, bool); 5] = [
+        let markers: [Markers<'_>; 5] = [
             (std::slice::from_ref(&figure.bs_m), "BS", BLACK, true, false),
             (&figure.true_va_m, "true VA", RED, false, false),
             (&figure.estimated_va_m, "estimated VA", RED, true, true),
