@@ -11,6 +11,9 @@
 //! - [`SpebtEkf`]: the SPEBT beam tracker of Liu et al. 2024, state
 //!   `[|alpha|, AoD, AoA]` driven by estimated vehicle poses (Proposition 2),
 //!   measured by the pilot's power, re-initialised on large deviations;
+//! - [`geometric`]: geometric Doppler-bearing tracking of Zoechmann et al.
+//!   2019 (recursive H-infinity/RLS on the initial state, the Ho-Chan batch
+//!   baseline, two genie bounds, beam selection with measurement counting);
 //! - [`PilotTracker`]: the predict / update roles every such tracker plays,
 //!   so experiments drive them alike;
 //! - [`valid_tracking`]: the paper's metric, blocks until the RMS angle error
@@ -28,6 +31,7 @@ mod angle_ekf;
 mod error;
 mod link;
 mod position_velocity_ekf;
+pub mod geometric;
 pub mod spebt;
 pub mod sweep;
 pub mod valid_tracking;
