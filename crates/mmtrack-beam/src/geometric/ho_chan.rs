@@ -82,7 +82,10 @@ impl RangeEstimator for HoChanBatch {
         let mut m: Sym3 = [[0.0; 3]; 3];
         let mut z = [0.0; 3];
         for (a, col_a) in columns.iter().enumerate() {
-            let g_col: Vec<f64> = (0..4).map(|i| (0..4).map(|j| g[i][j] * col_a[j]).sum()).collect();
+            let mut g_col = [0.0; 4];
+            for i in 0..4 {
+                g_col[i] = (0..4).map(|j| g[i][j] * col_a[j]).sum();
+            }
             for (b, col_b) in columns.iter().enumerate() {
                 m[b][a] = (0..4).map(|i| col_b[i] * g_col[i]).sum();
             }
