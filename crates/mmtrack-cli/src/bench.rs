@@ -33,6 +33,8 @@ enum Kind {
     Mpc(crate::bench_mpc::MpcBenchArgs),
     /// End-to-end radar odometry scans/s on real Oxford scans (PNG decode included), per stage.
     Odometry(crate::bench_odometry::OdometryBenchArgs),
+    /// 5G mmWave SLAM filter: time per 200 ms epoch (2000 particles, 10 iterations) vs real time and one thread.
+    Slam(crate::slam::bench::SlamBenchArgs),
     /// Oxford-folder ingest (PNG bytes carried) in scans/s vs copying the folder; peak memory at two folder sizes.
     Ingest {
         /// Scans in the large folder (400 x 3768 each).
@@ -428,6 +430,7 @@ pub fn run(args: &BenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.kind {
         Kind::Odometry(odometry) => crate::bench_odometry::run(odometry, quiet),
         Kind::Mpc(mpc) => crate::bench_mpc::run(mpc, quiet),
+        Kind::Slam(slam) => crate::slam::bench::run(slam, quiet),
         Kind::Ingest { scans, repeats, check, dir, readme, from } => ingest(
             &IngestBench {
                 scans: *scans,

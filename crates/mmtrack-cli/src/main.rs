@@ -25,6 +25,7 @@ mod reproduce_mpc;
 mod reproduce_mpc_report;
 mod simulate;
 mod simulate_sounder;
+mod slam;
 mod threads;
 
 use std::path::PathBuf;

@@ -22,6 +22,7 @@ mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;
 mod reproduce;
+mod reproduce_kim;
 mod reproduce_shaham;
 mod reproduce_spebt;
 mod simulate_radar;
