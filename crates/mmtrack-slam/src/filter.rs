@@ -285,7 +285,7 @@ impl SlamFilter {
         // Sources: confirmed ones by an iterated EKF, unconfirmed and new ones
         // by their two hypotheses.
         let post_mean = ue_of(&post.mean, self.particles.z_m);
-        let post_cov = meas_cov(&post.cov);
+        let pre_cov = meas_cov(&ue_now.cov);
         let mut confirmed = Vec::new();
         for (l, (column, score)) in assignment.iter().enumerate() {
             let z = &paths[l];
@@ -294,7 +294,7 @@ impl SlamFilter {
                 self.sources[0].last_seen_epoch = k;
                 Decision::Initialisation
             } else if let Some(m) = *column {
-                self.observe_source(m, z, &post_mean, &post_cov, &weights, k, &mut confirmed);
+                self.observe_source(m, z, (&ue_mean, &pre_cov), &post_mean, &weights, k, &mut confirmed);
                 Decision::Source(self.sources[m].id)
             } else {
                 let id = self.create_source(z, &post_mean, &weights, k);
@@ -537,8 +537,8 @@ impl SlamFilter {
         &mut self,
         m: usize,
         z: &PathMeasurement,
+        (ue_prior, p_prior): (&UeState, &Mat<f64>),
         ue: &UeState,
-        p_s: &Mat<f64>,
         weights: &[f64],
         k: usize,
         confirmed: &mut Vec<u64>,
@@ -552,7 +552,7 @@ impl SlamFilter {
                 } else {
                     SourceType::ScatteringPoint
                 };
-                if let Some(g) = self.ekf_source(&self.sources[m].belief, kind, z, ue, p_s) {
+                if let Some(g) = self.ekf_source(&self.sources[m].belief, kind, z, ue_prior, p_prior) {
                     self.sources[m].belief = g;
                 }
             }

@@ -26,21 +26,36 @@ fn run(run: &SlamRun, config: SlamConfig, seed: u64) -> (Vec<[f64; 3]>, SlamFilt
 #[ignore = "diagnostic: prints one paper run (cargo test --release -- --ignored --nocapture)"]
 fn diagnostic_paper_run() {
     let scenario = SlamScenario::default();
-    let r = scenario.realise(1, 0).unwrap();
-    let (errors, filter) = run(&r, SlamConfig::default(), 1);
-    for (k, e) in errors.iter().enumerate() {
-        let n_va = filter
+    let seed: u64 = std::env::var("SLAM_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
+    let r = scenario.realise(2018, seed).unwrap();
+    let mut filter = SlamFilter::new(SlamConfig::default(), r.truth[0].ue, seed).unwrap();
+    for (k, (epoch, truth)) in r.epochs.iter().zip(&r.truth).enumerate() {
+        let report = filter.step(epoch).unwrap();
+        let e = report.estimate;
+        let err = sub3(e.state.position_m, truth.ue.position_m);
+        let vas: Vec<String> = filter
             .sources()
             .iter()
-            .filter(|s| s.status == SourceStatus::VirtualAnchor && s.confirmed_epoch.is_some_and(|c| c <= k))
-            .count();
-        println!("{k:3} pos {:.3} head {:.4} bias {:.3} va {n_va}", e[0], e[1], e[2]);
+            .filter(|s| s.status == SourceStatus::VirtualAnchor)
+            .map(|s| {
+                let nearest =
+                    r.world.virtual_anchors_m.iter().map(|t| norm3(sub3(*t, s.belief.mean_m))).fold(f64::MAX, f64::min);
+                format!("{:.2}/{:.2}", nearest, s.belief.spread_m())
+            })
+            .collect();
+        println!(
+            "{k:3} pos {:.3} (std {:.3}) head {:.4} bias {:.3} (std {:.3}) stages {} ess {:.0} upd {} va {}",
+            norm3(err),
+            e.position_std_m,
+            wrap_angle_rad(e.state.heading_rad - truth.ue.heading_rad).abs(),
+            e.state.clock_bias_m - truth.ue.clock_bias_m,
+            e.clock_bias_std_m,
+            report.stages,
+            report.ess,
+            report.paths_in_update,
+            vas.join(" ")
+        );
     }
-    for s in filter.sources() {
-        println!("{:?} {:?} {:?} seen {} conf {:?}", s.id, s.status, s.belief.mean_m, s.sightings, s.confirmed_epoch);
-    }
-    println!("true VAs {:?}", r.world.virtual_anchors_m);
-    println!("true SPs {:?}", r.world.scattering_points_m);
     let _ = PathOrigin::Clutter;
 }
 
