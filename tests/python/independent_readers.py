@@ -40,6 +40,8 @@ def check_all_types(root):
     expected = {
         ("/ground_truth/pose", "mmtrack.Pose2D"): 5,
         ("/viz/ground_truth", "foxglove.PoseInFrame"): 5,
+        # world -> base_link per pose, and once the mount base_link -> gnss.
+        ("/tf", "foxglove.FrameTransforms"): 6,
         ("/gnss/fix", "mmtrack.GnssFix"): 1,
         ("/viz/gnss", "foxglove.LocationFix"): 1,
         ("/channel/cir", "mmtrack.CirSnapshot"): 1,

@@ -219,6 +219,9 @@ fn ingest_quietly(folder: &Path, recording: &Path) -> anyhow::Result<()> {
         compression: CompressionArg::Zstd,
         zstd_level: 1,
         no_foxglove_views: true,
+        no_radar_cartesian: true,
+        radar_cartesian_m_per_px: mmtrack_io::recording::CartesianGrid::default().metres_per_pixel,
+        radar_cartesian_size_px: mmtrack_io::recording::CartesianGrid::default().size_px,
         no_sync: true,
     };
     crate::ingest::oxford_folder(folder, &output, &Default::default(), true)?;

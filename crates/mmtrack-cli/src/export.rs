@@ -1,15 +1,20 @@
 //! `mmtrack export`: trajectory tables as standard text (TUM, KITTI, Boreas)
-//! for evo, the KITTI devkit and pyboreas. The formats are in
-//! `mmtrack_analysis::export`.
+//! for evo, the KITTI devkit and pyboreas (the formats are in
+//! `mmtrack_analysis::export`), or as poses in a copy of the recording for
+//! Foxglove (`--format mcap`, [`mmtrack_io::recording::copy_with_estimate`]).
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use mmtrack_analysis::export::{ExportFormat, export_sequence};
 use mmtrack_analysis::pipeline::{inventory, read_trajectories};
-use mmtrack_io::Overwrite;
+use mmtrack_core::{OdometryEstimate, StampedPose};
+use mmtrack_io::recording::{EstimateToAdd, METADATA_NAME, RawReader, RecordingMetadata, copy_with_estimate};
+use mmtrack_io::table::{read_table, table_path};
+use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Format {
@@ -20,6 +25,9 @@ enum Format {
     Kitti,
     /// pyboreas odometry benchmark: `t_us` + 3x4 vehicle_from_world, `boreas/estimate/<seq>.txt`.
     Boreas,
+    /// A copy of `--recording` with the estimate added as poses (`/estimate/pose`, `/viz/estimate`, and
+    /// `world -> estimate` on `/tf`) for Foxglove; `-o` is the new recording's path.
+    Mcap,
 }
 
 #[derive(Args)]
@@ -27,9 +35,12 @@ enum Format {
     long_about = "Writes the estimate (table `odometry`) and, when present, the ground truth (table `ground_truth`) of \
 each sequence as text files that evo, the KITTI odometry devkit and pyboreas read. Numbers are written at full \
 precision (shortest round-trip) and times as exact decimals. Files: <seq>.estimate.<fmt>.txt and \
-<seq>.ground_truth.<fmt>.txt (KITTI also <seq>.times.txt; Boreas boreas/{estimate,ground_truth}/<seq>.txt).",
-    after_help = "Example: mmtrack export --format kitti out/tables -o out/kitti && evo_ape kitti \
-out/kitti/seq.ground_truth.kitti.txt out/kitti/seq.estimate.kitti.txt"
+<seq>.ground_truth.<fmt>.txt (KITTI also <seq>.times.txt; Boreas boreas/{estimate,ground_truth}/<seq>.txt). \
+With --format mcap: a copy of --recording (never modified) plus the estimate of its sequence as poses, written \
+to -o atomically.",
+    after_help = "Examples: mmtrack export --format kitti out/tables -o out/kitti && evo_ape kitti \
+out/kitti/seq.ground_truth.kitti.txt out/kitti/seq.estimate.kitti.txt\n\
+mmtrack export --format mcap out/tables --recording rec.mcap -o rec.estimate.mcap   (then open it in Foxglove)"
 )]
 pub struct ExportArgs {
     /// Output format.
@@ -37,9 +48,12 @@ pub struct ExportArgs {
     format: Format,
     /// Table directory written by `mmtrack process`.
     tables: PathBuf,
-    /// Output directory.
-    #[arg(short, long, value_name = "DIR")]
+    /// Output directory (text formats) or recording (`--format mcap`).
+    #[arg(short, long, value_name = "DIR or OUT.mcap")]
     output: PathBuf,
+    /// The recording the tables came from (`--format mcap` only): copied, with the estimate added.
+    #[arg(long, value_name = "RECORDING.mcap", required_if_eq("format", "mcap"))]
+    recording: Option<PathBuf>,
     /// Export only this sequence (default: every sequence with an odometry table).
     #[arg(long, value_name = "ID")]
     sequence: Option<String>,
@@ -52,6 +66,12 @@ pub fn run(args: &ExportArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
     if !args.tables.is_dir() {
         bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", args.tables.display());
+    }
+    if let Format::Mcap = args.format {
+        return export_mcap(args, overwrite, quiet);
+    }
+    if args.recording.is_some() {
+        bail!("--recording is only used with --format mcap");
     }
     let mut inputs = read_trajectories(&args.tables)?;
     if inputs.is_empty() {
@@ -72,6 +92,7 @@ pub fn run(args: &ExportArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         Format::Tum => ExportFormat::Tum,
         Format::Kitti => ExportFormat::Kitti,
         Format::Boreas => ExportFormat::Boreas,
+        Format::Mcap => return export_mcap(args, overwrite, quiet),
     };
     for (sequence, input) in &inputs {
         let files = export_sequence(&args.output, sequence, input, format, overwrite)
@@ -84,6 +105,52 @@ pub fn run(args: &ExportArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 println!("{sequence}: no ground_truth table; estimate only");
             }
         }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The recording's `mmtrack.recording` metadata (writers put it first).
+fn recording_metadata(path: &Path) -> anyhow::Result<RecordingMetadata> {
+    let mut reader = RawReader::open(path)?;
+    while reader.metadata().is_empty() && reader.next_message()?.is_some() {}
+    reader
+        .metadata()
+        .get(METADATA_NAME)
+        .and_then(RecordingMetadata::from_map)
+        .with_context(|| format!("{}: not an mmtrack recording (no mmtrack.recording metadata)", path.display()))
+}
+
+/// `--format mcap`: the recording plus the `odometry` table of its sequence.
+fn export_mcap(args: &ExportArgs, overwrite: Overwrite, quiet: bool) -> anyhow::Result<ExitCode> {
+    let Some(recording) = &args.recording else { bail!("--format mcap needs --recording <RECORDING.mcap>") };
+    let metadata = recording_metadata(recording)?;
+    let sequence = args.sequence.clone().unwrap_or_else(|| metadata.sequence_id.clone());
+    let table = table_path(&args.tables, "odometry", &sequence)?;
+    if !table.is_file() {
+        bail!(
+            "{}: no odometry table of sequence {sequence} (the recording's; pick another with --sequence; found {})",
+            table.display(),
+            inventory(&args.tables)?.describe()
+        );
+    }
+    let rows: Vec<OdometryEstimate> = read_table(&table)?;
+    let poses: Vec<StampedPose> =
+        rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
+    let estimate = EstimateToAdd {
+        poses: &poses,
+        parent_frame: "world",
+        metadata: BTreeMap::from([("estimate.source".to_string(), table.display().to_string())]),
+    };
+    let options = RecordingOptions { overwrite, durability: Durability::Fsync, ..RecordingOptions::default() };
+    let summary = copy_with_estimate(recording, &args.output, &estimate, &options)?;
+    if !quiet {
+        println!(
+            "{sequence}: {} estimate poses added to a copy of {}: {} ({:.1} MB)",
+            poses.len(),
+            recording.display(),
+            summary.path.display(),
+            summary.file_bytes as f64 / 1e6
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -14,6 +14,7 @@ use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_ingest::ros2::{RadarTopic, Ros2Topics};
 use mmtrack_io::recording::Compression;
 use mmtrack_io::recording::PoseStream;
+use mmtrack_io::recording::cartesian::{CartesianGrid, MAX_CARTESIAN_SIZE_PX};
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use crate::progress;
@@ -39,9 +40,20 @@ pub struct OutputArgs {
     /// zstd level (1 fast .. 19 small).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=19))]
     pub zstd_level: u32,
-    /// Omit the Foxglove display channels (/viz/...).
+    /// Omit the Foxglove display channels (/viz/..., /tf, /radar/cartesian).
     #[arg(long)]
     pub no_foxglove_views: bool,
+    /// Omit the Cartesian radar view (/radar/cartesian: each scan resampled onto a square grid around the radar
+    /// for Foxglove's image panel); the polar /radar/image is written either way.
+    #[arg(long)]
+    pub no_radar_cartesian: bool,
+    /// Pixel size of the Cartesian radar view, metres.
+    #[arg(long, default_value_t = CartesianGrid::default().metres_per_pixel, value_name = "M")]
+    pub radar_cartesian_m_per_px: f64,
+    /// Width and height of the Cartesian radar view, pixels (odd puts the radar on a pixel centre).
+    #[arg(long, default_value_t = CartesianGrid::default().size_px, value_name = "PX",
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_CARTESIAN_SIZE_PX)))]
+    pub radar_cartesian_size_px: u32,
     /// Skip the fsync before the final rename: faster on large recordings, but a
     /// power cut right afterwards may lose the new file.
     #[arg(long)]
@@ -70,6 +82,10 @@ impl OutputArgs {
             overwrite: if self.force { Overwrite::Replace } else { Overwrite::Refuse },
             foxglove_views: !self.no_foxglove_views,
             durability: if self.no_sync { Durability::PageCache } else { Durability::Fsync },
+            radar_cartesian: (!self.no_radar_cartesian && !self.no_foxglove_views).then_some(CartesianGrid {
+                metres_per_pixel: self.radar_cartesian_m_per_px,
+                size_px: self.radar_cartesian_size_px,
+            }),
             ..RecordingOptions::default()
         }
     }

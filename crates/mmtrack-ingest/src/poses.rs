@@ -300,8 +300,15 @@ pub fn write_poses(
     recording: &RecordingOptions,
 ) -> Result<WriteSummary, IngestError> {
     let extra = BTreeMap::from([(format!("{}.source", stream.topic().trim_start_matches('/')), source.to_string())]);
-    let mut writer =
-        crate::target::open_writer(out, extend, source, extra, &[stream.topic(), stream.viz_topic()], recording)?;
+    let mut writer = crate::target::open_writer(
+        out,
+        extend,
+        source,
+        extra,
+        poses.first().map(|p| p.t_ns),
+        &[stream.topic(), stream.viz_topic()],
+        recording,
+    )?;
     for pose in poses {
         writer.write_pose(stream, pose, "world", "vehicle")?;
     }

@@ -343,8 +343,32 @@ impl Sink<'_> {
     }
 }
 
-fn metadata(bag: &Path, topics: &Ros2Topics) -> RecordingMetadata {
+/// `header.stamp` of the first message on a chosen topic (every type we take
+/// starts with a `std_msgs/Header`), read ahead of the ingest so the
+/// recording's time base is known before it is written; `None` when the bag
+/// has no such message or it does not decode (the ingest then reports it).
+fn first_stamp_ns(bag: &Path, wanted: &[&str]) -> Result<Option<i64>, IngestError> {
+    let mut reader = RawReader::open(bag)?;
+    while let Some(message) = reader.next_message()? {
+        if wanted.contains(&message.channel.topic.as_str()) {
+            return Ok(Cdr::new(&message.data).and_then(|mut cdr| cdr.stamp_ns("header.stamp")).ok());
+        }
+    }
+    Ok(None)
+}
+
+fn metadata(bag: &Path, topics: &Ros2Topics, first_stamp_ns: Option<i64>) -> RecordingMetadata {
+    let time_base = first_stamp_ns.map_or(TimeBase::UnixEpoch, |t| TimeBase::unix_or(t, TimeBase::SimTime));
+    let time_note = match (first_stamp_ns, time_base) {
+        (Some(t), TimeBase::SimTime) => format!(
+            "header.stamp as in the bag; the first is {t} ns, before 2000-01-01, so the bag was stamped with a \
+             simulator's clock (use_sim_time), not UNIX time"
+        ),
+        (Some(t), _) => format!("header.stamp as in the bag (UNIX time; the first is {t} ns)"),
+        (None, _) => "header.stamp as in the bag (taken as UNIX time: no stamp was read ahead)".to_string(),
+    };
     let mut extra = BTreeMap::from([
+        ("time.note".to_string(), time_note),
         ("ros2.pose_topic".to_string(), topics.pose_topic.clone().unwrap_or_default()),
         ("ros2.gnss_topic".to_string(), topics.gnss_topic.clone().unwrap_or_default()),
     ]);
@@ -366,7 +390,7 @@ fn metadata(bag: &Path, topics: &Ros2Topics) -> RecordingMetadata {
     RecordingMetadata {
         sequence_id: bag.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bag".into()),
         source: format!("ros2:{}", bag.display()),
-        time_base: TimeBase::UnixEpoch,
+        time_base,
         extra,
     }
 }
@@ -383,14 +407,15 @@ pub fn ingest_ros2(
     progress: Progress<'_>,
 ) -> Result<Ros2Report, IngestError> {
     let bag_bytes = std::fs::metadata(bag).map(|m| m.len()).unwrap_or(0);
-    let mut reader = RawReader::open(bag)?;
-    let writer = RecordingWriter::create(out, &metadata(bag, topics), recording)?;
-    let mut sink = Sink { topics, writer, poses: 0, gnss_fixes: 0, no_fix: 0, radar_scans: 0, last_ns: [i64::MIN; 3] };
     let wanted: Vec<&str> = [topics.pose_topic.as_deref(), topics.gnss_topic.as_deref()]
         .into_iter()
         .flatten()
         .chain(topics.radar.as_ref().map(|r| r.topic.as_str()))
         .collect();
+    let first_stamp = first_stamp_ns(bag, &wanted)?;
+    let mut reader = RawReader::open(bag)?;
+    let writer = RecordingWriter::create(out, &metadata(bag, topics, first_stamp), recording)?;
+    let mut sink = Sink { topics, writer, poses: 0, gnss_fixes: 0, no_fix: 0, radar_scans: 0, last_ns: [i64::MIN; 3] };
     let mut found_topics = std::collections::BTreeSet::new();
     while let Some(message) = reader.next_message()? {
         let channel = &message.channel;

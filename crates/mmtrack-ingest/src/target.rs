@@ -11,21 +11,35 @@ use mmtrack_io::{RecordingOptions, RecordingWriter};
 use crate::IngestError;
 
 /// Opens the writer for `out`. Without `extend`, a new recording with
-/// `source`; with `extend`, a copy of that recording whose metadata gains
-/// `extra`. Fails when the existing recording already has one of `new_topics`.
+/// `source` whose time base follows `first_t_ns`, the first time the source
+/// gives: UNIX time, or [`TimeBase::Relative`] when it lies before
+/// 2000-01-01 (a log without dates, e.g. KITTI times from 0, CIRs without a
+/// `t0_ns`, a receiver's counter); with `extend`, a copy of that recording
+/// whose metadata gains `extra` (its time base is kept). Fails when the
+/// existing recording already has one of `new_topics`.
 pub fn open_writer(
     out: &Path,
     extend: Option<&Path>,
     source: &str,
-    extra: BTreeMap<String, String>,
+    mut extra: BTreeMap<String, String>,
+    first_t_ns: Option<i64>,
     new_topics: &[&str],
     recording: &RecordingOptions,
 ) -> Result<RecordingWriter, IngestError> {
     let Some(existing) = extend else {
+        let time_base = first_t_ns.map_or(TimeBase::UnixEpoch, |t| TimeBase::unix_or(t, TimeBase::Relative));
+        if time_base == TimeBase::Relative {
+            extra.entry("time.note".into()).or_insert_with(|| {
+                format!(
+                    "times as the source gives them; the first is {} ns, before 2000-01-01, so they are not UNIX time",
+                    first_t_ns.unwrap_or_default()
+                )
+            });
+        }
         let metadata = RecordingMetadata {
             sequence_id: out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "sequence".into()),
             source: source.to_string(),
-            time_base: TimeBase::UnixEpoch,
+            time_base,
             extra,
         };
         return Ok(RecordingWriter::create(out, &metadata, recording)?);

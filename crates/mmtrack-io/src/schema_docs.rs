@@ -68,7 +68,8 @@ fn results_index(tables: &[&TableSpec]) -> String {
 fn channels() -> String {
     let mut out = format!(
         "{GENERATED}# Channels of a canonical recording\n\nOne MCAP file per sequence; message encoding `protobuf` on every channel; schema data is a protobuf `FileDescriptorSet`. \
-         Metadata record `mmtrack.recording` holds `sequence_id`, `source`, `time_base` (`unix_epoch` or `scenario_start`), `mmtrack_version` and sensor keys. \
+         Metadata record `mmtrack.recording` holds `sequence_id`, `source`, `time_base` (`unix_epoch`, `scenario_start`, `sim_time` or `relative`; \
+         `time_base.meaning` says what it means, `time.note` where the source's time needs a word), `mmtrack_version` and sensor keys. \
          Log time = the message's `t_ns`.\n\n| topic | schema | role | meaning |\n|---|---|---|---|\n"
     );
     for c in CHANNELS {

@@ -254,7 +254,15 @@ pub fn ingest_cir(
     };
     let tap_spacing_s = first.tap_spacing_s;
     let source = format!("cir-{}:{}", format.name(), absolute(input).display());
-    let mut writer = crate::target::open_writer(out, None, &source, file.metadata.clone(), &[CIR_TOPIC], recording)?;
+    let mut writer = crate::target::open_writer(
+        out,
+        None,
+        &source,
+        file.metadata.clone(),
+        file.snapshots.first().map(|c| c.t_ns),
+        &[CIR_TOPIC],
+        recording,
+    )?;
     let total = file.snapshots.len() as u64;
     for (i, snapshot) in file.snapshots.iter().enumerate() {
         writer.write_cir(snapshot)?;

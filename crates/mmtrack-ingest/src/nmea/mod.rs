@@ -481,7 +481,15 @@ pub fn ingest_nmea(
         extra.insert("gnss.enu_origin_altitude_m".to_string(), altitude_m.to_string());
     }
     let source = format!("nmea:{}", input.display());
-    let mut writer = crate::target::open_writer(out, extend, &source, extra, &[GNSS_TOPIC, GNSS_VIZ_TOPIC], recording)?;
+    let mut writer = crate::target::open_writer(
+        out,
+        extend,
+        &source,
+        extra,
+        log.fixes.first().map(|f| f.t_ns),
+        &[GNSS_TOPIC, GNSS_VIZ_TOPIC],
+        recording,
+    )?;
     for fix in &log.fixes {
         writer.write_gnss_fix(fix)?;
     }

@@ -284,6 +284,13 @@ pub fn ingest_oxford(
     })
 }
 
+/// A scan PNG as read and decoded on a worker thread.
+struct DecodedScan {
+    decoded: DecodedScanPng,
+    png: Vec<u8>,
+    cartesian: Option<Vec<u8>>,
+}
+
 /// Decodes Oxford/Boreas-style scan PNGs (one worker per core) and writes them
 /// in order: the PNG bytes carried unchanged, or decoded mono8 images. Every
 /// scan must have the size of the first.
@@ -295,18 +302,35 @@ pub(crate) fn write_navtech_scans(
     progress: Progress<'_>,
 ) -> Result<(), IngestError> {
     let total = scans.len() as u64;
-    let decode = |scan: &ScanFile| -> Result<(DecodedScanPng, Vec<u8>), IngestError> {
+    // The Cartesian view is resampled on the decoding threads, from the
+    // decoded image with its header columns skipped.
+    let resampler = writer.cartesian_resampler().cloned();
+    let decode = |scan: &ScanFile| -> Result<DecodedScan, IngestError> {
         let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
-        Ok((decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?, bytes))
+        let decoded = decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?;
+        let cartesian =
+            match &resampler {
+                Some(r) => Some(r.resample(&decoded.header, &decoded.pixels, decoded.width, HEADER_COLUMNS).map_err(
+                    |detail| IngestError::BadRecord {
+                        path: scan.path.clone(),
+                        record: "scan image".into(),
+                        field: "cartesian view".into(),
+                        detail,
+                    },
+                )?),
+                None => None,
+            };
+        Ok(DecodedScan { decoded, png: bytes, cartesian })
     };
     let mut same_size = SameSize::default();
-    let mut write = |index: usize, (decoded, bytes): (DecodedScanPng, Vec<u8>)| -> Result<(), IngestError> {
+    let mut write = |index: usize, scan: DecodedScan| -> Result<(), IngestError> {
+        let DecodedScan { decoded, png, cartesian } = scan;
         let path = &scans[index].path;
         same_size.check(path, decoded.header.azimuths.len(), decoded.header.bins_per_azimuth)?;
         if carry_png {
-            writer.write_radar_png(&decoded.header, &bytes, HEADER_COLUMNS as u32)?;
+            writer.write_radar_png_and_view(&decoded.header, &png, HEADER_COLUMNS as u32, cartesian.as_deref())?;
         } else {
-            writer.write_radar_scan(&decoded.into_scan())?;
+            writer.write_radar_scan_and_view(&decoded.into_scan(), cartesian.as_deref())?;
         }
         progress(index as u64 + 1, total);
         Ok(())

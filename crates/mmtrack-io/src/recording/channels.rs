@@ -15,6 +15,8 @@ pub struct ChannelSpec {
 
 /// Topic of radar power images.
 pub const RADAR_IMAGE_TOPIC: &str = "/radar/image";
+/// Display view of radar scans resampled onto a Cartesian grid.
+pub const RADAR_CARTESIAN_TOPIC: &str = "/radar/cartesian";
 /// Topic of radar per-azimuth metadata.
 pub const RADAR_META_TOPIC: &str = "/radar/scan_meta";
 /// Topic of GNSS fixes.
@@ -166,6 +168,24 @@ pub const CHANNELS: &[ChannelSpec] = &[
         schema_names: &["mmtrack.GnssFix"],
         canonical: true,
         meaning: "GNSS position fix of the beam-sweeping array (e.g. a roadside unit); the vehicle's fixes are on /gnss/fix",
+    },
+    ChannelSpec {
+        topic: RADAR_CARTESIAN_TOPIC,
+        schema_names: &["foxglove.RawImage"],
+        canonical: false,
+        meaning: "display copy of a radar scan resampled onto a Cartesian grid (mono8, frame radar, the sensor at the \
+                  centre pixel, image up = forward, image left = left; metres per pixel and size in the recording \
+                  options, default 0.25 m x 501 px; bilinear in azimuth and range, header columns and invalid rows \
+                  left out); same sequence number and time as the /radar/image it shows",
+    },
+    ChannelSpec {
+        topic: super::tf::TF_TOPIC,
+        schema_names: &["foxglove.FrameTransforms"],
+        canonical: false,
+        meaning: "coordinate frames for Foxglove's 3D panel: world -> base_link at each ground-truth pose, \
+                  world -> estimate at each estimated pose, world -> tx / rx at each sounder car pose (parent: the \
+                  pose's parent frame), and once, at the first log time, the static sensor mounts base_link -> radar \
+                  and base_link -> gnss (identity: the ground truth is the radar's pose)",
     },
     ChannelSpec {
         topic: "/viz/ground_truth",

@@ -9,19 +9,31 @@
 //! dataset's PNG bytes unchanged), paired by MCAP sequence number with an
 //! `mmtrack.RadarScanMeta` message holding the per-azimuth times and angles.
 //!
+//! For Foxglove's 3D panel the writer also puts the vehicle, sensor and
+//! estimate frames on `/tf` ([`tf`]), and, when asked, each radar scan
+//! resampled onto a Cartesian grid on `/radar/cartesian` ([`cartesian`]).
+//!
 //! The channel table lives in [`channels`] and is what `schemas/` documents.
 
+pub mod cartesian;
 pub mod channels;
+mod copy;
 pub mod pulse;
 mod reader;
+pub mod tf;
 mod writer;
 
+pub use cartesian::{CartesianGrid, CartesianResampler};
 pub use channels::{BEAM_SITE_KEY, CHANNELS, ChannelSpec, PoseStream};
+pub use copy::{EstimateToAdd, copy_with_estimate};
 pub use reader::{
     ChannelInfo, ChannelSummary, EncodedScan, RawMessage, RawReader, RecordingEvent, RecordingItem, RecordingReader,
     RecordingSummary, inspect_recording, inspect_recording_with_progress,
 };
-pub use writer::{Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TimeBase, WriteSummary};
+pub use writer::{
+    Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TIME_BASE_MEANING_KEY, TimeBase, WriteSummary,
+    YEAR_2000_NS,
+};
 
 /// Name of the MCAP metadata record that holds [`RecordingMetadata`].
 pub const METADATA_NAME: &str = "mmtrack.recording";

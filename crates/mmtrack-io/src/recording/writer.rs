@@ -1,19 +1,23 @@
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use foxglove::Encode;
-use foxglove::schemas::{CompressedImage, LocationFix, Pose, PoseInFrame, Quaternion, RawImage, Timestamp, Vector3};
-use mmtrack_core::{BeamSweep, CirSnapshot, GnssFix, MpcTruth, PolarScan, PolarScanHeader, StampedPose};
+use foxglove::schemas::{CompressedImage, FrameTransforms, LocationFix, Pose, PoseInFrame, RawImage, Vector3};
+use mmtrack_core::{BeamSweep, CirSnapshot, GnssFix, MpcTruth, PolarScan, PolarScanHeader, Se2, StampedPose};
 use prost::Message;
 
 use super::METADATA_NAME;
+use super::cartesian::{CartesianGrid, CartesianResampler};
 use super::channels::{
     BEAM_SWEEP_TOPIC, CIR_TOPIC, GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC,
-    PoseStream, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
+    PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
 };
 use super::reader::RawMessage;
+use super::tf::{
+    GNSS_FRAME, RADAR_FRAME, TF_TOPIC, VEHICLE_FRAME, frame_transform, timestamp, vehicle_frame, yaw_quaternion,
+};
 use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
@@ -45,6 +49,12 @@ pub struct RecordingOptions {
     pub foxglove_views: bool,
     /// Flush to disk before the final rename.
     pub durability: Durability,
+    /// Also write each radar scan resampled onto this Cartesian grid
+    /// (`/radar/cartesian`, for Foxglove's image panel; see
+    /// [`super::cartesian`]). Off by default here, since it costs a resampling
+    /// per scan; `mmtrack ingest` and `mmtrack simulate` turn it on unless
+    /// `--no-radar-cartesian`.
+    pub radar_cartesian: Option<CartesianGrid>,
 }
 
 impl Default for RecordingOptions {
@@ -55,39 +65,86 @@ impl Default for RecordingOptions {
             overwrite: Overwrite::Refuse,
             foxglove_views: true,
             durability: Durability::Fsync,
+            radar_cartesian: None,
         }
     }
 }
 
-/// What `t_ns` counts from.
+/// What `t_ns` counts from. Only [`TimeBase::UnixEpoch`] is a date; viewers
+/// that show log times as dates (Foxglove) show the others near 1970-01-01.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TimeBase {
     /// Nanoseconds since the UNIX epoch (real recordings).
     UnixEpoch,
     /// Nanoseconds since the start of a simulated scenario.
     ScenarioStart,
+    /// A simulator's clock (ROS 2 `/clock`, `use_sim_time`), as the source
+    /// stamps it: counts from the simulation's start, not a date.
+    SimTime,
+    /// Nanoseconds since an unknown instant at or before the start of the
+    /// source's log (the source has no absolute time, e.g. a row index times
+    /// a period, or a receiver's free-running counter).
+    Relative,
 }
 
 impl TimeBase {
+    /// Every time base.
+    pub const ALL: [TimeBase; 4] = [Self::UnixEpoch, Self::ScenarioStart, Self::SimTime, Self::Relative];
+
     /// Value stored under the metadata key `time_base`.
     #[must_use]
     pub fn as_str(self) -> &'static str {
         match self {
             Self::UnixEpoch => "unix_epoch",
             Self::ScenarioStart => "scenario_start",
+            Self::SimTime => "sim_time",
+            Self::Relative => "relative",
+        }
+    }
+
+    /// What the value means, stored beside it under `time_base.meaning`.
+    #[must_use]
+    pub fn meaning(self) -> &'static str {
+        match self {
+            Self::UnixEpoch => "t_ns and log times are nanoseconds since 1970-01-01 00:00 UTC (UNIX time)",
+            Self::ScenarioStart => {
+                "t_ns and log times are nanoseconds since the start of the simulated scenario, not UNIX time \
+                 (viewers showing dates show 1970-01-01)"
+            }
+            Self::SimTime => {
+                "t_ns and log times are a simulator's clock (ROS sim time) as the source stamps them, not UNIX time \
+                 (viewers showing dates show dates near 1970-01-01)"
+            }
+            Self::Relative => {
+                "t_ns and log times count from an unknown instant at or before the start of the source's log; the \
+                 source has no absolute time (viewers showing dates show dates near 1970-01-01)"
+            }
         }
     }
 
     /// Parses [`TimeBase::as_str`].
     #[must_use]
     pub fn parse(s: &str) -> Option<Self> {
-        match s {
-            "unix_epoch" => Some(Self::UnixEpoch),
-            "scenario_start" => Some(Self::ScenarioStart),
-            _ => None,
-        }
+        Self::ALL.into_iter().find(|t| t.as_str() == s)
+    }
+
+    /// The time base of a source's stamps that may or may not be UNIX time:
+    /// `otherwise` (e.g. [`TimeBase::SimTime`] for a ROS 2 bag,
+    /// [`TimeBase::Relative`] for a log without dates) when the first stamp
+    /// lies before 2000-01-01 (no real recording of ours is older, and sim
+    /// time and relative logs start near 0), else [`TimeBase::UnixEpoch`].
+    #[must_use]
+    pub fn unix_or(first_t_ns: i64, otherwise: TimeBase) -> Self {
+        if first_t_ns < YEAR_2000_NS { otherwise } else { Self::UnixEpoch }
     }
 }
+
+/// 2000-01-01 00:00:00 UTC, nanoseconds since the UNIX epoch: stamps before
+/// it are taken as not UNIX time ([`TimeBase::unix_or`]).
+pub const YEAR_2000_NS: i64 = 946_684_800_000_000_000;
+
+/// Metadata key holding [`TimeBase::meaning`].
+pub const TIME_BASE_MEANING_KEY: &str = "time_base.meaning";
 
 /// Recording-level metadata, stored as the MCAP metadata record `mmtrack.recording`.
 #[derive(Debug, Clone, PartialEq)]
@@ -112,6 +169,7 @@ impl RecordingMetadata {
         let source = extra.remove("source")?;
         let time_base = TimeBase::parse(&extra.remove("time_base")?)?;
         extra.remove("mmtrack_version");
+        extra.remove(TIME_BASE_MEANING_KEY);
         Some(Self { sequence_id, source, time_base, extra })
     }
 
@@ -122,6 +180,7 @@ impl RecordingMetadata {
         map.insert("sequence_id".into(), self.sequence_id.clone());
         map.insert("source".into(), self.source.clone());
         map.insert("time_base".into(), self.time_base.as_str().into());
+        map.insert(TIME_BASE_MEANING_KEY.into(), self.time_base.meaning().into());
         map.insert("mmtrack_version".into(), env!("CARGO_PKG_VERSION").into());
         map
     }
@@ -161,12 +220,13 @@ pub struct RecordingWriter {
     channels: BTreeMap<String, ChannelState>,
     counts: BTreeMap<String, u64>,
     buffer: Vec<u8>,
-}
-
-fn timestamp(t_ns: i64) -> Option<Timestamp> {
-    let t_ns = u64::try_from(t_ns).ok()?;
-    let sec = u32::try_from(t_ns / 1_000_000_000).ok()?;
-    Some(Timestamp::new(sec, (t_ns % 1_000_000_000) as u32))
+    cartesian: Option<CartesianResampler>,
+    /// Earliest log time written, for the sensor mounts on `/tf`.
+    first_log_time_ns: Option<u64>,
+    /// Sensor frames that need a mount on `/tf` (sensors written).
+    mounts_needed: BTreeSet<&'static str>,
+    /// Mounts `base_link -> sensor` already in the file (copied `/tf`).
+    mounts_present: BTreeSet<String>,
 }
 
 impl RecordingWriter {
@@ -190,6 +250,15 @@ impl RecordingWriter {
             let threads = u32::try_from(rayon::current_num_threads()).unwrap_or(1).max(1);
             write_options = write_options.compression_level(level).compression_threads(threads);
         }
+        let cartesian = match options.radar_cartesian {
+            Some(grid) => Some(CartesianResampler::new(grid).map_err(|detail| IoError::BadValue {
+                path: path.to_path_buf(),
+                record: "recording options".into(),
+                field: "radar_cartesian",
+                detail,
+            })?),
+            None => None,
+        };
         let mut mcap = write_options.create(file.writer()?).map_err(|e| write_err(path, e))?;
         mcap.write_metadata(&mcap::records::Metadata { name: METADATA_NAME.into(), metadata: metadata.to_map() })
             .map_err(|e| write_err(path, e))?;
@@ -202,7 +271,44 @@ impl RecordingWriter {
             channels: BTreeMap::new(),
             counts: BTreeMap::new(),
             buffer: Vec::with_capacity(1 << 16),
+            cartesian,
+            first_log_time_ns: None,
+            mounts_needed: BTreeSet::new(),
+            mounts_present: BTreeSet::new(),
         })
+    }
+
+    /// The Cartesian radar view's resampler, when the options ask for one;
+    /// callers that decode scans on worker threads clone it and pass each
+    /// view to [`Self::write_radar_png_and_view`] or
+    /// [`Self::write_radar_scan_and_view`].
+    #[must_use]
+    pub fn cartesian_resampler(&self) -> Option<&CartesianResampler> {
+        self.cartesian.as_ref()
+    }
+
+    fn saw_log_time(&mut self, log_time_ns: u64) {
+        self.first_log_time_ns = Some(self.first_log_time_ns.map_or(log_time_ns, |t| t.min(log_time_ns)));
+    }
+
+    /// Notes the sensor mounts a copied message implies or carries.
+    fn note_copied(&mut self, message: &RawMessage) {
+        match message.channel.topic.as_str() {
+            RADAR_IMAGE_TOPIC => {
+                self.mounts_needed.insert(RADAR_FRAME);
+            }
+            GNSS_TOPIC => {
+                self.mounts_needed.insert(GNSS_FRAME);
+            }
+            TF_TOPIC if message.channel.schema_name == "foxglove.FrameTransforms" => {
+                if let Ok(tf) = <FrameTransforms as Message>::decode(message.data.clone()) {
+                    for t in tf.transforms.into_iter().filter(|t| t.parent_frame_id == VEHICLE_FRAME) {
+                        self.mounts_present.insert(t.child_frame_id);
+                    }
+                }
+            }
+            _ => {}
+        }
     }
 
     fn path(&self) -> &Path {
@@ -257,6 +363,8 @@ impl RecordingWriter {
         };
         let path = self.file.target().to_path_buf();
         self.mcap.write_to_known_channel(&header, &message.data).map_err(|e| write_err(&path, e))?;
+        self.saw_log_time(message.log_time_ns);
+        self.note_copied(message);
         if let Some(state) = self.channels.get_mut(&channel.topic) {
             state.next_sequence = state.next_sequence.max(message.sequence.wrapping_add(1));
         }
@@ -282,6 +390,7 @@ impl RecordingWriter {
         let header = mcap::records::MessageHeader { channel_id, sequence, log_time, publish_time: log_time };
         let path = self.file.target().to_path_buf();
         self.mcap.write_to_known_channel(&header, &self.buffer).map_err(|e| write_err(&path, e))?;
+        self.saw_log_time(log_time);
         *self.counts.entry(topic.to_string()).or_insert(0) += 1;
         Ok(sequence)
     }
@@ -337,8 +446,33 @@ impl RecordingWriter {
     }
 
     /// Writes a radar scan: its power as a mono8 `foxglove.RawImage` and its
-    /// per-azimuth metadata, both with the same sequence number.
+    /// per-azimuth metadata, both with the same sequence number, and, when the
+    /// options ask for it, its Cartesian view (resampled here).
     pub fn write_radar_scan(&mut self, scan: &PolarScan) -> Result<()> {
+        let view = match &self.cartesian {
+            Some(resampler) => Some(
+                resampler
+                    .resample(&scan.header, &scan.power, scan.header.bins_per_azimuth, 0)
+                    .map_err(|detail| self.bad_scan(&scan.header, detail))?,
+            ),
+            None => None,
+        };
+        self.write_radar_scan_and_view(scan, view.as_deref())
+    }
+
+    fn bad_scan(&self, header: &PolarScanHeader, detail: String) -> IoError {
+        IoError::BadValue {
+            path: self.path().to_path_buf(),
+            record: format!("radar scan at {} ns", header.t_ns),
+            field: "power",
+            detail,
+        }
+    }
+
+    /// [`Self::write_radar_scan`] with the Cartesian view computed by the
+    /// caller (e.g. on worker threads, with [`Self::cartesian_resampler`]);
+    /// `None` writes no view.
+    pub fn write_radar_scan_and_view(&mut self, scan: &PolarScan, cartesian: Option<&[u8]>) -> Result<()> {
         let header = &scan.header;
         let meta = self.header_message(header, 0)?;
         let sequence = self.write_spec(RADAR_META_TOPIC, header.t_ns, &meta, None)?;
@@ -352,6 +486,42 @@ impl RecordingWriter {
             data: bytes::Bytes::copy_from_slice(&scan.power),
         };
         self.write_foxglove(RADAR_IMAGE_TOPIC, header.t_ns, &image, Some(sequence))?;
+        self.mounts_needed.insert(RADAR_FRAME);
+        if let Some(pixels) = cartesian {
+            self.write_radar_cartesian(header.t_ns, pixels, sequence)?;
+        }
+        Ok(())
+    }
+
+    /// Writes a Cartesian view on `/radar/cartesian` (mono8 `foxglove.RawImage`,
+    /// frame `radar`, the grid of [`Self::cartesian_resampler`]), with the
+    /// sequence number of the polar scan it shows.
+    fn write_radar_cartesian(&mut self, t_ns: i64, pixels: &[u8], sequence: u32) -> Result<()> {
+        let Some(grid) = self.cartesian.as_ref().map(CartesianResampler::grid) else {
+            return Err(IoError::RecordingWrite {
+                path: self.path().to_path_buf(),
+                detail: "a Cartesian radar view was given but the recording options set no radar_cartesian grid".into(),
+            });
+        };
+        let side = grid.size_px as usize;
+        if pixels.len() != side * side {
+            return Err(IoError::BadValue {
+                path: self.path().to_path_buf(),
+                record: format!("radar scan at {t_ns} ns"),
+                field: "cartesian view",
+                detail: format!("{} bytes, expected {side} x {side}", pixels.len()),
+            });
+        }
+        let image = RawImage {
+            timestamp: timestamp(t_ns),
+            frame_id: RADAR_FRAME.into(),
+            width: grid.size_px,
+            height: grid.size_px,
+            encoding: "mono8".into(),
+            step: grid.size_px,
+            data: bytes::Bytes::copy_from_slice(pixels),
+        };
+        self.write_foxglove(RADAR_CARTESIAN_TOPIC, t_ns, &image, Some(sequence))?;
         Ok(())
     }
 
@@ -360,6 +530,19 @@ impl RecordingWriter {
     /// number of leading image columns that are not range bins (11 for the
     /// Oxford/Boreas row header). The caller has checked the PNG's shape.
     pub fn write_radar_png(&mut self, header: &PolarScanHeader, png: &[u8], power_column_offset: u32) -> Result<()> {
+        self.write_radar_png_and_view(header, png, power_column_offset, None)
+    }
+
+    /// [`Self::write_radar_png`] and the scan's Cartesian view computed by the
+    /// caller from the decoded PNG (with [`Self::cartesian_resampler`]);
+    /// `None` writes no view.
+    pub fn write_radar_png_and_view(
+        &mut self,
+        header: &PolarScanHeader,
+        png: &[u8],
+        power_column_offset: u32,
+        cartesian: Option<&[u8]>,
+    ) -> Result<()> {
         let meta = self.header_message(header, power_column_offset)?;
         let sequence = self.write_spec(RADAR_META_TOPIC, header.t_ns, &meta, None)?;
         let image = CompressedImage {
@@ -369,6 +552,10 @@ impl RecordingWriter {
             format: "png".into(),
         };
         self.write_foxglove(RADAR_IMAGE_TOPIC, header.t_ns, &image, Some(sequence))?;
+        self.mounts_needed.insert(RADAR_FRAME);
+        if let Some(pixels) = cartesian {
+            self.write_radar_cartesian(header.t_ns, pixels, sequence)?;
+        }
         Ok(())
     }
 
@@ -391,23 +578,27 @@ impl RecordingWriter {
         };
         self.write_spec(stream.topic(), pose.t_ns, &message, None)?;
         if self.foxglove_views {
-            let half_yaw = 0.5 * p.yaw_rad;
             let view = PoseInFrame {
                 timestamp: timestamp(pose.t_ns),
                 frame_id: parent_frame.into(),
                 pose: Some(Pose {
                     position: Some(Vector3 { x: p.x_m, y: p.y_m, z: 0.0 }),
-                    orientation: Some(Quaternion { x: 0.0, y: 0.0, z: half_yaw.sin(), w: half_yaw.cos() }),
+                    orientation: Some(yaw_quaternion(p.yaw_rad)),
                 }),
             };
             self.write_foxglove(stream.viz_topic(), pose.t_ns, &view, None)?;
+            let tf = FrameTransforms {
+                transforms: vec![frame_transform(pose.t_ns, parent_frame, vehicle_frame(stream), p)],
+            };
+            self.write_foxglove(TF_TOPIC, pose.t_ns, &tf, None)?;
         }
         Ok(())
     }
 
     /// Writes a GNSS fix of the vehicle (and its Foxglove display copy).
     pub fn write_gnss_fix(&mut self, fix: &GnssFix) -> Result<()> {
-        self.write_fix(GNSS_TOPIC, GNSS_VIZ_TOPIC, "gnss", fix)
+        self.mounts_needed.insert(GNSS_FRAME);
+        self.write_fix(GNSS_TOPIC, GNSS_VIZ_TOPIC, GNSS_FRAME, fix)
     }
 
     /// Writes a GNSS fix of the beam-sweeping array, e.g. a roadside unit
@@ -509,8 +700,34 @@ impl RecordingWriter {
         Ok(())
     }
 
-    /// Completes the file (summary, index, footer) and moves it into place.
+    /// Writes the sensor mounts `base_link -> radar` / `base_link -> gnss`
+    /// (identity, see [`super::tf`]) on `/tf` at the first log time, for the
+    /// sensors written and not already mounted in a copied `/tf`.
+    fn write_mounts(&mut self) -> Result<()> {
+        let Some(first_ns) = self.first_log_time_ns else { return Ok(()) };
+        let t_ns = i64::try_from(first_ns).map_err(|_| IoError::RecordingWrite {
+            path: self.path().to_path_buf(),
+            detail: format!("first log time {first_ns} ns does not fit in 63 bits"),
+        })?;
+        let transforms: Vec<_> = self
+            .mounts_needed
+            .iter()
+            .filter(|frame| !self.mounts_present.contains(**frame))
+            .map(|frame| frame_transform(t_ns, VEHICLE_FRAME, frame, Se2::IDENTITY))
+            .collect();
+        if transforms.is_empty() {
+            return Ok(());
+        }
+        self.write_foxglove(TF_TOPIC, t_ns, &FrameTransforms { transforms }, None)?;
+        Ok(())
+    }
+
+    /// Completes the file (sensor mounts on `/tf`, summary, index, footer) and
+    /// moves it into place.
     pub fn finish(mut self) -> Result<WriteSummary> {
+        if self.foxglove_views {
+            self.write_mounts()?;
+        }
         let path = self.file.target().to_path_buf();
         self.mcap.finish().map_err(|e| write_err(&path, e))?;
         let mut inner = self.mcap.into_inner();

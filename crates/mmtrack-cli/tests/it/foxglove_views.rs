@@ -1,0 +1,172 @@
+//! Foxglove-ready recordings, checked with independent readers: Python's
+//! `mcap` package decodes every `foxglove.*` message against the schema
+//! embedded in the file (`mcap-protobuf-support`), `/tf` chains the radar and
+//! the estimate to `world`, the Cartesian radar view is a whole image, and
+//! `export --format mcap` adds the estimate to a copy without touching the
+//! input. Time bases are named truthfully (the sounder simulator's
+//! scenario time; a ROS 2 bag stamped with sim time).
+
+use std::path::Path;
+use std::process::Command;
+
+use super::common::{mmtrack, realdata, text, venv_python};
+
+/// A short simulated drive: 8 sweeps of 500 bins (a second of driving).
+const RADAR: &str = r#"
+seed = 5
+start_t_ns = 1_700_000_000_000_000_000
+max_scans = 8
+[sensor]
+bins = 500
+[motion]
+speed_mps = 8.0
+yaw_rate_radps = 0.05
+duration_s = 3.0
+[generator]
+"#;
+
+/// Reads a recording with the `mcap` package, decodes every message whose
+/// schema is a Foxglove one, checks the frame tree and the Cartesian images,
+/// and prints one JSON line of counts and metadata.
+const CHECK: &str = r#"
+import json, sys
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+path = sys.argv[1]
+counts, parents, cartesian = {}, {}, 0
+with open(path, "rb") as f:
+    reader = make_reader(f, decoder_factories=[DecoderFactory()])
+    metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
+    for schema, channel, message, decoded in reader.iter_decoded_messages():
+        if not schema.name.startswith("foxglove."):
+            continue
+        # Decoded against the FileDescriptorSet embedded in the file.
+        assert decoded.DESCRIPTOR.full_name == schema.name, (decoded.DESCRIPTOR.full_name, schema.name)
+        counts[schema.name] = counts.get(schema.name, 0) + 1
+        if schema.name == "foxglove.FrameTransforms":
+            for t in decoded.transforms:
+                q = t.rotation
+                norm = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w
+                assert abs(norm - 1.0) < 1e-12, norm
+                previous = parents.setdefault(t.child_frame_id, t.parent_frame_id)
+                assert previous == t.parent_frame_id, (t.child_frame_id, previous, t.parent_frame_id)
+        if channel.topic == "/radar/cartesian":
+            assert decoded.encoding == "mono8" and decoded.step == decoded.width, decoded.encoding
+            assert decoded.width * decoded.height == len(decoded.data), (decoded.width, decoded.height, len(decoded.data))
+            assert decoded.frame_id == "radar"
+            assert max(decoded.data) > 0, "a blank radar view"
+            cartesian += 1
+
+def root(frame):
+    seen = [frame]
+    while frame in parents:
+        frame = parents[frame]
+        assert frame not in seen, f"cycle {seen}"
+        seen.append(frame)
+    return seen
+
+print(json.dumps({
+    "counts": counts,
+    "cartesian": cartesian,
+    "chains": {f: root(f) for f in sorted(set(parents) | set(parents.values()))},
+    "metadata": metadata.get("mmtrack.recording", {}),
+}))
+"#;
+
+/// Runs [`CHECK`] on `recording`; its JSON output.
+fn check(python: &Path, dir: &Path, recording: &Path) -> serde_json::Value {
+    let script = dir.join("check_foxglove.py");
+    std::fs::write(&script, CHECK).unwrap();
+    let out = Command::new(python).arg(&script).arg(recording).output().unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{} failed:\n{stdout}\n{stderr}", recording.display());
+    serde_json::from_str(stdout.trim()).unwrap_or_else(|e| panic!("{e}: {stdout}"))
+}
+
+fn chain(json: &serde_json::Value, frame: &str) -> Vec<String> {
+    serde_json::from_value(json["chains"][frame].clone()).unwrap_or_default()
+}
+
+#[test]
+fn foxglove_messages_decode_frames_chain_and_estimates_are_added_to_a_copy() {
+    let python = venv_python().expect("Python 3 with pip access to PyPI (the mcap and protobuf readers) is needed");
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), RADAR).unwrap();
+    let run = |args: &[&str]| {
+        let out = mmtrack(d, args);
+        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+        text(&out).0
+    };
+    run(&["simulate", "radar", "--scenario", "s.toml", "-o", "sim.mcap", "-q"]);
+    run(&["process", "odometry", "sim.mcap", "-o", "tables", "--preset", "fast-cfear", "-q"]);
+    let before = std::fs::read(d.join("sim.mcap")).unwrap();
+    let stdout = run(&["export", "--format", "mcap", "tables", "--recording", "sim.mcap", "-o", "est.mcap"]);
+    assert!(stdout.contains("8 estimate poses"), "{stdout}");
+    assert_eq!(std::fs::read(d.join("sim.mcap")).unwrap(), before, "the input recording is never modified");
+
+    let sim = check(&python, d, &d.join("sim.mcap"));
+    let est = check(&python, d, &d.join("est.mcap"));
+    // 8 sweeps: 8 polar images and 8 Cartesian views, 8 ground-truth poses
+    // (and 8 more estimate poses in the copy), each with its /tf message,
+    // plus one message of sensor mounts.
+    assert_eq!(sim["cartesian"], 8, "{sim}");
+    assert_eq!(sim["counts"]["foxglove.RawImage"], 16, "{sim}");
+    assert_eq!(sim["counts"]["foxglove.FrameTransforms"], 8 + 1, "{sim}");
+    assert_eq!(est["counts"]["foxglove.FrameTransforms"], 8 + 8 + 1, "{est}");
+    assert_eq!(est["counts"]["foxglove.PoseInFrame"], 16, "{est}");
+    assert_eq!(chain(&est, "radar"), ["radar", "base_link", "world"], "{est}");
+    assert_eq!(chain(&est, "estimate"), ["estimate", "world"], "{est}");
+    assert_eq!(est["metadata"]["time_base"], "unix_epoch");
+    assert!(est["metadata"]["estimate.source"].as_str().unwrap().contains("odometry"), "{est}");
+
+    // Refused: writing over the input, and an input that has estimates already.
+    let out = mmtrack(d, &["export", "--format", "mcap", "tables", "--recording", "sim.mcap", "-o", "sim.mcap"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("never modified"), "{}", text(&out).1);
+    let out = mmtrack(d, &["export", "--format", "mcap", "tables", "--recording", "est.mcap", "-o", "twice.mcap"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("already holds an estimate"), "{}", text(&out).1);
+    assert!(!d.join("twice.mcap").exists());
+
+    // Without the Cartesian view: the same recording minus /radar/cartesian.
+    run(&["simulate", "radar", "--scenario", "s.toml", "-o", "plain.mcap", "--no-radar-cartesian", "-q"]);
+    let plain = check(&python, d, &d.join("plain.mcap"));
+    assert_eq!(plain["cartesian"], 0, "{plain}");
+    assert_eq!(plain["counts"]["foxglove.RawImage"], 8, "{plain}");
+}
+
+#[test]
+fn sounder_recordings_name_their_scenario_time_base() {
+    let python = venv_python().expect("Python 3 with pip access to PyPI (the mcap and protobuf readers) is needed");
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scenario = super::common::root().join("data/sounder/convoy-tunnel.toml");
+    let out =
+        mmtrack(d, &["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "--sets", "3", "-o", "s.mcap"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let json = check(&python, d, &d.join("s.mcap"));
+    assert_eq!(json["metadata"]["time_base"], "scenario_start", "{json}");
+    assert!(json["metadata"]["time_base.meaning"].as_str().unwrap().contains("not UNIX time"), "{json}");
+    // Both cars move in /tf.
+    assert_eq!(chain(&json, "tx"), ["tx", "world"], "{json}");
+    assert_eq!(chain(&json, "rx"), ["rx", "world"], "{json}");
+}
+
+#[test]
+fn a_ros2_bag_stamped_with_sim_time_is_labelled_sim_time() {
+    let Some(realdata) = realdata("ros2_sim_time") else { return };
+    let python = venv_python().expect("Python 3 with pip access to PyPI (the mcap and protobuf readers) is needed");
+    let bag = realdata.join("ros2-mcap/nav2_turtlebot.mcap");
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "ros2", bag.to_str().unwrap(), "-o", "bag.mcap"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let json = check(&python, dir.path(), &dir.path().join("bag.mcap"));
+    // The evo test bag is a Gazebo TurtleBot: its stamps start a few minutes after 0.
+    assert_eq!(json["metadata"]["time_base"], "sim_time", "{json}");
+    assert!(json["metadata"]["time.note"].as_str().unwrap().contains("before 2000-01-01"), "{json}");
+    // Its /odom poses move the estimate frame under the bag's own parent frame.
+    assert_eq!(json["counts"]["foxglove.FrameTransforms"], 2639, "{json}");
+    assert_eq!(chain(&json, "estimate").last().map(String::as_str), Some("odom"), "{json}");
+}

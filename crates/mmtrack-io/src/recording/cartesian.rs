@@ -1,0 +1,243 @@
+//! Polar radar scans resampled onto a Cartesian grid, for display only
+//! (`/radar/cartesian`, a mono8 `foxglove.RawImage` that Foxglove's image
+//! panel shows as the bird's-eye view radar users expect). The polar image on
+//! `/radar/image` stays the canonical data; nothing reads this view back.
+//!
+//! # Geometry
+//!
+//! The image is `size_px` x `size_px` pixels of `metres_per_pixel`, centred on
+//! the radar: the centre pixel `c = (size_px - 1) / 2` is the sensor, image
+//! up is the sensor's forward axis (`x`), image left its left (`y`), so the
+//! view is a map seen from above. Pixel `(row, col)` is the point
+//!
+//! ```text
+//! x_m = (c - row) * metres_per_pixel,   y_m = (c - col) * metres_per_pixel
+//! ```
+//!
+//! in the radar frame. Its range `sqrt(x^2 + y^2)` and azimuth
+//! `atan2(-y, x)` (clockwise from forward, as Navtech encoders count, see
+//! [`mmtrack_core::AzimuthSample`]) are looked up bilinearly in the polar scan:
+//! range bin `(range_m - range_offset_m) / range_resolution_m` (bin centres as
+//! [`mmtrack_core::PolarScanHeader::range_m`]), azimuth row
+//! `(azimuth - azimuth_0) / (2 pi / rows)`, wrapping from the last row to the
+//! first. The rows are taken as evenly spaced over one clockwise turn starting
+//! at row 0's azimuth, as a spinning radar sweeps (Oxford: 400 rows of 14
+//! encoder counts out of 5600). Rows flagged invalid count as power 0, and so
+//! does everything beyond the last range bin or before the first.
+//!
+//! This is the resampling of the Oxford Radar RobotCar SDK's
+//! `radar_polar_to_cartesian` (bilinear in azimuth and range), whose example
+//! defaults the grid's defaults follow (0.25 m per pixel, 501 pixels: 62.6 m
+//! around the sensor).
+
+use mmtrack_core::PolarScanHeader;
+
+/// Size and resolution of the Cartesian radar image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CartesianGrid {
+    /// Edge of one (square) pixel, metres.
+    pub metres_per_pixel: f64,
+    /// Width and height of the image, pixels; odd sizes put the sensor on a
+    /// pixel centre.
+    pub size_px: u32,
+}
+
+impl Default for CartesianGrid {
+    /// The Oxford SDK example's grid: 0.25 m per pixel, 501 x 501 pixels.
+    fn default() -> Self {
+        Self { metres_per_pixel: 0.25, size_px: 501 }
+    }
+}
+
+/// Largest image edge, pixels (4096 x 4096 is 16 MiB per scan).
+pub const MAX_CARTESIAN_SIZE_PX: u32 = 4096;
+
+impl CartesianGrid {
+    /// Checks the resolution is positive and finite and the size within
+    /// 1..=[`MAX_CARTESIAN_SIZE_PX`]; the error says which.
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.metres_per_pixel.is_finite() && self.metres_per_pixel > 0.0) {
+            return Err(format!("metres per pixel {} is not a positive number", self.metres_per_pixel));
+        }
+        if self.size_px == 0 || self.size_px > MAX_CARTESIAN_SIZE_PX {
+            return Err(format!("image size {} px is not within 1..={MAX_CARTESIAN_SIZE_PX}", self.size_px));
+        }
+        Ok(())
+    }
+
+    /// Distance from the sensor to the image edge along x or y, metres.
+    #[must_use]
+    pub fn half_width_m(&self) -> f64 {
+        0.5 * f64::from(self.size_px) * self.metres_per_pixel
+    }
+}
+
+/// A Cartesian grid with its per-pixel range and azimuth computed once, so a
+/// scan costs a bilinear lookup per pixel. Shared by reference between
+/// threads.
+#[derive(Debug, Clone)]
+pub struct CartesianResampler {
+    grid: CartesianGrid,
+    /// Range of each pixel centre, metres, row-major.
+    range_m: Vec<f32>,
+    /// Azimuth of each pixel centre in turns, [0, 1), clockwise from forward.
+    azimuth_turns: Vec<f32>,
+}
+
+impl CartesianResampler {
+    /// Precomputes the grid; the error says what is wrong with it.
+    pub fn new(grid: CartesianGrid) -> Result<Self, String> {
+        grid.check()?;
+        let n = grid.size_px as usize;
+        let centre = 0.5 * (f64::from(grid.size_px) - 1.0);
+        let mut range_m = Vec::with_capacity(n * n);
+        let mut azimuth_turns = Vec::with_capacity(n * n);
+        for row in 0..n {
+            let x_m = (centre - row as f64) * grid.metres_per_pixel;
+            for col in 0..n {
+                let y_m = (centre - col as f64) * grid.metres_per_pixel;
+                range_m.push(x_m.hypot(y_m) as f32);
+                let turns = (-y_m).atan2(x_m) / std::f64::consts::TAU;
+                azimuth_turns.push(turns.rem_euclid(1.0) as f32);
+            }
+        }
+        Ok(Self { grid, range_m, azimuth_turns })
+    }
+
+    /// The grid.
+    #[must_use]
+    pub fn grid(&self) -> CartesianGrid {
+        self.grid
+    }
+
+    /// Resamples one scan. `rows` holds the polar image row-major, `row_stride`
+    /// bytes per azimuth row, the range bins starting `column_offset` bytes
+    /// into each row (11 for a carried Oxford PNG, whose rows start with the
+    /// per-azimuth header; 0 for bare power). Returns `size_px * size_px`
+    /// bytes, row-major; the error says which size does not fit.
+    pub fn resample(
+        &self,
+        header: &PolarScanHeader,
+        rows: &[u8],
+        row_stride: usize,
+        column_offset: usize,
+    ) -> Result<Vec<u8>, String> {
+        let azimuths = header.azimuths.len();
+        let bins = header.bins_per_azimuth;
+        let needed = azimuths.checked_mul(row_stride).ok_or("image size overflows")?;
+        if column_offset.checked_add(bins).is_none_or(|end| end > row_stride) || rows.len() < needed {
+            return Err(format!(
+                "polar image of {} bytes cannot hold {azimuths} rows of {row_stride} bytes with {bins} bins after \
+                 {column_offset} header bytes",
+                rows.len()
+            ));
+        }
+        let pixels = self.range_m.len();
+        if azimuths == 0 || bins == 0 {
+            return Ok(vec![0; pixels]);
+        }
+        let range_resolution_m = header.range_resolution_m as f32;
+        let range_offset_m = header.range_offset_m as f32;
+        let first_turns = (header.azimuths[0].azimuth_rad / std::f64::consts::TAU).rem_euclid(1.0) as f32;
+        let rows_per_turn = azimuths as f32;
+        let last_bin = (bins - 1) as f32;
+        let valid: Vec<bool> = header.azimuths.iter().map(|a| a.valid).collect();
+        // Power of bin `b` of row `r` (0 on invalid rows).
+        let power = |r: usize, b: usize| -> f32 {
+            if valid[r] { f32::from(rows[r * row_stride + column_offset + b]) } else { 0.0 }
+        };
+        let mut out = vec![0u8; pixels];
+        for ((value, &range), &turns) in out.iter_mut().zip(&self.range_m).zip(&self.azimuth_turns) {
+            let bin = (range - range_offset_m) / range_resolution_m;
+            if !(bin >= 0.0 && bin <= last_bin) {
+                continue;
+            }
+            let row = (turns - first_turns).rem_euclid(1.0) * rows_per_turn;
+            // `row` is in [0, rows]; f32 rounding may give exactly `rows`.
+            let r0 = (row as usize).min(azimuths - 1);
+            let r1 = (r0 + 1) % azimuths;
+            let (b0, wr) = (bin as usize, row - r0 as f32);
+            let b1 = (b0 + 1).min(bins - 1);
+            let wb = bin - b0 as f32;
+            let near = power(r0, b0) + wb * (power(r0, b1) - power(r0, b0));
+            let far = power(r1, b0) + wb * (power(r1, b1) - power(r1, b0));
+            *value = (near + wr.clamp(0.0, 1.0) * (far - near)).round() as u8;
+        }
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use mmtrack_core::AzimuthSample;
+
+    use super::*;
+
+    fn header(azimuths: usize, bins: usize, resolution_m: f64) -> PolarScanHeader {
+        PolarScanHeader {
+            t_ns: 0,
+            range_resolution_m: resolution_m,
+            range_offset_m: 0.0,
+            bins_per_azimuth: bins,
+            azimuths: (0..azimuths)
+                .map(|i| AzimuthSample {
+                    t_ns: i as i64,
+                    azimuth_rad: i as f64 * std::f64::consts::TAU / azimuths as f64,
+                    valid: true,
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn a_target_straight_ahead_lands_above_the_centre_and_one_to_the_right_lands_right() {
+        // 4 rows: 0 forward, 1 right (clockwise), 2 behind, 3 left; 100 bins of 0.1 m.
+        let (n, bins) = (4, 100);
+        let mut power = vec![0u8; n * bins];
+        power[50] = 200; // row 0 (forward), 5.0 m
+        power[bins + 30] = 100; // row 1 (right), 3.0 m
+        let resampler = CartesianResampler::new(CartesianGrid { metres_per_pixel: 1.0, size_px: 21 }).unwrap();
+        let image = resampler.resample(&header(n, bins, 0.1), &power, bins, 0).unwrap();
+        assert_eq!(image.len(), 21 * 21);
+        let at = |row: usize, col: usize| image[row * 21 + col];
+        // Centre pixel (10, 10); 5 m forward is row 5, column 10; 3 m right is row 10, column 13.
+        assert_eq!(at(5, 10), 200);
+        assert_eq!(at(10, 13), 100);
+        // Nothing behind or on the left.
+        assert_eq!(at(15, 10), 0);
+        assert_eq!(at(10, 7), 0);
+    }
+
+    #[test]
+    fn header_columns_are_skipped_and_invalid_rows_are_dark() {
+        let (n, bins, offset) = (8, 20, 11);
+        let stride = offset + bins;
+        // Header bytes of 255 everywhere (what Oxford's valid flag holds), power 7.
+        let mut rows = vec![255u8; n * stride];
+        for r in 0..n {
+            rows[r * stride + offset..(r + 1) * stride].fill(7);
+        }
+        let mut h = header(n, bins, 1.0);
+        let resampler = CartesianResampler::new(CartesianGrid { metres_per_pixel: 1.0, size_px: 31 }).unwrap();
+        let image = resampler.resample(&h, &rows, stride, offset).unwrap();
+        // Within range every pixel is 7 (never a header byte), beyond it 0.
+        assert!(image.iter().all(|&v| v == 7 || v == 0), "{image:?}");
+        assert_eq!(image[15 * 31 + 15], 7);
+        assert_eq!(image[0], 0, "the corner is 21.2 m out, past the last bin (19 m)");
+        for a in &mut h.azimuths {
+            a.valid = false;
+        }
+        assert!(resampler.resample(&h, &rows, stride, offset).unwrap().iter().all(|&v| v == 0));
+    }
+
+    #[test]
+    fn bad_sizes_are_errors_not_panics() {
+        let resampler = CartesianResampler::new(CartesianGrid::default()).unwrap();
+        let h = header(4, 10, 0.1);
+        assert!(resampler.resample(&h, &[0; 39], 10, 0).is_err());
+        assert!(resampler.resample(&h, &[0; 40], 10, 1).is_err());
+        assert!(CartesianResampler::new(CartesianGrid { metres_per_pixel: 0.0, size_px: 5 }).is_err());
+        assert!(CartesianResampler::new(CartesianGrid { metres_per_pixel: 0.1, size_px: 0 }).is_err());
+        assert!(CartesianResampler::new(CartesianGrid { metres_per_pixel: f64::NAN, size_px: 5 }).is_err());
+    }
+}
