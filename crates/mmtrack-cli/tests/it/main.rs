@@ -11,6 +11,7 @@ mod cli;
 mod common;
 mod error_lines;
 mod fixtures;
+mod foxglove_views;
 mod independent_readers;
 mod ingest_navtech;
 mod interrupt;
