@@ -21,6 +21,7 @@ mod process;
 mod progress;
 mod readme_block;
 mod reproduce;
+mod reproduce_all;
 mod reproduce_mpc;
 mod reproduce_mpc_report;
 mod simulate;

@@ -33,9 +33,12 @@ pub const ODOMETRY_DRIVE_SCENARIO: &str = include_str!("../../../data/reproduce/
 const DEFAULT_TRAJECTORY: &str = "../shared/realdata/oxford-gt-full-seq/radar_odometry.csv";
 
 #[derive(Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_required = false, arg_required_else_help = true)]
 pub struct ReproduceArgs {
     #[command(subcommand)]
-    experiment: Experiment,
+    experiment: Option<Experiment>,
+    #[command(flatten)]
+    all: crate::reproduce_all::AllArgs,
 }
 
 #[derive(Subcommand)]
@@ -156,7 +159,13 @@ struct OdometryExperimentArgs {
 }
 
 pub fn run(args: &ReproduceArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    match &args.experiment {
+    let Some(experiment) = &args.experiment else {
+        if !args.all.all {
+            bail!("name an experiment (`mmtrack reproduce --help` lists them) or pass --all");
+        }
+        return crate::reproduce_all::run(&args.all, quiet);
+    };
+    match experiment {
         Experiment::Odometry(a) => a.threads.install(|| odometry(a, quiet))?,
         Experiment::MpcArtificial(a) => crate::reproduce_mpc::run(a, quiet),
         Experiment::Shaham(a) => crate::beam::reproduce_shaham::run(a, quiet),
@@ -182,7 +191,7 @@ const TARGETS: [Target; 3] = [
 
 const PRESETS: [&str; 2] = ["fast-cfear", "cfear"];
 /// Entries of the output directory; `--force` replaces only a directory holding nothing else.
-const OWN_ENTRIES: [&str; 3] = ["tables", "analysis", "reproduce.md"];
+const OWN_ENTRIES: [&str; 4] = ["tables", "analysis", "reproduce.md", crate::reproduce_all::METRICS_FILE];
 
 fn check_output(out: &Path, force: bool) -> anyhow::Result<()> {
     if !out.exists() {
@@ -326,6 +335,7 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
     let verdicts = verdicts(&results);
     let report = report(args, &scenario_name, &results, &verdicts, ground_truth.len(), elapsed_s);
     std::fs::write(staging.path().join("reproduce.md"), &report)?;
+    crate::reproduce_all::write_metrics(staging.path(), &metrics(&results))?;
     if args.output.exists() {
         std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
     }
@@ -350,6 +360,25 @@ struct PresetResult {
     preset: &'static str,
     result: TrajectoryResult,
     low_confidence: usize,
+}
+
+/// The numbers `reproduce --all` checks: KITTI drift of both presets (the
+/// paper's 6.56 % is fast-cfear's on Oxford).
+fn metrics(results: &[PresetResult]) -> Vec<crate::reproduce_all::Metric> {
+    use crate::reproduce_all::Metric;
+    let mut out = Vec::new();
+    for r in results {
+        let m = &r.result.metrics;
+        let paper = (r.preset == "fast-cfear").then_some(6.56);
+        if let Some(v) = m.kitti_translational_pct {
+            out.push(Metric::new(format!("{} KITTI translational drift", r.preset), v, "%", paper));
+        }
+        if let Some(v) = m.kitti_rotational_deg_per_100m {
+            out.push(Metric::new(format!("{} KITTI rotational drift", r.preset), v, "deg/100 m", None));
+        }
+        out.push(Metric::new(format!("{} ATE RMSE", r.preset), m.ate_rmse_m, "m", None));
+    }
+    out
 }
 
 fn verdicts(results: &[PresetResult]) -> Vec<Verdict> {

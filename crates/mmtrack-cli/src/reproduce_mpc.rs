@@ -149,6 +149,7 @@ pub fn run(args: &MpcArtificialArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     write_atomically(&args.output.join("results.csv"), &report::csv(&sweep.points))?;
     write_atomically(&args.output.join("results_by_separation.csv"), &report::separation_csv(&sweep.bins))?;
     write_atomically(&args.output.join("reproduce.md"), &markdown)?;
+    crate::reproduce_all::write_metrics(&args.output, &report::metrics(&sweep))?;
     write_figures(&sweep, &args.output)?;
     if let Some(readme) = &args.readme {
         let summary = report::readme_summary(&sweep, &figures_location(readme, &args.output));

@@ -121,6 +121,35 @@ impl Verdicts {
     }
 }
 
+/// The numbers `reproduce --all` checks, Kaiser window: at the target power
+/// (-116 dB) and at -126 dB, each tracker's mean number of tracks and the
+/// proposed tracker's mean delay error and share of runs with two tracks.
+pub fn metrics(sweep: &Sweep) -> Vec<crate::reproduce_all::Metric> {
+    use crate::reproduce_all::Metric;
+    let mut out = Vec::new();
+    for power in [TARGET_ERROR_POWER_DB, TARGET_TWO_TRACKS_DOWN_TO_DB] {
+        for tracker in [ArtificialTracker::Proposed, ArtificialTracker::GmPhd] {
+            let Some(p) = sweep.point(power, true, tracker) else { continue };
+            let name = tracker.name();
+            out.push(Metric::new(format!("{name} mean tracks, {power} dB"), p.mean_tracks, "tracks", Some(2.0)));
+            if tracker == ArtificialTracker::Proposed {
+                let paper = (power == TARGET_ERROR_POWER_DB).then_some(TARGET_ERROR_NS);
+                if p.mean_delay_error_ns.is_finite() {
+                    out.push(Metric::new(
+                        format!("{name} mean delay error, {power} dB"),
+                        p.mean_delay_error_ns,
+                        "ns",
+                        paper,
+                    ));
+                }
+                let share = p.runs_with_two_tracks as f64 / p.runs.max(1) as f64;
+                out.push(Metric::new(format!("{name} runs with two tracks, {power} dB"), share, "share", Some(1.0)));
+            }
+        }
+    }
+    out
+}
+
 pub fn verdicts(sweep: &Sweep) -> Verdicts {
     let proposed = ArtificialTracker::Proposed;
     let error_ns = sweep.point(TARGET_ERROR_POWER_DB, true, proposed).map(|p| p.mean_delay_error_ns);

@@ -350,6 +350,7 @@ fn write_outputs(
         std::fs::write(staging.path().join(file), svg).with_context(|| file.to_string())?;
     }
     std::fs::write(staging.path().join("reproduce.md"), summary)?;
+    crate::reproduce_all::write_metrics(staging.path(), &report::metrics(experiment, results))?;
     if args.output.exists() {
         std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
     }

@@ -506,6 +506,9 @@ fn write_outputs(
         std::fs::write(staging.path().join(file), svg).context(file)?;
     }
     std::fs::write(staging.path().join("reproduce.md"), summary)?;
+    let metrics: Vec<_> =
+        outcomes.iter().flat_map(|o| output::metrics(&output::summary_row(experiment, &args.trajectory, o))).collect();
+    crate::reproduce_all::write_metrics(staging.path(), &metrics)?;
     if args.output.exists() {
         std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
     }

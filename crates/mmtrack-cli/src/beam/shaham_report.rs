@@ -22,6 +22,34 @@ fn blocks_text(blocks: Option<usize>, simulated: usize) -> String {
     blocks.map_or(format!("> {simulated}"), |b| b.to_string())
 }
 
+/// The numbers `reproduce --all` checks: valid tracking of each tracker at
+/// each point (blocks simulated + 1 where it never ended), the paper's
+/// number beside the proposed EKF's, and its gain over the angle-state EKF.
+pub fn metrics(experiment: &Experiment, results: &[PointResult]) -> Vec<crate::reproduce_all::Metric> {
+    use crate::reproduce_all::Metric;
+    let mut out = Vec::new();
+    for p in results {
+        for (t, tracker) in TRACKERS.iter().enumerate() {
+            let paper = experiment
+                .targets
+                .iter()
+                .find(|g| t == 0 && g.snr_db == p.snr_db && g.speed_kmh == p.speed_kmh)
+                .map(|g| g.paper_blocks as f64);
+            let blocks = p.valid_blocks[t].unwrap_or(experiment.blocks + 1) as f64;
+            let key = format!("{tracker} valid tracking, {} dB, {} km/h", p.snr_db, p.speed_kmh);
+            out.push(Metric::new(key, blocks, "blocks", paper));
+        }
+    }
+    if let Some(p) = point(results, 0.0, 60.0)
+        && let (Some(pv), Some(angle)) = (p.valid_blocks[0], p.valid_blocks[2])
+        && angle > 0
+    {
+        let gain = 100.0 * (pv as f64 / angle as f64 - 1.0);
+        out.push(Metric::new("pv-ekf gain over angle-ekf, 0 dB, 60 km/h", gain, "%", Some(experiment.paper_gain_pct)));
+    }
+    out
+}
+
 /// Each published number within the tolerance, the two orderings and the
 /// gain over the angle-state EKF, for the proposed tracker (`pv-ekf`).
 pub fn verdicts(experiment: &Experiment, results: &[PointResult]) -> Vec<Verdict> {

@@ -38,6 +38,24 @@ pub(super) fn summary_row(experiment: &Experiment, trajectory: &Path, outcome: &
     }
 }
 
+/// The numbers `reproduce --all` checks for one experiment: RMSE of
+/// |alpha|, AoD and AoA and the re-initialisation share, with the paper's.
+pub(super) fn metrics(row: &SpebtSummaryRow) -> Vec<crate::reproduce_all::Metric> {
+    use crate::reproduce_all::Metric;
+    let e = &row.experiment;
+    vec![
+        Metric::new(format!("{e} RMSE abs(alpha)"), row.rmse_gain_pct, "%", Some(row.paper_rmse_gain_pct)),
+        Metric::new(format!("{e} RMSE AoD"), row.rmse_aod_deg, "deg", Some(row.paper_rmse_aod_deg)),
+        Metric::new(format!("{e} RMSE AoA"), row.rmse_aoa_deg, "deg", Some(row.paper_rmse_aoa_deg)),
+        Metric::new(
+            format!("{e} re-initialisation share"),
+            row.reinitialisation_share_pct,
+            "%",
+            Some(row.paper_reinitialisation_share_pct),
+        ),
+    ]
+}
+
 /// The `spebt_per_slot` rows of one experiment.
 pub(super) fn slot_rows(outcome: &Outcome) -> Vec<SpebtSlotRow> {
     let (link, r) = (&outcome.link, &outcome.result);

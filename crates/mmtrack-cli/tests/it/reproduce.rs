@@ -134,3 +134,26 @@ fn mpc_artificial_refuses_a_readme_without_its_markers() {
     assert_eq!(std::fs::read_to_string(dir.path().join("README.md")).unwrap(), unmarked);
     assert!(!dir.path().join("out").exists(), "the run must not start");
 }
+
+/// `reproduce --all --smoke`: every experiment's CI version, each metric
+/// within its smoke expectation (data/reproduce/*.expected.toml).
+#[test]
+fn all_smoke_runs_every_experiment_within_its_expectations() {
+    let Some(_) = realdata("reproduce_all_smoke") else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let out_dir = dir.path().join("all");
+    // From the repository root: the experiments' default trajectories are
+    // ../shared/realdata paths relative to it.
+    let out = mmtrack(&root(), &["reproduce", "--all", "--smoke", "-o", out_dir.to_str().unwrap()]);
+    let (stdout, stderr) = text(&out);
+    println!("{stdout}");
+    assert!(out.status.success(), "a metric left its expected range:\n{stdout}\n{stderr}");
+    assert!(stdout.contains("41 metrics of 4 experiments, 0 outside their expected range"), "{stdout}");
+    for experiment in ["odometry", "mpc-artificial", "shaham", "spebt"] {
+        assert!(out_dir.join(experiment).join("metrics.json").is_file(), "{experiment}");
+    }
+    assert!(out_dir.join("summary.md").is_file());
+    // Neither an experiment nor --all: a usage error naming both.
+    let none = mmtrack(dir.path(), &["reproduce", "--smoke"]);
+    assert!(!none.status.success());
+}
