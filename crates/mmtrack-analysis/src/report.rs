@@ -5,6 +5,7 @@
 use std::fmt::Write;
 
 use crate::pipeline::TrajectoryResult;
+use crate::tables::TrajectoryMetrics;
 use crate::trajectory::DriftOptions;
 
 fn opt(v: Option<f64>, decimals: usize) -> String {
@@ -20,6 +21,50 @@ fn step(options: &DriftOptions) -> String {
         crate::trajectory::FirstFrameStep::Frames(n) => format!("every {n} frame{}", if n == 1 { "" } else { "s" }),
         crate::trajectory::FirstFrameStep::Metres(m) => format!("every {m} m"),
     }
+}
+
+/// Every sequence's metrics pooled (module docs of the trajectory section):
+/// KITTI drift weighted by segments, RMSEs by poses, RPE by frame pairs,
+/// maxima and sums over sequences. Fields without a pooled meaning (times,
+/// step, the end-point error) are taken from the first sequence or zeroed.
+#[must_use]
+/// `None` for no sequences.
+pub fn pooled_metrics(ms: &[&TrajectoryMetrics]) -> Option<TrajectoryMetrics> {
+    let rms = |value: fn(&TrajectoryMetrics) -> f64, weight: fn(&TrajectoryMetrics) -> f64| {
+        let total: f64 = ms.iter().map(|m| weight(m)).sum();
+        if total > 0.0 { (ms.iter().map(|m| weight(m) * value(m).powi(2)).sum::<f64>() / total).sqrt() } else { 0.0 }
+    };
+    let segments: u64 = ms.iter().map(|m| m.kitti_segments).sum();
+    let by_segments = |value: fn(&TrajectoryMetrics) -> Option<f64>| {
+        (segments > 0).then(|| {
+            ms.iter().filter_map(|m| value(m).map(|v| v * m.kitti_segments as f64)).sum::<f64>() / segments as f64
+        })
+    };
+    let poses = |m: &TrajectoryMetrics| m.associated_poses as f64;
+    let pairs = |m: &TrajectoryMetrics| m.associated_poses.saturating_sub(1) as f64;
+    let first = ms.first()?;
+    Some(TrajectoryMetrics {
+        estimate_poses: ms.iter().map(|m| m.estimate_poses).sum(),
+        associated_poses: ms.iter().map(|m| m.associated_poses).sum(),
+        interpolated_poses: ms.iter().map(|m| m.interpolated_poses).sum(),
+        dropped_poses: ms.iter().map(|m| m.dropped_poses).sum(),
+        path_length_m: ms.iter().map(|m| m.path_length_m).sum(),
+        estimate_path_length_m: ms.iter().map(|m| m.estimate_path_length_m).sum(),
+        kitti_segments: segments,
+        kitti_translational_pct: by_segments(|m| m.kitti_translational_pct),
+        kitti_rotational_deg_per_m: by_segments(|m| m.kitti_rotational_deg_per_m),
+        kitti_rotational_deg_per_100m: by_segments(|m| m.kitti_rotational_deg_per_100m),
+        ate_rmse_m: rms(|m| m.ate_rmse_m, poses),
+        ate_max_m: ms.iter().map(|m| m.ate_max_m).fold(0.0, f64::max),
+        x_rmse_m: rms(|m| m.x_rmse_m, poses),
+        y_rmse_m: rms(|m| m.y_rmse_m, poses),
+        position_rmse_m: rms(|m| m.position_rmse_m, poses),
+        yaw_rmse_rad: rms(|m| m.yaw_rmse_rad, poses),
+        final_position_error_m: 0.0,
+        rpe_translation_rmse_m: rms(|m| m.rpe_translation_rmse_m, pairs),
+        rpe_yaw_rmse_rad: rms(|m| m.rpe_yaw_rmse_rad, pairs),
+        ..(*first).clone()
+    })
 }
 
 /// The one-line summary of a sequence, as the CLI prints it.
@@ -84,20 +129,30 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
         "## Trajectory (table `odometry` against `ground_truth`)\n\n\
          Both trajectories are associated by time (ground truth interpolated) and start at the identity. \
          KITTI drift follows the KITTI odometry devkit: segment lengths {} m, first frames {}; mean over all segments. \
-         ATE is the position RMSE after the least-squares SE(2) alignment; x/y/yaw RMSE are without alignment.\n\n",
+         ATE is the position RMSE after the least-squares SE(2) alignment; x/y/yaw RMSE are without alignment; RPE \
+         is the RMSE of the frame-to-frame relative translation and yaw errors. The pooled row (several sequences) \
+         weights each sequence by what its metric averages over: KITTI drift by its segments (the mean over every \
+         segment of every sequence, as the devkit pools a dataset), ATE and RMSEs by their poses, RPE by its frame \
+         pairs; paths and poses are summed.\n\n",
         lengths(options),
         step(options)
     );
     out.push_str(
         "| sequence | poses | dropped | path (m) | KITTI t (%) | KITTI r (deg/m) | KITTI r (deg/100 m) | ATE (m) | \
-         RMSE (x, y) (m) | yaw RMSE (deg) | end-point error (m) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+         ATE max (m) | RMSE (x, y) (m) | yaw RMSE (deg) | RPE t (m) | RPE yaw (deg) | end-point error (m) |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    for r in results {
-        let m = &r.metrics;
+    let pooled =
+        if results.len() > 1 { pooled_metrics(&results.iter().map(|r| &r.metrics).collect::<Vec<_>>()) } else { None };
+    // The pooled row has no end point.
+    let rows = results
+        .iter()
+        .map(|r| (r.sequence.as_str(), &r.metrics, Some(r.metrics.final_position_error_m)))
+        .chain(pooled.as_ref().map(|p| ("all (pooled)", p, None)));
+    for (name, m, end_point_m) in rows {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.1} | {} | {} | {} | {:.3} | ({:.3}, {:.3}) | {:.3} | {:.3} |",
-            r.sequence,
+            "| {name} | {} | {} | {:.1} | {} | {} | {} | {:.3} | {:.3} | ({:.3}, {:.3}) | {:.3} | {:.4} | {:.4} | {} |",
             m.associated_poses,
             m.dropped_poses,
             m.path_length_m,
@@ -105,13 +160,27 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
             opt(m.kitti_rotational_deg_per_m, 5),
             opt(m.kitti_rotational_deg_per_100m, 3),
             m.ate_rmse_m,
+            m.ate_max_m,
             m.x_rmse_m,
             m.y_rmse_m,
             m.yaw_rmse_rad.to_degrees(),
-            m.final_position_error_m
+            m.rpe_translation_rmse_m,
+            m.rpe_yaw_rmse_rad.to_degrees(),
+            end_point_m.map_or_else(|| "-".to_string(), |e| format!("{e:.3}"))
         );
     }
     out.push('\n');
+    let without: Vec<&str> =
+        results.iter().filter(|r| r.metrics.kitti_segments == 0).map(|r| r.sequence.as_str()).collect();
+    if !without.is_empty() {
+        let _ = writeln!(
+            out,
+            "KITTI drift is n/a for {}: the path is shorter than the shortest segment length ({} m); pass shorter \
+             `--segment-lengths-m`.\n",
+            without.iter().map(|s| format!("`{s}`")).collect::<Vec<_>>().join(", "),
+            options.segment_lengths_m.iter().copied().fold(f64::INFINITY, f64::min)
+        );
+    }
     for r in results {
         let _ = writeln!(out, "### `{}`\n", r.sequence);
         if r.drift.per_length.is_empty() {
@@ -140,5 +209,59 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
             "![trajectory](plots/{s}/trajectory.svg)\n![errors vs distance](plots/{s}/errors_vs_distance.svg)\n\
              ![drift per length](plots/{s}/drift_per_length.svg)\n"
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn metrics(poses: u64, segments: u64, kitti_pct: Option<f64>, ate_m: f64, rpe_m: f64) -> TrajectoryMetrics {
+        TrajectoryMetrics {
+            estimate_poses: poses,
+            associated_poses: poses,
+            interpolated_poses: 0,
+            dropped_poses: 0,
+            first_t_ns: 0,
+            last_t_ns: 1,
+            path_length_m: 100.0,
+            estimate_path_length_m: 101.0,
+            segment_lengths_m: vec![10.0],
+            step_frames: Some(1),
+            step_m: None,
+            kitti_segments: segments,
+            kitti_translational_pct: kitti_pct,
+            kitti_rotational_deg_per_m: kitti_pct.map(|p| p / 100.0),
+            kitti_rotational_deg_per_100m: kitti_pct,
+            ate_rmse_m: ate_m,
+            ate_max_m: 2.0 * ate_m,
+            x_rmse_m: ate_m,
+            y_rmse_m: ate_m,
+            position_rmse_m: ate_m,
+            yaw_rmse_rad: 0.01,
+            final_position_error_m: 5.0,
+            rpe_translation_rmse_m: rpe_m,
+            rpe_yaw_rmse_rad: 0.001,
+        }
+    }
+
+    #[test]
+    fn pooled_row_weights_segments_poses_and_frame_pairs_by_hand() {
+        // a: 11 poses (10 pairs), 3 segments at 1 %, ATE 1 m, RPE 0.1 m;
+        // b: 31 poses (30 pairs), 1 segment at 5 %, ATE 2 m, RPE 0.2 m.
+        let a = metrics(11, 3, Some(1.0), 1.0, 0.1);
+        let b = metrics(31, 1, Some(5.0), 2.0, 0.2);
+        let p = pooled_metrics(&[&a, &b]).unwrap();
+        assert_eq!((p.associated_poses, p.kitti_segments, p.path_length_m), (42, 4, 200.0));
+        // (3 x 1 + 1 x 5) / 4 = 2 %.
+        assert_eq!(p.kitti_translational_pct, Some(2.0));
+        // sqrt((11 x 1 + 31 x 4) / 42) and sqrt((10 x 0.01 + 30 x 0.04) / 40).
+        assert!((p.ate_rmse_m - (135.0f64 / 42.0).sqrt()).abs() < 1e-12);
+        assert!((p.rpe_translation_rmse_m - (1.3f64 / 40.0).sqrt()).abs() < 1e-12);
+        assert_eq!(p.ate_max_m, 4.0);
+        // A sequence without segments adds none and no drift.
+        let short = metrics(5, 0, None, 1.0, 0.1);
+        let p = pooled_metrics(&[&a, &short]).unwrap();
+        assert_eq!((p.kitti_translational_pct, p.kitti_segments), (Some(1.0), 3));
     }
 }
