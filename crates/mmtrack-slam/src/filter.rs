@@ -12,7 +12,7 @@ use crate::association::associate;
 use crate::config::SlamConfig;
 use crate::error::SlamError;
 use crate::map::{Gauss3, Hypotheses, MapSource, SourceStatus, fuse};
-use crate::model::{UE_MEAS_DIM, invert, jacobians};
+use crate::model::{FastPath, UE_MEAS_DIM, invert, jacobians};
 use crate::particles::{Moments, Particles, PreparedPath, STATE_DIM, normal};
 use crate::small::{cholesky_lower, col, from3, mul, sandwich, spd_inverse, symmetrise, to3, to5};
 
@@ -473,7 +473,10 @@ impl SlamFilter {
             s[(i, i)] += self.sigma_var[i];
         }
         let (inv, _) = spd_inverse(&s)?;
-        Some(PreparedPath { kind, source_m: belief.mean_m, z: z.to_array(), information: to5(&inv) })
+        Some(PreparedPath {
+            fast: FastPath::new(kind, belief.mean_m, self.config.bs_m, &z.to_array()),
+            information: to5(&inv),
+        })
     }
 
     /// The UE belief update: the product of the path messages applied in up
@@ -494,13 +497,13 @@ impl SlamFilter {
             return Ok(0);
         }
         while remaining > 0.0 && stages < self.config.iterations {
-            self.particles.log_likelihood(paths, self.config.bs_m);
+            self.particles.log_likelihood(paths);
             stages += 1;
             let delta = if stages == self.config.iterations || self.particles.ess_with(remaining) >= target {
                 remaining
             } else {
                 let (mut lo, mut hi) = (0.0, remaining);
-                for _ in 0..16 {
+                for _ in 0..10 {
                     let mid = 0.5 * (lo + hi);
                     if self.particles.ess_with(mid) >= target { lo = mid } else { hi = mid }
                 }

@@ -4,13 +4,13 @@
 //! on the number of threads.
 
 use faer::Mat;
-use mmtrack_core::slam::{SourceType, UeState, ctrv_displacement_m};
+use mmtrack_core::slam::ctrv_displacement_m;
 use mmtrack_core::wrap_angle_rad;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
 
-use crate::model::residual;
+use crate::model::FastPath;
 
 /// Dimensions of a particle's varying state: `[x, y, heading, speed, turn
 /// rate, clock bias]` (the height is fixed).
@@ -59,9 +59,7 @@ impl Chunk {
 /// measurement and the inverse of `Sigma + H_m P_m H_m^T`.
 #[derive(Debug, Clone)]
 pub(crate) struct PreparedPath {
-    pub(crate) kind: SourceType,
-    pub(crate) source_m: [f64; 3],
-    pub(crate) z: [f64; 5],
+    pub(crate) fast: FastPath,
     pub(crate) information: [[f64; 5]; 5],
 }
 
@@ -145,20 +143,16 @@ impl Particles {
 
     /// Stores in `ll` the log-likelihood `sum_l -r^T W_l r / 2` of every
     /// particle (`-inf` for a degenerate geometry).
-    pub(crate) fn log_likelihood(&mut self, paths: &[PreparedPath], bs_m: [f64; 3]) {
+    pub(crate) fn log_likelihood(&mut self, paths: &[PreparedPath]) {
         let z_m = self.z_m;
         self.chunks.par_iter_mut().for_each(|chunk| {
             for i in 0..chunk.len() {
-                let ue = UeState {
-                    position_m: [chunk.x[i], chunk.y[i], z_m],
-                    heading_rad: chunk.heading[i],
-                    speed_mps: chunk.speed[i],
-                    turn_rate_radps: chunk.turn[i],
-                    clock_bias_m: chunk.bias[i],
-                };
+                let x = [chunk.x[i], chunk.y[i], z_m];
+                let heading = chunk.heading[i].sin_cos();
+                let bias = chunk.bias[i];
                 let mut ll = 0.0;
                 for p in paths {
-                    let Some(r) = residual(&ue, bs_m, p.kind, p.source_m, &p.z) else {
+                    let Some(r) = p.fast.residual(x, heading, bias) else {
                         ll = f64::NEG_INFINITY;
                         break;
                     };
