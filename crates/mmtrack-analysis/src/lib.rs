@@ -46,6 +46,7 @@ pub mod output;
 pub mod pipeline;
 pub mod plots;
 pub mod report;
+pub mod report_html;
 pub mod slam;
 pub mod tables;
 pub mod trajectory;

@@ -15,11 +15,11 @@ use crate::beam::{BeamResults, plots as beam_plots, spebt_plots, tables::BeamSwe
 use crate::mpc::MpcResult;
 use crate::pipeline::TrajectoryResult;
 use crate::trajectory::DriftOptions;
-use crate::{mpc_plots, mpc_report, plots, report};
+use crate::{mpc_plots, mpc_report, plots, report, report_html};
 
 /// Entries of a results directory; `--force` replaces only a directory that
 /// holds nothing else, so a mistyped `-o` cannot delete unrelated files.
-pub const OWN_ENTRIES: [&str; 3] = ["tables", "plots", "report.md"];
+pub const OWN_ENTRIES: [&str; 4] = ["tables", "plots", "report.md", "report.html"];
 
 /// What [`write_results`] wrote (final paths).
 #[derive(Debug, Clone, PartialEq)]
@@ -32,6 +32,8 @@ pub struct WrittenResults {
     pub plots_dir: PathBuf,
     /// `<out>/report.md`.
     pub report: PathBuf,
+    /// `<out>/report.html`: the same, one self-contained page.
+    pub report_html: PathBuf,
     /// Number of table files and plots written.
     pub files: usize,
 }
@@ -125,14 +127,27 @@ pub fn write_all_results(
         text.push_str(&report::not_analyzed(skipped));
         std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
     }
+    files += write_html(staging.path(), run)?;
     publish(staging.keep(), out, overwrite)?;
     Ok(WrittenResults {
         out_dir: out.to_path_buf(),
         tables_dir: out.join("tables"),
         plots_dir: out.join("plots"),
         report: out.join("report.md"),
+        report_html: out.join("report.html"),
         files,
     })
+}
+
+/// `report.html` beside the staged `report.md`, its plots embedded.
+fn write_html(dir: &Path, run: &RunInfo) -> anyhow::Result<usize> {
+    let markdown_path = dir.join("report.md");
+    let markdown = std::fs::read_to_string(&markdown_path).with_context(|| markdown_path.display().to_string())?;
+    let provenance = report_html::Provenance { config_json: &run.config_json, version: env!("CARGO_PKG_VERSION") };
+    let path = dir.join("report.html");
+    std::fs::write(&path, report_html::html(&markdown, dir, &provenance))
+        .with_context(|| path.display().to_string())?;
+    Ok(1)
 }
 
 fn write_into(

@@ -45,14 +45,14 @@ run 0 against the truth (Liu et al. Fig. 5).\n\n\
 Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
 mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary,spebt_summary}/sequence=<id>/part-0.parquet, \
 <OUT>/tables/{beam_sweep_pooled,spebt_pooled}/sequence=all/part-0.parquet, \
-<OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md. The directory appears whole or not at all; an existing one is replaced \
+<OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md and <OUT>/report.html (the same report as one self-contained page: plots embedded, with the software version, inputs and configuration). The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.",
     after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
 )]
 pub struct AnalyzeArgs {
     /// Table directory written by `mmtrack process` (any number of sequences).
     tables: PathBuf,
-    /// Output directory for tables/, plots/ and report.md.
+    /// Output directory for tables/, plots/, report.md and report.html.
     #[arg(short, long, value_name = "DIR")]
     output: PathBuf,
     /// Replace earlier results in the output directory.
@@ -168,11 +168,12 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             println!("{sequence}: not analyzed: {reason}");
         }
         println!(
-            "wrote {} files: tables {}, plots {}, report {}",
+            "wrote {} files: tables {}, plots {}, report {} and {}",
             written.files,
             written.tables_dir.display(),
             written.plots_dir.display(),
-            written.report.display()
+            written.report.display(),
+            written.report_html.display()
         );
     }
     Ok(ExitCode::SUCCESS)

@@ -11,7 +11,7 @@
 //! 3. beam: SPEBT beam tracking along the radar drive, driven by the
 //!    odometry of step 1;
 //! 4. analyze every table together: trajectory metrics, MPC statistics,
-//!    SPEBT accuracy, plots and `report.md`.
+//!    SPEBT accuracy, plots, `report.md` and `report.html`.
 //!
 //! SLAM joins when its pipeline lands (issue #16).
 
@@ -111,7 +111,8 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!("  radar recording (Foxglove):    {recording}");
         println!("  sounder recording:             {sounder}");
         println!("  tables (Parquet, Hive layout): {tables}");
-        println!("  analysis (metrics, plots):     {analysis} (report {analysis}/report.md)");
+        println!("  analysis (metrics, plots):     {analysis}");
+        println!("  report (open in a browser):    {analysis}/report.html (and report.md)");
         println!("\nNot in the demo yet: the SLAM pipeline (issue #16).");
     }
     Ok(ExitCode::SUCCESS)

@@ -72,6 +72,59 @@ fn demo_runs_every_pipeline_and_its_tables_read_back_as_documented() {
     assert!(stdout.contains("tables/spebt_pooled: 1 rows") && stdout.contains("checked 25 tables"), "{stdout}");
 }
 
+/// A headless browser from the system packages, if there is one.
+fn chromium() -> Option<&'static str> {
+    ["chromium", "chromium-browser", "google-chrome", "google-chrome-stable"]
+        .into_iter()
+        .find(|b| std::process::Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success()))
+}
+
+/// `report.html` of the demo in a real browser (headless Chromium): the
+/// page renders, every embedded plot decodes (a check script appended to a
+/// copy of the page marks the body with the count of images and broken
+/// ones) and the console stays free of errors. Skipped, visibly, where no
+/// Chromium is installed (`apt-get install chromium`).
+#[test]
+fn report_html_renders_in_headless_chromium_with_every_plot() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let analysis = dir.path().join("d/analysis");
+    let page = std::fs::read_to_string(analysis.join("report.html")).unwrap();
+    assert!(page.contains("<h2>Provenance</h2>") && page.contains("Software: mmtrack "), "{}", &page[..2000]);
+    assert!(page.contains("&quot;command&quot;: &quot;analyze&quot;") && !page.contains("<script"), "configuration shown, no scripts");
+    let embedded = page.matches("<img src=\"data:image/svg+xml;base64,").count();
+    let report = std::fs::read_to_string(analysis.join("report.md")).unwrap();
+    assert_eq!(embedded, report.matches("\n![").count(), "every image of report.md is embedded");
+    let Some(browser) = chromium() else {
+        eprintln!("skipped: report.html in a browser: no chromium / google-chrome on PATH (apt-get install chromium)");
+        return;
+    };
+    let check = page.replace(
+        "</body>",
+        "<script>window.addEventListener('load', () => { const images = [...document.images]; \
+         const broken = images.filter((i) => !(i.complete && i.naturalWidth > 0)); \
+         document.body.setAttribute('data-check', `images=${images.length} broken=${broken.length}`); });</script></body>",
+    );
+    std::fs::write(analysis.join("check.html"), check).unwrap();
+    let url = format!("file://{}", analysis.join("check.html").display());
+    let run = std::process::Command::new(browser)
+        .args(["--headless", "--no-sandbox", "--disable-gpu", "--virtual-time-budget=10000"])
+        .args(["--enable-logging=stderr", "--v=0", "--dump-dom", &url])
+        .output()
+        .unwrap();
+    let (dom, log) = text(&run);
+    assert!(run.status.success(), "{log}");
+    assert!(
+        dom.contains(&format!("data-check=\"images={embedded} broken=0\"")),
+        "{log}\n{}",
+        &dom[..dom.len().min(3000)]
+    );
+    assert!(dom.contains("<h2>SPEBT beam tracking"), "the page rendered its sections");
+    let console: Vec<&str> = log.lines().filter(|l| l.contains("CONSOLE") || l.contains("Uncaught")).collect();
+    assert!(console.is_empty(), "console messages: {console:?}");
+}
+
 #[test]
 fn corrupt_recording_is_one_line_naming_the_file_exit_1() {
     let dir = tempfile::tempdir().unwrap();
