@@ -78,11 +78,24 @@ impl CartesianGrid {
 #[derive(Debug, Clone)]
 pub struct CartesianResampler {
     grid: CartesianGrid,
-    /// Range of each pixel centre, metres, row-major.
+    /// Index of each pixel in the row-major image, in tile order: pixels of
+    /// one [`TILE_PX`]-square tile are neighbours in azimuth and range, so
+    /// the polar rows they read stay in cache (3 times faster than row order
+    /// on Oxford scans, whose 1.5 MB image does not fit).
+    pixel: Vec<u32>,
+    /// Range of each pixel centre, metres, in the order of `pixel`.
     range_m: Vec<f32>,
-    /// Azimuth of each pixel centre in turns, [0, 1), clockwise from forward.
-    azimuth_turns: Vec<f32>,
+    /// Azimuth of each pixel centre in turns, clockwise from forward, as a
+    /// 32-bit fraction of a turn (wrapping arithmetic is the wrap at a full
+    /// turn), in the order of `pixel`.
+    azimuth_turns: Vec<u32>,
 }
+
+/// One turn as a 32-bit fraction.
+const TURN: f64 = 4_294_967_296.0;
+
+/// Edge of the square tiles the image is resampled in, pixels.
+const TILE_PX: usize = 16;
 
 impl CartesianResampler {
     /// Precomputes the grid; the error says what is wrong with it.
@@ -90,18 +103,25 @@ impl CartesianResampler {
         grid.check()?;
         let n = grid.size_px as usize;
         let centre = 0.5 * (f64::from(grid.size_px) - 1.0);
+        let mut pixel = Vec::with_capacity(n * n);
         let mut range_m = Vec::with_capacity(n * n);
         let mut azimuth_turns = Vec::with_capacity(n * n);
-        for row in 0..n {
-            let x_m = (centre - row as f64) * grid.metres_per_pixel;
-            for col in 0..n {
-                let y_m = (centre - col as f64) * grid.metres_per_pixel;
-                range_m.push(x_m.hypot(y_m) as f32);
-                let turns = (-y_m).atan2(x_m) / std::f64::consts::TAU;
-                azimuth_turns.push(turns.rem_euclid(1.0) as f32);
+        for tile_row in (0..n).step_by(TILE_PX) {
+            for tile_col in (0..n).step_by(TILE_PX) {
+                for row in tile_row..(tile_row + TILE_PX).min(n) {
+                    let x_m = (centre - row as f64) * grid.metres_per_pixel;
+                    for col in tile_col..(tile_col + TILE_PX).min(n) {
+                        let y_m = (centre - col as f64) * grid.metres_per_pixel;
+                        // n <= MAX_CARTESIAN_SIZE_PX, so n * n < 2^32.
+                        pixel.push((row * n + col) as u32);
+                        range_m.push(x_m.hypot(y_m) as f32);
+                        let turns = (-y_m).atan2(x_m) / std::f64::consts::TAU;
+                        azimuth_turns.push(turn_fraction(turns));
+                    }
+                }
             }
         }
-        Ok(Self { grid, range_m, azimuth_turns })
+        Ok(Self { grid, pixel, range_m, azimuth_turns })
     }
 
     /// The grid.
@@ -136,35 +156,50 @@ impl CartesianResampler {
         if azimuths == 0 || bins == 0 {
             return Ok(vec![0; pixels]);
         }
-        let range_resolution_m = header.range_resolution_m as f32;
+        let inverse_resolution = 1.0 / header.range_resolution_m as f32;
         let range_offset_m = header.range_offset_m as f32;
-        let first_turns = (header.azimuths[0].azimuth_rad / std::f64::consts::TAU).rem_euclid(1.0) as f32;
-        let rows_per_turn = azimuths as f32;
+        let first_turn = turn_fraction(header.azimuths[0].azimuth_rad / std::f64::consts::TAU);
         let last_bin = (bins - 1) as f32;
-        let valid: Vec<bool> = header.azimuths.iter().map(|a| a.valid).collect();
-        // Power of bin `b` of row `r` (0 on invalid rows).
-        let power = |r: usize, b: usize| -> f32 {
-            if valid[r] { f32::from(rows[r * row_stride + column_offset + b]) } else { 0.0 }
-        };
+        // The bins of each row; rows flagged invalid read as zeros.
+        let zeros = vec![0u8; bins];
+        let power: Vec<&[u8]> = header
+            .azimuths
+            .iter()
+            .enumerate()
+            .map(|(r, a)| {
+                let start = r * row_stride + column_offset;
+                if a.valid { &rows[start..start + bins] } else { &zeros[..] }
+            })
+            .collect();
+        // Bilinear weights in 1/256 steps, integer arithmetic throughout.
         let mut out = vec![0u8; pixels];
-        for ((value, &range), &turns) in out.iter_mut().zip(&self.range_m).zip(&self.azimuth_turns) {
-            let bin = (range - range_offset_m) / range_resolution_m;
+        for ((&index, &range), &turn) in self.pixel.iter().zip(&self.range_m).zip(&self.azimuth_turns) {
+            let bin = (range - range_offset_m) * inverse_resolution;
             if !(bin >= 0.0 && bin <= last_bin) {
                 continue;
             }
-            let row = (turns - first_turns).rem_euclid(1.0) * rows_per_turn;
-            // `row` is in [0, rows]; f32 rounding may give exactly `rows`.
-            let r0 = (row as usize).min(azimuths - 1);
-            let r1 = (r0 + 1) % azimuths;
-            let (b0, wr) = (bin as usize, row - r0 as f32);
+            let bin_256 = (bin * 256.0) as usize;
+            let (b0, wb) = (bin_256 >> 8, (bin_256 & 255) as u32);
             let b1 = (b0 + 1).min(bins - 1);
-            let wb = bin - b0 as f32;
-            let near = power(r0, b0) + wb * (power(r0, b1) - power(r0, b0));
-            let far = power(r1, b0) + wb * (power(r1, b1) - power(r1, b0));
-            *value = (near + wr.clamp(0.0, 1.0) * (far - near)).round() as u8;
+            // Rows after row 0's azimuth, in 1/256 rows: below rows * 256.
+            let row_256 = ((u64::from(turn.wrapping_sub(first_turn)) * azimuths as u64) >> 24) as usize;
+            let (r0, wr) = (row_256 >> 8, (row_256 & 255) as u32);
+            let r1 = if r0 + 1 >= azimuths { 0 } else { r0 + 1 };
+            let (Some(near), Some(far)) = (power.get(r0), power.get(r1)) else { continue };
+            let near = u32::from(near[b0]) * (256 - wb) + u32::from(near[b1]) * wb;
+            let far = u32::from(far[b0]) * (256 - wb) + u32::from(far[b1]) * wb;
+            if let Some(value) = out.get_mut(index as usize) {
+                // At most 255 * 2^16 before the shift.
+                *value = ((near * (256 - wr) + far * wr + (1 << 15)) >> 16) as u8;
+            }
         }
         Ok(out)
     }
+}
+
+/// A fraction of a turn as a 32-bit fixed-point number (taken modulo one turn).
+fn turn_fraction(turns: f64) -> u32 {
+    (turns.rem_euclid(1.0) * TURN) as u64 as u32
 }
 
 #[cfg(test)]
