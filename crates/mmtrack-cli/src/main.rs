@@ -18,6 +18,7 @@ mod export;
 mod ingest;
 mod inspect;
 mod process;
+mod process_manifest;
 mod progress;
 mod readme_block;
 mod reproduce;

@@ -67,6 +67,19 @@ enum Pipeline {
     /// pose-error model; it writes `spebt_per_slot` and `spebt_summary`.
     #[command(verbatim_doc_comment)]
     Beam(crate::beam::process::BeamArgs),
+    /// Many sequences at once: every `mmtrack process` command line of a manifest as its own task.
+    ///
+    /// The manifest (TOML) lists `[[task]]` tables, each with `args`: a
+    /// `mmtrack process` command line without `mmtrack process` and `-o`,
+    /// e.g. `args = ["odometry", "runs/a.mcap", "--preset", "cfear"]`.
+    /// Every task writes its sequence partitions into the same `-o`
+    /// directory and runs as an independent task on the thread pool; the
+    /// tables do not depend on the order or the thread count. A failed task
+    /// is reported and the others finish (exit 1). `--print-commands` prints
+    /// the per-sequence command lines, one cluster job each (see
+    /// examples/ray_process.py).
+    #[command(verbatim_doc_comment)]
+    Manifest(crate::process_manifest::ManifestArgs),
 }
 
 #[derive(Args)]
@@ -108,6 +121,7 @@ pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Pipeline::Beam(beam_args) => crate::beam::process::run(beam_args, quiet),
+        Pipeline::Manifest(manifest_args) => crate::process_manifest::run(manifest_args, quiet),
     }
 }
 

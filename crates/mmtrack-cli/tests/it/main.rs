@@ -16,6 +16,7 @@ mod independent_readers;
 mod ingest_navtech;
 mod interrupt;
 mod process_beam_spebt;
+mod process_manifest;
 mod process_mpc;
 mod process_odometry;
 mod realdata_beams;
