@@ -16,6 +16,7 @@ pub mod spebt_plots;
 pub mod spebt_tables;
 pub mod sweeps;
 pub mod tables;
+pub mod zoechmann_plots;
 
 /// What `mmtrack analyze` computed from beam-tracking tables.
 #[derive(Debug, Clone, Default, PartialEq)]

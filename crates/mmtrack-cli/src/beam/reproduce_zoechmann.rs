@@ -1,0 +1,538 @@
+//! `mmtrack reproduce zoechmann`: geometric Doppler-bearing tracking of
+//! Zoechmann et al. 2019, Sec. VI and Figs. 4-5 (PAPERS.md section 4).
+//!
+//! On the simulated overtaking manoeuvres (`mmtrack_sim::beam::overtaking`),
+//! four estimators run on the same Monte Carlo realisations:
+//!
+//! - `proposed`: the recursive tracker (`GeometricTracker`) on the azimuths
+//!   of its own beam schedule (full scans for the first 10 epochs, then the
+//!   3 beams nearest the azimuth it projects to the epoch);
+//! - `ho-chan`: the running-reference batch baseline on full-scan azimuths
+//!   (a full scan every epoch: the baseline has no beam schedule);
+//! - `error-free-genie` and `nullspace-genie`: the bounds of Sec. V on the
+//!   true azimuths.
+//!
+//! All see the same noisy Doppler shifts. Per epoch: the NMSE of the range
+//! over the runs. Checked: the paper's ordering at the end of each run,
+//! the full-overtaking hand-over time (about 0.5 s), the beam-measurement
+//! saving (counted), and the time of the whole run. The experiment, its
+//! published numbers and tolerances are one TOML file
+//! (`data/reproduce/zoechmann.toml`, embedded).
+//!
+//! Runs are split into fixed chunks computed on rayon and merged in chunk
+//! order, so the numbers do not depend on the thread count.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use clap::Args;
+use mmtrack_analysis::beam::zoechmann_plots::{
+    NmseCurve, PositionTrace, ZoechmannNmseRow, ZoechmannSummaryRow, zoechmann_figure_svg,
+};
+use mmtrack_beam::geometric::{
+    BeamCount, BeamSchedule, BeamSelection, DopplerBearing, ErrorFreeRegressors, GeometricTracker,
+    GeometricTrackerConfig, HoChanBatch, NullspaceProjection, RangeEstimator,
+};
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{RunInfo, write_table};
+use mmtrack_sim::beam::overtaking::{Manoeuvre, OvertakingReceiver, OvertakingScenario};
+use rayon::prelude::*;
+use serde::Deserialize;
+
+use super::zoechmann_report::{self as report, README_BLOCK};
+use crate::threads::ThreadsArg;
+
+/// The experiment, embedded so it runs from any directory.
+pub const ZOECHMANN_EXPERIMENT: &str = include_str!("../../../../data/reproduce/zoechmann.toml");
+
+#[derive(Args)]
+pub struct ZoechmannArgs {
+    /// Output directory (tables/, one SVG figure per manoeuvre, reproduce.md).
+    #[arg(short, long, default_value = "out/reproduce/zoechmann")]
+    output: PathBuf,
+    /// Replace a previous run's output directory.
+    #[arg(long)]
+    force: bool,
+    /// Experiment file (TOML; default: the embedded data/reproduce/zoechmann.toml).
+    #[arg(long, value_name = "EXPERIMENT.toml")]
+    experiment: Option<PathBuf>,
+    /// Monte Carlo runs per manoeuvre (default: the experiment's, 100000).
+    #[arg(long)]
+    runs: Option<u64>,
+    /// The CI version: the experiment's quick_runs (2000) runs per manoeuvre.
+    #[arg(long)]
+    quick: bool,
+    /// Replace the block `<!-- reproduce-zoechmann:begin -->` ... `end` in
+    /// this file with the summary (checked before the run).
+    #[arg(long, value_name = "README.md")]
+    readme: Option<PathBuf>,
+    #[command(flatten)]
+    threads: ThreadsArg,
+}
+
+/// The experiment file.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct Experiment {
+    pub seed: u64,
+    pub runs: u64,
+    pub quick_runs: u64,
+    /// H-infinity level of the proposed tracker.
+    pub gamma: f64,
+    /// `c` of its initial information `P_0^-1 = c I`.
+    pub initial_information: f64,
+    /// Distinct azimuths before the hand-over to RLS.
+    pub distinct_azimuths_for_rls: usize,
+    /// Full scans before the beam window.
+    pub full_scan_epochs: usize,
+    /// Beams measured around the projected azimuth.
+    pub window_beams: usize,
+    /// The manoeuvre whose hand-over time is checked.
+    pub convergence_manoeuvre: String,
+    pub paper_convergence_s: f64,
+    pub convergence_tolerance_s: f64,
+    /// The paper's saving per tracked epoch (128 / 3).
+    pub paper_saving: f64,
+    pub saving_tolerance: f64,
+    /// Wall-time target of the full run, seconds, and the runs it applies to.
+    pub time_target_s: f64,
+    pub time_target_runs: u64,
+    #[serde(default)]
+    pub scenario: OvertakingScenario,
+    pub manoeuvres: Vec<Manoeuvre>,
+}
+
+/// The estimators, in table order.
+pub(super) const ESTIMATORS: [&str; 5] =
+    ["proposed", "ho-chan", "error-free-genie", "nullspace-genie", "proposed-full-scan"];
+/// Index of the variant: the proposed tracker on full-scan azimuths every
+/// epoch (no beam-selection feedback), a diagnostic beside the paper's four.
+pub(super) const FULL_SCAN_VARIANT: usize = 4;
+const N: usize = ESTIMATORS.len();
+
+/// Runs per rayon task: fixed, so partial sums merge in the same order on
+/// any number of threads.
+const RUNS_PER_CHUNK: u64 = 250;
+
+/// What one manoeuvre measured.
+pub(super) struct ManoeuvreResult {
+    pub manoeuvre: Manoeuvre,
+    pub runs: u64,
+    /// NMSE per estimator and epoch.
+    pub nmse: [Vec<f64>; N],
+    /// RMSE per estimator and epoch, metres.
+    pub rmse_m: [Vec<f64>; N],
+    /// Runs with an estimate per estimator and epoch.
+    pub counted: [Vec<u64>; N],
+    /// Hand-over time of each converged run, sorted.
+    pub handovers_s: Vec<f64>,
+    /// The same for the full-scan variant.
+    pub handovers_full_scan_s: Vec<f64>,
+    pub beams: BeamCount,
+    pub window_epochs: u64,
+    pub window_hits: u64,
+    pub failures: u64,
+    pub trace: PositionTrace,
+}
+
+impl ManoeuvreResult {
+    /// NMSE of estimator `e` at the last epoch.
+    pub fn final_nmse(&self, e: usize) -> Option<f64> {
+        self.nmse[e].last().copied().filter(|v| v.is_finite())
+    }
+
+    /// Nearest-rank quantile `q` of the hand-over times.
+    pub fn handover_quantile(&self, q: f64) -> Option<f64> {
+        quantile(&self.handovers_s, q)
+    }
+
+    /// Mean hand-over time.
+    pub fn handover_mean(&self) -> Option<f64> {
+        let n = self.handovers_s.len();
+        (n > 0).then(|| self.handovers_s.iter().sum::<f64>() / n as f64)
+    }
+}
+
+pub fn run(args: &ZoechmannArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    if args.output.exists() && !args.force {
+        bail!("{}: exists; use --force to replace it (nothing was done)", args.output.display());
+    }
+    if let Some(readme) = &args.readme {
+        crate::readme_block::check_block(readme, README_BLOCK)?;
+    }
+    let (source, text) = match &args.experiment {
+        Some(path) => {
+            (path.display().to_string(), std::fs::read_to_string(path).with_context(|| path.display().to_string())?)
+        }
+        None => ("embedded data/reproduce/zoechmann.toml".to_string(), ZOECHMANN_EXPERIMENT.to_string()),
+    };
+    let experiment: Experiment = toml::from_str(&text).with_context(|| source.clone())?;
+    let runs = match (args.runs, args.quick) {
+        (Some(n), _) => n,
+        (None, true) => experiment.quick_runs,
+        (None, false) => experiment.runs,
+    };
+    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    anyhow::ensure!(!experiment.manoeuvres.is_empty(), "{source}: no [[manoeuvres]] (nothing was done)");
+    for m in &experiment.manoeuvres {
+        experiment.scenario.validate(m).with_context(|| format!("{source}: [scenario] / manoeuvre {}", m.name))?;
+    }
+    tracker_config(&experiment).validate().with_context(|| source.clone())?;
+
+    let load_before = crate::bench_mpc::load_average();
+    let started = Instant::now();
+    let (results, threads) = args.threads.install(|| -> anyhow::Result<(Vec<ManoeuvreResult>, usize)> {
+        let receiver = experiment.scenario.receiver().with_context(|| format!("{source}: [scenario]"))?;
+        let chunks = runs.div_ceil(RUNS_PER_CHUNK);
+        let bar = crate::progress::bar(runs * experiment.manoeuvres.len() as u64, "reproduce zoechmann", "runs", quiet);
+        let mut results = Vec::new();
+        for manoeuvre in &experiment.manoeuvres {
+            let partials: Vec<Chunk> = (0..chunks)
+                .into_par_iter()
+                .map(|c| {
+                    let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
+                    let n = range.end - range.start;
+                    let chunk = run_chunk(&experiment, manoeuvre, &receiver, range);
+                    bar.inc(n);
+                    chunk
+                })
+                .collect::<anyhow::Result<_>>()
+                .with_context(|| manoeuvre.name.clone())?;
+            let epochs = manoeuvre.epochs(experiment.scenario.epoch_s);
+            let mut total = Chunk::new(epochs);
+            for part in partials {
+                total.merge(part);
+            }
+            results.push(total.finish(manoeuvre.clone(), runs));
+        }
+        bar.finish_and_clear();
+        Ok((results, rayon::current_num_threads()))
+    })??;
+    let elapsed_s = started.elapsed().as_secs_f64();
+    let load = (load_before, crate::bench_mpc::load_average());
+
+    let verdicts = report::verdicts(&experiment, &results, runs, elapsed_s);
+    let summary = report::summary(&experiment, &results, &verdicts, runs, (elapsed_s, threads, load));
+    write_outputs(args, &experiment, &source, &results, runs, &summary)?;
+    if let Some(readme) = &args.readme {
+        crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;
+    }
+    if !quiet {
+        print!("{summary}");
+        println!("\noutputs: {}", args.output.display());
+    }
+    Ok(if verdicts.iter().all(|v| v.met || v.informational) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+/// Nearest-rank quantile `q` of sorted values.
+pub(super) fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
+    let n = sorted.len();
+    (n > 0).then(|| sorted[((q * n as f64).ceil() as usize).clamp(1, n) - 1])
+}
+
+fn tracker_config(experiment: &Experiment) -> GeometricTrackerConfig {
+    GeometricTrackerConfig {
+        wavelength_m: experiment.scenario.wavelength_m(),
+        gamma: experiment.gamma,
+        initial_information: experiment.initial_information,
+        distinct_azimuths_for_rls: experiment.distinct_azimuths_for_rls,
+    }
+}
+
+/// Partial sums of a chunk of runs.
+struct Chunk {
+    squared_error: [Vec<f64>; N],
+    counted: [Vec<u64>; N],
+    /// Sum of the squared true range per estimator (over the runs it counts).
+    squared_range: [Vec<f64>; N],
+    handovers_s: Vec<f64>,
+    handovers_full_scan_s: Vec<f64>,
+    beams: BeamCount,
+    window_epochs: u64,
+    window_hits: u64,
+    failures: u64,
+    trace: Option<PositionTrace>,
+}
+
+impl Chunk {
+    fn new(epochs: usize) -> Self {
+        Self {
+            squared_error: std::array::from_fn(|_| vec![0.0; epochs]),
+            counted: std::array::from_fn(|_| vec![0; epochs]),
+            squared_range: std::array::from_fn(|_| vec![0.0; epochs]),
+            handovers_s: Vec::new(),
+            handovers_full_scan_s: Vec::new(),
+            beams: BeamCount::default(),
+            window_epochs: 0,
+            window_hits: 0,
+            failures: 0,
+            trace: None,
+        }
+    }
+
+    fn merge(&mut self, other: Chunk) {
+        for e in 0..N {
+            for (a, b) in self.squared_error[e].iter_mut().zip(&other.squared_error[e]) {
+                *a += b;
+            }
+            for (a, b) in self.squared_range[e].iter_mut().zip(&other.squared_range[e]) {
+                *a += b;
+            }
+            for (a, b) in self.counted[e].iter_mut().zip(&other.counted[e]) {
+                *a += b;
+            }
+        }
+        self.handovers_s.extend(other.handovers_s);
+        self.handovers_full_scan_s.extend(other.handovers_full_scan_s);
+        self.beams.merge(&other.beams);
+        self.window_epochs += other.window_epochs;
+        self.window_hits += other.window_hits;
+        self.failures += other.failures;
+        if self.trace.is_none() {
+            self.trace = other.trace;
+        }
+    }
+
+    fn finish(mut self, manoeuvre: Manoeuvre, runs: u64) -> ManoeuvreResult {
+        let nmse = std::array::from_fn(|e| {
+            self.squared_error[e].iter().zip(&self.squared_range[e]).map(|(s, r)| s / r).collect()
+        });
+        let rmse_m = std::array::from_fn(|e| {
+            self.squared_error[e].iter().zip(&self.counted[e]).map(|(s, &n)| (s / n as f64).sqrt()).collect()
+        });
+        self.handovers_s.sort_by(f64::total_cmp);
+        self.handovers_full_scan_s.sort_by(f64::total_cmp);
+        ManoeuvreResult {
+            manoeuvre,
+            runs,
+            nmse,
+            rmse_m,
+            counted: self.counted,
+            handovers_s: self.handovers_s,
+            handovers_full_scan_s: self.handovers_full_scan_s,
+            beams: self.beams,
+            window_epochs: self.window_epochs,
+            window_hits: self.window_hits,
+            failures: self.failures,
+            trace: self.trace.unwrap_or_default(),
+        }
+    }
+}
+
+fn run_chunk(
+    experiment: &Experiment,
+    manoeuvre: &Manoeuvre,
+    receiver: &OvertakingReceiver,
+    runs: std::ops::Range<u64>,
+) -> anyhow::Result<Chunk> {
+    let scenario = &experiment.scenario;
+    let lambda = scenario.wavelength_m();
+    let schedule = BeamSchedule {
+        beams: scenario.beams,
+        full_scan_epochs: experiment.full_scan_epochs,
+        window_beams: experiment.window_beams,
+    };
+    let mut chunk = Chunk::new(manoeuvre.epochs(scenario.epoch_s));
+    for run_index in runs {
+        let run = scenario.realise(manoeuvre, experiment.seed, run_index)?;
+        let mut proposed = GeometricTracker::new(tracker_config(experiment))?;
+        let mut estimators: [Option<Box<dyn RangeEstimator>>; 3] = [
+            Some(Box::new(HoChanBatch::new(lambda)?)),
+            Some(Box::new(ErrorFreeRegressors::new(lambda)?)),
+            Some(Box::new(NullspaceProjection::new(lambda)?)),
+        ];
+        let mut full_scan = Some(GeometricTracker::new(tracker_config(experiment))?);
+        let mut proposed_ok = true;
+        let mut trace = (run_index == 0).then(PositionTrace::default);
+        for (k, truth) in run.epochs.iter().enumerate() {
+            let doppler_hz = truth.measured_doppler_hz();
+            let full_scan_beam = receiver.strongest_beam(truth.azimuth_rad);
+            // The proposed tracker's beams: projected from its last state.
+            if proposed_ok {
+                let projected = if k > 0 { proposed.state().map(|s| s.azimuth_rad(truth.t_s)) } else { None };
+                let selection = schedule.select(k, projected);
+                chunk.beams.add(&selection, scenario.beams);
+                let beam = match &selection {
+                    BeamSelection::FullScan => full_scan_beam,
+                    BeamSelection::Window(window) => {
+                        chunk.window_epochs += 1;
+                        if window.contains(&full_scan_beam) {
+                            chunk.window_hits += 1;
+                        }
+                        receiver.strongest_of(window, truth.azimuth_rad).unwrap_or(full_scan_beam)
+                    }
+                };
+                let observation =
+                    DopplerBearing { t_s: truth.t_s, azimuth_rad: receiver.beam_azimuth_rad(beam), doppler_hz };
+                match proposed.update(&observation) {
+                    Ok(()) => {
+                        if let (Some(r), Some(state)) = (proposed.range_now_m(), proposed.state()) {
+                            add(&mut chunk, 0, k, r, truth.range_m);
+                            if let Some(trace) = &mut trace {
+                                trace.truth_m.push(truth.position_m);
+                                trace.estimate_m.push(state.position_m(truth.t_s));
+                            }
+                        }
+                    }
+                    Err(_) => {
+                        chunk.failures += 1;
+                        proposed_ok = false;
+                    }
+                }
+            }
+            let full_scan_azimuth_rad = receiver.beam_azimuth_rad(full_scan_beam);
+            if let Some(tracker) = &mut full_scan {
+                let observation = DopplerBearing { t_s: truth.t_s, azimuth_rad: full_scan_azimuth_rad, doppler_hz };
+                match tracker.update(&observation) {
+                    Ok(()) => {
+                        if let Some(r) = tracker.range_now_m() {
+                            add(&mut chunk, FULL_SCAN_VARIANT, k, r, truth.range_m);
+                        }
+                    }
+                    Err(_) => {
+                        chunk.failures += 1;
+                        full_scan = None;
+                    }
+                }
+            }
+            let azimuths = [full_scan_azimuth_rad, truth.azimuth_rad, truth.azimuth_rad];
+            for (e, slot) in estimators.iter_mut().enumerate() {
+                let Some(estimator) = slot else { continue };
+                let observation = DopplerBearing { t_s: truth.t_s, azimuth_rad: azimuths[e], doppler_hz };
+                match estimator.update(&observation) {
+                    Ok(()) => {
+                        if let Some(r) = estimator.range_now_m() {
+                            add(&mut chunk, e + 1, k, r, truth.range_m);
+                        }
+                    }
+                    Err(_) => {
+                        chunk.failures += 1;
+                        *slot = None;
+                    }
+                }
+            }
+        }
+        if let Some(t) = proposed.handover_t_s().filter(|_| proposed_ok) {
+            chunk.handovers_s.push(t);
+        }
+        if let Some(t) = full_scan.and_then(|f| f.handover_t_s()) {
+            chunk.handovers_full_scan_s.push(t);
+        }
+        if let Some(trace) = trace {
+            chunk.trace = Some(trace);
+        }
+    }
+    Ok(chunk)
+}
+
+fn add(chunk: &mut Chunk, estimator: usize, epoch: usize, range_m: f64, true_range_m: f64) {
+    if range_m.is_finite() {
+        chunk.squared_error[estimator][epoch] += (range_m - true_range_m).powi(2);
+        chunk.squared_range[estimator][epoch] += true_range_m * true_range_m;
+        chunk.counted[estimator][epoch] += 1;
+    }
+}
+
+fn write_outputs(
+    args: &ZoechmannArgs,
+    experiment: &Experiment,
+    source: &str,
+    results: &[ManoeuvreResult],
+    runs: u64,
+    summary: &str,
+) -> anyhow::Result<()> {
+    let parent = match args.output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
+    let staging = mmtrack_io::staging_dir(&parent, ".reproduce-zoechmann.")?;
+    let tables = staging.path().join("tables");
+    let info = RunInfo {
+        config_json: serde_json::json!({
+            "command": "reproduce zoechmann",
+            "experiment": source,
+            "runs": runs,
+            "seed": experiment.seed,
+            "gamma": experiment.gamma,
+            "full_scan_epochs": experiment.full_scan_epochs,
+            "window_beams": experiment.window_beams,
+            "radius_wavelengths": experiment.scenario.radius_wavelengths,
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    let epoch_s = experiment.scenario.epoch_s;
+    let mut nmse_rows = Vec::new();
+    let mut summary_rows = Vec::new();
+    for r in results {
+        for (e, name) in ESTIMATORS.iter().enumerate() {
+            for (k, &nmse) in r.nmse[e].iter().enumerate() {
+                nmse_rows.push(ZoechmannNmseRow {
+                    manoeuvre: r.manoeuvre.name.clone(),
+                    estimator: (*name).to_string(),
+                    epoch: k as u64,
+                    t_s: k as f64 * epoch_s,
+                    runs: r.counted[e][k],
+                    nmse,
+                    nmse_db: 10.0 * nmse.log10(),
+                    rmse_m: r.rmse_m[e][k],
+                });
+            }
+        }
+        summary_rows.push(ZoechmannSummaryRow {
+            manoeuvre: r.manoeuvre.name.clone(),
+            runs: r.runs,
+            epochs: r.manoeuvre.epochs(epoch_s) as u64,
+            not_converged_runs: r.runs - r.handovers_s.len() as u64,
+            handover_median_s: r.handover_quantile(0.5),
+            handover_mean_s: r.handover_mean(),
+            handover_p90_s: r.handover_quantile(0.9),
+            handover_median_full_scan_s: quantile(&r.handovers_full_scan_s, 0.5),
+            beams_measured: r.beams.measured,
+            beams_full_scan: r.beams.full_scan_equivalent,
+            saving: r.beams.saving().unwrap_or(f64::NAN),
+            windowed_saving: r.beams.windowed_saving(experiment.scenario.beams).unwrap_or(f64::NAN),
+            window_hit_rate: r.window_hits as f64 / r.window_epochs.max(1) as f64,
+            estimator_failures: r.failures,
+        });
+    }
+    write_table(&tables, "zoechmann", &nmse_rows, &info, Overwrite::Refuse)?;
+    write_table(&tables, "zoechmann", &summary_rows, &info, Overwrite::Refuse)?;
+    for r in results {
+        let curves: Vec<NmseCurve> = ESTIMATORS
+            .iter()
+            .enumerate()
+            .map(|(e, name)| NmseCurve { label: (*name).to_string(), nmse: r.nmse[e].clone() })
+            .collect();
+        let title = format!("{}: {} runs (Zoechmann et al. 2019, Figs. 4-5)", r.manoeuvre.name, r.runs);
+        let svg = zoechmann_figure_svg(&title, &r.trace, &curves, epoch_s)?;
+        let file = format!("{}.svg", r.manoeuvre.name);
+        std::fs::write(staging.path().join(&file), svg).with_context(|| file.clone())?;
+    }
+    std::fs::write(staging.path().join("reproduce.md"), summary)?;
+    if args.output.exists() {
+        std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
+    }
+    let staged = staging.keep();
+    std::fs::rename(&staged, &args.output).with_context(|| args.output.display().to_string())?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_embedded_experiment_parses_and_has_the_papers_manoeuvres() {
+        let experiment: Experiment = toml::from_str(ZOECHMANN_EXPERIMENT).unwrap();
+        assert_eq!(experiment.runs, 100_000);
+        let names: Vec<&str> = experiment.manoeuvres.iter().map(|m| m.name.as_str()).collect();
+        assert_eq!(names, ["half-overtaking", "full-overtaking"]);
+        assert_eq!(experiment.manoeuvres[0], Manoeuvre::half_overtaking());
+        assert_eq!(experiment.manoeuvres[1], Manoeuvre::full_overtaking());
+        assert!(tracker_config(&experiment).validate().is_ok());
+    }
+}

@@ -1,0 +1,186 @@
+//! Verdicts and the Markdown summary of `reproduce zoechmann` (also the
+//! README block).
+
+use super::reproduce_zoechmann::{ESTIMATORS, Experiment, FULL_SCAN_VARIANT, ManoeuvreResult, quantile};
+
+/// The README block the summary replaces with `--readme`.
+pub const README_BLOCK: &str = "reproduce-zoechmann";
+
+/// One checked claim of the paper.
+pub struct Verdict {
+    pub claim: String,
+    pub paper: String,
+    pub measured: String,
+    pub met: bool,
+    /// Reported, not a target: does not set the exit status.
+    pub informational: bool,
+}
+
+fn db(v: Option<f64>) -> String {
+    v.map_or("-".into(), |v| format!("{:.1}", 10.0 * v.log10()))
+}
+
+/// The ordering at the end of each manoeuvre, the full-overtaking hand-over,
+/// the beam saving, and (for the full run) the time.
+pub fn verdicts(experiment: &Experiment, results: &[ManoeuvreResult], runs: u64, elapsed_s: f64) -> Vec<Verdict> {
+    let mut out = Vec::new();
+    for r in results {
+        let [proposed, ho_chan, error_free, nullspace] = [0, 1, 2, 3].map(|e| r.final_nmse(e));
+        let met = match (proposed, ho_chan, error_free, nullspace) {
+            (Some(p), Some(h), Some(e), Some(n)) => n <= e && e <= p && p < h,
+            _ => false,
+        };
+        out.push(Verdict {
+            claim: format!("{}: NMSE at the end, nullspace <= error-free <= proposed < Ho-Chan", r.manoeuvre.name),
+            paper: "ordering of Figs. 4-5".into(),
+            measured: format!("{} / {} / {} / {} dB", db(nullspace), db(error_free), db(proposed), db(ho_chan)),
+            met,
+            informational: false,
+        });
+        let variant = r.final_nmse(FULL_SCAN_VARIANT);
+        out.push(Verdict {
+            claim: format!("{}: the same with the proposed tracker on full-scan azimuths (variant)", r.manoeuvre.name),
+            paper: "-".into(),
+            measured: format!("{} / {} / {} / {} dB", db(nullspace), db(error_free), db(variant), db(ho_chan)),
+            met: match (variant, ho_chan, error_free, nullspace) {
+                (Some(p), Some(h), Some(e), Some(n)) => n <= e && e <= p && p < h,
+                _ => false,
+            },
+            informational: true,
+        });
+    }
+    let convergence = results.iter().find(|r| r.manoeuvre.name == experiment.convergence_manoeuvre);
+    let median = convergence.and_then(|r| r.handover_quantile(0.5));
+    out.push(Verdict {
+        claim: format!(
+            "{}: hand-over to RLS (third distinct azimuth), median within {} s",
+            experiment.convergence_manoeuvre, experiment.convergence_tolerance_s
+        ),
+        paper: format!("about {} s", experiment.paper_convergence_s),
+        measured: match (median, convergence) {
+            (Some(m), Some(r)) => format!(
+                "{m:.2} s (mean {:.2}, p90 {:.2}; {} of {} runs never; full-scan variant: median {})",
+                r.handover_mean().unwrap_or(f64::NAN),
+                r.handover_quantile(0.9).unwrap_or(f64::NAN),
+                r.runs - r.handovers_s.len() as u64,
+                r.runs,
+                quantile(&r.handovers_full_scan_s, 0.5).map_or("-".into(), |v| format!("{v:.2} s"))
+            ),
+            _ => "-".into(),
+        },
+        met: median.is_some_and(|m| (m - experiment.paper_convergence_s).abs() <= experiment.convergence_tolerance_s),
+        informational: false,
+    });
+    for r in results {
+        let windowed = r.beams.windowed_saving(experiment.scenario.beams);
+        out.push(Verdict {
+            claim: format!(
+                "{}: beam-measurement saving per tracked epoch, within {:.0} %",
+                r.manoeuvre.name,
+                100.0 * experiment.saving_tolerance
+            ),
+            paper: format!("{:.1}x", experiment.paper_saving),
+            measured: format!(
+                "{}x (whole run {}x; window holds the strongest beam in {:.2} % of epochs)",
+                windowed.map_or("-".into(), |v| format!("{v:.1}")),
+                r.beams.saving().map_or("-".into(), |v| format!("{v:.1}")),
+                100.0 * r.window_hits as f64 / r.window_epochs.max(1) as f64
+            ),
+            met: windowed.is_some_and(|v| {
+                (v - experiment.paper_saving).abs() <= experiment.saving_tolerance * experiment.paper_saving
+            }),
+            informational: false,
+        });
+    }
+    if runs >= experiment.time_target_runs {
+        out.push(Verdict {
+            claim: format!("{runs} runs of every manoeuvre in under {} s", experiment.time_target_s),
+            paper: "(issue target, not the paper's)".into(),
+            measured: format!("{elapsed_s:.1} s"),
+            met: elapsed_s < experiment.time_target_s,
+            informational: false,
+        });
+    }
+    out
+}
+
+/// The Markdown summary: setup, NMSE table, verdicts, speed.
+pub fn summary(
+    experiment: &Experiment,
+    results: &[ManoeuvreResult],
+    verdicts: &[Verdict],
+    runs: u64,
+    (elapsed_s, threads, load): (f64, usize, (Option<f64>, Option<f64>)),
+) -> String {
+    let s = &experiment.scenario;
+    let mut out = format!(
+        "Written by `mmtrack reproduce zoechmann`. {} GHz UCA of {} elements (radius {} wavelengths), {}-bit phase \
+         shifters, {} beams, {} ms epochs, Doppler noise {} Hz, lateral offset +/- {} m, heading +/- {} deg; {runs} Monte \
+         Carlo runs per manoeuvre, seed {}. Proposed tracker: H-infinity (gamma = {}) until {} distinct azimuths, then \
+         RLS; {} full scans, then the {} beams nearest the projected azimuth. NMSE of the range = sum (r_est - r)^2 / sum \
+         r^2 over the runs.\n\n",
+        s.carrier_hz / 1e9,
+        s.elements,
+        s.radius_wavelengths,
+        s.phase_bits,
+        s.beams,
+        s.epoch_s * 1e3,
+        s.doppler_sigma_hz,
+        s.lateral_jitter_m,
+        s.heading_jitter_deg,
+        experiment.seed,
+        experiment.gamma,
+        experiment.distinct_azimuths_for_rls,
+        experiment.full_scan_epochs,
+        experiment.window_beams,
+    );
+    out.push_str("| manoeuvre | time s | ");
+    out.push_str(&ESTIMATORS.join(" dB | "));
+    out.push_str(" dB |\n|---|---|---|---|---|---|---|\n");
+    let epoch_s = s.epoch_s;
+    for r in results {
+        let epochs = r.nmse[0].len();
+        // A few times along the run: 0.2 s, a quarter, half, three quarters, the end.
+        let mut picks: Vec<usize> = [0.2 / epoch_s, 0.25 * (epochs - 1) as f64, 0.5 * (epochs - 1) as f64]
+            .iter()
+            .chain(&[0.75 * (epochs - 1) as f64, (epochs - 1) as f64])
+            .map(|v| (v.round() as usize).min(epochs - 1))
+            .collect();
+        picks.dedup();
+        for k in picks {
+            let cells: Vec<String> = (0..ESTIMATORS.len()).map(|e| db(r.nmse[e].get(k).copied())).collect();
+            out.push_str(&format!("| {} | {:.2} | {} |\n", r.manoeuvre.name, k as f64 * epoch_s, cells.join(" | ")));
+        }
+    }
+    out.push_str("\n| claim | paper | measured | verdict |\n|---|---|---|---|\n");
+    for v in verdicts {
+        out.push_str(&format!(
+            "| {} | {} | {} | {} |\n",
+            v.claim,
+            v.paper,
+            v.measured,
+            match (v.met, v.informational) {
+                (true, false) => "met",
+                (false, false) => "**missed**",
+                (true, true) => "holds (variant, not a target)",
+                (false, true) => "does not hold (variant, not a target)",
+            }
+        ));
+    }
+    let failures: u64 = results.iter().map(|r| r.failures).sum();
+    let epochs: u64 = results.iter().map(|r| r.runs * r.nmse[0].len() as u64).sum();
+    out.push_str(&format!(
+        "\n{} manoeuvres x {runs} runs x 5 estimators ({epochs} epochs) in {elapsed_s:.1} s on {threads} threads \
+         ({:.0} runs/s); estimator errors: {failures}.\n",
+        results.len(),
+        runs as f64 * results.len() as f64 / elapsed_s.max(1e-9),
+    ));
+    let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+    out.push_str(&format!(
+        "1-minute load average before / after the run: {} / {} (on {threads} threads; above that, other work shared \
+         the cores and the times are longer).\n",
+        fmt(load.0),
+        fmt(load.1)
+    ));
+    out
+}
