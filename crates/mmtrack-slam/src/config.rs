@@ -57,6 +57,13 @@ pub struct SlamConfig {
     /// posterior standard deviations (0.2): position and heading have no
     /// process noise in (1), so resampled copies are spread by this kernel.
     pub jitter_bandwidth: f64,
+    /// Keep a confirmed source's covariance at least as large as the error
+    /// the UE's current uncertainty induces in it (true). Message passing
+    /// treats the UE's error as independent from epoch to epoch, but it
+    /// changes slowly, so without this floor a source's belief shrinks as
+    /// if that error averaged out, and the overconfident map then holds
+    /// the UE to its own past errors.
+    pub ue_error_floor: bool,
     /// Sightings an unconfirmed source needs before it may be classified (3).
     pub confirm_min_sightings: usize,
     /// Footnote 3's test: a hypothesis is rejected when its drift statistic
@@ -95,6 +102,7 @@ impl Default for SlamConfig {
             association_gate: 100.0,
             ess_fraction: 0.5,
             jitter_bandwidth: 0.2,
+            ue_error_floor: true,
             confirm_min_sightings: 3,
             confirm_ratio: 10.0,
             confirm_min_drift: 16.3,

@@ -624,15 +624,33 @@ impl SlamFilter {
             let next: [f64; 3] = std::array::from_fn(|i| prior.mean_m[i] + dx[(i, 0)]);
             let moved = (0..3).map(|i| (next[i] - mu[i]).powi(2)).sum::<f64>().sqrt();
             mu = next;
-            last = Some((gain, h_src, r_cov));
+            last = Some((gain, h_src, r_cov, h_ue));
             if moved < 1e-4 {
                 break;
             }
         }
-        let (gain, h, r_cov) = last?;
+        let (gain, h, r_cov, h_ue) = last?;
         let ikh = Mat::<f64>::identity(3, 3) - mul(&gain, &h);
-        let cov = symmetrise(&(sandwich(&ikh, &p) + sandwich(&gain, &r_cov)));
+        let mut cov = symmetrise(&(sandwich(&ikh, &p) + sandwich(&gain, &r_cov)));
+        if self.config.ue_error_floor {
+            cov = psd_max(&cov, &self.ue_induced(&h, &h_ue, p_s)?)?;
+        }
         Some(Gauss3 { mean_m: mu, cov_m2: to3(&cov) })
+    }
+
+    /// The source error one epoch's UE error induces: `A H_s P_s H_s^T A^T`
+    /// with `A = (H_m^T Sigma^-1 H_m)^-1 H_m^T Sigma^-1` the least-squares
+    /// inverse of the measurement with respect to the source. The UE error
+    /// changes slowly from epoch to epoch, so this part of a source's error
+    /// does not average out over its sightings as the measurement noise
+    /// does; message passing treats the epochs as independent and would
+    /// shrink it all the same (see `SlamConfig::ue_error_floor`).
+    fn ue_induced(&self, h_src: &Mat<f64>, h_ue: &Mat<f64>, p_s: &Mat<f64>) -> Option<Mat<f64>> {
+        let w = Mat::from_fn(5, 5, |i, j| if i == j { 1.0 / self.sigma_var[i] } else { 0.0 });
+        let ht_w = mul(&h_src.transpose().to_owned(), &w);
+        let (info_inv, _) = spd_inverse(&mul(&ht_w, h_src))?;
+        let a = mul(&info_inv, &ht_w);
+        Some(symmetrise(&sandwich(&mul(&a, h_ue), p_s)))
     }
 
     /// The VA and SP hypotheses of a path under the UE posterior (Sec.
@@ -802,4 +820,16 @@ impl Acc {
             }),
         })
     }
+}
+
+/// The smallest covariance (in the PSD order, along the eigenvectors of
+/// the difference) at least as large as both `a` and `b`:
+/// `a + (b - a)_+`.
+fn psd_max(a: &Mat<f64>, b: &Mat<f64>) -> Option<Mat<f64>> {
+    let d = symmetrise(&(b - a));
+    let eig = d.self_adjoint_eigen(faer::Side::Lower).ok()?;
+    let (u, lambda) = (eig.U(), eig.S().column_vector());
+    let n = a.nrows();
+    let plus = Mat::from_fn(n, n, |i, j| (0..n).map(|k| u[(i, k)] * lambda[k].max(0.0) * u[(j, k)]).sum::<f64>());
+    Some(symmetrise(&(a + &plus)))
 }

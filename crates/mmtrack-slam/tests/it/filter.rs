@@ -28,11 +28,15 @@ fn diagnostic_paper_run() {
     let scenario = SlamScenario::default();
     let seed: u64 = std::env::var("SLAM_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
     let r = scenario.realise(2018, seed).unwrap();
-    let mut filter = SlamFilter::new(SlamConfig::default(), r.truth[0].ue, seed).unwrap();
+    let min_sightings: usize = std::env::var("SLAM_MIN_SIGHTINGS").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
+    let config = SlamConfig { confirm_min_sightings: min_sightings, ..SlamConfig::default() };
+    let mut filter = SlamFilter::new(config, r.truth[0].ue, seed).unwrap();
+    let mut nees = Vec::new();
     for (k, (epoch, truth)) in r.epochs.iter().zip(&r.truth).enumerate() {
         let report = filter.step(epoch).unwrap();
         let e = report.estimate;
         let err = sub3(e.state.position_m, truth.ue.position_m);
+        nees.push((norm3(err) / e.position_std_m).powi(2));
         let vas: Vec<String> = filter
             .sources()
             .iter()
@@ -56,6 +60,10 @@ fn diagnostic_paper_run() {
             vas.join(" ")
         );
     }
+    println!(
+        "mean squared normalised position error {:.2} (2 if consistent)",
+        nees.iter().sum::<f64>() / nees.len() as f64
+    );
     let _ = PathOrigin::Clutter;
 }
 
