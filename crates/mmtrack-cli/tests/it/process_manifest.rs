@@ -102,3 +102,48 @@ fn manifest_tasks_give_the_same_tables_for_any_thread_count_and_alone() {
     assert!(stdout.contains("2 of 2 sequences done on Ray"), "{stdout}");
     assert!(table_bytes(&d.join("ray")) == reference, "the Ray run differs from the local one");
 }
+
+/// `examples/campaign_figures.py` (polars + matplotlib from PyPI in a venv)
+/// loads the demo's tables and draws its figures. Polars older than 1.43
+/// cannot read parquet-rs 60 footers ("Invalid thrift: bad data"), so the
+/// version is pinned to a current one.
+#[test]
+fn campaign_figures_example_draws_the_demo_tables_with_polars() {
+    let target =
+        std::env::var_os("CARGO_TARGET_DIR").map(std::path::PathBuf::from).unwrap_or_else(|| root().join("target"));
+    let venv = target.join("py-venv-examples");
+    let python = venv.join("bin/python");
+    let ready = |p: &Path| {
+        Command::new(p)
+            .args(["-c", "import polars, matplotlib; assert polars.__version__ == '2.1.0'"])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !ready(&python) {
+        let made = Command::new("python3").args(["-m", "venv"]).arg(&venv).status().is_ok_and(|s| s.success())
+            && Command::new(&python)
+                .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
+                .args(["polars==2.1.0", "matplotlib==3.10.7"])
+                .status()
+                .is_ok_and(|s| s.success());
+        if !made || !ready(&python) {
+            eprintln!("skipped: examples/campaign_figures.py: polars and matplotlib could not be installed from PyPI");
+            return;
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
+    let run = Command::new(&python)
+        .arg(root().join("examples/campaign_figures.py"))
+        .args(["d/tables", "d/analysis/tables", "-o", "figures"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&run);
+    assert!(run.status.success(), "{stdout}\n{stderr}");
+    assert!(stdout.contains("oxford-demo"), "the summary table: {stdout}");
+    for figure in ["trajectories.png", "drift_per_length.png", "mpcs_per_set.png", "spebt_errors.png"] {
+        let bytes = std::fs::read(dir.path().join("figures").join(figure)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG") && bytes.len() > 5000, "{figure}");
+    }
+}
