@@ -14,6 +14,7 @@ use mmtrack_analysis::pipeline::{inventory, read_trajectories};
 use mmtrack_core::{OdometryEstimate, StampedPose};
 use mmtrack_io::recording::{EstimateToAdd, METADATA_NAME, RawReader, RecordingMetadata, copy_with_estimate};
 use mmtrack_io::table::{read_table, table_path};
+use mmtrack_io::table_kv::read_key_value_metadata;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -136,10 +137,21 @@ fn export_mcap(args: &ExportArgs, overwrite: Overwrite, quiet: bool) -> anyhow::
     let rows: Vec<OdometryEstimate> = read_table(&table)?;
     let poses: Vec<StampedPose> =
         rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
+    // Tables in the ground truth's frame share the recording's `world`; older
+    // tables, and runs without ground truth, start at the first scan's pose.
+    let run_config = read_key_value_metadata(&table)?.remove("mmtrack.run_config").unwrap_or_default();
+    let world = serde_json::from_str::<serde_json::Value>(&run_config)
+        .ok()
+        .and_then(|c| c["frame"]["world"].as_str().map(str::to_string))
+        .unwrap_or_else(|| "first_scan".to_string());
+    let parent_frame = if world == "ground_truth" { "world" } else { "odometry_first_scan" };
     let estimate = EstimateToAdd {
         poses: &poses,
-        parent_frame: "world",
-        metadata: BTreeMap::from([("estimate.source".to_string(), table.display().to_string())]),
+        parent_frame,
+        metadata: BTreeMap::from([
+            ("estimate.source".to_string(), table.display().to_string()),
+            ("estimate.frame".to_string(), parent_frame.to_string()),
+        ]),
     };
     let options = RecordingOptions { overwrite, durability: Durability::Fsync, ..RecordingOptions::default() };
     let summary = copy_with_estimate(recording, &args.output, &estimate, &options)?;

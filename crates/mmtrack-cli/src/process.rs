@@ -106,6 +106,10 @@ pub struct OdometryArgs {
     /// Replace existing output tables of this sequence.
     #[arg(long)]
     pub force: bool,
+    /// Name of this run: the tables go to `<output>/run=<ID>/`, so runs written under one directory read back
+    /// together with a `run` column (DuckDB/polars Hive partitioning) instead of overwriting each other.
+    #[arg(long, value_name = "ID")]
+    pub run_id: Option<String>,
     #[command(flatten)]
     pub threads: ThreadsArg,
 }
@@ -253,6 +257,16 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("a recording and --output are required (unless --print-config)");
     };
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
+    let run_output;
+    let output = match &args.run_id {
+        Some(id) => {
+            // The same characters as a sequence id: one safe path component.
+            table_path(output, "odometry", id).with_context(|| format!("--run-id {id}"))?;
+            run_output = output.join(format!("run={id}"));
+            &run_output
+        }
+        None => output,
+    };
     // Check the outputs before the work, so a refusal costs nothing.
     let sequence_hint = args.sequence.clone();
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &sequence_hint) {
@@ -293,18 +307,21 @@ pub fn write_outputs(
     recording: &Path,
     overwrite: Overwrite,
 ) -> anyhow::Result<Vec<TableWriteSummary>> {
+    let (estimates, frame) = in_ground_truth_frame(&run.estimates, &run.ground_truth);
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process odometry",
             "recording": recording.display().to_string(),
             "preset": preset,
             "odometry": config,
+            "frame": frame,
+            "run_id": run_id_of(output),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
     };
     let mut written = vec![
-        write_table(output, sequence, &run.estimates, &info, overwrite)?,
+        write_table(output, sequence, &estimates, &info, overwrite)?,
         write_table(output, sequence, &run.timings, &info, overwrite)?,
     ];
     if !run.ground_truth.is_empty() {
@@ -312,6 +329,57 @@ pub fn write_outputs(
         written.push(write_table(output, sequence, &truth, &info, overwrite)?);
     }
     Ok(written)
+}
+
+/// The run id of a table directory `.../run=<id>`, if it is one.
+fn run_id_of(output: &Path) -> Option<String> {
+    output.file_name()?.to_str()?.strip_prefix("run=").map(str::to_string)
+}
+
+/// The odometry's poses in the ground truth's frame, and the `frame` entry of
+/// the run configuration saying which frame the table is in.
+///
+/// With ground truth covering a scan, the first estimate inside the
+/// ground-truth time span is placed at the ground-truth pose of its time
+/// (interpolated as `mmtrack analyze` does,
+/// [`mmtrack_analysis::trajectory::interpolate_pose`], when no pose has that
+/// time) and every estimate moves with it:
+/// `world_from_vehicle = truth(t_a) * estimate(t_a)^-1 * estimate`. This is
+/// the anchor `analyze` uses, so its metrics do not change, while a join of
+/// `odometry` and `ground_truth` on `(sequence, t_ns)` (or evo without
+/// alignment flags) now compares like with like. Without ground truth the
+/// frame stays the vehicle's pose at the first scan.
+fn in_ground_truth_frame(
+    estimates: &[OdometryEstimate],
+    ground_truth: &[StampedPose],
+) -> (Vec<OdometryEstimate>, serde_json::Value) {
+    let span = ground_truth.first().zip(ground_truth.last()).map(|(a, b)| a.t_ns..=b.t_ns);
+    let anchor = span.and_then(|span| estimates.iter().find(|e| span.contains(&e.t_ns)));
+    let Some(anchor) = anchor else {
+        let frame = serde_json::json!({
+            "world": "first_scan",
+            "meaning": "world is the vehicle's pose at the first scan (no ground truth at the scan times)",
+        });
+        return (estimates.to_vec(), frame);
+    };
+    let truth = match ground_truth.binary_search_by_key(&anchor.t_ns, |g| g.t_ns) {
+        Ok(i) => ground_truth[i].parent_from_child,
+        // The anchor lies strictly inside the span, so 0 < i < len.
+        Err(i) => mmtrack_analysis::trajectory::interpolate_pose(&ground_truth[i - 1], &ground_truth[i], anchor.t_ns),
+    };
+    let truth_from_odometry = truth * anchor.world_from_vehicle.inverse();
+    let moved = estimates
+        .iter()
+        .map(|e| OdometryEstimate { world_from_vehicle: truth_from_odometry * e.world_from_vehicle, ..*e })
+        .collect();
+    let frame = serde_json::json!({
+        "world": "ground_truth",
+        "meaning": "the ground truth's world frame (table ground_truth, recording topic /ground_truth/pose): the \
+                    estimate at anchor_t_ns sits at the ground-truth pose of that time, the others follow the odometry",
+        "anchor_t_ns": anchor.t_ns,
+        "ground_truth_from_odometry": [truth_from_odometry.x_m, truth_from_odometry.y_m, truth_from_odometry.yaw_rad],
+    });
+    (moved, frame)
 }
 
 fn print_summary(run: &OdometryRun, preset: &str, written: &[TableWriteSummary]) {

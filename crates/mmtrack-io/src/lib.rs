@@ -21,6 +21,7 @@ pub mod proto;
 pub mod recording;
 pub mod schema_docs;
 pub mod table;
+pub mod table_kv;
 
 pub use atomic::{AtomicFile, Durability, Overwrite, staging_dir};
 pub use error::{IoError, Result};

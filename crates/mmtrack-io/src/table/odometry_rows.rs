@@ -19,7 +19,9 @@ crate::define_table! {
     /// `odometry`: one radar odometry estimate per scan.
     pub const ODOMETRY = "odometry",
         "One odometry estimate world_from_vehicle per radar scan, in time order, with registration diagnostics; \
-the world frame is the pose of the first scan.";
+the world frame is the ground truth's when the recording has ground truth (the first estimate inside its time span \
+sits at the ground-truth pose of that time), else the vehicle's pose at the first scan: the run config's `frame` \
+says which.";
     OdometryEstimate {
         t_ns: i64, "ns", "scan time";
         x_m: f64, "m", "estimated x of the vehicle in the world frame", |r| r.world_from_vehicle.x_m;
