@@ -15,6 +15,7 @@ mod foxglove_views;
 mod independent_readers;
 mod ingest_navtech;
 mod interrupt;
+mod odometry_frames;
 mod process_beam_spebt;
 mod process_manifest;
 mod process_mpc;
