@@ -25,8 +25,8 @@ estimates it directly).";
     pub struct ZoechmannNmseRow {
         manoeuvre: String, "", "half-overtaking or full-overtaking";
         estimator: String, "",
-            "proposed, ho-chan, error-free-genie, nullspace-genie or proposed-full-scan (the proposed tracker on a full \
-scan's azimuth every epoch, a variant)";
+            "proposed, ho-chan, error-free-genie, nullspace-genie; variants: proposed-full-scan (the proposed tracker on \
+a full scan's azimuth every epoch), proposed-gated (its 3-beam window only after the hand-over to RLS)";
         epoch: u64, "", "epoch index (20 ms each)";
         t_s: f64, "s", "time since the start of the manoeuvre";
         runs: u64, "", "Monte Carlo runs with an estimate at this epoch";
@@ -59,6 +59,9 @@ nearest the projected azimuth) against a full scan at every epoch.";
         saving: f64, "", "beams_full_scan / beams_measured over whole runs";
         windowed_saving: f64, "", "the same over the epochs after the full scans (the paper's 128 / 3)";
         window_hit_rate: f64, "", "share of windowed epochs whose 3 beams include the strongest beam of the codebook";
+        gated_saving: f64, "",
+            "saving over whole runs of the gated variant (window only after the hand-over to RLS, full scans before)";
+        gated_window_hit_rate: f64, "", "window_hit_rate of the gated variant";
         estimator_failures: u64, "", "estimator updates that returned an error (all estimators, all runs)";
     }
 }

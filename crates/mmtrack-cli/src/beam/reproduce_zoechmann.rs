@@ -33,11 +33,11 @@ use mmtrack_analysis::beam::zoechmann_plots::{
 };
 use mmtrack_beam::geometric::{
     BeamCount, BeamSchedule, BeamSelection, DopplerBearing, ErrorFreeRegressors, GeometricTracker,
-    GeometricTrackerConfig, HoChanBatch, NullspaceProjection, RangeEstimator,
+    GeometricTrackerConfig, HoChanBatch, NullspaceProjection, PolarState, RangeEstimator,
 };
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
-use mmtrack_sim::beam::overtaking::{Manoeuvre, OvertakingReceiver, OvertakingScenario};
+use mmtrack_sim::beam::overtaking::{EpochTruth, Manoeuvre, OvertakingReceiver, OvertakingScenario};
 use rayon::prelude::*;
 use serde::Deserialize;
 
@@ -105,11 +105,14 @@ pub(super) struct Experiment {
 }
 
 /// The estimators, in table order.
-pub(super) const ESTIMATORS: [&str; 5] =
-    ["proposed", "ho-chan", "error-free-genie", "nullspace-genie", "proposed-full-scan"];
-/// Index of the variant: the proposed tracker on full-scan azimuths every
+pub(super) const ESTIMATORS: [&str; 6] =
+    ["proposed", "ho-chan", "error-free-genie", "nullspace-genie", "proposed-full-scan", "proposed-gated"];
+/// Index of a variant: the proposed tracker on full-scan azimuths every
 /// epoch (no beam-selection feedback), a diagnostic beside the paper's four.
 pub(super) const FULL_SCAN_VARIANT: usize = 4;
+/// Index of a variant: the proposed tracker whose 3-beam window starts only
+/// once it has handed over to RLS (full scans before), a diagnostic.
+pub(super) const GATED_VARIANT: usize = 5;
 const N: usize = ESTIMATORS.len();
 
 /// Runs per rayon task: fixed, so partial sums merge in the same order on
@@ -130,9 +133,11 @@ pub(super) struct ManoeuvreResult {
     pub handovers_s: Vec<f64>,
     /// The same for the full-scan variant.
     pub handovers_full_scan_s: Vec<f64>,
-    pub beams: BeamCount,
-    pub window_epochs: u64,
-    pub window_hits: u64,
+    /// Beam accounting of the proposed tracker (index 0) and of the gated
+    /// variant (1).
+    pub beams: [BeamCount; 2],
+    pub window_epochs: [u64; 2],
+    pub window_hits: [u64; 2],
     pub failures: u64,
     pub trace: PositionTrace,
 }
@@ -146,6 +151,12 @@ impl ManoeuvreResult {
     /// Nearest-rank quantile `q` of the hand-over times.
     pub fn handover_quantile(&self, q: f64) -> Option<f64> {
         quantile(&self.handovers_s, q)
+    }
+
+    /// Share of windowed epochs whose window held the strongest beam, of the
+    /// proposed tracker (0) or the gated variant (1).
+    pub fn window_hit_rate(&self, i: usize) -> f64 {
+        self.window_hits[i] as f64 / self.window_epochs[i].max(1) as f64
     }
 
     /// Mean hand-over time.
@@ -249,9 +260,9 @@ struct Chunk {
     squared_range: [Vec<f64>; N],
     handovers_s: Vec<f64>,
     handovers_full_scan_s: Vec<f64>,
-    beams: BeamCount,
-    window_epochs: u64,
-    window_hits: u64,
+    beams: [BeamCount; 2],
+    window_epochs: [u64; 2],
+    window_hits: [u64; 2],
     failures: u64,
     trace: Option<PositionTrace>,
 }
@@ -264,9 +275,9 @@ impl Chunk {
             squared_range: std::array::from_fn(|_| vec![0.0; epochs]),
             handovers_s: Vec::new(),
             handovers_full_scan_s: Vec::new(),
-            beams: BeamCount::default(),
-            window_epochs: 0,
-            window_hits: 0,
+            beams: [BeamCount::default(); 2],
+            window_epochs: [0; 2],
+            window_hits: [0; 2],
             failures: 0,
             trace: None,
         }
@@ -286,9 +297,11 @@ impl Chunk {
         }
         self.handovers_s.extend(other.handovers_s);
         self.handovers_full_scan_s.extend(other.handovers_full_scan_s);
-        self.beams.merge(&other.beams);
-        self.window_epochs += other.window_epochs;
-        self.window_hits += other.window_hits;
+        for i in 0..2 {
+            self.beams[i].merge(&other.beams[i]);
+            self.window_epochs[i] += other.window_epochs[i];
+            self.window_hits[i] += other.window_hits[i];
+        }
         self.failures += other.failures;
         if self.trace.is_none() {
             self.trace = other.trace;
@@ -337,49 +350,33 @@ fn run_chunk(
     let mut chunk = Chunk::new(manoeuvre.epochs(scenario.epoch_s));
     for run_index in runs {
         let run = scenario.realise(manoeuvre, experiment.seed, run_index)?;
-        let mut proposed = GeometricTracker::new(tracker_config(experiment))?;
+        let proposed = GeometricTracker::new(tracker_config(experiment))?;
         let mut estimators: [Option<Box<dyn RangeEstimator>>; 3] = [
             Some(Box::new(HoChanBatch::new(lambda)?)),
             Some(Box::new(ErrorFreeRegressors::new(lambda)?)),
             Some(Box::new(NullspaceProjection::new(lambda)?)),
         ];
         let mut full_scan = Some(GeometricTracker::new(tracker_config(experiment))?);
-        let mut proposed_ok = true;
+        let mut windowed = [
+            Windowed { tracker: Some(proposed), gated: false, estimator: 0, counter: 0 },
+            Windowed {
+                tracker: Some(GeometricTracker::new(tracker_config(experiment))?),
+                gated: true,
+                estimator: GATED_VARIANT,
+                counter: 1,
+            },
+        ];
         let mut trace = (run_index == 0).then(PositionTrace::default);
         for (k, truth) in run.epochs.iter().enumerate() {
             let doppler_hz = truth.measured_doppler_hz();
             let full_scan_beam = receiver.strongest_beam(truth.azimuth_rad);
-            // The proposed tracker's beams: projected from its last state.
-            if proposed_ok {
-                let projected = if k > 0 { proposed.state().map(|s| s.azimuth_rad(truth.t_s)) } else { None };
-                let selection = schedule.select(k, projected);
-                chunk.beams.add(&selection, scenario.beams);
-                let beam = match &selection {
-                    BeamSelection::FullScan => full_scan_beam,
-                    BeamSelection::Window(window) => {
-                        chunk.window_epochs += 1;
-                        if window.contains(&full_scan_beam) {
-                            chunk.window_hits += 1;
-                        }
-                        receiver.strongest_of(window, truth.azimuth_rad).unwrap_or(full_scan_beam)
-                    }
-                };
-                let observation =
-                    DopplerBearing { t_s: truth.t_s, azimuth_rad: receiver.beam_azimuth_rad(beam), doppler_hz };
-                match proposed.update(&observation) {
-                    Ok(()) => {
-                        if let (Some(r), Some(state)) = (proposed.range_now_m(), proposed.state()) {
-                            add(&mut chunk, 0, k, r, truth.range_m);
-                            if let Some(trace) = &mut trace {
-                                trace.truth_m.push(truth.position_m);
-                                trace.estimate_m.push(state.position_m(truth.t_s));
-                            }
-                        }
-                    }
-                    Err(_) => {
-                        chunk.failures += 1;
-                        proposed_ok = false;
-                    }
+            for w in &mut windowed {
+                let Some(state) = w.step(&mut chunk, &schedule, receiver, k, truth, full_scan_beam) else { continue };
+                if w.estimator == 0
+                    && let Some(trace) = &mut trace
+                {
+                    trace.truth_m.push(truth.position_m);
+                    trace.estimate_m.push(state.position_m(truth.t_s));
                 }
             }
             let full_scan_azimuth_rad = receiver.beam_azimuth_rad(full_scan_beam);
@@ -414,7 +411,7 @@ fn run_chunk(
                 }
             }
         }
-        if let Some(t) = proposed.handover_t_s().filter(|_| proposed_ok) {
+        if let Some(t) = windowed[0].tracker.as_ref().and_then(GeometricTracker::handover_t_s) {
             chunk.handovers_s.push(t);
         }
         if let Some(t) = full_scan.and_then(|f| f.handover_t_s()) {
@@ -425,6 +422,61 @@ fn run_chunk(
         }
     }
     Ok(chunk)
+}
+
+/// A proposed tracker that measures through its own beam window.
+struct Windowed {
+    /// `None` after an estimator error.
+    tracker: Option<GeometricTracker>,
+    /// Window only after the hand-over to RLS (the gated variant).
+    gated: bool,
+    /// Column of the NMSE sums.
+    estimator: usize,
+    /// Index of the beam accounting.
+    counter: usize,
+}
+
+impl Windowed {
+    /// Selects the beams, measures the strongest of them, updates the
+    /// tracker and adds its range error; the new state on success.
+    fn step(
+        &mut self,
+        chunk: &mut Chunk,
+        schedule: &BeamSchedule,
+        receiver: &OvertakingReceiver,
+        k: usize,
+        truth: &EpochTruth,
+        full_scan_beam: usize,
+    ) -> Option<PolarState> {
+        let tracker = self.tracker.as_mut()?;
+        let may_window = k > 0 && (!self.gated || tracker.converged());
+        let projected = if may_window { tracker.state().map(|s| s.azimuth_rad(truth.t_s)) } else { None };
+        let selection = schedule.select(k, projected);
+        chunk.beams[self.counter].add(&selection, schedule.beams);
+        let beam = match &selection {
+            BeamSelection::FullScan => full_scan_beam,
+            BeamSelection::Window(window) => {
+                chunk.window_epochs[self.counter] += 1;
+                if window.contains(&full_scan_beam) {
+                    chunk.window_hits[self.counter] += 1;
+                }
+                receiver.strongest_of(window, truth.azimuth_rad).unwrap_or(full_scan_beam)
+            }
+        };
+        let observation = DopplerBearing {
+            t_s: truth.t_s,
+            azimuth_rad: receiver.beam_azimuth_rad(beam),
+            doppler_hz: truth.measured_doppler_hz(),
+        };
+        if tracker.update(&observation).is_err() {
+            chunk.failures += 1;
+            self.tracker = None;
+            return None;
+        }
+        let (range_m, state) = (tracker.range_now_m()?, tracker.state()?);
+        add(chunk, self.estimator, k, range_m, truth.range_m);
+        Some(state)
+    }
 }
 
 fn add(chunk: &mut Chunk, estimator: usize, epoch: usize, range_m: f64, true_range_m: f64) {
@@ -491,11 +543,13 @@ fn write_outputs(
             handover_mean_s: r.handover_mean(),
             handover_p90_s: r.handover_quantile(0.9),
             handover_median_full_scan_s: quantile(&r.handovers_full_scan_s, 0.5),
-            beams_measured: r.beams.measured,
-            beams_full_scan: r.beams.full_scan_equivalent,
-            saving: r.beams.saving().unwrap_or(f64::NAN),
-            windowed_saving: r.beams.windowed_saving(experiment.scenario.beams).unwrap_or(f64::NAN),
-            window_hit_rate: r.window_hits as f64 / r.window_epochs.max(1) as f64,
+            beams_measured: r.beams[0].measured,
+            beams_full_scan: r.beams[0].full_scan_equivalent,
+            saving: r.beams[0].saving().unwrap_or(f64::NAN),
+            windowed_saving: r.beams[0].windowed_saving(experiment.scenario.beams).unwrap_or(f64::NAN),
+            window_hit_rate: r.window_hit_rate(0),
+            gated_saving: r.beams[1].saving().unwrap_or(f64::NAN),
+            gated_window_hit_rate: r.window_hit_rate(1),
             estimator_failures: r.failures,
         });
     }
