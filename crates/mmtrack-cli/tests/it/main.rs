@@ -28,6 +28,7 @@ mod reproduce;
 mod reproduce_kim;
 mod reproduce_shaham;
 mod reproduce_spebt;
+mod reproduce_zoechmann;
 mod simulate_radar;
 mod simulate_sounder;
 mod threads;
