@@ -28,9 +28,9 @@
 //!
 //! The arrays carry no timestamps: sweep `r` of the scenario (0-based row)
 //! is at `r * sweep_period` from the scenario's first sweep (time base
-//! `scenario_start`), so times increase across passes though the real gaps
-//! between passes are unknown. Fix quality is `unknown` (the arrays do not
-//! say) and altitude absent.
+//! `relative`: real data without a clock, not a simulation), so times
+//! increase across passes though the real gaps between passes are unknown.
+//! Fix quality is `unknown` (the arrays do not say) and altitude absent.
 //!
 //! Metadata keys: `beam.site` (`deepsense-scenario<S>`: recordings of one
 //! array at one place, within which beam maps may be fitted), `beam.scenario`,
@@ -517,7 +517,7 @@ fn write_pass(
     let metadata = RecordingMetadata {
         sequence_id: sequence_id.to_string(),
         source: format!("deepsense:{}", folder.display()),
-        time_base: TimeBase::ScenarioStart,
+        time_base: TimeBase::Relative,
         extra,
     };
     let mut writer = RecordingWriter::create(path, &metadata, recording)?;

@@ -104,7 +104,7 @@ fn each_pass_becomes_a_recording_with_sweeps_and_both_units_fixes() {
     assert_eq!(metadata["beam.site"], "deepsense-scenario3");
     assert_eq!(metadata["beam.pass"], "2");
     assert_eq!(metadata["beam.first_row"], "3");
-    assert_eq!(metadata["time_base"], "scenario_start");
+    assert_eq!(metadata["time_base"], "relative");
     assert!(metadata["gnss.vehicle_positions"].starts_with("calibrated (scenario3_unit2_loc_cal_1-5.npy)"));
     let sweeps: Vec<(BeamSweep, Option<String>)> = events
         .iter()
