@@ -110,9 +110,18 @@ pub fn zoechmann_figure_svg(
 }
 
 fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace: &PositionTrace) -> anyhow::Result<()> {
-    let all = || trace.truth_m.iter().chain(&trace.estimate_m);
-    let x = padded_range(all().map(|p| p[0]).chain([0.0]));
-    let y = padded_range(all().map(|p| p[1]).chain([0.0]));
+    // The axes follow the true path (and the receiver), padded by 30 % or
+    // 5 m: a diverged estimate must not squash the picture; estimates outside
+    // are counted in the legend.
+    let pad = |r: std::ops::Range<f64>| {
+        let p = (0.3 * (r.end - r.start)).max(5.0);
+        (r.start - p)..(r.end + p)
+    };
+    let x = pad(padded_range(trace.truth_m.iter().map(|p| p[0]).chain([0.0])));
+    let y = pad(padded_range(trace.truth_m.iter().map(|p| p[1]).chain([0.0])));
+    let inside: Vec<(f64, f64)> =
+        trace.estimate_m.iter().map(|p| (p[0], p[1])).filter(|(a, b)| x.contains(a) && y.contains(b)).collect();
+    let outside = trace.estimate_m.len() - inside.len();
     let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
@@ -127,15 +136,13 @@ fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace:
         .label("true path")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], truth));
     chart
-        .draw_series(
-            trace
-                .estimate_m
-                .iter()
-                .filter(|p| p[0].is_finite() && p[1].is_finite())
-                .map(|p| Cross::new((p[0], p[1]), 3, RED.stroke_width(1))),
-        )
+        .draw_series(inside.iter().map(|&p| Cross::new(p, 3, RED.stroke_width(1))))
         .map_err(err)?
-        .label("proposed, first run")
+        .label(if outside == 0 {
+            "proposed, first run".to_string()
+        } else {
+            format!("proposed, first run ({outside} estimates outside the frame)")
+        })
         .legend(|(x, y)| Cross::new((x + 10, y), 3, RED.stroke_width(1)));
     chart
         .draw_series([Circle::new((0.0, 0.0), 5, BLUE.filled())])
@@ -170,8 +177,11 @@ fn draw_nmse(
         .build_cartesian_2d(0f64..t_end, y.clone())
         .map_err(err)?;
     chart.configure_mesh().x_desc("time (s)").y_desc("NMSE of the range (dB)").draw().map_err(err)?;
-    for (curve, color) in curves.iter().zip(palette.iter()) {
-        let style = color.stroke_width(2);
+    // Variants (after the paper's four) thin and first, so the four stay on top.
+    let order: Vec<usize> = (4..curves.len()).chain(0..curves.len().min(4)).collect();
+    for index in order {
+        let (curve, color) = (&curves[index], palette[index % palette.len()]);
+        let style = color.stroke_width(if index < 4 { 2 } else { 1 });
         let points = curve
             .nmse
             .iter()
