@@ -179,6 +179,11 @@ fn write_recording(
     if let Some(t) = &args.trajectory {
         extra.insert("simulator.trajectory".to_string(), t.display().to_string());
     }
+    // Scan times are the trajectory's: UNIX time when a real trajectory or the
+    // scenario's `start_t_ns` puts the drive at a date, scenario time from 0 otherwise.
+    let mut simulator = simulator.peekable();
+    let first_t_ns = simulator.peek().map_or(0, |(scan, _)| scan.header.t_ns);
+    let time_base = TimeBase::unix_or(first_t_ns, TimeBase::ScenarioStart);
     let metadata = RecordingMetadata {
         sequence_id: output
             .output
@@ -186,7 +191,7 @@ fn write_recording(
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "simulated".into()),
         source: format!("simulate:{}", args.scenario.display()),
-        time_base: TimeBase::UnixEpoch,
+        time_base,
         extra,
     };
     let mut writer = RecordingWriter::create(&output.output, &metadata, &output.recording_options())?;
