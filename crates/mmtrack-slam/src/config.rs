@@ -50,6 +50,10 @@ pub struct SlamConfig {
     /// Squared Mahalanobis distance beyond which a (path, source) pair is
     /// not considered at all (100).
     pub association_gate: f64,
+    /// The same gate for the line of sight that initialises the UE (20.5,
+    /// the chi-square(5) 99.9 % quantile): under the broad prior a
+    /// reflection can pass the general gate when the LOS path is missing.
+    pub initialisation_gate: f64,
     /// Effective sample size, as a fraction of the particles, that each
     /// tempering stage keeps (0.5).
     pub ess_fraction: f64,
@@ -100,6 +104,7 @@ impl Default for SlamConfig {
             detection_probability: 0.99,
             new_source_density: 1e-3,
             association_gate: 100.0,
+            initialisation_gate: 20.5,
             ess_fraction: 0.5,
             jitter_bandwidth: 0.2,
             ue_error_floor: true,
@@ -149,6 +154,7 @@ impl SlamConfig {
         }
         ensure_positive("new_source_density", self.new_source_density)?;
         ensure_positive("association_gate", self.association_gate)?;
+        ensure_positive("initialisation_gate", self.initialisation_gate)?;
         let ess = self.ess_fraction;
         if !(ess.is_finite() && ess > 0.0 && ess < 1.0) {
             return Err(invalid("ess_fraction", ess, "a fraction in (0, 1)"));

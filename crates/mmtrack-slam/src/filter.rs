@@ -381,9 +381,19 @@ impl SlamFilter {
             predicted.push(hyps);
         }
         let norm = 2.5 * std::f64::consts::TAU.ln();
+        // Before the UE is initialised only the BS is in the map, and a wrong
+        // LOS cannot be undone: the LOS must be the shortest path (triangle
+        // inequality: a reflected or scattered path is longer) and pass the
+        // tighter initialisation gate.
+        let gate = if self.initialised { self.config.association_gate } else { self.config.initialisation_gate };
+        let shortest = paths.iter().enumerate().min_by(|a, b| a.1.toa_m.total_cmp(&b.1.toa_m)).map(|(l, _)| l);
         let log_s: Vec<Vec<f64>> = paths
             .iter()
-            .map(|z| {
+            .enumerate()
+            .map(|(l, z)| {
+                if !self.initialised && Some(l) != shortest {
+                    return vec![f64::NEG_INFINITY; predicted.len()];
+                }
                 let z = z.to_array();
                 predicted
                     .iter()
@@ -392,7 +402,7 @@ impl SlamFilter {
                         for (t, (w, eta, inv, log_det)) in hyps.iter().enumerate().take(2) {
                             let r = innovation(&z, eta);
                             let d2: f64 = (0..5).map(|a| (0..5).map(|b| r[a] * inv[a][b] * r[b]).sum::<f64>()).sum();
-                            if d2 <= self.config.association_gate {
+                            if d2 <= gate {
                                 terms[t] = w.ln() - 0.5 * d2 - 0.5 * log_det - norm;
                             }
                         }

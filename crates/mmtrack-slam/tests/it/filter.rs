@@ -142,3 +142,25 @@ fn maps_the_paper_world_and_tracks_the_ue() {
         assert!(nearest < 2.0, "SP {:?} is {nearest} m from the nearest true SP", sp.belief.mean_m);
     }
 }
+
+#[test]
+fn without_a_line_of_sight_the_filter_waits_and_maps_nothing() {
+    let r = SlamScenario { epochs: 3, ..SlamScenario::default() }.realise(4, 0).unwrap();
+    let mut filter = SlamFilter::new(SlamConfig { particles: 300, ..SlamConfig::default() }, r.truth[0].ue, 2).unwrap();
+    // Epoch 1 without its LOS path: nothing to initialise from, every path waits.
+    let mut first = r.epochs[0].clone();
+    let los = r.truth[0].origins.iter().position(|o| *o == PathOrigin::LineOfSight).unwrap();
+    first.paths.remove(los);
+    let report = filter.step(&first).unwrap();
+    assert!(!report.initialised);
+    assert!(report.associations.iter().all(|a| a.decision == mmtrack_slam::Decision::Waiting), "{report:?}");
+    assert_eq!(filter.sources().len(), 1, "only the BS");
+    // Epoch 2 with it: initialised from the LOS, the other paths become new sources.
+    let report = filter.step(&r.epochs[1]).unwrap();
+    assert!(report.initialised);
+    let inits = report.associations.iter().filter(|a| a.decision == mmtrack_slam::Decision::Initialisation).count();
+    assert_eq!(inits, 1);
+    assert_eq!(filter.sources().len(), r.epochs[1].paths.len());
+    let e = report.estimate.state;
+    assert!(norm3(sub3(e.position_m, r.truth[1].ue.position_m)) < 5.0, "{e:?}");
+}
