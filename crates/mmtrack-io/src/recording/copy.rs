@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 use mmtrack_core::StampedPose;
 
 use super::channels::PoseStream;
+use super::metadata::RecordingMetadata;
 use super::tf::ESTIMATE_FRAME;
-use super::writer::{RecordingMetadata, RecordingOptions, RecordingWriter, WriteSummary};
+use super::writer::{RecordingOptions, RecordingWriter, WriteSummary};
 use super::{METADATA_NAME, RawReader};
 use crate::error::{IoError, Result};
 

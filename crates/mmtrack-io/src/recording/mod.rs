@@ -18,6 +18,7 @@
 pub mod cartesian;
 pub mod channels;
 mod copy;
+mod metadata;
 pub mod pulse;
 mod reader;
 pub mod tf;
@@ -26,14 +27,12 @@ mod writer;
 pub use cartesian::{CartesianGrid, CartesianResampler};
 pub use channels::{BEAM_SITE_KEY, CHANNELS, ChannelSpec, PoseStream};
 pub use copy::{EstimateToAdd, copy_with_estimate};
+pub use metadata::{RecordingMetadata, TIME_BASE_MEANING_KEY, TimeBase, YEAR_2000_NS};
 pub use reader::{
     ChannelInfo, ChannelSummary, EncodedScan, RawMessage, RawReader, RecordingEvent, RecordingItem, RecordingReader,
     RecordingSummary, inspect_recording, inspect_recording_with_progress,
 };
-pub use writer::{
-    Compression, RecordingMetadata, RecordingOptions, RecordingWriter, TIME_BASE_MEANING_KEY, TimeBase, WriteSummary,
-    YEAR_2000_NS,
-};
+pub use writer::{Compression, RecordingOptions, RecordingWriter, WriteSummary};
 
 /// Name of the MCAP metadata record that holds [`RecordingMetadata`].
 pub const METADATA_NAME: &str = "mmtrack.recording";
