@@ -118,3 +118,33 @@ impl RecordingMetadata {
         map
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_time_base_round_trips_with_its_meaning() {
+        for time_base in TimeBase::ALL {
+            let metadata = RecordingMetadata {
+                sequence_id: "s".into(),
+                source: "test".into(),
+                time_base,
+                extra: BTreeMap::from([("time.note".to_string(), "n".to_string())]),
+            };
+            let map = metadata.to_map();
+            assert_eq!(map["time_base"], time_base.as_str());
+            assert_eq!(map[TIME_BASE_MEANING_KEY], time_base.meaning());
+            assert_eq!(RecordingMetadata::from_map(&map), Some(metadata));
+        }
+        assert_eq!(TimeBase::parse("gps_week"), None);
+    }
+
+    #[test]
+    fn stamps_before_2000_are_not_unix_time() {
+        assert_eq!(TimeBase::unix_or(928_800_000_000, TimeBase::SimTime), TimeBase::SimTime);
+        assert_eq!(TimeBase::unix_or(YEAR_2000_NS - 1, TimeBase::Relative), TimeBase::Relative);
+        assert_eq!(TimeBase::unix_or(YEAR_2000_NS, TimeBase::Relative), TimeBase::UnixEpoch);
+        assert_eq!(TimeBase::unix_or(1_547_131_046_353_776_000, TimeBase::SimTime), TimeBase::UnixEpoch);
+    }
+}
