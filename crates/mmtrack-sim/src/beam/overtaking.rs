@@ -250,7 +250,7 @@ impl OvertakingScenario {
                     range_m,
                     azimuth_rad: position_m[1].atan2(position_m[0]),
                     doppler_hz: range_rate_mps / lambda,
-                    doppler_noise_hz: self.doppler_sigma_hz * normal(&mut rng),
+                    doppler_noise_hz: self.doppler_sigma_hz * standard_normal(&mut rng),
                 }
             })
             .collect();
@@ -455,7 +455,7 @@ impl OvertakingReceiver {
 }
 
 /// Standard normal by Box-Muller (one value per call).
-fn normal(rng: &mut Pcg64) -> f64 {
+pub(crate) fn standard_normal(rng: &mut Pcg64) -> f64 {
     let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
     let u2: f64 = rng.random();
     (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
