@@ -204,6 +204,48 @@ fn draw_nmse(
     Ok(())
 }
 
+mmtrack_io::define_table! {
+    /// `zoechmann_nlos_error`: per path, position error over time.
+    pub const ZOECHMANN_NLOS_ERROR = "zoechmann_nlos_error",
+        "The proposed geometric tracker on each path of an overtaking between two walls (line of sight and the two \
+single wall bounces, image method), per epoch: RMS error over the Monte Carlo runs of the apparent source's position \
+(the transmitter or its mirror image) and velocity, against the simulator's truth.";
+    /// One row of [`ZOECHMANN_NLOS_ERROR`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ZoechmannNlosErrorRow {
+        path: String, "", "los, left-wall or right-wall";
+        epoch: u64, "", "epoch index (20 ms each)";
+        t_s: f64, "s", "time since the start of the manoeuvre";
+        runs: u64, "", "runs with an estimate at this epoch";
+        position_rmse_m: f64, "m", "RMS distance between estimated and true apparent source";
+        velocity_rmse_mps: f64, "m/s", "RMS norm of the relative-velocity error";
+    }
+}
+
+mmtrack_io::define_table! {
+    /// `zoechmann_path_labels`: per path and epoch, the tracker's state of one run.
+    pub const ZOECHMANN_PATH_LABELS = "zoechmann_path_labels",
+        "Labels for other sensors (Zoechmann et al. 2019, Sec. II and VII): for each path of the first Monte Carlo run, \
+the tracker's estimate of the apparent source (transmitter or wall image) in the receiver's frame (x along its heading, \
+y to the left) and its relative velocity, per epoch, beside the simulator's truth and the reflection point.";
+    /// One row of [`ZOECHMANN_PATH_LABELS`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ZoechmannPathLabelRow {
+        path: String, "", "los, left-wall or right-wall";
+        t_s: f64, "s", "time since the start of the manoeuvre";
+        x_m: f64, "m", "estimated x of the apparent source";
+        y_m: f64, "m", "estimated y of the apparent source";
+        vx_mps: f64, "m/s", "estimated relative velocity, x";
+        vy_mps: f64, "m/s", "estimated relative velocity, y";
+        true_x_m: f64, "m", "true x of the apparent source";
+        true_y_m: f64, "m", "true y of the apparent source";
+        true_vx_mps: f64, "m/s", "true relative velocity, x";
+        true_vy_mps: f64, "m/s", "true relative velocity, y";
+        reflection_x_m: Option<f64>, "m", "x of the reflection point on the wall; null for line of sight";
+        reflection_y_m: Option<f64>, "m", "y of the reflection point; null for line of sight";
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,4 +12,5 @@ mod shaham_report;
 mod spebt_odometry;
 mod spebt_output;
 mod spebt_report;
+mod zoechmann_nlos;
 mod zoechmann_report;

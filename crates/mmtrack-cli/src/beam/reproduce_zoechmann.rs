@@ -41,6 +41,7 @@ use mmtrack_sim::beam::overtaking::{EpochTruth, Manoeuvre, OvertakingReceiver, O
 use rayon::prelude::*;
 use serde::Deserialize;
 
+use super::zoechmann_nlos::{self as nlos, NlosConfig, NlosResult};
 use super::zoechmann_report::{self as report, README_BLOCK};
 use crate::threads::ThreadsArg;
 
@@ -102,6 +103,8 @@ pub(super) struct Experiment {
     #[serde(default)]
     pub scenario: OvertakingScenario,
     pub manoeuvres: Vec<Manoeuvre>,
+    /// The non-line-of-sight run.
+    pub nlos: NlosConfig,
 }
 
 /// The estimators, in table order.
@@ -194,7 +197,9 @@ pub fn run(args: &ZoechmannArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     let load_before = crate::bench_mpc::load_average();
     let started = Instant::now();
-    let (results, threads) = args.threads.install(|| -> anyhow::Result<(Vec<ManoeuvreResult>, usize)> {
+    let nlos_runs = args.runs.unwrap_or(if args.quick { experiment.nlos.quick_runs } else { experiment.nlos.runs });
+    let mut elapsed_s = 0.0;
+    let (results, nlos_result, threads) = args.threads.install(|| -> anyhow::Result<_> {
         let receiver = experiment.scenario.receiver().with_context(|| format!("{source}: [scenario]"))?;
         let chunks = runs.div_ceil(RUNS_PER_CHUNK);
         let bar = crate::progress::bar(runs * experiment.manoeuvres.len() as u64, "reproduce zoechmann", "runs", quiet);
@@ -219,14 +224,17 @@ pub fn run(args: &ZoechmannArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             results.push(total.finish(manoeuvre.clone(), runs));
         }
         bar.finish_and_clear();
-        Ok((results, rayon::current_num_threads()))
+        elapsed_s = started.elapsed().as_secs_f64();
+        let nlos_result = nlos::run(&experiment, &experiment.nlos, &receiver, nlos_runs.max(1))
+            .with_context(|| format!("{source}: [nlos]"))?;
+        Ok((results, nlos_result, rayon::current_num_threads()))
     })??;
-    let elapsed_s = started.elapsed().as_secs_f64();
     let load = (load_before, crate::bench_mpc::load_average());
 
     let verdicts = report::verdicts(&experiment, &results, runs, elapsed_s);
-    let summary = report::summary(&experiment, &results, &verdicts, runs, (elapsed_s, threads, load));
-    write_outputs(args, &experiment, &source, &results, runs, &summary)?;
+    let mut summary = report::summary(&experiment, &results, &verdicts, runs, (elapsed_s, threads, load));
+    summary.push_str(&nlos::summary(&nlos_result, &experiment.nlos, experiment.scenario.epoch_s));
+    write_outputs(args, &experiment, &source, (&results, &nlos_result), runs, &summary)?;
     if let Some(readme) = &args.readme {
         crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;
     }
@@ -243,7 +251,7 @@ pub(super) fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
     (n > 0).then(|| sorted[((q * n as f64).ceil() as usize).clamp(1, n) - 1])
 }
 
-fn tracker_config(experiment: &Experiment) -> GeometricTrackerConfig {
+pub(super) fn tracker_config(experiment: &Experiment) -> GeometricTrackerConfig {
     GeometricTrackerConfig {
         wavelength_m: experiment.scenario.wavelength_m(),
         gamma: experiment.gamma,
@@ -491,7 +499,7 @@ fn write_outputs(
     args: &ZoechmannArgs,
     experiment: &Experiment,
     source: &str,
-    results: &[ManoeuvreResult],
+    (results, nlos_result): (&[ManoeuvreResult], &NlosResult),
     runs: u64,
     summary: &str,
 ) -> anyhow::Result<()> {
@@ -555,6 +563,8 @@ fn write_outputs(
     }
     write_table(&tables, "zoechmann", &nmse_rows, &info, Overwrite::Refuse)?;
     write_table(&tables, "zoechmann", &summary_rows, &info, Overwrite::Refuse)?;
+    write_table(&tables, "zoechmann", &nlos::error_rows(nlos_result, epoch_s), &info, Overwrite::Refuse)?;
+    write_table(&tables, "zoechmann", &nlos_result.labels, &info, Overwrite::Refuse)?;
     for r in results {
         let curves: Vec<NmseCurve> = ESTIMATORS
             .iter()
