@@ -115,8 +115,8 @@ def check_tables(root):
     check(rows == [("seq-a", 1, 12.5), ("seq-b", 1, 12.5)], f"duckdb group by {rows}")
     taps = con.execute("SELECT len(taps_re), taps_im[2] FROM read_parquet(?)", [str(tables / "cir_snapshots" / "*" / "*.parquet")]).fetchall()
     check(taps == [(16, -1.0)], f"duckdb list columns {taps}")
-    poses = con.execute("SELECT count(*) FROM read_parquet(?)", [str(root / "demo" / "tables" / "poses" / "*" / "*.parquet")]).fetchone()
-    check(poses == (8,), f"demo poses {poses}")
+    poses = con.execute("SELECT count(*) FROM read_parquet(?)", [str(root / "demo" / "tables" / "ground_truth" / "*" / "*.parquet")]).fetchone()
+    check(poses == (8,), f"demo ground truth {poses}")
     print("parquet (pyarrow, duckdb): ok")
 
 
