@@ -233,14 +233,29 @@ pub fn ingest_mulran(
     };
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;
     let total = folder.scans.len() as u64;
-    let decode = |scan: &ScanFile| {
+    // The Cartesian view is resampled on the decoding threads too.
+    let resampler = writer.cartesian_resampler().cloned();
+    let decode = |scan: &ScanFile| -> Result<(PolarScan, Option<Vec<u8>>), IngestError> {
         let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
-        decode_mulran_png(&scan.path, &bytes, scan.t_ns, options)
+        let polar = decode_mulran_png(&scan.path, &bytes, scan.t_ns, options)?;
+        let view =
+            match &resampler {
+                Some(r) => Some(r.resample(&polar.header, &polar.power, polar.header.bins_per_azimuth, 0).map_err(
+                    |detail| IngestError::BadRecord {
+                        path: scan.path.clone(),
+                        record: "scan image".into(),
+                        field: "cartesian view".into(),
+                        detail,
+                    },
+                )?),
+                None => None,
+            };
+        Ok((polar, view))
     };
     let mut same_size = SameSize::default();
-    decode_in_order(&folder.scans, &decode, &mut |index, scan: PolarScan| {
+    decode_in_order(&folder.scans, &decode, &mut |index, (scan, view): (PolarScan, Option<Vec<u8>>)| {
         same_size.check(&folder.scans[index].path, scan.header.azimuths.len(), scan.header.bins_per_azimuth)?;
-        writer.write_radar_scan(&scan)?;
+        writer.write_radar_scan_and_view(&scan, view.as_deref())?;
         progress(index as u64 + 1, total);
         Ok(())
     })?;
