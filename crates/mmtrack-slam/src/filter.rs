@@ -253,13 +253,14 @@ impl SlamFilter {
                             log_score: *score,
                         });
                     }
-                    return Ok(self.report(k, epoch.t_ns, skipped_paths, associations, 0, 0, Vec::new()));
+                    return Ok(self.report(k, epoch.t_ns, skipped_paths, associations, 0, 0, Vec::new(), &prior));
                 }
             }
         }
 
         // UE update with the paths of the BS and of confirmed sources.
-        let ue_now = self.particles.moments();
+        // The particles changed since `prior` only if the LOS initialised them.
+        let ue_now = if init_path.is_some() { self.particles.moments() } else { prior.clone() };
         let ue_mean = ue_of(&ue_now.mean, self.particles.z_m);
         let mut prepared = Vec::new();
         for (l, (column, _)) in assignment.iter().enumerate() {
@@ -303,7 +304,7 @@ impl SlamFilter {
             associations.push(PathAssociation { path: path_index[l], decision, log_score: *score });
         }
         self.maintain(k);
-        Ok(self.report(k, epoch.t_ns, skipped_paths, associations, prepared.len(), stages, confirmed))
+        Ok(self.report(k, epoch.t_ns, skipped_paths, associations, prepared.len(), stages, confirmed, &post))
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -316,8 +317,8 @@ impl SlamFilter {
         paths_in_update: usize,
         stages: usize,
         confirmed: Vec<u64>,
+        m: &Moments,
     ) -> EpochReport {
-        let m = self.particles.moments();
         let estimate = UeEstimate {
             state: ue_of(&m.mean, self.particles.z_m),
             position_std_m: (m.cov[(0, 0)] + m.cov[(1, 1)]).max(0.0).sqrt(),

@@ -232,7 +232,7 @@ impl FastPath {
             }
             SourceType::ScatteringPoint => {
                 let q = sub3(source_m, bs_m);
-                let rho = q[0].hypot(q[1]);
+                let rho = (q[0] * q[0] + q[1] * q[1]).sqrt();
                 let r = norm3(q);
                 if rho > 0.0 && r > 0.0 {
                     sp = (r, [az_diff(q[0], q[1], rho, sc[2]), el_diff(q[2], rho, r, sc[3])]);
@@ -250,7 +250,7 @@ impl FastPath {
     pub(crate) fn residual(&self, x: [f64; 3], heading_sc: (f64, f64), bias_m: f64) -> Option<[f64; 5]> {
         let src = if self.kind == SourceType::BaseStation { self.bs_m } else { self.source_m };
         let d = sub3(src, x);
-        let rho = d[0].hypot(d[1]);
+        let rho = (d[0] * d[0] + d[1] * d[1]).sqrt();
         let r = (rho * rho + d[2] * d[2]).sqrt();
         if rho <= 0.0 || r <= 0.0 {
             return None;
@@ -279,7 +279,7 @@ impl FastPath {
                     self.source_m[1] - s * d[1] - self.bs_m[1],
                     self.source_m[2] - s * d[2] - self.bs_m[2],
                 ];
-                let rho_q = q[0].hypot(q[1]);
+                let rho_q = (q[0] * q[0] + q[1] * q[1]).sqrt();
                 let r_q = (rho_q * rho_q + q[2] * q[2]).sqrt();
                 if rho_q <= 0.0 || r_q <= 0.0 {
                     return None;

@@ -87,9 +87,18 @@ pub(crate) fn stream(seed: u64, words: &[u64]) -> Pcg64 {
 /// Standard normal by Box-Muller.
 #[inline]
 pub(crate) fn normal(rng: &mut Pcg64) -> f64 {
+    normal_pair(rng).0
+}
+
+/// Two independent standard normals by Box-Muller (both of its outputs: one
+/// logarithm, square root and `sin_cos` for two values).
+#[inline]
+pub(crate) fn normal_pair(rng: &mut Pcg64) -> (f64, f64) {
     let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
     let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    let r = (-2.0 * u1.ln()).sqrt();
+    let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
+    (r * c, r * s)
 }
 
 /// Weighted moments of the particles.
@@ -134,8 +143,9 @@ impl Particles {
                 chunk.x[i] += dx;
                 chunk.y[i] += dy;
                 chunk.heading[i] = wrap_angle_rad(chunk.heading[i] + chunk.turn[i] * dt_s);
-                chunk.speed[i] += noise[0] * normal(&mut rng);
-                chunk.turn[i] += noise[1] * normal(&mut rng);
+                let (a, b) = normal_pair(&mut rng);
+                chunk.speed[i] += noise[0] * a;
+                chunk.turn[i] += noise[1] * b;
                 chunk.bias[i] += noise[2] * normal(&mut rng);
             }
         });
@@ -290,7 +300,9 @@ impl Particles {
             for i in 0..chunk.len() {
                 let mut s = picked[c * chunk_size + i];
                 if let Some(l) = jitter_chol {
-                    let n: [f64; STATE_DIM] = std::array::from_fn(|_| normal(&mut rng));
+                    let pairs = [normal_pair(&mut rng), normal_pair(&mut rng), normal_pair(&mut rng)];
+                    let n: [f64; STATE_DIM] =
+                        std::array::from_fn(|k| if k % 2 == 0 { pairs[k / 2].0 } else { pairs[k / 2].1 });
                     for a in 0..STATE_DIM {
                         let mut v = 0.0;
                         for b in 0..=a {

@@ -19,8 +19,8 @@ fn quick_kim_meets_its_tolerances_and_writes_tables_figures_and_its_readme_block
     println!("{report}");
     // 7 claims on the paper row; --quick allows twice the paper's errors
     // (data/reproduce/kim.toml: 500 particles, 2 runs). Measured when this
-    // test was written: UE 0.38 m / 0.0029 rad / 0.24 m, VA 0.59 m, SP
-    // 0.51 m, all VAs by epoch 12.0 and all SPs by 76.5 on average, against
+    // test was written: UE 0.48 m / 0.0025 rad / 0.27 m, VA 0.58 m, SP
+    // 0.65 m, all VAs by epoch 12.0 and all SPs by 76.5 on average, against
     // bounds of 1.0 m / 0.04 rad / 0.6 m, 1.6 m, 1.2 m, 52 and 182.
     assert_eq!(report.matches("| met |").count(), 7, "{report}\n{stderr}");
     assert!(out.status.success(), "{stderr}");
