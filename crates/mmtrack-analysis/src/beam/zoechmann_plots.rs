@@ -246,6 +246,33 @@ y to the left) and its relative velocity, per epoch, beside the simulator's trut
     }
 }
 
+mmtrack_io::define_table! {
+    /// `geometric_per_epoch`: `process beam --tracker geometric`, one row per epoch.
+    pub const GEOMETRIC_PER_EPOCH = "geometric_per_epoch",
+        "The geometric Doppler-bearing tracker (Zoechmann et al. 2019) on a recording's two vehicles (channel-sounder \
+ground truth of transmitter and receiver): the receiver's 60 GHz UCA codebook and Doppler are simulated along the true \
+poses every epoch; per epoch the tracker's estimate and the truth in the receiver's frame (x forward, y left), the \
+filter in use and the beams measured.";
+    /// One row of [`GEOMETRIC_PER_EPOCH`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct GeometricEpochRow {
+        epoch: u64, "", "epoch index";
+        t_ns: i64, "ns", "time of the epoch (recording clock)";
+        filter: String, "", "h-infinity (not converged) or rls";
+        beams_measured: u64, "", "beams measured at this epoch (full scan or window)";
+        measured_azimuth_rad: f64, "rad", "azimuth of the strongest measured beam";
+        measured_doppler_hz: f64, "Hz", "simulated Doppler shift (range rate / wavelength plus noise)";
+        range_m: f64, "m", "estimated range";
+        true_range_m: f64, "m", "true range";
+        azimuth_rad: f64, "rad", "estimated azimuth (projection (11))";
+        true_azimuth_rad: f64, "rad", "true azimuth";
+        vx_mps: f64, "m/s", "estimated relative velocity, x";
+        vy_mps: f64, "m/s", "estimated relative velocity, y";
+        true_vx_mps: f64, "m/s", "true relative velocity in the receiver's frame, x (central difference)";
+        true_vy_mps: f64, "m/s", "true relative velocity, y";
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,6 +4,7 @@
 //! Doppler-bearing tracking of Zoechmann et al. 2019).
 
 pub mod process;
+mod process_geometric;
 mod process_spebt;
 pub mod reproduce_shaham;
 pub mod reproduce_spebt;

@@ -57,6 +57,9 @@ pub enum TrackerArg {
     /// SPEBT (Liu et al. 2024) on a simulated link along the recording's ground truth, driven by
     /// --odometry or by the pose-error model; runs alone (spebt_per_slot, spebt_summary tables).
     Spebt,
+    /// Geometric Doppler-bearing tracking (Zoechmann et al. 2019) between a recording's two vehicles
+    /// (sounder ground truth), UCA scans and Doppler simulated along it; runs alone (geometric_per_epoch).
+    Geometric,
 }
 
 impl TrackerArg {
@@ -69,6 +72,7 @@ impl TrackerArg {
             Self::LastFullSweep => "last-full-sweep",
             Self::GnssMap => "gnss-map",
             Self::Spebt => "spebt",
+            Self::Geometric => "geometric",
         }
     }
 
@@ -106,6 +110,8 @@ pub struct BeamArgs {
     force: bool,
     #[command(flatten)]
     spebt: super::process_spebt::SpebtOptions,
+    #[command(flatten)]
+    geometric: super::process_geometric::GeometricOptions,
 }
 
 /// One recording, read: its full sweeps and both units' positions.
@@ -305,6 +311,7 @@ fn tracker(kind: TrackerArg, reacquire: ReacquireArg, map: Option<&BeamMap>) -> 
         TrackerArg::LastFullSweep => Box::new(LastFullSweep::new()),
         TrackerArg::GnssMap => Box::new(GnssMapOnly),
         TrackerArg::Spebt => bail!("spebt is not a beam-sweep tracker (it runs alone, process_spebt)"),
+        TrackerArg::Geometric => bail!("geometric is not a beam-sweep tracker (it runs alone, process_geometric)"),
     })
 }
 
@@ -355,6 +362,17 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     kinds.sort();
     kinds.dedup();
     let files = expand(&args.recordings)?;
+    if kinds.contains(&TrackerArg::Geometric) {
+        if kinds.len() > 1 {
+            bail!(
+                "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
+            );
+        }
+        return super::process_geometric::run(&files, &args.output, args.force, &args.geometric, quiet);
+    }
+    if let Some(flag) = args.geometric.given().first() {
+        bail!("{flag} is an option of --tracker geometric only");
+    }
     if kinds.contains(&TrackerArg::Spebt) {
         if kinds.len() > 1 {
             bail!(
