@@ -53,6 +53,17 @@
 //!   and the process noise carries them to `(v_k, omega_k)` (step 4).
 //! - `P_D = 1` makes eq. (3)'s `P_D / (1 - P_D)` infinite; the filter uses
 //!   `detection_probability` (0.99 by default).
+//! - A confirmed source's covariance is kept at least as large as the error
+//!   the UE's current uncertainty induces in it
+//!   ([`SlamConfig::ue_error_floor`]): message passing treats the slowly
+//!   varying UE error as independent from epoch to epoch, and without the
+//!   floor the map grew overconfident and held the UE to its early errors.
+//!   A confirmed source's EKF takes the predicted UE belief as its message,
+//!   so a path is not counted twice within an epoch.
+//! - The UE initialises from the shortest path of an epoch only (a
+//!   reflected or scattered path is longer than the line of sight), within
+//!   a tighter gate ([`SlamConfig::initialisation_gate`]); until then the
+//!   filter only predicts and maps nothing.
 //!
 //! Particles live in structure-of-arrays chunks of 256 processed in parallel
 //! on rayon; every random draw comes from a stream seeded by `(seed, epoch,
