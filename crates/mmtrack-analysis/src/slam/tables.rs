@@ -17,6 +17,9 @@ SP seen along the drive was confirmed.";
         detection_probability: f64, "", "probability that a path is detected";
         clutter_per_epoch: u64, "", "clutter paths per epoch";
         ue_position_error_m: f64, "m", "mean UE position error";
+        ue_error_over_spread: f64, "",
+            "RMS UE position error over the RMS of the filter's position spread (root of the horizontal covariance \
+trace), all epochs of all runs: 1 for a consistent filter, above 1 for an overconfident one";
         ue_heading_error_rad: f64, "rad", "mean absolute UE heading error";
         ue_clock_bias_error_m: f64, "m", "mean absolute clock-bias error";
         ue_speed_error_mps: f64, "m/s", "mean absolute speed error (1-step smoothed)";

@@ -11,6 +11,8 @@ use mmtrack_slam::{SlamConfig, SlamFilter, SourceStatus};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EpochErrors {
     pub position_m: f64,
+    /// The filter's horizontal position spread (root of the covariance trace).
+    pub position_std_m: f64,
     pub heading_rad: f64,
     pub clock_bias_m: f64,
     pub speed_mps: f64,
@@ -107,6 +109,7 @@ pub fn run_filter(
         }
         outcome.epochs.push(EpochErrors {
             position_m: norm3(sub3(e.position_m, truth.ue.position_m)),
+            position_std_m: report.estimate.position_std_m,
             heading_rad: wrap_angle_rad(e.heading_rad - truth.ue.heading_rad).abs(),
             clock_bias_m: (e.clock_bias_m - truth.ue.clock_bias_m).abs(),
             speed_mps: (e.speed_mps - truth.ue.speed_mps).abs(),

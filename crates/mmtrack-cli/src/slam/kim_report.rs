@@ -124,23 +124,24 @@ pub fn summary(
         experiment.match_radius_m,
     );
     out.push_str(
-        "| row | P_D | clutter/epoch | UE position (m) | heading (rad) | clock bias (m) | speed (m/s) | turn rate (rad/s) \
+        "| row | P_D | clutter/epoch | UE position (m) | error / spread | heading (rad) | clock bias (m) | speed (m/s) | turn rate (rad/s) \
          | VA (m) | SP (m) | all VAs by epoch (mean / worst) | all SPs by epoch (mean / worst) | false sources/run |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let t = &experiment.targets;
     out.push_str(&format!(
-        "| Kim et al. (one run) | 1 | 0 | {} | {} | {} | < 1.5 | < 0.6 | {} | {} | {} | {} | 0 |\n",
+        "| Kim et al. (one run) | 1 | 0 | {} | - | {} | {} | < 1.5 | < 0.6 | {} | {} | {} | {} | 0 |\n",
         t.ue_position_m, t.ue_heading_rad, t.ue_clock_bias_m, t.va_m, t.sp_m, t.all_va_epoch, t.all_sp_epoch
     ));
     for r in results {
         let s = &r.summary;
         out.push_str(&format!(
-            "| {} | {} | {} | {:.3} | {:.4} | {:.3} | {:.3} | {:.4} | {} | {} | {:.1} / {} | {:.1} / {} | {:.2} |\n",
+            "| {} | {} | {} | {:.3} | {:.1} | {:.4} | {:.3} | {:.3} | {:.4} | {} | {} | {:.1} / {} | {:.1} / {} | {:.2} |\n",
             s.row,
             s.detection_probability,
             s.clutter_per_epoch,
             s.ue_position_error_m,
+            s.ue_error_over_spread,
             s.ue_heading_error_rad,
             s.ue_clock_bias_error_m,
             s.ue_speed_error_mps,

@@ -236,6 +236,12 @@ fn aggregate(
         detection_probability: row.detection_probability,
         clutter_per_epoch: row.clutter_per_epoch as u64,
         ue_position_error_m: mean_of(0).unwrap_or(f64::NAN),
+        ue_error_over_spread: {
+            let all = || outcomes.iter().flat_map(|o| o.epochs.iter());
+            let e2: f64 = all().map(|e| e.position_m * e.position_m).sum();
+            let s2: f64 = all().map(|e| e.position_std_m * e.position_std_m).sum();
+            (e2 / s2).sqrt()
+        },
         ue_heading_error_rad: mean_of(1).unwrap_or(f64::NAN),
         ue_clock_bias_error_m: mean_of(2).unwrap_or(f64::NAN),
         ue_speed_error_mps: mean_of(3).unwrap_or(f64::NAN),
