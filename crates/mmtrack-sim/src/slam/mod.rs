@@ -454,6 +454,42 @@ mod tests {
     }
 
     #[test]
+    fn a_straight_road_with_more_walls() {
+        // Straight along +x at 15 m/s, a fifth wall at y = 30 m, SPs beside the road.
+        let mut walls = SlamScenario::default().walls;
+        walls.push(Wall { point_m: [0.0, 30.0, 0.0], normal: [0.0, 1.0, 0.0] });
+        let scenario = SlamScenario {
+            walls,
+            initial: InitialState {
+                position_m: [-50.0, -10.0, 0.0],
+                heading_rad: 0.0,
+                speed_mps: 15.0,
+                turn_rate_radps: 0.0,
+                clock_bias_m: 0.0,
+            },
+            turn_rate_std_radps: 0.0,
+            epochs: 30,
+            ..SlamScenario::default()
+        };
+        let run = scenario.realise(1, 0).unwrap();
+        assert_eq!(run.world.virtual_anchors_m.len(), 5);
+        // The wall y = 30 mirrors the BS (0, 0, 40) to (0, 60, 40).
+        assert!(norm3(sub3(run.world.virtual_anchors_m[4], [0.0, 60.0, 40.0])) < 1e-9);
+        for sp in &run.world.scattering_points_m {
+            let off = (sp[1] + 10.0).abs();
+            assert!((5.0..=25.0).contains(&off) && (-50.0..=40.0).contains(&sp[0]), "{sp:?}");
+        }
+        // The heading stays 0 and y stays -10 (no turn-rate noise).
+        let last = run.truth.last().unwrap().ue;
+        assert!(last.heading_rad.abs() < 1e-12 && (last.position_m[1] + 10.0).abs() < 1e-9, "{last:?}");
+        // Every epoch sees the LOS and the five reflections (all walls face the road).
+        for truth in &run.truth {
+            let reflections = truth.origins.iter().filter(|o| matches!(o, PathOrigin::VirtualAnchor(_))).count();
+            assert_eq!(reflections, 5);
+        }
+    }
+
+    #[test]
     fn bad_parameters_are_named() {
         let s = SlamScenario { detection_probability: 1.5, ..SlamScenario::default() };
         assert!(s.validate().unwrap_err().to_string().contains("detection_probability"));
