@@ -9,6 +9,8 @@
 //! We build the descriptor in code rather than with `protoc` so that a fresh
 //! machine needs nothing beyond the Rust toolchain.
 
+mod slam;
+
 use prost::Message;
 use prost_types::field_descriptor_proto::{Label, Type};
 use prost_types::{DescriptorProto, FieldDescriptorProto, FieldOptions, FileDescriptorProto, FileDescriptorSet};
@@ -543,6 +545,19 @@ impl SpecMessage for BeamSweep {
     const SPEC: &'static MessageSpec = &BEAM_SWEEP_SPEC;
 }
 
+pub use slam::{
+    PATH_MEASUREMENTS_SPEC, PathMeasurements, SLAM_SOURCE_SPEC, SLAM_UE_TRUTH_SPEC, SlamSource, SlamUeTruth,
+};
+
 /// All mmtrack message schemas, for documentation and tests.
-pub const ALL_SPECS: &[&MessageSpec] =
-    &[&POSE2D_SPEC, &GNSS_FIX_SPEC, &RADAR_SCAN_META_SPEC, &CIR_SNAPSHOT_SPEC, &MPC_TRUTH_SPEC, &BEAM_SWEEP_SPEC];
+pub const ALL_SPECS: &[&MessageSpec] = &[
+    &POSE2D_SPEC,
+    &GNSS_FIX_SPEC,
+    &RADAR_SCAN_META_SPEC,
+    &CIR_SNAPSHOT_SPEC,
+    &MPC_TRUTH_SPEC,
+    &BEAM_SWEEP_SPEC,
+    &PATH_MEASUREMENTS_SPEC,
+    &SLAM_UE_TRUTH_SPEC,
+    &SLAM_SOURCE_SPEC,
+];

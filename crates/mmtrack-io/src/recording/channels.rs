@@ -34,6 +34,12 @@ pub const BEAM_SWEEP_TOPIC: &str = "/beam/sweeps";
 pub const GNSS_ARRAY_TOPIC: &str = "/gnss/array";
 /// Display view of the array's GNSS fixes.
 pub const GNSS_ARRAY_VIZ_TOPIC: &str = "/viz/gnss_array";
+/// Topic of the path measurements of 5G mmWave SLAM epochs.
+pub const SLAM_PATHS_TOPIC: &str = "/slam/paths";
+/// Topic of the simulator's UE state and path origins per SLAM epoch.
+pub const SLAM_UE_TRUTH_TOPIC: &str = "/slam/ue_truth";
+/// Topic of the sources of the SLAM paths (base station, true VAs and SPs).
+pub const SLAM_SOURCES_TOPIC: &str = "/slam/sources";
 /// Recording metadata key naming the site of a beam-sweep recording: one
 /// array at one place (e.g. `deepsense-scenario1`). Recordings of one site
 /// share the array's boresight and codebook, so a beam map fitted on some of
@@ -168,6 +174,27 @@ pub const CHANNELS: &[ChannelSpec] = &[
         schema_names: &["mmtrack.GnssFix"],
         canonical: true,
         meaning: "GNSS position fix of the beam-sweeping array (e.g. a roadside unit); the vehicle's fixes are on /gnss/fix",
+    },
+    ChannelSpec {
+        topic: SLAM_PATHS_TOPIC,
+        schema_names: &["mmtrack.PathMeasurements"],
+        canonical: true,
+        meaning: "the propagation paths (TOA, DOA and DOD azimuth and elevation) a 5G mmWave UE estimated in one \
+                  epoch; the UE's true pose per epoch is on /ground_truth/pose when the recording has ground truth",
+    },
+    ChannelSpec {
+        topic: SLAM_UE_TRUTH_TOPIC,
+        schema_names: &["mmtrack.SlamUeTruth"],
+        canonical: true,
+        meaning: "simulator ground truth of one SLAM epoch (same t_ns as its /slam/paths): the full UE state \
+                  (position, heading, speed, turn rate, clock bias) and the source of each path",
+    },
+    ChannelSpec {
+        topic: SLAM_SOURCES_TOPIC,
+        schema_names: &["mmtrack.SlamSource"],
+        canonical: true,
+        meaning: "one source of the SLAM paths, written once: the base station (known to the UE) and, as ground \
+                  truth, each virtual anchor and scattering point",
     },
     ChannelSpec {
         topic: RADAR_CARTESIAN_TOPIC,

@@ -25,7 +25,9 @@ pub mod tf;
 mod writer;
 
 pub use cartesian::{CartesianGrid, CartesianResampler};
-pub use channels::{BEAM_SITE_KEY, CHANNELS, ChannelSpec, PoseStream};
+pub use channels::{
+    BEAM_SITE_KEY, CHANNELS, ChannelSpec, PoseStream, SLAM_PATHS_TOPIC, SLAM_SOURCES_TOPIC, SLAM_UE_TRUTH_TOPIC,
+};
 pub use copy::{EstimateToAdd, copy_with_estimate};
 pub use metadata::{RecordingMetadata, TIME_BASE_MEANING_KEY, TimeBase, YEAR_2000_NS};
 pub use reader::{

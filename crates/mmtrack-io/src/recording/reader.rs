@@ -7,6 +7,7 @@ use std::sync::Arc;
 use foxglove::schemas::{CompressedImage, RawImage};
 use mcap::records::Record;
 use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
+use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 use mmtrack_core::{
     AzimuthSample, BeamSweep, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTruth, PolarScan, PolarScanHeader,
     Se2, StampedPose,
@@ -20,6 +21,8 @@ use super::channels::{
 };
 use crate::error::{IoError, Result, os_err};
 use crate::proto;
+
+mod slam;
 
 /// A channel of an MCAP file.
 #[derive(Debug)]
@@ -189,6 +192,28 @@ pub enum RecordingEvent {
     Cir(CirSnapshot),
     /// A true multipath component of a simulated CIR snapshot.
     MpcTruth(MpcTruth),
+    /// The path measurements of a 5G mmWave SLAM epoch (`/slam/paths`).
+    SlamPaths(SlamEpoch),
+    /// The simulator's truth of a SLAM epoch (`/slam/ue_truth`).
+    SlamUeTruth {
+        /// Epoch time, nanoseconds.
+        t_ns: i64,
+        /// The true UE state.
+        ue: UeState,
+        /// The source of each path of the epoch's measurements, same order.
+        origins: Vec<PathOrigin>,
+    },
+    /// A source of the SLAM paths (`/slam/sources`).
+    SlamSource {
+        /// Time from which it is valid, nanoseconds.
+        t_ns: i64,
+        /// Base station, virtual anchor or scattering point.
+        kind: SourceType,
+        /// Index among the sources of its kind.
+        index: usize,
+        /// Position, metres.
+        position_m: [f64; 3],
+    },
 }
 
 /// Reads a canonical recording as a stream of [`RecordingEvent`]s, holding at
@@ -292,6 +317,8 @@ impl RecordingReader {
                     taps,
                     first_path_hint_s: c.first_path_hint_s,
                 }))));
+            } else if let Some(event) = self.decode_slam(&m)? {
+                return Ok(Some(RecordingItem::Event(event)));
             } else if topic == MPC_TRUTH_TOPIC {
                 let t: proto::MpcTruth = self.decode(&m)?;
                 return Ok(Some(RecordingItem::Event(RecordingEvent::MpcTruth(MpcTruth {

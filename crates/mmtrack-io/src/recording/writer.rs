@@ -23,6 +23,8 @@ use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
 
+mod slam;
+
 /// Chunk compression of a recording.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Compression {

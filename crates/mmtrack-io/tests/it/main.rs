@@ -6,5 +6,6 @@ mod bad_input;
 mod roundtrip;
 mod roundtrip_beam;
 mod roundtrip_mpc;
+mod roundtrip_slam;
 mod samples;
 mod schemas;

@@ -139,5 +139,26 @@ fn descriptors_match_prost_encoding() {
         measured: vec![true, false],
         codebook: Some("c".into()),
     });
-    assert_eq!(ALL_SPECS.len(), 6, "a new message needs a sample above");
+    check(&proto::PathMeasurements {
+        t_ns: 1,
+        toa_m: vec![1.0],
+        doa_az_rad: vec![0.1],
+        doa_el_rad: vec![0.2],
+        dod_az_rad: vec![0.3],
+        dod_el_rad: vec![0.4],
+    });
+    check(&proto::SlamUeTruth {
+        t_ns: 1,
+        x_m: 1.0,
+        y_m: 2.0,
+        z_m: 3.0,
+        heading_rad: 0.1,
+        speed_mps: 2.0,
+        turn_rate_radps: 0.3,
+        clock_bias_m: 300.0,
+        path_source: vec!["bs".into()],
+        path_source_index: vec![0],
+    });
+    check(&proto::SlamSource { t_ns: 1, kind: "va".into(), index: 1, x_m: 1.0, y_m: 2.0, z_m: 3.0 });
+    assert_eq!(ALL_SPECS.len(), 9, "a new message needs a sample above");
 }
