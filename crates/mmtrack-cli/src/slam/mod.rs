@@ -5,3 +5,4 @@ pub mod bench;
 pub mod evaluate;
 mod kim_report;
 pub mod reproduce_kim;
+pub mod simulate;
