@@ -23,6 +23,13 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::beam::spebt_tables::SPEBT_SUMMARY,
     &crate::beam::spebt_tables::SPEBT_PER_SLOT,
     &crate::beam::spebt_tables::SPEBT_POOLED,
+    &crate::beam::zoechmann_plots::ZOECHMANN_NMSE,
+    &crate::beam::zoechmann_plots::ZOECHMANN_SUMMARY,
+    &crate::beam::zoechmann_plots::ZOECHMANN_NLOS_ERROR,
+    &crate::beam::zoechmann_plots::ZOECHMANN_PATH_LABELS,
+    &crate::beam::zoechmann_plots::GEOMETRIC_PER_EPOCH,
+    &crate::slam::tables::SLAM_SUMMARY,
+    &crate::slam::tables::SLAM_PER_EPOCH,
 ];
 
 mmtrack_io::define_table! {

@@ -23,6 +23,7 @@ mod progress;
 mod readme_block;
 mod reproduce;
 mod reproduce_all;
+mod reproduce_common;
 mod reproduce_mpc;
 mod reproduce_mpc_report;
 mod simulate;

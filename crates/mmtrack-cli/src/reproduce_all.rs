@@ -79,7 +79,7 @@ struct Spec {
     expected_path: &'static str,
 }
 
-const EXPERIMENTS: [Spec; 4] = [
+const EXPERIMENTS: [Spec; 6] = [
     Spec {
         name: "odometry",
         readme: false,
@@ -103,6 +103,18 @@ const EXPERIMENTS: [Spec; 4] = [
         readme: true,
         expected: include_str!("../../../data/reproduce/spebt.expected.toml"),
         expected_path: "data/reproduce/spebt.expected.toml",
+    },
+    Spec {
+        name: "zoechmann",
+        readme: true,
+        expected: include_str!("../../../data/reproduce/zoechmann.expected.toml"),
+        expected_path: "data/reproduce/zoechmann.expected.toml",
+    },
+    Spec {
+        name: "kim",
+        readme: true,
+        expected: include_str!("../../../data/reproduce/kim.expected.toml"),
+        expected_path: "data/reproduce/kim.expected.toml",
     },
 ];
 
@@ -276,7 +288,7 @@ pub fn stale_readme_rows(readme: &str) -> Vec<String> {
 /// Options of `reproduce --all`.
 #[derive(Args, Debug, Clone)]
 pub struct AllArgs {
-    /// Run every experiment (odometry, mpc-artificial, shaham, spebt) and check each metric against
+    /// Run every experiment (odometry, mpc-artificial, shaham, spebt, zoechmann, kim) and check each metric against
     /// data/reproduce/<experiment>.expected.toml; exit 1 on a miss.
     #[arg(long)]
     pub all: bool,

@@ -244,27 +244,17 @@ pub(super) enum PoseSource<'a> {
 }
 
 pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    if args.output.exists() && !args.force {
-        bail!("{}: exists; use --force to replace it (nothing was done)", args.output.display());
-    }
-    if let Some(readme) = &args.readme {
-        crate::readme_block::check_block(readme, README_BLOCK)?;
-    }
-    let (source, text) = match &args.experiment {
-        Some(path) => {
-            (path.display().to_string(), std::fs::read_to_string(path).with_context(|| path.display().to_string())?)
-        }
-        None => ("embedded data/reproduce/spebt.toml".to_string(), SPEBT_EXPERIMENT.to_string()),
-    };
-    let experiment: Experiment = toml::from_str(&text).with_context(|| source.clone())?;
-    let runs = |full: u64, quick: u64| match (args.runs, args.quick) {
-        (Some(n), _) => n,
-        (None, true) => quick,
-        (None, false) => full,
-    };
-    let (runs_a, runs_b) =
-        (runs(experiment.runs, experiment.quick_runs), runs(experiment.odometry.runs, experiment.odometry.quick_runs));
-    anyhow::ensure!(runs_a >= 1 && runs_b >= 1, "--runs must be at least 1 (nothing was done)");
+    crate::reproduce_common::check_start(&args.output, args.force, args.readme.as_deref(), README_BLOCK)?;
+    let (source, experiment): (String, Experiment) = crate::reproduce_common::load_experiment(
+        args.experiment.as_deref(),
+        SPEBT_EXPERIMENT,
+        "data/reproduce/spebt.toml",
+    )?;
+    let runs = |full: u64, quick: u64| crate::reproduce_common::run_count(args.runs, args.quick, quick, full);
+    let (runs_a, runs_b) = (
+        runs(experiment.runs, experiment.quick_runs)?,
+        runs(experiment.odometry.runs, experiment.odometry.quick_runs)?,
+    );
     anyhow::ensure!(experiment.slots >= 2, "{source}: slots = {} (need at least 2)", experiment.slots);
     let poses = load_poses(args, &experiment)?;
     let link = SpebtLink::new(&experiment.scenario, &poses)
@@ -466,12 +456,7 @@ fn write_outputs(
     outcomes: &[Outcome],
     summary: &str,
 ) -> anyhow::Result<()> {
-    let parent = match args.output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
-    let staging = mmtrack_io::staging_dir(&parent, ".reproduce-spebt.")?;
+    let staging = crate::reproduce_common::Staged::new(&args.output, "spebt")?;
     let tables = staging.path().join("tables");
     for outcome in outcomes {
         let info = RunInfo {
@@ -509,12 +494,7 @@ fn write_outputs(
     let metrics: Vec<_> =
         outcomes.iter().flat_map(|o| output::metrics(&output::summary_row(experiment, &args.trajectory, o))).collect();
     crate::reproduce_all::write_metrics(staging.path(), &metrics)?;
-    if args.output.exists() {
-        std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
-    }
-    let staged = staging.keep();
-    std::fs::rename(&staged, &args.output).with_context(|| args.output.display().to_string())?;
-    Ok(())
+    staging.publish()
 }
 
 #[cfg(test)]

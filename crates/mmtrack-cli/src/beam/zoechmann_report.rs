@@ -20,6 +20,38 @@ fn db(v: Option<f64>) -> String {
     v.map_or("-".into(), |v| format!("{:.1}", 10.0 * v.log10()))
 }
 
+/// The numbers `reproduce --all` checks: per manoeuvre the final NMSE of
+/// range of every estimator and variant (dB) and the beam-measurement saving
+/// per tracked epoch (the paper's 43x beside it); the median hand-over time
+/// of the convergence manoeuvre (the paper's 0.5 s beside it). Timing is
+/// left out (not deterministic).
+pub fn metrics(experiment: &Experiment, results: &[ManoeuvreResult]) -> Vec<crate::reproduce_all::Metric> {
+    use crate::reproduce_all::Metric;
+    let mut out = Vec::new();
+    for r in results {
+        let name = &r.manoeuvre.name;
+        for (e, estimator) in ESTIMATORS.iter().enumerate() {
+            if let Some(v) = r.final_nmse(e) {
+                out.push(Metric::new(format!("{name} {estimator} final NMSE of range"), 10.0 * v.log10(), "dB", None));
+            }
+        }
+        if let Some(v) = r.beams[0].windowed_saving(experiment.scenario.beams) {
+            out.push(Metric::new(
+                format!("{name} beam saving per tracked epoch"),
+                v,
+                "x",
+                Some(experiment.paper_saving),
+            ));
+        }
+        if *name == experiment.convergence_manoeuvre
+            && let Some(m) = r.handover_quantile(0.5)
+        {
+            out.push(Metric::new(format!("{name} median hand-over"), m, "s", Some(experiment.paper_convergence_s)));
+        }
+    }
+    out
+}
+
 /// The ordering at the end of each manoeuvre, the full-overtaking hand-over,
 /// the beam saving, and (for the full run) the time.
 pub fn verdicts(experiment: &Experiment, results: &[ManoeuvreResult], runs: u64, elapsed_s: f64) -> Vec<Verdict> {

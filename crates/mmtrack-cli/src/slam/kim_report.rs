@@ -2,7 +2,6 @@
 //! block).
 
 use mmtrack_slam::SlamConfig;
-use serde::Serialize;
 
 use super::reproduce_kim::{Experiment, RowResult, Targets};
 
@@ -17,14 +16,7 @@ pub struct Verdict {
     pub met: bool,
 }
 
-/// One measured number, in the shape `reproduce --all` reads (`metrics.json`).
-#[derive(Debug, Clone, Serialize)]
-pub struct Metric {
-    pub key: String,
-    pub value: f64,
-    pub unit: String,
-    pub paper: Option<f64>,
-}
+use crate::reproduce_all::Metric;
 
 /// Every row's numbers, the paper's beside the paper row's.
 pub fn metrics(targets: &Targets, results: &[RowResult]) -> Vec<Metric> {

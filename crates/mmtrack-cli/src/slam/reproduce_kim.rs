@@ -20,7 +20,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use clap::Args;
 use mmtrack_analysis::slam::plots::{EpochCurve, MapFigure, epoch_curves_svg, map_svg};
 use mmtrack_analysis::slam::tables::{SlamPerEpochRow, SlamSummaryRow};
@@ -120,25 +120,13 @@ pub(super) struct RowResult {
 }
 
 pub fn run(args: &KimArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    if args.output.exists() && !args.force {
-        bail!("{}: exists; use --force to replace it (nothing was done)", args.output.display());
-    }
-    if let Some(readme) = &args.readme {
-        crate::readme_block::check_block(readme, README_BLOCK)?;
-    }
-    let (source, text) = match &args.experiment {
-        Some(path) => {
-            (path.display().to_string(), std::fs::read_to_string(path).with_context(|| path.display().to_string())?)
-        }
-        None => ("embedded data/reproduce/kim.toml".to_string(), KIM_EXPERIMENT.to_string()),
-    };
-    let experiment: Experiment = toml::from_str(&text).with_context(|| source.clone())?;
-    let runs = match (args.runs, args.quick) {
-        (Some(n), _) => n,
-        (None, true) => experiment.quick_runs,
-        (None, false) => experiment.runs,
-    };
-    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    crate::reproduce_common::check_start(&args.output, args.force, args.readme.as_deref(), README_BLOCK)?;
+    let (source, experiment): (String, Experiment) = crate::reproduce_common::load_experiment(
+        args.experiment.as_deref(),
+        KIM_EXPERIMENT,
+        "data/reproduce/kim.toml",
+    )?;
+    let runs = crate::reproduce_common::run_count(args.runs, args.quick, experiment.quick_runs, experiment.runs)?;
     anyhow::ensure!(!experiment.rows.is_empty(), "{source}: no [[rows]] (nothing was done)");
     let mut filter = experiment.filter.clone();
     if let Some(p) = args.particles {
@@ -288,12 +276,7 @@ fn write_outputs(
     runs: u64,
     summary: &str,
 ) -> anyhow::Result<()> {
-    let parent = match args.output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
-    let staging = mmtrack_io::staging_dir(&parent, ".reproduce-kim.")?;
+    let staging = crate::reproduce_common::Staged::new(&args.output, "kim")?;
     let tables = staging.path().join("tables");
     let info = RunInfo {
         config_json: serde_json::json!({
@@ -314,14 +297,8 @@ fn write_outputs(
         std::fs::write(staging.path().join(file), svg).with_context(|| file.to_string())?;
     }
     std::fs::write(staging.path().join("reproduce.md"), summary)?;
-    let metrics = serde_json::to_string_pretty(&report::metrics(&experiment.targets, results))?;
-    std::fs::write(staging.path().join("metrics.json"), metrics + "\n")?;
-    if args.output.exists() {
-        std::fs::remove_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
-    }
-    let staged = staging.keep();
-    std::fs::rename(&staged, &args.output).with_context(|| args.output.display().to_string())?;
-    Ok(())
+    crate::reproduce_all::write_metrics(staging.path(), &report::metrics(&experiment.targets, results))?;
+    staging.publish()
 }
 
 /// The map of the first run of the first row (Fig. 3), the UE errors over

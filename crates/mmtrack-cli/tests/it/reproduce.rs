@@ -148,8 +148,8 @@ fn all_smoke_runs_every_experiment_within_its_expectations() {
     let (stdout, stderr) = text(&out);
     println!("{stdout}");
     assert!(out.status.success(), "a metric left its expected range:\n{stdout}\n{stderr}");
-    assert!(stdout.contains("41 metrics of 4 experiments, 0 outside their expected range"), "{stdout}");
-    for experiment in ["odometry", "mpc-artificial", "shaham", "spebt"] {
+    assert!(stdout.contains("80 metrics of 6 experiments, 0 outside their expected range"), "{stdout}");
+    for experiment in ["odometry", "mpc-artificial", "shaham", "spebt", "zoechmann", "kim"] {
         assert!(out_dir.join(experiment).join("metrics.json").is_file(), "{experiment}");
     }
     assert!(out_dir.join("summary.md").is_file());
