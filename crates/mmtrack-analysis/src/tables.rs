@@ -30,6 +30,10 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::beam::zoechmann_plots::GEOMETRIC_PER_EPOCH,
     &crate::slam::tables::SLAM_SUMMARY,
     &crate::slam::tables::SLAM_PER_EPOCH,
+    &crate::slam::tables::SLAM_UE,
+    &crate::slam::tables::SLAM_MAP,
+    &crate::slam::tables::SLAM_ASSOCIATIONS,
+    &crate::slam::tables::SLAM_TRUE_SOURCES,
 ];
 
 mmtrack_io::define_table! {

@@ -67,6 +67,18 @@ enum Pipeline {
     /// pose-error model; it writes `spebt_per_slot` and `spebt_summary`.
     #[command(verbatim_doc_comment)]
     Beam(crate::beam::process::BeamArgs),
+    /// 5G mmWave SLAM (Kim et al. 2018) on the recording's per-epoch path measurements.
+    ///
+    /// Runs the particle belief-propagation SLAM filter over /slam/paths (from
+    /// `mmtrack simulate slam`) and writes per sequence partition: `slam_ue`
+    /// (UE estimate per epoch, beside the truth when the recording has it),
+    /// `slam_map` (every map source after every epoch: bs, va, sp or
+    /// unconfirmed, position, spread, confirmation), `slam_associations` (the
+    /// source each path was given, beside its true source) and
+    /// `slam_true_sources`. Unusable paths are skipped and counted, or refused
+    /// with --strict. Then run `mmtrack analyze <out>`.
+    #[command(verbatim_doc_comment)]
+    Slam(crate::slam::process::SlamArgs),
     /// Many sequences at once: every `mmtrack process` command line of a manifest as its own task.
     ///
     /// The manifest (TOML) lists `[[task]]` tables, each with `args`: a
@@ -125,6 +137,10 @@ pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             Ok(ExitCode::SUCCESS)
         }
         Pipeline::Beam(beam_args) => crate::beam::process::run(beam_args, quiet),
+        Pipeline::Slam(slam_args) => {
+            crate::slam::process::run(slam_args, quiet)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Pipeline::Manifest(manifest_args) => crate::process_manifest::run(manifest_args, quiet),
     }
 }

@@ -54,3 +54,103 @@ Figs. 4-6): UE errors, localisation errors of the confirmed sources and the numb
         confirmed_sp: f64, "", "mean number of confirmed SPs";
     }
 }
+
+mmtrack_io::define_table! {
+    /// `slam_ue`: the UE estimate of each epoch, with the truth when known.
+    pub const SLAM_UE = "slam_ue",
+        "The 5G mmWave SLAM filter's UE estimate per epoch of one recording (`mmtrack process slam`, Kim et al. \
+2018): the posterior mean and spreads after the epoch's update, what the epoch held and used, and the true state when \
+the recording carries it (/slam/ue_truth; null otherwise).";
+    /// One row of [`SLAM_UE`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SlamUeRow {
+        epoch: u64, "", "epoch k (1-based, as the paper's k)";
+        t_ns: i64, "ns", "epoch time";
+        initialised: bool, "", "the UE has been initialised from a line-of-sight path (before that the estimate is the prior)";
+        x_m: f64, "m", "estimated UE position x";
+        y_m: f64, "m", "estimated UE position y";
+        z_m: f64, "m", "UE height (not estimated: the prior's)";
+        heading_rad: f64, "rad", "estimated heading";
+        speed_mps: f64, "m/s", "estimated speed (1-step smoothed)";
+        turn_rate_radps: f64, "rad/s", "estimated turn rate (1-step smoothed)";
+        clock_bias_m: f64, "m", "estimated clock bias";
+        position_std_m: f64, "m", "root of the trace of the horizontal position covariance";
+        heading_std_rad: f64, "rad", "heading standard deviation";
+        clock_bias_std_m: f64, "m", "clock-bias standard deviation";
+        paths: u64, "", "paths in the epoch's measurement set";
+        skipped_paths: u64, "", "paths skipped as unusable (NaN, elevation out of [-pi/2, pi/2])";
+        paths_in_update: u64, "", "paths from the BS and confirmed sources used in the UE update";
+        ess: f64, "", "effective sample size of the particles after the update";
+        true_x_m: Option<f64>, "m", "true UE position x; null without ground truth";
+        true_y_m: Option<f64>, "m", "true UE position y";
+        true_z_m: Option<f64>, "m", "true UE height";
+        true_heading_rad: Option<f64>, "rad", "true heading";
+        true_speed_mps: Option<f64>, "m/s", "true speed";
+        true_turn_rate_radps: Option<f64>, "rad/s", "true turn rate";
+        true_clock_bias_m: Option<f64>, "m", "true clock bias";
+    }
+}
+
+mmtrack_io::define_table! {
+    /// `slam_map`: every map source after every epoch.
+    pub const SLAM_MAP = "slam_map",
+        "The 5G mmWave SLAM map over time (`mmtrack process slam`): after each epoch, one row per source of the \
+filter's map (the known base station, confirmed virtual anchors and scattering points, unconfirmed sources), with its \
+type, spatial belief and history.";
+    /// One row of [`SLAM_MAP`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SlamMapRow {
+        epoch: u64, "", "epoch k (1-based) after which the map is shown";
+        t_ns: i64, "ns", "epoch time";
+        source_id: u64, "", "source identifier, stable over epochs and never reused (0 = base station)";
+        status: String, "", "bs, va (confirmed virtual anchor), sp (confirmed scattering point) or unconfirmed";
+        confirmed: bool, "", "the source is the base station or a confirmed VA or SP";
+        x_m: f64, "m", "mean of the spatial belief, x (unconfirmed: the latest SP hypothesis, else the VA one)";
+        y_m: f64, "m", "mean of the spatial belief, y";
+        z_m: f64, "m", "mean of the spatial belief, z";
+        spread_m: f64, "m", "root of the trace of the belief's covariance";
+        first_seen_epoch: u64, "", "epoch (1-based) of the first sighting";
+        sightings: u64, "", "epochs with a path associated with the source";
+        confirmed_epoch: Option<u64>, "", "epoch (1-based) at which it was confirmed; null while unconfirmed (the BS: 0)";
+    }
+}
+
+mmtrack_io::define_table! {
+    /// `slam_associations`: the source each path of each epoch was given.
+    pub const SLAM_ASSOCIATIONS = "slam_associations",
+        "The 5G mmWave SLAM data association (`mmtrack process slam`, Kim et al. 2018, eq. (3)-(7), solved by \
+Kuhn-Munkres): one row per usable path of each epoch, the decision and its score, beside the path's true source when \
+the recording carries it.";
+    /// One row of [`SLAM_ASSOCIATIONS`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SlamAssociationRow {
+        epoch: u64, "", "epoch k (1-based)";
+        t_ns: i64, "ns", "epoch time";
+        path: u64, "", "index of the path in the epoch's /slam/paths message";
+        decision: String, "",
+            "source (an existing map source), new_source (a new unconfirmed source), initialisation (the line of sight \
+that initialised the UE) or waiting (dropped before the UE was initialised)";
+        source_id: Option<u64>, "", "the map source (source and new_source); null otherwise";
+        log_score: f64, "", "natural log of the chosen likelihood-matrix entry (log P_N for a new source)";
+        true_source: Option<String>, "", "the path's true source type: bs, va, sp or clutter; null without ground truth";
+        true_source_index: Option<u64>, "", "index of the true source among those of its type (slam_true_sources)";
+    }
+}
+
+mmtrack_io::define_table! {
+    /// `slam_true_sources`: the sources of the paths in the recording.
+    pub const SLAM_TRUE_SOURCES = "slam_true_sources",
+        "The sources of the 5G mmWave paths as the recording gives them (/slam/sources): the base station and, \
+from a simulation, the true virtual anchors and scattering points; with the number of epochs each was seen in \
+(from the ground-truth path origins).";
+    /// One row of [`SLAM_TRUE_SOURCES`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SlamTrueSourceRow {
+        kind: String, "", "bs, va or sp";
+        index: u64, "", "index among the sources of its kind";
+        x_m: f64, "m", "position x";
+        y_m: f64, "m", "position y";
+        z_m: f64, "m", "position z";
+        detected_epochs: Option<u64>, "", "epochs with a measured path from this source; null without path origins";
+    }
+}
