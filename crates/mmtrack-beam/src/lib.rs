@@ -29,9 +29,9 @@
 
 mod angle_ekf;
 mod error;
+pub mod geometric;
 mod link;
 mod position_velocity_ekf;
-pub mod geometric;
 pub mod spebt;
 pub mod sweep;
 pub mod valid_tracking;

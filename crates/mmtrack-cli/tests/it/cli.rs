@@ -92,7 +92,10 @@ fn report_html_renders_in_headless_chromium_with_every_plot() {
     let analysis = dir.path().join("d/analysis");
     let page = std::fs::read_to_string(analysis.join("report.html")).unwrap();
     assert!(page.contains("<h2>Provenance</h2>") && page.contains("Software: mmtrack "), "{}", &page[..2000]);
-    assert!(page.contains("&quot;command&quot;: &quot;analyze&quot;") && !page.contains("<script"), "configuration shown, no scripts");
+    assert!(
+        page.contains("&quot;command&quot;: &quot;analyze&quot;") && !page.contains("<script"),
+        "configuration shown, no scripts"
+    );
     let embedded = page.matches("<img src=\"data:image/svg+xml;base64,").count();
     let report = std::fs::read_to_string(analysis.join("report.md")).unwrap();
     assert_eq!(embedded, report.matches("\n![").count(), "every image of report.md is embedded");
