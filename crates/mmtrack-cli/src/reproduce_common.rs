@@ -10,13 +10,29 @@ use anyhow::{Context, bail};
 use serde::de::DeserializeOwned;
 
 /// Checks, before any work, that `output` may be written and that `readme`
-/// (when given) holds the block `block`.
+/// (when given) holds the block `block`. `--force` replaces only an empty
+/// directory or an earlier experiment output (one holding `reproduce.md`),
+/// so a mistyped `-o` cannot delete unrelated files.
 ///
 /// # Errors
-/// `output` exists and `force` is off; the README lacks the block.
+/// `output` exists and `force` is off, or it is not an earlier output; the
+/// README lacks the block.
 pub fn check_start(output: &Path, force: bool, readme: Option<&Path>, block: &str) -> anyhow::Result<()> {
     if output.exists() && !force {
         bail!("{}: exists; use --force to replace it (nothing was done)", output.display());
+    }
+    if output.exists() {
+        let empty = std::fs::read_dir(output)
+            .with_context(|| format!("{}: not a directory this command can replace", output.display()))?
+            .next()
+            .is_none();
+        if !empty && !output.join("reproduce.md").is_file() {
+            bail!(
+                "{}: holds no reproduce.md, so it is not an earlier output of an experiment; refusing to replace it \
+                 with --force (nothing was done)",
+                output.display()
+            );
+        }
     }
     if let Some(readme) = readme {
         crate::readme_block::check_block(readme, block)?;
@@ -92,5 +108,25 @@ impl Staged {
         }
         let staged = self.dir.keep();
         std::fs::rename(&staged, &self.output).with_context(|| self.output.display().to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn force_replaces_only_empty_dirs_and_earlier_outputs() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        assert!(check_start(&out, false, None, "b").is_ok(), "absent");
+        std::fs::create_dir(&out).unwrap();
+        assert!(check_start(&out, false, None, "b").unwrap_err().to_string().contains("--force"));
+        assert!(check_start(&out, true, None, "b").is_ok(), "empty");
+        std::fs::write(out.join("notes.txt"), "mine").unwrap();
+        let err = check_start(&out, true, None, "b").unwrap_err().to_string();
+        assert!(err.contains("holds no reproduce.md"), "{err}");
+        std::fs::write(out.join("reproduce.md"), "").unwrap();
+        assert!(check_start(&out, true, None, "b").is_ok(), "an earlier output");
     }
 }
