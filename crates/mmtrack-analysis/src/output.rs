@@ -86,7 +86,7 @@ pub fn write_results(
     run: &RunInfo,
     overwrite: Overwrite,
 ) -> anyhow::Result<WrittenResults> {
-    write_all_results(out, results, &[], &BeamResults::default(), skipped, options, run, overwrite)
+    write_all_results(out, results, &[], &BeamResults::default(), &[], skipped, options, run, overwrite)
 }
 
 /// Writes tables, plots and the report for trajectory, MPC and beam-tracking
@@ -97,6 +97,7 @@ pub fn write_all_results(
     results: &[TrajectoryResult],
     mpc: &[MpcResult],
     beam: &BeamResults,
+    slam: &[crate::slam::analysis::SlamSequenceResult],
     skipped: &[(String, String)],
     options: &DriftOptions,
     run: &RunInfo,
@@ -112,7 +113,8 @@ pub fn write_all_results(
     files += write_mpc_into(staging.path(), mpc, run)?;
     files += write_beam_into(staging.path(), &beam.sweeps, run)?;
     files += write_spebt_into(staging.path(), &beam.spebt, run)?;
-    if !mpc.is_empty() || !beam.is_empty() {
+    files += crate::slam::analysis::write_slam_into(staging.path(), slam, run)?;
+    if !mpc.is_empty() || !beam.is_empty() || !slam.is_empty() {
         let report_path = staging.path().join("report.md");
         let mut text = report::markdown(results, &[], options);
         if !mpc.is_empty() {
@@ -123,6 +125,9 @@ pub fn write_all_results(
         }
         if !beam.spebt.is_empty() {
             spebt_analysis::section(&mut text, &beam.spebt);
+        }
+        if !slam.is_empty() {
+            crate::slam::analysis::section(&mut text, slam);
         }
         text.push_str(&report::not_analyzed(skipped));
         std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;

@@ -99,6 +99,9 @@ pub struct Plan {
     /// Sequences with `spebt_summary` and `spebt_per_slot` tables (`process
     /// beam --tracker spebt`): SPEBT accuracy.
     pub spebt: Vec<String>,
+    /// Sequences with `slam_ue`, `slam_map` and `slam_true_sources` tables
+    /// (`process slam`): the SLAM metrics.
+    pub slam: Vec<String>,
     /// Sequences that have tables but no metric applies, with the reason.
     pub skipped: Vec<(String, String)>,
 }
@@ -120,6 +123,18 @@ pub fn plan(inventory: &Inventory) -> Plan {
                     "has an {} table but no {} table: SPEBT accuracy needs both",
                     SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name
                 ),
+            ));
+        }
+    }
+    for seq in inventory.sequences(crate::slam::tables::SLAM_UE.name) {
+        let missing: Vec<&str> =
+            crate::slam::analysis::INPUT_TABLES.into_iter().filter(|t| !inventory.sequences(t).contains(seq)).collect();
+        if missing.is_empty() {
+            plan.slam.push(seq.clone());
+        } else {
+            plan.skipped.push((
+                seq.clone(),
+                format!("has a slam_ue table but not {}: the SLAM metrics need them", missing.join(", ")),
             ));
         }
     }

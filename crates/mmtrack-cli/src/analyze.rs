@@ -42,8 +42,13 @@ Tables spebt_summary + spebt_per_slot of `mmtrack process beam --tracker spebt` 
 per sequence the RMSE of abs(alpha), AoD and AoA and the re-initialisation share (the summary is checked against the \
 per-slot RMSEs), pooled per experiment kind weighting each sequence by its (slots - 1) x runs estimates; a plot of \
 run 0 against the truth (Liu et al. Fig. 5).\n\n\
+Tables slam_ue + slam_map + slam_true_sources of `mmtrack process slam` -> per sequence the 5G mmWave SLAM metrics \
+of Kim et al. 2018 (time-averaged UE position, heading and clock-bias errors, VA and SP localisation errors, the \
+epochs when all VAs and all SPs were confirmed) as slam_summary and slam_per_epoch, plots of the map (true and \
+estimated sources, true and estimated track), the UE errors and the confirmed sources over the epochs.\n\n\
 Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
-mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary,spebt_summary}/sequence=<id>/part-0.parquet, \
+mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary,spebt_summary,\
+slam_summary,slam_per_epoch}/sequence=<id>/part-0.parquet, \
 <OUT>/tables/{beam_sweep_pooled,spebt_pooled}/sequence=all/part-0.parquet, \
 <OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md and <OUT>/report.html (the same report as one self-contained page: plots embedded, with the software version, inputs and configuration). The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.",
@@ -108,11 +113,17 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     let found = inventory(&args.tables)?;
     let plan = plan(&found);
-    if plan.trajectory.is_empty() && plan.mpc.is_empty() && plan.beam.is_empty() && plan.spebt.is_empty() {
+    if plan.trajectory.is_empty()
+        && plan.mpc.is_empty()
+        && plan.beam.is_empty()
+        && plan.spebt.is_empty()
+        && plan.slam.is_empty()
+    {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         bail!(
             "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
-             {}, {}, {} (MPC statistics), {} (beam sweeps) and {} with {} (SPEBT); found {}{reasons}",
+             {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT) and slam_ue with slam_map and \
+             slam_true_sources (SLAM); found {}{reasons}",
             args.tables.display(),
             ODOMETRY.name,
             GROUND_TRUTH.name,
@@ -130,6 +141,7 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let mpc_options = MpcOptions { first_path_dynamic_range_db: args.first_path_range_db };
     let mpc_results = analyze_mpc_all(&args.tables, &plan, &mpc_options)?;
     let beam_results = analyze_beam_all(&args.tables, &plan)?;
+    let slam_results = mmtrack_analysis::slam::analysis::analyze_slam_all(&args.tables, &plan.slam)?;
     let run = RunInfo {
         config_json: serde_json::json!({
             "command": "analyze",
@@ -146,6 +158,7 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         &results,
         &mpc_results,
         &beam_results,
+        &slam_results,
         &plan.skipped,
         &options,
         &run,
@@ -162,6 +175,9 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             println!("{line}");
         }
         for line in mmtrack_analysis::beam::spebt_analysis::one_lines(&beam_results.spebt) {
+            println!("{line}");
+        }
+        for line in mmtrack_analysis::slam::analysis::one_lines(&slam_results) {
             println!("{line}");
         }
         for (sequence, reason) in &plan.skipped {

@@ -4,5 +4,7 @@
 //! Pure data in, tables and SVG documents out; the Monte Carlo loop and the
 //! filter run in the CLI.
 
+pub mod analysis;
+pub mod metrics;
 pub mod plots;
 pub mod tables;

@@ -6,7 +6,8 @@ mmtrack_io::define_table! {
         "5G mmWave SLAM over the Monte Carlo runs of one scenario variant (Kim et al. 2018, Sec. V): mean over \
 runs of the time-averaged UE errors, of the time-averaged localisation errors of the confirmed VAs and SPs (each \
 against the nearest true source of its type), and the epochs (1-based, as the paper's k) at which every VA and every \
-SP seen along the drive was confirmed.";
+SP seen along the drive was confirmed. Written by `reproduce kim` (one row per scenario variant) and by `mmtrack \
+analyze` on the tables of `process slam` (one partition per sequence, row = the sequence, runs = 1).";
     /// One row of [`SLAM_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamSummaryRow {
@@ -39,7 +40,8 @@ mmtrack_io::define_table! {
     /// `slam_per_epoch`: errors and map size per epoch, averaged over runs.
     pub const SLAM_PER_EPOCH = "slam_per_epoch",
         "5G mmWave SLAM per epoch, averaged over the Monte Carlo runs of one scenario variant (Kim et al. 2018, \
-Figs. 4-6): UE errors, localisation errors of the confirmed sources and the number of confirmed VAs and SPs.";
+Figs. 4-6): UE errors, localisation errors of the confirmed sources and the number of confirmed VAs and SPs. \
+`mmtrack analyze` writes it per sequence of `process slam` (one run: the values of that run).";
     /// One row of [`SLAM_PER_EPOCH`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamPerEpochRow {

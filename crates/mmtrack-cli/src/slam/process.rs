@@ -348,6 +348,7 @@ pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
             "prior": [prior.position_m[0], prior.position_m[1], prior.position_m[2], prior.heading_rad,
                       prior.speed_mps, prior.turn_rate_radps, prior.clock_bias_m],
             "filter": config,
+            "scenario": recording.scenario,
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
