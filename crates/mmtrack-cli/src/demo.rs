@@ -10,10 +10,11 @@
 //!    (GM-PHD baseline included);
 //! 3. beam: SPEBT beam tracking along the radar drive, driven by the
 //!    odometry of step 1;
-//! 4. analyze every table together: trajectory metrics, MPC statistics,
-//!    SPEBT accuracy, plots, `report.md` and `report.html`.
-//!
-//! SLAM joins when its pipeline lands (issue #16).
+//! 4. SLAM: simulate a short stretch ([`DEMO_SLAM_EPOCHS`] epochs) of the 5G
+//!    mmWave SLAM world of Kim et al. 2018 and run the SLAM filter on it
+//!    ([`DEMO_SLAM_PARTICLES`] particles);
+//! 5. analyze every table together: trajectory metrics, MPC statistics,
+//!    SPEBT accuracy, SLAM metrics, plots, `report.md` and `report.html`.
 
 use std::ffi::OsString;
 use std::path::{Path, PathBuf};
@@ -30,6 +31,10 @@ pub const DEMO_SCENARIO: &str = include_str!("../../../data/demo/radar-scenario.
 pub const DEMO_SOUNDER_SCENARIO: &str = include_str!("../../../data/sounder/convoy-tunnel.toml");
 /// Sets of the sounder scenario the demo simulates (0.4 s of driving).
 pub const DEMO_SOUNDER_SETS: usize = 40;
+/// Epochs of the SLAM world the demo simulates (6 s of the paper's lap).
+pub const DEMO_SLAM_EPOCHS: usize = 30;
+/// UE particles of the demo's SLAM run (the paper's 2000 take longer).
+pub const DEMO_SLAM_PARTICLES: usize = 500;
 /// Sequence id of the demo radar data (the folder name, as for real Oxford data).
 pub const DEMO_SEQUENCE: &str = "oxford-demo";
 
@@ -79,6 +84,8 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let folder = arg(&input.join(DEMO_SEQUENCE))?;
     let recording = arg(&out.join("recording.mcap"))?;
     let sounder = arg(&out.join("sounder.mcap"))?;
+    let slam = arg(&out.join("slam.mcap"))?;
+    let (slam_epochs, slam_particles) = (DEMO_SLAM_EPOCHS.to_string(), DEMO_SLAM_PARTICLES.to_string());
     let tables = arg(&out.join("tables"))?;
     let analysis = arg(&out.join("analysis"))?;
     let sets = DEMO_SOUNDER_SETS.to_string();
@@ -86,15 +93,19 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let sounder_scenario = arg(&sounder_scenario)?;
 
     if !quiet {
-        println!("mmtrack demo: radar odometry, multipath tracking and SPEBT beam tracking on simulated data");
+        println!(
+            "mmtrack demo: radar odometry, multipath tracking, SPEBT beam tracking and 5G mmWave SLAM on simulated data"
+        );
     }
-    let steps: [Vec<String>; 7] = [
+    let steps: [Vec<String>; 9] = [
         line(&["simulate", "radar", "--scenario", &radar_scenario, "--format", "oxford", "-o", &folder, "--force"]),
         line(&["ingest", "oxford", &folder, "-o", &recording, "--bins", "auto", "--force"]),
         line(&["process", "odometry", &recording, "-o", &tables, "--preset", "cfear", "--force"]),
         line(&["simulate", "sounder", "--scenario", &sounder_scenario, "--sets", &sets, "-o", &sounder, "--force"]),
         line(&["process", "mpc", &sounder, "-o", &tables, "--gmphd", "--force"]),
         line(&["process", "beam", &recording, "--tracker", "spebt", "--odometry", &tables, "-o", &tables, "--force"]),
+        line(&["simulate", "slam", "--epochs", &slam_epochs, "-o", &slam, "--force"]),
+        line(&["process", "slam", &slam, "-o", &tables, "--particles", &slam_particles, "--force"]),
         // The demo drive is 14 m: KITTI segments scaled down from the
         // devkit's 100..800 m, a first frame at every scan.
         line(&["analyze", &tables, "-o", &analysis, "--segment-lengths-m", "4,8,12", "--step-frames", "1", "--force"]),
@@ -110,10 +121,10 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!("  input folder (Oxford layout): {folder}");
         println!("  radar recording (Foxglove):    {recording}");
         println!("  sounder recording:             {sounder}");
+        println!("  SLAM recording:                {slam}");
         println!("  tables (Parquet, Hive layout): {tables}");
         println!("  analysis (metrics, plots):     {analysis}");
         println!("  report (open in a browser):    {analysis}/report.html (and report.md)");
-        println!("\nNot in the demo yet: the SLAM pipeline (issue #16).");
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -42,19 +42,35 @@ fn demo_runs_every_pipeline_and_its_tables_read_back_as_documented() {
     let out = mmtrack(dir.path(), &["demo", "--out", "d"]);
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
-    for command in
-        ["$ mmtrack process odometry", "$ mmtrack process mpc", "$ mmtrack process beam", "$ mmtrack analyze"]
-    {
+    for command in [
+        "$ mmtrack process odometry",
+        "$ mmtrack process mpc",
+        "$ mmtrack process beam",
+        "$ mmtrack simulate slam",
+        "$ mmtrack process slam",
+        "$ mmtrack analyze",
+    ] {
         assert!(stdout.contains(command), "{command}: {stdout}");
     }
     let d = dir.path().join("d");
-    for table in ["odometry", "ground_truth", "mpc_detections", "mpc_tracks", "mpc_tracks_gmphd", "spebt_summary"] {
+    for table in [
+        "odometry",
+        "ground_truth",
+        "mpc_detections",
+        "mpc_tracks",
+        "mpc_tracks_gmphd",
+        "spebt_summary",
+        "slam_ue",
+        "slam_map",
+        "slam_associations",
+        "slam_true_sources",
+    ] {
         let tables = d.join("tables").join(table);
         let part = std::fs::read_dir(&tables).unwrap().next().unwrap().unwrap().path().join("part-0.parquet");
         assert!(std::fs::metadata(&part).unwrap().len() > 0, "{}", part.display());
     }
     let report = std::fs::read_to_string(d.join("analysis/report.md")).unwrap();
-    for section in ["KITTI", "## Multipath components", "## SPEBT beam tracking"] {
+    for section in ["KITTI", "## Multipath components", "## SPEBT beam tracking", "## 5G mmWave SLAM"] {
         assert!(report.contains(section), "{section}: {report}");
     }
     let plots: Vec<&str> = report.split("](plots/").skip(1).map(|rest| rest.split(')').next().unwrap()).collect();
@@ -69,7 +85,7 @@ fn demo_runs_every_pipeline_and_its_tables_read_back_as_documented() {
     let checked = checked.unwrap();
     let (stdout, stderr) = text(&checked);
     assert!(checked.status.success(), "{stdout}{stderr}");
-    assert!(stdout.contains("tables/spebt_pooled: 1 rows") && stdout.contains("checked 25 tables"), "{stdout}");
+    assert!(stdout.contains("tables/spebt_pooled: 1 rows") && stdout.contains("checked 31 tables"), "{stdout}");
 }
 
 /// A headless browser from the system packages, if there is one.
