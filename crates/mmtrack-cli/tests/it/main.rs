@@ -32,4 +32,5 @@ mod reproduce_spebt;
 mod reproduce_zoechmann;
 mod simulate_radar;
 mod simulate_sounder;
+mod slam_pipeline;
 mod threads;
