@@ -112,7 +112,7 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     }
 
     let found = inventory(&args.tables)?;
-    let plan = plan(&found);
+    let mut plan = plan(&found);
     if plan.trajectory.is_empty()
         && plan.mpc.is_empty()
         && plan.beam.is_empty()
@@ -141,7 +141,8 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let mpc_options = MpcOptions { first_path_dynamic_range_db: args.first_path_range_db };
     let mpc_results = analyze_mpc_all(&args.tables, &plan, &mpc_options)?;
     let beam_results = analyze_beam_all(&args.tables, &plan)?;
-    let slam_results = mmtrack_analysis::slam::analysis::analyze_slam_all(&args.tables, &plan.slam)?;
+    let (slam_results, slam_skipped) = mmtrack_analysis::slam::analysis::analyze_slam_all(&args.tables, &plan.slam)?;
+    plan.skipped.extend(slam_skipped);
     let run = RunInfo {
         config_json: serde_json::json!({
             "command": "analyze",

@@ -208,16 +208,32 @@ pub fn sequence_result(
     Ok(SlamSequenceResult { sequence: sequence.to_string(), summary, per_epoch, map, outcome })
 }
 
-/// The SLAM results of `sequences` under the table directory `root`.
+/// A sequence left out and why.
+pub type Skipped = (String, String);
+
+/// The SLAM results of `sequences` under the table directory `root`, and
+/// the sequences left out with the reason (no ground truth: a recording
+/// without `/slam/ue_truth`).
 ///
 /// # Errors
-/// A table that cannot be read, or [`sequence_result`]'s errors, naming the
-/// directory and sequence.
-pub fn analyze_slam_all(root: &Path, sequences: &[String]) -> anyhow::Result<Vec<SlamSequenceResult>> {
+/// A table that cannot be read, or another of [`sequence_result`]'s errors,
+/// naming the directory and sequence.
+pub fn analyze_slam_all(root: &Path, sequences: &[String]) -> anyhow::Result<(Vec<SlamSequenceResult>, Vec<Skipped>)> {
     let mut out = Vec::with_capacity(sequences.len());
+    let mut skipped = Vec::new();
     for sequence in sequences {
         let ue_path = table_path(root, SLAM_UE.name, sequence)?;
         let ue: Vec<SlamUeRow> = read_table(&ue_path)?;
+        if let Some(row) = ue.iter().find(|r| truth_of(r).is_none()) {
+            skipped.push((
+                sequence.clone(),
+                format!(
+                    "has {} without the true UE state (epoch {}): the SLAM metrics need a recording with ground truth",
+                    SLAM_UE.name, row.epoch
+                ),
+            ));
+            continue;
+        }
         let map: Vec<SlamMapRow> = read_table(&table_path(root, SLAM_MAP.name, sequence)?)?;
         let sources: Vec<SlamTrueSourceRow> = read_table(&table_path(root, SLAM_TRUE_SOURCES.name, sequence)?)?;
         let kv = read_key_value_metadata(&ue_path)?;
@@ -229,7 +245,7 @@ pub fn analyze_slam_all(root: &Path, sequences: &[String]) -> anyhow::Result<Vec
             .map_err(|e| anyhow::anyhow!("{}: sequence {sequence}: {e}", root.display()))?;
         out.push(result);
     }
-    Ok(out)
+    Ok((out, skipped))
 }
 
 /// Writes `slam_summary` and `slam_per_epoch` per sequence and the plots;

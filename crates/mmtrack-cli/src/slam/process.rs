@@ -56,7 +56,12 @@ pub struct SlamArgs {
     pub seed: u64,
     /// Prior UE state x,y,z,heading,speed,turn_rate,clock_bias (m, rad, m/s, rad/s, m) for recordings without
     /// ground truth (default: the recording's first true state).
-    #[arg(long, value_delimiter = ',', num_args = 7, value_name = "X,Y,Z,HEADING,SPEED,TURN_RATE,BIAS")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "X,Y,Z,HEADING,SPEED,TURN_RATE,BIAS"
+    )]
     pub prior: Option<Vec<f64>>,
     /// Refuse a recording with an unusable path (NaN, elevation out of range) instead of skipping and counting it.
     #[arg(long)]

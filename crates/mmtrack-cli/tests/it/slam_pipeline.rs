@@ -62,7 +62,7 @@ fn simulate_process_analyze_gives_the_papers_metrics_for_any_thread_count() {
 
 /// A recording of the paper's first epochs with an empty epoch, a NaN and
 /// an elevation out of range.
-fn bad_recording(path: &std::path::Path, with_bs: bool) {
+fn bad_recording(path: &std::path::Path, with_bs: bool, with_truth: bool) {
     let scenario = SlamScenario { epochs: 6, ..SlamScenario::default() };
     let run = scenario.realise(1, 0).unwrap();
     let metadata = RecordingMetadata {
@@ -88,7 +88,9 @@ fn bad_recording(path: &std::path::Path, with_bs: bool) {
             _ => {}
         }
         writer.write_slam_paths(&epoch).unwrap();
-        writer.write_slam_ue_truth(epoch.t_ns, &truth.ue, &origins).unwrap();
+        if with_truth {
+            writer.write_slam_ue_truth(epoch.t_ns, &truth.ue, &origins).unwrap();
+        }
     }
     writer.finish().unwrap();
 }
@@ -97,7 +99,7 @@ fn bad_recording(path: &std::path::Path, with_bs: bool) {
 fn unusable_paths_are_counted_or_refused_with_file_epoch_path_and_field() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    bad_recording(&d.join("bad.mcap"), true);
+    bad_recording(&d.join("bad.mcap"), true, true);
     ok(d, &["process", "slam", "bad.mcap", "-o", "t", "--particles", "200", "-q"]);
     let ue: Vec<SlamUeRow> = read_table(&d.join("t/slam_ue/sequence=bad/part-0.parquet")).unwrap();
     assert_eq!(ue.len(), 6);
@@ -113,10 +115,20 @@ fn unusable_paths_are_counted_or_refused_with_file_epoch_path_and_field() {
     }
     assert!(!d.join("strict").exists(), "nothing written");
 
-    bad_recording(&d.join("nobs.mcap"), false);
+    bad_recording(&d.join("nobs.mcap"), false, true);
     let out = mmtrack(d, &["process", "slam", "nobs.mcap", "-o", "t2"]);
     let (_, stderr) = text(&out);
     assert!(!out.status.success() && stderr.contains("nobs.mcap") && stderr.contains("no base station"), "{stderr}");
+
+    // Without ground truth: the prior comes from --prior, and analyze leaves
+    // the sequence out with the reason instead of failing.
+    bad_recording(&d.join("notruth.mcap"), true, false);
+    let out = mmtrack(d, &["process", "slam", "notruth.mcap", "-o", "t3", "-q"]);
+    assert!(!out.status.success() && text(&out).1.contains("--prior"), "{}", text(&out).1);
+    let prior = "--prior=70.73,0,0,1.5708,22.22,0.31416,300";
+    ok(d, &["process", "slam", "notruth.mcap", "-o", "t3", "--particles", "200", prior, "-q"]);
+    let stdout = ok(d, &["analyze", "t3", "-o", "a3"]);
+    assert!(stdout.contains("bad: not analyzed") && stdout.contains("ground truth"), "{stdout}");
 }
 
 /// A configured world from TOML: a straight road past a fifth wall, a
