@@ -14,6 +14,26 @@ use mmtrack_sim::slam::SlamScenario;
 
 use super::common::{mmtrack, text};
 
+/// Decodes the SLAM channels with Python's `mcap` and `mcap_protobuf`
+/// (from the descriptors embedded in the file, no mmtrack code) and prints
+/// per epoch the TOAs and DOA elevations, the true x, and the sources, every
+/// float as the integer of its IEEE-754 bits (exact through JSON).
+const PY_READER: &str = "
+import json, struct, sys
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+with open(sys.argv[1], 'rb') as f:
+    msgs = [(c.topic, m) for _, c, _, m in make_reader(f, decoder_factories=[DecoderFactory()]).iter_decoded_messages()]
+def bits(x):
+    return struct.unpack('<Q', struct.pack('<d', x))[0]
+print(json.dumps({
+    'toa_m': [[bits(v) for v in m.toa_m] for t, m in msgs if t == '/slam/paths'],
+    'doa_el_rad': [[bits(v) for v in m.doa_el_rad] for t, m in msgs if t == '/slam/paths'],
+    'true_x_m': [bits(m.x_m) for t, m in msgs if t == '/slam/ue_truth'],
+    'sources': [[m.kind, m.index, bits(m.z_m)] for t, m in msgs if t == '/slam/sources'],
+}))
+";
+
 const TABLES: [&str; 4] = ["slam_ue", "slam_map", "slam_associations", "slam_true_sources"];
 
 fn ok(dir: &std::path::Path, args: &[&str]) -> String {
@@ -28,6 +48,7 @@ fn simulate_process_analyze_gives_the_papers_metrics_for_any_thread_count() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     ok(d, &["simulate", "slam", "--epochs", "40", "--seed", "3", "-o", "s.mcap"]);
+    independent_reader_agrees(&d.join("s.mcap"));
     for (threads, out) in [("1", "t1"), ("2", "t2")] {
         ok(d, &["process", "slam", "s.mcap", "-o", out, "--particles", "500", "--threads", threads, "-q"]);
     }
@@ -161,4 +182,36 @@ fn a_toml_world_with_clutter_runs_through_the_pipeline() {
     assert_eq!(clutter, 25, "one clutter path per epoch, each labelled");
     let bad = mmtrack(d, &["simulate", "slam", "--scenario", "world.toml", "-o", "w.mcap"]);
     assert!(!bad.status.success() && text(&bad).1.contains("exists"), "an existing output is kept");
+}
+
+/// Python's `mcap` reads the recording's SLAM channels to the same values,
+/// bit for bit.
+fn independent_reader_agrees(recording: &std::path::Path) {
+    let Some(python) = super::common::venv_python() else { panic!("the Python venv (mcap, pyarrow) is required") };
+    let out = std::process::Command::new(python).arg("-c").arg(PY_READER).arg(recording).output().unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let py: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let mut toa = Vec::new();
+    let mut el = Vec::new();
+    let mut true_x = Vec::new();
+    let mut sources = Vec::new();
+    for event in mmtrack_io::RecordingReader::open(recording).unwrap() {
+        match event.unwrap() {
+            mmtrack_io::RecordingEvent::SlamPaths(e) => {
+                toa.push(e.paths.iter().map(|p| p.toa_m.to_bits()).collect::<Vec<_>>());
+                el.push(e.paths.iter().map(|p| p.doa_el_rad.to_bits()).collect::<Vec<_>>());
+            }
+            mmtrack_io::RecordingEvent::SlamUeTruth { ue, .. } => true_x.push(ue.position_m[0].to_bits()),
+            mmtrack_io::RecordingEvent::SlamSource { kind, index, position_m, .. } => {
+                sources.push(serde_json::json!([kind.name(), index, position_m[2].to_bits()]));
+            }
+            _ => {}
+        }
+    }
+    assert_eq!(toa.len(), 40);
+    assert_eq!(py["toa_m"], serde_json::json!(toa));
+    assert_eq!(py["doa_el_rad"], serde_json::json!(el));
+    assert_eq!(py["true_x_m"], serde_json::json!(true_x));
+    assert_eq!(py["sources"], serde_json::Value::Array(sources));
 }
