@@ -1,5 +1,8 @@
-//! The 5G mmWave SLAM pipeline's commands: `reproduce kim` (the vehicular
-//! SLAM experiment of Kim et al. 2018) and `bench slam` (time per epoch).
+//! The 5G mmWave SLAM pipeline's commands: `simulate slam` (the world of
+//! Kim et al. 2018 into a recording), `process slam` (the filter on a
+//! recording, into tables), `reproduce kim` (the paper's experiment) and
+//! `bench slam` (time per epoch). `analyze` measures `process slam`'s tables
+//! with `mmtrack_analysis::slam`.
 
 pub mod bench;
 pub mod evaluate;

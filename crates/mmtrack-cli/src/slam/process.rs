@@ -45,7 +45,7 @@ pub struct SlamArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Filter parameters (TOML: any field of the SLAM filter configuration, e.g. particles = 500,
-    /// toa_std_m = 0.1); the others keep their defaults (the paper's).
+    /// toa_std_m = 0.1); the others keep their defaults (the paper's). bs_m is the recording's base station.
     #[arg(long, value_name = "TOML")]
     pub config: Option<PathBuf>,
     /// UE particles (overrides the configuration's, 2000).
