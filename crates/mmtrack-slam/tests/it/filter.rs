@@ -23,51 +23,6 @@ fn run(run: &SlamRun, config: SlamConfig, seed: u64) -> (Vec<[f64; 3]>, SlamFilt
 }
 
 #[test]
-#[ignore = "diagnostic: prints one paper run (cargo test --release -- --ignored --nocapture)"]
-fn diagnostic_paper_run() {
-    let scenario = SlamScenario::default();
-    let seed: u64 = std::env::var("SLAM_SEED").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
-    let r = scenario.realise(2018, seed).unwrap();
-    let min_sightings: usize = std::env::var("SLAM_MIN_SIGHTINGS").ok().and_then(|s| s.parse().ok()).unwrap_or(3);
-    let config = SlamConfig { confirm_min_sightings: min_sightings, ..SlamConfig::default() };
-    let mut filter = SlamFilter::new(config, r.truth[0].ue, seed).unwrap();
-    let mut nees = Vec::new();
-    for (k, (epoch, truth)) in r.epochs.iter().zip(&r.truth).enumerate() {
-        let report = filter.step(epoch).unwrap();
-        let e = report.estimate;
-        let err = sub3(e.state.position_m, truth.ue.position_m);
-        nees.push((norm3(err) / e.position_std_m).powi(2));
-        let vas: Vec<String> = filter
-            .sources()
-            .iter()
-            .filter(|s| s.status == SourceStatus::VirtualAnchor)
-            .map(|s| {
-                let nearest =
-                    r.world.virtual_anchors_m.iter().map(|t| norm3(sub3(*t, s.belief.mean_m))).fold(f64::MAX, f64::min);
-                format!("{:.2}/{:.2}", nearest, s.belief.spread_m())
-            })
-            .collect();
-        println!(
-            "{k:3} pos {:.3} (std {:.3}) head {:.4} bias {:.3} (std {:.3}) stages {} ess {:.0} upd {} va {}",
-            norm3(err),
-            e.position_std_m,
-            wrap_angle_rad(e.state.heading_rad - truth.ue.heading_rad).abs(),
-            e.state.clock_bias_m - truth.ue.clock_bias_m,
-            e.clock_bias_std_m,
-            report.stages,
-            report.ess,
-            report.paths_in_update,
-            vas.join(" ")
-        );
-    }
-    println!(
-        "mean squared normalised position error {:.2} (2 if consistent)",
-        nees.iter().sum::<f64>() / nees.len() as f64
-    );
-    let _ = PathOrigin::Clutter;
-}
-
-#[test]
 fn same_seed_same_run_for_any_thread_count() {
     let r = SlamScenario { epochs: 25, ..SlamScenario::default() }.realise(5, 0).unwrap();
     let config = SlamConfig { particles: 600, chunk_size: 64, ..SlamConfig::default() };
