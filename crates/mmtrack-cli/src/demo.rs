@@ -16,12 +16,11 @@
 //! 5. analyze every table together: trajectory metrics, MPC statistics,
 //!    SPEBT accuracy, SLAM metrics, plots, `report.md` and `report.html`.
 
-use std::ffi::OsString;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use clap::{Args, Parser};
+use clap::Args;
 
 use crate::inspect;
 
@@ -45,23 +44,16 @@ pub struct DemoArgs {
     out: PathBuf,
 }
 
-/// A path as a command-line argument.
-fn arg(path: &Path) -> anyhow::Result<String> {
-    path.to_str().map(str::to_string).with_context(|| format!("{}: the demo needs a UTF-8 path", path.display()))
-}
-
 /// Runs one `mmtrack` command line, printing it first.
 fn step(args: &[String], quiet: bool) -> anyhow::Result<()> {
     if !quiet {
         println!("\n$ mmtrack {}", args.join(" "));
     }
-    let mut argv: Vec<OsString> = vec!["mmtrack".into()];
-    argv.extend(args.iter().map(OsString::from));
+    let mut words = args.to_vec();
     if quiet {
-        argv.push("--quiet".into());
+        words.push("--quiet".into());
     }
-    let cli = crate::Cli::try_parse_from(argv).with_context(|| format!("demo step `mmtrack {}`", args.join(" ")))?;
-    let code = crate::run(cli).with_context(|| format!("demo step `mmtrack {}`", args.join(" ")))?;
+    let code = crate::run_words(&words).with_context(|| format!("demo step `mmtrack {}`", args.join(" ")))?;
     if code != ExitCode::SUCCESS {
         bail!("demo step `mmtrack {}` failed", args.join(" "));
     }
@@ -81,16 +73,16 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let sounder_scenario = input.join("sounder-scenario.toml");
     std::fs::write(&radar_scenario, DEMO_SCENARIO).with_context(|| radar_scenario.display().to_string())?;
     std::fs::write(&sounder_scenario, DEMO_SOUNDER_SCENARIO).with_context(|| sounder_scenario.display().to_string())?;
-    let folder = arg(&input.join(DEMO_SEQUENCE))?;
-    let recording = arg(&out.join("recording.mcap"))?;
-    let sounder = arg(&out.join("sounder.mcap"))?;
-    let slam = arg(&out.join("slam.mcap"))?;
+    let folder = crate::path_word(&input.join(DEMO_SEQUENCE))?;
+    let recording = crate::path_word(&out.join("recording.mcap"))?;
+    let sounder = crate::path_word(&out.join("sounder.mcap"))?;
+    let slam = crate::path_word(&out.join("slam.mcap"))?;
     let (slam_epochs, slam_particles) = (DEMO_SLAM_EPOCHS.to_string(), DEMO_SLAM_PARTICLES.to_string());
-    let tables = arg(&out.join("tables"))?;
-    let analysis = arg(&out.join("analysis"))?;
+    let tables = crate::path_word(&out.join("tables"))?;
+    let analysis = crate::path_word(&out.join("analysis"))?;
     let sets = DEMO_SOUNDER_SETS.to_string();
-    let radar_scenario = arg(&radar_scenario)?;
-    let sounder_scenario = arg(&sounder_scenario)?;
+    let radar_scenario = crate::path_word(&radar_scenario)?;
+    let sounder_scenario = crate::path_word(&sounder_scenario)?;
 
     if !quiet {
         println!(

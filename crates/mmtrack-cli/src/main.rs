@@ -126,6 +126,23 @@ fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyho
     }
 }
 
+/// Runs `args` (the words after `mmtrack`) in this process, as that command
+/// line would: what `demo`, `reproduce --all` and `process manifest` use to
+/// run the same commands a user types. Usage errors come back as one line.
+fn run_words(args: &[String]) -> anyhow::Result<ExitCode> {
+    let argv = std::iter::once("mmtrack".to_string()).chain(args.iter().cloned());
+    let cli = Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
+    run(cli)
+}
+
+/// `path` as a command-line word.
+///
+/// # Errors
+/// A path that is not UTF-8, naming it.
+fn path_word(path: &std::path::Path) -> anyhow::Result<String> {
+    path.to_str().map(str::to_string).ok_or_else(|| anyhow::anyhow!("{}: expected a UTF-8 path", path.display()))
+}
+
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     let quiet = cli.quiet;
     match cli.command {

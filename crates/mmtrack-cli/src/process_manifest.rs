@@ -19,12 +19,11 @@
 //! running them: exactly what a cluster runs, one job per line (see
 //! `examples/ray_process.py`).
 
-use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use clap::{Args, Parser};
+use clap::Args;
 use rayon::prelude::*;
 use serde::Deserialize;
 
@@ -107,7 +106,7 @@ fn shell_word(word: &str) -> String {
 pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let tasks = read_manifest(&args.manifest)?;
     let output = match &args.output {
-        Some(o) => o.to_str().map(str::to_string).with_context(|| format!("{}: expected a UTF-8 path", o.display()))?,
+        Some(o) => crate::path_word(o)?,
         None => "<tables>".to_string(),
     };
     let lines: Vec<Vec<String>> = tasks.iter().map(|t| command_line(t, &output, args.force)).collect();
@@ -121,11 +120,9 @@ pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         lines
             .par_iter()
             .map(|line| {
-                let mut argv: Vec<OsString> = vec!["mmtrack".into()];
-                argv.extend(line.iter().map(OsString::from));
-                argv.push("--quiet".into());
-                let cli = crate::Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
-                crate::run(cli)
+                let mut words = line.clone();
+                words.push("--quiet".into());
+                crate::run_words(&words)
             })
             .collect()
     })?;

@@ -19,14 +19,13 @@
 //! table of every metric; a test checks that block against the expectation
 //! files, so a README that no longer matches them fails CI.
 
-use std::ffi::OsString;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::{Context, bail};
-use clap::{Args, Parser};
+use clap::Args;
 use serde::{Deserialize, Serialize};
 
 /// File name of an experiment's measured metrics.
@@ -304,18 +303,6 @@ pub struct AllArgs {
     pub readme: Option<PathBuf>,
 }
 
-/// Runs `argv` (after `mmtrack`) as the CLI would.
-fn run_command(args: &[String]) -> anyhow::Result<ExitCode> {
-    let mut argv: Vec<OsString> = vec!["mmtrack".into()];
-    argv.extend(args.iter().map(OsString::from));
-    let cli = crate::Cli::try_parse_from(argv).with_context(|| format!("`mmtrack {}`", args.join(" ")))?;
-    crate::run(cli).with_context(|| format!("`mmtrack {}`", args.join(" ")))
-}
-
-fn path_arg(path: &Path) -> anyhow::Result<String> {
-    path.to_str().map(str::to_string).with_context(|| format!("{}: expected a UTF-8 path", path.display()))
-}
-
 /// `reproduce --all`.
 pub fn run(args: &AllArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if let Some(readme) = &args.readme {
@@ -330,13 +317,18 @@ pub fn run(args: &AllArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let mut timings = Vec::new();
     for (k, (spec, expected)) in EXPERIMENTS.iter().zip(&expectations).enumerate() {
         let dir = args.output.join(spec.name);
-        let mut line =
-            vec!["reproduce".to_string(), spec.name.to_string(), "-o".into(), path_arg(&dir)?, "--force".into()];
+        let mut line = vec![
+            "reproduce".to_string(),
+            spec.name.to_string(),
+            "-o".into(),
+            crate::path_word(&dir)?,
+            "--force".into(),
+        ];
         if args.smoke {
             line.push("--quick".into());
         }
         if let (Some(readme), true) = (&args.readme, spec.readme) {
-            line.extend(["--readme".to_string(), path_arg(readme)?]);
+            line.extend(["--readme".to_string(), crate::path_word(readme)?]);
         }
         line.push("--quiet".into());
         if !quiet {
@@ -345,7 +337,7 @@ pub fn run(args: &AllArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         let experiment_started = Instant::now();
         // Exit code 1 is a missed paper target: expected for some
         // experiments (README); the expectations decide here.
-        run_command(&line)?;
+        crate::run_words(&line).with_context(|| format!("`mmtrack {}`", line.join(" ")))?;
         let seconds = experiment_started.elapsed().as_secs_f64();
         timings.push((spec.name, seconds));
         let metrics_path = dir.join(METRICS_FILE);
