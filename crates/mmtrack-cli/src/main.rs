@@ -26,6 +26,7 @@ mod reproduce_all;
 mod reproduce_common;
 mod reproduce_mpc;
 mod reproduce_mpc_report;
+mod run_id;
 mod simulate;
 mod simulate_sounder;
 mod slam;

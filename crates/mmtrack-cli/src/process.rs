@@ -15,6 +15,7 @@ use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 
 use crate::progress;
+use crate::run_id::{RunIdArg, run_id_of};
 use crate::threads::ThreadsArg;
 
 #[path = "process_mpc.rs"]
@@ -87,7 +88,9 @@ enum Pipeline {
     /// Every task writes its sequence partitions into the same `-o`
     /// directory and runs as an independent task on the thread pool; the
     /// tables do not depend on the order or the thread count. A failed task
-    /// is reported and the others finish (exit 1). `--print-commands` prints
+    /// is reported and the others finish (exit 1). A task's `--run-id ID`
+    /// puts its tables under `<output>/run=<ID>/`, so several runs of one
+    /// sequence fit in one manifest. `--print-commands` prints
     /// the per-sequence command lines, one cluster job each (see
     /// examples/ray_process.py).
     #[command(verbatim_doc_comment)]
@@ -118,10 +121,8 @@ pub struct OdometryArgs {
     /// Replace existing output tables of this sequence.
     #[arg(long)]
     pub force: bool,
-    /// Name of this run: the tables go to `<output>/run=<ID>/`, so runs written under one directory read back
-    /// together with a `run` column (DuckDB/polars Hive partitioning) instead of overwriting each other.
-    #[arg(long, value_name = "ID")]
-    pub run_id: Option<String>,
+    #[command(flatten)]
+    pub run_id: RunIdArg,
     #[command(flatten)]
     pub threads: ThreadsArg,
 }
@@ -273,16 +274,7 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("a recording and --output are required (unless --print-config)");
     };
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
-    let run_output;
-    let output = match &args.run_id {
-        Some(id) => {
-            // The same characters as a sequence id: one safe path component.
-            table_path(output, "odometry", id).with_context(|| format!("--run-id {id}"))?;
-            run_output = output.join(format!("run={id}"));
-            &run_output
-        }
-        None => output,
-    };
+    let output = &args.run_id.run_dir(output)?;
     // Check the outputs before the work, so a refusal costs nothing.
     let sequence_hint = args.sequence.clone();
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &sequence_hint) {
@@ -345,11 +337,6 @@ pub fn write_outputs(
         written.push(write_table(output, sequence, &truth, &info, overwrite)?);
     }
     Ok(written)
-}
-
-/// The run id of a table directory `.../run=<id>`, if it is one.
-fn run_id_of(output: &Path) -> Option<String> {
-    output.file_name()?.to_str()?.strip_prefix("run=").map(str::to_string)
 }
 
 /// The odometry's poses in the ground truth's frame, and the `frame` entry of

@@ -15,6 +15,11 @@
 //! depend on the order or the number of threads. A failed task is reported
 //! and the others still finish; the command then exits 1.
 //!
+//! A task's own flags pass through unchanged, `--run-id` included: tasks of
+//! one sequence with different run ids write side by side under
+//! `<tables>/run=<ID>/` (`crate::run_id`), each refusing only its own
+//! existing partitions.
+//!
 //! `--print-commands` prints the per-sequence command lines instead of
 //! running them: exactly what a cluster runs, one job per line (see
 //! `examples/ray_process.py`).

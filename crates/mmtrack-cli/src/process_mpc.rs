@@ -31,6 +31,7 @@ use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_mpc::{MpcConfig, MpcPipeline, SnapshotDetections, SounderPulse};
 
 use crate::progress;
+use crate::run_id::{RunIdArg, run_id_of};
 use crate::threads::ThreadsArg;
 
 /// Every table `process mpc` may write.
@@ -71,6 +72,8 @@ pub struct MpcArgs {
     /// Replace existing output tables of this sequence.
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub run_id: RunIdArg,
 }
 
 fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
@@ -377,6 +380,7 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     if let Some(link) = &args.link {
         parse_link(link)?;
     }
+    let output = &args.run_id.run_dir(output)?;
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
     // Check the outputs before the work, so a refusal costs nothing.
     let hinted = match &args.sequence {
@@ -401,6 +405,7 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
             "pulse": args.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
             "link": args.link,
             "mpc": config,
+            "run_id": run_id_of(output),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),

@@ -43,6 +43,8 @@ use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata};
 use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, table_path, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
 
+use crate::run_id::{RunIdArg, run_id_of};
+
 /// The policies `process beam` runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
 pub enum TrackerArg {
@@ -108,6 +110,8 @@ pub struct BeamArgs {
     /// Replace existing output tables of these sequences.
     #[arg(long)]
     force: bool,
+    #[command(flatten)]
+    run_id: RunIdArg,
     #[command(flatten)]
     spebt: super::process_spebt::SpebtOptions,
     #[command(flatten)]
@@ -357,6 +361,7 @@ fn rows(
 }
 
 pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    let output = &args.run_id.run_dir(&args.output)?;
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
     let mut kinds = args.tracker.clone();
     kinds.sort();
@@ -368,7 +373,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
             );
         }
-        return super::process_geometric::run(&files, &args.output, args.force, &args.geometric, quiet);
+        return super::process_geometric::run(&files, output, args.force, &args.geometric, quiet);
     }
     if let Some(flag) = args.geometric.given().first() {
         bail!("{flag} is an option of --tracker geometric only");
@@ -380,7 +385,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                  give the sweep trackers in another call"
             );
         }
-        return super::process_spebt::run(&files, &args.output, args.force, &args.spebt, quiet);
+        return super::process_spebt::run(&files, output, args.force, &args.spebt, quiet);
     }
     if let Some(flag) = args.spebt.given().first() {
         bail!("{flag} is an option of --tracker spebt only");
@@ -397,7 +402,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             );
         }
         if overwrite == Overwrite::Refuse {
-            let path = table_path(&args.output, BEAM_SWEEPS_TRACKED.name, &r.sequence_id)?;
+            let path = table_path(output, BEAM_SWEEPS_TRACKED.name, &r.sequence_id)?;
             if path.exists() {
                 bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
             }
@@ -447,17 +452,18 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             "window": format!("{:?}", WindowTrackerConfig { search: search(args.reacquire), ..Default::default() }),
             "gnss_window": format!("{:?} (initial_offset_sigma_beams: each pass's map residual)", GnssTrackerConfig { search: search(args.reacquire), ..Default::default() }),
             "beam_map": "fitted leave-one-pass-out over the recordings of each site given together",
+            "run_id": run_id_of(output),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
     };
     let mut written = Vec::new();
     for (sequence, rows) in &tables {
-        written.push(write_table(&args.output, sequence, rows, &info, overwrite)?);
+        written.push(write_table(output, sequence, rows, &info, overwrite)?);
     }
     if !quiet {
         print_summary(&sites, &summaries);
-        println!("wrote {} {} partitions under {}", written.len(), BEAM_SWEEPS_TRACKED.name, args.output.display());
+        println!("wrote {} {} partitions under {}", written.len(), BEAM_SWEEPS_TRACKED.name, output.display());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -35,6 +35,8 @@ use mmtrack_sim::beam::overtaking::OvertakingScenario;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 
+use crate::run_id::run_id_of;
+
 /// Which beams the tracker measures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum ScheduleArg {
@@ -133,6 +135,9 @@ fn relative_m(v: &TwoVehicles, t_ns: i64) -> [f64; 2] {
 }
 
 /// Runs the tracker on each recording; one partition per recording.
+///
+/// `output_dir` is the run directory (`<output>/run=<ID>` with `--run-id`,
+/// `crate::run_id`): refusals look there and the tables go there.
 pub fn run(
     recordings: &[PathBuf],
     output_dir: &Path,
@@ -220,6 +225,7 @@ pub fn run(
                 "epoch_s": epoch_s,
                 "doppler_seed": seed,
                 "scenario": scenario,
+                "run_id": run_id_of(output_dir),
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),

@@ -43,6 +43,7 @@ use super::reproduce_spebt::{
 };
 use super::spebt_odometry::{into_link_frame, into_truth_frame};
 use super::spebt_output as output;
+use crate::run_id::run_id_of;
 
 /// The options of `--tracker spebt` (refused with the sweep trackers).
 #[derive(Args, Debug, Clone, Default)]
@@ -248,6 +249,9 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(Experiment, String)> {
 }
 
 /// Runs SPEBT on each recording; one partition of each table per recording.
+///
+/// `output_dir` is the run directory (`<output>/run=<ID>` with `--run-id`,
+/// `crate::run_id`): refusals look there and the tables go there.
 pub fn run(
     recordings: &[PathBuf],
     output_dir: &Path,
@@ -309,6 +313,7 @@ pub fn run(
                     "gain_threshold": experiment.tracker.gain_threshold,
                     "angle_threshold_deg": experiment.tracker.angle_threshold_deg,
                 },
+                "run_id": run_id_of(output_dir),
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),

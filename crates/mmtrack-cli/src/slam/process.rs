@@ -35,6 +35,7 @@ use mmtrack_sim::slam::SlamScenario;
 use mmtrack_slam::{Decision, EpochReport, SlamConfig, SlamFilter, SourceStatus};
 
 use super::simulate::SCENARIO_JSON_KEY;
+use crate::run_id::{RunIdArg, run_id_of};
 use crate::threads::ThreadsArg;
 
 #[derive(Args)]
@@ -72,6 +73,8 @@ pub struct SlamArgs {
     /// Replace existing output tables of this sequence.
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub run_id: RunIdArg,
     #[command(flatten)]
     pub threads: ThreadsArg,
 }
@@ -327,14 +330,15 @@ fn prior_of(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<UeStat
 }
 
 pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
+    let output = &args.run_id.run_dir(&args.output)?;
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
     if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &args.sequence) {
-        refuse_existing(&args.output, sequence)?;
+        refuse_existing(output, sequence)?;
     }
     let recording = read_recording(&args.recording)?;
     let sequence = args.sequence.clone().unwrap_or_else(|| recording.sequence_id.clone());
     if overwrite == Overwrite::Refuse {
-        refuse_existing(&args.output, &sequence)?;
+        refuse_existing(output, &sequence)?;
     }
     if args.strict {
         check_strict(&args.recording, &recording.epochs)?;
@@ -354,15 +358,16 @@ pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
                       prior.speed_mps, prior.turn_rate_radps, prior.clock_bias_m],
             "filter": config,
             "scenario": recording.scenario,
+            "run_id": run_id_of(output),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
     };
     let written: Vec<TableWriteSummary> = vec![
-        write_table(&args.output, &sequence, &tables.ue, &info, overwrite)?,
-        write_table(&args.output, &sequence, &tables.map, &info, overwrite)?,
-        write_table(&args.output, &sequence, &tables.associations, &info, overwrite)?,
-        write_table(&args.output, &sequence, &tables.true_sources, &info, overwrite)?,
+        write_table(output, &sequence, &tables.ue, &info, overwrite)?,
+        write_table(output, &sequence, &tables.map, &info, overwrite)?,
+        write_table(output, &sequence, &tables.associations, &info, overwrite)?,
+        write_table(output, &sequence, &tables.true_sources, &info, overwrite)?,
     ];
     if !quiet {
         let last = tables.map.iter().filter(|r| Some(r.epoch) == tables.ue.last().map(|u| u.epoch));

@@ -30,6 +30,7 @@ mod reproduce_kim;
 mod reproduce_shaham;
 mod reproduce_spebt;
 mod reproduce_zoechmann;
+mod run_ids;
 mod simulate_radar;
 mod simulate_sounder;
 mod slam_pipeline;
