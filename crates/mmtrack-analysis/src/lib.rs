@@ -29,13 +29,18 @@
 //! plots + report`. It depends on `mmtrack-core` and `mmtrack-io` only, never
 //! on algorithm crates, and never prints (the CLI does).
 //!
-//! ARCHITECTURE.md places polars here. This crate does not use it yet: the
-//! metrics so far are a few vectors per sequence, written through
-//! `mmtrack-io`'s `TableRow`, and polars would multiply the build time of the
-//! workspace on small machines for nothing we need. Campaign-wide queries run
-//! on the Hive-partitioned output with DuckDB or polars outside the binary.
+//! - [`campaign`]: several runs side by side, on polars: lazy scans of the
+//!   runs' Hive-partitioned result tables, group-bys per run for the pooled
+//!   rows (the pooling rules are stated there and used by every report).
+//!
+//! Polars stays inside this crate (ARCHITECTURE.md), with the features
+//! `lazy` and `parquet` only. The per-sequence metrics themselves (KITTI
+//! drift, RPE, ATE, MPC statistics) are algorithms on a few vectors and stay
+//! plain Rust; tables are written through `mmtrack-io`'s `TableRow` so every
+//! table carries the same units and run metadata.
 
 pub mod beam;
+pub mod campaign;
 pub mod export;
 pub mod mpc;
 pub mod mpc_artificial;

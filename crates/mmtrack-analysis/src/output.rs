@@ -11,14 +11,15 @@ use mmtrack_io::table::{RunInfo, write_table};
 
 use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::sweeps::{self, BeamSweepResults};
-use crate::beam::{BeamResults, plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
+use crate::beam::{plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
 use crate::mpc::MpcResult;
-use crate::pipeline::TrajectoryResult;
+use crate::pipeline::{RunResults, TrajectoryResult};
 use crate::trajectory::DriftOptions;
 use crate::{mpc_plots, mpc_report, plots, report, report_html};
 
-/// Entries of a results directory; `--force` replaces only a directory that
-/// holds nothing else, so a mistyped `-o` cannot delete unrelated files.
+/// Entries of a results directory (and `run=<id>` folders of several runs);
+/// `--force` replaces only a directory that holds nothing else, so a
+/// mistyped `-o` cannot delete unrelated files.
 pub const OWN_ENTRIES: [&str; 4] = ["tables", "plots", "report.md", "report.html"];
 
 /// What [`write_results`] wrote (final paths).
@@ -52,7 +53,7 @@ pub fn check_output(out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
     for entry in std::fs::read_dir(out).with_context(|| out.display().to_string())? {
         let name = entry.with_context(|| out.display().to_string())?.file_name().to_string_lossy().into_owned();
         any = true;
-        if !OWN_ENTRIES.contains(&name.as_str()) {
+        if !OWN_ENTRIES.contains(&name.as_str()) && !name.starts_with("run=") {
             foreign.push(name);
         }
     }
@@ -86,37 +87,100 @@ pub fn write_results(
     run: &RunInfo,
     overwrite: Overwrite,
 ) -> anyhow::Result<WrittenResults> {
-    write_all_results(out, results, &[], &BeamResults::default(), &[], skipped, options, run, overwrite)
+    let results = RunResults { trajectory: results.to_vec(), skipped: skipped.to_vec(), ..RunResults::default() };
+    write_all_results(out, &results, options, run, overwrite)
 }
 
-/// Writes tables, plots and the report for trajectory, MPC and beam-tracking
-/// (sweeps, SPEBT) results into `out`.
-#[allow(clippy::too_many_arguments)] // one per kind of result, plus where and how
+/// Writes tables, plots and the report of one run's results (trajectory,
+/// MPC, beam tracking, SLAM) into `out`.
 pub fn write_all_results(
     out: &Path,
-    results: &[TrajectoryResult],
-    mpc: &[MpcResult],
-    beam: &BeamResults,
-    slam: &[crate::slam::analysis::SlamSequenceResult],
-    skipped: &[(String, String)],
+    results: &RunResults,
     options: &DriftOptions,
     run: &RunInfo,
     overwrite: Overwrite,
 ) -> anyhow::Result<WrittenResults> {
     check_output(out, overwrite)?;
+    let staging = stage_beside(out)?;
+    let files = write_run_into(staging.path(), results, options, run)?;
+    publish(staging.keep(), out, overwrite)?;
+    Ok(WrittenResults::at(out, files))
+}
+
+/// Writes several runs into `out`: each run's results as [`write_all_results`]
+/// would, into `<out>/run=<id>/`, then the runs side by side (polars over
+/// the runs' result tables, [`crate::campaign`]): table
+/// `<out>/tables/run_comparison/sequence=all/part-0.parquet` and
+/// `<out>/report.md` / `report.html` linking each run's own report.
+pub fn write_campaign(
+    out: &Path,
+    runs: &[(String, RunResults)],
+    inputs: &[(String, PathBuf)],
+    options: &DriftOptions,
+    run: &RunInfo,
+    overwrite: Overwrite,
+) -> anyhow::Result<WrittenResults> {
+    check_output(out, overwrite)?;
+    let staging = stage_beside(out)?;
+    let mut files = 0;
+    for (id, results) in runs {
+        files += write_run_into(&staging.path().join(format!("run={id}")), results, options, run)
+            .with_context(|| format!("run {id}"))?;
+    }
+    let rows = crate::campaign::compare_runs(staging.path())?;
+    let tables = staging.path().join("tables");
+    write_table(&tables, "all", &rows, run, Overwrite::Refuse)?;
+    let ids: Vec<String> = runs.iter().map(|(id, _)| id.clone()).collect();
+    let mut text = String::from("# mmtrack campaign report\n\n");
+    text.push_str("| run | tables | report |\n|---|---|---|\n");
+    for (id, tables) in inputs {
+        text.push_str(&format!(
+            "| `{id}` | `{}` | [report.md](run={id}/report.md), [report.html](run={id}/report.html) |\n",
+            tables.display()
+        ));
+    }
+    text.push('\n');
+    text.push_str(&crate::campaign::section(&rows, &ids));
+    let report_path = staging.path().join("report.md");
+    std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
+    files += 1 + write_html(staging.path(), run)?;
+    publish(staging.keep(), out, overwrite)?;
+    Ok(WrittenResults::at(out, files))
+}
+
+fn stage_beside(out: &Path) -> anyhow::Result<tempfile::TempDir> {
     let parent = parent_dir(out);
     std::fs::create_dir_all(&parent).with_context(|| parent.display().to_string())?;
     let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "results".into());
-    let staging = mmtrack_io::staging_dir(&parent, &format!(".{name}."))
-        .with_context(|| format!("{}: cannot create a staging directory", parent.display()))?;
-    let mut files = write_into(staging.path(), results, skipped, options, run)?;
-    files += write_mpc_into(staging.path(), mpc, run)?;
-    files += write_beam_into(staging.path(), &beam.sweeps, run)?;
-    files += write_spebt_into(staging.path(), &beam.spebt, run)?;
-    files += crate::slam::analysis::write_slam_into(staging.path(), slam, run)?;
+    mmtrack_io::staging_dir(&parent, &format!(".{name}."))
+        .with_context(|| format!("{}: cannot create a staging directory", parent.display()))
+}
+
+impl WrittenResults {
+    fn at(out: &Path, files: usize) -> Self {
+        WrittenResults {
+            out_dir: out.to_path_buf(),
+            tables_dir: out.join("tables"),
+            plots_dir: out.join("plots"),
+            report: out.join("report.md"),
+            report_html: out.join("report.html"),
+            files,
+        }
+    }
+}
+
+/// One run's tables, plots, `report.md` and `report.html` into `dir`.
+fn write_run_into(dir: &Path, results: &RunResults, options: &DriftOptions, run: &RunInfo) -> anyhow::Result<usize> {
+    let RunResults { trajectory, mpc, beam, slam, skipped } = results;
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let mut files = write_into(dir, trajectory, skipped, options, run)?;
+    files += write_mpc_into(dir, mpc, run)?;
+    files += write_beam_into(dir, &beam.sweeps, run)?;
+    files += write_spebt_into(dir, &beam.spebt, run)?;
+    files += crate::slam::analysis::write_slam_into(dir, slam, run)?;
     if !mpc.is_empty() || !beam.is_empty() || !slam.is_empty() {
-        let report_path = staging.path().join("report.md");
-        let mut text = report::markdown(results, &[], options);
+        let report_path = dir.join("report.md");
+        let mut text = report::markdown(trajectory, &[], options)?;
         if !mpc.is_empty() {
             mpc_report::section(&mut text, mpc);
         }
@@ -132,16 +196,8 @@ pub fn write_all_results(
         text.push_str(&report::not_analyzed(skipped));
         std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
     }
-    files += write_html(staging.path(), run)?;
-    publish(staging.keep(), out, overwrite)?;
-    Ok(WrittenResults {
-        out_dir: out.to_path_buf(),
-        tables_dir: out.join("tables"),
-        plots_dir: out.join("plots"),
-        report: out.join("report.md"),
-        report_html: out.join("report.html"),
-        files,
-    })
+    files += write_html(dir, run)?;
+    Ok(files)
 }
 
 /// `report.html` beside the staged `report.md`, its plots embedded.
@@ -184,7 +240,7 @@ fn write_into(
         files += 6;
     }
     let report_path = dir.join("report.md");
-    std::fs::write(&report_path, report::markdown(results, skipped, options))
+    std::fs::write(&report_path, report::markdown(results, skipped, options)?)
         .with_context(|| report_path.display().to_string())?;
     Ok(files + 1)
 }

@@ -427,3 +427,56 @@ pub const MPC_TABLE_NAMES: [&str; 9] = [
     GROUND_TRUTH_TX.name,
     GROUND_TRUTH_RX.name,
 ];
+
+/// Everything one run's analysis produced (one table directory).
+#[derive(Debug, Clone, Default)]
+pub struct RunResults {
+    /// Trajectory metrics per sequence.
+    pub trajectory: Vec<TrajectoryResult>,
+    /// MPC statistics per sequence.
+    pub mpc: Vec<MpcResult>,
+    /// Beam-sweep accounting and SPEBT accuracy.
+    pub beam: BeamResults,
+    /// SLAM metrics per sequence.
+    pub slam: Vec<crate::slam::analysis::SlamSequenceResult>,
+    /// Sequences with tables but no metric, and why.
+    pub skipped: Vec<(String, String)>,
+}
+
+/// Analyzes every sequence of the table directory `root`: the metrics that
+/// apply ([`plan`]). An error when nothing applies names what was looked for
+/// and what was found.
+pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions) -> anyhow::Result<RunResults> {
+    let found = inventory(root)?;
+    let mut plan = plan(&found);
+    if plan.trajectory.is_empty()
+        && plan.mpc.is_empty()
+        && plan.beam.is_empty()
+        && plan.spebt.is_empty()
+        && plan.slam.is_empty()
+    {
+        let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
+        anyhow::bail!(
+            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
+             {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT) and slam_ue with slam_map and \
+             slam_true_sources (SLAM); found {}{reasons}",
+            root.display(),
+            ODOMETRY.name,
+            GROUND_TRUTH.name,
+            MPC_SETS.name,
+            MPC_DETECTIONS.name,
+            MPC_TRACKS.name,
+            MPC_LONG_TERM.name,
+            BEAM_SWEEPS_TRACKED.name,
+            SPEBT_SUMMARY.name,
+            SPEBT_PER_SLOT.name,
+            found.describe()
+        );
+    }
+    let trajectory = analyze_all(root, &plan, options)?;
+    let mpc = analyze_mpc_all(root, &plan, mpc_options)?;
+    let beam = analyze_beam_all(root, &plan)?;
+    let (slam, slam_skipped) = crate::slam::analysis::analyze_slam_all(root, &plan.slam)?;
+    plan.skipped.extend(slam_skipped);
+    Ok(RunResults { trajectory, mpc, beam, slam, skipped: plan.skipped })
+}

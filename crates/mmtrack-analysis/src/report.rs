@@ -5,7 +5,6 @@
 use std::fmt::Write;
 
 use crate::pipeline::TrajectoryResult;
-use crate::tables::TrajectoryMetrics;
 use crate::trajectory::DriftOptions;
 
 fn opt(v: Option<f64>, decimals: usize) -> String {
@@ -21,50 +20,6 @@ fn step(options: &DriftOptions) -> String {
         crate::trajectory::FirstFrameStep::Frames(n) => format!("every {n} frame{}", if n == 1 { "" } else { "s" }),
         crate::trajectory::FirstFrameStep::Metres(m) => format!("every {m} m"),
     }
-}
-
-/// Every sequence's metrics pooled (module docs of the trajectory section):
-/// KITTI drift weighted by segments, RMSEs by poses, RPE by frame pairs,
-/// maxima and sums over sequences. Fields without a pooled meaning (times,
-/// step, the end-point error) are taken from the first sequence or zeroed.
-#[must_use]
-/// `None` for no sequences.
-pub fn pooled_metrics(ms: &[&TrajectoryMetrics]) -> Option<TrajectoryMetrics> {
-    let rms = |value: fn(&TrajectoryMetrics) -> f64, weight: fn(&TrajectoryMetrics) -> f64| {
-        let total: f64 = ms.iter().map(|m| weight(m)).sum();
-        if total > 0.0 { (ms.iter().map(|m| weight(m) * value(m).powi(2)).sum::<f64>() / total).sqrt() } else { 0.0 }
-    };
-    let segments: u64 = ms.iter().map(|m| m.kitti_segments).sum();
-    let by_segments = |value: fn(&TrajectoryMetrics) -> Option<f64>| {
-        (segments > 0).then(|| {
-            ms.iter().filter_map(|m| value(m).map(|v| v * m.kitti_segments as f64)).sum::<f64>() / segments as f64
-        })
-    };
-    let poses = |m: &TrajectoryMetrics| m.associated_poses as f64;
-    let pairs = |m: &TrajectoryMetrics| m.associated_poses.saturating_sub(1) as f64;
-    let first = ms.first()?;
-    Some(TrajectoryMetrics {
-        estimate_poses: ms.iter().map(|m| m.estimate_poses).sum(),
-        associated_poses: ms.iter().map(|m| m.associated_poses).sum(),
-        interpolated_poses: ms.iter().map(|m| m.interpolated_poses).sum(),
-        dropped_poses: ms.iter().map(|m| m.dropped_poses).sum(),
-        path_length_m: ms.iter().map(|m| m.path_length_m).sum(),
-        estimate_path_length_m: ms.iter().map(|m| m.estimate_path_length_m).sum(),
-        kitti_segments: segments,
-        kitti_translational_pct: by_segments(|m| m.kitti_translational_pct),
-        kitti_rotational_deg_per_m: by_segments(|m| m.kitti_rotational_deg_per_m),
-        kitti_rotational_deg_per_100m: by_segments(|m| m.kitti_rotational_deg_per_100m),
-        ate_rmse_m: rms(|m| m.ate_rmse_m, poses),
-        ate_max_m: ms.iter().map(|m| m.ate_max_m).fold(0.0, f64::max),
-        x_rmse_m: rms(|m| m.x_rmse_m, poses),
-        y_rmse_m: rms(|m| m.y_rmse_m, poses),
-        position_rmse_m: rms(|m| m.position_rmse_m, poses),
-        yaw_rmse_rad: rms(|m| m.yaw_rmse_rad, poses),
-        final_position_error_m: 0.0,
-        rpe_translation_rmse_m: rms(|m| m.rpe_translation_rmse_m, pairs),
-        rpe_yaw_rmse_rad: rms(|m| m.rpe_yaw_rmse_rad, pairs),
-        ..(*first).clone()
-    })
 }
 
 /// The one-line summary of a sequence, as the CLI prints it.
@@ -99,14 +54,17 @@ pub fn one_line(r: &TrajectoryResult) -> String {
 }
 
 /// The report, with links relative to the output directory.
-#[must_use]
-pub fn markdown(results: &[TrajectoryResult], skipped: &[(String, String)], options: &DriftOptions) -> String {
+pub fn markdown(
+    results: &[TrajectoryResult],
+    skipped: &[(String, String)],
+    options: &DriftOptions,
+) -> anyhow::Result<String> {
     let mut out = String::from("# mmtrack analysis report\n\n");
     if !results.is_empty() {
-        trajectory_section(&mut out, results, options);
+        trajectory_section(&mut out, results, options)?;
     }
     out.push_str(&not_analyzed(skipped));
-    out
+    Ok(out)
 }
 
 /// The "Not analyzed" section (empty when nothing was skipped).
@@ -123,7 +81,7 @@ pub fn not_analyzed(skipped: &[(String, String)]) -> String {
     out
 }
 
-fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &DriftOptions) {
+fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &DriftOptions) -> anyhow::Result<()> {
     let _ = write!(
         out,
         "## Trajectory (table `odometry` against `ground_truth`)\n\n\
@@ -142,8 +100,11 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
          ATE max (m) | RMSE (x, y) (m) | yaw RMSE (deg) | RPE t (m) | RPE yaw (deg) | end-point error (m) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    let pooled =
-        if results.len() > 1 { pooled_metrics(&results.iter().map(|r| &r.metrics).collect::<Vec<_>>()) } else { None };
+    let pooled = if results.len() > 1 {
+        crate::campaign::pooled_trajectory_metrics(&results.iter().map(|r| &r.metrics).collect::<Vec<_>>())?
+    } else {
+        None
+    };
     // The pooled row has no end point.
     let rows = results
         .iter()
@@ -210,11 +171,13 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
              ![drift per length](plots/{s}/drift_per_length.svg)\n"
         );
     }
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
-    use super::*;
+    use crate::campaign::pooled_trajectory_metrics;
+    use crate::tables::TrajectoryMetrics;
 
     fn metrics(poses: u64, segments: u64, kitti_pct: Option<f64>, ate_m: f64, rpe_m: f64) -> TrajectoryMetrics {
         TrajectoryMetrics {
@@ -251,7 +214,7 @@ mod tests {
         // b: 31 poses (30 pairs), 1 segment at 5 %, ATE 2 m, RPE 0.2 m.
         let a = metrics(11, 3, Some(1.0), 1.0, 0.1);
         let b = metrics(31, 1, Some(5.0), 2.0, 0.2);
-        let p = pooled_metrics(&[&a, &b]).unwrap();
+        let p = pooled_trajectory_metrics(&[&a, &b]).unwrap().unwrap();
         assert_eq!((p.associated_poses, p.kitti_segments, p.path_length_m), (42, 4, 200.0));
         // (3 x 1 + 1 x 5) / 4 = 2 %.
         assert_eq!(p.kitti_translational_pct, Some(2.0));
@@ -261,7 +224,7 @@ mod tests {
         assert_eq!(p.ate_max_m, 4.0);
         // A sequence without segments adds none and no drift.
         let short = metrics(5, 0, None, 1.0, 0.1);
-        let p = pooled_metrics(&[&a, &short]).unwrap();
+        let p = pooled_trajectory_metrics(&[&a, &short]).unwrap().unwrap();
         assert_eq!((p.kitti_translational_pct, p.kitti_segments), (Some(1.0), 3));
     }
 }

@@ -34,6 +34,7 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::slam::tables::SLAM_MAP,
     &crate::slam::tables::SLAM_ASSOCIATIONS,
     &crate::slam::tables::SLAM_TRUE_SOURCES,
+    &crate::campaign::RUN_COMPARISON,
 ];
 
 mmtrack_io::define_table! {

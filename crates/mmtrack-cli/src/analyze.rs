@@ -7,16 +7,14 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use mmtrack_analysis::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY};
+use mmtrack_analysis::campaign::discover_runs;
 use mmtrack_analysis::mpc::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, MpcOptions};
-use mmtrack_analysis::output::{check_output, write_all_results};
-use mmtrack_analysis::pipeline::{analyze_all, analyze_beam_all, analyze_mpc_all, inventory, plan};
+use mmtrack_analysis::output::{check_output, write_all_results, write_campaign};
+use mmtrack_analysis::pipeline::{RunResults, analyze_run};
 use mmtrack_analysis::report::one_line;
 use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{
-    BEAM_SWEEPS_TRACKED, GROUND_TRUTH, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS, ODOMETRY, RunInfo,
-};
+use mmtrack_io::table::RunInfo;
 
 #[derive(Args)]
 #[command(
@@ -51,12 +49,25 @@ mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_s
 slam_summary,slam_per_epoch}/sequence=<id>/part-0.parquet, \
 <OUT>/tables/{beam_sweep_pooled,spebt_pooled}/sequence=all/part-0.parquet, \
 <OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md and <OUT>/report.html (the same report as one self-contained page: plots embedded, with the software version, inputs and configuration). The directory appears whole or not at all; an existing one is replaced \
-only with --force and only if it holds nothing but earlier results.",
-    after_help = "Example: mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80"
+only with --force and only if it holds nothing but earlier results.\n\n\
+Several runs (several TABLES directories, or run=<ID> folders written by `mmtrack process ... --run-id <ID>`; a \
+directory holding tables directly is a run named after the directory): each run is analyzed as above into \
+<OUT>/run=<ID>/, then the runs are compared side by side with polars (lazy scans of the runs' result tables, \
+group-bys per run): <OUT>/tables/run_comparison/sequence=all/part-0.parquet (long format: run, source_table, \
+sequence_id, key, metric, unit, value) and <OUT>/report.md / report.html with one table per result table and a \
+column per run. Pooled trajectory rows per run: `all` pools KITTI drift over the segments of every sequence (as the \
+KITTI devkit pools a dataset), RMSEs and ATE over poses, RPE over frame pairs; `mean` is the mean of the \
+per-sequence values.",
+    after_help = "Examples:\n  mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80\n  \
+mmtrack process odometry rec.mcap -o out/runs --preset cfear --run-id cfear\n  \
+mmtrack process odometry rec.mcap -o out/runs --preset fast-cfear --run-id fast-cfear\n  \
+mmtrack analyze out/runs -o out/compare    # cfear and fast-cfear side by side"
 )]
 pub struct AnalyzeArgs {
-    /// Table directory written by `mmtrack process` (any number of sequences).
-    tables: PathBuf,
+    /// Table directories written by `mmtrack process` (any number of sequences each). A directory holding
+    /// `run=<ID>` folders (`process --run-id`) gives one run per folder; several runs are compared side by side.
+    #[arg(required = true, value_name = "TABLES")]
+    tables: Vec<PathBuf>,
     /// Output directory for tables/, plots/, report.md and report.html.
     #[arg(short, long, value_name = "DIR")]
     output: PathBuf,
@@ -99,10 +110,12 @@ fn check_not_inside(tables: &Path, output: &Path) -> anyhow::Result<()> {
 
 pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
-    if !args.tables.is_dir() {
-        bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", args.tables.display());
+    for tables in &args.tables {
+        if !tables.is_dir() {
+            bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", tables.display());
+        }
+        check_not_inside(tables, &args.output)?;
     }
-    check_not_inside(&args.tables, &args.output)?;
     check_output(&args.output, overwrite)?;
     let options = drift_options(args);
     // Options are checked by the metric too, but a usage error should not wait for the tables to load.
@@ -111,42 +124,12 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         bail!("--first-path-range-db {}: expected a finite, non-negative number of dB", args.first_path_range_db);
     }
 
-    let found = inventory(&args.tables)?;
-    let mut plan = plan(&found);
-    if plan.trajectory.is_empty()
-        && plan.mpc.is_empty()
-        && plan.beam.is_empty()
-        && plan.spebt.is_empty()
-        && plan.slam.is_empty()
-    {
-        let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
-        bail!(
-            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
-             {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT) and slam_ue with slam_map and \
-             slam_true_sources (SLAM); found {}{reasons}",
-            args.tables.display(),
-            ODOMETRY.name,
-            GROUND_TRUTH.name,
-            MPC_SETS.name,
-            MPC_DETECTIONS.name,
-            MPC_TRACKS.name,
-            MPC_LONG_TERM.name,
-            BEAM_SWEEPS_TRACKED.name,
-            SPEBT_SUMMARY.name,
-            SPEBT_PER_SLOT.name,
-            found.describe()
-        );
-    }
-    let results = analyze_all(&args.tables, &plan, &options)?;
+    let runs = discover_runs(&args.tables)?;
     let mpc_options = MpcOptions { first_path_dynamic_range_db: args.first_path_range_db };
-    let mpc_results = analyze_mpc_all(&args.tables, &plan, &mpc_options)?;
-    let beam_results = analyze_beam_all(&args.tables, &plan)?;
-    let (slam_results, slam_skipped) = mmtrack_analysis::slam::analysis::analyze_slam_all(&args.tables, &plan.slam)?;
-    plan.skipped.extend(slam_skipped);
-    let run = RunInfo {
+    let config = |tables: serde_json::Value| RunInfo {
         config_json: serde_json::json!({
             "command": "analyze",
-            "tables": args.tables.display().to_string(),
+            "tables": tables,
             "segment_lengths_m": options.segment_lengths_m,
             "step": format!("{:?}", options.step),
             "first_path_range_db": args.first_path_range_db,
@@ -154,44 +137,63 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         })
         .to_string(),
     };
-    let written = write_all_results(
-        &args.output,
-        &results,
-        &mpc_results,
-        &beam_results,
-        &slam_results,
-        &plan.skipped,
-        &options,
-        &run,
-        overwrite,
-    )?;
+    // One run: its results straight into the output, as always.
+    if let [only] = runs.as_slice()
+        && args.tables.len() == 1
+        && only.tables == args.tables[0]
+    {
+        let results = analyze_run(&only.tables, &options, &mpc_options)?;
+        let run = config(serde_json::json!(only.tables.display().to_string()));
+        let written = write_all_results(&args.output, &results, &options, &run, overwrite)?;
+        if !quiet {
+            print_run(&results, "");
+            println!(
+                "wrote {} files: tables {}, plots {}, report {} and {}",
+                written.files,
+                written.tables_dir.display(),
+                written.plots_dir.display(),
+                written.report.display(),
+                written.report_html.display()
+            );
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut analyzed = Vec::new();
+    for run in &runs {
+        let results = analyze_run(&run.tables, &options, &mpc_options).with_context(|| format!("run {}", run.id))?;
+        analyzed.push((run.id.clone(), results));
+    }
+    let inputs: Vec<(String, PathBuf)> = runs.iter().map(|r| (r.id.clone(), r.tables.clone())).collect();
+    let tables: serde_json::Map<String, serde_json::Value> =
+        inputs.iter().map(|(id, t)| (id.clone(), serde_json::json!(t.display().to_string()))).collect();
+    let run = config(serde_json::Value::Object(tables));
+    let written = write_campaign(&args.output, &analyzed, &inputs, &options, &run, overwrite)?;
     if !quiet {
-        for r in &results {
-            println!("{}", one_line(r));
-        }
-        for r in &mpc_results {
-            println!("{}", mmtrack_analysis::mpc_report::one_line(r));
-        }
-        for line in mmtrack_analysis::beam::sweeps::one_lines(&beam_results.sweeps) {
-            println!("{line}");
-        }
-        for line in mmtrack_analysis::beam::spebt_analysis::one_lines(&beam_results.spebt) {
-            println!("{line}");
-        }
-        for line in mmtrack_analysis::slam::analysis::one_lines(&slam_results) {
-            println!("{line}");
-        }
-        for (sequence, reason) in &plan.skipped {
-            println!("{sequence}: not analyzed: {reason}");
+        for (id, results) in &analyzed {
+            print_run(results, &format!("run {id}: "));
         }
         println!(
-            "wrote {} files: tables {}, plots {}, report {} and {}",
+            "{} runs side by side: wrote {} files: each run under {}/run=<id>/, the comparison {} and report {} and {}",
+            analyzed.len(),
             written.files,
-            written.tables_dir.display(),
-            written.plots_dir.display(),
+            written.out_dir.display(),
+            written.tables_dir.join("run_comparison").display(),
             written.report.display(),
             written.report_html.display()
         );
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The one-line summaries of one run's results, each line after `prefix`.
+fn print_run(results: &RunResults, prefix: &str) {
+    let mut lines: Vec<String> = results.trajectory.iter().map(one_line).collect();
+    lines.extend(results.mpc.iter().map(mmtrack_analysis::mpc_report::one_line));
+    lines.extend(mmtrack_analysis::beam::sweeps::one_lines(&results.beam.sweeps));
+    lines.extend(mmtrack_analysis::beam::spebt_analysis::one_lines(&results.beam.spebt));
+    lines.extend(mmtrack_analysis::slam::analysis::one_lines(&results.slam));
+    lines.extend(results.skipped.iter().map(|(sequence, reason)| format!("{sequence}: not analyzed: {reason}")));
+    for line in lines {
+        println!("{prefix}{line}");
+    }
 }

@@ -275,3 +275,106 @@ fn export_writes_tum_and_boreas_files_that_parse_back() {
     assert_eq!(first[0], (estimate[1].t_ns / 1000) as f64);
     assert!(dir.path().join("b/boreas/ground_truth/s1.txt").is_file());
 }
+
+/// DuckDB over the campaign output, independent of polars: per run, the
+/// pooled trajectory values computed from the runs' own `trajectory_metrics`
+/// by the stated rules, and the same values read from `run_comparison`.
+const CAMPAIGN_QUERY: &str = r#"
+import json, sys, duckdb
+root = sys.argv[1]
+con = duckdb.connect()
+metrics = f"read_parquet('{root}/run=*/tables/trajectory_metrics/*/*.parquet', hive_partitioning=true)"
+comparison = f"read_parquet('{root}/tables/run_comparison/*/*.parquet', hive_partitioning=true)"
+mine = con.execute(f"""
+    SELECT run,
+        sum(kitti_translational_pct * kitti_segments) / sum(kitti_segments),
+        sqrt(sum(associated_poses * ate_rmse_m ^ 2) / sum(associated_poses)),
+        sqrt(sum((associated_poses - 1) * rpe_translation_rmse_m ^ 2) / sum(associated_poses - 1)),
+        avg(position_rmse_m),
+        count(*)
+    FROM {metrics} GROUP BY run ORDER BY run
+""").fetchall()
+theirs = con.execute(f"""
+    SELECT run,
+        max(CASE WHEN sequence_id = 'all' AND metric = 'kitti_translational_pct' THEN value END),
+        max(CASE WHEN sequence_id = 'all' AND metric = 'ate_rmse_m' THEN value END),
+        max(CASE WHEN sequence_id = 'all' AND metric = 'rpe_translation_rmse_m' THEN value END),
+        max(CASE WHEN sequence_id = 'mean' AND metric = 'position_rmse_m' THEN value END),
+        count(DISTINCT sequence_id) - 2
+    FROM {comparison} WHERE source_table = 'trajectory_metrics' GROUP BY run ORDER BY run
+""").fetchall()
+print(json.dumps({"duckdb": [list(r) for r in mine], "run_comparison": [list(r) for r in theirs]}))
+"#;
+
+#[test]
+fn analyze_puts_runs_side_by_side_with_pooled_rows_a_duckdb_query_reproduces() {
+    let python = super::common::venv_python().expect("Python 3 with pip access to PyPI (duckdb) is needed");
+    let dir = tempfile::tempdir().unwrap();
+    // Two runs of two sequences of different lengths (so the pooling weights
+    // matter); run b's estimates are run a's with a different yaw bias.
+    for (run, yaw_bias_rad) in [("a", 0.0), ("b", 1e-3)] {
+        for (sequence, frames) in [("long", 2400), ("short", 900)] {
+            let (mut estimate, truth) = drive(frames);
+            let mut bias = Se2::IDENTITY;
+            for e in &mut estimate {
+                bias = bias * Se2::new(0.0, 0.0, yaw_bias_rad);
+                e.world_from_vehicle = e.world_from_vehicle * bias;
+            }
+            write_pair(&dir.path().join("runs").join(format!("run={run}")), sequence, &estimate, Some(&truth));
+        }
+    }
+    // A third run given as a plain directory, named after it.
+    let (estimate, truth) = drive(900);
+    write_pair(&dir.path().join("baseline"), "short", &estimate, Some(&truth));
+    let lengths = "50,100,150,200";
+    let out = mmtrack(dir.path(), &["analyze", "runs", "baseline", "-o", "cmp", "--segment-lengths-m", lengths]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("run a: long:") && stdout.contains("3 runs side by side"), "{stdout}");
+    for run in ["a", "b", "baseline"] {
+        let report = dir.path().join(format!("cmp/run={run}/report.md"));
+        assert!(report.is_file() && dir.path().join(format!("cmp/run={run}/report.html")).is_file(), "{run}");
+    }
+    let report = std::fs::read_to_string(dir.path().join("cmp/report.md")).unwrap();
+    assert!(report.contains("## Runs side by side") && report.contains("| a | b | baseline |"), "{report}");
+    assert!(report.contains("| all | kitti_translational_pct | % |"), "{report}");
+    // Run baseline has no `long` sequence.
+    let long_ate = report.lines().find(|l| l.starts_with("| long | ate_rmse_m |")).unwrap();
+    assert!(long_ate.ends_with("| - |"), "{long_ate}");
+
+    // Independent check: DuckDB pools the runs' own tables by the stated rules.
+    let checked = Command::new(python).args(["-c", CAMPAIGN_QUERY]).arg(dir.path().join("cmp")).output().unwrap();
+    assert!(checked.status.success(), "{}", String::from_utf8_lossy(&checked.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&checked.stdout).unwrap();
+    let (duckdb, ours) = (json["duckdb"].as_array().unwrap(), json["run_comparison"].as_array().unwrap());
+    assert_eq!(duckdb.len(), 3, "{json}");
+    for (d, o) in duckdb.iter().zip(ours) {
+        assert_eq!(d[0], o[0]);
+        for k in 1..5 {
+            let (d, o) = (d[k].as_f64().unwrap(), o[k].as_f64().unwrap());
+            assert!(relative_diff(d, o) < 1e-12, "{json}");
+        }
+        assert_eq!(d[5], o[5], "sequences per run: {json}");
+    }
+    // The runs differ where they should: run b's heading bias (orientations
+    // only, positions untouched) shows in KITTI drift and RPE, not in the ATE.
+    let value = |run: usize, k: usize| duckdb[run][k].as_f64().unwrap();
+    assert!(value(1, 1) > value(0, 1) && value(1, 3) > value(0, 3), "{json}");
+    assert_eq!(value(1, 2), value(0, 2), "{json}");
+
+    // Deterministic, and replaced only with --force.
+    let again = mmtrack(dir.path(), &["analyze", "runs", "baseline", "-o", "cmp", "--segment-lengths-m", lengths]);
+    assert_eq!(again.status.code(), Some(1));
+    let forced =
+        mmtrack(dir.path(), &["analyze", "runs", "baseline", "-o", "cmp", "--segment-lengths-m", lengths, "--force"]);
+    assert!(forced.status.success(), "{}", text(&forced).1);
+    assert_eq!(std::fs::read_to_string(dir.path().join("cmp/report.md")).unwrap(), report);
+
+    // Two runs with one name are refused, naming both.
+    let clash = dir.path().join("clash");
+    write_pair(&clash.join("run=a"), "short", &estimate, Some(&truth));
+    let out = mmtrack(dir.path(), &["analyze", "runs", "clash", "-o", "cmp2"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(text(&out).1.contains("run id `a` twice"), "{}", text(&out).1);
+    assert!(!dir.path().join("cmp2").exists());
+}

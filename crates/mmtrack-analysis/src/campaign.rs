@@ -1,0 +1,549 @@
+//! Several runs at once: `mmtrack analyze <DIR>...` over the table
+//! directories of many runs (e.g. `process odometry --preset cfear` and
+//! `--preset fast-cfear`, or MPC tracking with two configurations), each
+//! analyzed as usual into `<out>/run=<id>/`, then compared side by side.
+//!
+//! The comparison is a polars query over the Hive-partitioned result tables
+//! the runs just wrote: a lazy scan of
+//! `<out>/run=*/tables/<table>/sequence=*/part-0.parquet` per result table
+//! (the `run` and `sequence` columns come from the paths), group-bys per run
+//! for the pooled rows, and one long table `run_comparison` (run, table,
+//! sequence, key, metric, unit, value) that the report turns into one
+//! side-by-side table per result table.
+//!
+//! Pooling rules (the same for one run's report, [`pooled_trajectory_metrics`]):
+//! - sequence `all`: KITTI drift pooled over segments, as the KITTI devkit
+//!   pools a dataset (the mean over every segment of every sequence, so a long
+//!   sequence weighs more); position/yaw RMSEs and the ATE pooled over the
+//!   associated poses (the RMS over all poses); the RPE over the frame pairs;
+//! - sequence `mean`: the plain mean of the per-sequence values (each sequence
+//!   weighs the same, as papers that report one number per sequence average).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use anyhow::{Context, bail};
+use mmtrack_io::table::TableSpec;
+use polars::df;
+use polars::prelude::{
+    DataFrame, DataType, Expr, Field, HiveOptions, IntoLazy, LazyFrame, NULL, PlRefPath, PlSmallStr, ScanArgsParquet,
+    Schema, SortMultipleOptions, col, lit, when,
+};
+
+use crate::tables::TrajectoryMetrics;
+
+mmtrack_io::define_table! {
+    /// `run_comparison`: the runs of one `analyze` side by side, long format.
+    pub const RUN_COMPARISON = "run_comparison",
+        "One value of one metric of one run, in long format: the main metrics of the result tables \
+(trajectory_metrics, mpc_summary, beam_sweep_summary, spebt_summary, slam_summary) of every run analyzed together, \
+plus the pooled trajectory rows (sequence `all`: KITTI drift over segments, RMSEs over poses, RPE over frame pairs; \
+sequence `mean`: the mean of the per-sequence values). Pivot on `run` for the side-by-side table.";
+    /// One row of [`RUN_COMPARISON`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct RunComparisonRow {
+        run: String, "", "run id (the run=<id> folder of the inputs, or the input directory's name)";
+        source_table: String, "", "result table the value comes from";
+        sequence_id: String, "", "sequence; `all` and `mean` for the pooled trajectory rows";
+        key: String, "",
+            "row within the sequence: the tracker of beam_sweep_summary, the experiment / trajectory of \
+spebt_summary, the scenario row of slam_summary; empty otherwise";
+        metric: String, "", "column of source_table";
+        unit: String, "", "unit of that column (empty for unitless)";
+        value: Option<f64>, "", "the value in that unit; null where the table has none (e.g. KITTI drift of a path \
+shorter than every segment)";
+    }
+}
+
+/// A result table and the columns compared across runs.
+#[derive(Debug, Clone, Copy)]
+pub struct ComparedTable {
+    /// The table.
+    pub spec: &'static TableSpec,
+    /// String columns that tell rows of one sequence apart (joined by ` / `).
+    pub keys: &'static [&'static str],
+    /// Numeric columns compared, in report order.
+    pub metrics: &'static [&'static str],
+}
+
+/// The main metric columns of `trajectory_metrics`, compared and pooled.
+pub const TRAJECTORY_COMPARED: [&str; 7] = [
+    "kitti_translational_pct",
+    "kitti_rotational_deg_per_100m",
+    "ate_rmse_m",
+    "position_rmse_m",
+    "yaw_rmse_rad",
+    "rpe_translation_rmse_m",
+    "rpe_yaw_rmse_rad",
+];
+
+/// What the side-by-side compares, per result table.
+pub const COMPARED: [ComparedTable; 5] = [
+    ComparedTable { spec: &crate::tables::TRAJECTORY_METRICS, keys: &[], metrics: &TRAJECTORY_COMPARED },
+    ComparedTable {
+        spec: &crate::mpc_tables::MPC_SUMMARY,
+        keys: &[],
+        metrics: &[
+            "mean_mpcs_per_set",
+            "birth_rate_per_m",
+            "death_rate_per_m",
+            "mean_detection_loss_db",
+            "mean_tracking_loss_db",
+            "mean_gmphd_tracking_loss_db",
+            "precision",
+            "recall",
+            "track_purity",
+        ],
+    },
+    ComparedTable {
+        spec: &crate::beam::tables::BEAM_SWEEP_SUMMARY,
+        keys: &["tracker"],
+        metrics: &["mean_loss_db", "p90_loss_db", "top1", "mean_beams_per_sweep"],
+    },
+    ComparedTable {
+        spec: &crate::beam::spebt_tables::SPEBT_SUMMARY,
+        keys: &["experiment", "trajectory"],
+        metrics: &["rmse_gain_pct", "rmse_aod_deg", "rmse_aoa_deg", "reinitialisation_share_pct"],
+    },
+    ComparedTable {
+        spec: &crate::slam::tables::SLAM_SUMMARY,
+        keys: &["row"],
+        metrics: &["ue_position_error_m", "ue_heading_error_rad", "ue_clock_bias_error_m", "va_error_m", "sp_error_m"],
+    },
+];
+
+/// One run's table directory, as named on the command line.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RunTables {
+    /// Run id: the `run=<id>` folder's id, else the directory's name.
+    pub id: String,
+    /// The table directory (`<table>/sequence=<id>/part-0.parquet` inside).
+    pub tables: PathBuf,
+}
+
+fn has_tables(dir: &Path) -> anyhow::Result<bool> {
+    Ok(!crate::pipeline::inventory(dir)?.tables.is_empty())
+}
+
+/// The runs under `inputs`: each input's `run=<id>` folders (what `process
+/// --run-id` writes), and the input itself when it holds tables directly
+/// (named after the directory), or when it holds neither. Errors name the
+/// input: not a directory, or two runs with the same id.
+pub fn discover_runs(inputs: &[PathBuf]) -> anyhow::Result<Vec<RunTables>> {
+    let mut runs: Vec<RunTables> = Vec::new();
+    for input in inputs {
+        if !input.is_dir() {
+            bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", input.display());
+        }
+        let mut found = Vec::new();
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(input)
+            .with_context(|| format!("{}: cannot read table directory", input.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .collect();
+        entries.sort();
+        for path in entries {
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            if let Some(id) = name.strip_prefix("run=") {
+                if id.is_empty() {
+                    bail!("{}: empty run id", path.display());
+                }
+                found.push(RunTables { id: id.to_string(), tables: path });
+            }
+        }
+        // The input is a run itself when it holds tables, or when it holds no
+        // runs either (analyzing it then says what was looked for).
+        if has_tables(input)? || found.is_empty() {
+            let name = input
+                .canonicalize()
+                .ok()
+                .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+                .unwrap_or_else(|| input.display().to_string());
+            found.insert(0, RunTables { id: name, tables: input.clone() });
+        }
+        for run in found {
+            if let Some(other) = runs.iter().find(|r| r.id == run.id) {
+                bail!(
+                    "run id `{}` twice: {} and {}; give runs distinct names (`mmtrack process ... --run-id <ID>`) \
+                     or directories with distinct names",
+                    run.id,
+                    other.tables.display(),
+                    run.tables.display()
+                );
+            }
+            runs.push(run);
+        }
+    }
+    Ok(runs)
+}
+
+/// A lazy scan of `<out>/run=*/tables/<table>/sequence=*/part-0.parquet`
+/// with `run` and `sequence` as string columns from the paths; `None` when
+/// no run has the table.
+pub fn scan_runs(out: &Path, table: &str) -> anyhow::Result<Option<LazyFrame>> {
+    let any = std::fs::read_dir(out)
+        .with_context(|| out.display().to_string())?
+        .filter_map(Result::ok)
+        .any(|e| e.file_name().to_string_lossy().starts_with("run=") && e.path().join("tables").join(table).is_dir());
+    if !any {
+        return Ok(None);
+    }
+    let pattern = out.join("run=*").join("tables").join(table).join("sequence=*").join("part-0.parquet");
+    let pattern = pattern.to_str().with_context(|| format!("{}: not UTF-8", out.display()))?.to_string();
+    let hive_schema: Schema =
+        [Field::new("run".into(), DataType::String), Field::new("sequence".into(), DataType::String)]
+            .into_iter()
+            .collect();
+    let args = ScanArgsParquet {
+        hive_options: HiveOptions {
+            enabled: Some(true),
+            hive_start_idx: 0,
+            schema: Some(Arc::new(hive_schema)),
+            try_parse_dates: false,
+        },
+        ..ScanArgsParquet::default()
+    };
+    let frame = LazyFrame::scan_parquet(PlRefPath::new(pattern.as_str()), args)
+        .with_context(|| format!("{pattern}: cannot scan"))?;
+    Ok(Some(frame))
+}
+
+/// `sqrt(sum(w v^2) / sum(w))`, 0 when the weights sum to 0.
+fn weighted_rms(value: &str, weight: Expr) -> Expr {
+    let total = weight.clone().sum();
+    when(total.clone().gt(lit(0.0)))
+        .then(((weight * col(value).pow(2)).sum() / total).sqrt())
+        .otherwise(lit(0.0))
+        .alias(value)
+}
+
+/// `sum(v segments) / sum(segments)` over the sequences with segments; null
+/// without any.
+fn by_segments(value: &str) -> Expr {
+    let segments = col("kitti_segments").cast(DataType::Float64);
+    let total = segments.clone().sum();
+    when(total.clone().gt(lit(0.0))).then((col(value) * segments).sum() / total).otherwise(lit(NULL)).alias(value)
+}
+
+/// The pooled trajectory metrics as polars aggregations over rows of
+/// `trajectory_metrics` (module docs: KITTI drift over segments, RMSEs and
+/// ATE over poses, RPE over frame pairs, counts and lengths summed, the
+/// largest ATE error).
+#[must_use]
+pub fn pooled_trajectory_exprs() -> Vec<Expr> {
+    let poses = col("associated_poses").cast(DataType::Float64);
+    let pairs = when(col("associated_poses").gt(lit(0u64)))
+        .then(col("associated_poses").cast(DataType::Float64) - lit(1.0))
+        .otherwise(lit(0.0));
+    let mut exprs: Vec<Expr> =
+        ["estimate_poses", "associated_poses", "interpolated_poses", "dropped_poses", "kitti_segments"]
+            .into_iter()
+            .map(|c| col(c).sum())
+            .collect();
+    exprs.extend(["path_length_m", "estimate_path_length_m"].into_iter().map(|c| col(c).sum()));
+    exprs.extend(
+        ["kitti_translational_pct", "kitti_rotational_deg_per_m", "kitti_rotational_deg_per_100m"]
+            .into_iter()
+            .map(by_segments),
+    );
+    exprs.extend(
+        ["ate_rmse_m", "x_rmse_m", "y_rmse_m", "position_rmse_m", "yaw_rmse_rad"]
+            .into_iter()
+            .map(|c| weighted_rms(c, poses.clone())),
+    );
+    exprs.push(col("ate_max_m").max());
+    exprs.extend(["rpe_translation_rmse_m", "rpe_yaw_rmse_rad"].into_iter().map(|c| weighted_rms(c, pairs.clone())));
+    exprs
+}
+
+fn f64_at(df: &DataFrame, name: &str, row: usize) -> anyhow::Result<Option<f64>> {
+    let column = df.column(name).with_context(|| format!("column {name}"))?;
+    let column = column.cast(&DataType::Float64).with_context(|| format!("column {name}"))?;
+    Ok(column.f64().with_context(|| format!("column {name}"))?.get(row))
+}
+
+fn u64_at(df: &DataFrame, name: &str, row: usize) -> anyhow::Result<u64> {
+    let column = df.column(name).with_context(|| format!("column {name}"))?;
+    let column = column.cast(&DataType::UInt64).with_context(|| format!("column {name}"))?;
+    Ok(column.u64().with_context(|| format!("column {name}"))?.get(row).unwrap_or(0))
+}
+
+/// One run's sequences pooled (module docs); `None` for no sequences.
+/// Fields without a pooled meaning (times, step, the end-point error) are
+/// the first sequence's or zero.
+pub fn pooled_trajectory_metrics(ms: &[&TrajectoryMetrics]) -> anyhow::Result<Option<TrajectoryMetrics>> {
+    let Some(first) = ms.first() else { return Ok(None) };
+    let u = |f: fn(&TrajectoryMetrics) -> u64| ms.iter().map(|m| f(m)).collect::<Vec<u64>>();
+    let v = |f: fn(&TrajectoryMetrics) -> f64| ms.iter().map(|m| f(m)).collect::<Vec<f64>>();
+    let o = |f: fn(&TrajectoryMetrics) -> Option<f64>| ms.iter().map(|m| f(m)).collect::<Vec<Option<f64>>>();
+    let frame = df!(
+        "estimate_poses" => u(|m| m.estimate_poses),
+        "associated_poses" => u(|m| m.associated_poses),
+        "interpolated_poses" => u(|m| m.interpolated_poses),
+        "dropped_poses" => u(|m| m.dropped_poses),
+        "kitti_segments" => u(|m| m.kitti_segments),
+        "path_length_m" => v(|m| m.path_length_m),
+        "estimate_path_length_m" => v(|m| m.estimate_path_length_m),
+        "kitti_translational_pct" => o(|m| m.kitti_translational_pct),
+        "kitti_rotational_deg_per_m" => o(|m| m.kitti_rotational_deg_per_m),
+        "kitti_rotational_deg_per_100m" => o(|m| m.kitti_rotational_deg_per_100m),
+        "ate_rmse_m" => v(|m| m.ate_rmse_m),
+        "x_rmse_m" => v(|m| m.x_rmse_m),
+        "y_rmse_m" => v(|m| m.y_rmse_m),
+        "position_rmse_m" => v(|m| m.position_rmse_m),
+        "yaw_rmse_rad" => v(|m| m.yaw_rmse_rad),
+        "ate_max_m" => v(|m| m.ate_max_m),
+        "rpe_translation_rmse_m" => v(|m| m.rpe_translation_rmse_m),
+        "rpe_yaw_rmse_rad" => v(|m| m.rpe_yaw_rmse_rad),
+    )?;
+    let pooled = frame.lazy().select(pooled_trajectory_exprs()).collect()?;
+    let f = |name: &str| f64_at(&pooled, name, 0);
+    let n = |name: &str| u64_at(&pooled, name, 0);
+    Ok(Some(TrajectoryMetrics {
+        estimate_poses: n("estimate_poses")?,
+        associated_poses: n("associated_poses")?,
+        interpolated_poses: n("interpolated_poses")?,
+        dropped_poses: n("dropped_poses")?,
+        path_length_m: f("path_length_m")?.unwrap_or(0.0),
+        estimate_path_length_m: f("estimate_path_length_m")?.unwrap_or(0.0),
+        kitti_segments: n("kitti_segments")?,
+        kitti_translational_pct: f("kitti_translational_pct")?,
+        kitti_rotational_deg_per_m: f("kitti_rotational_deg_per_m")?,
+        kitti_rotational_deg_per_100m: f("kitti_rotational_deg_per_100m")?,
+        ate_rmse_m: f("ate_rmse_m")?.unwrap_or(0.0),
+        ate_max_m: f("ate_max_m")?.unwrap_or(0.0),
+        x_rmse_m: f("x_rmse_m")?.unwrap_or(0.0),
+        y_rmse_m: f("y_rmse_m")?.unwrap_or(0.0),
+        position_rmse_m: f("position_rmse_m")?.unwrap_or(0.0),
+        yaw_rmse_rad: f("yaw_rmse_rad")?.unwrap_or(0.0),
+        final_position_error_m: 0.0,
+        rpe_translation_rmse_m: f("rpe_translation_rmse_m")?.unwrap_or(0.0),
+        rpe_yaw_rmse_rad: f("rpe_yaw_rmse_rad")?.unwrap_or(0.0),
+        ..(*first).clone()
+    }))
+}
+
+fn unit_of(spec: &TableSpec, column: &str) -> String {
+    spec.columns.iter().find(|c| c.name == column).map_or("", |c| c.unit).to_string()
+}
+
+fn string_at(df: &DataFrame, name: &str, row: usize) -> anyhow::Result<String> {
+    let column = df.column(name).with_context(|| format!("column {name}"))?;
+    Ok(column.str().with_context(|| format!("column {name}"))?.get(row).unwrap_or("").to_string())
+}
+
+/// Wide rows (run, sequence, keys, metrics) into long rows.
+fn long_rows(
+    df: &DataFrame,
+    compared: &ComparedTable,
+    sequence: Option<&str>,
+    rows: &mut Vec<RunComparisonRow>,
+) -> anyhow::Result<()> {
+    for row in 0..df.height() {
+        let run = string_at(df, "run", row)?;
+        let sequence_id = match sequence {
+            Some(s) => s.to_string(),
+            None => string_at(df, "sequence", row)?,
+        };
+        let key = compared.keys.iter().map(|k| string_at(df, k, row)).collect::<anyhow::Result<Vec<_>>>()?.join(" / ");
+        for metric in compared.metrics {
+            rows.push(RunComparisonRow {
+                run: run.clone(),
+                source_table: compared.spec.name.to_string(),
+                sequence_id: sequence_id.clone(),
+                key: key.clone(),
+                metric: (*metric).to_string(),
+                unit: unit_of(compared.spec, metric),
+                value: f64_at(df, metric, row)?,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The `run_comparison` rows of the runs written under `out`
+/// (`<out>/run=<id>/tables/...`): every compared table's metrics per run and
+/// sequence, and for `trajectory_metrics` the pooled rows `all` and `mean`
+/// per run (module docs). Sorted by table, sequence, key, metric order, run.
+pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<RunComparisonRow>> {
+    let mut rows = Vec::new();
+    for compared in &COMPARED {
+        let Some(frame) = scan_runs(out, compared.spec.name)? else { continue };
+        let what = || format!("{}: runs side by side", out.join("run=*/tables").join(compared.spec.name).display());
+        let mut select: Vec<Expr> = vec![col("run"), col("sequence")];
+        select.extend(compared.keys.iter().map(|k| col(*k)));
+        select.extend(compared.metrics.iter().map(|m| col(*m).cast(DataType::Float64)));
+        let mut order: Vec<PlSmallStr> = vec!["sequence".into()];
+        order.extend(compared.keys.iter().map(|k| PlSmallStr::from(*k)));
+        order.push("run".into());
+        let wide =
+            frame.clone().select(select).sort(order, SortMultipleOptions::default()).collect().with_context(what)?;
+        long_rows(&wide, compared, None, &mut rows)?;
+        if compared.spec.name == crate::tables::TRAJECTORY_METRICS.name {
+            let pooled = frame
+                .clone()
+                .group_by([col("run")])
+                .agg(pooled_trajectory_exprs())
+                .sort(["run"], SortMultipleOptions::default())
+                .collect()
+                .with_context(what)?;
+            long_rows(&pooled, compared, Some("all"), &mut rows)?;
+            let means = frame
+                .group_by([col("run")])
+                .agg(compared.metrics.iter().map(|m| col(*m).cast(DataType::Float64).mean()).collect::<Vec<_>>())
+                .sort(["run"], SortMultipleOptions::default())
+                .collect()
+                .with_context(what)?;
+            long_rows(&means, compared, Some("mean"), &mut rows)?;
+        }
+    }
+    let metric_rank = |row: &RunComparisonRow| {
+        COMPARED
+            .iter()
+            .find(|c| c.spec.name == row.source_table)
+            .and_then(|c| c.metrics.iter().position(|m| *m == row.metric))
+            .unwrap_or(usize::MAX)
+    };
+    let sequence_rank = |s: &str| match s {
+        "all" => 1,
+        "mean" => 2,
+        _ => 0,
+    };
+    rows.sort_by(|a, b| {
+        let table = |r: &RunComparisonRow| COMPARED.iter().position(|c| c.spec.name == r.source_table);
+        (table(a), sequence_rank(&a.sequence_id), &a.sequence_id, &a.key, metric_rank(a), &a.run).cmp(&(
+            table(b),
+            sequence_rank(&b.sequence_id),
+            &b.sequence_id,
+            &b.key,
+            metric_rank(b),
+            &b.run,
+        ))
+    });
+    Ok(rows)
+}
+
+/// (sequence, key, metric, unit) of one line of the side-by-side table.
+type LineId = (String, String, String, String);
+
+fn cell(value: Option<f64>) -> String {
+    match value {
+        None => "n/a".into(),
+        Some(v) if v != 0.0 && v.abs() < 1e-3 => format!("{v:.3e}"),
+        Some(v) => format!("{v:.4}"),
+    }
+}
+
+/// The side-by-side section of the campaign report: one Markdown table per
+/// compared result table, a column per run.
+#[must_use]
+pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
+    use std::fmt::Write;
+    let mut text = String::from("## Runs side by side\n\n");
+    let _ = writeln!(
+        text,
+        "Runs: {}. Every value is the run's own result table (`run=<id>/tables/...`); the same numbers are in \
+         `tables/run_comparison` (long format). Pooled trajectory rows: `all` pools KITTI drift over the segments of \
+         every sequence (as the KITTI devkit pools a dataset), the RMSEs and ATE over the associated poses and the \
+         RPE over the frame pairs; `mean` is the plain mean of the per-sequence values.\n",
+        runs.iter().map(|r| format!("`{r}`")).collect::<Vec<_>>().join(", ")
+    );
+    let tables: BTreeSet<&str> = rows.iter().map(|r| r.source_table.as_str()).collect();
+    for compared in COMPARED.iter().filter(|c| tables.contains(c.spec.name)) {
+        let _ = writeln!(text, "### {}\n", compared.spec.name);
+        let mut header = String::from("| sequence |");
+        let mut rule = String::from("|---|");
+        if !compared.keys.is_empty() {
+            header.push_str(&format!(" {} |", compared.keys.join(" / ")));
+            rule.push_str("---|");
+        }
+        header.push_str(" metric | unit |");
+        rule.push_str("---|---|");
+        for run in runs {
+            header.push_str(&format!(" {run} |"));
+            rule.push_str("---:|");
+        }
+        let _ = writeln!(text, "{header}\n{rule}");
+        // (sequence, key, metric) in row order -> run -> value.
+        let mut lines: Vec<(LineId, BTreeMap<String, Option<f64>>)> = Vec::new();
+        for row in rows.iter().filter(|r| r.source_table == compared.spec.name) {
+            let id = (row.sequence_id.clone(), row.key.clone(), row.metric.clone(), row.unit.clone());
+            match lines.last_mut() {
+                Some((last, values)) if *last == id => {
+                    values.insert(row.run.clone(), row.value);
+                }
+                _ => lines.push((id, BTreeMap::from([(row.run.clone(), row.value)]))),
+            }
+        }
+        for ((sequence, key, metric, unit), values) in lines {
+            let mut line = format!("| {sequence} |");
+            if !compared.keys.is_empty() {
+                line.push_str(&format!(" {key} |"));
+            }
+            line.push_str(&format!(" {metric} | {unit} |"));
+            for run in runs {
+                let value = values.get(run).map_or_else(|| "-".to_string(), |v| cell(*v));
+                line.push_str(&format!(" {value} |"));
+            }
+            let _ = writeln!(text, "{line}");
+        }
+        text.push('\n');
+    }
+    if tables.is_empty() {
+        text.push_str("No run has a result table with compared metrics.\n\n");
+    }
+    text.push_str("`-`: the run has no such row; `n/a`: the table holds no value (see that run's report for why).\n\n");
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn discover_runs_names_plain_and_run_folders_and_refuses_duplicates() {
+        let dir = tempfile::tempdir().unwrap();
+        let seq = |p: &Path| {
+            let d = p.join("odometry").join("sequence=s");
+            std::fs::create_dir_all(&d).unwrap();
+            std::fs::write(d.join("part-0.parquet"), b"x").unwrap();
+        };
+        let campaign = dir.path().join("campaign");
+        seq(&campaign.join("run=cfear"));
+        seq(&campaign.join("run=fast-cfear"));
+        let plain = dir.path().join("baseline");
+        seq(&plain);
+        let runs = discover_runs(&[campaign.clone(), plain.clone()]).unwrap();
+        let ids: Vec<&str> = runs.iter().map(|r| r.id.as_str()).collect();
+        assert_eq!(ids, ["cfear", "fast-cfear", "baseline"]);
+        assert_eq!(runs[2].tables, plain);
+
+        let other = dir.path().join("other");
+        seq(&other.join("run=cfear"));
+        let err = discover_runs(&[campaign, other]).unwrap_err().to_string();
+        assert!(err.contains("run id `cfear` twice"), "{err}");
+
+        // A directory without tables or runs is a run that will say so when analyzed.
+        let empty = dir.path().join("empty");
+        std::fs::create_dir_all(&empty).unwrap();
+        assert_eq!(discover_runs(std::slice::from_ref(&empty)).unwrap()[0].tables, empty);
+    }
+
+    #[test]
+    fn section_puts_runs_side_by_side_and_marks_missing_rows() {
+        let row = |run: &str, sequence: &str, value: Option<f64>| RunComparisonRow {
+            run: run.into(),
+            source_table: "trajectory_metrics".into(),
+            sequence_id: sequence.into(),
+            key: String::new(),
+            metric: "ate_rmse_m".into(),
+            unit: "m".into(),
+            value,
+        };
+        let rows = [row("a", "s1", Some(1.5)), row("b", "s1", None), row("a", "s2", Some(2.0))];
+        let text = section(&rows, &["a".into(), "b".into()]);
+        assert!(text.contains("| s1 | ate_rmse_m | m | 1.5000 | n/a |"), "{text}");
+        assert!(text.contains("| s2 | ate_rmse_m | m | 2.0000 | - |"), "{text}");
+    }
+}
