@@ -67,7 +67,7 @@ def check_table(table_dir, schemas_dir):
 def main():
     out, schemas_dir = pathlib.Path(sys.argv[1]), pathlib.Path(sys.argv[2])
     checked = 0
-    for tables in [out / "tables", out / "analysis" / "tables"]:
+    for tables in [out / "tables", out / "analysis" / "tables", out / "compare" / "tables"]:
         for table_dir in sorted(p for p in tables.iterdir() if p.is_dir()):
             check_table(table_dir, schemas_dir)
             checked += 1

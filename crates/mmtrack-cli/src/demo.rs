@@ -14,7 +14,9 @@
 //!    mmWave SLAM world of Kim et al. 2018 and run the SLAM filter on it
 //!    ([`DEMO_SLAM_PARTICLES`] particles);
 //! 5. analyze every table together: trajectory metrics, MPC statistics,
-//!    SPEBT accuracy, SLAM metrics, plots, `report.md` and `report.html`.
+//!    SPEBT accuracy, SLAM metrics, plots, `report.md` and `report.html`;
+//! 6. compare runs: radar odometry with both presets (`cfear`,
+//!    `fast-cfear`) as two named runs (`--run-id`), analyzed side by side.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -80,6 +82,8 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let (slam_epochs, slam_particles) = (DEMO_SLAM_EPOCHS.to_string(), DEMO_SLAM_PARTICLES.to_string());
     let tables = crate::path_word(&out.join("tables"))?;
     let analysis = crate::path_word(&out.join("analysis"))?;
+    let runs = crate::path_word(&out.join("runs"))?;
+    let compare = crate::path_word(&out.join("compare"))?;
     let sets = DEMO_SOUNDER_SETS.to_string();
     let radar_scenario = crate::path_word(&radar_scenario)?;
     let sounder_scenario = crate::path_word(&sounder_scenario)?;
@@ -89,7 +93,10 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             "mmtrack demo: radar odometry, multipath tracking, SPEBT beam tracking and 5G mmWave SLAM on simulated data"
         );
     }
-    let steps: [Vec<String>; 9] = [
+    // The demo drive is 14 m: KITTI segments scaled down from the devkit's
+    // 100..800 m, a first frame at every scan.
+    let kitti = ["--segment-lengths-m", "4,8,12", "--step-frames", "1"];
+    let steps: [Vec<String>; 12] = [
         line(&["simulate", "radar", "--scenario", &radar_scenario, "--format", "oxford", "-o", &folder, "--force"]),
         line(&["ingest", "oxford", &folder, "-o", &recording, "--bins", "auto", "--force"]),
         line(&["process", "odometry", &recording, "-o", &tables, "--preset", "cfear", "--force"]),
@@ -98,9 +105,21 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         line(&["process", "beam", &recording, "--tracker", "spebt", "--odometry", &tables, "-o", &tables, "--force"]),
         line(&["simulate", "slam", "--epochs", &slam_epochs, "-o", &slam, "--force"]),
         line(&["process", "slam", &slam, "-o", &tables, "--particles", &slam_particles, "--force"]),
-        // The demo drive is 14 m: KITTI segments scaled down from the
-        // devkit's 100..800 m, a first frame at every scan.
-        line(&["analyze", &tables, "-o", &analysis, "--segment-lengths-m", "4,8,12", "--step-frames", "1", "--force"]),
+        line(&[&["analyze", &tables, "-o", &analysis][..], &kitti, &["--force"]].concat()),
+        line(&["process", "odometry", &recording, "-o", &runs, "--preset", "cfear", "--run-id", "cfear", "--force"]),
+        line(&[
+            "process",
+            "odometry",
+            &recording,
+            "-o",
+            &runs,
+            "--preset",
+            "fast-cfear",
+            "--run-id",
+            "fast-cfear",
+            "--force",
+        ]),
+        line(&[&["analyze", &runs, "-o", &compare][..], &kitti, &["--force"]].concat()),
     ];
     for args in &steps {
         step(args, quiet)?;
@@ -117,6 +136,7 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!("  tables (Parquet, Hive layout): {tables}");
         println!("  analysis (metrics, plots):     {analysis}");
         println!("  report (open in a browser):    {analysis}/report.html (and report.md)");
+        println!("  runs cfear and fast-cfear:     {runs}/run=<id>/ (tables), side by side in {compare}/report.html");
     }
     Ok(ExitCode::SUCCESS)
 }

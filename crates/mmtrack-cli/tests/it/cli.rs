@@ -85,7 +85,11 @@ fn demo_runs_every_pipeline_and_its_tables_read_back_as_documented() {
     let checked = checked.unwrap();
     let (stdout, stderr) = text(&checked);
     assert!(checked.status.success(), "{stdout}{stderr}");
-    assert!(stdout.contains("tables/spebt_pooled: 1 rows") && stdout.contains("checked 31 tables"), "{stdout}");
+    assert!(stdout.contains("tables/spebt_pooled: 1 rows") && stdout.contains("checked 32 tables"), "{stdout}");
+    // The two odometry runs side by side.
+    let compare = std::fs::read_to_string(d.join("compare/report.md")).unwrap();
+    assert!(compare.contains("| cfear | fast-cfear |") && compare.contains("| all | ate_rmse_m | m |"), "{compare}");
+    assert!(d.join("compare/run=fast-cfear/report.html").is_file());
 }
 
 /// A headless browser from the system packages, if there is one.
