@@ -12,6 +12,7 @@ use mmtrack_io::table::{RunInfo, write_table};
 use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::sweeps::{self, BeamSweepResults};
 use crate::beam::{plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
+use crate::campaign::RunTables;
 use crate::mpc::MpcResult;
 use crate::pipeline::{RunResults, TrajectoryResult};
 use crate::trajectory::DriftOptions;
@@ -114,8 +115,7 @@ pub fn write_all_results(
 /// `<out>/report.md` / `report.html` linking each run's own report.
 pub fn write_campaign(
     out: &Path,
-    runs: &[(String, RunResults)],
-    inputs: &[(String, PathBuf)],
+    runs: &[(RunTables, RunResults)],
     options: &DriftOptions,
     run: &RunInfo,
     overwrite: Overwrite,
@@ -123,17 +123,17 @@ pub fn write_campaign(
     check_output(out, overwrite)?;
     let staging = stage_beside(out)?;
     let mut files = 0;
-    for (id, results) in runs {
+    for (RunTables { id, .. }, results) in runs {
         files += write_run_into(&staging.path().join(format!("run={id}")), results, options, run)
             .with_context(|| format!("run {id}"))?;
     }
     let rows = crate::campaign::compare_runs(staging.path())?;
     let tables = staging.path().join("tables");
     write_table(&tables, "all", &rows, run, Overwrite::Refuse)?;
-    let ids: Vec<String> = runs.iter().map(|(id, _)| id.clone()).collect();
+    let ids: Vec<String> = runs.iter().map(|(r, _)| r.id.clone()).collect();
     let mut text = String::from("# mmtrack campaign report\n\n");
     text.push_str("| run | tables | report |\n|---|---|---|\n");
-    for (id, tables) in inputs {
+    for (RunTables { id, tables }, _) in runs {
         text.push_str(&format!(
             "| `{id}` | `{}` | [report.md](run={id}/report.md), [report.html](run={id}/report.html) |\n",
             tables.display()

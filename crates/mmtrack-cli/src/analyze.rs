@@ -161,16 +161,15 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let mut analyzed = Vec::new();
     for run in &runs {
         let results = analyze_run(&run.tables, &options, &mpc_options).with_context(|| format!("run {}", run.id))?;
-        analyzed.push((run.id.clone(), results));
+        analyzed.push((run.clone(), results));
     }
-    let inputs: Vec<(String, PathBuf)> = runs.iter().map(|r| (r.id.clone(), r.tables.clone())).collect();
     let tables: serde_json::Map<String, serde_json::Value> =
-        inputs.iter().map(|(id, t)| (id.clone(), serde_json::json!(t.display().to_string()))).collect();
+        runs.iter().map(|r| (r.id.clone(), serde_json::json!(r.tables.display().to_string()))).collect();
     let run = config(serde_json::Value::Object(tables));
-    let written = write_campaign(&args.output, &analyzed, &inputs, &options, &run, overwrite)?;
+    let written = write_campaign(&args.output, &analyzed, &options, &run, overwrite)?;
     if !quiet {
-        for (id, results) in &analyzed {
-            print_run(results, &format!("run {id}: "));
+        for (run, results) in &analyzed {
+            print_run(results, &format!("run {}: ", run.id));
         }
         println!(
             "{} runs side by side: wrote {} files: each run under {}/run=<id>/, the comparison {} and report {} and {}",
