@@ -17,6 +17,7 @@ pub mod spebt_tables;
 pub mod sweeps;
 pub mod tables;
 pub mod zoechmann_plots;
+pub mod zoechmann_tables;
 
 /// What `mmtrack analyze` computed from beam-tracking tables.
 #[derive(Debug, Clone, Default, PartialEq)]

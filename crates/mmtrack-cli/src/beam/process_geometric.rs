@@ -23,7 +23,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail, ensure};
 use clap::{Args, ValueEnum};
-use mmtrack_analysis::beam::zoechmann_plots::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
+use mmtrack_analysis::beam::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
 use mmtrack_beam::geometric::{
     BeamSchedule, BeamSelection, DopplerBearing, GeometricTracker, GeometricTrackerConfig, RangeEstimator,
 };

@@ -11,7 +11,7 @@
 //! chunks on rayon, so the numbers do not depend on the thread count.
 
 use anyhow::Context;
-use mmtrack_analysis::beam::zoechmann_plots::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
+use mmtrack_analysis::beam::zoechmann_tables::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 use mmtrack_beam::geometric::{DopplerBearing, GeometricTracker, RangeEstimator};
 use mmtrack_sim::beam::overtaking::OvertakingReceiver;
 use mmtrack_sim::beam::overtaking_paths::{PathKind, Walls, realise_paths};

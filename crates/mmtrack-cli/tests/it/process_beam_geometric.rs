@@ -1,6 +1,6 @@
 //! `mmtrack process beam --tracker geometric` on a simulated sounder convoy.
 
-use mmtrack_analysis::beam::zoechmann_plots::GeometricEpochRow;
+use mmtrack_analysis::beam::zoechmann_tables::GeometricEpochRow;
 use mmtrack_io::table::read_table;
 
 use super::common::{mmtrack, root, text};
