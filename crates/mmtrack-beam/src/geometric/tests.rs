@@ -292,3 +292,58 @@ fn proposed_beats_the_baseline_and_genies_bound_it_on_one_half_overtaking() {
     assert!(proposed_error < 0.1, "{proposed_error}");
     assert!(nullspace_error < 0.02, "{nullspace_error}");
 }
+
+#[test]
+fn ranges_do_not_depend_on_where_the_azimuth_wraps() {
+    // Full overtaking starts behind the receiver (azimuth ~169 deg). Rotating
+    // the scene and the codebook by a whole number of beams moves the pass
+    // across the +/- 180 deg wrap (4 beams: from ~180 to ~-157 deg; 64 beams:
+    // the mirror side) and must leave every estimator's range unchanged, and
+    // turn the proposed tracker's projected azimuth (11), which picks its
+    // beam window, by exactly the rotation. (The rows (2), (5) use only sin b
+    // and cos b, so they cannot see a wrap; the projection and the
+    // distinct-azimuth count could.)
+    let (p0, v) = FULL;
+    let rotate = |p: [f64; 2], a: f64| {
+        let (s, c) = a.sin_cos();
+        [c * p[0] - s * p[1], s * p[0] + c * p[1]]
+    };
+    let ranges = |beams: i32| -> Vec<[f64; 5]> {
+        let a = f64::from(beams) * SPACING;
+        let (truth, measured) = pass(rotate(p0, a), rotate(v, a), 201, 100.0);
+        let mut estimators: [Box<dyn RangeEstimator>; 4] = [
+            Box::new(GeometricTracker::new(GeometricTrackerConfig::default()).unwrap()),
+            Box::new(HoChanBatch::new(LAMBDA).unwrap()),
+            Box::new(ErrorFreeRegressors::new(LAMBDA).unwrap()),
+            Box::new(NullspaceProjection::new(LAMBDA).unwrap()),
+        ];
+        truth
+            .iter()
+            .zip(&measured)
+            .map(|(t, m)| {
+                let truth_noisy = DopplerBearing { doppler_hz: m.doppler_hz, ..*t };
+                let mut out: [f64; 5] = std::array::from_fn(|e| {
+                    if e < 4 {
+                        estimators[e].update(if e < 2 { m } else { &truth_noisy }).unwrap();
+                        estimators[e].range_now_m().unwrap()
+                    } else {
+                        0.0
+                    }
+                });
+                let next_epoch_s = t.t_s + 0.02;
+                out[4] = mmtrack_core::wrap_angle_rad(estimators[0].state().unwrap().azimuth_rad(next_epoch_s) - a);
+                out
+            })
+            .collect()
+    };
+    let reference = ranges(0);
+    for beams in [4, 64, -60] {
+        for (k, (a, b)) in ranges(beams).iter().zip(&reference).enumerate() {
+            for e in 0..4 {
+                assert!((a[e] - b[e]).abs() <= 1e-6 * b[e].max(1.0), "rotated {beams} beams, epoch {k}, estimator {e}");
+            }
+            let turn = mmtrack_core::wrap_angle_rad(a[4] - b[4]).abs();
+            assert!(turn < 1e-6, "rotated {beams} beams, epoch {k}: projected azimuth off by {turn} rad");
+        }
+    }
+}
