@@ -546,7 +546,8 @@ fn write_outputs(
     }
     write_table(&tables, "zoechmann", &nmse_rows, &info, Overwrite::Refuse)?;
     write_table(&tables, "zoechmann", &summary_rows, &info, Overwrite::Refuse)?;
-    write_table(&tables, "zoechmann", &nlos::error_rows(nlos_result, epoch_s), &info, Overwrite::Refuse)?;
+    let nlos_errors = nlos::error_rows(nlos_result, epoch_s);
+    write_table(&tables, "zoechmann", &nlos_errors, &info, Overwrite::Refuse)?;
     write_table(&tables, "zoechmann", &nlos_result.labels, &info, Overwrite::Refuse)?;
     for r in results {
         let curves: Vec<NmseCurve> = ESTIMATORS
@@ -559,6 +560,18 @@ fn write_outputs(
         let file = format!("{}.svg", r.manoeuvre.name);
         std::fs::write(staging.path().join(&file), svg).with_context(|| file.clone())?;
     }
+    let walls = &experiment.nlos.walls;
+    let title = format!(
+        "{}: {} runs, each path tracked on its own (line of sight and single wall bounces)",
+        nlos_result.manoeuvre, nlos_result.runs
+    );
+    let svg = mmtrack_analysis::beam::zoechmann_plots::zoechmann_nlos_svg(
+        &title,
+        [walls.left_wall_m, walls.right_wall_m],
+        &nlos_result.labels,
+        &nlos_errors,
+    )?;
+    std::fs::write(staging.path().join("nlos.svg"), svg).context("nlos.svg")?;
     std::fs::write(staging.path().join("reproduce.md"), summary)?;
     crate::reproduce_all::write_metrics(staging.path(), &report::metrics(experiment, results))?;
     staging.publish()
