@@ -37,8 +37,8 @@ mmtrack_io::define_table! {
     /// `run_comparison`: the runs of one `analyze` side by side, long format.
     pub const RUN_COMPARISON = "run_comparison",
         "One value of one metric of one run, in long format: the main metrics of the result tables \
-(trajectory_metrics, mpc_summary, beam_sweep_summary, spebt_summary, slam_summary) of every run analyzed together, \
-plus the pooled trajectory rows (sequence `all`: KITTI drift over segments, RMSEs over poses, RPE over frame pairs; \
+(trajectory_metrics, mpc_summary, beam_sweep_summary, spebt_summary, geometric_summary, slam_summary) of every run \
+analyzed together, plus the pooled trajectory rows (sequence `all`: KITTI drift over segments, RMSEs over poses, RPE over frame pairs; \
 sequence `mean`: the mean of the per-sequence values). Pivot on `run` for the side-by-side table.";
     /// One row of [`RUN_COMPARISON`].
     #[derive(Debug, Clone, PartialEq)]
@@ -79,7 +79,7 @@ pub const TRAJECTORY_COMPARED: [&str; 7] = [
 ];
 
 /// What the side-by-side compares, per result table.
-pub const COMPARED: [ComparedTable; 5] = [
+pub const COMPARED: [ComparedTable; 6] = [
     ComparedTable { spec: &crate::tables::TRAJECTORY_METRICS, keys: &[], metrics: &TRAJECTORY_COMPARED },
     ComparedTable {
         spec: &crate::mpc_tables::MPC_SUMMARY,
@@ -105,6 +105,11 @@ pub const COMPARED: [ComparedTable; 5] = [
         spec: &crate::beam::spebt_tables::SPEBT_SUMMARY,
         keys: &["experiment", "trajectory"],
         metrics: &["rmse_gain_pct", "rmse_aod_deg", "rmse_aoa_deg", "reinitialisation_share_pct"],
+    },
+    ComparedTable {
+        spec: &crate::beam::zoechmann_tables::GEOMETRIC_SUMMARY,
+        keys: &[],
+        metrics: &["handover_s", "rls_share", "range_rmse_m", "azimuth_rmse_rad", "saving"],
     },
     ComparedTable {
         spec: &crate::slam::tables::SLAM_SUMMARY,

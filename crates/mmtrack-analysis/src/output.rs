@@ -9,9 +9,10 @@ use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
 
+use crate::beam::geometric_analysis::{self, GeometricResults};
 use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::sweeps::{self, BeamSweepResults};
-use crate::beam::{plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
+use crate::beam::{geometric_plots, plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
 use crate::campaign::RunTables;
 use crate::mpc::MpcResult;
 use crate::pipeline::{RunResults, TrajectoryResult};
@@ -177,6 +178,7 @@ fn write_run_into(dir: &Path, results: &RunResults, options: &DriftOptions, run:
     files += write_mpc_into(dir, mpc, run)?;
     files += write_beam_into(dir, &beam.sweeps, run)?;
     files += write_spebt_into(dir, &beam.spebt, run)?;
+    files += write_geometric_into(dir, &beam.geometric, run)?;
     files += crate::slam::analysis::write_slam_into(dir, slam, run)?;
     if !mpc.is_empty() || !beam.is_empty() || !slam.is_empty() {
         let report_path = dir.join("report.md");
@@ -189,6 +191,9 @@ fn write_run_into(dir: &Path, results: &RunResults, options: &DriftOptions, run:
         }
         if !beam.spebt.is_empty() {
             spebt_analysis::section(&mut text, &beam.spebt);
+        }
+        if !beam.geometric.is_empty() {
+            geometric_analysis::section(&mut text, &beam.geometric);
         }
         if !slam.is_empty() {
             crate::slam::analysis::section(&mut text, slam);
@@ -344,6 +349,22 @@ fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &RunInfo) -> anyhow
     }
     write_table(&tables, "all", &results.pooled, run, Overwrite::Refuse)?;
     Ok(files + 1)
+}
+
+fn write_geometric_into(dir: &Path, results: &GeometricResults, run: &RunInfo) -> anyhow::Result<usize> {
+    let tables = dir.join("tables");
+    for r in &results.sequences {
+        let seq = &r.sequence;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
+        let (file, _) = geometric_analysis::SEQUENCE_PLOT;
+        let title = format!("{seq}: geometric Doppler-bearing tracker against the truth");
+        write_svg(
+            &dir.join("plots").join(seq).join(file),
+            geometric_plots::geometric_tracking_svg(&title, &r.tracking_series()),
+            &format!("sequence {seq}: {file}"),
+        )?;
+    }
+    Ok(2 * results.sequences.len())
 }
 
 /// Moves the complete `staged` directory to `out`. An existing `out` is

@@ -15,9 +15,11 @@ use mmtrack_io::table::{
 };
 
 use crate::beam::BeamResults;
+use crate::beam::geometric_analysis::{self, GeometricResults};
 use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow, SpebtSummaryRow};
 use crate::beam::sweeps::analyze_beam_sweeps;
+use crate::beam::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
 use crate::mpc::{DistanceSource, MpcInput, MpcOptions, MpcResult, analyze_mpc};
 
 use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
@@ -99,6 +101,9 @@ pub struct Plan {
     /// Sequences with `spebt_summary` and `spebt_per_slot` tables (`process
     /// beam --tracker spebt`): SPEBT accuracy.
     pub spebt: Vec<String>,
+    /// Sequences with a `geometric_per_epoch` table (`process beam --tracker
+    /// geometric`): the geometric tracker's summary.
+    pub geometric: Vec<String>,
     /// Sequences with `slam_ue`, `slam_map` and `slam_true_sources` tables
     /// (`process slam`): the SLAM metrics.
     pub slam: Vec<String>,
@@ -112,7 +117,11 @@ pub struct Plan {
 /// accounting.
 #[must_use]
 pub fn plan(inventory: &Inventory) -> Plan {
-    let mut plan = Plan { beam: inventory.sequences(BEAM_SWEEPS_TRACKED.name).to_vec(), ..Plan::default() };
+    let mut plan = Plan {
+        beam: inventory.sequences(BEAM_SWEEPS_TRACKED.name).to_vec(),
+        geometric: inventory.sequences(GEOMETRIC_PER_EPOCH.name).to_vec(),
+        ..Plan::default()
+    };
     for seq in inventory.sequences(SPEBT_SUMMARY.name) {
         if inventory.sequences(SPEBT_PER_SLOT.name).contains(seq) {
             plan.spebt.push(seq.clone());
@@ -395,7 +404,8 @@ pub fn analyze_mpc_all(root: &Path, plan: &Plan, options: &MpcOptions) -> anyhow
 /// Beam-tracking results of every sequence of `plan`: beam-sweep accounting
 /// (table `beam_sweeps_tracked`) per sequence and pooled per site, and SPEBT
 /// accuracy (tables `spebt_summary`, `spebt_per_slot`) per sequence and
-/// pooled per experiment kind.
+/// pooled per experiment kind, and the geometric tracker's summary (table
+/// `geometric_per_epoch`) per sequence.
 pub fn analyze_beam_all(root: &Path, plan: &Plan) -> anyhow::Result<BeamResults> {
     let mut tables = BTreeMap::new();
     for sequence in &plan.beam {
@@ -412,7 +422,15 @@ pub fn analyze_beam_all(root: &Path, plan: &Plan) -> anyhow::Result<BeamResults>
         spebt.sequences.push(result);
     }
     spebt.pooled = spebt_analysis::pool(&spebt.sequences);
-    Ok(BeamResults { sweeps, spebt })
+    let mut geometric = GeometricResults::default();
+    for sequence in &plan.geometric {
+        let path = table_path(root, GEOMETRIC_PER_EPOCH.name, sequence)?;
+        let rows = read_required::<GeometricEpochRow>(root, sequence)?;
+        let result = geometric_analysis::sequence_result(sequence, rows)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        geometric.sequences.push(result);
+    }
+    Ok(BeamResults { sweeps, spebt, geometric })
 }
 
 /// Table names `process mpc` writes, for messages.
@@ -453,13 +471,14 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
         && plan.mpc.is_empty()
         && plan.beam.is_empty()
         && plan.spebt.is_empty()
+        && plan.geometric.is_empty()
         && plan.slam.is_empty()
     {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         anyhow::bail!(
             "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
-             {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT) and slam_ue with slam_map and \
-             slam_true_sources (SLAM); found {}{reasons}",
+             {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT), {} (geometric tracker) and \
+             slam_ue with slam_map and slam_true_sources (SLAM); found {}{reasons}",
             root.display(),
             ODOMETRY.name,
             GROUND_TRUTH.name,
@@ -470,6 +489,7 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
             BEAM_SWEEPS_TRACKED.name,
             SPEBT_SUMMARY.name,
             SPEBT_PER_SLOT.name,
+            GEOMETRIC_PER_EPOCH.name,
             found.describe()
         );
     }

@@ -28,6 +28,7 @@ pub const TABLES: &[&TableSpec] = &[
     &crate::beam::zoechmann_tables::ZOECHMANN_NLOS_ERROR,
     &crate::beam::zoechmann_tables::ZOECHMANN_PATH_LABELS,
     &crate::beam::zoechmann_tables::GEOMETRIC_PER_EPOCH,
+    &crate::beam::zoechmann_tables::GEOMETRIC_SUMMARY,
     &crate::slam::tables::SLAM_SUMMARY,
     &crate::slam::tables::SLAM_PER_EPOCH,
     &crate::slam::tables::SLAM_UE,

@@ -8,8 +8,14 @@
 //! The SPEBT experiment of Liu et al. 2024 (`mmtrack reproduce spebt`) has
 //! its own tables ([`spebt_tables`]) and figure ([`spebt_plots`]); `mmtrack
 //! analyze` checks and pools the tables `process beam --tracker spebt`
-//! writes ([`spebt_analysis`]).
+//! writes ([`spebt_analysis`]). The geometric Doppler-bearing tracker of
+//! Zoechmann et al. 2019 (`mmtrack reproduce zoechmann`) has its tables
+//! ([`zoechmann_tables`]) and figures ([`zoechmann_plots`]); `mmtrack
+//! analyze` summarises the table `process beam --tracker geometric` writes
+//! ([`geometric_analysis`], [`geometric_plots`]).
 
+pub mod geometric_analysis;
+pub mod geometric_plots;
 pub mod plots;
 pub mod spebt_analysis;
 pub mod spebt_plots;
@@ -26,12 +32,14 @@ pub struct BeamResults {
     pub sweeps: sweeps::BeamSweepResults,
     /// SPEBT runs (`spebt_summary` + `spebt_per_slot`).
     pub spebt: spebt_analysis::SpebtResults,
+    /// Geometric Doppler-bearing tracker runs (`geometric_per_epoch`).
+    pub geometric: geometric_analysis::GeometricResults,
 }
 
 impl BeamResults {
     /// Whether there is nothing.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.sweeps.is_empty() && self.spebt.is_empty()
+        self.sweeps.is_empty() && self.spebt.is_empty() && self.geometric.is_empty()
     }
 }

@@ -125,3 +125,34 @@ filter in use and the beams measured.";
         true_vy_mps: f64, "m/s", "true relative velocity, y";
     }
 }
+
+mmtrack_io::define_table! {
+    /// `geometric_summary`: `mmtrack analyze` of one `geometric_per_epoch` partition.
+    pub const GEOMETRIC_SUMMARY = "geometric_summary",
+        "The geometric Doppler-bearing tracker (Zoechmann et al. 2019) on one recording, from table \
+geometric_per_epoch (process beam --tracker geometric), one row per sequence: the hand-over from H-infinity to RLS \
+(the epoch of the third distinct azimuth, Sec. IV), the range and azimuth errors from the hand-over on (before it \
+the range is unobservable and the estimate is reported as not converged, never scored), and the beams measured \
+against a full scan at every epoch. Written by `mmtrack analyze`.";
+    /// One row of [`GEOMETRIC_SUMMARY`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct GeometricSummaryRow {
+        epochs: u64, "", "epochs (rows of geometric_per_epoch)";
+        duration_s: f64, "s", "time from the first to the last epoch";
+        handover_epoch: Option<u64>, "", "first epoch in RLS; null if the tracker never left H-infinity";
+        handover_s: Option<f64>, "s", "time of the first RLS epoch since the first epoch; null if never";
+        rls_share: f64, "", "share of the epochs in RLS (after the hand-over)";
+        range_rmse_m: Option<f64>, "m",
+            "RMS of range_m - true_range_m over the epochs from the hand-over on; null if never converged";
+        final_range_error_m: Option<f64>, "m", "abs(range_m - true_range_m) at the last epoch; null if never converged";
+        azimuth_rmse_rad: Option<f64>, "rad",
+            "RMS of the wrapped azimuth_rad - true_azimuth_rad from the hand-over on; null if never converged";
+        final_azimuth_error_rad: Option<f64>, "rad",
+            "abs of the wrapped azimuth error at the last epoch; null if never converged";
+        codebook_beams: u64, "",
+            "beams of a full scan: the most beams measured at one epoch (the schedule starts with full scans)";
+        beams_measured: u64, "", "beams measured over all epochs";
+        beams_full_scan: u64, "", "beams a full scan at every epoch would measure (epochs x codebook_beams)";
+        saving: f64, "", "beams_full_scan / beams_measured (the paper's 128 / 3 on the windowed epochs)";
+    }
+}
