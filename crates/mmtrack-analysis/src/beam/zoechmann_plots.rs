@@ -171,8 +171,8 @@ const PATH_COLORS: [RGBColor; 6] = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
 /// appearance in `errors`.
 ///
 /// The map's axes follow the true tracks, reflection points, receiver and
-/// walls (padded); estimates outside (an unconverged start) are counted in
-/// the legend, not drawn.
+/// walls (padded, with room for the legend above); estimates outside (an
+/// unconverged start) are counted in the legend, not drawn.
 ///
 /// # Errors
 /// When plotters fails to draw (not expected for finite input).
@@ -215,6 +215,8 @@ fn draw_nlos_map(
         (r.start - p)..(r.end + p)
     };
     let (x, y) = (pad(padded_range(xs)), pad(padded_range(ys)));
+    // Room above the scene for the legend (up to ten entries).
+    let y = y.start..(y.end + 0.8 * (y.end - y.start));
     let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
