@@ -40,13 +40,17 @@ Tables spebt_summary + spebt_per_slot of `mmtrack process beam --tracker spebt` 
 per sequence the RMSE of abs(alpha), AoD and AoA and the re-initialisation share (the summary is checked against the \
 per-slot RMSEs), pooled per experiment kind weighting each sequence by its (slots - 1) x runs estimates; a plot of \
 run 0 against the truth (Liu et al. Fig. 5).\n\n\
+Table geometric_per_epoch of `mmtrack process beam --tracker geometric` -> per sequence the hand-over from \
+H-infinity to RLS, the share of epochs in RLS, the range and azimuth errors from the hand-over on (null if it never \
+hands over), beams measured against a full scan every epoch and the saving (geometric_summary); a plot of range, \
+azimuth and beams over time with the H-infinity span shaded.\n\n\
 Tables slam_ue + slam_map + slam_true_sources of `mmtrack process slam` -> per sequence the 5G mmWave SLAM metrics \
 of Kim et al. 2018 (time-averaged UE position, heading and clock-bias errors, VA and SP localisation errors, the \
 epochs when all VAs and all SPs were confirmed) as slam_summary and slam_per_epoch, plots of the map (true and \
 estimated sources, true and estimated track), the UE errors and the confirmed sources over the epochs.\n\n\
 Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,mpc_summary,mpc_set_metrics,\
 mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary,spebt_summary,\
-slam_summary,slam_per_epoch}/sequence=<id>/part-0.parquet, \
+geometric_summary,slam_summary,slam_per_epoch}/sequence=<id>/part-0.parquet, \
 <OUT>/tables/{beam_sweep_pooled,spebt_pooled}/sequence=all/part-0.parquet, \
 <OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md and <OUT>/report.html (the same report as one self-contained page: plots embedded, with the software version, inputs and configuration). The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.\n\n\
@@ -190,6 +194,7 @@ fn print_run(results: &RunResults, prefix: &str) {
     lines.extend(results.mpc.iter().map(mmtrack_analysis::mpc_report::one_line));
     lines.extend(mmtrack_analysis::beam::sweeps::one_lines(&results.beam.sweeps));
     lines.extend(mmtrack_analysis::beam::spebt_analysis::one_lines(&results.beam.spebt));
+    lines.extend(mmtrack_analysis::beam::geometric_analysis::one_lines(&results.beam.geometric));
     lines.extend(mmtrack_analysis::slam::analysis::one_lines(&results.slam));
     lines.extend(results.skipped.iter().map(|(sequence, reason)| format!("{sequence}: not analyzed: {reason}")));
     for line in lines {

@@ -17,7 +17,9 @@ estimates it directly).";
         manoeuvre: String, "", "half-overtaking or full-overtaking";
         estimator: String, "",
             "proposed, ho-chan, error-free-genie, nullspace-genie; variants: proposed-full-scan (the proposed tracker on \
-a full scan's azimuth every epoch), proposed-gated (its 3-beam window only after the hand-over to RLS)";
+a full scan's azimuth every epoch), proposed-gated (its 3-beam window only after the hand-over to RLS); diagnostics: \
+ho-chan-true-azimuth (the baseline on the true azimuths), ho-chan-doppler-mps, error-free-genie-doppler-mps, \
+proposed-full-scan-doppler-mps (the Doppler equation (5) multiplied by the wavelength, i.e. in m/s)";
         epoch: u64, "", "epoch index (20 ms each)";
         t_s: f64, "s", "time since the start of the manoeuvre";
         runs: u64, "", "Monte Carlo runs with an estimate at this epoch";
@@ -53,6 +55,8 @@ nearest the projected azimuth) against a full scan at every epoch.";
         gated_saving: f64, "",
             "saving over whole runs of the gated variant (window only after the hand-over to RLS, full scans before)";
         gated_window_hit_rate: f64, "", "window_hit_rate of the gated variant";
+        first_window_off_share: f64, "",
+            "share of runs whose first 3-beam window (epoch 11) is centred more than 90 deg from the true azimuth";
         estimator_failures: u64, "", "estimator updates that returned an error (all estimators, all runs)";
     }
 }

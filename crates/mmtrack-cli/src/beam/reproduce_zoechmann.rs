@@ -50,7 +50,7 @@ pub const ZOECHMANN_EXPERIMENT: &str = include_str!("../../../../data/reproduce/
 
 #[derive(Args)]
 pub struct ZoechmannArgs {
-    /// Output directory (tables/, one SVG figure per manoeuvre, reproduce.md).
+    /// Output directory (tables/, one SVG figure per manoeuvre, nlos.svg, reproduce.md).
     #[arg(short, long, default_value = "out/reproduce/zoechmann")]
     output: PathBuf,
     /// Replace a previous run's output directory.
@@ -107,16 +107,55 @@ pub(super) struct Experiment {
     pub nlos: NlosConfig,
 }
 
-/// The estimators, in table order.
-pub(super) const ESTIMATORS: [&str; 6] =
-    ["proposed", "ho-chan", "error-free-genie", "nullspace-genie", "proposed-full-scan", "proposed-gated"];
+/// The estimators, in table order: the paper's four, two variants of the
+/// proposed tracker's beam schedule, and four diagnostics of the
+/// full-overtaking miss (README "Beam tracking II"):
+/// - `ho-chan-true-azimuth`: the baseline on the true azimuths (what its
+///   quantisation bias costs);
+/// - `*-doppler-mps`: the same estimators with the Doppler equation (5)
+///   multiplied by `lambda` ([`DOPPLER_MPS`]).
+pub(super) const ESTIMATORS: [&str; 10] = [
+    "proposed",
+    "ho-chan",
+    "error-free-genie",
+    "nullspace-genie",
+    "proposed-full-scan",
+    "proposed-gated",
+    "ho-chan-true-azimuth",
+    "ho-chan-doppler-mps",
+    "error-free-genie-doppler-mps",
+    "proposed-full-scan-doppler-mps",
+];
+/// The estimators of the time-series table and the figures: the paper's
+/// four and the two schedule variants.
+pub(super) const PLOTTED: usize = 6;
 /// Index of a variant: the proposed tracker on full-scan azimuths every
 /// epoch (no beam-selection feedback), a diagnostic beside the paper's four.
 pub(super) const FULL_SCAN_VARIANT: usize = 4;
 /// Index of a variant: the proposed tracker whose 3-beam window starts only
 /// once it has handed over to RLS (full scans before), a diagnostic.
 pub(super) const GATED_VARIANT: usize = 5;
+/// Index of the first `*-doppler-mps` diagnostic.
+pub(super) const DOPPLER_MPS_FIRST: usize = 7;
 const N: usize = ESTIMATORS.len();
+
+/// The Doppler equation (5) multiplied by `lambda`: `a_D = [0, sin b, cos
+/// b]`, `y = lambda nu` (the range rate, m/s, noise 0.5 m/s). The same
+/// equation, but in the unweighted least squares of (7) its weight against
+/// the bearing rows (2) (metres; quantisation error ~0.5 m at 20 m) drops by
+/// `lambda^2`: printed in Hz, a Doppler row counts `(1 / lambda)^2 = 4e4`
+/// times a bearing row of the same size. The estimators take it as a
+/// "wavelength" of 1 m and a "Doppler shift" of `lambda nu`.
+const DOPPLER_MPS: f64 = 1.0;
+
+/// Where an estimator's azimuths come from.
+#[derive(Clone, Copy)]
+enum Azimuths {
+    /// The strongest beam of a full codebook scan.
+    FullScan,
+    /// The true (unquantised) azimuth: the genies.
+    True,
+}
 
 /// Runs per rayon task: fixed, so partial sums merge in the same order on
 /// any number of threads.
@@ -141,6 +180,11 @@ pub(super) struct ManoeuvreResult {
     pub beams: [BeamCount; 2],
     pub window_epochs: [u64; 2],
     pub window_hits: [u64; 2],
+    /// Per epoch: windowed runs and hits (proposed 0, gated 1).
+    pub window_epochs_by_epoch: [Vec<u64>; 2],
+    pub window_hits_by_epoch: [Vec<u64>; 2],
+    /// Runs whose first window points more than 90 deg from the truth.
+    pub backwards_first_windows: u64,
     pub failures: u64,
     pub trace: PositionTrace,
 }
@@ -160,6 +204,14 @@ impl ManoeuvreResult {
     /// proposed tracker (0) or the gated variant (1).
     pub fn window_hit_rate(&self, i: usize) -> f64 {
         self.window_hits[i] as f64 / self.window_epochs[i].max(1) as f64
+    }
+
+    /// Share of windowed runs whose window held the strongest beam over the
+    /// epochs `epochs`, proposed (0) or gated (1); `None` without windows.
+    pub fn window_hit_rate_over(&self, i: usize, epochs: std::ops::Range<usize>) -> Option<f64> {
+        let n: u64 = self.window_epochs_by_epoch[i].get(epochs.clone())?.iter().sum();
+        let hits: u64 = self.window_hits_by_epoch[i].get(epochs)?.iter().sum();
+        (n > 0).then(|| hits as f64 / n as f64)
     }
 
     /// Mean hand-over time.
@@ -259,6 +311,13 @@ struct Chunk {
     beams: [BeamCount; 2],
     window_epochs: [u64; 2],
     window_hits: [u64; 2],
+    /// Per epoch: windowed runs and hits, of the proposed tracker (0) and
+    /// the gated variant (1).
+    window_epochs_by_epoch: [Vec<u64>; 2],
+    window_hits_by_epoch: [Vec<u64>; 2],
+    /// Runs whose first window (the proposed tracker's) is centred more than
+    /// 90 deg from the true azimuth.
+    backwards_first_windows: u64,
     failures: u64,
     trace: Option<PositionTrace>,
 }
@@ -274,6 +333,9 @@ impl Chunk {
             beams: [BeamCount::default(); 2],
             window_epochs: [0; 2],
             window_hits: [0; 2],
+            window_epochs_by_epoch: std::array::from_fn(|_| vec![0; epochs]),
+            window_hits_by_epoch: std::array::from_fn(|_| vec![0; epochs]),
+            backwards_first_windows: 0,
             failures: 0,
             trace: None,
         }
@@ -297,7 +359,14 @@ impl Chunk {
             self.beams[i].merge(&other.beams[i]);
             self.window_epochs[i] += other.window_epochs[i];
             self.window_hits[i] += other.window_hits[i];
+            for (a, b) in self.window_epochs_by_epoch[i].iter_mut().zip(&other.window_epochs_by_epoch[i]) {
+                *a += b;
+            }
+            for (a, b) in self.window_hits_by_epoch[i].iter_mut().zip(&other.window_hits_by_epoch[i]) {
+                *a += b;
+            }
         }
+        self.backwards_first_windows += other.backwards_first_windows;
         self.failures += other.failures;
         if self.trace.is_none() {
             self.trace = other.trace;
@@ -324,6 +393,9 @@ impl Chunk {
             beams: self.beams,
             window_epochs: self.window_epochs,
             window_hits: self.window_hits,
+            window_epochs_by_epoch: self.window_epochs_by_epoch,
+            window_hits_by_epoch: self.window_hits_by_epoch,
+            backwards_first_windows: self.backwards_first_windows,
             failures: self.failures,
             trace: self.trace.unwrap_or_default(),
         }
@@ -347,10 +419,15 @@ fn run_chunk(
     for run_index in runs {
         let run = scenario.realise(manoeuvre, experiment.seed, run_index)?;
         let proposed = GeometricTracker::new(tracker_config(experiment))?;
-        let mut estimators: [Option<Box<dyn RangeEstimator>>; 3] = [
-            Some(Box::new(HoChanBatch::new(lambda)?)),
-            Some(Box::new(ErrorFreeRegressors::new(lambda)?)),
-            Some(Box::new(NullspaceProjection::new(lambda)?)),
+        let mps_tracker = GeometricTrackerConfig { wavelength_m: DOPPLER_MPS, ..tracker_config(experiment) };
+        let mut estimators = [
+            Fed::new(1, HoChanBatch::new(lambda)?, Azimuths::FullScan, false),
+            Fed::new(2, ErrorFreeRegressors::new(lambda)?, Azimuths::True, false),
+            Fed::new(3, NullspaceProjection::new(lambda)?, Azimuths::True, false),
+            Fed::new(6, HoChanBatch::new(lambda)?, Azimuths::True, false),
+            Fed::new(DOPPLER_MPS_FIRST, HoChanBatch::new(DOPPLER_MPS)?, Azimuths::FullScan, true),
+            Fed::new(DOPPLER_MPS_FIRST + 1, ErrorFreeRegressors::new(DOPPLER_MPS)?, Azimuths::True, true),
+            Fed::new(DOPPLER_MPS_FIRST + 2, GeometricTracker::new(mps_tracker)?, Azimuths::FullScan, true),
         ];
         let mut full_scan = Some(GeometricTracker::new(tracker_config(experiment))?);
         let mut windowed = [
@@ -390,19 +467,23 @@ fn run_chunk(
                     }
                 }
             }
-            let azimuths = [full_scan_azimuth_rad, truth.azimuth_rad, truth.azimuth_rad];
-            for (e, slot) in estimators.iter_mut().enumerate() {
-                let Some(estimator) = slot else { continue };
-                let observation = DopplerBearing { t_s: truth.t_s, azimuth_rad: azimuths[e], doppler_hz };
+            for fed in &mut estimators {
+                let Some(estimator) = &mut fed.estimator else { continue };
+                let azimuth_rad = match fed.azimuths {
+                    Azimuths::FullScan => full_scan_azimuth_rad,
+                    Azimuths::True => truth.azimuth_rad,
+                };
+                let doppler_hz = if fed.doppler_mps { lambda * doppler_hz } else { doppler_hz };
+                let observation = DopplerBearing { t_s: truth.t_s, azimuth_rad, doppler_hz };
                 match estimator.update(&observation) {
                     Ok(()) => {
                         if let Some(r) = estimator.range_now_m() {
-                            add(&mut chunk, e + 1, k, r, truth.range_m);
+                            add(&mut chunk, fed.column, k, r, truth.range_m);
                         }
                     }
                     Err(_) => {
                         chunk.failures += 1;
-                        *slot = None;
+                        fed.estimator = None;
                     }
                 }
             }
@@ -418,6 +499,22 @@ fn run_chunk(
         }
     }
     Ok(chunk)
+}
+
+/// An estimator fed without beam-selection feedback: its NMSE column, the
+/// estimator (`None` after an error), where its azimuths come from and
+/// whether its Doppler equation is in m/s ([`DOPPLER_MPS`]).
+struct Fed {
+    column: usize,
+    estimator: Option<Box<dyn RangeEstimator>>,
+    azimuths: Azimuths,
+    doppler_mps: bool,
+}
+
+impl Fed {
+    fn new(column: usize, estimator: impl RangeEstimator + 'static, azimuths: Azimuths, doppler_mps: bool) -> Self {
+        Self { column, estimator: Some(Box::new(estimator)), azimuths, doppler_mps }
+    }
 }
 
 /// A proposed tracker that measures through its own beam window.
@@ -453,8 +550,18 @@ impl Windowed {
             BeamSelection::FullScan => full_scan_beam,
             BeamSelection::Window(window) => {
                 chunk.window_epochs[self.counter] += 1;
+                chunk.window_epochs_by_epoch[self.counter][k] += 1;
                 if window.contains(&full_scan_beam) {
                     chunk.window_hits[self.counter] += 1;
+                    chunk.window_hits_by_epoch[self.counter][k] += 1;
+                }
+                // The proposed tracker's first window (the gated one opens later).
+                if self.counter == 0
+                    && k == schedule.full_scan_epochs
+                    && let Some(projected) = projected
+                    && mmtrack_core::wrap_angle_rad(projected - truth.azimuth_rad).abs() > std::f64::consts::FRAC_PI_2
+                {
+                    chunk.backwards_first_windows += 1;
                 }
                 receiver.strongest_of(window, truth.azimuth_rad).unwrap_or(full_scan_beam)
             }
@@ -541,6 +648,7 @@ fn write_outputs(
             window_hit_rate: r.window_hit_rate(0),
             gated_saving: r.beams[1].saving().unwrap_or(f64::NAN),
             gated_window_hit_rate: r.window_hit_rate(1),
+            first_window_off_share: r.backwards_first_windows as f64 / r.runs.max(1) as f64,
             estimator_failures: r.failures,
         });
     }
@@ -550,7 +658,7 @@ fn write_outputs(
     write_table(&tables, "zoechmann", &nlos_errors, &info, Overwrite::Refuse)?;
     write_table(&tables, "zoechmann", &nlos_result.labels, &info, Overwrite::Refuse)?;
     for r in results {
-        let curves: Vec<NmseCurve> = ESTIMATORS
+        let curves: Vec<NmseCurve> = ESTIMATORS[..PLOTTED]
             .iter()
             .enumerate()
             .map(|(e, name)| NmseCurve { label: (*name).to_string(), nmse: r.nmse[e].clone() })

@@ -26,12 +26,13 @@ fn quick_zoechmann_writes_tables_figures_verdicts_and_its_readme_block() {
     println!("{report}");
     let missed = report.matches("| **missed** |").count();
     assert_eq!(out.status.success(), missed == 0, "exit status must follow the verdicts:\n{stderr}");
-    // 2 orderings, 1 hand-over, 2 savings (the time target only on the full run).
+    // 2 orderings, 1 hand-over, 2 savings (the time target only on the full
+    // run); the variants and diagnostics report without a verdict of met or missed.
     assert_eq!(report.matches("| met |").count() + missed, 5, "{report}");
 
     let nmse: Vec<ZoechmannNmseRow> =
         read_table(&dir.path().join("out/tables/zoechmann_nmse/sequence=zoechmann/part-0.parquet")).unwrap();
-    assert_eq!(nmse.len(), (101 + 201) * 6, "epochs 0..=100 and 0..=200, 6 estimators");
+    assert_eq!(nmse.len(), (101 + 201) * 10, "epochs 0..=100 and 0..=200, 10 estimators");
     assert!(nmse.iter().all(|r| r.runs == 2000), "every estimator counted in every run and epoch");
     // What holds at 2000 runs with wide margins (full-run numbers in the
     // README): on half overtaking the proposed tracker ends within 2 dB of
@@ -48,6 +49,14 @@ fn quick_zoechmann_writes_tables_figures_verdicts_and_its_readme_block() {
     let full = |e: &str| 10.0 * final_nmse(&nmse, "full-overtaking", e).log10();
     assert!(full("proposed-full-scan") < -30.0, "{report}");
     assert!(full("nullspace-genie") < full("error-free-genie"), "{report}");
+    // The diagnostics of that miss (full-run numbers in the README): with the
+    // Doppler equation in m/s the genie gains several dB (7.3 measured) and
+    // the tracker on full-scan azimuths ends below the baseline (1.7 dB);
+    // the baseline on true azimuths gains about 1 dB on full overtaking, 8 on
+    // half overtaking.
+    assert!(full("error-free-genie-doppler-mps") < full("error-free-genie") - 4.0, "{report}");
+    assert!(full("proposed-full-scan-doppler-mps") < full("ho-chan-doppler-mps"), "{report}");
+    assert!(half("ho-chan-true-azimuth") < half("ho-chan") - 5.0, "{report}");
 
     let summary: Vec<ZoechmannSummaryRow> =
         read_table(&dir.path().join("out/tables/zoechmann_summary/sequence=zoechmann/part-0.parquet")).unwrap();
@@ -64,7 +73,13 @@ fn quick_zoechmann_writes_tables_figures_verdicts_and_its_readme_block() {
     // median measured); the paper's "approximately 0.5 s".
     let median = full_row.handover_median_full_scan_s.unwrap();
     assert!((0.3..=0.8).contains(&median), "{full_row:?}");
-    for name in ["half-overtaking.svg", "full-overtaking.svg"] {
+    // The literal schedule's first window points away from the car in
+    // almost every full-overtaking run (the range is unobserved while every
+    // azimuth is the same beam), in none of the half-overtaking runs.
+    assert!(full_row.first_window_off_share > 0.9, "{full_row:?}");
+    let half_row = summary.iter().find(|r| r.manoeuvre == "half-overtaking").unwrap();
+    assert!(half_row.first_window_off_share == 0.0, "{half_row:?}");
+    for name in ["half-overtaking.svg", "full-overtaking.svg", "nlos.svg"] {
         let svg = std::fs::read_to_string(dir.path().join("out").join(name)).unwrap();
         let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(doc.root_element().tag_name().name(), "svg");
