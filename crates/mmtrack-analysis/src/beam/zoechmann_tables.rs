@@ -19,7 +19,8 @@ estimates it directly).";
             "proposed, ho-chan, error-free-genie, nullspace-genie; variants: proposed-full-scan (the proposed tracker on \
 a full scan's azimuth every epoch), proposed-gated (its 3-beam window only after the hand-over to RLS); diagnostics: \
 ho-chan-true-azimuth (the baseline on the true azimuths), ho-chan-doppler-mps, error-free-genie-doppler-mps, \
-proposed-full-scan-doppler-mps (the Doppler equation (5) multiplied by the wavelength, i.e. in m/s)";
+proposed-full-scan-doppler-mps (the Doppler equation (5) multiplied by the wavelength, i.e. in m/s), \
+proposed-doppler-mps (the same for the proposed tracker with its own beam window)";
         epoch: u64, "", "epoch index (20 ms each)";
         t_s: f64, "s", "time since the start of the manoeuvre";
         runs: u64, "", "Monte Carlo runs with an estimate at this epoch";

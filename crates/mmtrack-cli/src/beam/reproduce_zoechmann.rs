@@ -113,8 +113,9 @@ pub(super) struct Experiment {
 /// - `ho-chan-true-azimuth`: the baseline on the true azimuths (what its
 ///   quantisation bias costs);
 /// - `*-doppler-mps`: the same estimators with the Doppler equation (5)
-///   multiplied by `lambda` ([`DOPPLER_MPS`]).
-pub(super) const ESTIMATORS: [&str; 10] = [
+///   multiplied by `lambda` ([`DOPPLER_MPS`]); `proposed-doppler-mps` is the
+///   proposed tracker so, with its own beam window.
+pub(super) const ESTIMATORS: [&str; 11] = [
     "proposed",
     "ho-chan",
     "error-free-genie",
@@ -125,6 +126,7 @@ pub(super) const ESTIMATORS: [&str; 10] = [
     "ho-chan-doppler-mps",
     "error-free-genie-doppler-mps",
     "proposed-full-scan-doppler-mps",
+    "proposed-doppler-mps",
 ];
 /// The estimators of the time-series table and the figures: the paper's
 /// four and the two schedule variants.
@@ -137,6 +139,13 @@ pub(super) const FULL_SCAN_VARIANT: usize = 4;
 pub(super) const GATED_VARIANT: usize = 5;
 /// Index of the first `*-doppler-mps` diagnostic.
 pub(super) const DOPPLER_MPS_FIRST: usize = 7;
+/// Index of the proposed tracker with its own window and the Doppler
+/// equation in m/s.
+pub(super) const WINDOWED_DOPPLER_MPS: usize = 10;
+/// Trackers that measure through their own beam window (beam accounting
+/// index): the proposed tracker (0), the gated variant (1) and the
+/// proposed tracker with the Doppler equation in m/s (2).
+pub(super) const WINDOWED: usize = 3;
 const N: usize = ESTIMATORS.len();
 
 /// The Doppler equation (5) multiplied by `lambda`: `a_D = [0, sin b, cos
@@ -177,12 +186,12 @@ pub(super) struct ManoeuvreResult {
     pub handovers_full_scan_s: Vec<f64>,
     /// Beam accounting of the proposed tracker (index 0) and of the gated
     /// variant (1).
-    pub beams: [BeamCount; 2],
-    pub window_epochs: [u64; 2],
-    pub window_hits: [u64; 2],
+    pub beams: [BeamCount; WINDOWED],
+    pub window_epochs: [u64; WINDOWED],
+    pub window_hits: [u64; WINDOWED],
     /// Per epoch: windowed runs and hits (proposed 0, gated 1).
-    pub window_epochs_by_epoch: [Vec<u64>; 2],
-    pub window_hits_by_epoch: [Vec<u64>; 2],
+    pub window_epochs_by_epoch: [Vec<u64>; WINDOWED],
+    pub window_hits_by_epoch: [Vec<u64>; WINDOWED],
     /// Runs whose first window points more than 90 deg from the truth.
     pub backwards_first_windows: u64,
     pub failures: u64,
@@ -308,13 +317,13 @@ struct Chunk {
     squared_range: [Vec<f64>; N],
     handovers_s: Vec<f64>,
     handovers_full_scan_s: Vec<f64>,
-    beams: [BeamCount; 2],
-    window_epochs: [u64; 2],
-    window_hits: [u64; 2],
+    beams: [BeamCount; WINDOWED],
+    window_epochs: [u64; WINDOWED],
+    window_hits: [u64; WINDOWED],
     /// Per epoch: windowed runs and hits, of the proposed tracker (0) and
     /// the gated variant (1).
-    window_epochs_by_epoch: [Vec<u64>; 2],
-    window_hits_by_epoch: [Vec<u64>; 2],
+    window_epochs_by_epoch: [Vec<u64>; WINDOWED],
+    window_hits_by_epoch: [Vec<u64>; WINDOWED],
     /// Runs whose first window (the proposed tracker's) is centred more than
     /// 90 deg from the true azimuth.
     backwards_first_windows: u64,
@@ -330,9 +339,9 @@ impl Chunk {
             squared_range: std::array::from_fn(|_| vec![0.0; epochs]),
             handovers_s: Vec::new(),
             handovers_full_scan_s: Vec::new(),
-            beams: [BeamCount::default(); 2],
-            window_epochs: [0; 2],
-            window_hits: [0; 2],
+            beams: [BeamCount::default(); WINDOWED],
+            window_epochs: [0; WINDOWED],
+            window_hits: [0; WINDOWED],
             window_epochs_by_epoch: std::array::from_fn(|_| vec![0; epochs]),
             window_hits_by_epoch: std::array::from_fn(|_| vec![0; epochs]),
             backwards_first_windows: 0,
@@ -355,7 +364,7 @@ impl Chunk {
         }
         self.handovers_s.extend(other.handovers_s);
         self.handovers_full_scan_s.extend(other.handovers_full_scan_s);
-        for i in 0..2 {
+        for i in 0..WINDOWED {
             self.beams[i].merge(&other.beams[i]);
             self.window_epochs[i] += other.window_epochs[i];
             self.window_hits[i] += other.window_hits[i];
@@ -431,12 +440,20 @@ fn run_chunk(
         ];
         let mut full_scan = Some(GeometricTracker::new(tracker_config(experiment))?);
         let mut windowed = [
-            Windowed { tracker: Some(proposed), gated: false, estimator: 0, counter: 0 },
+            Windowed { tracker: Some(proposed), gated: false, doppler_factor: 1.0, estimator: 0, counter: 0 },
             Windowed {
                 tracker: Some(GeometricTracker::new(tracker_config(experiment))?),
                 gated: true,
+                doppler_factor: 1.0,
                 estimator: GATED_VARIANT,
                 counter: 1,
+            },
+            Windowed {
+                tracker: Some(GeometricTracker::new(mps_tracker)?),
+                gated: false,
+                doppler_factor: lambda,
+                estimator: WINDOWED_DOPPLER_MPS,
+                counter: 2,
             },
         ];
         let mut trace = (run_index == 0).then(PositionTrace::default);
@@ -523,6 +540,9 @@ struct Windowed {
     tracker: Option<GeometricTracker>,
     /// Window only after the hand-over to RLS (the gated variant).
     gated: bool,
+    /// Multiplies the measured Doppler shift: 1, or `lambda` for the Doppler
+    /// equation in m/s ([`DOPPLER_MPS`]).
+    doppler_factor: f64,
     /// Column of the NMSE sums.
     estimator: usize,
     /// Index of the beam accounting.
@@ -566,10 +586,11 @@ impl Windowed {
                 receiver.strongest_of(window, truth.azimuth_rad).unwrap_or(full_scan_beam)
             }
         };
+        let doppler_hz = truth.measured_doppler_hz();
         let observation = DopplerBearing {
             t_s: truth.t_s,
             azimuth_rad: receiver.beam_azimuth_rad(beam),
-            doppler_hz: truth.measured_doppler_hz(),
+            doppler_hz: self.doppler_factor * doppler_hz,
         };
         if tracker.update(&observation).is_err() {
             chunk.failures += 1;

@@ -2,7 +2,8 @@
 //! README block).
 
 use super::reproduce_zoechmann::{
-    DOPPLER_MPS_FIRST, ESTIMATORS, Experiment, FULL_SCAN_VARIANT, GATED_VARIANT, ManoeuvreResult, PLOTTED, quantile,
+    DOPPLER_MPS_FIRST, ESTIMATORS, Experiment, FULL_SCAN_VARIANT, GATED_VARIANT, ManoeuvreResult, PLOTTED, WINDOWED,
+    WINDOWED_DOPPLER_MPS, quantile,
 };
 
 /// The README block the summary replaces with `--readme`.
@@ -258,7 +259,8 @@ pub fn summary(
 /// baseline and genies with the quantisation or the Doppler weighting
 /// removed, and where the beam window loses the transmitter.
 fn diagnostics(experiment: &Experiment, results: &[ManoeuvreResult]) -> String {
-    let columns = [1, 6, 2, 4, DOPPLER_MPS_FIRST, DOPPLER_MPS_FIRST + 1, DOPPLER_MPS_FIRST + 2, 3];
+    let columns =
+        [1, 6, 2, 4, DOPPLER_MPS_FIRST, DOPPLER_MPS_FIRST + 1, DOPPLER_MPS_FIRST + 2, WINDOWED_DOPPLER_MPS, 3];
     let mut out = String::from(
         "\nDiagnostics, NMSE of the range at the end of the run (dB): the baseline on the true azimuths, and the \
          estimators with the Doppler equation (5) multiplied by lambda (range rate in m/s; printed in Hz, a Doppler \
@@ -276,7 +278,7 @@ fn diagnostics(experiment: &Experiment, results: &[ManoeuvreResult]) -> String {
     let bin = (0.5 / epoch_s).round().max(1.0) as usize;
     out.push_str(
         "\nShare of windowed runs whose 3-beam window holds the strongest beam, per 0.5 s (proposed / gated \
-         variant; - before any window):\n\n| manoeuvre | first window > 90 deg off | ",
+         variant / proposed-doppler-mps; - before any window):\n\n| manoeuvre | first window > 90 deg off | ",
     );
     // Bins of 0.5 s over the epochs after the first; the last epoch joins the last bin.
     let epochs = results.iter().map(|r| r.window_epochs_by_epoch[0].len()).max().unwrap_or(0);
@@ -301,7 +303,7 @@ fn diagnostics(experiment: &Experiment, results: &[ManoeuvreResult]) -> String {
                     return String::new();
                 }
                 let range = b..if b + bin + 1 >= n { n } else { b + bin };
-                format!("{} / {}", pct(r.window_hit_rate_over(0, range.clone())), pct(r.window_hit_rate_over(1, range)))
+                (0..WINDOWED).map(|i| pct(r.window_hit_rate_over(i, range.clone()))).collect::<Vec<_>>().join(" / ")
             })
             .collect();
         out.push_str(&format!(
