@@ -51,8 +51,7 @@ pub fn files(dir: &Path) -> Vec<PathBuf> {
 }
 
 /// PyPI packages of the independent readers and writers, pinned.
-const REQUIREMENTS: &str =
-    "mcap==1.6.0 mcap-protobuf-support==0.6.0 protobuf==7.36.2 pyarrow==26.0.1 duckdb==2.0.0 numpy==2.4.6";
+const REQUIREMENTS: &str = "mcap==1.6.0 mcap-protobuf-support==0.6.0 protobuf==7.36.2 pyarrow==26.0.1 duckdb==2.0.0 numpy==2.4.6 resvg-py==0.5.0";
 
 /// A Python with [`REQUIREMENTS`], in a venv under the target directory
 /// (`$MMTRACK_PY_VENV` to put it elsewhere), made on first use; `None`
