@@ -176,13 +176,7 @@ fn legend<'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
     chart: &mut Chart<'a, X, Y>,
     position: SeriesLabelPosition,
 ) -> anyhow::Result<()> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)
+    crate::plots::draw_legend(chart, position)
 }
 
 /// The minor grid lines (plotters' default is dark and dense on a log axis).

@@ -15,6 +15,25 @@ pub(crate) fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow::anyhow!("plot: {e}")
 }
 
+/// Draws the legend of the series labelled so far at `position`: black
+/// border on a translucent white box, the look of every figure here.
+pub(crate) fn draw_legend<'a, DB, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> anyhow::Result<()>
+where
+    DB: DrawingBackend + 'a,
+    CT: plotters::coord::CoordTranslate,
+{
+    chart
+        .configure_series_labels()
+        .position(position)
+        .border_style(BLACK)
+        .background_style(WHITE.mix(0.85))
+        .draw()
+        .map_err(err)
+}
+
 /// `[min, max]` of `values` padded by 5 % (1 unit when flat).
 pub(crate) fn padded_range(values: impl Iterator<Item = f64>) -> Range<f64> {
     let (lo, hi) =
@@ -60,13 +79,7 @@ pub fn trajectory_svg(result: &TrajectoryResult) -> anyhow::Result<String> {
             .label(format!("estimate ({})", result.sequence))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
         chart.draw_series(std::iter::once(Circle::new((0.0, 0.0), 5, BLUE.filled()))).map_err(err)?;
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .draw()
-            .map_err(err)?;
+        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

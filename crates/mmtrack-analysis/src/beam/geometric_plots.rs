@@ -94,13 +94,7 @@ fn shade(chart: &mut Chart<'_, '_>, s: &GeometricTrackingSeries, t_end: f64) -> 
 }
 
 fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>) -> anyhow::Result<()> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)
+    crate::plots::draw_legend(chart, SeriesLabelPosition::UpperRight)
 }
 
 /// A line with its legend entry.

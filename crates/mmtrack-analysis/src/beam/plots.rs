@@ -58,13 +58,7 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
             .map_err(err)?
             .label(format!("half beamwidth ({threshold_deg:.2} deg)"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], threshold));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .draw()
-            .map_err(err)?;
+        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
@@ -149,13 +143,7 @@ pub fn beam_index_svg(
                 .label(series.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .draw()
-            .map_err(err)?;
+        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
@@ -209,13 +197,7 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
                 .label(curve.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.85))
-            .draw()
-            .map_err(err)?;
+        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

@@ -129,13 +129,7 @@ where
             }
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)
+    crate::plots::draw_legend(chart, SeriesLabelPosition::UpperRight)
 }
 
 /// `(slot, value)` of the positive finite values (a log axis shows no others).

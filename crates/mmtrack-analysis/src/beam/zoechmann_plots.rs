@@ -105,13 +105,7 @@ fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace:
         .map_err(err)?
         .label("receiver array")
         .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)?;
+    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }
 
@@ -150,13 +144,7 @@ fn draw_nmse(
             .label(curve.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)?;
+    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -313,13 +301,7 @@ fn draw_nlos_errors(
             .label(format!("{path}: RMS position error"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)?;
+    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
