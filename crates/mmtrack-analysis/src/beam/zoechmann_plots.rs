@@ -14,13 +14,8 @@
 
 use plotters::prelude::*;
 
+use super::zoechmann_tables::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 use crate::plots::{err, padded_range};
-
-// The rows `reproduce zoechmann` and its test still import from here; new
-// code names `zoechmann_tables`.
-pub use super::zoechmann_tables::{
-    ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
-};
 
 /// One NMSE curve: label and NMSE (linear) per epoch.
 #[derive(Debug, Clone, PartialEq)]

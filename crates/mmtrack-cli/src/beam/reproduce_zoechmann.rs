@@ -28,9 +28,8 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use mmtrack_analysis::beam::zoechmann_plots::{
-    NmseCurve, PositionTrace, ZoechmannNmseRow, ZoechmannSummaryRow, zoechmann_figure_svg,
-};
+use mmtrack_analysis::beam::zoechmann_plots::{NmseCurve, PositionTrace, zoechmann_figure_svg};
+use mmtrack_analysis::beam::zoechmann_tables::{ZoechmannNmseRow, ZoechmannSummaryRow};
 use mmtrack_beam::geometric::{
     BeamCount, BeamSchedule, BeamSelection, DopplerBearing, ErrorFreeRegressors, GeometricTracker,
     GeometricTrackerConfig, HoChanBatch, NullspaceProjection, PolarState, RangeEstimator,

@@ -2,7 +2,7 @@
 //! Doppler-bearing tracking experiment (2000 runs per manoeuvre instead of
 //! 100 000).
 
-use mmtrack_analysis::beam::zoechmann_plots::{
+use mmtrack_analysis::beam::zoechmann_tables::{
     ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
 };
 use mmtrack_io::table::read_table;
