@@ -10,12 +10,12 @@ use clap::{Args, Subcommand};
 use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose, path_length_m};
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::recording::RecordingItem;
-use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary, table_path, write_table};
+use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 
 use crate::progress;
-use crate::run_id::{RunIdArg, run_id_of};
+use crate::run_id::{OutputArgs, run_id_of};
 use crate::threads::ThreadsArg;
 
 #[path = "process_mpc.rs"]
@@ -115,14 +115,8 @@ pub struct OdometryArgs {
     /// Print the effective configuration (the preset with `--config` on top) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
-    /// Sequence id of the output partitions (default: the recording's).
-    #[arg(long)]
-    pub sequence: Option<String>,
-    /// Replace existing output tables of this sequence.
-    #[arg(long)]
-    pub force: bool,
     #[command(flatten)]
-    pub run_id: RunIdArg,
+    pub output_args: OutputArgs,
     #[command(flatten)]
     pub threads: ThreadsArg,
 }
@@ -273,37 +267,26 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
     let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
         bail!("a recording and --output are required (unless --print-config)");
     };
-    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
-    let output = &args.run_id.run_dir(output)?;
+    let out = args.output_args.run.resolve(output)?;
     // Check the outputs before the work, so a refusal costs nothing.
-    let sequence_hint = args.sequence.clone();
-    if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &sequence_hint) {
-        refuse_existing(output, sequence)?;
+    if let Some(sequence) = &args.output_args.sequence {
+        out.refuse_existing(&TABLES, sequence)?;
     }
     let run = args
         .threads
         .install(|| run_odometry(recording, config.clone(), quiet))?
         .with_context(|| format!("{}", recording.display()))?;
-    let sequence = sequence_hint.unwrap_or_else(|| run.sequence_id.clone());
-    if overwrite == Overwrite::Refuse {
-        refuse_existing(output, &sequence)?;
-    }
-    let written = write_outputs(output, &sequence, &run, &config, &args.preset, recording, overwrite)?;
+    let sequence = args.output_args.sequence_or(&run.sequence_id);
+    out.refuse_existing(&TABLES, &sequence)?;
+    let written = write_outputs(&out.path, &sequence, &run, &config, &args.preset, recording, out.overwrite)?;
     if !quiet {
         print_summary(&run, &args.preset, &written);
     }
     Ok(())
 }
 
-fn refuse_existing(output: &Path, sequence: &str) -> anyhow::Result<()> {
-    for table in ["odometry", "odometry_timing", "ground_truth"] {
-        let path = table_path(output, table, sequence)?;
-        if path.exists() {
-            bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
-        }
-    }
-    Ok(())
-}
+/// Every table `process odometry` may write.
+const TABLES: [&str; 3] = ["odometry", "odometry_timing", "ground_truth"];
 
 /// Writes the tables; each appears atomically.
 pub fn write_outputs(

@@ -24,14 +24,13 @@ use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, Mpc
 use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
 use mmtrack_io::recording::{PoseStream, RecordingItem};
 use mmtrack_io::table::{
-    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MpcSnapshotStats, RunInfo, TableWriteSummary, table_path,
-    write_table,
+    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MpcSnapshotStats, RunInfo, TableWriteSummary, write_table,
 };
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_mpc::{MpcConfig, MpcPipeline, SnapshotDetections, SounderPulse};
 
 use crate::progress;
-use crate::run_id::{RunIdArg, run_id_of};
+use crate::run_id::{OutputArgs, RunDir, exists_error};
 use crate::threads::ThreadsArg;
 
 /// Every table `process mpc` may write.
@@ -65,15 +64,9 @@ pub struct MpcArgs {
     #[arg(long)]
     pub gmphd: bool,
     #[command(flatten)]
-    pub threads: ThreadsArg,
-    /// Sequence id of the output partitions (default: the recording's).
-    #[arg(long)]
-    pub sequence: Option<String>,
-    /// Replace existing output tables of this sequence.
-    #[arg(long)]
-    pub force: bool,
+    pub output_args: OutputArgs,
     #[command(flatten)]
-    pub run_id: RunIdArg,
+    pub threads: ThreadsArg,
 }
 
 fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
@@ -346,20 +339,21 @@ fn partitions(run: &MpcRun, sequence: &str, picked: bool) -> Vec<((u32, u32), St
         .collect()
 }
 
-/// Refuses when any table of `sequence` (or one of its link partitions) exists.
-fn refuse_existing(output: &Path, sequence: &str) -> anyhow::Result<()> {
+/// Without `--force`, refuses when any table of `sequence` (or one of its
+/// link partitions) exists.
+fn refuse_existing(out: &RunDir, sequence: &str) -> anyhow::Result<()> {
+    if out.overwrite == Overwrite::Replace {
+        return Ok(());
+    }
     for table in TABLES {
-        let path = table_path(output, table, sequence)?;
-        if path.exists() {
-            bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
-        }
-        let Ok(entries) = std::fs::read_dir(output.join(table)) else { continue };
+        out.refuse_existing(&[table], sequence)?;
+        let Ok(entries) = std::fs::read_dir(out.path.join(table)) else { continue };
         for entry in entries.flatten() {
             let name = entry.file_name().to_string_lossy().into_owned();
             let link_part =
                 name.strip_prefix(&format!("sequence={sequence}-tx")).is_some_and(|rest| rest.contains("-rx"));
             if link_part && entry.path().join("part-0.parquet").exists() {
-                bail!("{}: exists; use --force to replace it (nothing was written)", entry.path().display());
+                return Err(exists_error(&entry.path()));
             }
         }
     }
@@ -380,24 +374,22 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     if let Some(link) = &args.link {
         parse_link(link)?;
     }
-    let output = &args.run_id.run_dir(output)?;
-    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
+    let out = args.output_args.run.resolve(output)?;
     // Check the outputs before the work, so a refusal costs nothing.
-    let hinted = match &args.sequence {
+    let hinted = match &args.output_args.sequence {
         Some(s) => Some(s.clone()),
         None => RecordingReader::open(recording).ok().and_then(|mut r| {
             let _ = r.next_item();
             r.metadata().and_then(RecordingMetadata::from_map).map(|m| m.sequence_id)
         }),
     };
-    if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &hinted) {
-        refuse_existing(output, sequence)?;
+    if let Some(sequence) = &hinted {
+        refuse_existing(&out, sequence)?;
     }
     let run = args.threads.install(|| read_and_process(args, &config, quiet))??;
-    let sequence = args.sequence.clone().unwrap_or_else(|| run.sequence_id.clone());
-    if overwrite == Overwrite::Refuse {
-        refuse_existing(output, &sequence)?;
-    }
+    let sequence = args.output_args.sequence_or(&run.sequence_id);
+    refuse_existing(&out, &sequence)?;
+    let (output, overwrite) = (&out.path, out.overwrite);
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process mpc",
@@ -405,7 +397,7 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
             "pulse": args.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
             "link": args.link,
             "mpc": config,
-            "run_id": run_id_of(output),
+            "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),

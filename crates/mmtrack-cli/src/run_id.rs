@@ -1,19 +1,73 @@
-//! `--run-id ID`: one run's tables under `<output>/run=<ID>/`, the same flag
-//! for every `mmtrack process` pipeline.
+//! Where a `mmtrack process` pipeline writes: the output flags every pipeline
+//! shares (`--sequence`, `--force`, `--run-id`) and the run directory they
+//! resolve to.
 //!
-//! Runs written under one `-o` directory with different ids sit side by side
+//! `--run-id ID` puts one run's tables under `<output>/run=<ID>/`: runs
+//! written under one `-o` directory with different ids sit side by side
 //! (`<output>/run=a/<table>/sequence=<seq>/part-0.parquet`,
 //! `<output>/run=b/...`) and read back together with a `run` column (DuckDB /
 //! polars Hive partitioning) instead of overwriting each other. Every
-//! pipeline writes into [`RunIdArg::run_dir`], checks `--force` there (the
-//! partition that would be overwritten), and records [`run_id_of`] that
-//! directory as `"run_id"` in its run configuration JSON.
+//! pipeline resolves its flags to a [`RunDir`] before any work, refuses
+//! existing tables there without `--force` ([`RunDir::refuse_existing`]),
+//! writes there, and records [`run_id_of`] that directory as `"run_id"` in
+//! its run configuration JSON.
+//!
+//! `--threads` is not here: it does not change what is written, and
+//! [`crate::threads::ThreadsArg`] is shared with the commands that are not
+//! pipelines.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 use clap::Args;
+use mmtrack_io::Overwrite;
 use mmtrack_io::table::table_path;
+
+/// The output flags of the single-recording pipelines (odometry, mpc, slam).
+#[derive(Args, Clone, Debug, Default)]
+pub struct OutputArgs {
+    /// Sequence id of the output partitions (default: the recording's).
+    ///
+    /// The tables go to `<table>/sequence=<SEQUENCE>/part-0.parquet` under the output (or run) directory.
+    #[arg(long)]
+    pub sequence: Option<String>,
+    #[command(flatten)]
+    pub run: RunOutputArgs,
+}
+
+impl OutputArgs {
+    /// The sequence id to write: `--sequence`, else the recording's.
+    #[must_use]
+    pub fn sequence_or(&self, recording_sequence: &str) -> String {
+        self.sequence.clone().unwrap_or_else(|| recording_sequence.to_string())
+    }
+}
+
+/// `--force` and `--run-id`: the output flags of every pipeline, also of
+/// those whose sequences come from their recordings (`process beam`).
+#[derive(Args, Clone, Debug, Default)]
+pub struct RunOutputArgs {
+    /// Replace existing output tables of the sequences written.
+    ///
+    /// Only this run's tables are replaced (those under `<output>/run=<ID>/` with --run-id). Without --force, an
+    /// existing table stops the command and nothing is written.
+    #[arg(long)]
+    pub force: bool,
+    #[command(flatten)]
+    pub run_id: RunIdArg,
+}
+
+impl RunOutputArgs {
+    /// The run directory under `output` with the overwrite policy of
+    /// `--force`.
+    ///
+    /// # Errors
+    /// A bad `--run-id` ([`RunIdArg::run_dir`]). Call it before any work.
+    pub fn resolve(&self, output: &Path) -> anyhow::Result<RunDir> {
+        let overwrite = if self.force { Overwrite::Replace } else { Overwrite::Refuse };
+        Ok(RunDir { path: self.run_id.run_dir(output)?, overwrite })
+    }
+}
 
 /// The `--run-id` flag of the `mmtrack process` pipelines.
 #[derive(Args, Clone, Debug, Default)]
@@ -34,8 +88,7 @@ impl RunIdArg {
     /// `--run-id`. Call it before any work, so nothing is written.
     pub fn run_dir(&self, output: &Path) -> anyhow::Result<PathBuf> {
         let Some(id) = &self.run_id else { return Ok(output.to_path_buf()) };
-        // The partition-name rule of the sequence ids, so both read back the same way.
-        if table_path(output, "run", id).is_err() {
+        if !is_run_id(id) {
             bail!(
                 "--run-id '{id}': not a valid run id (use letters, digits, '-', '_', '.'; it names the directory \
                  run=<ID> under {}); nothing was written",
@@ -44,6 +97,56 @@ impl RunIdArg {
         }
         Ok(output.join(format!("run={id}")))
     }
+}
+
+/// Whether `id` can name a `run=<id>` directory: the partition-name rule of
+/// the sequence ids, so both read back the same way.
+#[must_use]
+pub fn is_run_id(id: &str) -> bool {
+    table_path(Path::new(""), "run", id).is_ok()
+}
+
+/// The directory a pipeline writes its tables to (`<output>` or
+/// `<output>/run=<ID>`), and whether it may replace tables there.
+#[derive(Clone, Debug)]
+pub struct RunDir {
+    /// The directory.
+    pub path: PathBuf,
+    /// `Replace` with `--force`, else `Refuse`.
+    pub overwrite: Overwrite,
+}
+
+impl RunDir {
+    /// What the run configuration records as `"run_id"` ([`run_id_of`]).
+    #[must_use]
+    pub fn run_id(&self) -> Option<String> {
+        run_id_of(&self.path)
+    }
+
+    /// Without `--force`, an error naming the first of `tables` that
+    /// `sequence` already has here; nothing with `--force`.
+    ///
+    /// # Errors
+    /// That table, or a `sequence` that is not a partition name.
+    pub fn refuse_existing(&self, tables: &[&str], sequence: &str) -> anyhow::Result<()> {
+        if self.overwrite == Overwrite::Replace {
+            return Ok(());
+        }
+        for table in tables {
+            let path = table_path(&self.path, table, sequence)?;
+            if path.exists() {
+                return Err(exists_error(&path));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The refusal of an existing output `path` without `--force`, the same
+/// words for every pipeline.
+#[must_use]
+pub fn exists_error(path: &Path) -> anyhow::Error {
+    anyhow::anyhow!("{}: exists; use --force to replace it (nothing was written)", path.display())
 }
 
 /// The run id of a table directory `.../run=<id>`, if it is one: what a
@@ -69,5 +172,28 @@ mod tests {
         }
         assert_eq!(run_id_of(&output.join("run=a")).as_deref(), Some("a"));
         assert_eq!(run_id_of(output), None);
+    }
+
+    #[test]
+    fn refusals_look_in_the_run_directory_and_force_lifts_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let flags = |force: bool, id: Option<&str>| RunOutputArgs {
+            force,
+            run_id: RunIdArg { run_id: id.map(str::to_string) },
+        };
+        let existing = dir.path().join("run=a/t2/sequence=s/part-0.parquet");
+        std::fs::create_dir_all(existing.parent().unwrap()).unwrap();
+        std::fs::write(&existing, b"").unwrap();
+        let run_a = flags(false, Some("a")).resolve(dir.path()).unwrap();
+        assert_eq!((run_a.path.as_path(), run_a.run_id().as_deref()), (dir.path().join("run=a").as_path(), Some("a")));
+        let err = run_a.refuse_existing(&["t1", "t2"], "s").unwrap_err().to_string();
+        assert_eq!(err, format!("{}: exists; use --force to replace it (nothing was written)", existing.display()));
+        // Another sequence, another run, no run id, or --force: nothing refused.
+        run_a.refuse_existing(&["t1", "t2"], "other").unwrap();
+        flags(false, Some("b")).resolve(dir.path()).unwrap().refuse_existing(&["t2"], "s").unwrap();
+        flags(false, None).resolve(dir.path()).unwrap().refuse_existing(&["t2"], "s").unwrap();
+        let forced = flags(true, Some("a")).resolve(dir.path()).unwrap();
+        assert_eq!(forced.overwrite, Overwrite::Replace);
+        forced.refuse_existing(&["t2"], "s").unwrap();
     }
 }

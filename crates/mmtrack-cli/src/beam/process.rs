@@ -40,10 +40,10 @@ use mmtrack_beam::sweep::{
 use mmtrack_core::{BeamSweep, GnssFix};
 use mmtrack_ingest::nmea::{EnuOrigin, geodetic_to_enu_m};
 use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata};
-use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, table_path, write_table};
-use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
+use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, write_table};
+use mmtrack_io::{RecordingEvent, RecordingReader};
 
-use crate::run_id::{RunIdArg, run_id_of};
+use crate::run_id::RunOutputArgs;
 
 /// The policies `process beam` runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
@@ -107,11 +107,8 @@ pub struct BeamArgs {
     /// Re-acquisition of the window trackers (window, gnss-window).
     #[arg(long, value_enum, default_value_t = ReacquireArg::Coarse)]
     reacquire: ReacquireArg,
-    /// Replace existing output tables of these sequences.
-    #[arg(long)]
-    force: bool,
     #[command(flatten)]
-    run_id: RunIdArg,
+    output_args: RunOutputArgs,
     #[command(flatten)]
     spebt: super::process_spebt::SpebtOptions,
     #[command(flatten)]
@@ -361,8 +358,7 @@ fn rows(
 }
 
 pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let output = &args.run_id.run_dir(&args.output)?;
-    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
+    let out = args.output_args.resolve(&args.output)?;
     let mut kinds = args.tracker.clone();
     kinds.sort();
     kinds.dedup();
@@ -373,7 +369,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
             );
         }
-        return super::process_geometric::run(&files, output, args.force, &args.geometric, quiet);
+        return super::process_geometric::run(&files, &out.path, args.output_args.force, &args.geometric, quiet);
     }
     if let Some(flag) = args.geometric.given().first() {
         bail!("{flag} is an option of --tracker geometric only");
@@ -385,7 +381,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                  give the sweep trackers in another call"
             );
         }
-        return super::process_spebt::run(&files, output, args.force, &args.spebt, quiet);
+        return super::process_spebt::run(&files, &out, &args.spebt, quiet);
     }
     if let Some(flag) = args.spebt.given().first() {
         bail!("{flag} is an option of --tracker spebt only");
@@ -401,12 +397,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 r.sequence_id
             );
         }
-        if overwrite == Overwrite::Refuse {
-            let path = table_path(output, BEAM_SWEEPS_TRACKED.name, &r.sequence_id)?;
-            if path.exists() {
-                bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
-            }
-        }
+        out.refuse_existing(&[BEAM_SWEEPS_TRACKED.name], &r.sequence_id)?;
     }
     let mut sites: BTreeMap<&str, Vec<&BeamRecording>> = BTreeMap::new();
     for r in &recordings {
@@ -452,18 +443,18 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             "window": format!("{:?}", WindowTrackerConfig { search: search(args.reacquire), ..Default::default() }),
             "gnss_window": format!("{:?} (initial_offset_sigma_beams: each pass's map residual)", GnssTrackerConfig { search: search(args.reacquire), ..Default::default() }),
             "beam_map": "fitted leave-one-pass-out over the recordings of each site given together",
-            "run_id": run_id_of(output),
+            "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
     };
     let mut written = Vec::new();
     for (sequence, rows) in &tables {
-        written.push(write_table(output, sequence, rows, &info, overwrite)?);
+        written.push(write_table(&out.path, sequence, rows, &info, out.overwrite)?);
     }
     if !quiet {
         print_summary(&sites, &summaries);
-        println!("wrote {} {} partitions under {}", written.len(), BEAM_SWEEPS_TRACKED.name, output.display());
+        println!("wrote {} {} partitions under {}", written.len(), BEAM_SWEEPS_TRACKED.name, out.path.display());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -33,7 +33,7 @@ use mmtrack_analysis::trajectory::interpolate_pose;
 use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
 use mmtrack_io::table::{ODOMETRY, RunInfo, read_table, table_path, write_table};
-use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
+use mmtrack_io::{RecordingEvent, RecordingReader};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtScenario};
 use serde::Deserialize;
 
@@ -43,7 +43,7 @@ use super::reproduce_spebt::{
 };
 use super::spebt_odometry::{into_link_frame, into_truth_frame};
 use super::spebt_output as output;
-use crate::run_id::run_id_of;
+use crate::run_id::RunDir;
 
 /// The options of `--tracker spebt` (refused with the sweep trackers).
 #[derive(Args, Debug, Clone, Default)]
@@ -250,28 +250,16 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(Experiment, String)> {
 
 /// Runs SPEBT on each recording; one partition of each table per recording.
 ///
-/// `output_dir` is the run directory (`<output>/run=<ID>` with `--run-id`,
+/// `out` is the run directory (`<output>/run=<ID>` with `--run-id`,
 /// `crate::run_id`): refusals look there and the tables go there.
-pub fn run(
-    recordings: &[PathBuf],
-    output_dir: &Path,
-    force: bool,
-    options: &SpebtOptions,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
-    let overwrite = if force { Overwrite::Replace } else { Overwrite::Refuse };
+pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: bool) -> anyhow::Result<ExitCode> {
     let (experiment, link_source) = experiment(options)?;
     let runs = options.runs.unwrap_or(1);
     ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
     let config = tracker_config(&experiment);
     let recordings = recordings.iter().map(|p| read_truth(p)).collect::<anyhow::Result<Vec<_>>>()?;
-    if overwrite == Overwrite::Refuse {
-        for r in &recordings {
-            for table in [SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name] {
-                let path = table_path(output_dir, table, &r.sequence_id)?;
-                ensure!(!path.exists(), "{}: exists; use --force to replace it (nothing was written)", path.display());
-            }
-        }
+    for r in &recordings {
+        out.refuse_existing(&[SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name], &r.sequence_id)?;
     }
     let mut outcomes = Vec::new();
     for recording in &recordings {
@@ -313,14 +301,14 @@ pub fn run(
                     "gain_threshold": experiment.tracker.gain_threshold,
                     "angle_threshold_deg": experiment.tracker.angle_threshold_deg,
                 },
-                "run_id": run_id_of(output_dir),
+                "run_id": out.run_id(),
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),
         };
         let summary = output::summary_row(&experiment, &recording.path, outcome);
-        write_table(output_dir, &recording.sequence_id, std::slice::from_ref(&summary), &info, overwrite)?;
-        write_table(output_dir, &recording.sequence_id, &output::slot_rows(outcome), &info, overwrite)?;
+        write_table(&out.path, &recording.sequence_id, std::slice::from_ref(&summary), &info, out.overwrite)?;
+        write_table(&out.path, &recording.sequence_id, &output::slot_rows(outcome), &info, out.overwrite)?;
         if !quiet {
             println!(
                 "{} ({}, {} slots, {} run{}): RMSE |alpha| {:.3} %, AoD {:.3} deg, AoA {:.3} deg; \
@@ -344,7 +332,7 @@ pub fn run(
             outcomes.len(),
             SPEBT_PER_SLOT.name,
             SPEBT_SUMMARY.name,
-            output_dir.display()
+            out.path.display()
         );
     }
     Ok(ExitCode::SUCCESS)

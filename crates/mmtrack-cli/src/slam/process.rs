@@ -28,14 +28,14 @@ use mmtrack_analysis::slam::tables::{
     SlamUeRow,
 };
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
+use mmtrack_io::RecordingEvent;
 use mmtrack_io::recording::RecordingMetadata;
-use mmtrack_io::table::{RunInfo, TableWriteSummary, table_path, write_table};
-use mmtrack_io::{Overwrite, RecordingEvent};
+use mmtrack_io::table::{RunInfo, TableWriteSummary, write_table};
 use mmtrack_sim::slam::SlamScenario;
 use mmtrack_slam::{Decision, EpochReport, SlamConfig, SlamFilter, SourceStatus};
 
 use super::simulate::SCENARIO_JSON_KEY;
-use crate::run_id::{RunIdArg, run_id_of};
+use crate::run_id::OutputArgs;
 use crate::threads::ThreadsArg;
 
 #[derive(Args)]
@@ -67,14 +67,8 @@ pub struct SlamArgs {
     /// Refuse a recording with an unusable path (NaN, elevation out of range) instead of skipping and counting it.
     #[arg(long)]
     pub strict: bool,
-    /// Sequence id of the output partitions (default: the recording's).
-    #[arg(long)]
-    pub sequence: Option<String>,
-    /// Replace existing output tables of this sequence.
-    #[arg(long)]
-    pub force: bool,
     #[command(flatten)]
-    pub run_id: RunIdArg,
+    pub output_args: OutputArgs,
     #[command(flatten)]
     pub threads: ThreadsArg,
 }
@@ -302,16 +296,6 @@ pub fn run_filter(
 
 const TABLE_NAMES: [&str; 4] = [SLAM_UE.name, SLAM_MAP.name, SLAM_ASSOCIATIONS.name, SLAM_TRUE_SOURCES.name];
 
-fn refuse_existing(output: &Path, sequence: &str) -> anyhow::Result<()> {
-    for table in TABLE_NAMES {
-        let path = table_path(output, table, sequence)?;
-        if path.exists() {
-            bail!("{}: exists; use --force to replace it (nothing was written)", path.display());
-        }
-    }
-    Ok(())
-}
-
 fn prior_of(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<UeState> {
     if let Some(p) = &args.prior {
         let [x, y, z, heading_rad, speed_mps, turn_rate_radps, clock_bias_m] = p[..] else {
@@ -330,16 +314,13 @@ fn prior_of(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<UeStat
 }
 
 pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
-    let output = &args.run_id.run_dir(&args.output)?;
-    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
-    if let (Overwrite::Refuse, Some(sequence)) = (overwrite, &args.sequence) {
-        refuse_existing(output, sequence)?;
+    let out = args.output_args.run.resolve(&args.output)?;
+    if let Some(sequence) = &args.output_args.sequence {
+        out.refuse_existing(&TABLE_NAMES, sequence)?;
     }
     let recording = read_recording(&args.recording)?;
-    let sequence = args.sequence.clone().unwrap_or_else(|| recording.sequence_id.clone());
-    if overwrite == Overwrite::Refuse {
-        refuse_existing(output, &sequence)?;
-    }
+    let sequence = args.output_args.sequence_or(&recording.sequence_id);
+    out.refuse_existing(&TABLE_NAMES, &sequence)?;
     if args.strict {
         check_strict(&args.recording, &recording.epochs)?;
     }
@@ -358,11 +339,12 @@ pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
                       prior.speed_mps, prior.turn_rate_radps, prior.clock_bias_m],
             "filter": config,
             "scenario": recording.scenario,
-            "run_id": run_id_of(output),
+            "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
     };
+    let (output, overwrite) = (&out.path, out.overwrite);
     let written: Vec<TableWriteSummary> = vec![
         write_table(output, &sequence, &tables.ue, &info, overwrite)?,
         write_table(output, &sequence, &tables.map, &info, overwrite)?,
