@@ -18,7 +18,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 use clap::Args;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::table_path;
@@ -142,6 +142,27 @@ impl RunDir {
     }
 }
 
+/// The ids of the `run=<ID>` directories in `dir` (none when `dir` is not a
+/// directory), sorted: the runs a reader of `dir` can choose from.
+///
+/// # Errors
+/// `dir` cannot be listed.
+pub fn run_ids_in(dir: &Path) -> anyhow::Result<Vec<String>> {
+    if !dir.is_dir() {
+        return Ok(Vec::new());
+    }
+    let listing = || format!("{}: cannot list", dir.display());
+    let mut ids = Vec::new();
+    for entry in std::fs::read_dir(dir).with_context(listing)? {
+        let entry = entry.with_context(listing)?;
+        if entry.path().is_dir() {
+            ids.extend(run_id_of(&entry.path()));
+        }
+    }
+    ids.sort();
+    Ok(ids)
+}
+
 /// The refusal of an existing output `path` without `--force`, the same
 /// words for every pipeline.
 #[must_use]
@@ -195,5 +216,16 @@ mod tests {
         let forced = flags(true, Some("a")).resolve(dir.path()).unwrap();
         assert_eq!(forced.overwrite, Overwrite::Replace);
         forced.refuse_existing(&["t2"], "s").unwrap();
+    }
+
+    #[test]
+    fn run_ids_are_the_run_directories_sorted() {
+        let dir = tempfile::tempdir().unwrap();
+        assert!(run_ids_in(&dir.path().join("missing")).unwrap().is_empty());
+        for sub in ["run=b", "run=a", "odometry", "run=c.txt"] {
+            std::fs::create_dir(dir.path().join(sub)).unwrap();
+        }
+        std::fs::write(dir.path().join("run=file"), b"").unwrap();
+        assert_eq!(run_ids_in(dir.path()).unwrap(), ["a", "b", "c.txt"]);
     }
 }

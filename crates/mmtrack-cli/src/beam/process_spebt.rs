@@ -8,7 +8,9 @@
 //! beams from pose estimates, which are either
 //!
 //! - `--odometry <tables>`: the recording's sequence in an `odometry` table
-//!   (from `mmtrack process odometry`), one slot per estimate, the ground
+//!   (from `mmtrack process odometry`; directly under `<tables>`, else in the
+//!   `run=<ID>/` folder of `--odometry-run` or the only one holding it,
+//!   `find_odometry_table`), one slot per estimate, the ground
 //!   truth interpolated at the estimates' times, the estimates moved into the
 //!   ground truth's frame at the first slot (as `reproduce spebt` experiment
 //!   (b) does, `spebt_odometry`); or
@@ -43,16 +45,22 @@ use super::reproduce_spebt::{
 };
 use super::spebt_odometry::{into_link_frame, into_truth_frame};
 use super::spebt_output as output;
-use crate::run_id::RunDir;
+use crate::run_id::{RunDir, is_run_id, run_ids_in};
 
 /// The options of `--tracker spebt` (refused with the sweep trackers).
 #[derive(Args, Debug, Clone, Default)]
 pub struct SpebtOptions {
     /// spebt: table directory of `mmtrack process odometry` whose `odometry` table (the
-    /// recording's sequence) drives the tracker; without it, the ground truth plus the
-    /// pose-error model (--sigma-r-m, --sigma-theta-deg) does.
+    /// recording's sequence) drives the tracker: the one directly under TABLES, else the one
+    /// in its only `run=<ID>/` folder holding it (`process odometry --run-id`; several: pick
+    /// one with --odometry-run). Without it, the ground truth plus the pose-error model
+    /// (--sigma-r-m, --sigma-theta-deg) drives the tracker.
     #[arg(long, value_name = "TABLES")]
     pub odometry: Option<PathBuf>,
+    /// spebt: read the odometry table of run ID, `<TABLES>/run=<ID>/` (written by
+    /// `process odometry --run-id ID`), instead of looking for it.
+    #[arg(long, value_name = "ID", requires = "odometry")]
+    pub odometry_run: Option<String>,
     /// spebt: the link and tracker, a TOML file with a `[scenario]` table (Table I's
     /// fields, e.g. bs_x_m, carrier_hz, bs_elements) and a `[tracker]` table, as in
     /// data/reproduce/spebt.toml (default: that file's values, the paper's Table I).
@@ -78,6 +86,7 @@ impl SpebtOptions {
     pub fn given(&self) -> Vec<&'static str> {
         [
             ("--odometry", self.odometry.is_some()),
+            ("--odometry-run", self.odometry_run.is_some()),
             ("--link", self.link.is_some()),
             ("--sigma-r-m", self.sigma_r_m.is_some()),
             ("--sigma-theta-deg", self.sigma_theta_deg.is_some()),
@@ -137,26 +146,73 @@ fn read_truth(path: &Path) -> anyhow::Result<TruthRecording> {
     Ok(TruthRecording { path: path.to_path_buf(), sequence_id, ground_truth })
 }
 
-/// The recording's sequence of the `odometry` table under `dir`, checked:
+/// The file of the recording's sequence of the `odometry` table under `dir`
+/// (`--odometry`): in `dir/run=<ID>/` for `run` (`--odometry-run`), else
+/// directly under `dir`, else in the only `run=<ID>/` folder of `dir` that
+/// holds it. Several such runs are refused, naming their ids.
+fn find_odometry_table(dir: &Path, run: Option<&str>, recording: &TruthRecording) -> anyhow::Result<PathBuf> {
+    let sequence = &recording.sequence_id;
+    let in_run = |id: &str| table_path(&dir.join(format!("run={id}")), ODOMETRY.name, sequence);
+    let mut holding = Vec::new();
+    for id in run_ids_in(dir)? {
+        if in_run(&id)?.exists() {
+            holding.push(id);
+        }
+    }
+    let listed = if holding.is_empty() { "none".to_string() } else { holding.join(", ") };
+    if let Some(id) = run {
+        ensure!(
+            is_run_id(id),
+            "--odometry-run '{id}': not a valid run id (letters, digits, '-', '_', '.'; it names the directory \
+             run=<ID> under {})",
+            dir.display()
+        );
+        let file = in_run(id)?;
+        ensure!(
+            file.exists(),
+            "{}: not found; --odometry-run {id}: run {id} has no `{}` table of sequence {sequence} (the recording {}); \
+             runs under {} holding one: {listed}",
+            file.display(),
+            ODOMETRY.name,
+            recording.path.display(),
+            dir.display()
+        );
+        return Ok(file);
+    }
+    let file = table_path(dir, ODOMETRY.name, sequence)?;
+    if file.exists() {
+        return Ok(file);
+    }
+    match &holding[..] {
+        [id] => Ok(in_run(id)?),
+        [] => bail!(
+            "{}: not found, nor in a run=<ID>/ folder of {}; --odometry needs the `{}` table of sequence {sequence} \
+             (the recording {}), as written by `mmtrack process odometry`",
+            file.display(),
+            dir.display(),
+            ODOMETRY.name,
+            recording.path.display()
+        ),
+        _ => bail!(
+            "{}: {} runs hold an `{}` table of sequence {sequence} (the recording {}), run ids {listed}; pick one with \
+             --odometry-run <ID>",
+            dir.display(),
+            holding.len(),
+            ODOMETRY.name,
+            recording.path.display()
+        ),
+    }
+}
+
+/// The recording's sequence of the `odometry` table `file`, checked:
 /// finite rows, increasing times without gaps (a step above `max_step_ratio`
 /// times the median), inside the ground truth's time span.
 fn read_estimates(
-    dir: &Path,
+    file: &Path,
     recording: &TruthRecording,
     max_step_ratio: f64,
-) -> anyhow::Result<(PathBuf, Vec<OdometryEstimate>)> {
-    let file = table_path(dir, ODOMETRY.name, &recording.sequence_id)?;
-    if !file.exists() {
-        bail!(
-            "{}: not found; --odometry needs the `{}` table of sequence {} (the recording {}), as written by \
-             `mmtrack process odometry`",
-            file.display(),
-            ODOMETRY.name,
-            recording.sequence_id,
-            recording.path.display()
-        );
-    }
-    let rows = read_table::<OdometryEstimate>(&file)?;
+) -> anyhow::Result<Vec<OdometryEstimate>> {
+    let rows = read_table::<OdometryEstimate>(file)?;
     let name = file.display();
     ensure!(rows.len() >= 2, "{name}: {} rows; need at least 2 estimates to track", rows.len());
     for (row, e) in rows.iter().enumerate() {
@@ -197,7 +253,7 @@ fn read_estimates(
             recording.path.display()
         );
     }
-    Ok((file, rows))
+    Ok(rows)
 }
 
 /// The ground truth at `t_ns` (inside its span): the pose with that time,
@@ -261,11 +317,19 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: 
     for r in &recordings {
         out.refuse_existing(&[SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name], &r.sequence_id)?;
     }
+    // Every odometry table found before any work.
+    let odometry_files = recordings
+        .iter()
+        .map(|r| {
+            let dir = options.odometry.as_deref();
+            dir.map(|dir| find_odometry_table(dir, options.odometry_run.as_deref(), r)).transpose()
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let mut outcomes = Vec::new();
-    for recording in &recordings {
-        let (name, slots, estimates, odometry_file) = match &options.odometry {
-            Some(dir) => {
-                let (file, rows) = read_estimates(dir, recording, experiment.scenario.max_step_ratio)?;
+    for (recording, odometry_file) in recordings.iter().zip(odometry_files) {
+        let (name, slots, estimates, odometry_file) = match odometry_file {
+            Some(file) => {
+                let rows = read_estimates(&file, recording, experiment.scenario.max_step_ratio)?;
                 let slots: Vec<StampedPose> = rows.iter().map(|e| truth_at(&recording.ground_truth, e.t_ns)).collect();
                 let first_truth = slots[0].parent_from_child;
                 let raw: Vec<Se2> = rows.iter().map(|e| e.world_from_vehicle).collect();
@@ -324,6 +388,9 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: 
                 summary.reinitialisations_mean,
                 summary.reinitialisation_share_pct
             );
+            if let Some(file) = odometry_file {
+                println!("  poses from {}", file.display());
+            }
         }
     }
     if !quiet {

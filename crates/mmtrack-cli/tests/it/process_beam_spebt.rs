@@ -1,7 +1,8 @@
 //! `mmtrack process beam --tracker spebt`: SPEBT on a simulated radar drive,
 //! driven by the `odometry` table of `process odometry` or by the ground
 //! truth plus the pose-error model; bad odometry tables and recordings
-//! without ground truth are named.
+//! without ground truth are named; odometry tables written with `--run-id`
+//! are found in their `run=<ID>` folder.
 
 use std::path::Path;
 
@@ -9,6 +10,7 @@ use mmtrack_analysis::beam::spebt_tables::{SpebtPooledRow, SpebtSlotRow, SpebtSu
 use mmtrack_core::OdometryEstimate;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, read_table, write_table};
+use mmtrack_io::table_kv::read_key_value_metadata;
 
 use super::common::{mmtrack, text};
 
@@ -168,4 +170,90 @@ fn a_recording_without_ground_truth_is_named() {
     let (ok, _, stderr) = run(dir.path(), &["process", "beam", "a.mcap", "--tracker", "spebt", "-o", "out"]);
     assert!(!ok && stderr.contains("a.mcap: 0 ground-truth poses") && stderr.contains("ground truth"), "{stderr}");
     assert!(!dir.path().join("out").exists());
+}
+
+/// The odometry table that drove the spebt tables under `out`, as recorded
+/// in their run configuration.
+fn odometry_used(dir: &Path, out: &str) -> String {
+    let file = dir.join(out).join("spebt_summary/sequence=drive/part-0.parquet");
+    let metadata = read_key_value_metadata(&file).unwrap();
+    let config: serde_json::Value = serde_json::from_str(&metadata["mmtrack.run_config"]).unwrap();
+    config["odometry"].as_str().unwrap().to_string()
+}
+
+#[test]
+fn the_odometry_table_is_found_in_its_run_folder_and_several_runs_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), DRIVE).unwrap();
+    let (ok, _, stderr) = run(d, &["simulate", "radar", "--scenario", "s.toml", "-o", "drive.mcap", "-q"]);
+    assert!(ok, "{stderr}");
+    let (ok, _, stderr) = run(d, &["process", "odometry", "drive.mcap", "-o", "tables", "--run-id", "a", "-q"]);
+    assert!(ok, "{stderr}");
+    let spebt = ["process", "beam", "drive.mcap", "--tracker", "spebt", "-q"];
+    let with = |rest: &[&str]| -> Vec<String> { spebt.iter().chain(rest).map(|s| s.to_string()).collect() };
+    let go = |rest: &[&str]| {
+        let args = with(rest);
+        run(d, &args.iter().map(String::as_str).collect::<Vec<_>>())
+    };
+
+    // One run: found in tables/run=a, the same tables as pointing at it by hand.
+    let (ok, _, stderr) = go(&["--odometry", "tables", "-o", "found"]);
+    assert!(ok, "{stderr}");
+    assert!(odometry_used(d, "found").ends_with("tables/run=a/odometry/sequence=drive/part-0.parquet"));
+    let (ok, _, stderr) = go(&["--odometry", "tables/run=a", "-o", "by-hand"]);
+    assert!(ok, "{stderr}");
+    let run_a = tables(d, "found");
+    assert_eq!(run_a, tables(d, "by-hand"));
+
+    // A second run whose heading is 30 degrees off from row 12 on: which run
+    // was read shows in the tracker's estimates.
+    let mut rows =
+        read_table::<OdometryEstimate>(&d.join("tables/run=a/odometry/sequence=drive/part-0.parquet")).unwrap();
+    rows[12..].iter_mut().for_each(|r| r.world_from_vehicle.yaw_rad += 30f64.to_radians());
+    let info = RunInfo { config_json: "{}".into() };
+    write_table(&d.join("tables/run=b"), "drive", &rows, &info, Overwrite::Refuse).unwrap();
+    // A run of another sequence only does not count.
+    write_table(&d.join("tables/run=other"), "elsewhere", &rows, &info, Overwrite::Refuse).unwrap();
+
+    // Two runs hold the sequence: refused naming both ids, nothing written.
+    let (ok, _, stderr) = go(&["--odometry", "tables", "-o", "ambiguous"]);
+    assert!(!ok, "two runs were not refused");
+    assert!(stderr.contains("tables: 2 runs hold an `odometry` table of sequence drive"), "{stderr}");
+    assert!(stderr.contains("run ids a, b;") && stderr.contains("--odometry-run <ID>"), "{stderr}");
+    assert!(!d.join("ambiguous").exists());
+
+    // --odometry-run picks one: run b's tables differ from run a's from slot 12 on.
+    let (ok, _, stderr) = go(&["--odometry", "tables", "--odometry-run", "b", "-o", "picked-b"]);
+    assert!(ok, "{stderr}");
+    assert!(odometry_used(d, "picked-b").ends_with("tables/run=b/odometry/sequence=drive/part-0.parquet"));
+    let (_, run_b) = tables(d, "picked-b");
+    assert_eq!(run_b[..12], run_a.1[..12]);
+    assert!((run_b[12].run0_aoa_deg - run_a.1[12].run0_aoa_deg).abs() > 1.0 || run_b[12].run0_reinitialised);
+    let (ok, _, stderr) = go(&["--odometry", "tables", "--odometry-run", "a", "-o", "picked-a"]);
+    assert!(ok, "{stderr}");
+    assert_eq!(tables(d, "picked-a"), run_a);
+
+    // A run without the table, a bad id, --odometry-run without --odometry or with the sweep trackers.
+    let (ok, _, stderr) = go(&["--odometry", "tables", "--odometry-run", "other", "-o", "x"]);
+    assert!(!ok && stderr.contains("run=other/odometry/sequence=drive/part-0.parquet: not found"), "{stderr}");
+    assert!(stderr.contains("holding one: a, b"), "{stderr}");
+    let (ok, _, stderr) = go(&["--odometry", "tables", "--odometry-run", "../a", "-o", "x"]);
+    assert!(!ok && stderr.contains("--odometry-run '../a': not a valid run id"), "{stderr}");
+    let (ok, _, stderr) = go(&["--odometry-run", "a", "-o", "x"]);
+    assert!(!ok && stderr.contains("--odometry <TABLES>"), "{stderr}");
+    let (ok, _, stderr) =
+        run(d, &["process", "beam", "drive.mcap", "--odometry", "tables", "--odometry-run", "a", "-o", "x"]);
+    assert!(!ok && stderr.contains("is an option of --tracker spebt only"), "{stderr}");
+    assert!(!d.join("x").exists());
+
+    // A table directly under the directory (no --run-id) is the one read, as before run folders.
+    write_table(&d.join("tables"), "drive", &rows, &info, Overwrite::Refuse).unwrap();
+    let (ok, _, stderr) = go(&["--odometry", "tables", "-o", "plain"]);
+    assert!(ok, "{stderr}");
+    assert!(odometry_used(d, "plain").ends_with("tables/odometry/sequence=drive/part-0.parquet"));
+    assert_eq!(tables(d, "plain").1, run_b);
+    // No table anywhere: the message says where it looked.
+    let (ok, _, stderr) = go(&["--odometry", "nothing", "-o", "x"]);
+    assert!(!ok && stderr.contains("nor in a run=<ID>/ folder of nothing"), "{stderr}");
 }
