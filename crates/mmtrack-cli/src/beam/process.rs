@@ -369,7 +369,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
             );
         }
-        return super::process_geometric::run(&files, &out.path, args.output_args.force, &args.geometric, quiet);
+        return super::process_geometric::run(&files, &out, &args.geometric, quiet);
     }
     if let Some(flag) = args.geometric.given().first() {
         bail!("{flag} is an option of --tracker geometric only");

@@ -29,13 +29,13 @@ use mmtrack_beam::geometric::{
 };
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
-use mmtrack_io::table::{RunInfo, table_path, write_table};
-use mmtrack_io::{Overwrite, RecordingEvent, RecordingReader};
+use mmtrack_io::table::{RunInfo, write_table};
+use mmtrack_io::{RecordingEvent, RecordingReader};
 use mmtrack_sim::beam::overtaking::OvertakingScenario;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 
-use crate::run_id::run_id_of;
+use crate::run_id::RunDir;
 
 /// Which beams the tracker measures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
@@ -138,14 +138,8 @@ fn relative_m(v: &TwoVehicles, t_ns: i64) -> [f64; 2] {
 ///
 /// `output_dir` is the run directory (`<output>/run=<ID>` with `--run-id`,
 /// `crate::run_id`): refusals look there and the tables go there.
-pub fn run(
-    recordings: &[PathBuf],
-    output_dir: &Path,
-    force: bool,
-    options: &GeometricOptions,
-    quiet: bool,
-) -> anyhow::Result<ExitCode> {
-    let overwrite = if force { Overwrite::Replace } else { Overwrite::Refuse };
+pub fn run(recordings: &[PathBuf], out: &RunDir, options: &GeometricOptions, quiet: bool) -> anyhow::Result<ExitCode> {
+    let output_dir = out.path.as_path();
     let scenario = OvertakingScenario::default();
     let epoch_s = options.epoch_ms.unwrap_or(1e3 * scenario.epoch_s) * 1e-3;
     ensure!(epoch_s.is_finite() && epoch_s > 0.0, "--epoch-ms must be positive (nothing was done)");
@@ -158,11 +152,8 @@ pub fn run(
         ScheduleArg::FullScan => BeamSchedule { full_scan_epochs: usize::MAX, ..BeamSchedule::paper(scenario.beams) },
     };
     let inputs = recordings.iter().map(|p| read(p).map(|r| (p, r))).collect::<anyhow::Result<Vec<_>>>()?;
-    if overwrite == Overwrite::Refuse {
-        for (_, r) in &inputs {
-            let path = table_path(output_dir, GEOMETRIC_PER_EPOCH.name, &r.sequence_id)?;
-            ensure!(!path.exists(), "{}: exists; use --force to replace it (nothing was written)", path.display());
-        }
+    for (_, r) in &inputs {
+        out.refuse_existing(&[GEOMETRIC_PER_EPOCH.name], &r.sequence_id)?;
     }
     let step_ns = (epoch_s * 1e9).round() as i64;
     for (path, vehicles) in &inputs {
@@ -225,12 +216,12 @@ pub fn run(
                 "epoch_s": epoch_s,
                 "doppler_seed": seed,
                 "scenario": scenario,
-                "run_id": run_id_of(output_dir),
+                "run_id": out.run_id(),
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),
         };
-        write_table(output_dir, &vehicles.sequence_id, &rows, &info, overwrite)?;
+        write_table(output_dir, &vehicles.sequence_id, &rows, &info, out.overwrite)?;
         if !quiet {
             let last = rows.last().context("no epochs")?;
             println!(
