@@ -269,8 +269,8 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
     };
     let out = args.output_args.run.resolve(output)?;
     // Check the outputs before the work, so a refusal costs nothing.
-    if let Some(sequence) = &args.output_args.sequence {
-        out.refuse_existing(&TABLES, sequence)?;
+    if let Some(sequence) = args.output_args.sequence_hint(recording) {
+        out.refuse_existing(&TABLES, &sequence)?;
     }
     let run = args
         .threads

@@ -376,14 +376,7 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     }
     let out = args.output_args.run.resolve(output)?;
     // Check the outputs before the work, so a refusal costs nothing.
-    let hinted = match &args.output_args.sequence {
-        Some(s) => Some(s.clone()),
-        None => RecordingReader::open(recording).ok().and_then(|mut r| {
-            let _ = r.next_item();
-            r.metadata().and_then(RecordingMetadata::from_map).map(|m| m.sequence_id)
-        }),
-    };
-    if let Some(sequence) = &hinted {
+    if let Some(sequence) = &args.output_args.sequence_hint(recording) {
         refuse_existing(&out, sequence)?;
     }
     let run = args.threads.install(|| read_and_process(args, &config, quiet))??;

@@ -41,6 +41,19 @@ impl OutputArgs {
     pub fn sequence_or(&self, recording_sequence: &str) -> String {
         self.sequence.clone().unwrap_or_else(|| recording_sequence.to_string())
     }
+
+    /// The sequence id the run will most likely write, known before any
+    /// work: `--sequence`, else the id in the recording's metadata (its
+    /// first record). `None` when that cannot be read; the pipeline then
+    /// reports the problem itself and checks again after its work.
+    #[must_use]
+    pub fn sequence_hint(&self, recording: &Path) -> Option<String> {
+        self.sequence.clone().or_else(|| {
+            let mut reader = mmtrack_io::RecordingReader::open(recording).ok()?;
+            let _ = reader.next_item();
+            reader.metadata().and_then(mmtrack_io::recording::RecordingMetadata::from_map).map(|m| m.sequence_id)
+        })
+    }
 }
 
 /// `--force` and `--run-id`: the output flags of every pipeline, also of

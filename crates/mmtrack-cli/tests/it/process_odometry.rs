@@ -4,7 +4,7 @@
 use mmtrack_core::OdometryEstimate;
 use mmtrack_io::table::{GroundTruthPose, read_table_dir};
 
-use super::common::{mmtrack, text};
+use super::common::{mmtrack, root, text};
 
 #[test]
 fn real_oxford_recording_gives_odometry_and_ground_truth_tables() {
@@ -70,4 +70,29 @@ fn config_overrides_are_checked() {
         mmtrack(dir.path(), &["process", "odometry", "x.mcap", "-o", "t", "--config", "ok.toml", "--print-config"]);
     assert!(out.status.success(), "{}", text(&out).1);
     assert!(text(&out).0.contains("k_strongest = 12"));
+}
+
+/// An existing table of the recording's own sequence is refused before the
+/// work (its id is read from the recording's metadata), not after it: on a
+/// recording without radar scans the refusal, not the odometry's "no radar
+/// scans", is what the user sees.
+#[test]
+fn an_existing_table_is_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = root().join("data/sounder/convoy-tunnel.toml");
+    let sim = mmtrack(
+        dir.path(),
+        &["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "rec.mcap", "--sets", "3", "-q"],
+    );
+    assert!(sim.status.success(), "{}", text(&sim).1);
+    let fresh = mmtrack(dir.path(), &["process", "odometry", "rec.mcap", "-o", "t"]);
+    assert!(text(&fresh).1.contains("no radar scans"), "{}", text(&fresh).1);
+    let part = dir.path().join("t/odometry/sequence=rec");
+    std::fs::create_dir_all(&part).unwrap();
+    std::fs::write(part.join("part-0.parquet"), b"earlier results").unwrap();
+    let again = mmtrack(dir.path(), &["process", "odometry", "rec.mcap", "-o", "t"]);
+    let (_, stderr) = text(&again);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(stderr.contains("exists; use --force") && !stderr.contains("no radar scans"), "{stderr}");
+    assert_eq!(std::fs::read(part.join("part-0.parquet")).unwrap(), b"earlier results");
 }
