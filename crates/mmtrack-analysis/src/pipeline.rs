@@ -229,9 +229,10 @@ impl TrajectoryResult {
     }
 }
 
-fn rms(values: impl Iterator<Item = f64>) -> f64 {
+/// Root mean square; `None` without values.
+pub(crate) fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
     let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    if n == 0 { 0.0 } else { (sum / n as f64).sqrt() }
+    (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
 fn path_length(poses: &[Se2]) -> f64 {
@@ -279,8 +280,8 @@ pub fn analyze_trajectory(
         position_rmse_m: unaligned.position_rmse_m,
         yaw_rmse_rad: unaligned.yaw_rmse_rad,
         final_position_error_m: unaligned.final_position_error_m,
-        rpe_translation_rmse_m: rms(rpe.iter().map(|e| e.translation_error_m)),
-        rpe_yaw_rmse_rad: rms(rpe.iter().map(|e| e.yaw_error_rad)),
+        rpe_translation_rmse_m: rms(rpe.iter().map(|e| e.translation_error_m)).unwrap_or(0.0),
+        rpe_yaw_rmse_rad: rms(rpe.iter().map(|e| e.yaw_error_rad)).unwrap_or(0.0),
     };
     Ok(TrajectoryResult { sequence: sequence.to_string(), association, drift, rpe, metrics })
 }

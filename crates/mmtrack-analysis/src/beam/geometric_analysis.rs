@@ -26,6 +26,7 @@ use mmtrack_core::wrap_angle_rad;
 
 use super::geometric_plots::GeometricTrackingSeries;
 use super::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow, GeometricSummaryRow};
+use crate::pipeline::rms;
 
 /// The figure of one sequence, with its caption.
 pub const SEQUENCE_PLOT: (&str, &str) =
@@ -144,11 +145,6 @@ fn check(sequence: &str, rows: &[GeometricEpochRow]) -> Result<(), String> {
     Ok(())
 }
 
-fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    (n > 0).then(|| (sum / n as f64).sqrt())
-}
-
 /// Checks one sequence's `geometric_per_epoch` rows and summarises them
 /// (module docs).
 ///
@@ -159,10 +155,8 @@ fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
 /// a filter other than `h-infinity` then `rls`.
 pub fn sequence_result(sequence: &str, rows: Vec<GeometricEpochRow>) -> Result<GeometricSequenceResult, String> {
     check(sequence, &rows)?;
-    let (first, last) = match (rows.first(), rows.last()) {
-        (Some(first), Some(last)) => (first, last),
-        _ => return Err(format!("sequence {sequence}: table {} has no rows", GEOMETRIC_PER_EPOCH.name)),
-    };
+    // `check` refuses an empty table.
+    let (first, last) = (&rows[0], &rows[rows.len() - 1]);
     let handover = rows.iter().position(|r| r.filter == RLS);
     let converged = &rows[handover.unwrap_or(rows.len())..];
     let range_error = |r: &GeometricEpochRow| r.range_m - r.true_range_m;

@@ -23,6 +23,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail, ensure};
 use clap::{Args, ValueEnum};
+use mmtrack_analysis::beam::geometric_analysis::{H_INFINITY, RLS};
 use mmtrack_analysis::beam::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
 use mmtrack_beam::geometric::{
     BeamSchedule, BeamSelection, DopplerBearing, GeometricTracker, GeometricTrackerConfig, RangeEstimator,
@@ -193,7 +194,7 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &GeometricOptions, qui
             rows.push(GeometricEpochRow {
                 epoch: k as u64,
                 t_ns,
-                filter: if tracker.converged() { "rls" } else { "h-infinity" }.to_string(),
+                filter: if tracker.converged() { RLS } else { H_INFINITY }.to_string(),
                 beams_measured,
                 measured_azimuth_rad,
                 measured_doppler_hz: doppler_hz,
