@@ -14,6 +14,7 @@
 //! - [`array`]: antenna array responses, beamforming gains, beamwidths and
 //!   beam codebooks; [`array_uca`]: uniform circular arrays and their
 //!   phase-quantised codebooks;
+//! - [`progress`]: the trait long library calls report their progress through;
 //! - [`parallel`]: order-keeping parallel maps on rayon, for every parallel stage;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
@@ -35,6 +36,7 @@ mod mpc;
 mod odometry;
 pub mod parallel;
 mod pose;
+pub mod progress;
 mod radar;
 pub mod slam;
 pub mod sounder;
