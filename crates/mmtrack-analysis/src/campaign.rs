@@ -97,22 +97,22 @@ pub const COMPARED: [ComparedTable; 6] = [
         ],
     },
     ComparedTable {
-        spec: &crate::beam::tables::BEAM_SWEEP_SUMMARY,
+        spec: &mmtrack_io::table::BEAM_SWEEP_SUMMARY,
         keys: &["tracker"],
         metrics: &["mean_loss_db", "p90_loss_db", "top1", "mean_beams_per_sweep"],
     },
     ComparedTable {
-        spec: &crate::beam::spebt_tables::SPEBT_SUMMARY,
+        spec: &mmtrack_io::table::SPEBT_SUMMARY,
         keys: &["experiment", "trajectory"],
         metrics: &["rmse_gain_pct", "rmse_aod_deg", "rmse_aoa_deg", "reinitialisation_share_pct"],
     },
     ComparedTable {
-        spec: &crate::beam::zoechmann_tables::GEOMETRIC_SUMMARY,
+        spec: &mmtrack_io::table::GEOMETRIC_SUMMARY,
         keys: &[],
         metrics: &["handover_s", "rls_share", "range_rmse_m", "azimuth_rmse_rad", "saving"],
     },
     ComparedTable {
-        spec: &crate::slam::tables::SLAM_SUMMARY,
+        spec: &mmtrack_io::table::SLAM_SUMMARY,
         keys: &["row"],
         metrics: &["ue_position_error_m", "ue_heading_error_rad", "ue_clock_bias_error_m", "va_error_m", "sp_error_m"],
     },

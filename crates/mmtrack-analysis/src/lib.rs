@@ -39,6 +39,7 @@
 //! plain Rust; tables are written through `mmtrack-io`'s `TableRow` so every
 //! table carries the same units and run metadata.
 
+pub mod analyze;
 pub mod beam;
 pub mod campaign;
 pub mod export;

@@ -12,12 +12,13 @@ use mmtrack_io::table::{RunInfo, write_table};
 use crate::beam::geometric_analysis::{self, GeometricResults};
 use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::sweeps::{self, BeamSweepResults};
-use crate::beam::{geometric_plots, plots as beam_plots, spebt_plots, tables::BeamSweepPooledRow};
+use crate::beam::{geometric_plots, plots as beam_plots, spebt_plots};
 use crate::campaign::RunTables;
 use crate::mpc::MpcResult;
 use crate::pipeline::{RunResults, TrajectoryResult};
 use crate::trajectory::DriftOptions;
 use crate::{mpc_plots, mpc_report, plots, report, report_html};
+use mmtrack_io::table::BeamSweepPooledRow;
 
 /// Entries of a results directory (and `run=<id>` folders of several runs);
 /// `--force` replaces only a directory that holds nothing else, so a

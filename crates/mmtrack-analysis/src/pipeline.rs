@@ -17,10 +17,10 @@ use mmtrack_io::table::{
 use crate::beam::BeamResults;
 use crate::beam::geometric_analysis::{self, GeometricResults};
 use crate::beam::spebt_analysis::{self, SpebtResults};
-use crate::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow, SpebtSummaryRow};
 use crate::beam::sweeps::analyze_beam_sweeps;
-use crate::beam::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
 use crate::mpc::{DistanceSource, MpcInput, MpcOptions, MpcResult, analyze_mpc};
+use mmtrack_io::table::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
+use mmtrack_io::table::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow, SpebtSummaryRow};
 
 use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
 use crate::trajectory::{
@@ -135,7 +135,7 @@ pub fn plan(inventory: &Inventory) -> Plan {
             ));
         }
     }
-    for seq in inventory.sequences(crate::slam::tables::SLAM_UE.name) {
+    for seq in inventory.sequences(mmtrack_io::table::SLAM_UE.name) {
         let missing: Vec<&str> =
             crate::slam::analysis::INPUT_TABLES.into_iter().filter(|t| !inventory.sequences(t).contains(seq)).collect();
         if missing.is_empty() {

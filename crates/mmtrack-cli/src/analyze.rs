@@ -2,19 +2,16 @@
 //! tables `mmtrack process` writes. The work is in `mmtrack-analysis`; this
 //! module parses arguments and talks to the terminal.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, bail};
 use clap::Args;
-use mmtrack_analysis::campaign::discover_runs;
+use mmtrack_analysis::analyze::{AnalyzeOptions, Analyzed, analyze};
 use mmtrack_analysis::mpc::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, MpcOptions};
-use mmtrack_analysis::output::{check_output, write_all_results, write_campaign};
-use mmtrack_analysis::pipeline::{RunResults, analyze_run};
+use mmtrack_analysis::pipeline::RunResults;
 use mmtrack_analysis::report::one_line;
 use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::RunInfo;
 
 #[derive(Args)]
 #[command(
@@ -103,54 +100,28 @@ fn drift_options(args: &AnalyzeArgs) -> DriftOptions {
     }
 }
 
-/// Refuses an output directory that is, or contains, the input.
-fn check_not_inside(tables: &Path, output: &Path) -> anyhow::Result<()> {
-    let (Ok(tables), Ok(output)) = (tables.canonicalize(), output.canonicalize()) else { return Ok(()) };
-    if tables.starts_with(&output) {
-        bail!("{}: the output directory contains the input tables; choose another output", output.display());
+/// The library's options of `args`.
+pub fn options(args: &AnalyzeArgs) -> AnalyzeOptions {
+    AnalyzeOptions {
+        drift: drift_options(args),
+        mpc: MpcOptions { first_path_dynamic_range_db: args.first_path_range_db },
+        overwrite: if args.force { Overwrite::Replace } else { Overwrite::Refuse },
     }
-    Ok(())
 }
 
 pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
-    for tables in &args.tables {
-        if !tables.is_dir() {
-            bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", tables.display());
-        }
-        check_not_inside(tables, &args.output)?;
+    let analyzed = analyze(&args.tables, &args.output, &options(args))?;
+    if !quiet {
+        print_analyzed(&analyzed);
     }
-    check_output(&args.output, overwrite)?;
-    let options = drift_options(args);
-    // Options are checked by the metric too, but a usage error should not wait for the tables to load.
-    mmtrack_analysis::trajectory::kitti_drift(&[], &[], &options).context("--segment-lengths-m / --step-*")?;
-    if !(args.first_path_range_db.is_finite() && args.first_path_range_db >= 0.0) {
-        bail!("--first-path-range-db {}: expected a finite, non-negative number of dB", args.first_path_range_db);
-    }
+    Ok(ExitCode::SUCCESS)
+}
 
-    let runs = discover_runs(&args.tables)?;
-    let mpc_options = MpcOptions { first_path_dynamic_range_db: args.first_path_range_db };
-    let config = |tables: serde_json::Value| RunInfo {
-        config_json: serde_json::json!({
-            "command": "analyze",
-            "tables": tables,
-            "segment_lengths_m": options.segment_lengths_m,
-            "step": format!("{:?}", options.step),
-            "first_path_range_db": args.first_path_range_db,
-            "mmtrack_version": env!("CARGO_PKG_VERSION"),
-        })
-        .to_string(),
-    };
-    // One run: its results straight into the output, as always.
-    if let [only] = runs.as_slice()
-        && args.tables.len() == 1
-        && only.tables == args.tables[0]
-    {
-        let results = analyze_run(&only.tables, &options, &mpc_options)?;
-        let run = config(serde_json::json!(only.tables.display().to_string()));
-        let written = write_all_results(&args.output, &results, &options, &run, overwrite)?;
-        if !quiet {
-            print_run(&results, "");
+/// What `analyze` prints after its work.
+pub fn print_analyzed(analyzed: &Analyzed) {
+    match analyzed {
+        Analyzed::Run { results, written } => {
+            print_run(results, "");
             println!(
                 "wrote {} files: tables {}, plots {}, report {} and {}",
                 written.files,
@@ -160,32 +131,22 @@ pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 written.report_html.display()
             );
         }
-        return Ok(ExitCode::SUCCESS);
-    }
-    let mut analyzed = Vec::new();
-    for run in &runs {
-        let results = analyze_run(&run.tables, &options, &mpc_options).with_context(|| format!("run {}", run.id))?;
-        analyzed.push((run.clone(), results));
-    }
-    let tables: serde_json::Map<String, serde_json::Value> =
-        runs.iter().map(|r| (r.id.clone(), serde_json::json!(r.tables.display().to_string()))).collect();
-    let run = config(serde_json::Value::Object(tables));
-    let written = write_campaign(&args.output, &analyzed, &options, &run, overwrite)?;
-    if !quiet {
-        for (run, results) in &analyzed {
-            print_run(results, &format!("run {}: ", run.id));
+        Analyzed::Campaign { runs, written } => {
+            for (run, results) in runs {
+                print_run(results, &format!("run {}: ", run.id));
+            }
+            println!(
+                "{} runs side by side: wrote {} files: each run under {}/run=<id>/, the comparison {} and report {} \
+                 and {}",
+                runs.len(),
+                written.files,
+                written.out_dir.display(),
+                written.tables_dir.join("run_comparison").display(),
+                written.report.display(),
+                written.report_html.display()
+            );
         }
-        println!(
-            "{} runs side by side: wrote {} files: each run under {}/run=<id>/, the comparison {} and report {} and {}",
-            analyzed.len(),
-            written.files,
-            written.out_dir.display(),
-            written.tables_dir.join("run_comparison").display(),
-            written.report.display(),
-            written.report_html.display()
-        );
     }
-    Ok(ExitCode::SUCCESS)
 }
 
 /// The one-line summaries of one run's results, each line after `prefix`.

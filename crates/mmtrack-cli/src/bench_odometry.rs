@@ -11,7 +11,10 @@ use clap::Args;
 use mmtrack_odometry::OdometryConfig;
 
 use crate::ingest::{CompressionArg, OutputArgs};
-use crate::process::run_odometry;
+use mmtrack_core::progress::NoProgress;
+use mmtrack_process::events::for_each_event;
+use mmtrack_process::odometry::run_odometry;
+
 use crate::readme_block::replace_block;
 
 /// Issue #4: end-to-end scans per second on this 2-core machine (CFEAR-1
@@ -46,7 +49,7 @@ pub struct OdometryBenchArgs {
 /// and rayon decoding as `process odometry`: the baseline.
 fn decode_only(recording: &Path) -> anyhow::Result<usize> {
     let mut scans = 0;
-    crate::process::for_each_event(recording, |event, _| {
+    for_each_event(recording, |event, _| {
         if let mmtrack_io::RecordingEvent::RadarScan(_) = event {
             scans += 1;
         }
@@ -89,7 +92,7 @@ pub fn run(args: &OdometryBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         let (mut scans, mut elapsed_s) = (0usize, 0.0);
         let (mut filter_s, mut surface_s, mut register_s) = (0.0, 0.0, 0.0);
         for _ in 0..args.passes {
-            let run = run_odometry(&recording, config.clone(), true)?;
+            let run = run_odometry(&recording, config.clone(), &NoProgress)?;
             scans += run.estimates.len();
             elapsed_s += run.elapsed_s;
             for t in &run.timings {
@@ -248,7 +251,7 @@ fn simulated_recording(scans: usize, dir: &Path) -> anyhow::Result<PathBuf> {
         SimOptions { limits: ScanLimits { max_scans: Some(scans), max_distance_m: None }, ..scenario.options() };
     let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)?;
     let folder = dir.join(format!("drive-{scans}"));
-    crate::simulate::write_oxford_streaming(&scenario, simulator, &folder, true, &|| {})?;
+    mmtrack_process::simulate::radar::write_oxford_streaming(&scenario, simulator, &folder, true, &NoProgress)?;
     let recording = dir.join(format!("drive-{scans}.mcap"));
     ingest_quietly(&folder, &recording)?;
     std::fs::remove_dir_all(&folder)?;

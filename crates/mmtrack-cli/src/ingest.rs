@@ -103,6 +103,17 @@ pub enum PoseFormat {
 }
 
 impl PoseFormat {
+    /// The library's trajectory format.
+    #[must_use]
+    pub fn trajectory_format(self) -> mmtrack_process::simulate::radar::TrajectoryFormat {
+        use mmtrack_process::simulate::radar::TrajectoryFormat;
+        match self {
+            Self::Tum => TrajectoryFormat::Tum,
+            Self::Kitti => TrajectoryFormat::Kitti,
+            Self::Oxford => TrajectoryFormat::Oxford,
+        }
+    }
+
     fn name(self) -> &'static str {
         match self {
             Self::Tum => "tum",

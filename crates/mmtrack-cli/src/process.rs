@@ -1,25 +1,19 @@
-//! `mmtrack process <pipeline>`: run an algorithm on a recording, write tables.
+//! `mmtrack process <pipeline>`: the arguments of each pipeline, one call
+//! of `mmtrack_process` each, and the summary printed after it.
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 use clap::{Args, Subcommand};
-use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose, path_length_m};
-use mmtrack_io::recording::PoseStream;
-use mmtrack_io::recording::RecordingItem;
-use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary, write_table};
-use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
-use mmtrack_odometry::{OdometryConfig, RadarOdometry};
+use mmtrack_core::{OdometryTiming, StampedPose, path_length_m};
+use mmtrack_io::table::TableWriteSummary;
+use mmtrack_odometry::OdometryConfig;
+use mmtrack_process::{manifest, mpc, odometry, slam};
 
-use crate::progress;
-use crate::run_id::{OutputArgs, run_id_of};
+use crate::output_args::OutputArgs;
+use crate::progress::Bars;
 use crate::threads::ThreadsArg;
-
-#[path = "process_mpc.rs"]
-mod process_mpc;
 
 #[derive(Args)]
 pub struct ProcessArgs {
@@ -51,7 +45,7 @@ enum Pipeline {
     /// Several TX/RX links: each is its own partition `<sequence>-tx<T>-rx<R>`
     /// unless `--link T:R` picks one. Then run `mmtrack analyze <out>`.
     #[command(verbatim_doc_comment)]
-    Mpc(process_mpc::MpcArgs),
+    Mpc(MpcArgs),
     /// Beam trackers: sweep trackers on measured beam sweeps, or SPEBT on a recording with ground truth.
     ///
     /// Sweep trackers (window, gnss-window, last-full-sweep, gnss-map) on
@@ -67,7 +61,7 @@ enum Pipeline {
     /// `mmtrack process odometry`) or from the ground truth plus the
     /// pose-error model; it writes `spebt_per_slot` and `spebt_summary`.
     #[command(verbatim_doc_comment)]
-    Beam(crate::beam::process::BeamArgs),
+    Beam(crate::process_beam::BeamArgs),
     /// 5G mmWave SLAM (Kim et al. 2018) on the recording's per-epoch path measurements.
     ///
     /// Runs the particle belief-propagation SLAM filter over /slam/paths (from
@@ -79,7 +73,7 @@ enum Pipeline {
     /// `slam_true_sources`. Unusable paths are skipped and counted, or refused
     /// with --strict. Then run `mmtrack analyze <out>`.
     #[command(verbatim_doc_comment)]
-    Slam(crate::slam::process::SlamArgs),
+    Slam(SlamArgs),
     /// Many sequences at once: every `mmtrack process` command line of a manifest as its own task.
     ///
     /// The manifest (TOML) lists `[[task]]` tables, each with `args`: a
@@ -94,7 +88,7 @@ enum Pipeline {
     /// the per-sequence command lines, one cluster job each (see
     /// examples/ray_process.py).
     #[command(verbatim_doc_comment)]
-    Manifest(crate::process_manifest::ManifestArgs),
+    Manifest(ManifestArgs),
 }
 
 #[derive(Args)]
@@ -121,144 +115,105 @@ pub struct OdometryArgs {
     pub threads: ThreadsArg,
 }
 
+#[derive(Args)]
+pub struct MpcArgs {
+    /// Recording with CIR snapshots on /channel/cir (from `mmtrack ingest cir` or `mmtrack simulate sounder`); not
+    /// needed with `--print-config`.
+    #[arg(required_unless_present = "print_config")]
+    pub recording: Option<PathBuf>,
+    /// Output table directory (created if missing); not needed with `--print-config`.
+    #[arg(short, long, required_unless_present = "print_config")]
+    pub output: Option<PathBuf>,
+    /// TOML file overriding single fields of the default configuration (see `--print-config`).
+    #[arg(long, value_name = "TOML")]
+    pub config: Option<PathBuf>,
+    /// Print the effective configuration (the defaults with `--config` and `--gmphd` on top) as TOML and exit.
+    #[arg(long)]
+    pub print_config: bool,
+    /// Sounder pulse: `flat` (the band's flat spectrum), or a `.npy` file holding a back-to-back calibration CIR
+    /// [default: the pulse spectrum in the recording's metadata (`sounder.pulse_spectrum`), else flat].
+    #[arg(long, value_name = "flat|FILE.npy")]
+    pub pulse: Option<String>,
+    /// Process only the link TX:RX (antenna indices), written as the sequence itself. Without it every link is
+    /// processed, each as partition `<sequence>-tx<T>-rx<R>` when there are several.
+    #[arg(long, value_name = "TX:RX")]
+    pub link: Option<String>,
+    /// Also run the GM-PHD baseline (Mahler et al. 2017, Table I) on the same detections, set by set (table
+    /// mpc_tracks_gmphd); the same as `run_gmphd = true` in the configuration.
+    #[arg(long)]
+    pub gmphd: bool,
+    #[command(flatten)]
+    pub output_args: OutputArgs,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
+}
+
+#[derive(Args)]
+pub struct SlamArgs {
+    /// Recording with /slam/paths and /slam/sources (from `mmtrack simulate slam`).
+    pub recording: PathBuf,
+    /// Output table directory (created if missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Filter parameters (TOML: any field of the SLAM filter configuration, e.g. particles = 500,
+    /// toa_std_m = 0.1); the others keep their defaults (the paper's). bs_m is the recording's base station.
+    #[arg(long, value_name = "TOML")]
+    pub config: Option<PathBuf>,
+    /// UE particles (overrides the configuration's, 2000).
+    #[arg(long)]
+    pub particles: Option<usize>,
+    /// Seed of the filter's random streams.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Prior UE state x,y,z,heading,speed,turn_rate,clock_bias (m, rad, m/s, rad/s, m) for recordings without
+    /// ground truth (default: the recording's first true state).
+    #[arg(
+        long,
+        value_delimiter = ',',
+        allow_negative_numbers = true,
+        value_name = "X,Y,Z,HEADING,SPEED,TURN_RATE,BIAS"
+    )]
+    pub prior: Option<Vec<f64>>,
+    /// Refuse a recording with an unusable path (NaN, elevation out of range) instead of skipping and counting it.
+    #[arg(long)]
+    pub strict: bool,
+    #[command(flatten)]
+    pub output_args: OutputArgs,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
+}
+
+#[derive(Args)]
+pub struct ManifestArgs {
+    /// Manifest TOML: `[[task]]` tables, each with `args`, a `mmtrack process` command line without `mmtrack
+    /// process` and without `-o` (paths as typed in the directory you run from).
+    pub manifest: PathBuf,
+    /// Output table directory every task writes into (its own sequence partitions).
+    #[arg(short, long, required_unless_present = "print_commands")]
+    pub output: Option<PathBuf>,
+    /// Pass --force to every task (replace their earlier partitions).
+    #[arg(long)]
+    pub force: bool,
+    /// Print the per-sequence command lines (what a cluster runs, one job each) and exit.
+    #[arg(long)]
+    pub print_commands: bool,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
+}
+
 pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match &args.pipeline {
-        Pipeline::Odometry(odometry_args) => {
-            odometry(odometry_args, quiet)?;
-            Ok(ExitCode::SUCCESS)
-        }
-        Pipeline::Mpc(mpc_args) => {
-            process_mpc::run(mpc_args, quiet)?;
-            Ok(ExitCode::SUCCESS)
-        }
-        Pipeline::Beam(beam_args) => crate::beam::process::run(beam_args, quiet),
-        Pipeline::Slam(slam_args) => {
-            crate::slam::process::run(slam_args, quiet)?;
-            Ok(ExitCode::SUCCESS)
-        }
-        Pipeline::Manifest(manifest_args) => crate::process_manifest::run(manifest_args, quiet),
+        Pipeline::Odometry(odometry_args) => run_odometry(odometry_args, quiet)?,
+        Pipeline::Mpc(mpc_args) => run_mpc(mpc_args, quiet)?,
+        Pipeline::Beam(beam_args) => crate::process_beam::run(beam_args, quiet)?,
+        Pipeline::Slam(slam_args) => run_slam(slam_args, quiet)?,
+        Pipeline::Manifest(manifest_args) => return run_manifest(manifest_args, quiet),
     }
+    Ok(ExitCode::SUCCESS)
 }
 
-/// The effective configuration: the preset with the TOML file's fields on top.
-fn effective_config(preset: &str, overrides: Option<&Path>) -> anyhow::Result<OdometryConfig> {
-    let base = OdometryConfig::preset(preset).with_context(|| format!("unknown preset '{preset}'"))?;
-    let Some(path) = overrides else { return Ok(base) };
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
-    let changes: toml::Table = toml::from_str(&text).with_context(|| format!("{}: not valid TOML", path.display()))?;
-    let mut merged = toml::Table::try_from(&base)?;
-    for (key, value) in changes {
-        if !merged.contains_key(&key) {
-            let known: Vec<&String> = merged.keys().collect();
-            bail!("{}: unknown odometry parameter '{key}'; known: {known:?}", path.display());
-        }
-        merged.insert(key, value);
-    }
-    let config: OdometryConfig =
-        merged.try_into().with_context(|| format!("{}: a value has the wrong type", path.display()))?;
-    config.validate().with_context(|| path.display().to_string())?;
-    Ok(config)
-}
-
-/// What the odometry run produced.
-pub struct OdometryRun {
-    /// One estimate per scan.
-    pub estimates: Vec<OdometryEstimate>,
-    /// Stage timings per scan.
-    pub timings: Vec<OdometryTiming>,
-    /// Ground truth from the recording (may be empty).
-    pub ground_truth: Vec<StampedPose>,
-    /// The recording's sequence id.
-    pub sequence_id: String,
-    /// Wall-clock seconds for reading, decoding and processing.
-    pub elapsed_s: f64,
-}
-
-/// Reads the recording and decodes its scans on the current rayon pool while
-/// the odometry runs on the previous ones ([`for_each_event`]).
-pub fn run_odometry(recording: &Path, config: OdometryConfig, quiet: bool) -> anyhow::Result<OdometryRun> {
-    let started = Instant::now();
-    let mut odometry = RadarOdometry::new(config)?;
-    let total_bytes = std::fs::metadata(recording).map(|m| m.len()).unwrap_or(0);
-    let bar = progress::bytes_bar("odometry", quiet);
-    bar.set_length(total_bytes);
-    let mut estimates = Vec::new();
-    let mut timings = Vec::new();
-    let mut ground_truth = Vec::new();
-    let metadata = for_each_event(recording, |event, bytes_read| {
-        bar.set_position(bytes_read);
-        match event {
-            RecordingEvent::RadarScan(scan) => {
-                let result = process_scan(&mut odometry, &scan, estimates.len())?;
-                estimates.push(result.estimate);
-                timings.push(result.timing);
-            }
-            RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => ground_truth.push(pose),
-            _ => {}
-        }
-        Ok(())
-    })?;
-    bar.finish_and_clear();
-    let sequence_id = metadata
-        .as_ref()
-        .and_then(RecordingMetadata::from_map)
-        .map(|m| m.sequence_id)
-        .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", recording.display()))?;
-    if estimates.is_empty() {
-        bail!("{}: the recording has no radar scans (topic /radar/image); nothing written", recording.display());
-    }
-    Ok(OdometryRun { estimates, timings, ground_truth, sequence_id, elapsed_s: started.elapsed().as_secs_f64() })
-}
-
-/// Scans decoded ahead of `f`, per thread of the pool.
-const SCANS_PER_THREAD: usize = 2;
-
-/// Calls `f` with every event of the recording in file order (and the bytes
-/// read so far). Radar scans are decoded on the current rayon pool, a few per
-/// thread ahead of `f` ([`mmtrack_core::parallel::map_in_order`]), so
-/// reading, PNG inflating and `f` overlap, order is kept and memory holds a
-/// bounded number of scans. Reading stops at the first bad record. Returns the
-/// recording metadata.
-pub fn for_each_event(
-    recording: &Path,
-    mut f: impl FnMut(RecordingEvent, u64) -> anyhow::Result<()> + Send,
-) -> anyhow::Result<Option<BTreeMap<String, String>>> {
-    let mut reader = RecordingReader::open(recording)?;
-    let mut failed = false;
-    let items = std::iter::from_fn(|| {
-        if failed {
-            return None;
-        }
-        let item = reader.next_item()?;
-        failed = item.is_err();
-        Some((item, reader.bytes_read()))
-    });
-    mmtrack_core::parallel::map_in_order(
-        items,
-        SCANS_PER_THREAD,
-        |(item, bytes_read)| {
-            let event = match item {
-                Ok(RecordingItem::Event(event)) => Ok(event),
-                Ok(RecordingItem::Scan(scan)) => scan.decode().map(RecordingEvent::RadarScan),
-                Err(e) => Err(e),
-            };
-            (event, bytes_read)
-        },
-        |(event, bytes_read)| f(event?, bytes_read),
-    )?;
-    Ok(reader.metadata().cloned())
-}
-
-fn process_scan(
-    odometry: &mut RadarOdometry,
-    scan: &PolarScan,
-    index: usize,
-) -> anyhow::Result<mmtrack_odometry::ScanOdometry> {
-    odometry.process(scan).with_context(|| format!("radar scan {index} (t_ns {})", scan.header.t_ns))
-}
-
-fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
-    let config = effective_config(&args.preset, args.config.as_deref())?;
+fn run_odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
+    let config = odometry::effective_config(&args.preset, args.config.as_deref())?;
     if args.print_config {
         print!("{}", toml::to_string(&config)?);
         return Ok(());
@@ -267,108 +222,18 @@ fn odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
     let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
         bail!("a recording and --output are required (unless --print-config)");
     };
-    let out = args.output_args.run.resolve(output)?;
-    // Check the outputs before the work, so a refusal costs nothing.
-    if let Some(sequence) = args.output_args.sequence_hint(recording) {
-        out.refuse_existing(&TABLES, &sequence)?;
-    }
-    let run = args
+    let options = args.output_args.options();
+    let progress = Bars::new(quiet);
+    let done = args
         .threads
-        .install(|| run_odometry(recording, config.clone(), quiet))?
-        .with_context(|| format!("{}", recording.display()))?;
-    let sequence = args.output_args.sequence_or(&run.sequence_id);
-    out.refuse_existing(&TABLES, &sequence)?;
-    let written = write_outputs(&out.path, &sequence, &run, &config, &args.preset, recording, out.overwrite)?;
+        .install(|| odometry::process_odometry(recording, output, &args.preset, &config, &options, &progress))??;
     if !quiet {
-        print_summary(&run, &args.preset, &written);
+        print_odometry(&done.run, &args.preset, &done.written);
     }
     Ok(())
 }
 
-/// Every table `process odometry` may write.
-const TABLES: [&str; 3] = ["odometry", "odometry_timing", "ground_truth"];
-
-/// Writes the tables; each appears atomically.
-pub fn write_outputs(
-    output: &Path,
-    sequence: &str,
-    run: &OdometryRun,
-    config: &OdometryConfig,
-    preset: &str,
-    recording: &Path,
-    overwrite: Overwrite,
-) -> anyhow::Result<Vec<TableWriteSummary>> {
-    let (estimates, frame) = in_ground_truth_frame(&run.estimates, &run.ground_truth);
-    let info = RunInfo {
-        config_json: serde_json::json!({
-            "command": "process odometry",
-            "recording": recording.display().to_string(),
-            "preset": preset,
-            "odometry": config,
-            "frame": frame,
-            "run_id": run_id_of(output),
-            "mmtrack_version": env!("CARGO_PKG_VERSION"),
-        })
-        .to_string(),
-    };
-    let mut written = vec![
-        write_table(output, sequence, &estimates, &info, overwrite)?,
-        write_table(output, sequence, &run.timings, &info, overwrite)?,
-    ];
-    if !run.ground_truth.is_empty() {
-        let truth: Vec<GroundTruthPose> = run.ground_truth.iter().cloned().map(GroundTruthPose).collect();
-        written.push(write_table(output, sequence, &truth, &info, overwrite)?);
-    }
-    Ok(written)
-}
-
-/// The odometry's poses in the ground truth's frame, and the `frame` entry of
-/// the run configuration saying which frame the table is in.
-///
-/// With ground truth covering a scan, the first estimate inside the
-/// ground-truth time span is placed at the ground-truth pose of its time
-/// (interpolated as `mmtrack analyze` does,
-/// [`mmtrack_analysis::trajectory::interpolate_pose`], when no pose has that
-/// time) and every estimate moves with it:
-/// `world_from_vehicle = truth(t_a) * estimate(t_a)^-1 * estimate`. This is
-/// the anchor `analyze` uses, so its metrics do not change, while a join of
-/// `odometry` and `ground_truth` on `(sequence, t_ns)` (or evo without
-/// alignment flags) now compares like with like. Without ground truth the
-/// frame stays the vehicle's pose at the first scan.
-fn in_ground_truth_frame(
-    estimates: &[OdometryEstimate],
-    ground_truth: &[StampedPose],
-) -> (Vec<OdometryEstimate>, serde_json::Value) {
-    let span = ground_truth.first().zip(ground_truth.last()).map(|(a, b)| a.t_ns..=b.t_ns);
-    let anchor = span.and_then(|span| estimates.iter().find(|e| span.contains(&e.t_ns)));
-    let Some(anchor) = anchor else {
-        let frame = serde_json::json!({
-            "world": "first_scan",
-            "meaning": "world is the vehicle's pose at the first scan (no ground truth at the scan times)",
-        });
-        return (estimates.to_vec(), frame);
-    };
-    let truth = match ground_truth.binary_search_by_key(&anchor.t_ns, |g| g.t_ns) {
-        Ok(i) => ground_truth[i].parent_from_child,
-        // The anchor lies strictly inside the span, so 0 < i < len.
-        Err(i) => mmtrack_analysis::trajectory::interpolate_pose(&ground_truth[i - 1], &ground_truth[i], anchor.t_ns),
-    };
-    let truth_from_odometry = truth * anchor.world_from_vehicle.inverse();
-    let moved = estimates
-        .iter()
-        .map(|e| OdometryEstimate { world_from_vehicle: truth_from_odometry * e.world_from_vehicle, ..*e })
-        .collect();
-    let frame = serde_json::json!({
-        "world": "ground_truth",
-        "meaning": "the ground truth's world frame (table ground_truth, recording topic /ground_truth/pose): the \
-                    estimate at anchor_t_ns sits at the ground-truth pose of that time, the others follow the odometry",
-        "anchor_t_ns": anchor.t_ns,
-        "ground_truth_from_odometry": [truth_from_odometry.x_m, truth_from_odometry.y_m, truth_from_odometry.yaw_rad],
-    });
-    (moved, frame)
-}
-
-fn print_summary(run: &OdometryRun, preset: &str, written: &[TableWriteSummary]) {
+pub(crate) fn print_odometry(run: &odometry::OdometryRun, preset: &str, written: &[TableWriteSummary]) {
     let n = run.estimates.len();
     let low = run.estimates.iter().filter(|e| e.low_confidence).count();
     let path: Vec<StampedPose> =
@@ -393,4 +258,123 @@ fn print_summary(run: &OdometryRun, preset: &str, written: &[TableWriteSummary])
     for w in written {
         println!("  wrote {} ({} rows)", w.path.display(), w.rows);
     }
+}
+
+fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
+    let mut config = mpc::effective_config(args.config.as_deref())?;
+    config.run_gmphd |= args.gmphd;
+    if args.print_config {
+        print!("{}", toml::to_string(&config)?);
+        return Ok(());
+    }
+    // clap requires both unless --print-config.
+    let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
+        bail!("a recording and --output are required (unless --print-config)");
+    };
+    let options = mpc::MpcOptions {
+        pulse: args.pulse.clone(),
+        link: args.link.as_deref().map(mpc::parse_link).transpose()?,
+        output: args.output_args.options(),
+    };
+    let progress = Bars::new(quiet);
+    let done = args.threads.install(|| mpc::process_mpc(recording, output, &config, &options, &progress))??;
+    if quiet {
+        return Ok(());
+    }
+    for link in &done.links {
+        println!(
+            "mpc {} (link tx{}:rx{}): {} sets, {} detections, {} short-term tracks, {} long-term entries",
+            link.partition, link.link.0, link.link.1, link.sets, link.detections, link.tracks, link.long_term
+        );
+        let (most, needed) = (link.most_snapshots_per_set, config.short_term.min_track_length);
+        if link.tracks == 0 && link.detections > 0 && (most as usize) < needed {
+            println!(
+                "  no short-term tracks: sets hold at most {most} snapshot(s) and a track follows one path over at \
+                 least short_term.min_track_length = {needed} snapshots of one set (Mahler et al. Sec. III-B); \
+                 this source gives detections and first paths only"
+            );
+        }
+    }
+    for w in &done.written {
+        println!("  wrote {} ({} {})", w.path.display(), w.rows, mpc::record_noun(&w.path));
+    }
+    Ok(())
+}
+
+fn run_slam(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
+    let options = slam::SlamOptions {
+        config: args.config.clone(),
+        particles: args.particles,
+        seed: args.seed,
+        prior: args.prior.clone(),
+        strict: args.strict,
+        output: args.output_args.options(),
+    };
+    let done = args.threads.install(|| slam::process_slam(&args.recording, &args.output, &options))??;
+    if !quiet {
+        let (va, sp) = done.confirmed_at_end();
+        let ue = &done.tables.ue;
+        let skipped: u64 = ue.iter().map(|r| r.skipped_paths).sum();
+        let empty = ue.iter().filter(|r| r.paths == 0).count();
+        println!(
+            "slam ({} particles): {} epochs ({empty} without paths, {skipped} paths skipped), {va} VAs and {sp} SPs \
+             confirmed at the end",
+            done.config.particles,
+            ue.len()
+        );
+        for w in &done.written {
+            println!("  wrote {} ({} rows)", w.path.display(), w.rows);
+        }
+    }
+    Ok(())
+}
+
+/// One manifest task (`process <pipeline> ...`): its words parsed as the
+/// arguments of `mmtrack process` and run by the library call of its
+/// pipeline, quietly (a `--quiet` among them is accepted).
+fn run_task(line: &[String]) -> anyhow::Result<()> {
+    use clap::FromArgMatches;
+    let words = line.iter().skip(1).filter(|w| *w != "--quiet" && *w != "-q");
+    let command = ProcessArgs::augment_args(clap::Command::new("mmtrack process")).no_binary_name(true);
+    let usage = |e: clap::Error| anyhow::anyhow!("{}", e.to_string().trim());
+    let args = ProcessArgs::from_arg_matches(&command.try_get_matches_from(words).map_err(usage)?).map_err(usage)?;
+    if matches!(args.pipeline, Pipeline::Manifest(_)) {
+        bail!("a manifest cannot run a manifest");
+    }
+    run(&args, true).map(|_| ())
+}
+
+fn run_manifest(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    let tasks = manifest::read_manifest(&args.manifest)?;
+    let output = match &args.output {
+        Some(o) => crate::path_word(o)?,
+        None => "<tables>".to_string(),
+    };
+    let lines: Vec<Vec<String>> = tasks.iter().map(|t| manifest::command_line(t, &output, args.force)).collect();
+    let shown = |line: &[String]| line.iter().map(|w| manifest::shell_word(w)).collect::<Vec<_>>().join(" ");
+    if args.print_commands {
+        for line in &lines {
+            println!("mmtrack {}", shown(line));
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let outcomes = args.threads.install(|| manifest::run_tasks(&lines, |line| run_task(line)))?;
+    let mut failed = 0;
+    for (line, outcome) in lines.iter().zip(&outcomes) {
+        match outcome {
+            Ok(()) => {
+                if !quiet {
+                    println!("ok      mmtrack {}", shown(line));
+                }
+            }
+            Err(e) => {
+                failed += 1;
+                eprintln!("failed  mmtrack {}: {}", shown(line), crate::one_line(e));
+            }
+        }
+    }
+    if !quiet {
+        println!("{} of {} tasks done; tables under {output}", tasks.len() - failed, tasks.len());
+    }
+    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }

@@ -20,12 +20,13 @@ use mmtrack_core::{OdometryEstimate, OdometryTiming, StampedPose};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::RunInfo;
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
+use mmtrack_process::odometry::{self, OdometryRun};
+use mmtrack_process::output::RunDir;
 use mmtrack_sim::radar::{RadarSimulator, Trajectory};
 
 use crate::ingest::PoseFormat;
-use crate::process::{self, OdometryRun};
-use crate::simulate;
 use crate::threads::ThreadsArg;
+use mmtrack_process::simulate::radar::{parse_scenario, read_trajectory};
 
 /// The drive scenario, embedded so the experiment runs from any directory.
 pub const ODOMETRY_DRIVE_SCENARIO: &str = include_str!("../../../data/reproduce/odometry-drive.toml");
@@ -247,7 +248,7 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
         }
         None => ("embedded data/reproduce/odometry-drive.toml".to_string(), ODOMETRY_DRIVE_SCENARIO.to_string()),
     };
-    let mut scenario = simulate::parse_scenario(&text).with_context(|| scenario_name.clone())?;
+    let mut scenario = parse_scenario(&text).with_context(|| scenario_name.clone())?;
     if args.quick {
         scenario.max_distance_m = Some(300.0);
     }
@@ -267,7 +268,7 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
         }
         bail!("{}: not found (--trajectory)", args.trajectory.display());
     }
-    let poses = simulate::read_trajectory(&args.trajectory, args.trajectory_format, None, 0)?;
+    let poses = read_trajectory(&args.trajectory, args.trajectory_format.trajectory_format(), None, 0)?;
     let trajectory = Trajectory::from_poses(poses).with_context(|| args.trajectory.display().to_string())?;
     let world = scenario.build_world(&trajectory).with_context(|| scenario_name.clone())?;
     let sim_options = scenario.options();
@@ -324,15 +325,8 @@ fn odometry(args: &OdometryExperimentArgs, quiet: bool) -> anyhow::Result<ExitCo
             sequence_id: sequence.clone(),
             elapsed_s,
         };
-        process::write_outputs(
-            &tables,
-            &sequence,
-            &odometry_run,
-            &run.config,
-            run.preset,
-            Path::new(&scenario_name),
-            Overwrite::Refuse,
-        )?;
+        let out = RunDir { path: tables.clone(), overwrite: Overwrite::Refuse };
+        odometry::write_outputs(&out, &sequence, &odometry_run, &run.config, run.preset, Path::new(&scenario_name))?;
         let low_confidence = odometry_run.estimates.iter().filter(|e| e.low_confidence).count();
         let result = analyze_trajectory(&sequence, &estimate, &ground_truth, &options)
             .with_context(|| format!("sequence {sequence}"))?;

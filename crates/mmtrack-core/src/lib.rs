@@ -48,7 +48,7 @@ pub use gnss::{GnssFix, GnssFixQuality};
 pub use mpc::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth};
 pub use num_complex::Complex64;
 pub use odometry::{OdometryEstimate, OdometryTiming};
-pub use pose::{Se2, StampedPose, path_length_m, wrap_angle_rad};
+pub use pose::{Se2, StampedPose, interpolate_pose, path_length_m, wrap_angle_rad};
 pub use radar::{AzimuthSample, PolarScan, PolarScanHeader};
 
 /// Nanoseconds per second, for converting `t_ns` to seconds at the edges.

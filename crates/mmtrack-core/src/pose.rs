@@ -105,6 +105,21 @@ pub struct StampedPose {
     pub parent_from_child: Se2,
 }
 
+/// The pose at `t_ns` between two stamped poses `a.t_ns <= t_ns <= b.t_ns`:
+/// x and y linear in time, yaw along the shortest arc
+/// (`yaw_a + alpha * wrap(yaw_b - yaw_a)`, `alpha = (t - t_a) / (t_b - t_a)`).
+#[must_use]
+pub fn interpolate_pose(a: &StampedPose, b: &StampedPose, t_ns: i64) -> Se2 {
+    let span = (i128::from(b.t_ns) - i128::from(a.t_ns)) as f64;
+    let alpha = if span > 0.0 { (i128::from(t_ns) - i128::from(a.t_ns)) as f64 / span } else { 0.0 };
+    let (pa, pb) = (a.parent_from_child, b.parent_from_child);
+    Se2::new(
+        pa.x_m + alpha * (pb.x_m - pa.x_m),
+        pa.y_m + alpha * (pb.y_m - pa.y_m),
+        wrap_angle_rad(pa.yaw_rad + alpha * wrap_angle_rad(pb.yaw_rad - pa.yaw_rad)),
+    )
+}
+
 /// Total length of the path through the translations of `poses`, metres.
 #[must_use]
 pub fn path_length_m(poses: &[StampedPose]) -> f64 {

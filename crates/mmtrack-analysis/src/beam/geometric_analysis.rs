@@ -20,22 +20,18 @@
 //! every epoch would measure over the beams measured (the paper's Sec. VI:
 //! 128 / 3 ~ 43 on the windowed epochs).
 
+use mmtrack_io::table::{GEOMETRIC_FILTER_H_INFINITY as H_INFINITY, GEOMETRIC_FILTER_RLS as RLS};
 use std::fmt::Write;
 
 use mmtrack_core::wrap_angle_rad;
 
 use super::geometric_plots::GeometricTrackingSeries;
-use super::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow, GeometricSummaryRow};
 use crate::pipeline::rms;
+use mmtrack_io::table::{GEOMETRIC_PER_EPOCH, GeometricEpochRow, GeometricSummaryRow};
 
 /// The figure of one sequence, with its caption.
 pub const SEQUENCE_PLOT: (&str, &str) =
     ("geometric_tracking.svg", "range, azimuth and beams measured against the truth");
-
-/// `filter` of an H-infinity epoch.
-pub const H_INFINITY: &str = "h-infinity";
-/// `filter` of an RLS epoch.
-pub const RLS: &str = "rls";
 
 /// One sequence: its summary and epochs.
 #[derive(Debug, Clone, PartialEq)]

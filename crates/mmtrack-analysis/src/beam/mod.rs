@@ -19,11 +19,8 @@ pub mod geometric_plots;
 pub mod plots;
 pub mod spebt_analysis;
 pub mod spebt_plots;
-pub mod spebt_tables;
 pub mod sweeps;
-pub mod tables;
 pub mod zoechmann_plots;
-pub mod zoechmann_tables;
 
 /// What `mmtrack analyze` computed from beam-tracking tables.
 #[derive(Debug, Clone, Default, PartialEq)]

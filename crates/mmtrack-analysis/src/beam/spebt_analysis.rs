@@ -14,7 +14,7 @@
 use std::fmt::Write;
 
 use super::spebt_plots::SpebtTrackingSeries;
-use super::spebt_tables::{SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
+use mmtrack_io::table::{SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
 
 /// The figure of one sequence, with its caption.
 pub const SEQUENCE_PLOT: (&str, &str) = ("spebt_tracking.svg", "run 0 against the truth (Liu et al. Fig. 5)");

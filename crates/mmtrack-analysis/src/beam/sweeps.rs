@@ -17,7 +17,7 @@ use std::fmt::Write;
 use mmtrack_io::table::BeamSweepTracked;
 
 use super::plots::{BeamIndexSeries, LossCurve};
-use super::tables::{BeamSweepPooledRow, BeamSweepSummaryRow};
+use mmtrack_io::table::{BeamSweepPooledRow, BeamSweepSummaryRow};
 
 /// Files of the plots of one sequence (under `plots/<sequence>/`) and of a
 /// site (under `plots/site=<site>/`), with their captions.

@@ -1,6 +1,6 @@
 //! The geometric Doppler-bearing tracking experiment of Zoechmann et al.
 //! 2019 (`mmtrack reproduce zoechmann`): its figures (its tables are in
-//! [`super::zoechmann_tables`]), like the paper's Figs. 4 and 5: the `(x, y)` estimate of the proposed
+//! [`mmtrack_io::table`]), like the paper's Figs. 4 and 5: the `(x, y)` estimate of the proposed
 //! tracker on the first Monte Carlo run against the true path (middle panel)
 //! and the NMSE of the range over time for the four estimators (bottom
 //! panel), one figure per manoeuvre; and the non-line-of-sight figure
@@ -14,8 +14,8 @@
 
 use plotters::prelude::*;
 
-use super::zoechmann_tables::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 use crate::plots::{err, padded_range};
+use mmtrack_io::table::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 
 /// One NMSE curve: label and NMSE (linear) per epoch.
 #[derive(Debug, Clone, PartialEq)]

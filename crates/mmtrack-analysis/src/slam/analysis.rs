@@ -21,7 +21,7 @@ use mmtrack_io::table_kv::read_key_value_metadata;
 
 use super::metrics::{EpochView, MapTruth, RunOutcome, evaluate};
 use super::plots::{EpochCurve, MapFigure, epoch_curves_svg, map_svg};
-use super::tables::{
+use mmtrack_io::table::{
     SLAM_MAP, SLAM_TRUE_SOURCES, SLAM_UE, SlamMapRow, SlamPerEpochRow, SlamSummaryRow, SlamTrueSourceRow, SlamUeRow,
 };
 

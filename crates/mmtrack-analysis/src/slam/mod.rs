@@ -9,4 +9,3 @@
 pub mod analysis;
 pub mod metrics;
 pub mod plots;
-pub mod tables;

@@ -18,7 +18,7 @@ pub use errors::{
     relative_pose_errors, unaligned_errors,
 };
 
-use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
+use mmtrack_core::{Se2, StampedPose, interpolate_pose};
 
 /// Why a trajectory cannot be evaluated. Rows are 0-based positions in the
 /// slice given (= rows of the table it was read from).
@@ -157,21 +157,6 @@ impl Association {
     pub fn dropped(&self) -> usize {
         self.dropped_before + self.dropped_after
     }
-}
-
-/// Ground truth at `t_ns` between two stamped poses `a.t_ns <= t_ns <= b.t_ns`:
-/// x and y linear in time, yaw along the shortest arc
-/// (`yaw_a + alpha * wrap(yaw_b - yaw_a)`, `alpha = (t - t_a) / (t_b - t_a)`).
-#[must_use]
-pub fn interpolate_pose(a: &StampedPose, b: &StampedPose, t_ns: i64) -> Se2 {
-    let span = (i128::from(b.t_ns) - i128::from(a.t_ns)) as f64;
-    let alpha = if span > 0.0 { (i128::from(t_ns) - i128::from(a.t_ns)) as f64 / span } else { 0.0 };
-    let (pa, pb) = (a.parent_from_child, b.parent_from_child);
-    Se2::new(
-        pa.x_m + alpha * (pb.x_m - pa.x_m),
-        pa.y_m + alpha * (pb.y_m - pa.y_m),
-        wrap_angle_rad(pa.yaw_rad + alpha * wrap_angle_rad(pb.yaw_rad - pa.yaw_rad)),
-    )
 }
 
 /// Associates an estimate with ground truth by time.

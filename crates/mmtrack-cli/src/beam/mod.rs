@@ -3,9 +3,6 @@
 //! tracking of Liu et al. 2024) and `reproduce zoechmann` (geometric
 //! Doppler-bearing tracking of Zoechmann et al. 2019).
 
-pub mod process;
-mod process_geometric;
-mod process_spebt;
 pub mod reproduce_shaham;
 pub mod reproduce_spebt;
 pub mod reproduce_zoechmann;

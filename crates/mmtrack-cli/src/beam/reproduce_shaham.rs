@@ -22,12 +22,12 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use mmtrack_analysis::beam::plots::{RmsCurve, rms_curves_svg};
-use mmtrack_analysis::beam::tables::{BeamRmsRow, BeamValidTrackingRow};
 use mmtrack_beam::valid_tracking::{RmsPerBlock, valid_tracking_blocks};
 use mmtrack_beam::{
     AngleEkf, AngleEkfConfig, PilotTracker, PositionVelocityEkf, PositionVelocityEkfConfig, ProcessModel,
 };
 use mmtrack_io::Overwrite;
+use mmtrack_io::table::{BeamRmsRow, BeamValidTrackingRow};
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_sim::beam::overpass::{OverpassRun, OverpassScenario};
 use rayon::prelude::*;

@@ -29,13 +29,13 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use mmtrack_analysis::beam::zoechmann_plots::{NmseCurve, PositionTrace, zoechmann_figure_svg};
-use mmtrack_analysis::beam::zoechmann_tables::{ZoechmannNmseRow, ZoechmannSummaryRow};
 use mmtrack_beam::geometric::{
     BeamCount, BeamSchedule, BeamSelection, DopplerBearing, ErrorFreeRegressors, GeometricTracker,
     GeometricTrackerConfig, HoChanBatch, NullspaceProjection, PolarState, RangeEstimator,
 };
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
+use mmtrack_io::table::{ZoechmannNmseRow, ZoechmannSummaryRow};
 use mmtrack_sim::beam::overtaking::{EpochTruth, Manoeuvre, OvertakingReceiver, OvertakingScenario};
 use rayon::prelude::*;
 use serde::Deserialize;

@@ -14,10 +14,11 @@
 use anyhow::Context;
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
+use mmtrack_process::beam::spebt::monte_carlo::into_truth_frame;
 use mmtrack_sim::radar::{RadarSimulator, Trajectory};
 
 use crate::reproduce::ODOMETRY_DRIVE_SCENARIO;
-use crate::simulate;
+use mmtrack_process::simulate::radar::parse_scenario;
 
 /// The simulated drive and the odometry's estimates along it.
 pub(super) struct OdometryDrive {
@@ -54,7 +55,7 @@ impl OdometryDrive {
 pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyhow::Result<OdometryDrive> {
     let started = std::time::Instant::now();
     let mut scenario =
-        simulate::parse_scenario(ODOMETRY_DRIVE_SCENARIO).context("embedded data/reproduce/odometry-drive.toml")?;
+        parse_scenario(ODOMETRY_DRIVE_SCENARIO).context("embedded data/reproduce/odometry-drive.toml")?;
     scenario.max_distance_m = None;
     let trajectory = Trajectory::from_poses(poses)?;
     let world = scenario.build_world(&trajectory)?;
@@ -83,21 +84,4 @@ pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyho
         low_confidence,
         elapsed_s: started.elapsed().as_secs_f64(),
     })
-}
-
-/// Odometry estimates (their world frame is the first scan's pose) moved
-/// into the ground truth's frame at the first pose:
-/// `world_from_first_truth * first_estimate^-1 * estimate`. Empty for no
-/// estimates.
-pub(super) fn into_truth_frame(first_truth: Se2, raw: &[Se2]) -> Vec<Se2> {
-    let Some(first) = raw.first() else { return Vec::new() };
-    let truth_from_estimate = first_truth * first.inverse();
-    raw.iter().map(|e| truth_from_estimate * *e).collect()
-}
-
-/// Estimates in the ground truth's frame moved into the link's frame, whose
-/// positions are relative to the first true position (headings kept;
-/// `mmtrack_sim::beam::spebt_link` module docs).
-pub(super) fn into_link_frame(first_truth: Se2, estimates: &[Se2]) -> Vec<Se2> {
-    estimates.iter().map(|e| Se2::new(e.x_m - first_truth.x_m, e.y_m - first_truth.y_m, e.yaw_rad)).collect()
 }

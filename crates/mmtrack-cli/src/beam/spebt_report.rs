@@ -7,7 +7,9 @@ use mmtrack_core::path_length_m;
 use mmtrack_core::{StampedPose, wrap_angle_rad};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtSlot};
 
-use super::reproduce_spebt::{Experiment, ExperimentResult, Outcome};
+use mmtrack_process::beam::spebt::monte_carlo::{ExperimentResult, SpebtExperiment as Experiment};
+
+use super::reproduce_spebt::Outcome;
 use super::spebt_odometry::OdometryDrive;
 
 /// The README block the summary replaces with `--readme`.

@@ -11,8 +11,8 @@
 //! chunks on rayon, so the numbers do not depend on the thread count.
 
 use anyhow::Context;
-use mmtrack_analysis::beam::zoechmann_tables::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 use mmtrack_beam::geometric::{DopplerBearing, GeometricTracker, RangeEstimator};
+use mmtrack_io::table::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 use mmtrack_sim::beam::overtaking::OvertakingReceiver;
 use mmtrack_sim::beam::overtaking_paths::{PathKind, Walls, realise_paths};
 use rayon::prelude::*;

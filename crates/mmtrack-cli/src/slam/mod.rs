@@ -7,6 +7,5 @@
 pub mod bench;
 pub mod evaluate;
 mod kim_report;
-pub mod process;
 pub mod reproduce_kim;
 pub mod simulate;

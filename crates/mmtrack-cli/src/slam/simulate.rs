@@ -5,24 +5,13 @@
 //! (`/ground_truth/pose`); once, the base station and the true virtual
 //! anchors and scattering points (`/slam/sources`).
 
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Args;
-use mmtrack_core::slam::SourceType;
-use mmtrack_core::{Se2, StampedPose};
-use mmtrack_io::RecordingWriter;
-use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
-use mmtrack_sim::slam::{SlamRun, SlamScenario};
+use mmtrack_process::simulate::slam::{SlamSimulation, simulate_slam};
 
 use crate::ingest::OutputArgs;
 use crate::threads::ThreadsArg;
-
-/// Recording metadata keys the SLAM pipeline reads back.
-pub const SEED_KEY: &str = "simulator.seed";
-/// The scenario as JSON (every field, defaults included).
-pub const SCENARIO_JSON_KEY: &str = "slam.scenario_json";
 
 #[derive(Args)]
 pub struct SlamSimArgs {
@@ -43,82 +32,23 @@ pub struct SlamSimArgs {
     output: OutputArgs,
 }
 
-/// Parses and checks a SLAM world file.
-pub fn load_slam_scenario(path: &Path) -> anyhow::Result<SlamScenario> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
-    let scenario: SlamScenario = toml::from_str(&text).with_context(|| path.display().to_string())?;
-    scenario.validate().with_context(|| path.display().to_string())?;
-    Ok(scenario)
-}
-
-fn metadata(args: &SlamSimArgs, scenario: &SlamScenario) -> anyhow::Result<RecordingMetadata> {
-    let source = args.scenario.as_ref().map_or_else(|| "paper".to_string(), |p| p.display().to_string());
-    let extra = BTreeMap::from([
-        (SEED_KEY.to_string(), args.seed.to_string()),
-        ("simulator.scenario".to_string(), source.clone()),
-        (SCENARIO_JSON_KEY.to_string(), serde_json::to_string(scenario)?),
-    ]);
-    Ok(RecordingMetadata {
-        sequence_id: args
-            .output
-            .output
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "simulated".into()),
-        source: format!("simulate slam:{source}"),
-        time_base: TimeBase::ScenarioStart,
-        extra,
-    })
-}
-
-/// Writes a realised run: the sources at the first epoch's time, then per
-/// epoch the paths, the truth and the ground-truth pose.
-pub fn write_run(writer: &mut RecordingWriter, run: &SlamRun) -> anyhow::Result<()> {
-    let t0_ns = run.epochs.first().map_or(0, |e| e.t_ns);
-    let world = &run.world;
-    writer.write_slam_source(t0_ns, SourceType::BaseStation, 0, world.bs_m)?;
-    for (i, va) in world.virtual_anchors_m.iter().enumerate() {
-        writer.write_slam_source(t0_ns, SourceType::VirtualAnchor, i, *va)?;
-    }
-    for (i, sp) in world.scattering_points_m.iter().enumerate() {
-        writer.write_slam_source(t0_ns, SourceType::ScatteringPoint, i, *sp)?;
-    }
-    for (epoch, truth) in run.epochs.iter().zip(&run.truth) {
-        writer.write_slam_paths(epoch)?;
-        writer.write_slam_ue_truth(epoch.t_ns, &truth.ue, &truth.origins)?;
-        let ue = &truth.ue;
-        let pose = StampedPose {
-            t_ns: epoch.t_ns,
-            parent_from_child: Se2::new(ue.position_m[0], ue.position_m[1], ue.heading_rad),
-        };
-        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "ue")?;
-    }
-    Ok(())
-}
-
 pub fn run_slam(args: &SlamSimArgs, quiet: bool) -> anyhow::Result<()> {
-    let mut scenario = match &args.scenario {
-        Some(path) => load_slam_scenario(path)?,
-        None => SlamScenario::default(),
+    let simulation = SlamSimulation {
+        scenario: args.scenario.clone(),
+        seed: args.seed,
+        epochs: args.epochs,
+        output: args.output.output.clone(),
+        recording: args.output.recording_options(),
     };
-    if let Some(n) = args.epochs {
-        scenario.epochs = usize::try_from(n).context("--epochs")?;
-    }
-    let run = scenario.realise(args.seed, 0).with_context(|| {
-        args.scenario.as_ref().map_or_else(|| "the paper's scenario".to_string(), |p| p.display().to_string())
-    })?;
-    let output = &args.output;
-    let mut writer = RecordingWriter::create(&output.output, &metadata(args, &scenario)?, &output.recording_options())?;
-    write_run(&mut writer, &run)?;
-    writer.finish()?;
+    let done = simulate_slam(&simulation)?;
     if !quiet {
-        let paths: usize = run.epochs.iter().map(|e| e.paths.len()).sum();
         println!(
-            "{}: {} epochs, {paths} paths; BS, {} virtual anchors, {} scattering points",
-            output.output.display(),
-            run.epochs.len(),
-            run.world.virtual_anchors_m.len(),
-            run.world.scattering_points_m.len()
+            "{}: {} epochs, {} paths; BS, {} virtual anchors, {} scattering points",
+            args.output.output.display(),
+            done.epochs,
+            done.paths,
+            done.virtual_anchors,
+            done.scattering_points
         );
     }
     Ok(())

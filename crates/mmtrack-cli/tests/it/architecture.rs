@@ -13,6 +13,19 @@ fn allowed_internal(name: &str) -> Option<&'static [&'static str]> {
         "mmtrack-ingest" => &["mmtrack-core", "mmtrack-io"],
         "mmtrack-sim" => &["mmtrack-core"],
         "mmtrack-analysis" => &["mmtrack-core", "mmtrack-io"],
+        // The pipelines: algorithms wired to io (and ingest's readers, for a
+        // pulse file or GNSS geodesy); never analysis (polars) or a front end.
+        "mmtrack-process" => &[
+            "mmtrack-core",
+            "mmtrack-filter",
+            "mmtrack-io",
+            "mmtrack-ingest",
+            "mmtrack-sim",
+            "mmtrack-odometry",
+            "mmtrack-mpc",
+            "mmtrack-beam",
+            "mmtrack-slam",
+        ],
         "mmtrack-cli" => ANY,
         // Dev-only fuzzing of the readers (publish = false).
         "mmtrack-fuzz" => &["mmtrack-core", "mmtrack-io", "mmtrack-ingest"],
@@ -69,6 +82,10 @@ fn crates_follow_the_dependency_rule() {
                     | "mmtrack-slam"
                     | "mmtrack-sim"
             );
+            let library = matches!(name, "mmtrack-process" | "mmtrack-reproduce");
+            if library && ["clap", "indicatif"].contains(&dep_name) {
+                violations.push(format!("{name} depends on {dep_name}: only the CLI talks to the terminal"));
+            }
             if pure && is_io_crate(dep_name) {
                 violations.push(format!("{name} depends on {dep_name}: algorithms and simulators do no I/O"));
             }

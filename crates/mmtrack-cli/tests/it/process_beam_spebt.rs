@@ -6,10 +6,10 @@
 
 use std::path::Path;
 
-use mmtrack_analysis::beam::spebt_tables::{SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
 use mmtrack_core::OdometryEstimate;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, read_table, write_table};
+use mmtrack_io::table::{SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
 use mmtrack_io::table_kv::read_key_value_metadata;
 
 use super::common::{mmtrack, text};

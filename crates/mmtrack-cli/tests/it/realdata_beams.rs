@@ -6,9 +6,9 @@
 
 use std::path::Path;
 
-use mmtrack_analysis::beam::tables::{BeamSweepPooledRow, BeamSweepSummaryRow};
 use mmtrack_beam::sweep::{SweepPass, SweepRecord, SweepSummary, WindowTracker, WindowTrackerConfig, evaluate};
 use mmtrack_core::BeamSweep;
+use mmtrack_io::table::{BeamSweepPooledRow, BeamSweepSummaryRow};
 use mmtrack_io::table::{BeamSweepTracked, read_table_dir};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 

@@ -1,8 +1,8 @@
 //! `mmtrack reproduce kim --quick`: the CI version of the 5G mmWave SLAM
 //! experiment (2 runs per row with 500 particles instead of 20 with 2000).
 
-use mmtrack_analysis::slam::tables::{SlamPerEpochRow, SlamSummaryRow};
 use mmtrack_io::table::read_table;
+use mmtrack_io::table::{SlamPerEpochRow, SlamSummaryRow};
 
 use super::common::{mmtrack, text};
 

@@ -1,8 +1,8 @@
 //! `mmtrack reproduce shaham --quick`: the CI version of the valid-tracking
 //! experiment (200 runs per point instead of 3000).
 
-use mmtrack_analysis::beam::tables::{BeamRmsRow, BeamValidTrackingRow};
 use mmtrack_io::table::read_table;
+use mmtrack_io::table::{BeamRmsRow, BeamValidTrackingRow};
 
 use super::common::{mmtrack, text};
 

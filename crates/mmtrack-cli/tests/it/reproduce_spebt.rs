@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
-use mmtrack_analysis::beam::spebt_tables::{SpebtSlotRow, SpebtSummaryRow};
 use mmtrack_io::table::read_table;
+use mmtrack_io::table::{SpebtSlotRow, SpebtSummaryRow};
 
 use super::common::{mmtrack, realdata, text};
 

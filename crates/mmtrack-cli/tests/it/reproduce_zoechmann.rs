@@ -2,10 +2,8 @@
 //! Doppler-bearing tracking experiment (2000 runs per manoeuvre instead of
 //! 100 000).
 
-use mmtrack_analysis::beam::zoechmann_tables::{
-    ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
-};
 use mmtrack_io::table::read_table;
+use mmtrack_io::table::{ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow};
 
 use super::common::{mmtrack, text};
 

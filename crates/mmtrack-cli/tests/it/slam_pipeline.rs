@@ -5,10 +5,10 @@
 
 use std::collections::BTreeMap;
 
-use mmtrack_analysis::slam::tables::{SlamSummaryRow, SlamUeRow};
 use mmtrack_core::slam::{PathMeasurement, SourceType};
 use mmtrack_io::recording::{RecordingMetadata, TimeBase};
 use mmtrack_io::table::read_table;
+use mmtrack_io::table::{SlamSummaryRow, SlamUeRow};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 use mmtrack_sim::slam::SlamScenario;
 
@@ -176,7 +176,7 @@ fn a_toml_world_with_clutter_runs_through_the_pipeline() {
     let error_m = (last.x_m - last.true_x_m.unwrap()).hypot(last.y_m - last.true_y_m.unwrap());
     // Measured when this test was written: 0.43 m; 2 m is a sane bound on a 25-epoch run with clutter.
     assert!(error_m < 2.0, "{error_m}");
-    let associations: Vec<mmtrack_analysis::slam::tables::SlamAssociationRow> =
+    let associations: Vec<mmtrack_io::table::SlamAssociationRow> =
         read_table(&d.join("t/slam_associations/sequence=w/part-0.parquet")).unwrap();
     let clutter = associations.iter().filter(|a| a.true_source.as_deref() == Some("clutter")).count();
     assert_eq!(clutter, 25, "one clutter path per epoch, each labelled");

@@ -15,17 +15,30 @@
 //! its columns (name, Rust type, unit, meaning) give the spec, the writer and
 //! the reader.
 
+mod beam_result_rows;
 mod beam_rows;
 mod columns;
 mod define;
+mod geometric_rows;
 mod io;
 mod mpc_rows;
 mod odometry_rows;
 mod rows;
+mod slam_rows;
+mod spebt_rows;
 
 pub use arrow_array::ArrayRef;
+pub use beam_result_rows::{
+    BEAM_RMS_PER_BLOCK, BEAM_SWEEP_POOLED, BEAM_SWEEP_SUMMARY, BEAM_VALID_TRACKING, BeamRmsRow, BeamSweepPooledRow,
+    BeamSweepSummaryRow, BeamValidTrackingRow,
+};
 pub use beam_rows::{BEAM_SWEEPS_TRACKED, BeamSweepTracked};
 pub use columns::{ColumnValue, Columns, ListColumn};
+pub use geometric_rows::{
+    GEOMETRIC_FILTER_H_INFINITY, GEOMETRIC_FILTER_RLS, GEOMETRIC_PER_EPOCH, GEOMETRIC_SUMMARY, GeometricEpochRow,
+    GeometricSummaryRow, ZOECHMANN_NLOS_ERROR, ZOECHMANN_NMSE, ZOECHMANN_PATH_LABELS, ZOECHMANN_SUMMARY,
+    ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
+};
 pub use io::{
     RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, read_table, read_table_dir,
     table_path, write_table,
@@ -36,6 +49,11 @@ pub use mpc_rows::{
 };
 pub use odometry_rows::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, ODOMETRY_TIMING};
 pub use rows::{ALL_TABLES, CIR_SNAPSHOTS, GNSS_FIXES, MPC_DETECTIONS, MPC_TRACKS, POSES, RADAR_SCANS};
+pub use slam_rows::{
+    SLAM_ASSOCIATIONS, SLAM_MAP, SLAM_PER_EPOCH, SLAM_SUMMARY, SLAM_TRUE_SOURCES, SLAM_UE, SlamAssociationRow,
+    SlamMapRow, SlamPerEpochRow, SlamSummaryRow, SlamTrueSourceRow, SlamUeRow,
+};
+pub use spebt_rows::{SPEBT_PER_SLOT, SPEBT_POOLED, SPEBT_SUMMARY, SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
 
 use std::sync::Arc;
 

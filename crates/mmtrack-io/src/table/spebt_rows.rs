@@ -3,7 +3,7 @@
 //! (partitions named by experiment) and by `mmtrack process beam --tracker
 //! spebt` (partitions named by the recording's sequence).
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `spebt_summary`: one row per experiment (or recording).
     pub const SPEBT_SUMMARY = "spebt_summary",
         "Beam-tracking accuracy of the SPEBT EKF over the Monte Carlo runs of one experiment (Liu et al. 2024, \
@@ -41,7 +41,7 @@ process beam: the recording, whose ground truth it is)";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `spebt_per_slot`: truth, one run's estimate and the RMSE over runs per slot.
     pub const SPEBT_PER_SLOT = "spebt_per_slot",
         "Per slot of one SPEBT experiment: the true pose and channel, the estimate of run 0 (the realisation of \
@@ -69,7 +69,7 @@ Liu et al. 2024, Fig. 5) and the RMSE over all runs at that slot.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `spebt_pooled`: per experiment kind, every sequence pooled.
     pub const SPEBT_POOLED = "spebt_pooled",
         "SPEBT accuracy pooled over every sequence analysed (partition sequence=all), one row per experiment kind: \

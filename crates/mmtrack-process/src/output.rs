@@ -1,6 +1,6 @@
-//! Where a `mmtrack process` pipeline writes: the output flags every pipeline
-//! shares (`--sequence`, `--force`, `--run-id`) and the run directory they
-//! resolve to.
+//! Where a pipeline writes: the output options every pipeline shares
+//! (`--sequence`, `--force`, `--run-id` on the command line) and the run
+//! directory they resolve to.
 //!
 //! `--run-id ID` puts one run's tables under `<output>/run=<ID>/`: runs
 //! written under one `-o` directory with different ids sit side by side
@@ -12,39 +12,37 @@
 //! writes there, and records [`run_id_of`] that directory as `"run_id"` in
 //! its run configuration JSON.
 //!
-//! `--threads` is not here: it does not change what is written, and
-//! [`crate::threads::ThreadsArg`] is shared with the commands that are not
-//! pipelines.
+//! The thread count is not here: it does not change what is written (every
+//! pipeline runs on the caller's rayon pool).
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use clap::Args;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::table_path;
 
-/// The output flags of the single-recording pipelines (odometry, mpc, slam).
-#[derive(Args, Clone, Debug, Default)]
-pub struct OutputArgs {
+/// Where a pipeline writes, as the front end gave it: the output directory,
+/// an optional run id and whether existing tables may be replaced.
+#[derive(Clone, Debug, Default)]
+pub struct OutputOptions {
     /// Sequence id of the output partitions (default: the recording's).
-    ///
-    /// The tables go to `<table>/sequence=<SEQUENCE>/part-0.parquet` under the output (or run) directory.
-    #[arg(long)]
     pub sequence: Option<String>,
-    #[command(flatten)]
-    pub run: RunOutputArgs,
+    /// The tables go to `<output>/run=<ID>/` (see the module docs).
+    pub run_id: Option<String>,
+    /// Replace existing tables of the sequences written (only this run's).
+    pub force: bool,
 }
 
-impl OutputArgs {
-    /// The sequence id to write: `--sequence`, else the recording's.
+impl OutputOptions {
+    /// The sequence id to write: [`Self::sequence`], else the recording's.
     #[must_use]
     pub fn sequence_or(&self, recording_sequence: &str) -> String {
         self.sequence.clone().unwrap_or_else(|| recording_sequence.to_string())
     }
 
     /// The sequence id the run will most likely write, known before any
-    /// work: `--sequence`, else the id in the recording's metadata (its
-    /// first record). `None` when that cannot be read; the pipeline then
+    /// work: [`Self::sequence`], else the id in the recording's metadata
+    /// (its first record). `None` when that cannot be read; the pipeline then
     /// reports the problem itself and checks again after its work.
     #[must_use]
     pub fn sequence_hint(&self, recording: &Path) -> Option<String> {
@@ -54,62 +52,35 @@ impl OutputArgs {
             reader.metadata().and_then(mmtrack_io::recording::RecordingMetadata::from_map).map(|m| m.sequence_id)
         })
     }
-}
 
-/// `--force` and `--run-id`: the output flags of every pipeline, also of
-/// those whose sequences come from their recordings (`process beam`).
-#[derive(Args, Clone, Debug, Default)]
-pub struct RunOutputArgs {
-    /// Replace existing output tables of the sequences written.
-    ///
-    /// Only this run's tables are replaced (those under `<output>/run=<ID>/` with --run-id). Without --force, an
-    /// existing table stops the command and nothing is written.
-    #[arg(long)]
-    pub force: bool,
-    #[command(flatten)]
-    pub run_id: RunIdArg,
-}
-
-impl RunOutputArgs {
     /// The run directory under `output` with the overwrite policy of
-    /// `--force`.
+    /// [`Self::force`].
     ///
     /// # Errors
-    /// A bad `--run-id` ([`RunIdArg::run_dir`]). Call it before any work.
+    /// A bad run id ([`run_dir`]). Call it before any work.
     pub fn resolve(&self, output: &Path) -> anyhow::Result<RunDir> {
         let overwrite = if self.force { Overwrite::Replace } else { Overwrite::Refuse };
-        Ok(RunDir { path: self.run_id.run_dir(output)?, overwrite })
+        Ok(RunDir { path: run_dir(output, self.run_id.as_deref())?, overwrite })
     }
 }
 
-/// The `--run-id` flag of the `mmtrack process` pipelines.
-#[derive(Args, Clone, Debug, Default)]
-pub struct RunIdArg {
-    /// Name of this run: the tables go to `<output>/run=<ID>/`, so runs written under one directory read back
-    /// together with a `run` column (DuckDB/polars Hive partitioning) instead of overwriting each other.
-    #[arg(long, value_name = "ID")]
-    pub run_id: Option<String>,
-}
-
-impl RunIdArg {
-    /// The directory the tables go to: `output` itself without `--run-id`,
-    /// else `<output>/run=<ID>`.
-    ///
-    /// # Errors
-    /// An id that is not one safe path component (the characters of a
-    /// sequence id: letters, digits, `-`, `_`, `.`; not `.` or `..`), naming
-    /// `--run-id`. Call it before any work, so nothing is written.
-    pub fn run_dir(&self, output: &Path) -> anyhow::Result<PathBuf> {
-        let Some(id) = &self.run_id else { return Ok(output.to_path_buf()) };
-        if !is_run_id(id) {
-            bail!(
-                "--run-id '{id}': not a valid run id (use letters, digits, '-', '_', '.'; it names the directory \
-                 run=<ID> under {}); nothing was written",
-                output.display()
-            );
-        }
-        Ok(output.join(format!("run={id}")))
+/// The directory the tables go to: `output` itself without a run id, else
+/// `<output>/run=<ID>`.
+///
+/// # Errors
+/// An id that is not one safe path component (the characters of a
+/// sequence id: letters, digits, `-`, `_`, `.`; not `.` or `..`), naming
+/// `--run-id`. Call it before any work, so nothing is written.
+pub fn run_dir(output: &Path, run_id: Option<&str>) -> anyhow::Result<PathBuf> {
+    let Some(id) = run_id else { return Ok(output.to_path_buf()) };
+    if !is_run_id(id) {
+        bail!(
+            "--run-id '{id}': not a valid run id (use letters, digits, '-', '_', '.'; it names the directory \
+             run=<ID> under {}); nothing was written",
+            output.display()
+        );
     }
+    Ok(output.join(format!("run={id}")))
 }
 
 /// Whether `id` can name a `run=<id>` directory: the partition-name rule of
@@ -197,11 +168,10 @@ mod tests {
     #[test]
     fn run_dirs_are_one_checked_path_component() {
         let output = Path::new("tables");
-        let arg = |id: Option<&str>| RunIdArg { run_id: id.map(str::to_string) };
-        assert_eq!(arg(None).run_dir(output).unwrap(), output);
-        assert_eq!(arg(Some("fast-1.2_b")).run_dir(output).unwrap(), output.join("run=fast-1.2_b"));
+        assert_eq!(run_dir(output, None).unwrap(), output);
+        assert_eq!(run_dir(output, Some("fast-1.2_b")).unwrap(), output.join("run=fast-1.2_b"));
         for bad in ["../x", "a/b", "", ".", "..", "a b", "a=b"] {
-            let err = arg(Some(bad)).run_dir(output).unwrap_err().to_string();
+            let err = run_dir(output, Some(bad)).unwrap_err().to_string();
             assert!(err.starts_with(&format!("--run-id '{bad}': not a valid run id")), "{bad}: {err}");
         }
         assert_eq!(run_id_of(&output.join("run=a")).as_deref(), Some("a"));
@@ -211,10 +181,8 @@ mod tests {
     #[test]
     fn refusals_look_in_the_run_directory_and_force_lifts_them() {
         let dir = tempfile::tempdir().unwrap();
-        let flags = |force: bool, id: Option<&str>| RunOutputArgs {
-            force,
-            run_id: RunIdArg { run_id: id.map(str::to_string) },
-        };
+        let flags =
+            |force: bool, id: Option<&str>| OutputOptions { sequence: None, run_id: id.map(str::to_string), force };
         let existing = dir.path().join("run=a/t2/sequence=s/part-0.parquet");
         std::fs::create_dir_all(existing.parent().unwrap()).unwrap();
         std::fs::write(&existing, b"").unwrap();

@@ -1,4 +1,4 @@
-//! `mmtrack process beam --tracker spebt`: the SPEBT beam tracker (Liu et
+//! The SPEBT beam tracker (`mmtrack process beam --tracker spebt`; Liu et
 //! al. 2024) along a recording's ground-truth trajectory, driven by pose
 //! estimates.
 //!
@@ -25,64 +25,53 @@
 //! over runs per slot) and `spebt_summary` (RMSE of |alpha|, AoD and AoA,
 //! re-initialisations).
 
+pub mod monte_carlo;
+pub mod tables;
+
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use anyhow::{Context, bail, ensure};
-use clap::Args;
-use mmtrack_analysis::beam::spebt_tables::{SPEBT_PER_SLOT, SPEBT_SUMMARY};
-use mmtrack_analysis::trajectory::interpolate_pose;
-use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
+use mmtrack_core::progress::Progress;
+use mmtrack_core::{OdometryEstimate, Se2, StampedPose, interpolate_pose};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
 use mmtrack_io::table::{ODOMETRY, RunInfo, read_table, table_path, write_table};
+use mmtrack_io::table::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSummaryRow, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtScenario};
 use serde::Deserialize;
 
-use super::reproduce_spebt::{
-    Experiment, Outcome, POSE_ERROR_MODEL, PoseSource, RADAR_ODOMETRY, SPEBT_EXPERIMENT, TrackerParams, monte_carlo,
-    tracker_config,
+use self::monte_carlo::{
+    ExperimentResult, POSE_ERROR_MODEL, PoseSource, RADAR_ODOMETRY, SPEBT_EXPERIMENT, SpebtExperiment, TrackerParams,
+    into_link_frame, into_truth_frame, monte_carlo, tracker_config,
 };
-use super::spebt_odometry::{into_link_frame, into_truth_frame};
-use super::spebt_output as output;
-use crate::run_id::{RunDir, is_run_id, run_ids_in};
+use crate::output::{RunDir, is_run_id, run_ids_in};
 
-/// The options of `--tracker spebt` (refused with the sweep trackers).
-#[derive(Args, Debug, Clone, Default)]
+/// The options of [`process_spebt`] (`--tracker spebt`).
+#[derive(Debug, Clone, Default)]
 pub struct SpebtOptions {
-    /// spebt: table directory of `mmtrack process odometry` whose `odometry` table (the
-    /// recording's sequence) drives the tracker: the one directly under TABLES, else the one
-    /// in its only `run=<ID>/` folder holding it (`process odometry --run-id`; several: pick
-    /// one with --odometry-run). Without it, the ground truth plus the pose-error model
-    /// (--sigma-r-m, --sigma-theta-deg) drives the tracker.
-    #[arg(long, value_name = "TABLES")]
+    /// Table directory of `process odometry` whose `odometry` table (the
+    /// recording's sequence) drives the tracker: the one directly under it,
+    /// else the one in its only `run=<ID>/` folder holding it. Without it,
+    /// the ground truth plus the pose-error model drives the tracker.
     pub odometry: Option<PathBuf>,
-    /// spebt: read the odometry table of run ID, `<TABLES>/run=<ID>/` (written by
-    /// `process odometry --run-id ID`), instead of looking for it.
-    #[arg(long, value_name = "ID", requires = "odometry")]
+    /// Read the odometry table of this run (`<odometry>/run=<ID>/`).
     pub odometry_run: Option<String>,
-    /// spebt: the link and tracker, a TOML file with a `[scenario]` table (Table I's
-    /// fields, e.g. bs_x_m, carrier_hz, bs_elements) and a `[tracker]` table, as in
-    /// data/reproduce/spebt.toml (default: that file's values, the paper's Table I).
-    #[arg(long, value_name = "LINK.toml")]
+    /// The link and tracker: a TOML file with `[scenario]` and `[tracker]`
+    /// tables as in `data/reproduce/spebt.toml` (default: that file's).
     pub link: Option<PathBuf>,
-    /// spebt: pose-error model sigma_r, metres per coordinate (eq. (23)); drawn without
-    /// --odometry, and the filter's Q in both modes (default: the link file's, 1 m).
-    #[arg(long)]
+    /// Pose-error model sigma_r, metres per coordinate (eq. (23)).
     pub sigma_r_m: Option<f64>,
-    /// spebt: pose-error model sigma_theta, degrees (default: the link file's, 3 deg).
-    #[arg(long)]
+    /// Pose-error model sigma_theta, degrees.
     pub sigma_theta_deg: Option<f64>,
-    /// spebt: seed of the receiver noise and the pose errors (default: 2024).
-    #[arg(long)]
+    /// Seed of the receiver noise and the pose errors (default: the file's).
     pub seed: Option<u64>,
-    /// spebt: Monte Carlo runs (noise and pose-error realisations; default 1).
-    #[arg(long)]
+    /// Monte Carlo runs (default 1).
     pub runs: Option<u64>,
 }
 
 impl SpebtOptions {
     /// The options given, by flag name (the sweep trackers refuse them).
+    #[must_use]
     pub fn given(&self) -> Vec<&'static str> {
         [
             ("--odometry", self.odometry.is_some()),
@@ -270,8 +259,9 @@ fn truth_at(truth: &[StampedPose], t_ns: i64) -> StampedPose {
 
 /// The experiment: the embedded `reproduce spebt` file with the `--link`
 /// file's tables and the flags over it.
-fn experiment(options: &SpebtOptions) -> anyhow::Result<(Experiment, String)> {
-    let mut experiment: Experiment = toml::from_str(SPEBT_EXPERIMENT).context("embedded data/reproduce/spebt.toml")?;
+fn experiment(options: &SpebtOptions) -> anyhow::Result<(SpebtExperiment, String)> {
+    let mut experiment: SpebtExperiment =
+        toml::from_str(SPEBT_EXPERIMENT).context("embedded data/reproduce/spebt.toml")?;
     let mut source = "embedded data/reproduce/spebt.toml".to_string();
     if let Some(path) = &options.link {
         let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
@@ -304,11 +294,47 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(Experiment, String)> {
     Ok((experiment, source))
 }
 
-/// Runs SPEBT on each recording; one partition of each table per recording.
+/// One recording's result of [`process_spebt`].
+#[derive(Debug, Clone)]
+pub struct SpebtRecordingResult {
+    /// The recording's sequence id (the partition written).
+    pub sequence_id: String,
+    /// Where the pose estimates came from ([`POSE_ERROR_MODEL`] or [`RADAR_ODOMETRY`]).
+    pub pose_source: &'static str,
+    /// The odometry table read, with `odometry`.
+    pub odometry_file: Option<PathBuf>,
+    /// The `spebt_summary` row written.
+    pub summary: SpebtSummaryRow,
+}
+
+/// What [`process_spebt`] did.
+#[derive(Debug, Clone)]
+pub struct SpebtOutput {
+    /// Per recording, in the order given.
+    pub recordings: Vec<SpebtRecordingResult>,
+    /// Each table written, with its row count.
+    pub written: Vec<TableWriteSummary>,
+    /// The run directory written.
+    pub dir: PathBuf,
+}
+
+/// `mmtrack process beam --tracker spebt`: SPEBT on each recording, one
+/// partition of `spebt_summary` and `spebt_per_slot` per recording.
 ///
-/// `out` is the run directory (`<output>/run=<ID>` with `--run-id`,
-/// `crate::run_id`): refusals look there and the tables go there.
-pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: bool) -> anyhow::Result<ExitCode> {
+/// `out` is the run directory ([`crate::output::OutputOptions::resolve`]):
+/// refusals look there and the tables go there. Every recording and odometry
+/// table is found and checked before any work.
+///
+/// # Errors
+/// An existing table (without `force`), a recording without usable ground
+/// truth, a missing or bad odometry table, a bad link file or option, or a
+/// table that cannot be written.
+pub fn process_spebt(
+    recordings: &[PathBuf],
+    out: &RunDir,
+    options: &SpebtOptions,
+    progress: &dyn Progress,
+) -> anyhow::Result<SpebtOutput> {
     let (experiment, link_source) = experiment(options)?;
     let runs = options.runs.unwrap_or(1);
     ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
@@ -325,7 +351,7 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: 
             dir.map(|dir| find_odometry_table(dir, options.odometry_run.as_deref(), r)).transpose()
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut outcomes = Vec::new();
+    let mut results: Vec<(&TruthRecording, Option<PathBuf>, &'static str, SpebtLink, ExperimentResult)> = Vec::new();
     for (recording, odometry_file) in recordings.iter().zip(odometry_files) {
         let (name, slots, estimates, odometry_file) = match odometry_file {
             Some(file) => {
@@ -342,22 +368,24 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: 
             .with_context(|| format!("{}: ground truth", recording.path.display()))
             .with_context(|| format!("{link_source}: [scenario]"))?;
         let source = estimates.as_deref().map_or(PoseSource::ErrorModel, PoseSource::Fixed);
-        let result = monte_carlo(&link, &config, experiment.seed, runs, source, quiet)
+        let result = monte_carlo(&link, &config, experiment.seed, runs, source, progress)
             .with_context(|| recording.path.display().to_string())?;
-        outcomes.push((recording, odometry_file, Outcome { name, link, drive: None, result, verdicts: Vec::new() }));
+        results.push((recording, odometry_file, name, link, result));
     }
-    for (recording, odometry_file, outcome) in &outcomes {
+    let mut written = Vec::new();
+    let mut reports = Vec::new();
+    for (recording, odometry_file, name, link, result) in results {
         let info = RunInfo {
             config_json: serde_json::json!({
                 "command": "process beam",
                 "tracker": "spebt",
                 "recording": recording.path.display().to_string(),
                 "odometry": odometry_file.as_ref().map(|f| f.display().to_string()),
-                "pose_source": outcome.name,
+                "pose_source": name,
                 "link_file": link_source,
-                "runs": outcome.result.runs,
+                "runs": result.runs,
                 "seed": experiment.seed,
-                "slots": outcome.link.len(),
+                "slots": link.len(),
                 "scenario": experiment.scenario,
                 "tracker_params": {
                     "position_sigma_m": experiment.tracker.position_sigma_m,
@@ -370,37 +398,27 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &SpebtOptions, quiet: 
             })
             .to_string(),
         };
-        let summary = output::summary_row(&experiment, &recording.path, outcome);
-        write_table(&out.path, &recording.sequence_id, std::slice::from_ref(&summary), &info, out.overwrite)?;
-        write_table(&out.path, &recording.sequence_id, &output::slot_rows(outcome), &info, out.overwrite)?;
-        if !quiet {
-            println!(
-                "{} ({}, {} slots, {} run{}): RMSE |alpha| {:.3} %, AoD {:.3} deg, AoA {:.3} deg; \
-                 re-initialisations {:.1} per run ({:.2} % of slots)",
-                recording.sequence_id,
-                outcome.name,
-                summary.slots,
-                summary.runs,
-                if summary.runs == 1 { "" } else { "s" },
-                summary.rmse_gain_pct,
-                summary.rmse_aod_deg,
-                summary.rmse_aoa_deg,
-                summary.reinitialisations_mean,
-                summary.reinitialisation_share_pct
-            );
-            if let Some(file) = odometry_file {
-                println!("  poses from {}", file.display());
-            }
-        }
+        let summary = tables::summary_row(&experiment, &recording.path, name, &link, &result);
+        written.push(write_table(
+            &out.path,
+            &recording.sequence_id,
+            std::slice::from_ref(&summary),
+            &info,
+            out.overwrite,
+        )?);
+        written.push(write_table(
+            &out.path,
+            &recording.sequence_id,
+            &tables::slot_rows(&link, &result),
+            &info,
+            out.overwrite,
+        )?);
+        reports.push(SpebtRecordingResult {
+            sequence_id: recording.sequence_id.clone(),
+            pose_source: name,
+            odometry_file,
+            summary,
+        });
     }
-    if !quiet {
-        println!(
-            "wrote {} {} and {} partitions under {}",
-            outcomes.len(),
-            SPEBT_PER_SLOT.name,
-            SPEBT_SUMMARY.name,
-            out.path.display()
-        );
-    }
-    Ok(ExitCode::SUCCESS)
+    Ok(SpebtOutput { recordings: reports, written, dir: out.path.clone() })
 }

@@ -1,6 +1,6 @@
-//! `mmtrack process mpc`: multipath-component detection and tracking
+//! Multipath-component detection and tracking
 //! (Mahler et al. 2017) on the CIR snapshots of a recording, written as
-//! Parquet tables.
+//! Parquet tables (`mmtrack process mpc`).
 //!
 //! The recording is read as a stream: snapshots are grouped by link (TX, RX
 //! antenna) and by `set_index`, and each complete set goes to that link's
@@ -11,14 +11,13 @@
 //! Links: a recording with one link writes the partition `<sequence>`; with
 //! several, each link is its own partition `<sequence>-tx<T>-rx<R>` (its own
 //! long-term tracking, since MPCs of different antenna pairs are different
-//! paths), unless `--link T:R` picks one, which is then written as
+//! paths), unless [`MpcOptions::link`] picks one, which is then written as
 //! `<sequence>`.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{Context, bail};
-use clap::Args;
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
 use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
@@ -29,47 +28,45 @@ use mmtrack_io::table::{
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_mpc::{MpcConfig, MpcPipeline, SnapshotDetections, SounderPulse};
 
-use crate::progress;
-use crate::run_id::{OutputArgs, RunDir, exists_error};
-use crate::threads::ThreadsArg;
+use mmtrack_core::progress::Progress;
+use mmtrack_io::table::{
+    GROUND_TRUTH_RX, GROUND_TRUTH_TX, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_SNAPSHOTS, MPC_TRACKS,
+    MPC_TRACKS_GMPHD, MPC_TRUTH,
+};
+
+use crate::output::{OutputOptions, RunDir, exists_error};
 
 /// Every table `process mpc` may write.
-const TABLES: [&str; 9] = mmtrack_analysis::pipeline::MPC_TABLE_NAMES;
+pub const TABLES: [&str; 9] = [
+    MPC_DETECTIONS.name,
+    MPC_TRACKS.name,
+    MPC_TRACKS_GMPHD.name,
+    MPC_LONG_TERM.name,
+    MPC_SETS.name,
+    MPC_SNAPSHOTS.name,
+    MPC_TRUTH.name,
+    GROUND_TRUTH_TX.name,
+    GROUND_TRUTH_RX.name,
+];
 
-#[derive(Args)]
-pub struct MpcArgs {
-    /// Recording with CIR snapshots on /channel/cir (from `mmtrack ingest cir` or `mmtrack simulate sounder`); not
-    /// needed with `--print-config`.
-    #[arg(required_unless_present = "print_config")]
-    pub recording: Option<PathBuf>,
-    /// Output table directory (created if missing); not needed with `--print-config`.
-    #[arg(short, long, required_unless_present = "print_config")]
-    pub output: Option<PathBuf>,
-    /// TOML file overriding single fields of the default configuration (see `--print-config`).
-    #[arg(long, value_name = "TOML")]
-    pub config: Option<PathBuf>,
-    /// Print the effective configuration (the defaults with `--config` and `--gmphd` on top) as TOML and exit.
-    #[arg(long)]
-    pub print_config: bool,
-    /// Sounder pulse: `flat` (the band's flat spectrum), or a `.npy` file holding a back-to-back calibration CIR
-    /// [default: the pulse spectrum in the recording's metadata (`sounder.pulse_spectrum`), else flat].
-    #[arg(long, value_name = "flat|FILE.npy")]
+/// The options of [`process_mpc`] besides the configuration.
+#[derive(Clone, Debug, Default)]
+pub struct MpcOptions {
+    /// Sounder pulse: `flat` (the band's flat spectrum), or a `.npy` file
+    /// holding a back-to-back calibration CIR; `None`: the pulse spectrum in
+    /// the recording's metadata (`sounder.pulse_spectrum`), else flat.
     pub pulse: Option<String>,
-    /// Process only the link TX:RX (antenna indices), written as the sequence itself. Without it every link is
-    /// processed, each as partition `<sequence>-tx<T>-rx<R>` when there are several.
-    #[arg(long, value_name = "TX:RX")]
-    pub link: Option<String>,
-    /// Also run the GM-PHD baseline (Mahler et al. 2017, Table I) on the same detections, set by set (table
-    /// mpc_tracks_gmphd); the same as `run_gmphd = true` in the configuration.
-    #[arg(long)]
-    pub gmphd: bool,
-    #[command(flatten)]
-    pub output_args: OutputArgs,
-    #[command(flatten)]
-    pub threads: ThreadsArg,
+    /// Only this link (TX, RX antenna indices), written as the sequence itself.
+    pub link: Option<(u32, u32)>,
+    /// Where the tables go.
+    pub output: OutputOptions,
 }
 
-fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
+/// `TX:RX` antenna indices (`--link`).
+///
+/// # Errors
+/// Anything else, quoting the text.
+pub fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
     let parse = || -> Option<(u32, u32)> {
         let (tx, rx) = text.split_once(':')?;
         Some((tx.trim().parse().ok()?, rx.trim().parse().ok()?))
@@ -82,7 +79,10 @@ fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
 /// table that names a `method` (the noise floor's) replaces the default's
 /// table, since its other fields depend on the method. Unknown fields are
 /// refused by name when the result is read back.
-fn effective_config(path: Option<&Path>) -> anyhow::Result<MpcConfig> {
+///
+/// # Errors
+/// The file cannot be read, is not TOML or not a valid configuration.
+pub fn effective_config(path: Option<&Path>) -> anyhow::Result<MpcConfig> {
     let Some(path) = path else { return Ok(MpcConfig::default()) };
     let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
     let changes: toml::Table = toml::from_str(&text).with_context(|| format!("{}: not valid TOML", path.display()))?;
@@ -226,12 +226,15 @@ fn choose_pulse(
     }
 }
 
-fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::Result<MpcRun> {
-    let Some(path) = &args.recording else { bail!("a recording is required (unless --print-config)") };
-    let link_filter = args.link.as_deref().map(parse_link).transpose()?;
+fn read_and_process(
+    path: &Path,
+    options: &MpcOptions,
+    config: &MpcConfig,
+    progress: &dyn Progress,
+) -> anyhow::Result<MpcRun> {
+    let link_filter = options.link;
     let mut reader = RecordingReader::open(path)?;
-    let bar = progress::bytes_bar("mpc", quiet);
-    bar.set_length(std::fs::metadata(path).map(|m| m.len()).unwrap_or(0));
+    progress.start("mpc", std::fs::metadata(path).map(|m| m.len()).unwrap_or(0), "bytes");
     let mut pulse: Option<SounderPulse> = None;
     let mut run = MpcRun {
         sequence_id: String::new(),
@@ -246,7 +249,7 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
             RecordingItem::Event(event) => event,
             RecordingItem::Scan(_) => continue,
         };
-        bar.set_position(reader.bytes_read());
+        progress.set_position(reader.bytes_read());
         match event {
             RecordingEvent::Cir(snapshot) => {
                 let key = (snapshot.tx_antenna, snapshot.rx_antenna);
@@ -264,7 +267,7 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
                     )
                 };
                 if pulse.is_none() {
-                    pulse = Some(choose_pulse(args.pulse.as_deref(), reader.metadata(), &snapshot, path)?);
+                    pulse = Some(choose_pulse(options.pulse.as_deref(), reader.metadata(), &snapshot, path)?);
                 }
                 let link = match run.links.entry(key) {
                     std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
@@ -313,7 +316,7 @@ fn read_and_process(args: &MpcArgs, config: &MpcConfig, quiet: bool) -> anyhow::
     for (key, link) in &mut run.links {
         link.end_set(true).with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
     }
-    bar.finish_and_clear();
+    progress.finish();
     run.sequence_id = reader
         .metadata()
         .and_then(RecordingMetadata::from_map)
@@ -360,35 +363,65 @@ fn refuse_existing(out: &RunDir, sequence: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
-pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
-    let mut config = effective_config(args.config.as_deref())?;
-    config.run_gmphd |= args.gmphd;
-    if args.print_config {
-        print!("{}", toml::to_string(&config)?);
-        return Ok(());
-    }
-    // clap requires both unless --print-config.
-    let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
-        bail!("a recording and --output are required (unless --print-config)");
-    };
-    if let Some(link) = &args.link {
-        parse_link(link)?;
-    }
-    let out = args.output_args.run.resolve(output)?;
+/// One link's counts, for the front end's summary.
+#[derive(Clone, Debug)]
+pub struct LinkSummary {
+    /// The partition written.
+    pub partition: String,
+    /// TX and RX antenna indices.
+    pub link: (u32, u32),
+    /// Sets processed.
+    pub sets: usize,
+    /// Detections over all snapshots.
+    pub detections: usize,
+    /// Short-term tracks.
+    pub tracks: usize,
+    /// Long-term entries.
+    pub long_term: usize,
+    /// Most snapshots a set held after skipped ones (no short-term track
+    /// can be longer).
+    pub most_snapshots_per_set: u64,
+}
+
+/// What [`process_mpc`] did.
+#[derive(Clone, Debug)]
+pub struct MpcOutput {
+    /// Per link, in link order.
+    pub links: Vec<LinkSummary>,
+    /// Each table written, with its row count.
+    pub written: Vec<TableWriteSummary>,
+}
+
+/// `mmtrack process mpc`: detection and tracking with `config` on the CIR
+/// snapshots of `recording`, tables under `output`. Existing tables (of the
+/// sequence or of its link partitions) are refused before any work unless
+/// `options.output.force`.
+///
+/// # Errors
+/// A bad run id, an existing table, a bad recording (naming file, snapshot
+/// and field), a bad pulse file, or a table that cannot be written.
+pub fn process_mpc(
+    recording: &Path,
+    output: &Path,
+    config: &MpcConfig,
+    options: &MpcOptions,
+    progress: &dyn Progress,
+) -> anyhow::Result<MpcOutput> {
+    let out = options.output.resolve(output)?;
     // Check the outputs before the work, so a refusal costs nothing.
-    if let Some(sequence) = &args.output_args.sequence_hint(recording) {
+    if let Some(sequence) = &options.output.sequence_hint(recording) {
         refuse_existing(&out, sequence)?;
     }
-    let run = args.threads.install(|| read_and_process(args, &config, quiet))??;
-    let sequence = args.output_args.sequence_or(&run.sequence_id);
+    let run = read_and_process(recording, options, config, progress)?;
+    let sequence = options.output.sequence_or(&run.sequence_id);
     refuse_existing(&out, &sequence)?;
     let (output, overwrite) = (&out.path, out.overwrite);
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process mpc",
             "recording": recording.display().to_string(),
-            "pulse": args.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
-            "link": args.link,
+            "pulse": options.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
+            "link": options.link.map(|(tx, rx)| format!("{tx}:{rx}")),
             "mpc": config,
             "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
@@ -396,42 +429,34 @@ pub fn run(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
         .to_string(),
     };
     let mut written = Vec::new();
-    for (key, partition) in partitions(&run, &sequence, args.link.is_some()) {
+    let mut links = Vec::new();
+    for (key, partition) in partitions(&run, &sequence, options.link.is_some()) {
         let link = &run.links[&key];
         written.extend(write_link(output, &partition, link, &run, config.run_gmphd, &info, overwrite)?);
-        if !quiet {
-            println!(
-                "mpc {partition} (link tx{}:rx{}): {} sets, {} detections, {} short-term tracks, {} long-term entries",
-                key.0,
-                key.1,
-                link.sets.len(),
-                link.detections.len(),
-                link.tracks.len(),
-                link.long_term.len()
-            );
-            let most = link.sets.iter().map(|s| s.snapshots.saturating_sub(s.skipped_snapshots)).max().unwrap_or(0);
-            let needed = config.short_term.min_track_length;
-            if link.tracks.is_empty() && !link.detections.is_empty() && (most as usize) < needed {
-                println!(
-                    "  no short-term tracks: sets hold at most {most} snapshot(s) and a track follows one path over at \
-                     least short_term.min_track_length = {needed} snapshots of one set (Mahler et al. Sec. III-B); \
-                     this source gives detections and first paths only"
-                );
-            }
-        }
+        links.push(LinkSummary {
+            partition,
+            link: key,
+            sets: link.sets.len(),
+            detections: link.detections.len(),
+            tracks: link.tracks.len(),
+            long_term: link.long_term.len(),
+            most_snapshots_per_set: link
+                .sets
+                .iter()
+                .map(|s| s.snapshots.saturating_sub(s.skipped_snapshots))
+                .max()
+                .unwrap_or(0)
+                .into(),
+        });
     }
-    if !quiet {
-        for w in &written {
-            println!("  wrote {} ({} {})", w.path.display(), w.rows, record_noun(&w.path));
-        }
-    }
-    Ok(())
+    Ok(MpcOutput { links, written })
 }
 
 /// What the records counted in a table's [`TableWriteSummary::rows`] are,
 /// from the table's directory in `<output>/<table>/sequence=<id>/part-0.parquet`:
 /// one record of `mpc_tracks` is a whole track (one row per point).
-fn record_noun(path: &Path) -> &'static str {
+#[must_use]
+pub fn record_noun(path: &Path) -> &'static str {
     let table = path.parent().and_then(Path::parent).and_then(Path::file_name).and_then(|n| n.to_str());
     match table {
         Some("mpc_detections") => "detections",

@@ -1,46 +1,45 @@
-//! `mmtrack process beam --tracker geometric`: the geometric Doppler-bearing
-//! tracker of Zoechmann et al. 2019 on a recording's two vehicles.
+//! The geometric Doppler-bearing tracker of Zoechmann et al. 2019 on a
+//! recording's two vehicles (`mmtrack process beam --tracker geometric`).
 //!
 //! The recording must hold the ground truth of a transmitter and a receiver
 //! vehicle (`/ground_truth_tx/pose` and `/ground_truth_rx/pose`, as `mmtrack
 //! simulate sounder` writes them). Both are interpolated (linearly; yaw on
-//! the shortest arc) every `--epoch-ms` within their common time span; the
+//! the shortest arc) every [`GeometricOptions::epoch_ms`] within their common time span; the
 //! transmitter's position in the receiver's frame gives the true range and
 //! azimuth, and central differences give the relative velocity and range
 //! rate. The receiver's 60 GHz UCA codebook and the Doppler measurement
 //! (`mmtrack_sim::beam::overtaking`'s defaults: 64 elements, 4-bit, 128
-//! beams, 100 Hz noise drawn from `--doppler-seed`) are simulated on those
+//! beams, 100 Hz noise drawn from [`GeometricOptions::doppler_seed`]) are simulated on those
 //! truths, and the tracker measures through the paper's beam schedule (10
 //! full scans, then the 3 beams nearest its projected azimuth) or, with
-//! `--beam-schedule full-scan`, a full scan every epoch. One
+//! [`Schedule::FullScan`], a full scan every epoch. One
 //! `geometric_per_epoch` partition per recording.
 //!
 //! The tracker assumes constant relative velocity; real drives (speed swings,
 //! curves) violate it, and the table shows how far the estimate drifts.
 
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use anyhow::{Context, bail, ensure};
-use clap::{Args, ValueEnum};
-use mmtrack_analysis::beam::geometric_analysis::{H_INFINITY, RLS};
-use mmtrack_analysis::beam::zoechmann_tables::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
 use mmtrack_beam::geometric::{
     BeamSchedule, BeamSelection, DopplerBearing, GeometricTracker, GeometricTrackerConfig, RangeEstimator,
 };
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
+use mmtrack_io::table::{
+    GEOMETRIC_FILTER_H_INFINITY, GEOMETRIC_FILTER_RLS, GEOMETRIC_PER_EPOCH, GeometricEpochRow, TableWriteSummary,
+};
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 use mmtrack_sim::beam::overtaking::OvertakingScenario;
 use rand::SeedableRng;
 use rand_pcg::Pcg64;
 
-use crate::run_id::RunDir;
+use crate::output::RunDir;
 
 /// Which beams the tracker measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
-pub enum ScheduleArg {
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Schedule {
     /// 10 full scans, then the 3 beams nearest the projected azimuth (the paper's).
     #[default]
     Paper,
@@ -48,17 +47,14 @@ pub enum ScheduleArg {
     FullScan,
 }
 
-/// The options of `--tracker geometric` (refused with the other trackers).
-#[derive(Args, Debug, Clone, Default)]
+/// The options of [`process_geometric`] (`--tracker geometric`).
+#[derive(Debug, Clone, Default)]
 pub struct GeometricOptions {
-    /// geometric: beams measured per epoch.
-    #[arg(long, value_enum)]
-    pub beam_schedule: Option<ScheduleArg>,
-    /// geometric: epoch (scan) interval, milliseconds (default 20).
-    #[arg(long, value_name = "MS")]
+    /// Beams measured per epoch.
+    pub beam_schedule: Option<Schedule>,
+    /// Epoch (scan) interval, milliseconds (default 20).
     pub epoch_ms: Option<f64>,
-    /// geometric: seed of the simulated Doppler noise (default 2019).
-    #[arg(long, value_name = "SEED")]
+    /// Seed of the simulated Doppler noise (default 2019).
     pub doppler_seed: Option<u64>,
 }
 
@@ -75,6 +71,28 @@ impl GeometricOptions {
         .filter_map(|(flag, given)| given.then_some(flag))
         .collect()
     }
+}
+
+/// One recording's result of [`process_geometric`].
+#[derive(Debug, Clone)]
+pub struct GeometricRecordingResult {
+    /// The sequence written.
+    pub sequence_id: String,
+    /// Epochs tracked.
+    pub epochs: usize,
+    /// The last epoch's row.
+    pub last: GeometricEpochRow,
+    /// Beams measured over all epochs.
+    pub beams_measured: u64,
+}
+
+/// What [`process_geometric`] did.
+#[derive(Debug, Clone)]
+pub struct GeometricOutput {
+    /// Per recording, in the order given.
+    pub recordings: Vec<GeometricRecordingResult>,
+    /// Each table written, with its row count.
+    pub written: Vec<TableWriteSummary>,
 }
 
 struct TwoVehicles {
@@ -137,9 +155,18 @@ fn relative_m(v: &TwoVehicles, t_ns: i64) -> [f64; 2] {
 
 /// Runs the tracker on each recording; one partition per recording.
 ///
-/// `output_dir` is the run directory (`<output>/run=<ID>` with `--run-id`,
-/// `crate::run_id`): refusals look there and the tables go there.
-pub fn run(recordings: &[PathBuf], out: &RunDir, options: &GeometricOptions, quiet: bool) -> anyhow::Result<ExitCode> {
+/// `out` is the run directory ([`crate::output::OutputOptions::resolve`]):
+/// refusals look there and the tables go there.
+///
+/// # Errors
+/// An existing table (without `force`), a recording without both vehicles'
+/// ground truth (or with too short an overlap), a bad epoch, or a table that
+/// cannot be written.
+pub fn process_geometric(
+    recordings: &[PathBuf],
+    out: &RunDir,
+    options: &GeometricOptions,
+) -> anyhow::Result<GeometricOutput> {
     let output_dir = out.path.as_path();
     let scenario = OvertakingScenario::default();
     let epoch_s = options.epoch_ms.unwrap_or(1e3 * scenario.epoch_s) * 1e-3;
@@ -149,14 +176,15 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &GeometricOptions, qui
     let receiver = scenario.receiver()?;
     let lambda = scenario.wavelength_m();
     let schedule = match schedule_arg {
-        ScheduleArg::Paper => BeamSchedule::paper(scenario.beams),
-        ScheduleArg::FullScan => BeamSchedule { full_scan_epochs: usize::MAX, ..BeamSchedule::paper(scenario.beams) },
+        Schedule::Paper => BeamSchedule::paper(scenario.beams),
+        Schedule::FullScan => BeamSchedule { full_scan_epochs: usize::MAX, ..BeamSchedule::paper(scenario.beams) },
     };
     let inputs = recordings.iter().map(|p| read(p).map(|r| (p, r))).collect::<anyhow::Result<Vec<_>>>()?;
     for (_, r) in &inputs {
         out.refuse_existing(&[GEOMETRIC_PER_EPOCH.name], &r.sequence_id)?;
     }
     let step_ns = (epoch_s * 1e9).round() as i64;
+    let (mut results, mut written) = (Vec::new(), Vec::new());
     for (path, vehicles) in &inputs {
         let start = vehicles.tx[0].t_ns.max(vehicles.rx[0].t_ns);
         let end = vehicles.tx[vehicles.tx.len() - 1].t_ns.min(vehicles.rx[vehicles.rx.len() - 1].t_ns);
@@ -194,7 +222,8 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &GeometricOptions, qui
             rows.push(GeometricEpochRow {
                 epoch: k as u64,
                 t_ns,
-                filter: if tracker.converged() { RLS } else { H_INFINITY }.to_string(),
+                filter: if tracker.converged() { GEOMETRIC_FILTER_RLS } else { GEOMETRIC_FILTER_H_INFINITY }
+                    .to_string(),
                 beams_measured,
                 measured_azimuth_rad,
                 measured_doppler_hz: doppler_hz,
@@ -222,21 +251,15 @@ pub fn run(recordings: &[PathBuf], out: &RunDir, options: &GeometricOptions, qui
             })
             .to_string(),
         };
-        write_table(output_dir, &vehicles.sequence_id, &rows, &info, out.overwrite)?;
-        if !quiet {
-            let last = rows.last().context("no epochs")?;
-            println!(
-                "{}: {} epochs, {}; last epoch range {:.2} m (true {:.2} m), {} beams measured in all",
-                vehicles.sequence_id,
-                rows.len(),
-                last.filter,
-                last.range_m,
-                last.true_range_m,
-                rows.iter().map(|r| r.beams_measured).sum::<u64>()
-            );
-        }
+        written.push(write_table(output_dir, &vehicles.sequence_id, &rows, &info, out.overwrite)?);
+        results.push(GeometricRecordingResult {
+            sequence_id: vehicles.sequence_id.clone(),
+            epochs: rows.len(),
+            last: rows.last().cloned().context("no epochs")?,
+            beams_measured: rows.iter().map(|r| r.beams_measured).sum(),
+        });
     }
-    Ok(ExitCode::SUCCESS)
+    Ok(GeometricOutput { recordings: results, written })
 }
 
 /// Standard normal by Box-Muller.

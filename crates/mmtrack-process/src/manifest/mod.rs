@@ -1,4 +1,5 @@
-//! `mmtrack process manifest`: many sequences, each an independent task.
+//! The manifest runner (`mmtrack process manifest`): many sequences, each an
+//! independent task.
 //!
 //! A manifest lists `mmtrack process` command lines, one per sequence:
 //!
@@ -17,40 +18,19 @@
 //!
 //! A task's own flags pass through unchanged, `--run-id` included: tasks of
 //! one sequence with different run ids write side by side under
-//! `<tables>/run=<ID>/` (`crate::run_id`), each refusing only its own
+//! `<tables>/run=<ID>/` ([`crate::output`]), each refusing only its own
 //! existing partitions.
 //!
-//! `--print-commands` prints the per-sequence command lines instead of
-//! running them: exactly what a cluster runs, one job per line (see
+//! The front end parses each task's command line ([`command_line`]) and
+//! runs it with [`run_tasks`]; `--print-commands` prints the lines instead
+//! ([`shell_word`]): exactly what a cluster runs, one job per line (see
 //! `examples/ray_process.py`).
 
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
+use std::path::Path;
 
 use anyhow::{Context, bail};
-use clap::Args;
 use rayon::prelude::*;
 use serde::Deserialize;
-
-use crate::threads::ThreadsArg;
-
-#[derive(Args)]
-pub struct ManifestArgs {
-    /// Manifest TOML: `[[task]]` tables, each with `args`, a `mmtrack process` command line without `mmtrack
-    /// process` and without `-o` (paths as typed in the directory you run from).
-    pub manifest: PathBuf,
-    /// Output table directory every task writes into (its own sequence partitions).
-    #[arg(short, long, required_unless_present = "print_commands")]
-    pub output: Option<PathBuf>,
-    /// Pass --force to every task (replace their earlier partitions).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the per-sequence command lines (what a cluster runs, one job each) and exit.
-    #[arg(long)]
-    pub print_commands: bool,
-    #[command(flatten)]
-    pub threads: ThreadsArg,
-}
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -58,15 +38,22 @@ struct Manifest {
     task: Vec<Task>,
 }
 
-#[derive(Debug, Deserialize)]
+/// One task: a `mmtrack process` command line without `mmtrack process`
+/// and without `-o`.
+#[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Task {
-    args: Vec<String>,
+pub struct Task {
+    /// The words, e.g. `["odometry", "runs/a.mcap", "--preset", "cfear"]`.
+    pub args: Vec<String>,
 }
 
 /// The tasks of `path`, checked: at least one, each naming a pipeline and
 /// leaving `-o` to the manifest command.
-fn read_manifest(path: &Path) -> anyhow::Result<Vec<Task>> {
+///
+/// # Errors
+/// The file cannot be read or parsed, has no task, a task is empty, runs
+/// a manifest or gives `-o`; naming the file and the task.
+pub fn read_manifest(path: &Path) -> anyhow::Result<Vec<Task>> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("{}: cannot read the manifest", path.display()))?;
     let manifest: Manifest = toml::from_str(&text).with_context(|| path.display().to_string())?;
@@ -89,7 +76,8 @@ fn read_manifest(path: &Path) -> anyhow::Result<Vec<Task>> {
 }
 
 /// One task's full command line after `mmtrack`.
-fn command_line(task: &Task, output: &str, force: bool) -> Vec<String> {
+#[must_use]
+pub fn command_line(task: &Task, output: &str, force: bool) -> Vec<String> {
     let mut line = vec!["process".to_string()];
     line.extend(task.args.iter().cloned());
     line.extend(["-o".to_string(), output.to_string()]);
@@ -100,7 +88,8 @@ fn command_line(task: &Task, output: &str, force: bool) -> Vec<String> {
 }
 
 /// Shell-quotes `word` when it needs it.
-fn shell_word(word: &str) -> String {
+#[must_use]
+pub fn shell_word(word: &str) -> String {
     if !word.is_empty() && word.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=:,+@".contains(c)) {
         word.to_string()
     } else {
@@ -108,52 +97,14 @@ fn shell_word(word: &str) -> String {
     }
 }
 
-pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let tasks = read_manifest(&args.manifest)?;
-    let output = match &args.output {
-        Some(o) => crate::path_word(o)?,
-        None => "<tables>".to_string(),
-    };
-    let lines: Vec<Vec<String>> = tasks.iter().map(|t| command_line(t, &output, args.force)).collect();
-    if args.print_commands {
-        for line in &lines {
-            println!("mmtrack {}", line.iter().map(|w| shell_word(w)).collect::<Vec<_>>().join(" "));
-        }
-        return Ok(ExitCode::SUCCESS);
-    }
-    let outcomes: Vec<anyhow::Result<ExitCode>> = args.threads.install(|| {
-        lines
-            .par_iter()
-            .map(|line| {
-                let mut words = line.clone();
-                words.push("--quiet".into());
-                crate::run_words(&words)
-            })
-            .collect()
-    })?;
-    let mut failed = 0;
-    for (line, outcome) in lines.iter().zip(&outcomes) {
-        let shown = line.iter().map(|w| shell_word(w)).collect::<Vec<_>>().join(" ");
-        match outcome {
-            Ok(code) if *code == ExitCode::SUCCESS => {
-                if !quiet {
-                    println!("ok      mmtrack {shown}");
-                }
-            }
-            Ok(_) => {
-                failed += 1;
-                eprintln!("failed  mmtrack {shown}: exit 1");
-            }
-            Err(e) => {
-                failed += 1;
-                eprintln!("failed  mmtrack {shown}: {}", crate::one_line(e));
-            }
-        }
-    }
-    if !quiet {
-        println!("{} of {} tasks done; tables under {output}", tasks.len() - failed, tasks.len());
-    }
-    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+/// Runs `run` on every task as its own task on the current rayon pool;
+/// one result per task, in task order. A failed task does not stop the
+/// others.
+pub fn run_tasks<T: Sync>(
+    tasks: &[T],
+    run: impl Fn(&T) -> anyhow::Result<()> + Send + Sync,
+) -> Vec<anyhow::Result<()>> {
+    tasks.par_iter().map(run).collect()
 }
 
 #[cfg(test)]

@@ -4,7 +4,7 @@
 //! partition `zoechmann`) and by `mmtrack process beam --tracker geometric`
 //! (`geometric_per_epoch`, one partition per recording).
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `zoechmann_nmse`: NMSE of the range per epoch, manoeuvre and estimator.
     pub const ZOECHMANN_NMSE = "zoechmann_nmse",
         "NMSE of the range over the Monte Carlo runs of one manoeuvre (Zoechmann et al. 2019, Figs. 4-5), per epoch and \
@@ -30,7 +30,7 @@ proposed-doppler-mps (the same for the proposed tracker with its own beam window
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `zoechmann_summary`: per manoeuvre, convergence and beam accounting.
     pub const ZOECHMANN_SUMMARY = "zoechmann_summary",
         "Per manoeuvre of reproduce zoechmann: the proposed tracker's hand-over from H-infinity to RLS (the epoch of the \
@@ -62,7 +62,7 @@ nearest the projected azimuth) against a full scan at every epoch.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `zoechmann_nlos_error`: per path, position error over time.
     pub const ZOECHMANN_NLOS_ERROR = "zoechmann_nlos_error",
         "The proposed geometric tracker on each path of an overtaking between two walls (line of sight and the two \
@@ -80,7 +80,7 @@ single wall bounces, image method), per epoch: RMS error over the Monte Carlo ru
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `zoechmann_path_labels`: per path and epoch, the tracker's state of one run.
     pub const ZOECHMANN_PATH_LABELS = "zoechmann_path_labels",
         "Labels for other sensors (Zoechmann et al. 2019, Sec. II and VII): for each path of the first Monte Carlo run, \
@@ -104,7 +104,7 @@ y to the left) and its relative velocity, per epoch, beside the simulator's trut
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `geometric_per_epoch`: `process beam --tracker geometric`, one row per epoch.
     pub const GEOMETRIC_PER_EPOCH = "geometric_per_epoch",
         "The geometric Doppler-bearing tracker (Zoechmann et al. 2019) on a recording's two vehicles (channel-sounder \
@@ -131,7 +131,7 @@ filter in use and the beams measured.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `geometric_summary`: `mmtrack analyze` of one `geometric_per_epoch` partition.
     pub const GEOMETRIC_SUMMARY = "geometric_summary",
         "The geometric Doppler-bearing tracker (Zoechmann et al. 2019) on one recording, from table \
@@ -161,3 +161,8 @@ against a full scan at every epoch. Written by `mmtrack analyze`.";
         saving: f64, "", "beams_full_scan / beams_measured (the paper's 128 / 3 on the windowed epochs)";
     }
 }
+
+/// `filter` of a [`GEOMETRIC_PER_EPOCH`] epoch tracked by the H-infinity recursion.
+pub const GEOMETRIC_FILTER_H_INFINITY: &str = "h-infinity";
+/// `filter` of a [`GEOMETRIC_PER_EPOCH`] epoch tracked by RLS (after the hand-over).
+pub const GEOMETRIC_FILTER_RLS: &str = "rls";

@@ -1,4 +1,4 @@
-//! `mmtrack process beam`: the beam-sweep trackers and their baselines on
+//! The beam-sweep trackers and their baselines (`mmtrack process beam`) on
 //! recordings of measured beam sweeps (e.g. from `mmtrack ingest beams`),
 //! one `beam_sweeps_tracked` partition per recording (sequence).
 //!
@@ -9,7 +9,7 @@
 //! The GNSS-driven policies (`gnss-window`, `gnss-map`) need the beam map
 //! (beam index against the car's bearing from the array, with the array's
 //! boresight, beam spacing and GNSS time offset fitted from data). It is
-//! fitted leave-one-pass-out over the recordings given on the command line:
+//! fitted leave-one-pass-out over the recordings given together:
 //! each recording is predicted by a map fitted on the other recordings of the
 //! same site (metadata `beam.site`; a recording without it is a site of its
 //! own), so a map is never scored on the sweeps it was fitted to. Those
@@ -22,16 +22,13 @@
 //! time, as `ingest beams` writes them); east/north metres from the array
 //! come from the WGS-84 local tangent plane.
 //!
-//! `--tracker spebt` is another kind of tracker: the SPEBT EKF on a
-//! simulated link along a recording's ground truth, driven by an `odometry`
-//! table or by the pose-error model (`process_spebt`); it runs alone.
+//! SPEBT ([`super::spebt`]) and geometric tracking ([`super::geometric`])
+//! are other kinds of trackers with their own calls.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
 use mmtrack_beam::sweep::{
     BeamMap, BeamMapConfig, GnssMapOnly, GnssPass, GnssTrackerConfig, GnssWindowTracker, LastFullSweep, MapPass,
     Reacquisition, SearchConfig, SweepPass, SweepRecord, SweepSummary, SweepTracker, WindowTracker,
@@ -40,14 +37,14 @@ use mmtrack_beam::sweep::{
 use mmtrack_core::{BeamSweep, GnssFix};
 use mmtrack_ingest::nmea::{EnuOrigin, geodetic_to_enu_m};
 use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata};
-use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, write_table};
+use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, TableWriteSummary, write_table};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 
-use crate::run_id::RunOutputArgs;
+use crate::output::OutputOptions;
 
-/// The policies `process beam` runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
-pub enum TrackerArg {
+/// The beam-sweep policies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum SweepTrackerKind {
     /// Constant-velocity Kalman filter on the beam index, from the measured beams alone.
     Window,
     /// The car's GNSS position through the beam map moves the window (SPEBT with GNSS for radar odometry).
@@ -56,15 +53,9 @@ pub enum TrackerArg {
     LastFullSweep,
     /// Baseline: the beam nearest the GNSS prediction of the beam map, no beam measured.
     GnssMap,
-    /// SPEBT (Liu et al. 2024) on a simulated link along the recording's ground truth, driven by
-    /// --odometry or by the pose-error model; runs alone (spebt_per_slot, spebt_summary tables).
-    Spebt,
-    /// Geometric Doppler-bearing tracking (Zoechmann et al. 2019) between a recording's two vehicles
-    /// (sounder ground truth), UCA scans and Doppler simulated along it; runs alone (geometric_per_epoch).
-    Geometric,
 }
 
-impl TrackerArg {
+impl SweepTrackerKind {
     /// Name in tables and messages.
     #[must_use]
     pub fn name(self) -> &'static str {
@@ -73,8 +64,6 @@ impl TrackerArg {
             Self::GnssWindow => "gnss-window",
             Self::LastFullSweep => "last-full-sweep",
             Self::GnssMap => "gnss-map",
-            Self::Spebt => "spebt",
-            Self::Geometric => "geometric",
         }
     }
 
@@ -84,35 +73,12 @@ impl TrackerArg {
 }
 
 /// How the window trackers find the beam at a pass start and after a loss.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ReacquireArg {
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Reacquire {
     /// Every 4th beam, then a climb to the local peak.
     Coarse,
     /// A full sweep (every beam).
     Full,
-}
-
-#[derive(Args)]
-pub struct BeamArgs {
-    /// Recordings with beam sweeps (files, or directories whose .mcap files are all read), e.g. from
-    /// `mmtrack ingest beams`; one sequence each.
-    #[arg(required = true, value_name = "RECORDING")]
-    recordings: Vec<PathBuf>,
-    /// Output table directory (created if missing).
-    #[arg(short, long)]
-    output: PathBuf,
-    /// Policies to run, comma-separated; all write into the same table, told apart by its `tracker` column.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "window,gnss-window,last-full-sweep,gnss-map")]
-    tracker: Vec<TrackerArg>,
-    /// Re-acquisition of the window trackers (window, gnss-window).
-    #[arg(long, value_enum, default_value_t = ReacquireArg::Coarse)]
-    reacquire: ReacquireArg,
-    #[command(flatten)]
-    output_args: RunOutputArgs,
-    #[command(flatten)]
-    spebt: super::process_spebt::SpebtOptions,
-    #[command(flatten)]
-    geometric: super::process_geometric::GeometricOptions,
 }
 
 /// One recording, read: its full sweeps and both units' positions.
@@ -133,7 +99,10 @@ pub struct BeamRecording {
 }
 
 /// The `.mcap` files of `inputs` (directories expanded, sorted), in order.
-fn expand(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+///
+/// # Errors
+/// A directory that cannot be listed or holds no `.mcap` file.
+pub fn expand(inputs: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let mut out = Vec::new();
     for input in inputs {
         if input.is_dir() {
@@ -285,21 +254,25 @@ fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
     Ok(SiteMaps { per_pass, gnss_beam, all })
 }
 
-fn search(reacquire: ReacquireArg) -> SearchConfig {
+fn search(reacquire: Reacquire) -> SearchConfig {
     let reacquisition = match reacquire {
-        ReacquireArg::Coarse => Reacquisition::Coarse { stride: 4 },
-        ReacquireArg::Full => Reacquisition::FullSweep,
+        Reacquire::Coarse => Reacquisition::Coarse { stride: 4 },
+        Reacquire::Full => Reacquisition::FullSweep,
     };
     SearchConfig { reacquisition, ..SearchConfig::default() }
 }
 
 /// A fresh tracker of `kind` for a pass whose map is `map`.
-fn tracker(kind: TrackerArg, reacquire: ReacquireArg, map: Option<&BeamMap>) -> anyhow::Result<Box<dyn SweepTracker>> {
+fn tracker(
+    kind: SweepTrackerKind,
+    reacquire: Reacquire,
+    map: Option<&BeamMap>,
+) -> anyhow::Result<Box<dyn SweepTracker>> {
     Ok(match kind {
-        TrackerArg::Window => {
+        SweepTrackerKind::Window => {
             Box::new(WindowTracker::new(WindowTrackerConfig { search: search(reacquire), ..Default::default() })?)
         }
-        TrackerArg::GnssWindow => {
+        SweepTrackerKind::GnssWindow => {
             let map = map.context("gnss-window without a beam map")?;
             Box::new(GnssWindowTracker::new(GnssTrackerConfig {
                 search: search(reacquire),
@@ -309,15 +282,13 @@ fn tracker(kind: TrackerArg, reacquire: ReacquireArg, map: Option<&BeamMap>) -> 
                 ..Default::default()
             })?)
         }
-        TrackerArg::LastFullSweep => Box::new(LastFullSweep::new()),
-        TrackerArg::GnssMap => Box::new(GnssMapOnly),
-        TrackerArg::Spebt => bail!("spebt is not a beam-sweep tracker (it runs alone, process_spebt)"),
-        TrackerArg::Geometric => bail!("geometric is not a beam-sweep tracker (it runs alone, process_geometric)"),
+        SweepTrackerKind::LastFullSweep => Box::new(LastFullSweep::new()),
+        SweepTrackerKind::GnssMap => Box::new(GnssMapOnly),
     })
 }
 
 /// Every pass of `site` through `kind`: the records of each pass.
-fn run_tracker(site: &Site<'_>, kind: TrackerArg, reacquire: ReacquireArg) -> anyhow::Result<Vec<Vec<SweepRecord>>> {
+fn run_tracker(site: &Site<'_>, kind: SweepTrackerKind, reacquire: Reacquire) -> anyhow::Result<Vec<Vec<SweepRecord>>> {
     site.passes
         .iter()
         .enumerate()
@@ -332,7 +303,7 @@ fn run_tracker(site: &Site<'_>, kind: TrackerArg, reacquire: ReacquireArg) -> an
 }
 
 fn rows(
-    kind: TrackerArg,
+    kind: SweepTrackerKind,
     site: &str,
     sweeps: &[BeamSweep],
     records: &[SweepRecord],
@@ -357,35 +328,53 @@ fn rows(
         .collect()
 }
 
-pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let out = args.output_args.resolve(&args.output)?;
-    let mut kinds = args.tracker.clone();
+/// One site of [`process_sweeps`]: its passes and, for the GNSS policies,
+/// the beam map fitted on all of them.
+#[derive(Debug, Clone)]
+pub struct SiteReport {
+    /// Site name.
+    pub name: String,
+    /// Recordings (passes) of the site.
+    pub passes: usize,
+    /// Sweeps over all passes.
+    pub sweeps: usize,
+    /// The beam map fitted on every pass (for display; each pass was
+    /// predicted by the map of the other passes).
+    pub map: Option<BeamMap>,
+}
+
+/// What [`process_sweeps`] did.
+#[derive(Debug, Clone)]
+pub struct SweepOutput {
+    /// Per site, in site order.
+    pub sites: Vec<SiteReport>,
+    /// Per site and policy: (site, policy, summary over its passes).
+    pub summaries: Vec<(String, SweepTrackerKind, SweepSummary)>,
+    /// Each table written, with its row count.
+    pub written: Vec<TableWriteSummary>,
+    /// The run directory written.
+    pub dir: PathBuf,
+}
+
+/// `mmtrack process beam --tracker window,...`: every policy of `kinds` on
+/// the full sweeps of each recording, one `beam_sweeps_tracked` partition
+/// per recording under `output`.
+///
+/// # Errors
+/// A bad run id, an existing table (without `force`), a bad recording, a
+/// sequence given twice, a site with too few passes for the beam map, or a
+/// table that cannot be written.
+pub fn process_sweeps(
+    files: &[PathBuf],
+    output: &Path,
+    kinds: &[SweepTrackerKind],
+    reacquire: Reacquire,
+    options: &OutputOptions,
+) -> anyhow::Result<SweepOutput> {
+    let out = options.resolve(output)?;
+    let mut kinds = kinds.to_vec();
     kinds.sort();
     kinds.dedup();
-    let files = expand(&args.recordings)?;
-    if kinds.contains(&TrackerArg::Geometric) {
-        if kinds.len() > 1 {
-            bail!(
-                "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
-            );
-        }
-        return super::process_geometric::run(&files, &out, &args.geometric, quiet);
-    }
-    if let Some(flag) = args.geometric.given().first() {
-        bail!("{flag} is an option of --tracker geometric only");
-    }
-    if kinds.contains(&TrackerArg::Spebt) {
-        if kinds.len() > 1 {
-            bail!(
-                "--tracker spebt runs alone (it tracks a simulated link along the ground truth, not measured sweeps); \
-                 give the sweep trackers in another call"
-            );
-        }
-        return super::process_spebt::run(&files, &out, &args.spebt, quiet);
-    }
-    if let Some(flag) = args.spebt.given().first() {
-        bail!("{flag} is an option of --tracker spebt only");
-    }
     let recordings = files.iter().map(|f| read_beam_recording(f)).collect::<anyhow::Result<Vec<_>>>()?;
     let mut by_sequence: BTreeMap<&str, &Path> = BTreeMap::new();
     for r in &recordings {
@@ -418,7 +407,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let mut summaries = Vec::new();
     for site in &sites {
         for &kind in &kinds {
-            let per_pass = run_tracker(site, kind, args.reacquire)?;
+            let per_pass = run_tracker(site, kind, reacquire)?;
             for (i, (pass, records)) in site.passes.iter().zip(&per_pass).enumerate() {
                 let gnss = site.maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
                 tables.entry(pass.sequence_id.clone()).or_default().extend(rows(
@@ -430,7 +419,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 ));
             }
             let summary = SweepSummary::from_records(per_pass.iter().flatten()).context("no sweeps")?;
-            summaries.push((site.name.clone(), site.passes.len(), kind, summary));
+            summaries.push((site.name.clone(), kind, summary));
         }
     }
     let info = RunInfo {
@@ -438,10 +427,10 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             "command": "process beam",
             "recordings": files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
             "trackers": kinds.iter().map(|k| k.name()).collect::<Vec<_>>(),
-            "reacquire": format!("{:?}", search(args.reacquire).reacquisition),
-            "search": format!("{:?}", search(args.reacquire)),
-            "window": format!("{:?}", WindowTrackerConfig { search: search(args.reacquire), ..Default::default() }),
-            "gnss_window": format!("{:?} (initial_offset_sigma_beams: each pass's map residual)", GnssTrackerConfig { search: search(args.reacquire), ..Default::default() }),
+            "reacquire": format!("{:?}", search(reacquire).reacquisition),
+            "search": format!("{:?}", search(reacquire)),
+            "window": format!("{:?}", WindowTrackerConfig { search: search(reacquire), ..Default::default() }),
+            "gnss_window": format!("{:?} (initial_offset_sigma_beams: each pass's map residual)", GnssTrackerConfig { search: search(reacquire), ..Default::default() }),
             "beam_map": "fitted leave-one-pass-out over the recordings of each site given together",
             "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
@@ -452,44 +441,14 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     for (sequence, rows) in &tables {
         written.push(write_table(&out.path, sequence, rows, &info, out.overwrite)?);
     }
-    if !quiet {
-        print_summary(&sites, &summaries);
-        println!("wrote {} {} partitions under {}", written.len(), BEAM_SWEEPS_TRACKED.name, out.path.display());
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
-fn print_summary(sites: &[Site<'_>], summaries: &[(String, usize, TrackerArg, SweepSummary)]) {
-    for site in sites {
-        let sweeps: usize = site.passes.iter().map(|p| p.sweeps.len()).sum();
-        println!("{}: {} passes, {sweeps} sweeps", site.name, site.passes.len());
-        if let Some(maps) = &site.maps {
-            let m = &maps.all;
-            println!(
-                "  beam map (all passes): boresight {:.1} deg from north, {:.3} deg per beam ({}), GNSS offset {:+.1} s, \
-                 RMS residual {:.2} beams",
-                m.boresight_bearing_rad().to_degrees(),
-                m.beam_spacing_rad().to_degrees(),
-                if m.beams_per_rad() < 0.0 { "index falls clockwise" } else { "index rises clockwise" },
-                m.gnss_time_offset_s(),
-                m.rms_residual_beams()
-            );
-        }
-        println!(
-            "  {:<16} {:>9} {:>9} {:>6} {:>6} {:>6} {:>6}",
-            "tracker", "mean dB", "median dB", "top1", "+-1", "beams", "reinit"
-        );
-        for (_, _, kind, s) in summaries.iter().filter(|(name, ..)| *name == site.name) {
-            println!(
-                "  {:<16} {:>9.3} {:>9.3} {:>6.3} {:>6.3} {:>6.2} {:>6}",
-                kind.name(),
-                s.mean_loss_db,
-                s.median_loss_db,
-                s.top1,
-                s.within_one,
-                s.mean_beams_per_sweep,
-                s.reinitialisations
-            );
-        }
-    }
+    let sites = sites
+        .iter()
+        .map(|site| SiteReport {
+            name: site.name.clone(),
+            passes: site.passes.len(),
+            sweeps: site.passes.iter().map(|p| p.sweeps.len()).sum(),
+            map: site.maps.as_ref().map(|m| m.all.clone()),
+        })
+        .collect();
+    Ok(SweepOutput { sites, summaries, written, dir: out.path })
 }

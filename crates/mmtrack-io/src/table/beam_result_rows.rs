@@ -1,6 +1,6 @@
 //! Result tables of the beam trackers, with units.
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `beam_rms_per_block`: RMS pointing error per block.
     pub const BEAM_RMS_PER_BLOCK = "beam_rms_per_block",
         "RMS transmit-beam pointing error over the Monte Carlo runs of one scenario point, per block and tracker \
@@ -17,7 +17,7 @@ pointed from its prediction; block 0 is the channel estimate the trackers start 
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `beam_valid_tracking`: blocks of valid tracking per scenario point.
     pub const BEAM_VALID_TRACKING = "beam_valid_tracking",
         "Valid-tracking duration per scenario point and tracker (Shaham et al. 2020, Sec. IV): the first block \
@@ -37,7 +37,7 @@ where it gives one.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `beam_sweep_summary`: per sequence, one row per beam-sweep tracker.
     pub const BEAM_SWEEP_SUMMARY = "beam_sweep_summary",
         "Beam-training accounting of one sequence (a vehicle pass) per tracker, from table beam_sweeps_tracked: \
@@ -65,7 +65,7 @@ its neighbour, beams measured per sweep (a full sweep counts all beams) and re-i
 #[derive(Debug, Clone, PartialEq)]
 pub struct BeamSweepPooledRow(pub BeamSweepSummaryRow);
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `beam_sweep_pooled`: per site and tracker, every sequence pooled.
     pub const BEAM_SWEEP_POOLED = "beam_sweep_pooled",
         "Beam-training accounting pooled over every sequence of a site, one row per site and tracker (partition \

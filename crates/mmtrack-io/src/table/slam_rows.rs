@@ -1,6 +1,6 @@
 //! Result tables of the 5G mmWave SLAM experiment, with units.
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `slam_summary`: one row per experiment row (scenario variant).
     pub const SLAM_SUMMARY = "slam_summary",
         "5G mmWave SLAM over the Monte Carlo runs of one scenario variant (Kim et al. 2018, Sec. V): mean over \
@@ -36,7 +36,7 @@ trace), all epochs of all runs: 1 for a consistent filter, above 1 for an overco
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `slam_per_epoch`: errors and map size per epoch, averaged over runs.
     pub const SLAM_PER_EPOCH = "slam_per_epoch",
         "5G mmWave SLAM per epoch, averaged over the Monte Carlo runs of one scenario variant (Kim et al. 2018, \
@@ -57,7 +57,7 @@ Figs. 4-6): UE errors, localisation errors of the confirmed sources and the numb
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `slam_ue`: the UE estimate of each epoch, with the truth when known.
     pub const SLAM_UE = "slam_ue",
         "The 5G mmWave SLAM filter's UE estimate per epoch of one recording (`mmtrack process slam`, Kim et al. \
@@ -93,7 +93,7 @@ the recording carries it (/slam/ue_truth; null otherwise).";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `slam_map`: every map source after every epoch.
     pub const SLAM_MAP = "slam_map",
         "The 5G mmWave SLAM map over time (`mmtrack process slam`): after each epoch, one row per source of the \
@@ -117,7 +117,7 @@ type, spatial belief and history.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `slam_associations`: the source each path of each epoch was given.
     pub const SLAM_ASSOCIATIONS = "slam_associations",
         "The 5G mmWave SLAM data association (`mmtrack process slam`, Kim et al. 2018, eq. (3)-(7), solved by \
@@ -139,7 +139,7 @@ that initialised the UE) or waiting (dropped before the UE was initialised)";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `slam_true_sources`: the sources of the paths in the recording.
     pub const SLAM_TRUE_SOURCES = "slam_true_sources",
         "The sources of the 5G mmWave paths as the recording gives them (/slam/sources): the base station and, \

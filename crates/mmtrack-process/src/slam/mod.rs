@@ -1,5 +1,5 @@
-//! `mmtrack process slam <recording> -o <tables>`: the 5G mmWave SLAM filter
-//! (Kim et al. 2018, `mmtrack_slam`) on a recording's per-epoch path
+//! The 5G mmWave SLAM filter
+//! (Kim et al. 2018, `mmtrack_slam`; `mmtrack process slam`) on a recording's per-epoch path
 //! measurements (`/slam/paths`), writing per sequence the tables
 //! `slam_ue` (UE estimate per epoch, with the truth when the recording has
 //! it), `slam_map` (every map source after every epoch), `slam_associations`
@@ -8,7 +8,7 @@
 //!
 //! The filter needs the base station's position (the `bs` message on
 //! `/slam/sources`) and a prior UE state: the recording's first true state
-//! (as the paper's Sec. V-A centres its prior on it), else `--prior`. When
+//! (as the paper's Sec. V-A centres its prior on it), else [`SlamOptions::prior`]. When
 //! the recording says which detection probability it was simulated with,
 //! the filter assumes it (at most its configured 0.99, eq. (3)).
 //!
@@ -16,67 +16,61 @@
 //! and counted in `slam_ue.skipped_paths`, or with `--strict` refused with an
 //! error naming the file, the epoch and the field; an epoch without paths
 //! only predicts. The particles run on rayon with random streams fixed by
-//! the seed and the chunking, so the tables do not depend on `--threads`.
+//! the seed and the chunking, so the tables do not depend on the thread count.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use clap::Args;
-use mmtrack_analysis::slam::tables::{
-    SLAM_ASSOCIATIONS, SLAM_MAP, SLAM_TRUE_SOURCES, SLAM_UE, SlamAssociationRow, SlamMapRow, SlamTrueSourceRow,
-    SlamUeRow,
-};
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 use mmtrack_io::RecordingEvent;
 use mmtrack_io::recording::RecordingMetadata;
 use mmtrack_io::table::{RunInfo, TableWriteSummary, write_table};
+use mmtrack_io::table::{
+    SLAM_ASSOCIATIONS, SLAM_MAP, SLAM_TRUE_SOURCES, SLAM_UE, SlamAssociationRow, SlamMapRow, SlamTrueSourceRow,
+    SlamUeRow,
+};
 use mmtrack_sim::slam::SlamScenario;
 use mmtrack_slam::{Decision, EpochReport, SlamConfig, SlamFilter, SourceStatus};
 
-use super::simulate::SCENARIO_JSON_KEY;
-use crate::run_id::OutputArgs;
-use crate::threads::ThreadsArg;
+use crate::events::for_each_event;
+use crate::output::OutputOptions;
 
-#[derive(Args)]
-pub struct SlamArgs {
-    /// Recording with /slam/paths and /slam/sources (from `mmtrack simulate slam`).
-    pub recording: PathBuf,
-    /// Output table directory (created if missing).
-    #[arg(short, long)]
-    pub output: PathBuf,
-    /// Filter parameters (TOML: any field of the SLAM filter configuration, e.g. particles = 500,
-    /// toa_std_m = 0.1); the others keep their defaults (the paper's). bs_m is the recording's base station.
-    #[arg(long, value_name = "TOML")]
+/// Recording metadata key holding the simulated scenario as JSON (written by
+/// `mmtrack simulate slam`).
+pub const SCENARIO_JSON_KEY: &str = "slam.scenario_json";
+
+/// The options of [`process_slam`].
+#[derive(Clone, Debug)]
+pub struct SlamOptions {
+    /// Filter parameters, a TOML file of any field of the SLAM filter
+    /// configuration; the others keep their defaults (the paper's).
     pub config: Option<PathBuf>,
-    /// UE particles (overrides the configuration's, 2000).
-    #[arg(long)]
+    /// UE particles (overrides the configuration's).
     pub particles: Option<usize>,
     /// Seed of the filter's random streams.
-    #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Prior UE state x,y,z,heading,speed,turn_rate,clock_bias (m, rad, m/s, rad/s, m) for recordings without
-    /// ground truth (default: the recording's first true state).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        allow_negative_numbers = true,
-        value_name = "X,Y,Z,HEADING,SPEED,TURN_RATE,BIAS"
-    )]
+    /// Prior UE state x, y, z, heading, speed, turn rate, clock bias (m,
+    /// rad, m/s, rad/s, m) for recordings without ground truth.
     pub prior: Option<Vec<f64>>,
-    /// Refuse a recording with an unusable path (NaN, elevation out of range) instead of skipping and counting it.
-    #[arg(long)]
+    /// Refuse a recording with an unusable path instead of skipping it.
     pub strict: bool,
-    #[command(flatten)]
-    pub output_args: OutputArgs,
-    #[command(flatten)]
-    pub threads: ThreadsArg,
+    /// Where the tables go.
+    pub output: OutputOptions,
+}
+
+impl Default for SlamOptions {
+    fn default() -> Self {
+        Self { config: None, particles: None, seed: 1, prior: None, strict: false, output: OutputOptions::default() }
+    }
 }
 
 /// What a SLAM recording holds.
 #[derive(Debug, Default)]
 pub struct SlamRecording {
+    /// The recording's sequence id.
     pub sequence_id: String,
+    /// The path measurements per epoch.
     pub epochs: Vec<SlamEpoch>,
     /// The truth per epoch time.
     pub truth: BTreeMap<i64, (UeState, Vec<PathOrigin>)>,
@@ -87,9 +81,12 @@ pub struct SlamRecording {
 }
 
 /// Reads the SLAM channels of a recording.
+///
+/// # Errors
+/// A bad record, no metadata or no `/slam/paths`, naming the file.
 pub fn read_recording(path: &Path) -> anyhow::Result<SlamRecording> {
     let mut out = SlamRecording::default();
-    let metadata = crate::process::for_each_event(path, |event, _| {
+    let metadata = for_each_event(path, |event, _| {
         match event {
             RecordingEvent::SlamPaths(epoch) => out.epochs.push(epoch),
             RecordingEvent::SlamUeTruth { t_ns, ue, origins } => {
@@ -118,7 +115,7 @@ pub fn read_recording(path: &Path) -> anyhow::Result<SlamRecording> {
 
 /// The filter configuration: defaults, the TOML file, `--particles`, the
 /// recording's base station and detection probability.
-fn filter_config(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<SlamConfig> {
+fn filter_config(path: &Path, args: &SlamOptions, recording: &SlamRecording) -> anyhow::Result<SlamConfig> {
     let mut config = match &args.config {
         Some(path) => {
             let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
@@ -132,10 +129,7 @@ fn filter_config(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<S
     config.strict = config.strict || args.strict;
     let bs = recording.sources.iter().find(|(kind, _, _)| *kind == SourceType::BaseStation);
     let Some((_, _, bs_m)) = bs else {
-        bail!(
-            "{}: no base station (kind bs) on /slam/sources: the filter needs its position",
-            args.recording.display()
-        );
+        bail!("{}: no base station (kind bs) on /slam/sources: the filter needs its position", path.display());
     };
     config.bs_m = *bs_m;
     if let Some(scenario) = &recording.scenario {
@@ -163,9 +157,13 @@ fn check_strict(path: &Path, epochs: &[SlamEpoch]) -> anyhow::Result<()> {
 /// The tables of one run.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SlamTables {
+    /// `slam_ue` rows.
     pub ue: Vec<SlamUeRow>,
+    /// `slam_map` rows.
     pub map: Vec<SlamMapRow>,
+    /// `slam_associations` rows.
     pub associations: Vec<SlamAssociationRow>,
+    /// `slam_true_sources` rows.
     pub true_sources: Vec<SlamTrueSourceRow>,
 }
 
@@ -294,9 +292,10 @@ pub fn run_filter(
     Ok(tables)
 }
 
-const TABLE_NAMES: [&str; 4] = [SLAM_UE.name, SLAM_MAP.name, SLAM_ASSOCIATIONS.name, SLAM_TRUE_SOURCES.name];
+/// Every table `process slam` writes.
+pub const TABLE_NAMES: [&str; 4] = [SLAM_UE.name, SLAM_MAP.name, SLAM_ASSOCIATIONS.name, SLAM_TRUE_SOURCES.name];
 
-fn prior_of(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<UeState> {
+fn prior_of(path: &Path, args: &SlamOptions, recording: &SlamRecording) -> anyhow::Result<UeState> {
     if let Some(p) = &args.prior {
         let [x, y, z, heading_rad, speed_mps, turn_rate_radps, clock_bias_m] = p[..] else {
             bail!("--prior: expected 7 values x,y,z,heading,speed,turn_rate,clock_bias, got {}", p.len());
@@ -308,32 +307,61 @@ fn prior_of(args: &SlamArgs, recording: &SlamRecording) -> anyhow::Result<UeStat
         Some((ue, _)) => Ok(*ue),
         None => bail!(
             "{}: no /slam/ue_truth at the first epoch to centre the prior on; give --prior x,y,z,heading,speed,turn_rate,clock_bias",
-            args.recording.display()
+            path.display()
         ),
     }
 }
 
-pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
-    let out = args.output_args.run.resolve(&args.output)?;
-    if let Some(sequence) = &args.output_args.sequence {
+/// What [`process_slam`] did.
+#[derive(Debug, Clone)]
+pub struct SlamOutput {
+    /// The configuration the filter ran with.
+    pub config: SlamConfig,
+    /// The tables written.
+    pub tables: SlamTables,
+    /// Each table written, with its row count.
+    pub written: Vec<TableWriteSummary>,
+}
+
+impl SlamOutput {
+    /// Virtual anchors and scattering points confirmed at the last epoch.
+    #[must_use]
+    pub fn confirmed_at_end(&self) -> (usize, usize) {
+        let last = self.tables.ue.last().map(|u| u.epoch);
+        self.tables.map.iter().filter(|r| Some(r.epoch) == last).fold((0, 0), |(va, sp), r| match r.status.as_str() {
+            "va" => (va + 1, sp),
+            "sp" => (va, sp + 1),
+            _ => (va, sp),
+        })
+    }
+}
+
+/// `mmtrack process slam`: the SLAM filter on `recording`'s path
+/// measurements, tables under `output`.
+///
+/// # Errors
+/// A bad run id, an existing table (without `force`), a bad recording or
+/// configuration, an unusable path with `strict`, or a table that cannot be
+/// written.
+pub fn process_slam(recording_path: &Path, output: &Path, args: &SlamOptions) -> anyhow::Result<SlamOutput> {
+    let out = args.output.resolve(output)?;
+    if let Some(sequence) = &args.output.sequence {
         out.refuse_existing(&TABLE_NAMES, sequence)?;
     }
-    let recording = read_recording(&args.recording)?;
-    let sequence = args.output_args.sequence_or(&recording.sequence_id);
+    let recording = read_recording(recording_path)?;
+    let sequence = args.output.sequence_or(&recording.sequence_id);
     out.refuse_existing(&TABLE_NAMES, &sequence)?;
     if args.strict {
-        check_strict(&args.recording, &recording.epochs)?;
+        check_strict(recording_path, &recording.epochs)?;
     }
-    let config = filter_config(args, &recording)?;
-    let prior = prior_of(args, &recording)?;
-    let tables = args
-        .threads
-        .install(|| run_filter(&recording, &config, prior, args.seed))?
-        .with_context(|| args.recording.display().to_string())?;
+    let config = filter_config(recording_path, args, &recording)?;
+    let prior = prior_of(recording_path, args, &recording)?;
+    let tables =
+        run_filter(&recording, &config, prior, args.seed).with_context(|| recording_path.display().to_string())?;
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process slam",
-            "recording": args.recording.display().to_string(),
+            "recording": recording_path.display().to_string(),
             "seed": args.seed,
             "prior": [prior.position_m[0], prior.position_m[1], prior.position_m[2], prior.heading_rad,
                       prior.speed_mps, prior.turn_rate_radps, prior.clock_bias_m],
@@ -351,24 +379,5 @@ pub fn run(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
         write_table(output, &sequence, &tables.associations, &info, overwrite)?,
         write_table(output, &sequence, &tables.true_sources, &info, overwrite)?,
     ];
-    if !quiet {
-        let last = tables.map.iter().filter(|r| Some(r.epoch) == tables.ue.last().map(|u| u.epoch));
-        let (va, sp) = last.fold((0, 0), |(va, sp), r| match r.status.as_str() {
-            "va" => (va + 1, sp),
-            "sp" => (va, sp + 1),
-            _ => (va, sp),
-        });
-        let skipped: u64 = tables.ue.iter().map(|r| r.skipped_paths).sum();
-        let empty = tables.ue.iter().filter(|r| r.paths == 0).count();
-        println!(
-            "slam ({} particles): {} epochs ({empty} without paths, {skipped} paths skipped), {va} VAs and {sp} SPs \
-             confirmed at the end",
-            config.particles,
-            tables.ue.len()
-        );
-        for w in &written {
-            println!("  wrote {} ({} rows)", w.path.display(), w.rows);
-        }
-    }
-    Ok(())
+    Ok(SlamOutput { config, tables, written })
 }

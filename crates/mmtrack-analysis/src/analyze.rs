@@ -1,0 +1,112 @@
+//! `mmtrack analyze` as one library call: table directories in, metric
+//! tables, plots and reports out.
+//!
+//! One table directory (no `run=<ID>` folders) is analyzed straight into the
+//! output; several directories, or one holding `run=<ID>` folders, give one
+//! run each: every run analyzed into `<output>/run=<ID>/`, then all side by
+//! side ([`crate::output::write_campaign`]).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::RunInfo;
+
+use crate::campaign::{RunTables, discover_runs};
+use crate::mpc::MpcOptions;
+use crate::output::{WrittenResults, check_output, write_all_results, write_campaign};
+use crate::pipeline::{RunResults, analyze_run};
+use crate::trajectory::DriftOptions;
+
+/// The options of [`analyze`].
+#[derive(Debug, Clone)]
+pub struct AnalyzeOptions {
+    /// KITTI segment lengths and first-frame step.
+    pub drift: DriftOptions,
+    /// MPC statistics (the first path's dynamic range).
+    pub mpc: MpcOptions,
+    /// Replace earlier results in the output directory.
+    pub overwrite: Overwrite,
+}
+
+/// What [`analyze`] wrote.
+pub enum Analyzed {
+    /// One run, written straight into the output.
+    Run {
+        /// Its results.
+        results: Box<RunResults>,
+        /// The files written.
+        written: WrittenResults,
+    },
+    /// Several runs, each under `run=<ID>/` and side by side.
+    Campaign {
+        /// Each run and its results.
+        runs: Vec<(RunTables, RunResults)>,
+        /// The files written.
+        written: WrittenResults,
+    },
+}
+
+/// Refuses an output directory that is, or contains, the input.
+fn check_not_inside(tables: &Path, output: &Path) -> anyhow::Result<()> {
+    let (Ok(tables), Ok(output)) = (tables.canonicalize(), output.canonicalize()) else { return Ok(()) };
+    if tables.starts_with(&output) {
+        bail!("{}: the output directory contains the input tables; choose another output", output.display());
+    }
+    Ok(())
+}
+
+/// Analyzes the table directories `tables` into `output`.
+///
+/// # Errors
+/// An input that is not a directory or lies inside the output, an existing
+/// output without overwrite, bad options (before the tables are read), bad
+/// tables (naming file, row and column), or a file that cannot be written.
+pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> anyhow::Result<Analyzed> {
+    for dir in tables {
+        if !dir.is_dir() {
+            bail!("{}: not a directory (expected a table directory written by `mmtrack process`)", dir.display());
+        }
+        check_not_inside(dir, output)?;
+    }
+    check_output(output, options.overwrite)?;
+    // Options are checked by the metric too, but a usage error should not wait for the tables to load.
+    crate::trajectory::kitti_drift(&[], &[], &options.drift).context("--segment-lengths-m / --step-*")?;
+    let range_db = options.mpc.first_path_dynamic_range_db;
+    if !(range_db.is_finite() && range_db >= 0.0) {
+        bail!("--first-path-range-db {range_db}: expected a finite, non-negative number of dB");
+    }
+    let runs = discover_runs(tables)?;
+    let config = |tables: serde_json::Value| RunInfo {
+        config_json: serde_json::json!({
+            "command": "analyze",
+            "tables": tables,
+            "segment_lengths_m": options.drift.segment_lengths_m,
+            "step": format!("{:?}", options.drift.step),
+            "first_path_range_db": range_db,
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    // One run: its results straight into the output, as always.
+    if let [only] = runs.as_slice()
+        && tables.len() == 1
+        && only.tables == tables[0]
+    {
+        let results = analyze_run(&only.tables, &options.drift, &options.mpc)?;
+        let run = config(serde_json::json!(only.tables.display().to_string()));
+        let written = write_all_results(output, &results, &options.drift, &run, options.overwrite)?;
+        return Ok(Analyzed::Run { results: Box::new(results), written });
+    }
+    let mut analyzed = Vec::new();
+    for run in &runs {
+        let results =
+            analyze_run(&run.tables, &options.drift, &options.mpc).with_context(|| format!("run {}", run.id))?;
+        analyzed.push((run.clone(), results));
+    }
+    let inputs: serde_json::Map<String, serde_json::Value> =
+        runs.iter().map(|r| (r.id.clone(), serde_json::json!(r.tables.display().to_string()))).collect();
+    let run = config(serde_json::Value::Object(inputs));
+    let written = write_campaign(output, &analyzed, &options.drift, &run, options.overwrite)?;
+    Ok(Analyzed::Campaign { runs: analyzed, written })
+}

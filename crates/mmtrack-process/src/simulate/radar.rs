@@ -1,0 +1,245 @@
+//! `mmtrack simulate radar`: the radar simulator's scans (`mmtrack_sim::radar`)
+//! streamed into a recording with ground truth or an Oxford-layout folder.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use mmtrack_core::StampedPose;
+use mmtrack_core::progress::Progress;
+use mmtrack_ingest::oxford::{self, NavtechLayout};
+use mmtrack_ingest::poses::{self, Plane};
+use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
+use mmtrack_io::{RecordingOptions, RecordingWriter};
+use mmtrack_sim::radar::{RadarSimulator, Scenario, Trajectory};
+
+/// Trajectory file formats.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrajectoryFormat {
+    /// Oxford `gt/radar_odometry.csv` (relative poses, chained).
+    Oxford,
+    /// TUM: `t x y z qx qy qz qw` per line.
+    Tum,
+    /// KITTI: 3x4 matrices per line, times from a separate file.
+    Kitti,
+}
+
+/// A trajectory file to drive along.
+#[derive(Debug, Clone)]
+pub struct TrajectoryFile {
+    /// The file.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: TrajectoryFormat,
+    /// KITTI: the times file (decimal seconds per line).
+    pub times: Option<PathBuf>,
+    /// KITTI: nanoseconds added to every time.
+    pub t0_ns: i64,
+}
+
+/// Where the simulated scans go.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RadarLayout {
+    /// A canonical MCAP recording with the ground truth as a pose stream.
+    Recording,
+    /// An Oxford Radar RobotCar folder (radar/*.png, radar.timestamps, gt/radar_odometry.csv).
+    Oxford,
+}
+
+/// One `simulate radar` run.
+#[derive(Debug, Clone)]
+pub struct RadarSimulation {
+    /// Scenario file (TOML).
+    pub scenario: PathBuf,
+    /// Drive along this instead of the scenario's `[motion]`.
+    pub trajectory: Option<TrajectoryFile>,
+    /// At most this many scans (overrides the scenario's).
+    pub max_scans: Option<usize>,
+    /// Stop after this many metres of path (overrides the scenario's).
+    pub max_distance_m: Option<f64>,
+    /// Recording or Oxford folder.
+    pub layout: RadarLayout,
+    /// The recording or folder to write.
+    pub output: PathBuf,
+    /// How the recording is written (overwrite, compression, views); for the
+    /// folder only `overwrite` counts.
+    pub recording: RecordingOptions,
+}
+
+/// What [`simulate_radar`] wrote.
+#[derive(Debug, Clone, Copy)]
+pub struct RadarSimulated {
+    /// Scans written.
+    pub scans: usize,
+    /// Surfaces in the world.
+    pub surfaces: usize,
+    /// Point targets in the world.
+    pub points: usize,
+}
+
+/// Parses a radar scenario file.
+///
+/// # Errors
+/// The file cannot be read, parsed or checked, naming it.
+pub fn load_scenario(path: &Path) -> anyhow::Result<Scenario> {
+    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    parse_scenario(&text).with_context(|| format!("{}", path.display()))
+}
+
+/// Parses and checks radar scenario text.
+///
+/// # Errors
+/// TOML errors and the scenario's own checks.
+pub fn parse_scenario(text: &str) -> anyhow::Result<Scenario> {
+    let scenario: Scenario = toml::from_str(text)?;
+    scenario.validate()?;
+    Ok(scenario)
+}
+
+/// Reads a trajectory file as `world_from_vehicle` poses.
+///
+/// # Errors
+/// The file (or KITTI's times file) cannot be read or parsed.
+pub fn read_trajectory(
+    path: &Path,
+    format: TrajectoryFormat,
+    times: Option<&Path>,
+    t0_ns: i64,
+) -> anyhow::Result<Vec<StampedPose>> {
+    let poses = match format {
+        TrajectoryFormat::Oxford => oxford::odometry::read_radar_odometry(path)?,
+        TrajectoryFormat::Tum => poses::parse_tum(path, &poses::read_text(path)?, Plane::Xy)?,
+        TrajectoryFormat::Kitti => {
+            let times_path = times.context("KITTI pose files carry no time: give --times <times.txt>")?;
+            let times = poses::parse_times(times_path, &poses::read_text(times_path)?, t0_ns)?;
+            poses::parse_kitti(path, &poses::read_text(path)?, &times, Plane::Xy)?
+        }
+    };
+    Ok(poses)
+}
+
+/// Streams `simulator`'s scans into an Oxford folder at `dir` (replaced
+/// atomically: built beside it, then renamed).
+///
+/// # Errors
+/// An existing `dir` without `force`, or a file that cannot be written.
+pub fn write_oxford_streaming(
+    scenario: &Scenario,
+    simulator: RadarSimulator<'_>,
+    dir: &Path,
+    force: bool,
+    progress: &dyn Progress,
+) -> anyhow::Result<()> {
+    if dir.exists() && !force {
+        anyhow::bail!("{}: output already exists (pass --force to replace it)", dir.display());
+    }
+    let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
+    let staging = mmtrack_io::staging_dir(parent, ".simulate-")?;
+    let layout = NavtechLayout {
+        range_resolution_m: scenario.sensor.range_resolution_m,
+        expected_bins: Some(scenario.sensor.bins),
+        ..oxford::OXFORD
+    };
+    let radar_dir = staging.path().join("radar");
+    std::fs::create_dir_all(&radar_dir).with_context(|| radar_dir.display().to_string())?;
+    let mut truth = Vec::new();
+    let mut timestamps = String::new();
+    for (scan, pose) in simulator {
+        let t_us = scan.header.t_ns / 1000;
+        let path = radar_dir.join(format!("{t_us}.png"));
+        let png = oxford::encode_scan_png(&scan, &layout).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        std::fs::write(&path, png).with_context(|| path.display().to_string())?;
+        timestamps.push_str(&format!("{t_us} 1\n"));
+        truth.push(pose);
+        progress.advance(1);
+    }
+    // The ingest crate's writer produces gt/radar_odometry.csv (its frame conventions);
+    // radar.timestamps is rewritten after it with the scans streamed above.
+    oxford::write_oxford_folder(staging.path(), &[], &truth, &layout)?;
+    let path = staging.path().join("radar.timestamps");
+    std::fs::write(&path, timestamps).with_context(|| path.display().to_string())?;
+    if dir.exists() {
+        std::fs::remove_dir_all(dir).with_context(|| dir.display().to_string())?;
+    }
+    let staged = staging.keep();
+    std::fs::rename(&staged, dir).with_context(|| dir.display().to_string())?;
+    Ok(())
+}
+
+fn write_recording(
+    sim: &RadarSimulation,
+    scenario: &Scenario,
+    simulator: RadarSimulator<'_>,
+    progress: &dyn Progress,
+) -> anyhow::Result<()> {
+    let mut extra = std::collections::BTreeMap::from([
+        ("simulator.seed".to_string(), scenario.seed.to_string()),
+        ("simulator.scenario".to_string(), sim.scenario.display().to_string()),
+        ("radar.model".to_string(), "simulated Navtech CTS350-X-like".to_string()),
+    ]);
+    if let Some(t) = &sim.trajectory {
+        extra.insert("simulator.trajectory".to_string(), t.path.display().to_string());
+    }
+    // Scan times are the trajectory's: UNIX time when a real trajectory or the
+    // scenario's `start_t_ns` puts the drive at a date, scenario time from 0 otherwise.
+    let mut simulator = simulator.peekable();
+    let first_t_ns = simulator.peek().map_or(0, |(scan, _)| scan.header.t_ns);
+    let time_base = TimeBase::unix_or(first_t_ns, TimeBase::ScenarioStart);
+    let metadata = RecordingMetadata {
+        sequence_id: sim
+            .output
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "simulated".into()),
+        source: format!("simulate:{}", sim.scenario.display()),
+        time_base,
+        extra,
+    };
+    let mut writer = RecordingWriter::create(&sim.output, &metadata, &sim.recording)?;
+    for (scan, pose) in simulator {
+        writer.write_radar_scan(&scan)?;
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "radar")?;
+        progress.advance(1);
+    }
+    writer.finish()?;
+    Ok(())
+}
+
+/// `mmtrack simulate radar`: renders the scenario's scans along its motion
+/// (or the trajectory file) into a recording or an Oxford folder.
+///
+/// # Errors
+/// A bad scenario or trajectory, an existing output without overwrite, or
+/// a file that cannot be written.
+pub fn simulate_radar(args: &RadarSimulation, progress: &dyn Progress) -> anyhow::Result<RadarSimulated> {
+    let mut scenario = load_scenario(&args.scenario)?;
+    if args.max_scans.is_some() {
+        scenario.max_scans = args.max_scans;
+    }
+    if args.max_distance_m.is_some() {
+        scenario.max_distance_m = args.max_distance_m;
+    }
+    let trajectory = match &args.trajectory {
+        Some(file) => {
+            let poses = read_trajectory(&file.path, file.format, file.times.as_deref(), file.t0_ns)?;
+            Trajectory::from_poses(poses).with_context(|| file.path.display().to_string())?
+        }
+        None => scenario.motion_trajectory().with_context(|| args.scenario.display().to_string())?,
+    };
+    let world = scenario.build_world(&trajectory).with_context(|| args.scenario.display().to_string())?;
+    let options = scenario.options();
+    let trajectory_source = args.trajectory.as_ref().map_or(&args.scenario, |t| &t.path);
+    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)
+        .with_context(|| trajectory_source.display().to_string())?;
+    let total = simulator.len();
+    progress.start("simulate radar", total as u64, "scans");
+    match args.layout {
+        RadarLayout::Oxford => {
+            let force = args.recording.overwrite == mmtrack_io::Overwrite::Replace;
+            write_oxford_streaming(&scenario, simulator, &args.output, force, progress)?;
+        }
+        RadarLayout::Recording => write_recording(args, &scenario, simulator, progress)?,
+    }
+    progress.finish();
+    Ok(RadarSimulated { scans: total, surfaces: world.segment_count(), points: world.point_count() })
+}
