@@ -97,8 +97,9 @@ fn mpc_and_geometric_run_on_a_simulated_convoy() {
     let rows: Vec<GeometricEpochRow> = read_table(&geometric.written[0].path).unwrap();
     assert_eq!(rows.len(), geometric.recordings[0].epochs);
     assert!(rows.iter().all(|r| r.true_range_m > 0.0 && r.range_m.is_finite()));
-    // 0.2 s of convoy at 20 ms epochs: inside the paper's 10 full scans of 128 beams, still H-infinity.
-    assert_eq!(rows.len(), 9);
+    // 20 sets span 190 ms: 8 epochs of 20 ms with a margin for the central differences, all inside the
+    // paper's 10 full scans of 128 beams, so still H-infinity.
+    assert_eq!(rows.len(), 8);
     assert!(rows.iter().all(|r| r.beams_measured == 128 && r.filter == GEOMETRIC_FILTER_H_INFINITY), "{rows:?}");
 }
 
