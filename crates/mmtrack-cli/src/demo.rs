@@ -28,6 +28,7 @@ use mmtrack_analysis::analyze::{AnalyzeOptions, analyze};
 use mmtrack_analysis::mpc::MpcOptions;
 use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
+use mmtrack_io::recording::cartesian::CartesianGrid;
 use mmtrack_io::{Overwrite, RecordingOptions};
 use mmtrack_process::beam::spebt::{SpebtOptions, process_spebt};
 use mmtrack_process::output::OutputOptions;
@@ -115,7 +116,12 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let analysis = out.join("analysis");
     let runs = out.join("runs");
     let compare = out.join("compare");
-    let replace = RecordingOptions { overwrite: Overwrite::Replace, ..RecordingOptions::default() };
+    // The CLI's recording defaults: replace, and the Cartesian radar view for Foxglove.
+    let replace = RecordingOptions {
+        overwrite: Overwrite::Replace,
+        radar_cartesian: Some(CartesianGrid::default()),
+        ..RecordingOptions::default()
+    };
     let (w_folder, w_recording, w_sounder, w_slam) = (word(&folder), word(&recording), word(&sounder), word(&slam));
     let (w_tables, w_analysis, w_runs, w_compare) = (word(&tables), word(&analysis), word(&runs), word(&compare));
     let force = OutputOptions { force: true, ..OutputOptions::default() };
