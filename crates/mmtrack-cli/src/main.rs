@@ -20,12 +20,9 @@ mod inspect;
 mod process;
 mod process_manifest;
 mod progress;
-mod readme_block;
 mod reproduce;
 mod reproduce_all;
 mod reproduce_common;
-mod reproduce_mpc;
-mod reproduce_mpc_report;
 mod run_id;
 mod simulate;
 mod simulate_sounder;
@@ -37,6 +34,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use mmtrack_core::error::printable;
+// `crate::readme_block` for the commands that rewrite README blocks (bench,
+// and reproduce spebt until it moves to mmtrack-reproduce).
+use mmtrack_reproduce::readme_block;
 
 #[derive(Parser)]
 #[command(
@@ -128,7 +128,7 @@ fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyho
 }
 
 /// Runs `args` (the words after `mmtrack`) in this process, as that command
-/// line would: what `demo`, `reproduce --all` and `process manifest` use to
+/// line would: what `demo` and `process manifest` use to
 /// run the same commands a user types. Usage errors come back as one line.
 fn run_words(args: &[String]) -> anyhow::Result<ExitCode> {
     let argv = std::iter::once("mmtrack".to_string()).chain(args.iter().cloned());

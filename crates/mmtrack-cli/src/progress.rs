@@ -1,6 +1,9 @@
 //! Progress bars on stderr; hidden with `--quiet` or when stderr is not a terminal.
 
+use std::sync::{PoisonError, RwLock};
+
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mmtrack_core::progress::Progress;
 
 /// A bar for `total` items of `unit` (e.g. "scans").
 pub fn bar(total: u64, message: &str, unit: &str, quiet: bool) -> ProgressBar {
@@ -29,4 +32,60 @@ pub fn bytes_bar(message: &str, quiet: bool) -> ProgressBar {
     }
     bar.set_message(message.to_string());
     bar
+}
+
+/// [`Progress`] of the library calls drawn as [`bar`]s: one bar per stage,
+/// notes on stderr (above the bar while one is drawn); nothing with
+/// `--quiet`.
+pub struct IndicatifProgress {
+    quiet: bool,
+    /// The current stage's bar (a hidden one between stages).
+    bar: RwLock<ProgressBar>,
+}
+
+impl IndicatifProgress {
+    /// Progress shown on stderr unless `quiet`.
+    pub fn new(quiet: bool) -> Self {
+        Self { quiet, bar: RwLock::new(ProgressBar::hidden()) }
+    }
+
+    fn current(&self) -> ProgressBar {
+        // A poisoned lock only means a thread panicked while swapping bars;
+        // the bar itself is still usable.
+        self.bar.read().unwrap_or_else(PoisonError::into_inner).clone()
+    }
+}
+
+impl Progress for IndicatifProgress {
+    fn start(&self, stage: &str, total: u64, unit: &str) {
+        let new = bar(total, stage, unit, self.quiet);
+        let old = std::mem::replace(&mut *self.bar.write().unwrap_or_else(PoisonError::into_inner), new);
+        old.finish_and_clear();
+    }
+
+    fn set_position(&self, done: u64) {
+        self.current().set_position(done);
+    }
+
+    fn advance(&self, by: u64) {
+        self.current().inc(by);
+    }
+
+    fn finish(&self) {
+        let old =
+            std::mem::replace(&mut *self.bar.write().unwrap_or_else(PoisonError::into_inner), ProgressBar::hidden());
+        old.finish_and_clear();
+    }
+
+    fn note(&self, text: &str) {
+        if self.quiet {
+            return;
+        }
+        let current = self.current();
+        if current.is_hidden() {
+            eprintln!("{text}");
+        } else {
+            current.println(text);
+        }
+    }
 }
