@@ -24,7 +24,7 @@
 //!
 //! It sits in the *process* stage: pure computation on in-memory types (no
 //! files, no printing); `mmtrack-sim` provides links to run on and
-//! `mmtrack-cli` wires the experiments. Depends on `mmtrack-core` (arrays)
+//! `mmtrack-reproduce` wires the experiments. Depends on `mmtrack-core` (arrays)
 //! and `mmtrack-filter` (the EKF) only.
 
 mod angle_ekf;

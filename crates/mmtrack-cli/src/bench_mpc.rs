@@ -31,6 +31,8 @@ use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
 
 use crate::readme_block::replace_block;
+// Also `crate::bench_mpc::load_average` for `bench slam`.
+pub(crate) use mmtrack_reproduce::common::load_average;
 
 /// Issue #5: this many snapshots ...
 pub const MPC_TARGET_SNAPSHOTS: usize = 10_000;
@@ -341,11 +343,6 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
         gmphd_s,
         proposed,
     })
-}
-
-/// The 1-minute load average (`/proc/loadavg`, Linux).
-pub(crate) fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }
 
 /// Seconds for [`MPC_TARGET_SNAPSHOTS`] at the measured rate.

@@ -39,7 +39,7 @@ use mmtrack_process::slam::{SlamOptions, process_slam};
 use mmtrack_process::{mpc, odometry};
 
 use crate::inspect;
-use crate::progress::Bars;
+use crate::progress::IndicatifProgress;
 
 /// The demo radar scenario, embedded so the demo runs from any directory.
 pub const DEMO_SCENARIO: &str = include_str!("../../../data/demo/radar-scenario.toml");
@@ -93,7 +93,8 @@ fn odometry_step(
     announce(&words, quiet);
     let config = odometry::effective_config(preset, None)?;
     let options = OutputOptions { run_id: run_id.map(str::to_string), force: true, ..OutputOptions::default() };
-    let done = odometry::process_odometry(recording, tables, preset, &config, &options, &Bars::new(quiet))?;
+    let done =
+        odometry::process_odometry(recording, tables, preset, &config, &options, &IndicatifProgress::new(quiet))?;
     if !quiet {
         crate::process::print_odometry(&done.run, preset, &done.written);
     }
@@ -145,7 +146,7 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         output: folder.clone(),
         recording: replace.clone(),
     };
-    let radar = simulate_radar(&simulation, &Bars::new(quiet))?;
+    let radar = simulate_radar(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {
         println!("{w_folder}: {} simulated scans", radar.scans);
     }
@@ -172,14 +173,14 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         output: sounder.clone(),
         recording: replace.clone(),
     };
-    let written = simulate_sounder(&simulation, &Bars::new(quiet))?;
+    let written = simulate_sounder(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {
         println!("{w_sounder}: {} sets, {} CIR snapshots", written.sets, written.snapshots);
     }
     announce(&["process", "mpc", &w_sounder, "-o", &w_tables, "--gmphd", "--force"], quiet);
     let config = mmtrack_mpc::MpcConfig { run_gmphd: true, ..mpc::effective_config(None)? };
     let options = mpc::MpcOptions { output: force.clone(), ..mpc::MpcOptions::default() };
-    let done = mpc::process_mpc(&sounder, &tables, &config, &options, &Bars::new(quiet))?;
+    let done = mpc::process_mpc(&sounder, &tables, &config, &options, &IndicatifProgress::new(quiet))?;
     if !quiet {
         for link in &done.links {
             println!(
@@ -195,7 +196,12 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         quiet,
     );
     let options = SpebtOptions { odometry: Some(tables.clone()), ..SpebtOptions::default() };
-    let done = process_spebt(std::slice::from_ref(&recording), &force.resolve(&tables)?, &options, &Bars::new(quiet))?;
+    let done = process_spebt(
+        std::slice::from_ref(&recording),
+        &force.resolve(&tables)?,
+        &options,
+        &IndicatifProgress::new(quiet),
+    )?;
     if !quiet {
         for r in &done.recordings {
             let s = &r.summary;

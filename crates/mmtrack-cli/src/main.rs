@@ -21,12 +21,9 @@ mod output_args;
 mod process;
 mod process_beam;
 mod progress;
-mod readme_block;
 mod reproduce;
 mod reproduce_all;
 mod reproduce_common;
-mod reproduce_mpc;
-mod reproduce_mpc_report;
 mod simulate;
 mod simulate_sounder;
 mod slam;
@@ -37,6 +34,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use mmtrack_core::error::printable;
+// `crate::readme_block` for the commands that rewrite README blocks (bench,
+// and reproduce spebt until it moves to mmtrack-reproduce).
+use mmtrack_reproduce::readme_block;
 
 #[derive(Parser)]
 #[command(
@@ -125,15 +125,6 @@ fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyho
             dir.display()
         )
     }
-}
-
-/// Runs `args` (the words after `mmtrack`) in this process, as that command
-/// line would: what `demo`, `reproduce --all` and `process manifest` use to
-/// run the same commands a user types. Usage errors come back as one line.
-fn run_words(args: &[String]) -> anyhow::Result<ExitCode> {
-    let argv = std::iter::once("mmtrack".to_string()).chain(args.iter().cloned());
-    let cli = Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
-    run(cli)
 }
 
 /// `path` as a command-line word.

@@ -12,7 +12,7 @@ use mmtrack_odometry::OdometryConfig;
 use mmtrack_process::{manifest, mpc, odometry, slam};
 
 use crate::output_args::OutputArgs;
-use crate::progress::Bars;
+use crate::progress::IndicatifProgress;
 use crate::threads::ThreadsArg;
 
 #[derive(Args)]
@@ -223,7 +223,7 @@ fn run_odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
         bail!("a recording and --output are required (unless --print-config)");
     };
     let options = args.output_args.options();
-    let progress = Bars::new(quiet);
+    let progress = IndicatifProgress::new(quiet);
     let done = args
         .threads
         .install(|| odometry::process_odometry(recording, output, &args.preset, &config, &options, &progress))??;
@@ -276,7 +276,7 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
         link: args.link.as_deref().map(mpc::parse_link).transpose()?,
         output: args.output_args.options(),
     };
-    let progress = Bars::new(quiet);
+    let progress = IndicatifProgress::new(quiet);
     let done = args.threads.install(|| mpc::process_mpc(recording, output, &config, &options, &progress))??;
     if quiet {
         return Ok(());

@@ -11,7 +11,7 @@ use mmtrack_process::beam::spebt::{self, SpebtOptions};
 use mmtrack_process::beam::sweep::{self, Reacquire, SweepOutput, SweepTrackerKind};
 
 use crate::output_args::RunOutputArgs;
-use crate::progress::Bars;
+use crate::progress::IndicatifProgress;
 
 /// The policies `process beam` runs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, ValueEnum)]
@@ -183,7 +183,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<()> {
                  give the sweep trackers in another call"
             );
         }
-        let done = spebt::process_spebt(&files, &out, &spebt_options, &Bars::new(quiet))?;
+        let done = spebt::process_spebt(&files, &out, &spebt_options, &IndicatifProgress::new(quiet))?;
         if !quiet {
             print_spebt(&done);
         }

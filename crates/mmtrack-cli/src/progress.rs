@@ -1,6 +1,9 @@
 //! Progress bars on stderr; hidden with `--quiet` or when stderr is not a terminal.
 
+use std::sync::{PoisonError, RwLock};
+
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use mmtrack_core::progress::Progress;
 
 /// A bar for `total` items of `unit` (e.g. "scans").
 pub fn bar(total: u64, message: &str, unit: &str, quiet: bool) -> ProgressBar {
@@ -31,66 +34,64 @@ pub fn bytes_bar(message: &str, quiet: bool) -> ProgressBar {
     bar
 }
 
-/// The CLI's [`Progress`](mmtrack_core::progress::Progress): one bar per
-/// stage on stderr (bytes or items by the stage's unit), notes printed above
-/// it; nothing with `--quiet`.
-pub struct Bars {
+/// [`Progress`] of the library calls drawn as [`bar`]s: one bar per stage,
+/// notes on stderr (above the bar while one is drawn); nothing with
+/// `--quiet`.
+pub struct IndicatifProgress {
     quiet: bool,
-    current: std::sync::Mutex<Option<ProgressBar>>,
+    /// The current stage's bar (a hidden one between stages).
+    bar: RwLock<ProgressBar>,
 }
 
-impl Bars {
-    /// Bars, hidden when `quiet`.
-    #[must_use]
+impl IndicatifProgress {
+    /// Progress shown on stderr unless `quiet`.
     pub fn new(quiet: bool) -> Self {
-        Self { quiet, current: std::sync::Mutex::new(None) }
+        Self { quiet, bar: RwLock::new(ProgressBar::hidden()) }
     }
 
-    fn with_bar(&self, f: impl FnOnce(&ProgressBar)) {
-        let bar = self.current.lock().ok().and_then(|b| b.clone());
-        if let Some(bar) = bar {
-            f(&bar);
-        }
+    fn current(&self) -> ProgressBar {
+        // A poisoned lock only means a thread panicked while swapping bars;
+        // the bar itself is still usable.
+        self.bar.read().unwrap_or_else(PoisonError::into_inner).clone()
     }
 }
 
-impl mmtrack_core::progress::Progress for Bars {
+impl Progress for IndicatifProgress {
     fn start(&self, stage: &str, total: u64, unit: &str) {
-        let bar = if unit == "bytes" {
-            let bar = bytes_bar(stage, self.quiet);
-            bar.set_length(total);
-            bar
+        let new = if unit == "bytes" {
+            let new = bytes_bar(stage, self.quiet);
+            new.set_length(total);
+            new
         } else {
             bar(total, stage, unit, self.quiet)
         };
-        if let Ok(mut current) = self.current.lock()
-            && let Some(old) = current.replace(bar)
-        {
-            old.finish_and_clear();
-        }
+        let old = std::mem::replace(&mut *self.bar.write().unwrap_or_else(PoisonError::into_inner), new);
+        old.finish_and_clear();
     }
 
     fn set_position(&self, done: u64) {
-        self.with_bar(|b| b.set_position(done));
+        self.current().set_position(done);
     }
 
     fn advance(&self, by: u64) {
-        self.with_bar(|b| b.inc(by));
+        self.current().inc(by);
     }
 
     fn finish(&self) {
-        if let Some(bar) = self.current.lock().ok().and_then(|mut b| b.take()) {
-            bar.finish_and_clear();
-        }
+        let old =
+            std::mem::replace(&mut *self.bar.write().unwrap_or_else(PoisonError::into_inner), ProgressBar::hidden());
+        old.finish_and_clear();
     }
 
     fn note(&self, text: &str) {
-        if !self.quiet {
-            let bar = self.current.lock().ok().and_then(|b| b.clone());
-            match bar {
-                Some(bar) => bar.suspend(|| eprintln!("{text}")),
-                None => eprintln!("{text}"),
-            }
+        if self.quiet {
+            return;
+        }
+        let current = self.current();
+        if current.is_hidden() {
+            eprintln!("{text}");
+        } else {
+            current.println(text);
         }
     }
 }

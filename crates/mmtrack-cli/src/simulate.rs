@@ -9,7 +9,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_process::simulate::radar::{RadarLayout, RadarSimulation, TrajectoryFile, simulate_radar};
 
 use crate::ingest::{OutputArgs, PoseFormat};
-use crate::progress::Bars;
+use crate::progress::IndicatifProgress;
 use crate::threads::ThreadsArg;
 
 #[derive(Args)]
@@ -109,7 +109,7 @@ fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
         output: args.output.output.clone(),
         recording: args.output.recording_options(),
     };
-    let done = simulate_radar(&simulation, &Bars::new(quiet))?;
+    let done = simulate_radar(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {
         println!(
             "{}: {} simulated scans ({} surfaces, {} point targets in the world)",

@@ -8,7 +8,7 @@ use clap::Args;
 use mmtrack_process::simulate::sounder::{SounderSimulation, simulate_sounder};
 
 use crate::ingest::OutputArgs;
-use crate::progress::Bars;
+use crate::progress::IndicatifProgress;
 use crate::threads::ThreadsArg;
 
 #[derive(Args)]
@@ -32,7 +32,7 @@ pub fn run_sounder(args: &SounderArgs, quiet: bool) -> anyhow::Result<()> {
         output: args.output.output.clone(),
         recording: args.output.recording_options(),
     };
-    let written = simulate_sounder(&simulation, &Bars::new(quiet))?;
+    let written = simulate_sounder(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {
         println!(
             "{}: {} sets, {} CIR snapshots, {} true MPCs ({})",

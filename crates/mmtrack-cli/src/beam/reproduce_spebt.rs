@@ -40,7 +40,7 @@ use super::spebt_odometry::{self, OdometryDrive};
 use super::spebt_output as output;
 use super::spebt_report::{self as report, README_BLOCK};
 use crate::ingest::PoseFormat;
-use crate::progress::Bars;
+use crate::progress::IndicatifProgress;
 use crate::threads::ThreadsArg;
 use mmtrack_process::simulate::radar::read_trajectory;
 
@@ -121,7 +121,14 @@ pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
     let started = Instant::now();
     let (outcomes, threads) = args.threads.install(|| -> anyhow::Result<(Vec<Outcome>, usize)> {
-        let result = monte_carlo(&link, &config, experiment.seed, runs_a, PoseSource::ErrorModel, &Bars::new(quiet))?;
+        let result = monte_carlo(
+            &link,
+            &config,
+            experiment.seed,
+            runs_a,
+            PoseSource::ErrorModel,
+            &IndicatifProgress::new(quiet),
+        )?;
         let verdicts = report::verdicts(&experiment, &result);
         let mut outcomes = vec![Outcome { name: POSE_ERROR_MODEL, link, drive: None, result, verdicts }];
         if !args.skip_odometry {
@@ -164,7 +171,14 @@ fn radar_odometry(
         .with_context(|| format!("the simulated drive along {}", args.trajectory.display()))?;
     // The link's positions are relative to the first true position: so are the estimates'.
     let estimates = into_link_frame(drive.ground_truth[0].parent_from_child, &drive.estimates);
-    let result = monte_carlo(&link, config, experiment.seed, runs, PoseSource::Fixed(&estimates), &Bars::new(quiet))?;
+    let result = monte_carlo(
+        &link,
+        config,
+        experiment.seed,
+        runs,
+        PoseSource::Fixed(&estimates),
+        &IndicatifProgress::new(quiet),
+    )?;
     let verdicts = report::verdicts(experiment, &result);
     Ok(Outcome { name: RADAR_ODOMETRY, link, drive: Some(drive), result, verdicts })
 }

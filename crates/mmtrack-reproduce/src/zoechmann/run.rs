@@ -1,5 +1,4 @@
-//! `mmtrack reproduce zoechmann`: geometric Doppler-bearing tracking of
-//! Zoechmann et al. 2019, Sec. VI and Figs. 4-5 (PAPERS.md section 4).
+//! The Monte Carlo of the Zoechmann experiment.
 //!
 //! On the simulated overtaking manoeuvres (`mmtrack_sim::beam::overtaking`),
 //! four estimators run on the same Monte Carlo realisations:
@@ -15,96 +14,26 @@
 //! All see the same noisy Doppler shifts. Per epoch: the NMSE of the range
 //! over the runs. Checked: the paper's ordering at the end of each run,
 //! the full-overtaking hand-over time (about 0.5 s), the beam-measurement
-//! saving (counted), and the time of the whole run. The experiment, its
-//! published numbers and tolerances are one TOML file
-//! (`data/reproduce/zoechmann.toml`, embedded).
+//! saving (counted), and the time of the whole run.
 //!
 //! Runs are split into fixed chunks computed on rayon and merged in chunk
 //! order, so the numbers do not depend on the thread count.
 
-use std::path::PathBuf;
-use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
-use clap::Args;
-use mmtrack_analysis::beam::zoechmann_plots::{NmseCurve, PositionTrace, zoechmann_figure_svg};
+use mmtrack_analysis::beam::zoechmann_plots::PositionTrace;
 use mmtrack_beam::geometric::{
     BeamCount, BeamSchedule, BeamSelection, DopplerBearing, ErrorFreeRegressors, GeometricTracker,
     GeometricTrackerConfig, HoChanBatch, NullspaceProjection, PolarState, RangeEstimator,
 };
-use mmtrack_io::Overwrite;
-use mmtrack_io::table::{RunInfo, write_table};
-use mmtrack_io::table::{ZoechmannNmseRow, ZoechmannSummaryRow};
-use mmtrack_sim::beam::overtaking::{EpochTruth, Manoeuvre, OvertakingReceiver, OvertakingScenario};
+use mmtrack_core::progress::Progress;
+use mmtrack_sim::beam::overtaking::{EpochTruth, Manoeuvre, OvertakingReceiver};
 use rayon::prelude::*;
-use serde::Deserialize;
 
-use super::zoechmann_nlos::{self as nlos, NlosConfig, NlosResult};
-use super::zoechmann_report::{self as report, README_BLOCK};
-use crate::threads::ThreadsArg;
-
-/// The experiment, embedded so it runs from any directory.
-pub const ZOECHMANN_EXPERIMENT: &str = include_str!("../../../../data/reproduce/zoechmann.toml");
-
-#[derive(Args)]
-pub struct ZoechmannArgs {
-    /// Output directory (tables/, one SVG figure per manoeuvre, nlos.svg, reproduce.md).
-    #[arg(short, long, default_value = "out/reproduce/zoechmann")]
-    output: PathBuf,
-    /// Replace a previous run's output directory.
-    #[arg(long)]
-    force: bool,
-    /// Experiment file (TOML; default: the embedded data/reproduce/zoechmann.toml).
-    #[arg(long, value_name = "EXPERIMENT.toml")]
-    experiment: Option<PathBuf>,
-    /// Monte Carlo runs per manoeuvre (default: the experiment's, 100000).
-    #[arg(long)]
-    runs: Option<u64>,
-    /// The CI version: the experiment's quick_runs (2000) runs per manoeuvre.
-    #[arg(long)]
-    quick: bool,
-    /// Replace the block `<!-- reproduce-zoechmann:begin -->` ... `end` in
-    /// this file with the summary (checked before the run).
-    #[arg(long, value_name = "README.md")]
-    readme: Option<PathBuf>,
-    #[command(flatten)]
-    threads: ThreadsArg,
-}
-
-/// The experiment file.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct Experiment {
-    pub seed: u64,
-    pub runs: u64,
-    pub quick_runs: u64,
-    /// H-infinity level of the proposed tracker.
-    pub gamma: f64,
-    /// `c` of its initial information `P_0^-1 = c I`.
-    pub initial_information: f64,
-    /// Distinct azimuths before the hand-over to RLS.
-    pub distinct_azimuths_for_rls: usize,
-    /// Full scans before the beam window.
-    pub full_scan_epochs: usize,
-    /// Beams measured around the projected azimuth.
-    pub window_beams: usize,
-    /// The manoeuvre whose hand-over time is checked.
-    pub convergence_manoeuvre: String,
-    pub paper_convergence_s: f64,
-    pub convergence_tolerance_s: f64,
-    /// The paper's saving per tracked epoch (128 / 3).
-    pub paper_saving: f64,
-    pub saving_tolerance: f64,
-    /// Wall-time target of the full run, seconds, and the runs it applies to.
-    pub time_target_s: f64,
-    pub time_target_runs: u64,
-    #[serde(default)]
-    pub scenario: OvertakingScenario,
-    pub manoeuvres: Vec<Manoeuvre>,
-    /// The non-line-of-sight run.
-    pub nlos: NlosConfig,
-}
+use super::config::Config;
+use super::nlos::{self, NlosResult};
+use crate::common::load_average;
 
 /// The estimators, in table order: the paper's four, two variants of the
 /// proposed tracker's beam schedule, and four diagnostics of the
@@ -114,7 +43,7 @@ pub(super) struct Experiment {
 /// - `*-doppler-mps`: the same estimators with the Doppler equation (5)
 ///   multiplied by `lambda` ([`DOPPLER_MPS`]); `proposed-doppler-mps` is the
 ///   proposed tracker so, with its own beam window.
-pub(super) const ESTIMATORS: [&str; 11] = [
+pub const ESTIMATORS: [&str; 11] = [
     "proposed",
     "ho-chan",
     "error-free-genie",
@@ -129,22 +58,22 @@ pub(super) const ESTIMATORS: [&str; 11] = [
 ];
 /// The estimators of the time-series table and the figures: the paper's
 /// four and the two schedule variants.
-pub(super) const PLOTTED: usize = 6;
+pub const PLOTTED: usize = 6;
 /// Index of a variant: the proposed tracker on full-scan azimuths every
 /// epoch (no beam-selection feedback), a diagnostic beside the paper's four.
-pub(super) const FULL_SCAN_VARIANT: usize = 4;
+pub const FULL_SCAN_VARIANT: usize = 4;
 /// Index of a variant: the proposed tracker whose 3-beam window starts only
 /// once it has handed over to RLS (full scans before), a diagnostic.
-pub(super) const GATED_VARIANT: usize = 5;
+pub const GATED_VARIANT: usize = 5;
 /// Index of the first `*-doppler-mps` diagnostic.
-pub(super) const DOPPLER_MPS_FIRST: usize = 7;
+pub const DOPPLER_MPS_FIRST: usize = 7;
 /// Index of the proposed tracker with its own window and the Doppler
 /// equation in m/s.
-pub(super) const WINDOWED_DOPPLER_MPS: usize = 10;
+pub const WINDOWED_DOPPLER_MPS: usize = 10;
 /// Trackers that measure through their own beam window (beam accounting
 /// index): the proposed tracker (0), the gated variant (1) and the
 /// proposed tracker with the Doppler equation in m/s (2).
-pub(super) const WINDOWED: usize = 3;
+pub const WINDOWED: usize = 3;
 const N: usize = ESTIMATORS.len();
 
 /// The Doppler equation (5) multiplied by `lambda`: `a_D = [0, sin b, cos
@@ -170,8 +99,11 @@ enum Azimuths {
 const RUNS_PER_CHUNK: u64 = 250;
 
 /// What one manoeuvre measured.
-pub(super) struct ManoeuvreResult {
+#[derive(Debug, Clone)]
+pub struct ManoeuvreResult {
+    /// The manoeuvre.
     pub manoeuvre: Manoeuvre,
+    /// Runs.
     pub runs: u64,
     /// NMSE per estimator and epoch.
     pub nmse: [Vec<f64>; N],
@@ -186,14 +118,19 @@ pub(super) struct ManoeuvreResult {
     /// Beam accounting of the proposed tracker (index 0) and of the gated
     /// variant (1).
     pub beams: [BeamCount; WINDOWED],
+    /// Windowed epochs over all runs, per windowed tracker.
     pub window_epochs: [u64; WINDOWED],
+    /// Windowed epochs whose window held the strongest beam, per windowed tracker.
     pub window_hits: [u64; WINDOWED],
     /// Per epoch: windowed runs and hits (proposed 0, gated 1).
     pub window_epochs_by_epoch: [Vec<u64>; WINDOWED],
+    /// See `window_epochs_by_epoch`.
     pub window_hits_by_epoch: [Vec<u64>; WINDOWED],
     /// Runs whose first window points more than 90 deg from the truth.
     pub backwards_first_windows: u64,
+    /// Estimator errors (the estimator stops for the rest of the run).
     pub failures: u64,
+    /// The first run's true and estimated positions (proposed tracker).
     pub trace: PositionTrace,
 }
 
@@ -229,83 +166,80 @@ impl ManoeuvreResult {
     }
 }
 
-pub fn run(args: &ZoechmannArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    crate::reproduce_common::check_start(&args.output, args.force, args.readme.as_deref(), README_BLOCK)?;
-    let (source, experiment): (String, Experiment) = crate::reproduce_common::load_experiment(
-        args.experiment.as_deref(),
-        ZOECHMANN_EXPERIMENT,
-        "data/reproduce/zoechmann.toml",
-    )?;
-    let runs = crate::reproduce_common::run_count(args.runs, args.quick, experiment.quick_runs, experiment.runs)?;
+/// What the whole Monte Carlo measured, and how long it took.
+#[derive(Debug, Clone)]
+pub struct Measured {
+    /// Runs per manoeuvre.
+    pub runs: u64,
+    /// One per manoeuvre, in the file's order.
+    pub manoeuvres: Vec<ManoeuvreResult>,
+    /// The non-line-of-sight run.
+    pub nlos: NlosResult,
+    /// Wall time of the manoeuvres' runs (not the NLOS run), seconds.
+    pub elapsed_s: f64,
+    /// Threads of the rayon pool.
+    pub threads: usize,
+    /// 1-minute load average before and after.
+    pub load: (Option<f64>, Option<f64>),
+}
+
+/// Runs `runs` realisations of every manoeuvre of `experiment`, then
+/// `nlos_runs` of the non-line-of-sight run.
+///
+/// # Errors
+/// No manoeuvres, an invalid scenario or tracker configuration, a
+/// simulator failure.
+pub fn measure(experiment: &Config, runs: u64, nlos_runs: u64, progress: &dyn Progress) -> anyhow::Result<Measured> {
+    let source = &experiment.source;
     anyhow::ensure!(!experiment.manoeuvres.is_empty(), "{source}: no [[manoeuvres]] (nothing was done)");
     for m in &experiment.manoeuvres {
         experiment.scenario.validate(m).with_context(|| format!("{source}: [scenario] / manoeuvre {}", m.name))?;
     }
-    tracker_config(&experiment).validate().with_context(|| source.clone())?;
+    experiment.tracker_config().validate().with_context(|| source.clone())?;
 
-    let load_before = crate::bench_mpc::load_average();
+    let load_before = load_average();
     let started = Instant::now();
-    let nlos_runs = args.runs.unwrap_or(if args.quick { experiment.nlos.quick_runs } else { experiment.nlos.runs });
-    let mut elapsed_s = 0.0;
-    let (results, nlos_result, threads) = args.threads.install(|| -> anyhow::Result<_> {
-        let receiver = experiment.scenario.receiver().with_context(|| format!("{source}: [scenario]"))?;
-        let chunks = runs.div_ceil(RUNS_PER_CHUNK);
-        let bar = crate::progress::bar(runs * experiment.manoeuvres.len() as u64, "reproduce zoechmann", "runs", quiet);
-        let mut results = Vec::new();
-        for manoeuvre in &experiment.manoeuvres {
-            let partials: Vec<Chunk> = (0..chunks)
-                .into_par_iter()
-                .map(|c| {
-                    let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
-                    let n = range.end - range.start;
-                    let chunk = run_chunk(&experiment, manoeuvre, &receiver, range);
-                    bar.inc(n);
-                    chunk
-                })
-                .collect::<anyhow::Result<_>>()
-                .with_context(|| manoeuvre.name.clone())?;
-            let epochs = manoeuvre.epochs(experiment.scenario.epoch_s);
-            let mut total = Chunk::new(epochs);
-            for part in partials {
-                total.merge(part);
-            }
-            results.push(total.finish(manoeuvre.clone(), runs));
+    let receiver = experiment.scenario.receiver().with_context(|| format!("{source}: [scenario]"))?;
+    let chunks = runs.div_ceil(RUNS_PER_CHUNK);
+    progress.start("reproduce zoechmann", runs * experiment.manoeuvres.len() as u64, "runs");
+    let mut results = Vec::new();
+    for manoeuvre in &experiment.manoeuvres {
+        let partials: Vec<Chunk> = (0..chunks)
+            .into_par_iter()
+            .map(|c| {
+                let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
+                let n = range.end - range.start;
+                let chunk = run_chunk(experiment, manoeuvre, &receiver, range);
+                progress.advance(n);
+                chunk
+            })
+            .collect::<anyhow::Result<_>>()
+            .with_context(|| manoeuvre.name.clone())?;
+        let epochs = manoeuvre.epochs(experiment.scenario.epoch_s);
+        let mut total = Chunk::new(epochs);
+        for part in partials {
+            total.merge(part);
         }
-        bar.finish_and_clear();
-        elapsed_s = started.elapsed().as_secs_f64();
-        let nlos_result = nlos::run(&experiment, &experiment.nlos, &receiver, nlos_runs.max(1))
-            .with_context(|| format!("{source}: [nlos]"))?;
-        Ok((results, nlos_result, rayon::current_num_threads()))
-    })??;
-    let load = (load_before, crate::bench_mpc::load_average());
-
-    let verdicts = report::verdicts(&experiment, &results, runs, elapsed_s);
-    let mut summary = report::summary(&experiment, &results, &verdicts, runs, (elapsed_s, threads, load));
-    summary.push_str(&nlos::summary(&nlos_result, &experiment.nlos, experiment.scenario.epoch_s));
-    write_outputs(args, &experiment, &source, (&results, &nlos_result), runs, &summary)?;
-    if let Some(readme) = &args.readme {
-        crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;
+        results.push(total.finish(manoeuvre.clone(), runs));
     }
-    if !quiet {
-        print!("{summary}");
-        println!("\noutputs: {}", args.output.display());
-    }
-    Ok(if verdicts.iter().all(|v| v.met || v.informational) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    progress.finish();
+    let elapsed_s = started.elapsed().as_secs_f64();
+    let nlos = nlos::run(experiment, &experiment.nlos, &receiver, nlos_runs.max(1))
+        .with_context(|| format!("{source}: [nlos]"))?;
+    Ok(Measured {
+        runs,
+        manoeuvres: results,
+        nlos,
+        elapsed_s,
+        threads: rayon::current_num_threads(),
+        load: (load_before, load_average()),
+    })
 }
 
 /// Nearest-rank quantile `q` of sorted values.
-pub(super) fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
+pub fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
     let n = sorted.len();
     (n > 0).then(|| sorted[((q * n as f64).ceil() as usize).clamp(1, n) - 1])
-}
-
-pub(super) fn tracker_config(experiment: &Experiment) -> GeometricTrackerConfig {
-    GeometricTrackerConfig {
-        wavelength_m: experiment.scenario.wavelength_m(),
-        gamma: experiment.gamma,
-        initial_information: experiment.initial_information,
-        distinct_azimuths_for_rls: experiment.distinct_azimuths_for_rls,
-    }
 }
 
 /// Partial sums of a chunk of runs.
@@ -411,7 +345,7 @@ impl Chunk {
 }
 
 fn run_chunk(
-    experiment: &Experiment,
+    experiment: &Config,
     manoeuvre: &Manoeuvre,
     receiver: &OvertakingReceiver,
     runs: std::ops::Range<u64>,
@@ -426,8 +360,8 @@ fn run_chunk(
     let mut chunk = Chunk::new(manoeuvre.epochs(scenario.epoch_s));
     for run_index in runs {
         let run = scenario.realise(manoeuvre, experiment.seed, run_index)?;
-        let proposed = GeometricTracker::new(tracker_config(experiment))?;
-        let mps_tracker = GeometricTrackerConfig { wavelength_m: DOPPLER_MPS, ..tracker_config(experiment) };
+        let proposed = GeometricTracker::new(experiment.tracker_config())?;
+        let mps_tracker = GeometricTrackerConfig { wavelength_m: DOPPLER_MPS, ..experiment.tracker_config() };
         let mut estimators = [
             Fed::new(1, HoChanBatch::new(lambda)?, Azimuths::FullScan, false),
             Fed::new(2, ErrorFreeRegressors::new(lambda)?, Azimuths::True, false),
@@ -437,11 +371,11 @@ fn run_chunk(
             Fed::new(DOPPLER_MPS_FIRST + 1, ErrorFreeRegressors::new(DOPPLER_MPS)?, Azimuths::True, true),
             Fed::new(DOPPLER_MPS_FIRST + 2, GeometricTracker::new(mps_tracker)?, Azimuths::FullScan, true),
         ];
-        let mut full_scan = Some(GeometricTracker::new(tracker_config(experiment))?);
+        let mut full_scan = Some(GeometricTracker::new(experiment.tracker_config())?);
         let mut windowed = [
             Windowed { tracker: Some(proposed), gated: false, doppler_factor: 1.0, estimator: 0, counter: 0 },
             Windowed {
-                tracker: Some(GeometricTracker::new(tracker_config(experiment))?),
+                tracker: Some(GeometricTracker::new(experiment.tracker_config())?),
                 gated: true,
                 doppler_factor: 1.0,
                 estimator: GATED_VARIANT,
@@ -607,116 +541,5 @@ fn add(chunk: &mut Chunk, estimator: usize, epoch: usize, range_m: f64, true_ran
         chunk.squared_error[estimator][epoch] += (range_m - true_range_m).powi(2);
         chunk.squared_range[estimator][epoch] += true_range_m * true_range_m;
         chunk.counted[estimator][epoch] += 1;
-    }
-}
-
-fn write_outputs(
-    args: &ZoechmannArgs,
-    experiment: &Experiment,
-    source: &str,
-    (results, nlos_result): (&[ManoeuvreResult], &NlosResult),
-    runs: u64,
-    summary: &str,
-) -> anyhow::Result<()> {
-    let staging = crate::reproduce_common::Staged::new(&args.output, "zoechmann")?;
-    let tables = staging.path().join("tables");
-    let info = RunInfo {
-        config_json: serde_json::json!({
-            "command": "reproduce zoechmann",
-            "experiment": source,
-            "runs": runs,
-            "seed": experiment.seed,
-            "gamma": experiment.gamma,
-            "full_scan_epochs": experiment.full_scan_epochs,
-            "window_beams": experiment.window_beams,
-            "radius_wavelengths": experiment.scenario.radius_wavelengths,
-            "mmtrack_version": env!("CARGO_PKG_VERSION"),
-        })
-        .to_string(),
-    };
-    let epoch_s = experiment.scenario.epoch_s;
-    let mut nmse_rows = Vec::new();
-    let mut summary_rows = Vec::new();
-    for r in results {
-        for (e, name) in ESTIMATORS.iter().enumerate() {
-            for (k, &nmse) in r.nmse[e].iter().enumerate() {
-                nmse_rows.push(ZoechmannNmseRow {
-                    manoeuvre: r.manoeuvre.name.clone(),
-                    estimator: (*name).to_string(),
-                    epoch: k as u64,
-                    t_s: k as f64 * epoch_s,
-                    runs: r.counted[e][k],
-                    nmse,
-                    nmse_db: 10.0 * nmse.log10(),
-                    rmse_m: r.rmse_m[e][k],
-                });
-            }
-        }
-        summary_rows.push(ZoechmannSummaryRow {
-            manoeuvre: r.manoeuvre.name.clone(),
-            runs: r.runs,
-            epochs: r.manoeuvre.epochs(epoch_s) as u64,
-            not_converged_runs: r.runs - r.handovers_s.len() as u64,
-            handover_median_s: r.handover_quantile(0.5),
-            handover_mean_s: r.handover_mean(),
-            handover_p90_s: r.handover_quantile(0.9),
-            handover_median_full_scan_s: quantile(&r.handovers_full_scan_s, 0.5),
-            beams_measured: r.beams[0].measured,
-            beams_full_scan: r.beams[0].full_scan_equivalent,
-            saving: r.beams[0].saving().unwrap_or(f64::NAN),
-            windowed_saving: r.beams[0].windowed_saving(experiment.scenario.beams).unwrap_or(f64::NAN),
-            window_hit_rate: r.window_hit_rate(0),
-            gated_saving: r.beams[1].saving().unwrap_or(f64::NAN),
-            gated_window_hit_rate: r.window_hit_rate(1),
-            first_window_off_share: r.backwards_first_windows as f64 / r.runs.max(1) as f64,
-            estimator_failures: r.failures,
-        });
-    }
-    write_table(&tables, "zoechmann", &nmse_rows, &info, Overwrite::Refuse)?;
-    write_table(&tables, "zoechmann", &summary_rows, &info, Overwrite::Refuse)?;
-    let nlos_errors = nlos::error_rows(nlos_result, epoch_s);
-    write_table(&tables, "zoechmann", &nlos_errors, &info, Overwrite::Refuse)?;
-    write_table(&tables, "zoechmann", &nlos_result.labels, &info, Overwrite::Refuse)?;
-    for r in results {
-        let curves: Vec<NmseCurve> = ESTIMATORS[..PLOTTED]
-            .iter()
-            .enumerate()
-            .map(|(e, name)| NmseCurve { label: (*name).to_string(), nmse: r.nmse[e].clone() })
-            .collect();
-        let title = format!("{}: {} runs (Zoechmann et al. 2019, Figs. 4-5)", r.manoeuvre.name, r.runs);
-        let svg = zoechmann_figure_svg(&title, &r.trace, &curves, epoch_s)?;
-        let file = format!("{}.svg", r.manoeuvre.name);
-        std::fs::write(staging.path().join(&file), svg).with_context(|| file.clone())?;
-    }
-    let walls = &experiment.nlos.walls;
-    let title = format!(
-        "{}: {} runs, each path tracked on its own (line of sight and single wall bounces)",
-        nlos_result.manoeuvre, nlos_result.runs
-    );
-    let svg = mmtrack_analysis::beam::zoechmann_plots::zoechmann_nlos_svg(
-        &title,
-        [walls.left_wall_m, walls.right_wall_m],
-        &nlos_result.labels,
-        &nlos_errors,
-    )?;
-    std::fs::write(staging.path().join("nlos.svg"), svg).context("nlos.svg")?;
-    std::fs::write(staging.path().join("reproduce.md"), summary)?;
-    crate::reproduce_all::write_metrics(staging.path(), &report::metrics(experiment, results))?;
-    staging.publish()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_embedded_experiment_parses_and_has_the_papers_manoeuvres() {
-        let experiment: Experiment = toml::from_str(ZOECHMANN_EXPERIMENT).unwrap();
-        assert_eq!(experiment.runs, 100_000);
-        let names: Vec<&str> = experiment.manoeuvres.iter().map(|m| m.name.as_str()).collect();
-        assert_eq!(names, ["half-overtaking", "full-overtaking"]);
-        assert_eq!(experiment.manoeuvres[0], Manoeuvre::half_overtaking());
-        assert_eq!(experiment.manoeuvres[1], Manoeuvre::full_overtaking());
-        assert!(tracker_config(&experiment).validate().is_ok());
     }
 }

@@ -1,4 +1,4 @@
-//! The non-line-of-sight part of `reproduce zoechmann`: the proposed
+//! The non-line-of-sight part of the Zoechmann experiment: the proposed
 //! geometric tracker on every path of an overtaking between two walls
 //! (`mmtrack_sim::beam::overtaking_paths`: line of sight and both single
 //! bounces), per-path position error over time against the simulator's
@@ -14,37 +14,34 @@ use anyhow::Context;
 use mmtrack_beam::geometric::{DopplerBearing, GeometricTracker, RangeEstimator};
 use mmtrack_io::table::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 use mmtrack_sim::beam::overtaking::OvertakingReceiver;
-use mmtrack_sim::beam::overtaking_paths::{PathKind, Walls, realise_paths};
+use mmtrack_sim::beam::overtaking_paths::{PathKind, realise_paths};
 use rayon::prelude::*;
-use serde::Deserialize;
 
-use super::reproduce_zoechmann::{Experiment, tracker_config};
-
-/// The `[nlos]` table of the experiment file.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct NlosConfig {
-    /// Name of the manoeuvre (one of `[[manoeuvres]]`).
-    pub manoeuvre: String,
-    pub runs: u64,
-    pub quick_runs: u64,
-    pub walls: Walls,
-}
+use super::config::{Config, NlosConfig};
 
 /// Per path, sums over runs.
 #[derive(Debug, Clone)]
-pub(super) struct PathErrors {
+pub struct PathErrors {
+    /// The path (`PathKind::name`).
     pub name: &'static str,
+    /// Per epoch: sum over runs of the squared position error, m^2 ...
     pub position_sq: Vec<f64>,
+    /// ... of the squared velocity error, (m/s)^2 ...
     pub velocity_sq: Vec<f64>,
+    /// ... and the runs counted.
     pub counted: Vec<u64>,
+    /// Runs whose tracker failed on this path.
     pub failures: u64,
 }
 
 /// What the NLOS run measured.
-pub(super) struct NlosResult {
+#[derive(Debug, Clone)]
+pub struct NlosResult {
+    /// The manoeuvre's name.
     pub manoeuvre: String,
+    /// Runs.
     pub runs: u64,
+    /// One per path, in `PathKind::ALL` order.
     pub paths: Vec<PathErrors>,
     /// The first run's per-path labels.
     pub labels: Vec<ZoechmannPathLabelRow>,
@@ -54,7 +51,7 @@ const RUNS_PER_CHUNK: u64 = 100;
 
 /// Runs the paths of `runs` realisations.
 pub(super) fn run(
-    experiment: &Experiment,
+    experiment: &Config,
     nlos: &NlosConfig,
     receiver: &OvertakingReceiver,
     runs: u64,
@@ -75,7 +72,7 @@ pub(super) fn run(
                 let path_runs = realise_paths(&experiment.scenario, manoeuvre, &nlos.walls, experiment.seed, run_index)
                     .context("[nlos]")?;
                 for (p, path) in path_runs.iter().enumerate() {
-                    let mut tracker = GeometricTracker::new(tracker_config(experiment))?;
+                    let mut tracker = GeometricTracker::new(experiment.tracker_config())?;
                     for (k, e) in path.epochs.iter().enumerate() {
                         let t = &e.truth;
                         let beam = receiver.strongest_beam(t.azimuth_rad);

@@ -1,14 +1,19 @@
-//! The outputs of `reproduce mpc-artificial` as text: the CSV files, the
-//! targets and verdicts, `reproduce.md` and the README block (the figures
-//! are drawn by `mmtrack_analysis::mpc_artificial`).
+//! What the artificial-channel experiment reports: the CSV files, the
+//! targets and verdicts, `reproduce.md`, the README block and the figures
+//! (drawn by `mmtrack_analysis::mpc_artificial`).
 
 use std::fmt::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use mmtrack_analysis::mpc_artificial::{ArtificialTracker, SeparationBin, SweepPoint};
-use mmtrack_sim::sounder::ArtificialChannelConfig;
+use anyhow::Context;
+use mmtrack_analysis::mpc_artificial::{self as plots, ArtificialTracker, SeparationBin, SweepPoint};
+use mmtrack_io::{AtomicFile, Durability, Overwrite};
 
-/// The README block `reproduce mpc-artificial --readme` replaces.
+use super::config::SEPARATION_PLOT_POWERS_DB;
+use super::run::Sweep;
+use crate::model::{Claim, METRICS_FILE, Metric, Rule, Verdict, write_metrics};
+
+/// The README block the summary replaces.
 pub const README_BLOCK: &str = "reproduce-mpc-artificial";
 /// Target: mean delay error below this ...
 pub const TARGET_ERROR_NS: f64 = 0.03;
@@ -26,18 +31,6 @@ pub const FIGURES: [(&str, &str); 3] = [
     ("delay_error_vs_separation.svg", "mean delay error vs the MPCs' separation, proposed tracker, Kaiser window"),
 ];
 
-/// Everything one run of the experiment measured.
-pub struct Sweep {
-    /// The channel (at the first power; only the power changes).
-    pub channel: ArtificialChannelConfig,
-    pub pulse_name: &'static str,
-    /// Whether detection zeroed the taps below floor + 6 dB (the paper's step 1).
-    pub zero_below_threshold: bool,
-    pub runs: u64,
-    pub points: Vec<SweepPoint>,
-    pub bins: Vec<SeparationBin>,
-}
-
 /// Where the README's links to the figures point.
 pub enum FiguresAt {
     /// The output directory relative to the README's directory.
@@ -46,86 +39,36 @@ pub enum FiguresAt {
     Elsewhere(PathBuf),
 }
 
-impl Sweep {
-    fn point(&self, power_db: f64, window: bool, tracker: ArtificialTracker) -> Option<&SweepPoint> {
-        self.points.iter().find(|p| p.power_db == power_db && p.kaiser_window == window && p.tracker == tracker)
-    }
-
-    /// The swept powers, highest first.
-    fn powers_db(&self) -> Vec<f64> {
-        let mut powers: Vec<f64> = self.points.iter().map(|p| p.power_db).collect();
-        powers.sort_by(|a, b| b.total_cmp(a));
-        powers.dedup();
-        powers
-    }
-
-    /// The lowest power down to which `holds` is true at every power from
-    /// the highest one (`None` when it fails at the highest).
-    fn down_to(&self, window: bool, tracker: ArtificialTracker, holds: impl Fn(&SweepPoint) -> bool) -> Option<f64> {
-        let mut lowest = None;
-        for power_db in self.powers_db() {
-            match self.point(power_db, window, tracker) {
-                Some(p) if holds(p) => lowest = Some(power_db),
-                _ => break,
-            }
-        }
-        lowest
-    }
-
-    fn description(&self) -> String {
-        let c = &self.channel;
-        format!(
-            "Two equal-power MPCs approaching from {:.1} to {:.1} ns over {} snapshots ({:.3} ms apart), noise floor \
-             {} dB, {:.1} GHz carrier, {:.1} GHz band, {} sounder pulse; {}; {} Monte Carlo runs per point. Tracks have \
-             at least 3 detections; a track is true when most of its points lie within 1 ns of a true MPC; delay \
-             errors are those of the true tracks' points against the nearer true MPC.",
-            c.start_separation_s * 1e9,
-            c.end_separation_s * 1e9,
-            c.snapshots,
-            c.snapshot_interval_s * 1e3,
-            c.sounder.noise_floor_db,
-            c.sounder.carrier_hz / 1e9,
-            c.sounder.bandwidth_hz / 1e9,
-            self.pulse_name,
-            if self.zero_below_threshold {
-                "taps below floor + 6 dB zeroed before the search (the paper's step 1)"
-            } else {
-                "taps below floor + 6 dB kept (variant: --keep-taps-below-threshold)"
-            },
-            self.runs,
-        )
-    }
-}
-
-/// The targets' measured values.
-pub struct Verdicts {
-    /// Mean delay error at the target power (proposed, Kaiser), ns.
-    error_ns: Option<f64>,
-    /// The separation band with the largest mean error there, and that error.
-    worst_band: Option<(String, f64)>,
-    /// Proposed, Kaiser: (power, runs with two tracks, runs) down to the target power.
-    two_tracks: Vec<(f64, u64, u64)>,
-}
-
-impl Verdicts {
-    fn error_met(&self) -> bool {
-        self.error_ns.is_some_and(|e| e < TARGET_ERROR_NS)
-    }
-
-    fn two_tracks_met(&self) -> bool {
-        !self.two_tracks.is_empty() && self.two_tracks.iter().all(|(_, two, runs)| two == runs)
-    }
-
-    pub fn all_met(&self) -> bool {
-        self.error_met() && self.two_tracks_met()
-    }
+/// One paragraph on what was run.
+fn description(sweep: &Sweep) -> String {
+    let c = &sweep.channel;
+    format!(
+        "Two equal-power MPCs approaching from {:.1} to {:.1} ns over {} snapshots ({:.3} ms apart), noise floor \
+         {} dB, {:.1} GHz carrier, {:.1} GHz band, {} sounder pulse; {}; {} Monte Carlo runs per point. Tracks have \
+         at least 3 detections; a track is true when most of its points lie within 1 ns of a true MPC; delay \
+         errors are those of the true tracks' points against the nearer true MPC.",
+        c.start_separation_s * 1e9,
+        c.end_separation_s * 1e9,
+        c.snapshots,
+        c.snapshot_interval_s * 1e3,
+        c.sounder.noise_floor_db,
+        c.sounder.carrier_hz / 1e9,
+        c.sounder.bandwidth_hz / 1e9,
+        sweep.pulse_name,
+        if sweep.zero_below_threshold {
+            "taps below floor + 6 dB zeroed before the search (the paper's step 1)"
+        } else {
+            "taps below floor + 6 dB kept (variant: --keep-taps-below-threshold)"
+        },
+        sweep.runs,
+    )
 }
 
 /// The numbers `reproduce --all` checks, Kaiser window: at the target power
 /// (-116 dB) and at -126 dB, each tracker's mean number of tracks and the
 /// proposed tracker's mean delay error and share of runs with two tracks.
-pub fn metrics(sweep: &Sweep) -> Vec<crate::reproduce_all::Metric> {
-    use crate::reproduce_all::Metric;
+#[must_use]
+pub fn metrics(sweep: &Sweep) -> Vec<Metric> {
     let mut out = Vec::new();
     for power in [TARGET_ERROR_POWER_DB, TARGET_TWO_TRACKS_DOWN_TO_DB] {
         for tracker in [ArtificialTracker::Proposed, ArtificialTracker::GmPhd] {
@@ -150,7 +93,11 @@ pub fn metrics(sweep: &Sweep) -> Vec<crate::reproduce_all::Metric> {
     out
 }
 
-pub fn verdicts(sweep: &Sweep) -> Verdicts {
+/// The two targets (proposed tracker, Kaiser window): the mean delay error
+/// at the target power, and two tracks in every run from the highest power
+/// down to the target power (measured: the smallest share of such runs).
+#[must_use]
+pub fn verdicts(sweep: &Sweep) -> Vec<Verdict> {
     let proposed = ArtificialTracker::Proposed;
     let error_ns = sweep.point(TARGET_ERROR_POWER_DB, true, proposed).map(|p| p.mean_delay_error_ns);
     let worst_band = sweep
@@ -160,14 +107,50 @@ pub fn verdicts(sweep: &Sweep) -> Verdicts {
         .filter(|b| b.mean_delay_error_ns.is_finite())
         .max_by(|a, b| a.mean_delay_error_ns.total_cmp(&b.mean_delay_error_ns))
         .map(|b| (format!("{}-{} ns", b.separation_ns.start, b.separation_ns.end), b.mean_delay_error_ns));
-    let two_tracks = sweep
+    let error = Claim::new(
+        format!(
+            "mean delay error below {TARGET_ERROR_NS} ns at {TARGET_ERROR_POWER_DB} dB, separations 20..2.5 ns \
+             (proposed, Kaiser)"
+        ),
+        "ns",
+        Some(TARGET_ERROR_NS),
+        format!("below {TARGET_ERROR_NS} ns"),
+        Rule::Below { bound: TARGET_ERROR_NS },
+    );
+    let error_text = format!(
+        "{}{}",
+        error_ns.map_or("-".into(), |e| format!("{e:.4} ns")),
+        worst_band.as_ref().map_or(String::new(), |(band, e)| format!("; largest in the {band} band: {e:.4} ns")),
+    );
+    // Proposed, Kaiser: (power, runs with two tracks, runs) down to the target power.
+    let two_tracks: Vec<(f64, u64, u64)> = sweep
         .powers_db()
         .into_iter()
         .filter(|&p| p >= TARGET_TWO_TRACKS_DOWN_TO_DB)
         .filter_map(|p| sweep.point(p, true, proposed))
         .map(|p| (p.power_db, p.runs_with_two_tracks, p.runs))
         .collect();
-    Verdicts { error_ns, worst_band, two_tracks }
+    let smallest_share = two_tracks.iter().map(|&(_, two, runs)| two as f64 / runs as f64).min_by(f64::total_cmp);
+    let every_run_two = |p: &SweepPoint| p.runs_with_two_tracks == p.runs;
+    let best = two_tracks.iter().max_by_key(|t| t.1);
+    let at_target = two_tracks.iter().find(|t| t.0 == TARGET_TWO_TRACKS_DOWN_TO_DB);
+    let runs = |t: Option<&(f64, u64, u64)>| t.map_or("-".into(), |t| format!("{}/{} runs at {} dB", t.1, t.2, t.0));
+    let two = Claim::new(
+        format!("two tracks in every run down to {TARGET_TWO_TRACKS_DOWN_TO_DB} dB (proposed, Kaiser)"),
+        "share of runs",
+        Some(1.0),
+        "every run",
+        Rule::AtLeast { bound: 1.0 },
+    );
+    let two_text = format!(
+        "two tracks in every run {}; at best {}; {}; exactly two tracks on the true MPCs in every run {} (the other \
+         tracks are made of noise detections)",
+        down_to(sweep.down_to(true, proposed, every_run_two)),
+        runs(best),
+        runs(at_target),
+        down_to(sweep.down_to(true, proposed, |p| p.runs_with_two_true_tracks == p.runs)),
+    );
+    vec![Verdict::judged(error, error_ns, error_text), Verdict::judged(two, smallest_share, two_text)]
 }
 
 fn verdict(met: bool) -> &'static str {
@@ -182,38 +165,18 @@ fn down_to(power: Option<f64>) -> String {
 /// The targets, measured values and verdicts, plus the paper's other
 /// observations for comparison.
 fn verdict_table(sweep: &Sweep) -> String {
-    let v = verdicts(sweep);
     let (proposed, gmphd, matched) =
         (ArtificialTracker::Proposed, ArtificialTracker::GmPhd, ArtificialTracker::GmPhdMatched);
     let every_run_two = |p: &SweepPoint| p.runs_with_two_tracks == p.runs;
-    let best = v.two_tracks.iter().max_by_key(|t| t.1);
-    let at_target = v.two_tracks.iter().find(|t| t.0 == TARGET_TWO_TRACKS_DOWN_TO_DB);
-    let runs = |t: Option<&(f64, u64, u64)>| t.map_or("-".into(), |t| format!("{}/{} runs at {} dB", t.1, t.2, t.0));
     let error_at = |tracker| {
         sweep
             .point(TARGET_ERROR_POWER_DB, true, tracker)
             .map_or("-".into(), |p| format!("{:.4} ns", p.mean_delay_error_ns))
     };
     let mut out = String::from("| target | measured | verdict |\n|---|---|---|\n");
-    let _ = writeln!(
-        out,
-        "| mean delay error below {TARGET_ERROR_NS} ns at {TARGET_ERROR_POWER_DB} dB, separations 20..2.5 ns \
-         (proposed, Kaiser) | {}{} | {} |",
-        v.error_ns.map_or("-".into(), |e| format!("{e:.4} ns")),
-        v.worst_band.as_ref().map_or(String::new(), |(band, e)| format!("; largest in the {band} band: {e:.4} ns")),
-        verdict(v.error_met()),
-    );
-    let _ = writeln!(
-        out,
-        "| two tracks in every run down to {TARGET_TWO_TRACKS_DOWN_TO_DB} dB (proposed, Kaiser) | two tracks in every \
-         run {}; at best {}; {}; exactly two tracks on the true MPCs in every run {} (the other tracks are made of \
-         noise detections) | {} |",
-        down_to(sweep.down_to(true, proposed, every_run_two)),
-        runs(best),
-        runs(at_target),
-        down_to(sweep.down_to(true, proposed, |p| p.runs_with_two_true_tracks == p.runs)),
-        verdict(v.two_tracks_met()),
-    );
+    for v in verdicts(sweep) {
+        let _ = writeln!(out, "| {} | {} | {} |", v.claim.what, v.note, verdict(v.met));
+    }
     let _ = writeln!(
         out,
         "| for comparison: GM-PHD splits from {PAPER_GMPHD_SPLITS_AT_DB} dB (paper, Fig. 4) | two tracks in every run \
@@ -302,8 +265,9 @@ fn separation_table(sweep: &Sweep, tracker: ArtificialTracker, window: bool) -> 
 }
 
 /// `reproduce.md`: everything, including the full per-point table.
+#[must_use]
 pub fn markdown(sweep: &Sweep) -> String {
-    let mut out = format!("# reproduce mpc-artificial\n\n{}\n\n{}\n", sweep.description(), verdict_table(sweep));
+    let mut out = format!("# reproduce mpc-artificial\n\n{}\n\n{}\n", description(sweep), verdict_table(sweep));
     out.push_str(&compact_table(sweep));
     out.push_str(
         "\n## All points\n\n| MPC power dB | window | tracker | mean tracks | on a true MPC | runs with 2 tracks | \
@@ -339,10 +303,11 @@ pub fn markdown(sweep: &Sweep) -> String {
 
 /// The README block: description, verdicts, compact table and where the
 /// figures are.
+#[must_use]
 pub fn readme_summary(sweep: &Sweep, figures: &FiguresAt) -> String {
     let mut out = format!(
         "Written by `mmtrack reproduce mpc-artificial --readme README.md`. {}\n\n{}\n",
-        sweep.description(),
+        description(sweep),
         verdict_table(sweep)
     );
     out.push_str(&compact_table(sweep));
@@ -363,7 +328,8 @@ pub fn readme_summary(sweep: &Sweep, figures: &FiguresAt) -> String {
     out
 }
 
-pub fn csv(points: &[SweepPoint]) -> String {
+/// `results.csv`: one row per point.
+fn csv(points: &[SweepPoint]) -> String {
     let mut out = String::from(
         "mpc_power_db,kaiser_window,tracker,mean_tracks,mean_true_tracks,runs_with_two_tracks,\
          runs_with_two_true_tracks,runs,mean_delay_error_ns,rms_delay_error_ns,gmphd_sigma_measurement_m\n",
@@ -388,7 +354,8 @@ pub fn csv(points: &[SweepPoint]) -> String {
     out
 }
 
-pub fn separation_csv(bins: &[SeparationBin]) -> String {
+/// `results_by_separation.csv`: one row per point and separation band.
+fn separation_csv(bins: &[SeparationBin]) -> String {
     let mut out = String::from(
         "mpc_power_db,kaiser_window,tracker,separation_min_ns,separation_max_ns,points,truth_points,mean_delay_error_ns\n",
     );
@@ -407,4 +374,79 @@ pub fn separation_csv(bins: &[SeparationBin]) -> String {
         );
     }
     out
+}
+
+/// Writes `results.csv`, `results_by_separation.csv`, `reproduce.md`
+/// (`markdown`), `metrics.json` and the figures into `output` (created if
+/// needed; files of an earlier run are replaced one by one); returns the
+/// files written.
+///
+/// # Errors
+/// A file or figure cannot be written.
+pub fn write_outputs(output: &Path, sweep: &Sweep, markdown: &str, metrics: &[Metric]) -> anyhow::Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(output).with_context(|| output.display().to_string())?;
+    write_atomically(&output.join("results.csv"), &csv(&sweep.points))?;
+    write_atomically(&output.join("results_by_separation.csv"), &separation_csv(&sweep.bins))?;
+    write_atomically(&output.join("reproduce.md"), markdown)?;
+    write_metrics(output, metrics)?;
+    write_figures(sweep, output)?;
+    let mut files: Vec<PathBuf> = ["results.csv", "results_by_separation.csv", "reproduce.md", METRICS_FILE]
+        .into_iter()
+        .chain(FIGURES.iter().map(|f| f.0))
+        .map(|name| output.join(name))
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let file = AtomicFile::create(path, Overwrite::Replace)?;
+    let mut writer = file.writer()?;
+    writer.write_all(text.as_bytes()).with_context(|| path.display().to_string())?;
+    writer.flush().with_context(|| path.display().to_string())?;
+    drop(writer);
+    file.commit(Overwrite::Replace, Durability::Fsync)?;
+    Ok(())
+}
+
+/// The figures, next to results.csv (names in [`FIGURES`]).
+fn write_figures(sweep: &Sweep, dir: &Path) -> anyhow::Result<()> {
+    let [tracks, error, separation] = FIGURES;
+    let svgs = [
+        (tracks.0, plots::tracks_vs_power_svg(&sweep.points, TARGET_TWO_TRACKS_DOWN_TO_DB)?),
+        (error.0, plots::delay_error_vs_power_svg(&sweep.points, TARGET_ERROR_NS, TARGET_ERROR_POWER_DB)?),
+        (
+            separation.0,
+            plots::delay_error_vs_separation_svg(
+                &sweep.bins,
+                ArtificialTracker::Proposed,
+                true,
+                &SEPARATION_PLOT_POWERS_DB,
+                TARGET_ERROR_NS,
+            )?,
+        ),
+    ];
+    for (name, svg) in svgs {
+        write_atomically(&dir.join(name), &svg)?;
+    }
+    Ok(())
+}
+
+/// Where a README at `readme` finds the figures in `output`: the output
+/// directory relative to the README's directory when it lies below it,
+/// else the path as given.
+#[must_use]
+pub fn figures_location(readme: &Path, output: &Path) -> FiguresAt {
+    let readme_dir = match readme.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    match (readme_dir.canonicalize(), output.canonicalize()) {
+        (Ok(base), Ok(out)) => match out.strip_prefix(&base) {
+            Ok(relative) => FiguresAt::Relative(relative.to_path_buf()),
+            Err(_) => FiguresAt::Elsewhere(output.to_path_buf()),
+        },
+        _ => FiguresAt::Elsewhere(output.to_path_buf()),
+    }
 }

@@ -1,23 +1,29 @@
-//! Verdicts and the Markdown summary of `reproduce zoechmann` (also the
-//! README block).
+//! What the Zoechmann experiment reports: the metrics of the regression
+//! check, the verdicts on the paper's claims, the Markdown summary (also
+//! the README block), the tables and the figures.
 
-use super::reproduce_zoechmann::{
-    DOPPLER_MPS_FIRST, ESTIMATORS, Experiment, FULL_SCAN_VARIANT, GATED_VARIANT, ManoeuvreResult, PLOTTED, WINDOWED,
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use mmtrack_analysis::beam::zoechmann_plots::{NmseCurve, zoechmann_figure_svg, zoechmann_nlos_svg};
+use mmtrack_io::Overwrite;
+use mmtrack_io::table::{RunInfo, write_table};
+use mmtrack_io::table::{ZoechmannNmseRow, ZoechmannSummaryRow};
+
+use super::config::Config;
+use super::nlos;
+use super::run::{
+    DOPPLER_MPS_FIRST, ESTIMATORS, FULL_SCAN_VARIANT, GATED_VARIANT, ManoeuvreResult, Measured, PLOTTED, WINDOWED,
     WINDOWED_DOPPLER_MPS, quantile,
 };
+use crate::common::Staged;
+use crate::model::{Claim, Metric, Rule, Verdict, verdict_rows, write_metrics};
 
-/// The README block the summary replaces with `--readme`.
+/// The README block the summary replaces.
 pub const README_BLOCK: &str = "reproduce-zoechmann";
 
-/// One checked claim of the paper.
-pub struct Verdict {
-    pub claim: String,
-    pub paper: String,
-    pub measured: String,
-    pub met: bool,
-    /// Reported, not a target: does not set the exit status.
-    pub informational: bool,
-}
+/// The paper's ordering of the final NMSEs of range, as the claims state it.
+const ORDERING: &str = "nullspace <= error-free <= proposed < Ho-Chan";
 
 fn db(v: Option<f64>) -> String {
     v.map_or("-".into(), |v| format!("{:.1}", 10.0 * v.log10()))
@@ -28,8 +34,8 @@ fn db(v: Option<f64>) -> String {
 /// per tracked epoch (the paper's 43x beside it); the median hand-over time
 /// of the convergence manoeuvre (the paper's 0.5 s beside it). Timing is
 /// left out (not deterministic).
-pub fn metrics(experiment: &Experiment, results: &[ManoeuvreResult]) -> Vec<crate::reproduce_all::Metric> {
-    use crate::reproduce_all::Metric;
+#[must_use]
+pub fn metrics(experiment: &Config, results: &[ManoeuvreResult]) -> Vec<Metric> {
     let mut out = Vec::new();
     for r in results {
         let name = &r.manoeuvre.name;
@@ -71,31 +77,31 @@ fn ordering(
     (measured, met)
 }
 
+/// A claim on the ordering of the final NMSEs.
+fn ordering_claim(what: String, paper: &str) -> Claim {
+    Claim::new(what, "dB", None, paper, Rule::Ordering { description: format!("final NMSE of range: {ORDERING}") })
+}
+
 /// The ordering at the end of each manoeuvre, the full-overtaking hand-over,
 /// the beam saving, and (for the full run) the time.
-pub fn verdicts(experiment: &Experiment, results: &[ManoeuvreResult], runs: u64, elapsed_s: f64) -> Vec<Verdict> {
+#[must_use]
+pub fn verdicts(experiment: &Config, results: &[ManoeuvreResult], runs: u64, elapsed_s: f64) -> Vec<Verdict> {
     let mut out = Vec::new();
     for r in results {
         let [proposed, ho_chan, error_free, nullspace] = [0, 1, 2, 3].map(|e| r.final_nmse(e));
         let (measured, met) = ordering(nullspace, error_free, proposed, ho_chan);
-        out.push(Verdict {
-            claim: format!("{}: NMSE at the end, nullspace <= error-free <= proposed < Ho-Chan", r.manoeuvre.name),
-            paper: "ordering of Figs. 4-5".into(),
-            measured,
-            met,
-            informational: false,
-        });
+        let claim =
+            ordering_claim(format!("{}: NMSE at the end, {ORDERING}", r.manoeuvre.name), "ordering of Figs. 4-5");
+        out.push(Verdict::decided(claim, met, measured));
         for (index, what) in
             [(FULL_SCAN_VARIANT, "on full-scan azimuths"), (GATED_VARIANT, "with its window only after the hand-over")]
         {
             let (measured, met) = ordering(nullspace, error_free, r.final_nmse(index), ho_chan);
-            out.push(Verdict {
-                claim: format!("{}: the same with the proposed tracker {what} (variant)", r.manoeuvre.name),
-                paper: "-".into(),
-                measured,
-                met,
-                informational: true,
-            });
+            let claim = ordering_claim(
+                format!("{}: the same with the proposed tracker {what} (variant)", r.manoeuvre.name),
+                "-",
+            );
+            out.push(Verdict::decided(claim.informational(), met, measured));
         }
         // Every estimator with the Doppler equation in m/s (the nullspace
         // genie does not change: scaling every Doppler row alike leaves its
@@ -103,83 +109,85 @@ pub fn verdicts(experiment: &Experiment, results: &[ManoeuvreResult], runs: u64,
         let [ho_chan_mps, error_free_mps, proposed_mps] =
             [DOPPLER_MPS_FIRST, DOPPLER_MPS_FIRST + 1, DOPPLER_MPS_FIRST + 2].map(|e| r.final_nmse(e));
         let (measured, met) = ordering(nullspace, error_free_mps, proposed_mps, ho_chan_mps);
-        out.push(Verdict {
-            claim: format!(
+        let claim = ordering_claim(
+            format!(
                 "{}: the same on full-scan azimuths with the Doppler equation (5) in m/s, all estimators (diagnostic)",
                 r.manoeuvre.name
             ),
-            paper: "-".into(),
-            measured,
-            met,
-            informational: true,
-        });
+            "-",
+        );
+        out.push(Verdict::decided(claim.informational(), met, measured));
     }
     let convergence = results.iter().find(|r| r.manoeuvre.name == experiment.convergence_manoeuvre);
     let median = convergence.and_then(|r| r.handover_quantile(0.5));
-    out.push(Verdict {
-        claim: format!(
+    let claim = Claim::new(
+        format!(
             "{}: hand-over to RLS (third distinct azimuth), median within {} s",
             experiment.convergence_manoeuvre, experiment.convergence_tolerance_s
         ),
-        paper: format!("about {} s", experiment.paper_convergence_s),
-        measured: match (median, convergence) {
-            (Some(m), Some(r)) => format!(
-                "{m:.2} s (mean {:.2}, p90 {:.2}; {} of {} runs never; full-scan variant: median {})",
-                r.handover_mean().unwrap_or(f64::NAN),
-                r.handover_quantile(0.9).unwrap_or(f64::NAN),
-                r.runs - r.handovers_s.len() as u64,
-                r.runs,
-                quantile(&r.handovers_full_scan_s, 0.5).map_or("-".into(), |v| format!("{v:.2} s"))
-            ),
-            _ => "-".into(),
-        },
-        met: median.is_some_and(|m| (m - experiment.paper_convergence_s).abs() <= experiment.convergence_tolerance_s),
-        informational: false,
-    });
+        "s",
+        Some(experiment.paper_convergence_s),
+        format!("about {} s", experiment.paper_convergence_s),
+        Rule::Within { target: experiment.paper_convergence_s, tolerance: experiment.convergence_tolerance_s },
+    );
+    let measured = match (median, convergence) {
+        (Some(m), Some(r)) => format!(
+            "{m:.2} s (mean {:.2}, p90 {:.2}; {} of {} runs never; full-scan variant: median {})",
+            r.handover_mean().unwrap_or(f64::NAN),
+            r.handover_quantile(0.9).unwrap_or(f64::NAN),
+            r.runs - r.handovers_s.len() as u64,
+            r.runs,
+            quantile(&r.handovers_full_scan_s, 0.5).map_or("-".into(), |v| format!("{v:.2} s"))
+        ),
+        _ => "-".into(),
+    };
+    out.push(Verdict::judged(claim, median, measured));
     for r in results {
         let windowed = r.beams[0].windowed_saving(experiment.scenario.beams);
-        out.push(Verdict {
-            claim: format!(
+        let claim = Claim::new(
+            format!(
                 "{}: beam-measurement saving per tracked epoch, within {:.0} %",
                 r.manoeuvre.name,
                 100.0 * experiment.saving_tolerance
             ),
-            paper: format!("{:.1}x", experiment.paper_saving),
-            measured: format!(
-                "{}x (whole run {}x; window holds the strongest beam in {:.2} % of epochs; gated variant: whole run \
-                 {}x, {:.2} %)",
-                windowed.map_or("-".into(), |v| format!("{v:.1}")),
-                r.beams[0].saving().map_or("-".into(), |v| format!("{v:.1}")),
-                100.0 * r.window_hit_rate(0),
-                r.beams[1].saving().map_or("-".into(), |v| format!("{v:.1}")),
-                100.0 * r.window_hit_rate(1),
-            ),
-            met: windowed.is_some_and(|v| {
-                (v - experiment.paper_saving).abs() <= experiment.saving_tolerance * experiment.paper_saving
-            }),
-            informational: false,
-        });
+            "x",
+            Some(experiment.paper_saving),
+            format!("{:.1}x", experiment.paper_saving),
+            Rule::Within {
+                target: experiment.paper_saving,
+                tolerance: experiment.saving_tolerance * experiment.paper_saving,
+            },
+        );
+        let measured = format!(
+            "{}x (whole run {}x; window holds the strongest beam in {:.2} % of epochs; gated variant: whole run \
+             {}x, {:.2} %)",
+            windowed.map_or("-".into(), |v| format!("{v:.1}")),
+            r.beams[0].saving().map_or("-".into(), |v| format!("{v:.1}")),
+            100.0 * r.window_hit_rate(0),
+            r.beams[1].saving().map_or("-".into(), |v| format!("{v:.1}")),
+            100.0 * r.window_hit_rate(1),
+        );
+        out.push(Verdict::judged(claim, windowed, measured));
     }
     if runs >= experiment.time_target_runs {
-        out.push(Verdict {
-            claim: format!("{runs} runs of every manoeuvre in under {} s", experiment.time_target_s),
-            paper: "(issue target, not the paper's)".into(),
-            measured: format!("{elapsed_s:.1} s"),
-            met: elapsed_s < experiment.time_target_s,
-            informational: false,
-        });
+        let claim = Claim::new(
+            format!("{runs} runs of every manoeuvre in under {} s", experiment.time_target_s),
+            "s",
+            None,
+            "(issue target, not the paper's)",
+            Rule::Below { bound: experiment.time_target_s },
+        );
+        out.push(Verdict::judged(claim, Some(elapsed_s), format!("{elapsed_s:.1} s")));
     }
     out
 }
 
-/// The Markdown summary: setup, NMSE table, verdicts, speed.
-pub fn summary(
-    experiment: &Experiment,
-    results: &[ManoeuvreResult],
-    verdicts: &[Verdict],
-    runs: u64,
-    (elapsed_s, threads, load): (f64, usize, (Option<f64>, Option<f64>)),
-) -> String {
+/// The Markdown summary: setup, NMSE table, verdicts, diagnostics, speed,
+/// and the non-line-of-sight paths.
+#[must_use]
+pub fn summary(experiment: &Config, measured: &Measured, verdicts: &[Verdict]) -> String {
+    let Measured { runs, manoeuvres: results, elapsed_s, threads, load, .. } = measured;
+    let (runs, elapsed_s, threads) = (*runs, *elapsed_s, *threads);
     let s = &experiment.scenario;
     let mut out = format!(
         "Written by `mmtrack reproduce zoechmann`. {} GHz UCA of {} elements (radius {} wavelengths), {}-bit phase \
@@ -223,20 +231,7 @@ pub fn summary(
         }
     }
     out.push_str("\n| claim | paper | measured | verdict |\n|---|---|---|---|\n");
-    for v in verdicts {
-        out.push_str(&format!(
-            "| {} | {} | {} | {} |\n",
-            v.claim,
-            v.paper,
-            v.measured,
-            match (v.met, v.informational) {
-                (true, false) => "met",
-                (false, false) => "**missed**",
-                (true, true) => "holds (variant, not a target)",
-                (false, true) => "does not hold (variant, not a target)",
-            }
-        ));
-    }
+    out.push_str(&verdict_rows(verdicts));
     out.push_str(&diagnostics(experiment, results));
     let failures: u64 = results.iter().map(|r| r.failures).sum();
     let epochs: u64 = results.iter().map(|r| r.runs * r.nmse[0].len() as u64).sum();
@@ -254,13 +249,14 @@ pub fn summary(
         fmt(load.0),
         fmt(load.1)
     ));
+    out.push_str(&nlos::summary(&measured.nlos, &experiment.nlos, experiment.scenario.epoch_s));
     out
 }
 
 /// The diagnostics of the full-overtaking miss: the end-of-run NMSE of the
 /// baseline and genies with the quantisation or the Doppler weighting
 /// removed, and where the beam window loses the transmitter.
-fn diagnostics(experiment: &Experiment, results: &[ManoeuvreResult]) -> String {
+fn diagnostics(experiment: &Config, results: &[ManoeuvreResult]) -> String {
     let columns =
         [1, 6, 2, 4, DOPPLER_MPS_FIRST, DOPPLER_MPS_FIRST + 1, DOPPLER_MPS_FIRST + 2, WINDOWED_DOPPLER_MPS, 3];
     let mut out = String::from(
@@ -316,4 +312,103 @@ fn diagnostics(experiment: &Experiment, results: &[ManoeuvreResult]) -> String {
         ));
     }
     out
+}
+
+/// Writes the tables, one figure per manoeuvre, `nlos.svg`, `reproduce.md`
+/// (`summary`) and `metrics.json` into a staging directory that replaces
+/// `output` whole; returns the files written.
+///
+/// # Errors
+/// A table, figure or file cannot be written.
+pub fn write_outputs(
+    output: &Path,
+    experiment: &Config,
+    measured: &Measured,
+    summary: &str,
+    metrics: &[Metric],
+) -> anyhow::Result<Vec<PathBuf>> {
+    let Measured { runs, manoeuvres: results, nlos: nlos_result, .. } = measured;
+    let runs = *runs;
+    let staging = Staged::new(output, "zoechmann")?;
+    let tables = staging.path().join("tables");
+    let info = RunInfo {
+        config_json: serde_json::json!({
+            "command": "reproduce zoechmann",
+            "experiment": experiment.source,
+            "runs": runs,
+            "seed": experiment.seed,
+            "gamma": experiment.gamma,
+            "full_scan_epochs": experiment.full_scan_epochs,
+            "window_beams": experiment.window_beams,
+            "radius_wavelengths": experiment.scenario.radius_wavelengths,
+            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+        })
+        .to_string(),
+    };
+    let epoch_s = experiment.scenario.epoch_s;
+    let mut nmse_rows = Vec::new();
+    let mut summary_rows = Vec::new();
+    for r in results {
+        for (e, name) in ESTIMATORS.iter().enumerate() {
+            for (k, &nmse) in r.nmse[e].iter().enumerate() {
+                nmse_rows.push(ZoechmannNmseRow {
+                    manoeuvre: r.manoeuvre.name.clone(),
+                    estimator: (*name).to_string(),
+                    epoch: k as u64,
+                    t_s: k as f64 * epoch_s,
+                    runs: r.counted[e][k],
+                    nmse,
+                    nmse_db: 10.0 * nmse.log10(),
+                    rmse_m: r.rmse_m[e][k],
+                });
+            }
+        }
+        summary_rows.push(ZoechmannSummaryRow {
+            manoeuvre: r.manoeuvre.name.clone(),
+            runs: r.runs,
+            epochs: r.manoeuvre.epochs(epoch_s) as u64,
+            not_converged_runs: r.runs - r.handovers_s.len() as u64,
+            handover_median_s: r.handover_quantile(0.5),
+            handover_mean_s: r.handover_mean(),
+            handover_p90_s: r.handover_quantile(0.9),
+            handover_median_full_scan_s: quantile(&r.handovers_full_scan_s, 0.5),
+            beams_measured: r.beams[0].measured,
+            beams_full_scan: r.beams[0].full_scan_equivalent,
+            saving: r.beams[0].saving().unwrap_or(f64::NAN),
+            windowed_saving: r.beams[0].windowed_saving(experiment.scenario.beams).unwrap_or(f64::NAN),
+            window_hit_rate: r.window_hit_rate(0),
+            gated_saving: r.beams[1].saving().unwrap_or(f64::NAN),
+            gated_window_hit_rate: r.window_hit_rate(1),
+            first_window_off_share: r.backwards_first_windows as f64 / r.runs.max(1) as f64,
+            estimator_failures: r.failures,
+        });
+    }
+    write_table(&tables, "zoechmann", &nmse_rows, &info, Overwrite::Refuse)?;
+    write_table(&tables, "zoechmann", &summary_rows, &info, Overwrite::Refuse)?;
+    let nlos_errors = nlos::error_rows(nlos_result, epoch_s);
+    write_table(&tables, "zoechmann", &nlos_errors, &info, Overwrite::Refuse)?;
+    write_table(&tables, "zoechmann", &nlos_result.labels, &info, Overwrite::Refuse)?;
+    for r in results {
+        let curves: Vec<NmseCurve> = ESTIMATORS[..PLOTTED]
+            .iter()
+            .enumerate()
+            .map(|(e, name)| NmseCurve { label: (*name).to_string(), nmse: r.nmse[e].clone() })
+            .collect();
+        let title = format!("{}: {} runs (Zoechmann et al. 2019, Figs. 4-5)", r.manoeuvre.name, r.runs);
+        let svg = zoechmann_figure_svg(&title, &r.trace, &curves, epoch_s)?;
+        let file = format!("{}.svg", r.manoeuvre.name);
+        std::fs::write(staging.path().join(&file), svg).with_context(|| file.clone())?;
+    }
+    let walls = &experiment.nlos.walls;
+    let title = format!(
+        "{}: {} runs, each path tracked on its own (line of sight and single wall bounces)",
+        nlos_result.manoeuvre, nlos_result.runs
+    );
+    let svg = zoechmann_nlos_svg(&title, [walls.left_wall_m, walls.right_wall_m], &nlos_result.labels, &nlos_errors)?;
+    std::fs::write(staging.path().join("nlos.svg"), svg).context("nlos.svg")?;
+    std::fs::write(staging.path().join("reproduce.md"), summary)?;
+    write_metrics(staging.path(), metrics)?;
+    let files = staging.files()?;
+    staging.publish()?;
+    Ok(files)
 }

@@ -12,6 +12,9 @@ use mmtrack_slam::{SlamConfig, SlamFilter, SourceStatus};
 
 /// Runs the filter (prior centred on the true first state, Sec. V-A) over
 /// `run` and measures it.
+///
+/// # Errors
+/// A run without epochs, or a filter step fails (naming the epoch).
 pub fn run_filter(
     run: &SlamRun,
     config: &SlamConfig,

@@ -1,12 +1,12 @@
-//! `mmtrack reproduce mpc-artificial`: the artificial-channel experiment of
-//! Mahler et al. 2017, Sec. IV-A, Figs. 4-5 (issue #5).
+//! The Monte Carlo of the artificial-channel experiment of Mahler et al.
+//! 2017, Sec. IV-A, Figs. 4-5.
 //!
 //! Two MPCs of equal power approach in delay over a -140 dB noise floor; the
 //! MPC power is swept. For each power, with and without the Kaiser window,
 //! the proposed tracker (short-term tracking over the whole approach, one
 //! set) and the GM-PHD baseline (Table I) run on the same detections. The
 //! paper compares with ground truth "up to a distance of 2.5 ns", so the
-//! channel approaches from 20 ns to 2.5 ns. Reported per point: the mean
+//! channel approaches from 20 ns to 2.5 ns. Measured per point: the mean
 //! number of tracks (>= 3 detections), how many of them follow a true MPC,
 //! and the mean delay error of those tracks' points against the nearer true
 //! MPC of the same snapshot, overall and per 2.5 ns band of the separation.
@@ -20,208 +20,103 @@
 //! tracker's true tracks at the same point, times c. The paper says its
 //! parameters were "matched to our measurement data"; Table I stays the
 //! reported baseline.
-//!
-//! Targets (PAPERS.md section 2): mean delay error below 0.03 ns at -116 dB
-//! (proposed, Kaiser window); exactly two tracks in every run down to
-//! -126 dB (proposed, Kaiser window).
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
-use anyhow::{Context, bail};
-use clap::Args;
-use mmtrack_analysis::mpc_artificial::{self as plots, ArtificialTracker, SeparationBin, SweepPoint};
+use mmtrack_analysis::mpc_artificial::{ArtificialTracker, SeparationBin, SweepPoint};
+use mmtrack_core::progress::Progress;
 use mmtrack_core::{MpcDetection, MpcTrack, MpcTruth};
-use mmtrack_io::{AtomicFile, Durability, Overwrite};
 use mmtrack_mpc::{
     DetectionConfig, Detector, GmPhdConfig, GmPhdSnapshot, SPEED_OF_LIGHT_M_PER_S, ShortTermConfig, SounderPulse,
 };
-use mmtrack_sim::sounder::{ArtificialChannelConfig, PulseModel, SounderConfig, artificial_channel};
+use mmtrack_sim::sounder::{ArtificialChannelConfig, artificial_channel};
 
-use crate::reproduce_mpc_report::{self as report, README_BLOCK, Sweep};
+use super::config::{Config, END_SEPARATION_NS, SEPARATION_BAND_NS, SEPARATION_BANDS, channel_config};
 
-#[derive(Args)]
-pub struct MpcArtificialArgs {
-    /// Output directory (results.csv, results_by_separation.csv, reproduce.md, SVG figures).
-    #[arg(short, long, default_value = "out/reproduce/mpc-artificial")]
-    output: PathBuf,
-    /// Replace a previous run's output directory.
-    #[arg(long)]
-    force: bool,
-    /// Monte Carlo runs per point (different noise and phases).
-    #[arg(long, default_value_t = 20)]
-    runs: u64,
-    /// Sounder pulse of the artificial channel: `measured-like` (band edges
-    /// rolled off and a small ripple, as a pulse measured through an RF
-    /// cable, which is what the paper used) or `flat` (an ideal band whose
-    /// off-grid paths spread over the whole CIR as a sinc).
-    #[arg(long, value_enum, default_value_t = PulseChoice::MeasuredLike)]
-    pulse: PulseChoice,
-    /// Detection variant: keep the CIR taps below floor + 6 dB instead of
-    /// zeroing them (the paper's step 1 zeroes them). Zeroing cuts the weak
-    /// skirts of each pulse, which costs delay accuracy; this shows how much.
-    #[arg(long)]
-    keep_taps_below_threshold: bool,
-    /// The CI version: 3 runs, powers -100..-130 dB in 6 dB steps plus -116 and -126 dB.
-    #[arg(long)]
-    quick: bool,
-    /// Replace the block `<!-- reproduce-mpc-artificial:begin -->` ... `end`
-    /// in this file with the summary (checked before the run).
-    #[arg(long, value_name = "README.md")]
-    readme: Option<PathBuf>,
+/// Everything one run of the experiment measured.
+#[derive(Debug, Clone)]
+pub struct Sweep {
+    /// The channel (at the first power; only the power changes).
+    pub channel: ArtificialChannelConfig,
+    /// Name of the sounder pulse.
+    pub pulse_name: &'static str,
+    /// Whether detection zeroed the taps below floor + 6 dB (the paper's step 1).
+    pub zero_below_threshold: bool,
+    /// Monte Carlo runs per point.
+    pub runs: u64,
+    /// One per power, window and tracker.
+    pub points: Vec<SweepPoint>,
+    /// Per power, window and tracker, one per separation band.
+    pub bins: Vec<SeparationBin>,
 }
 
-#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum PulseChoice {
-    MeasuredLike,
-    Flat,
-}
+impl Sweep {
+    /// The point of `tracker` at `power_db` with or without the window.
+    #[must_use]
+    pub fn point(&self, power_db: f64, window: bool, tracker: ArtificialTracker) -> Option<&SweepPoint> {
+        self.points.iter().find(|p| p.power_db == power_db && p.kaiser_window == window && p.tracker == tracker)
+    }
 
-impl PulseChoice {
-    fn model(self) -> PulseModel {
-        match self {
-            Self::MeasuredLike => PulseModel::measured_like(),
-            Self::Flat => PulseModel::Flat,
+    /// The swept powers, highest first.
+    #[must_use]
+    pub fn powers_db(&self) -> Vec<f64> {
+        let mut powers: Vec<f64> = self.points.iter().map(|p| p.power_db).collect();
+        powers.sort_by(|a, b| b.total_cmp(a));
+        powers.dedup();
+        powers
+    }
+
+    /// The lowest power down to which `holds` is true at every power from
+    /// the highest one (`None` when it fails at the highest).
+    pub fn down_to(
+        &self,
+        window: bool,
+        tracker: ArtificialTracker,
+        holds: impl Fn(&SweepPoint) -> bool,
+    ) -> Option<f64> {
+        let mut lowest = None;
+        for power_db in self.powers_db() {
+            match self.point(power_db, window, tracker) {
+                Some(p) if holds(p) => lowest = Some(power_db),
+                _ => break,
+            }
         }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Self::MeasuredLike => "measured-like",
-            Self::Flat => "flat",
-        }
+        lowest
     }
 }
 
-/// The approach: from this separation, ns ...
-const START_SEPARATION_NS: f64 = 20.0;
-/// ... down to this one (the paper compares "up to a distance of 2.5 ns").
-const END_SEPARATION_NS: f64 = 2.5;
-/// Width of the separation bands of `results_by_separation.csv`, ns.
-const SEPARATION_BAND_NS: f64 = 2.5;
-/// Number of bands between the end and the start separation.
-const SEPARATION_BANDS: usize = 7;
-const _: () = assert!(END_SEPARATION_NS + SEPARATION_BAND_NS * SEPARATION_BANDS as f64 == START_SEPARATION_NS);
-/// Powers in the separation figure (present in both the quick and the full sweep).
-const SEPARATION_PLOT_POWERS_DB: [f64; 5] = [-100.0, -112.0, -116.0, -124.0, -126.0];
-
-pub fn run(args: &MpcArtificialArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    if args.output.exists() && !args.force {
-        bail!("{}: exists; use --force to replace it (nothing was done)", args.output.display());
-    }
-    anyhow::ensure!(args.runs >= 1, "--runs must be at least 1 (nothing was done)");
-    if let Some(readme) = &args.readme {
-        crate::readme_block::check_block(readme, README_BLOCK)?;
-    }
-    let powers_db: Vec<f64> = if args.quick {
-        vec![-100.0, -106.0, -112.0, -116.0, -118.0, -124.0, -126.0, -130.0]
-    } else {
-        (0..=16).map(|i| -100.0 - 2.0 * f64::from(i)).collect()
-    };
-    let runs = if args.quick { 3 } else { args.runs };
-    let pulse = args.pulse.model();
+/// Runs `runs` realisations at every power of `powers_db`, with and without
+/// the Kaiser window; one progress item per power.
+///
+/// # Errors
+/// A detector or tracker set-up fails, or the simulator does.
+pub fn measure(config: &Config, powers_db: &[f64], runs: u64, progress: &dyn Progress) -> anyhow::Result<Sweep> {
+    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    let pulse = config.pulse.model();
     let mut sweep = Sweep {
         channel: channel_config(powers_db.first().copied().unwrap_or(-116.0), &pulse),
-        pulse_name: args.pulse.name(),
-        zero_below_threshold: !args.keep_taps_below_threshold,
+        pulse_name: config.pulse.name(),
+        zero_below_threshold: config.zero_below_threshold,
         runs,
         points: Vec::new(),
         bins: Vec::new(),
     };
-    for &power_db in &powers_db {
+    progress.start("reproduce mpc-artificial", powers_db.len() as u64, "powers");
+    for &power_db in powers_db {
         for window in [true, false] {
             let detection = DetectionConfig {
                 kaiser_beta: window.then_some(6.0),
-                zero_below_threshold: !args.keep_taps_below_threshold,
+                zero_below_threshold: config.zero_below_threshold,
                 ..DetectionConfig::default()
             };
             let (points, bins) = sweep_point(&channel_config(power_db, &pulse), detection, runs)?;
             sweep.points.extend(points);
             sweep.bins.extend(bins);
         }
-        if !quiet {
-            eprintln!("reproduce mpc-artificial: {power_db} dB done");
-        }
+        progress.advance(1);
     }
-    let markdown = report::markdown(&sweep);
-    std::fs::create_dir_all(&args.output).with_context(|| args.output.display().to_string())?;
-    write_atomically(&args.output.join("results.csv"), &report::csv(&sweep.points))?;
-    write_atomically(&args.output.join("results_by_separation.csv"), &report::separation_csv(&sweep.bins))?;
-    write_atomically(&args.output.join("reproduce.md"), &markdown)?;
-    crate::reproduce_all::write_metrics(&args.output, &report::metrics(&sweep))?;
-    write_figures(&sweep, &args.output)?;
-    if let Some(readme) = &args.readme {
-        let summary = report::readme_summary(&sweep, &figures_location(readme, &args.output));
-        crate::readme_block::replace_block(readme, README_BLOCK, &summary)?;
-    }
-    if !quiet {
-        println!("{markdown}");
-        println!("outputs: {}", args.output.display());
-    }
-    Ok(if report::verdicts(&sweep).all_met() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
-}
-
-/// The artificial channel at one MPC power.
-fn channel_config(power_db: f64, pulse: &PulseModel) -> ArtificialChannelConfig {
-    ArtificialChannelConfig {
-        mpc_power_db: power_db,
-        start_separation_s: START_SEPARATION_NS * 1e-9,
-        end_separation_s: END_SEPARATION_NS * 1e-9,
-        sounder: SounderConfig { pulse: pulse.clone(), ..Default::default() },
-        ..ArtificialChannelConfig::default()
-    }
-}
-
-fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write as _;
-    let file = AtomicFile::create(path, Overwrite::Replace)?;
-    let mut writer = file.writer()?;
-    writer.write_all(text.as_bytes()).with_context(|| path.display().to_string())?;
-    writer.flush().with_context(|| path.display().to_string())?;
-    drop(writer);
-    file.commit(Overwrite::Replace, Durability::Fsync)?;
-    Ok(())
-}
-
-/// The figures, next to results.csv (names in [`report::FIGURES`]).
-fn write_figures(sweep: &Sweep, dir: &Path) -> anyhow::Result<()> {
-    let [tracks, error, separation] = report::FIGURES;
-    let power = report::TARGET_ERROR_POWER_DB;
-    let svgs = [
-        (tracks.0, plots::tracks_vs_power_svg(&sweep.points, report::TARGET_TWO_TRACKS_DOWN_TO_DB)?),
-        (error.0, plots::delay_error_vs_power_svg(&sweep.points, report::TARGET_ERROR_NS, power)?),
-        (
-            separation.0,
-            plots::delay_error_vs_separation_svg(
-                &sweep.bins,
-                ArtificialTracker::Proposed,
-                true,
-                &SEPARATION_PLOT_POWERS_DB,
-                report::TARGET_ERROR_NS,
-            )?,
-        ),
-    ];
-    for (name, svg) in svgs {
-        write_atomically(&dir.join(name), &svg)?;
-    }
-    Ok(())
-}
-
-/// Where the README finds the figures: the output directory relative to the
-/// README's directory when it lies below it, else the path as given.
-fn figures_location(readme: &Path, output: &Path) -> report::FiguresAt {
-    let readme_dir = match readme.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    match (readme_dir.canonicalize(), output.canonicalize()) {
-        (Ok(base), Ok(out)) => match out.strip_prefix(&base) {
-            Ok(relative) => report::FiguresAt::Relative(relative.to_path_buf()),
-            Err(_) => report::FiguresAt::Elsewhere(output.to_path_buf()),
-        },
-        _ => report::FiguresAt::Elsewhere(output.to_path_buf()),
-    }
+    progress.finish();
+    Ok(sweep)
 }
 
 /// One Monte Carlo run's detections (as GM-PHD input) and truth, kept for

@@ -1,0 +1,321 @@
+//! `reproduce --all [--smoke]`: every paper experiment in one call, each
+//! checked against the values this code is expected to measure
+//! ([`crate::expectation`]).
+//!
+//! Each experiment writes, beside its own report, `metrics.json`: the
+//! numbers it measured, with units and the paper's number where the paper
+//! gives one ([`crate::model::write_metrics`]). A metric outside its
+//! tolerance, a metric the expectation names but the run did not produce,
+//! and a metric without an expectation are misses (the CLI exits 1).
+//!
+//! With a README (full runs only) the experiments that have a README block
+//! rewrite it, and the block `reproduce-all` receives the table of every
+//! metric; a test checks that block against the expectation files, so a
+//! README that no longer matches them fails CI.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context;
+use mmtrack_core::progress::Progress;
+
+use crate::expectation::{Check, ExpectedMetric, compare, parse_expected, table};
+use crate::model::{Metric, Outcome, RunOptions, Tier};
+use crate::{kim, mpc_artificial, readme_block, shaham, zoechmann};
+
+/// The README block that receives the table of every metric.
+pub const README_BLOCK: &str = "reproduce-all";
+
+/// How [`run_all`] runs an experiment.
+#[derive(Clone, Copy)]
+enum Runner {
+    /// An experiment of this crate: its check before the work (output
+    /// directory replaceable, README block present) and its run on the
+    /// embedded configuration.
+    Library {
+        check_start: fn(&Path, bool, Option<&Path>) -> anyhow::Result<()>,
+        run: fn(&RunOptions, &dyn Progress) -> anyhow::Result<Outcome>,
+    },
+    /// An experiment still inside the CLI, run through [`PendingExperiments`].
+    // TODO(issue 24): odometry and spebt move here once mmtrack-process exists.
+    Pending,
+}
+
+/// One experiment of [`run_all`].
+pub struct Experiment {
+    /// Its name (the CLI's subcommand).
+    pub name: &'static str,
+    /// Whether it has a README block of its own.
+    pub readme: bool,
+    /// Its expectation file (embedded: the call runs from anywhere).
+    pub expected: &'static str,
+    /// The file's path in the repository, for messages.
+    pub expected_path: &'static str,
+    runner: Runner,
+}
+
+impl Experiment {
+    /// The parsed expectation file.
+    ///
+    /// # Errors
+    /// See [`parse_expected`].
+    pub fn expectations(&self) -> anyhow::Result<Vec<ExpectedMetric>> {
+        parse_expected(self.expected_path, self.expected)
+    }
+}
+
+/// Every experiment, in the order [`run_all`] runs them.
+pub const EXPERIMENTS: [Experiment; 6] = [
+    Experiment {
+        name: "odometry",
+        readme: false,
+        expected: include_str!("../../../data/reproduce/odometry.expected.toml"),
+        expected_path: "data/reproduce/odometry.expected.toml",
+        runner: Runner::Pending,
+    },
+    Experiment {
+        name: mpc_artificial::NAME,
+        readme: true,
+        expected: include_str!("../../../data/reproduce/mpc-artificial.expected.toml"),
+        expected_path: "data/reproduce/mpc-artificial.expected.toml",
+        runner: Runner::Library { check_start: mpc_artificial::check_start, run: run_mpc_artificial },
+    },
+    Experiment {
+        name: shaham::NAME,
+        readme: true,
+        expected: include_str!("../../../data/reproduce/shaham.expected.toml"),
+        expected_path: "data/reproduce/shaham.expected.toml",
+        runner: Runner::Library { check_start: shaham::check_start, run: run_shaham },
+    },
+    Experiment {
+        name: "spebt",
+        readme: true,
+        expected: include_str!("../../../data/reproduce/spebt.expected.toml"),
+        expected_path: "data/reproduce/spebt.expected.toml",
+        runner: Runner::Pending,
+    },
+    Experiment {
+        name: zoechmann::NAME,
+        readme: true,
+        expected: include_str!("../../../data/reproduce/zoechmann.expected.toml"),
+        expected_path: "data/reproduce/zoechmann.expected.toml",
+        runner: Runner::Library { check_start: zoechmann::check_start, run: run_zoechmann },
+    },
+    Experiment {
+        name: kim::NAME,
+        readme: true,
+        expected: include_str!("../../../data/reproduce/kim.expected.toml"),
+        expected_path: "data/reproduce/kim.expected.toml",
+        runner: Runner::Library { check_start: kim::check_start, run: run_kim },
+    },
+];
+
+fn run_mpc_artificial(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    mpc_artificial::run(&mpc_artificial::Config::default(), options, progress)
+}
+
+fn run_shaham(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    shaham::run(&shaham::Config::embedded()?, options, progress)
+}
+
+fn run_zoechmann(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    zoechmann::run(&zoechmann::Config::embedded()?, options, progress)
+}
+
+fn run_kim(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    kim::run(&kim::Config::embedded()?, None, options, progress)
+}
+
+/// Runs the experiments that still live in the CLI (`odometry`, `spebt`)
+/// for [`run_all`]: a temporary hook.
+// TODO(issue 24): odometry and spebt move here once mmtrack-process exists.
+pub trait PendingExperiments {
+    /// Runs experiment `name` into `options.output_dir` (replacing an earlier
+    /// output there), at `options.tier` with its own run count, rewriting
+    /// its README block in `options.readme` when given, and returns the
+    /// metrics it measured (as written to its `metrics.json`).
+    ///
+    /// # Errors
+    /// The experiment could not run. A missed paper target is not an error.
+    fn run(&self, name: &str, options: &RunOptions) -> anyhow::Result<Vec<Metric>>;
+}
+
+impl<F: Fn(&str, &RunOptions) -> anyhow::Result<Vec<Metric>>> PendingExperiments for F {
+    fn run(&self, name: &str, options: &RunOptions) -> anyhow::Result<Vec<Metric>> {
+        self(name, options)
+    }
+}
+
+/// What [`run_all`] does.
+#[derive(Debug, Clone)]
+pub struct AllOptions {
+    /// Smoke (each experiment's CI version, against the smoke
+    /// expectations) or full.
+    pub tier: Tier,
+    /// One subdirectory per experiment, and `summary.md`.
+    pub output_dir: PathBuf,
+    /// The README whose experiment blocks and `reproduce-all` block are
+    /// rewritten (full runs only).
+    pub readme: Option<PathBuf>,
+}
+
+/// What [`run_all`] measured.
+#[derive(Debug, Clone)]
+pub struct AllOutcome {
+    /// Every metric against its expectation, experiment by experiment.
+    pub checks: Vec<Check>,
+    /// The Markdown summary (also `summary.md`, and the README block).
+    pub summary: String,
+}
+
+impl AllOutcome {
+    /// Metrics outside their expectation (missing and unexpected ones included).
+    #[must_use]
+    pub fn misses(&self) -> usize {
+        self.checks.iter().filter(|c| !c.ok()).count()
+    }
+}
+
+/// Runs every experiment of [`EXPERIMENTS`] into `options.output_dir/<name>`
+/// and checks each metric against its expectation; writes `summary.md`
+/// and, with a README, the blocks. `pending` runs the experiments still in
+/// the CLI. Progress: each experiment's stages, and a note per experiment.
+///
+/// # Errors
+/// A README without its blocks (checked before any work), an expectation
+/// file that does not parse, an experiment that fails, an output that
+/// cannot be written. Misses are not errors: see [`AllOutcome::misses`].
+pub fn run_all(
+    options: &AllOptions,
+    pending: &dyn PendingExperiments,
+    progress: &dyn Progress,
+) -> anyhow::Result<AllOutcome> {
+    anyhow::ensure!(
+        !(options.tier.is_smoke() && options.readme.is_some()),
+        "the README blocks come from full runs only (nothing was done)"
+    );
+    if let Some(readme) = &options.readme {
+        readme_block::check_block(readme, README_BLOCK)?;
+    }
+    let expectations: Vec<Vec<ExpectedMetric>> =
+        EXPERIMENTS.iter().map(Experiment::expectations).collect::<anyhow::Result<_>>()?;
+    std::fs::create_dir_all(&options.output_dir).with_context(|| options.output_dir.display().to_string())?;
+    let started = Instant::now();
+    let mut checks = Vec::new();
+    let mut timings = Vec::new();
+    for (k, (experiment, expected)) in EXPERIMENTS.iter().zip(&expectations).enumerate() {
+        let dir = options.output_dir.join(experiment.name);
+        let readme = options.readme.clone().filter(|_| experiment.readme);
+        progress.note(&format!(
+            "[{}/{}] reproduce {}{} -> {}",
+            k + 1,
+            EXPERIMENTS.len(),
+            experiment.name,
+            if options.tier.is_smoke() { " (smoke)" } else { "" },
+            dir.display()
+        ));
+        let run_options = RunOptions { tier: options.tier, runs: None, output_dir: dir, readme };
+        let experiment_started = Instant::now();
+        let measured = match experiment.runner {
+            Runner::Library { check_start, run } => {
+                check_start(&run_options.output_dir, true, run_options.readme.as_deref())?;
+                let outcome = run(&run_options, progress).with_context(|| format!("reproduce {}", experiment.name))?;
+                if let Some(readme) = &run_options.readme {
+                    readme_block::replace_block(readme, outcome.readme.name, &outcome.readme.body)?;
+                }
+                outcome.metrics
+            }
+            Runner::Pending => {
+                pending.run(experiment.name, &run_options).with_context(|| format!("reproduce {}", experiment.name))?
+            }
+        };
+        let seconds = experiment_started.elapsed().as_secs_f64();
+        timings.push((experiment.name, seconds));
+        let these = compare(experiment.name, &measured, expected, options.tier);
+        let misses = these.iter().filter(|c| !c.ok()).count();
+        progress.note(&format!("      {} metrics, {misses} missed, {seconds:.1} s", these.len()));
+        checks.extend(these);
+    }
+    let total_s = started.elapsed().as_secs_f64();
+    let misses = checks.iter().filter(|c| !c.ok()).count();
+    let threads = rayon::current_num_threads();
+    let timing = timings.iter().map(|(n, s)| format!("{n} {s:.1} s")).collect::<Vec<_>>().join(", ");
+    let mode = if options.tier.is_smoke() { "smoke (--quick)" } else { "full" };
+    let mut summary = format!(
+        "Written by `mmtrack reproduce --all{}`: {} metrics of {} experiments, {misses} outside their expected \
+         range. Expected values (data/reproduce/<experiment>.expected.toml) are what this code measured when the \
+         results were written, with absolute tolerances; the paper's numbers beside them.\n\n",
+        if options.tier.is_smoke() { " --smoke" } else { "" },
+        checks.len(),
+        EXPERIMENTS.len()
+    );
+    summary.push_str(&table(&checks));
+    let _ = writeln!(summary, "\n{mode} runs in {total_s:.1} s on {threads} threads ({timing}).");
+    let summary_path = options.output_dir.join("summary.md");
+    std::fs::write(&summary_path, &summary).with_context(|| summary_path.display().to_string())?;
+    if let Some(readme) = &options.readme {
+        readme_block::replace_block(readme, README_BLOCK, &summary)?;
+    }
+    Ok(AllOutcome { checks, summary })
+}
+
+/// Checks the README's `reproduce-all` block against the expectation
+/// files: every full-run expectation appears as a row whose measured value
+/// lies within its tolerance. Returns the problems (empty when current).
+#[must_use]
+#[cfg(test)]
+pub fn stale_readme_rows(readme: &str) -> Vec<String> {
+    let begin = format!("<!-- {README_BLOCK}:begin -->");
+    let end = format!("<!-- {README_BLOCK}:end -->");
+    let Some(block) = readme.split(&begin).nth(1).and_then(|rest| rest.split(&end).next()) else {
+        return vec![format!("README has no {begin} ... {end} block")];
+    };
+    let mut problems = Vec::new();
+    for spec in &EXPERIMENTS {
+        let expected = match spec.expectations() {
+            Ok(e) => e,
+            Err(e) => return vec![format!("{e:#}")],
+        };
+        for e in expected {
+            let row = block.lines().find(|l| l.starts_with(&format!("| {} | {} |", spec.name, e.key)));
+            let measured = row.and_then(|r| r.split('|').nth(4)).and_then(|cell| cell.trim().parse::<f64>().ok());
+            match measured {
+                None => problems.push(format!("{} `{}`: no row with a measured value", spec.name, e.key)),
+                Some(m) if (m - e.full.value).abs() > e.full.tolerance => problems.push(format!(
+                    "{} `{}`: README says {m}, {} expects {} +- {}",
+                    spec.name, e.key, spec.expected_path, e.full.value, e.full.tolerance
+                )),
+                Some(_) => {}
+            }
+        }
+    }
+    problems
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The README's `reproduce-all` table agrees with the expectation
+    /// files (written by `reproduce --all --readme README.md`).
+    #[test]
+    fn the_readme_table_matches_the_expectation_files() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md");
+        let readme = std::fs::read_to_string(&path).unwrap();
+        let problems = stale_readme_rows(&readme);
+        assert!(
+            problems.is_empty(),
+            "README.md's {README_BLOCK} block is stale (run `mmtrack reproduce --all --readme README.md`):\n{}",
+            problems.join("\n")
+        );
+    }
+
+    #[test]
+    fn every_expectation_file_parses() {
+        for spec in &EXPERIMENTS {
+            let expected = spec.expectations().unwrap();
+            assert!(!expected.is_empty(), "{}", spec.expected_path);
+        }
+    }
+}

@@ -1,0 +1,186 @@
+//! The Monte Carlo of the Kim experiment.
+//!
+//! On the paper's circular-road world (`mmtrack_sim::slam`), the filter of
+//! `mmtrack_slam` runs over Monte Carlo realisations (each its own 10 random
+//! SPs, trajectory and noise) of every row of the experiment: the paper's
+//! setting, then the robustness rows (detection probability 0.9, one
+//! clutter path per epoch). Reported per row: the mean over runs of the
+//! time-averaged UE position, heading, clock-bias (and smoothed speed and
+//! turn-rate) errors, the VA and SP localisation errors, and the epochs at
+//! which all VAs and all SPs are confirmed.
+//!
+//! Runs are computed on rayon and collected in run order; each filter's
+//! particles draw from streams seeded by (seed, run, epoch, chunk), so the
+//! numbers do not depend on the thread count.
+
+use std::time::Instant;
+
+use anyhow::Context;
+use mmtrack_core::progress::Progress;
+use mmtrack_io::table::{SlamPerEpochRow, SlamSummaryRow};
+use mmtrack_sim::slam::SlamScenario;
+use mmtrack_slam::SlamConfig;
+use rayon::prelude::*;
+
+use super::config::{Config, Row};
+use super::evaluate::{EpochErrors, RunOutcome, run_filter};
+use crate::common::load_average;
+
+/// What one row measured.
+#[derive(Debug, Clone)]
+pub struct RowResult {
+    /// The row.
+    pub row: Row,
+    /// Means over its runs.
+    pub summary: SlamSummaryRow,
+    /// Means over its runs, per epoch.
+    pub per_epoch: Vec<SlamPerEpochRow>,
+    /// Run 0, for the map figure.
+    pub first: RunOutcome,
+}
+
+/// What the whole Monte Carlo measured, and how long it took.
+#[derive(Debug, Clone)]
+pub struct Measured {
+    /// Runs per row.
+    pub runs: u64,
+    /// The filter every row ran (its detection probability adapted per row).
+    pub filter: SlamConfig,
+    /// One per row, in the file's order.
+    pub rows: Vec<RowResult>,
+    /// Wall time, seconds.
+    pub elapsed_s: f64,
+    /// Threads of the rayon pool.
+    pub threads: usize,
+    /// 1-minute load average before and after.
+    pub load: (Option<f64>, Option<f64>),
+}
+
+/// Runs `runs` realisations of every row of `experiment` with `filter`.
+///
+/// # Errors
+/// An invalid row, a simulator or filter failure (naming the row and run).
+pub fn measure(
+    experiment: &Config,
+    filter: &SlamConfig,
+    runs: u64,
+    progress: &dyn Progress,
+) -> anyhow::Result<Measured> {
+    let source = &experiment.source;
+    let load_before = load_average();
+    let started = Instant::now();
+    progress.start("reproduce kim", runs * experiment.rows.len() as u64, "runs");
+    let mut results = Vec::new();
+    for row in &experiment.rows {
+        let scenario = SlamScenario {
+            detection_probability: row.detection_probability,
+            clutter_per_epoch: row.clutter_per_epoch,
+            ..experiment.scenario.clone()
+        };
+        scenario.validate().with_context(|| format!("{source}: row {}", row.name))?;
+        // The filter assumes the row's detection probability (0.99 for P_D = 1, eq. (3)).
+        let config = SlamConfig {
+            detection_probability: row.detection_probability.min(filter.detection_probability),
+            ..filter.clone()
+        };
+        let outcomes: Vec<RunOutcome> = (0..runs)
+            .into_par_iter()
+            .map(|r| {
+                let realised = scenario.realise(experiment.seed, r)?;
+                let filter_seed = experiment.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ r;
+                let outcome = run_filter(
+                    &realised,
+                    &config,
+                    filter_seed,
+                    experiment.match_radius_m,
+                    experiment.sp_min_detections,
+                )
+                .with_context(|| format!("row {}, run {r}", row.name));
+                progress.advance(1);
+                outcome
+            })
+            .collect::<anyhow::Result<_>>()?;
+        results.push(aggregate(row, &scenario, &config, &outcomes)?);
+    }
+    progress.finish();
+    Ok(Measured {
+        runs,
+        filter: filter.clone(),
+        rows: results,
+        elapsed_s: started.elapsed().as_secs_f64(),
+        threads: rayon::current_num_threads(),
+        load: (load_before, load_average()),
+    })
+}
+
+/// Means over the runs of one row.
+fn aggregate(
+    row: &Row,
+    scenario: &SlamScenario,
+    config: &SlamConfig,
+    outcomes: &[RunOutcome],
+) -> anyhow::Result<RowResult> {
+    let first = outcomes.first().context("no runs")?.clone();
+    let n = outcomes.len() as f64;
+    let never = scenario.epochs + 1;
+    let averages: Vec<[Option<f64>; 7]> = outcomes.iter().map(RunOutcome::time_averages).collect();
+    let mean_of = |i: usize| -> Option<f64> {
+        let v: Vec<f64> = averages.iter().filter_map(|a| a[i]).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    let epochs_of = |f: &dyn Fn(&RunOutcome) -> Option<usize>| -> (f64, u64) {
+        let v: Vec<usize> = outcomes.iter().map(|o| f(o).unwrap_or(never)).collect();
+        (v.iter().sum::<usize>() as f64 / n, v.iter().copied().max().unwrap_or(never) as u64)
+    };
+    let (va_mean, va_max) = epochs_of(&|o| o.all_va_epoch);
+    let (sp_mean, sp_max) = epochs_of(&|o| o.all_sp_epoch);
+    let summary = SlamSummaryRow {
+        row: row.name.clone(),
+        runs: outcomes.len() as u64,
+        epochs: scenario.epochs as u64,
+        particles: config.particles as u64,
+        detection_probability: row.detection_probability,
+        clutter_per_epoch: row.clutter_per_epoch as u64,
+        ue_position_error_m: mean_of(0).unwrap_or(f64::NAN),
+        ue_error_over_spread: {
+            let all = || outcomes.iter().flat_map(|o| o.epochs.iter());
+            let e2: f64 = all().map(|e| e.position_m * e.position_m).sum();
+            let s2: f64 = all().map(|e| e.position_std_m * e.position_std_m).sum();
+            (e2 / s2).sqrt()
+        },
+        ue_heading_error_rad: mean_of(1).unwrap_or(f64::NAN),
+        ue_clock_bias_error_m: mean_of(2).unwrap_or(f64::NAN),
+        ue_speed_error_mps: mean_of(3).unwrap_or(f64::NAN),
+        ue_turn_rate_error_radps: mean_of(4).unwrap_or(f64::NAN),
+        va_error_m: mean_of(5),
+        sp_error_m: mean_of(6),
+        all_va_epoch_mean: va_mean,
+        all_va_epoch_max: va_max,
+        all_sp_epoch_mean: sp_mean,
+        all_sp_epoch_max: sp_max,
+        false_sources: outcomes.iter().map(|o| o.false_sources as f64).sum::<f64>() / n,
+        skipped_paths: outcomes.iter().map(|o| o.skipped_paths as u64).sum(),
+    };
+    let per_epoch = (0..scenario.epochs)
+        .map(|k| {
+            let at: Vec<_> = outcomes.iter().filter_map(|o| o.epochs.get(k)).collect();
+            let m = at.len().max(1) as f64;
+            let opt = |f: &dyn Fn(&EpochErrors) -> Option<f64>| {
+                let v: Vec<f64> = at.iter().filter_map(|e| f(e)).collect();
+                (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+            };
+            SlamPerEpochRow {
+                row: row.name.clone(),
+                epoch: k as u64 + 1,
+                ue_position_error_m: at.iter().map(|e| e.position_m).sum::<f64>() / m,
+                ue_heading_error_rad: at.iter().map(|e| e.heading_rad).sum::<f64>() / m,
+                ue_clock_bias_error_m: at.iter().map(|e| e.clock_bias_m).sum::<f64>() / m,
+                va_error_m: opt(&|e| e.va_m),
+                sp_error_m: opt(&|e| e.sp_m),
+                confirmed_va: at.iter().map(|e| e.confirmed_va as f64).sum::<f64>() / m,
+                confirmed_sp: at.iter().map(|e| e.confirmed_sp as f64).sum::<f64>() / m,
+            }
+        })
+        .collect();
+    Ok(RowResult { row: row.clone(), summary, per_epoch, first })
+}

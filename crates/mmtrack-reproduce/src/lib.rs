@@ -1,0 +1,40 @@
+//! # mmtrack-reproduce
+//!
+//! The paper experiments of mmtrack as library values: each experiment is a
+//! folder with its configuration (today's `data/reproduce/<name>.toml`,
+//! embedded), its Monte Carlo, and its report, and one entry point
+//! `run(config, options, progress) -> Outcome`. The outcome holds the
+//! metrics measured, the verdicts on the paper's claims, the files written,
+//! the Markdown report and the README block.
+//!
+//! It sits in the *reproduce* stage of the data flow, above the algorithms
+//! (`mmtrack-mpc`, `-beam`, `-slam`), the simulators (`mmtrack-sim`), `io`
+//! and `analysis`. It writes files (tables, figures, reports) but never
+//! prints and knows no command line: progress goes through
+//! [`mmtrack_core::progress::Progress`], and the CLI (or Python) decides
+//! what to show and which exit code a missed target gives.
+//!
+//! - [`model`]: the one model every experiment reports in ([`Metric`],
+//!   [`Claim`] and its [`Rule`], [`Verdict`], [`Tier`], [`RunOptions`],
+//!   [`Outcome`]);
+//! - [`expectation`]: the regression check against
+//!   `data/reproduce/<experiment>.expected.toml` (separate from the
+//!   verdicts: "did our numbers move?", not "does it reproduce the paper?");
+//! - [`mpc_artificial`], [`shaham`], [`zoechmann`], [`kim`]: the
+//!   experiments (the odometry and SPEBT experiments still live in the CLI
+//!   until the pipelines they run are a library);
+//! - [`all`]: every experiment in one call, checked against its expectations;
+//! - [`common`], [`readme_block`]: output directories, experiment files,
+//!   README blocks.
+
+pub mod all;
+pub mod common;
+pub mod expectation;
+pub mod kim;
+pub mod model;
+pub mod mpc_artificial;
+pub mod readme_block;
+pub mod shaham;
+pub mod zoechmann;
+
+pub use model::{Claim, Metric, Outcome, ReadmeBlock, Rule, RunOptions, Tier, Verdict};

@@ -1,0 +1,319 @@
+//! The one model every experiment reports in.
+//!
+//! Two different questions, two kinds of record (STYLE.md, detectron2):
+//!
+//! - "does it reproduce the paper?": a [`Claim`] of the paper (what, unit,
+//!   the paper's number, the [`Rule`] it is judged by) and its [`Verdict`]
+//!   (the measured value, met or not). Missed targets make the CLI exit 1.
+//! - "did our numbers move?": the [`Metric`]s an experiment measured,
+//!   checked against `data/reproduce/<experiment>.expected.toml` by
+//!   [`crate::expectation`]. The expectations are our earlier runs, never
+//!   the paper's numbers.
+//!
+//! A run of an experiment returns an [`Outcome`] holding both, the files it
+//! wrote, its Markdown report and its README block.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use serde::{Deserialize, Serialize};
+
+/// How long an experiment runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Tier {
+    /// The CI version (the CLI's `--quick`, `reproduce --all --smoke`):
+    /// fewer runs or points, checked against the smoke expectations.
+    Smoke,
+    /// The run the README's results come from.
+    Full,
+}
+
+impl Tier {
+    /// `true` for [`Tier::Smoke`].
+    #[must_use]
+    pub fn is_smoke(self) -> bool {
+        self == Self::Smoke
+    }
+}
+
+/// Where and how long one experiment runs.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Smoke or full.
+    pub tier: Tier,
+    /// Monte Carlo runs, replacing the tier's count of the experiment file.
+    pub runs: Option<u64>,
+    /// The output directory; an earlier output there is replaced (the
+    /// caller checks first that it may be, e.g. with
+    /// [`crate::common::check_start`]).
+    pub output_dir: PathBuf,
+    /// The README the caller will write [`Outcome::readme`] into, if any:
+    /// links from the block to the figures are relative to it. The run
+    /// does not write it.
+    pub readme: Option<PathBuf>,
+}
+
+impl RunOptions {
+    /// `tier` into `output_dir`, the experiment's own run count, no README.
+    #[must_use]
+    pub fn new(tier: Tier, output_dir: impl Into<PathBuf>) -> Self {
+        Self { tier, runs: None, output_dir: output_dir.into(), readme: None }
+    }
+}
+
+/// File name of an experiment's measured metrics, beside its report.
+pub const METRICS_FILE: &str = "metrics.json";
+
+/// One number an experiment measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Metric {
+    /// Stable name, the key of the expectation file.
+    pub key: String,
+    /// Measured value (finite).
+    pub value: f64,
+    /// Unit, for display ("blocks", "deg", "%", "ns").
+    pub unit: String,
+    /// The paper's number, where it gives one.
+    pub paper: Option<f64>,
+}
+
+impl Metric {
+    /// A metric.
+    pub fn new(key: impl Into<String>, value: f64, unit: &str, paper: Option<f64>) -> Self {
+        Self { key: key.into(), value, unit: unit.to_string(), paper }
+    }
+}
+
+/// Writes `metrics` as `dir/metrics.json`.
+///
+/// # Errors
+/// A metric that is not finite (named), or the file cannot be written.
+pub fn write_metrics(dir: &Path, metrics: &[Metric]) -> anyhow::Result<()> {
+    if let Some(bad) = metrics.iter().find(|m| !m.value.is_finite()) {
+        bail!("metric `{}` is {}; expected a finite value", bad.key, bad.value);
+    }
+    let path = dir.join(METRICS_FILE);
+    let text = serde_json::to_string_pretty(metrics).context("metrics as JSON")?;
+    std::fs::write(&path, text + "\n").with_context(|| path.display().to_string())
+}
+
+/// How a claim is judged against the measured value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Rule {
+    /// Strictly below `bound`.
+    Below {
+        /// The bound, in the claim's unit.
+        bound: f64,
+    },
+    /// At most `bound`.
+    AtMost {
+        /// The bound, in the claim's unit.
+        bound: f64,
+    },
+    /// At least `bound`.
+    AtLeast {
+        /// The bound, in the claim's unit.
+        bound: f64,
+    },
+    /// `|measured - target| <= tolerance`.
+    Within {
+        /// The value aimed at, in the claim's unit.
+        target: f64,
+        /// Largest accepted deviation, in the claim's unit (absolute).
+        tolerance: f64,
+    },
+    /// A relation between several measured values (an ordering), which the
+    /// experiment checks itself; `description` says which.
+    Ordering {
+        /// The relation, in words ("nullspace <= error-free <= proposed < Ho-Chan").
+        description: String,
+    },
+}
+
+impl Rule {
+    /// Whether `measured` satisfies a numeric rule (`None` for
+    /// [`Rule::Ordering`], which the experiment decides).
+    #[must_use]
+    pub fn holds(&self, measured: f64) -> Option<bool> {
+        Some(match *self {
+            Self::Below { bound } => measured < bound,
+            Self::AtMost { bound } => measured <= bound,
+            Self::AtLeast { bound } => measured >= bound,
+            Self::Within { target, tolerance } => (measured - target).abs() <= tolerance,
+            Self::Ordering { .. } => return None,
+        })
+    }
+}
+
+/// A published number or statement of a paper, and how it is judged.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Claim {
+    /// What is claimed, as the report prints it ("valid tracking, SNR 0 dB,
+    /// 60 km/h (Fig. 2), within 15 %").
+    pub what: String,
+    /// Unit of the measured value ("" for orderings).
+    pub unit: String,
+    /// The paper's number, where the claim has one.
+    pub paper_value: Option<f64>,
+    /// The paper's side as the report prints it ("99 blocks", "ordering of
+    /// Figs. 4-5", "-" for variants the paper does not have).
+    pub paper_text: String,
+    /// How the measured value is judged.
+    pub rule: Rule,
+    /// Reported beside the targets, not a target: does not set the exit
+    /// status (a variant or diagnostic of ours).
+    pub informational: bool,
+}
+
+impl Claim {
+    /// A target claim.
+    pub fn new(
+        what: impl Into<String>,
+        unit: &str,
+        paper_value: Option<f64>,
+        paper_text: impl Into<String>,
+        rule: Rule,
+    ) -> Self {
+        Self {
+            what: what.into(),
+            unit: unit.to_string(),
+            paper_value,
+            paper_text: paper_text.into(),
+            rule,
+            informational: false,
+        }
+    }
+
+    /// The same claim, reported but not a target.
+    #[must_use]
+    pub fn informational(self) -> Self {
+        Self { informational: true, ..self }
+    }
+}
+
+/// A claim against what was measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Verdict {
+    /// The claim.
+    pub claim: Claim,
+    /// The measured value, in the claim's unit (`None`: not measured, or
+    /// an ordering of several values).
+    pub measured: Option<f64>,
+    /// Whether the claim holds.
+    pub met: bool,
+    /// The measurement as the report prints it, with units and details
+    /// ("168 blocks", "> 400 blocks", "-21.3 / -20.1 / -19.0 / -2.4 dB").
+    pub note: String,
+}
+
+impl Verdict {
+    /// Judges `measured` by the claim's numeric rule: not met when nothing
+    /// was measured, nor for an [`Rule::Ordering`] claim (which takes
+    /// [`Verdict::decided`]).
+    pub fn judged(claim: Claim, measured: Option<f64>, note: impl Into<String>) -> Self {
+        let met = measured.and_then(|m| claim.rule.holds(m)).unwrap_or(false);
+        Self { claim, measured, met, note: note.into() }
+    }
+
+    /// A verdict the experiment decided itself (orderings).
+    pub fn decided(claim: Claim, met: bool, note: impl Into<String>) -> Self {
+        Self { claim, measured: None, met, note: note.into() }
+    }
+
+    /// The verdict column of the reports: "met", "**missed**", or for
+    /// informational claims whether the relation holds.
+    #[must_use]
+    pub fn word(&self) -> &'static str {
+        match (self.met, self.claim.informational) {
+            (true, false) => "met",
+            (false, false) => "**missed**",
+            (true, true) => "holds (variant, not a target)",
+            (false, true) => "does not hold (variant, not a target)",
+        }
+    }
+}
+
+/// `| claim | paper | measured | verdict |` rows, one per verdict (the
+/// header is the experiment's).
+#[must_use]
+pub fn verdict_rows(verdicts: &[Verdict]) -> String {
+    let mut out = String::new();
+    for v in verdicts {
+        let _ = writeln!(out, "| {} | {} | {} | {} |", v.claim.what, v.claim.paper_text, v.note, v.word());
+    }
+    out
+}
+
+/// A generated block of a README: the text between `<!-- {name}:begin -->`
+/// and `<!-- {name}:end -->` ([`crate::readme_block`] writes it).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ReadmeBlock {
+    /// The block's name (`reproduce-shaham`).
+    pub name: &'static str,
+    /// Its new body.
+    pub body: String,
+}
+
+/// What one run of an experiment produced.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// The experiment's name (`shaham`, the CLI's subcommand).
+    pub experiment: &'static str,
+    /// The numbers measured, for the regression check (also written as
+    /// `metrics.json` in the output directory).
+    pub metrics: Vec<Metric>,
+    /// The paper's claims against the measurement.
+    pub verdicts: Vec<Verdict>,
+    /// Every file written, under the output directory.
+    pub files: Vec<PathBuf>,
+    /// The Markdown report (`reproduce.md`).
+    pub report: String,
+    /// The README block the run rewrites when asked to.
+    pub readme: ReadmeBlock,
+}
+
+impl Outcome {
+    /// Every target claim met (informational ones do not count).
+    #[must_use]
+    pub fn targets_met(&self) -> bool {
+        self.verdicts.iter().all(|v| v.met || v.claim.informational)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rules_judge_the_measured_value_and_nothing_measured_is_a_miss() {
+        let claim = |rule| Claim::new("x", "m", Some(1.0), "1 m", rule);
+        assert!(Verdict::judged(claim(Rule::Below { bound: 1.0 }), Some(0.99), "").met);
+        assert!(!Verdict::judged(claim(Rule::Below { bound: 1.0 }), Some(1.0), "").met);
+        assert!(Verdict::judged(claim(Rule::AtMost { bound: 1.0 }), Some(1.0), "").met);
+        assert!(Verdict::judged(claim(Rule::AtLeast { bound: 1.0 }), Some(1.0), "").met);
+        assert!(Verdict::judged(claim(Rule::Within { target: 10.0, tolerance: 1.5 }), Some(8.5), "").met);
+        assert!(!Verdict::judged(claim(Rule::Within { target: 10.0, tolerance: 1.5 }), Some(8.4), "").met);
+        assert!(!Verdict::judged(claim(Rule::AtMost { bound: 1.0 }), None, "").met);
+        let ordering = claim(Rule::Ordering { description: "a < b".into() });
+        assert!(!Verdict::judged(ordering.clone(), Some(0.0), "").met, "orderings are decided, not judged");
+        assert!(Verdict::decided(ordering, true, "").met);
+    }
+
+    #[test]
+    fn informational_claims_do_not_set_the_outcome_and_print_their_own_words() {
+        let missed =
+            Verdict::decided(Claim::new("v", "", None, "-", Rule::AtLeast { bound: 1.0 }).informational(), false, "0");
+        assert_eq!(missed.word(), "does not hold (variant, not a target)");
+        let outcome = Outcome {
+            experiment: "x",
+            metrics: Vec::new(),
+            verdicts: vec![missed.clone()],
+            files: Vec::new(),
+            report: String::new(),
+            readme: ReadmeBlock { name: "x", body: String::new() },
+        };
+        assert!(outcome.targets_met());
+        assert_eq!(verdict_rows(&[missed]), "| v | - | 0 | does not hold (variant, not a target) |\n");
+    }
+}
