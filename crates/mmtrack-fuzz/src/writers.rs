@@ -97,18 +97,6 @@ pub fn npy(version: u8, descr: &str, fortran: bool, shape: &str, data: &[u8]) ->
     out
 }
 
-/// CRC-32 (IEEE, reflected), as ZIP uses.
-#[must_use]
-pub fn crc32(data: &[u8]) -> u32 {
-    !data.iter().fold(!0u32, |mut c, &byte| {
-        c ^= u32::from(byte);
-        for _ in 0..8 {
-            c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
-        }
-        c
-    })
-}
-
 /// A raw DEFLATE stream of stored (uncompressed) blocks.
 #[must_use]
 pub fn deflate_stored(data: &[u8]) -> Vec<u8> {
@@ -130,14 +118,9 @@ pub fn deflate_stored(data: &[u8]) -> Vec<u8> {
 /// A zlib stream of stored blocks, with its Adler-32.
 #[must_use]
 pub fn zlib_stored(data: &[u8]) -> Vec<u8> {
-    let (mut a, mut b) = (1u32, 0u32);
-    for &byte in data {
-        a = (a + u32::from(byte)) % 65_521;
-        b = (b + a) % 65_521;
-    }
     let mut out = vec![0x78, 0x01];
     out.extend(deflate_stored(data));
-    out.extend_from_slice(&((b << 16) | a).to_be_bytes());
+    out.extend_from_slice(&adler2::adler32_slice(data).to_be_bytes());
     out
 }
 
@@ -154,7 +137,7 @@ pub fn zip(members: &[(&str, Vec<u8>)], deflate: bool) -> Vec<u8> {
             out.extend_from_slice(&0u16.to_le_bytes()); // flags
             out.extend_from_slice(&(if deflate { 8u16 } else { 0 }).to_le_bytes());
             out.extend_from_slice(&[0; 4]); // time, date
-            out.extend_from_slice(&crc32(data).to_le_bytes());
+            out.extend_from_slice(&crc32fast::hash(data).to_le_bytes());
             out.extend_from_slice(&(body.len() as u32).to_le_bytes());
             out.extend_from_slice(&(data.len() as u32).to_le_bytes());
             out.extend_from_slice(&(name.len() as u16).to_le_bytes());

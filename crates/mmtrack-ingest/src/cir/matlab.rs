@@ -18,13 +18,14 @@
 //! file). One [`CirSnapshot`] is produced per (TX, RX) antenna pair, TX-major.
 //!
 //! Choices:
-//! - Written by hand, with a small zlib decoder (`inflate.rs`), because this
-//!   crate depends on no `.mat` or decompression crate (the `matfile` crate,
-//!   which reads these files, was dropped from the workspace as a dependency).
-//!   MATLAB's default `-v7` files compress every variable (the real sample
-//!   below is compressed), so a reader without zlib could not open them. Being
-//!   our own code, errors name the variable, the byte offset and the
-//!   sub-element, and big-endian files are read too.
+//! - The file structure is read here, by hand: the crate depends on no `.mat`
+//!   crate (the `matfile` crate, which reads these files, was dropped from the
+//!   workspace as a dependency). MATLAB's default `-v7` files compress every
+//!   variable (the real sample below is compressed); the zlib streams are
+//!   inflated by `miniz_oxide` (the inflater the `png` crate already brings),
+//!   bounded as `inflate.rs` says. Being our own code, errors name the
+//!   variable, the byte offset and the sub-element, and big-endian files are
+//!   read too.
 //! - A real (non-complex) array is refused unless [`MatCirLayout::allow_real`]:
 //!   a real "CIR" is usually a magnitude or a power profile, and treating it as
 //!   complex amplitudes with zero phase would silently mislabel it.

@@ -9,10 +9,10 @@
 //! error naming the dtype found.
 //!
 //! `.npz` is a ZIP archive of `<name>.npy` members (`np.savez` stores them,
-//! `np.savez_compressed` deflates them). The ZIP reader is ours, using the
-//! crate's DEFLATE decoder (`inflate.rs`) rather than adding a ZIP crate for
-//! one member of one archive; it checks each member's CRC-32 and reads ZIP64
-//! sizes, which NumPy writes. A deflated member may inflate to 16 MiB plus
+//! `np.savez_compressed` deflates them). The ZIP reader is ours, inflating
+//! with `miniz_oxide` (`inflate.rs`) rather than adding a ZIP crate for one
+//! member of one archive; it checks each member's CRC-32 (`crc32fast`) and
+//! reads ZIP64 sizes, which NumPy writes. A deflated member may inflate to 16 MiB plus
 //! 100 times its compressed size (`inflate::inflate_limit`: decompression
 //! bombs), and is refused before inflating when it declares more.
 
@@ -376,24 +376,11 @@ fn member_data(b: &[u8], m: &Member) -> Result<Vec<u8>, String> {
     if data.len() as u64 != m.uncompressed {
         return Err(format!("{} bytes after decompression, the directory says {}", data.len(), m.uncompressed));
     }
-    let crc = crc32(&data);
+    let crc = crc32fast::hash(&data);
     if crc != m.crc {
         return Err(format!("CRC-32 0x{crc:08x} of the data, expected 0x{:08x}", m.crc));
     }
     Ok(data)
-}
-
-/// CRC-32 (IEEE 802.3, reflected, as ZIP uses).
-pub(crate) fn crc32(data: &[u8]) -> u32 {
-    let mut table = [0u32; 256];
-    for (i, entry) in table.iter_mut().enumerate() {
-        let mut c = i as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
-        }
-        *entry = c;
-    }
-    !data.iter().fold(!0u32, |c, &byte| table[((c ^ u32::from(byte)) & 0xff) as usize] ^ (c >> 8))
 }
 
 #[cfg(test)]

@@ -23,7 +23,7 @@ pub(crate) fn stored_zip(members: &[(&str, Vec<u8>)]) -> Vec<u8> {
     let (mut out, mut central) = (Vec::new(), Vec::new());
     for (name, data) in members {
         let offset = out.len() as u32;
-        let (crc, len) = (crc32(data), data.len() as u32);
+        let (crc, len) = (crc32fast::hash(data), data.len() as u32);
         let common = |out: &mut Vec<u8>| {
             out.extend_from_slice(&20u16.to_le_bytes()); // version needed
             out.extend_from_slice(&[0, 0, 0, 0, 0, 0, 0, 0]); // flags, method 0, time, date
@@ -153,7 +153,7 @@ fn npz_decompression_bomb_is_refused() {
         let mut zip = stored_zip(&[("h.npy", stream)]);
         let directory = u32::from_le_bytes(zip[zip.len() - 6..zip.len() - 2].try_into().unwrap()) as usize;
         zip[directory + 10..directory + 12].copy_from_slice(&8u16.to_le_bytes());
-        zip[directory + 16..directory + 20].copy_from_slice(&crc32(data).to_le_bytes());
+        zip[directory + 16..directory + 20].copy_from_slice(&crc32fast::hash(data).to_le_bytes());
         zip[directory + 24..directory + 28].copy_from_slice(&declared.to_le_bytes());
         zip
     };
@@ -167,4 +167,33 @@ fn npz_decompression_bomb_is_refused() {
         e.contains(&format!("200000000 bytes when inflated from {compressed} compressed bytes: more than 100 times")),
         "{e}"
     );
+}
+
+/// The bound holds while inflating, not only on what the directory
+/// declares: a member declaring a plausible size whose stream (32 MiB of
+/// zeros, really deflated) inflates past it is refused once the output
+/// reaches the declared size, naming the file, the member and the field.
+#[test]
+fn npz_member_inflating_past_its_declared_size_is_refused() {
+    let p = Path::new("bomb.npz");
+    let zeros = vec![0u8; 32 << 20];
+    let stream = miniz_oxide::deflate::compress_to_vec(&zeros, 6);
+    let declared = 1_000_000u32;
+    let mut zip = stored_zip(&[("h.npy", stream.clone())]);
+    let directory = u32::from_le_bytes(zip[zip.len() - 6..zip.len() - 2].try_into().unwrap()) as usize;
+    zip[directory + 10..directory + 12].copy_from_slice(&8u16.to_le_bytes());
+    zip[directory + 16..directory + 20].copy_from_slice(&crc32fast::hash(&zeros).to_le_bytes());
+    zip[directory + 24..directory + 28].copy_from_slice(&declared.to_le_bytes());
+    let e = parse_npz(p, &zip, None).unwrap_err().to_string();
+    assert!(
+        e.starts_with("bomb.npz: member `h.npy`: ZIP member: ")
+            && e.contains("decompresses to more than 1000000 bytes"),
+        "{e}"
+    );
+    // Declaring the true size, the member is refused before inflating.
+    zip[directory + 24..directory + 28].copy_from_slice(&(zeros.len() as u32).to_le_bytes());
+    let e = parse_npz(p, &zip, None).unwrap_err().to_string();
+    let expected =
+        format!("{} bytes when inflated from {} compressed bytes: more than 100 times", zeros.len(), stream.len());
+    assert!(e.starts_with("bomb.npz: member `h.npy`: ZIP member: ") && e.contains(&expected), "{e}");
 }
