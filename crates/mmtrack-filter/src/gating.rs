@@ -10,7 +10,7 @@ use faer::Col;
 
 use crate::error::{FilterError, ensure_positive};
 use crate::gaussian::Gaussian;
-use crate::gmphd::Label;
+use crate::label::Label;
 
 /// One (prediction, measurement) pair put to a [`Gate`].
 #[derive(Debug, Clone, Copy)]

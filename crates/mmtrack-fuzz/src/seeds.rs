@@ -10,10 +10,15 @@ use std::path::{Path, PathBuf};
 
 use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader};
 use mmtrack_ingest::cir::{MatCirLayout, read_mat_cir};
-use mmtrack_ingest::oxford::{OXFORD, decode_scan_png, encode_scan_png};
+use mmtrack_ingest::oxford::{NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
 use mmtrack_io::recording::RawReader;
 
 use crate::writers::{CdrWriter, mat_v5, nmea_sentence, npy, zip};
+
+/// Oxford's layout with any number of bins and rows, as Boreas and MulRan
+/// read: the layout the small PNG seeds are encoded with and the `png`
+/// target's first decode.
+pub const ANY_SIZE: NavtechLayout = NavtechLayout { expected_bins: None, expected_azimuths: None, ..OXFORD };
 
 /// The real-data folder: `$MMTRACK_REALDATA`, else `../shared/realdata`
 /// beside the workspace; `None` when absent (a user's fresh clone).
@@ -68,7 +73,7 @@ fn scan(rows: usize, bins: usize) -> PolarScan {
 /// Oxford scan that compresses to a few KiB).
 #[must_use]
 pub fn png(realdata: Option<&Path>) -> Vec<Vec<u8>> {
-    let any = crate::targets::ANY_SIZE;
+    let any = ANY_SIZE;
     let mut out: Vec<Vec<u8>> =
         [(4, 16), (2, 1), (8, 40)].iter().filter_map(|&(r, b)| encode_scan_png(&scan(r, b), &any).ok()).collect();
     let Some(dir) = realdata else { return out };

@@ -30,7 +30,7 @@ use mmtrack_ingest::cir::{
     parse_decawave_log_detailed, parse_npy_matrix, read_cir_file, read_mat_cir,
 };
 use mmtrack_ingest::nmea::parse_nmea;
-use mmtrack_ingest::oxford::{NavtechLayout, OXFORD, decode_scan_png};
+use mmtrack_ingest::oxford::{OXFORD, decode_scan_png};
 use mmtrack_ingest::ros2::{decode_nav_sat_fix, decode_odometry, decode_pose_with_covariance_stamped};
 use mmtrack_ingest::ros2_image::{decode_image, image_to_scan};
 use mmtrack_ingest::sweep::SweepTiming;
@@ -147,12 +147,9 @@ pub fn png_chunk_crcs(png: &mut [u8]) {
     }
 }
 
-/// Oxford's layout with any number of bins and rows, as Boreas and MulRan read.
-pub const ANY_SIZE: NavtechLayout = NavtechLayout { expected_bins: None, expected_azimuths: None, ..OXFORD };
-
 fn png(_: &Scratch, input: &[u8]) -> String {
     let path = Path::new("fuzz.png");
-    let any = decode_scan_png(path, input, 1, &ANY_SIZE).map(|d| d.into_scan().power.len());
+    let any = decode_scan_png(path, input, 1, &seeds::ANY_SIZE).map(|d| d.into_scan().power.len());
     let oxford = decode_scan_png(path, input, 1, &OXFORD).map(|d| d.width);
     format!("{} | {}", outcome(&any), outcome(&oxford))
 }

@@ -18,6 +18,7 @@
 
 pub mod beams;
 pub mod boreas;
+pub mod cdr;
 pub mod cir;
 mod csv;
 mod error;

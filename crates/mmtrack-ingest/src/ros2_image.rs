@@ -3,7 +3,7 @@
 //! Layout (CDR, after the encapsulation header): `header` (`stamp`,
 //! `frame_id`), `uint32 height`, `uint32 width`, `string encoding`,
 //! `uint8 is_bigendian`, `uint32 step`, `sequence<uint8> data`. Decoded by hand
-//! with the bounds-checked reader of [`crate::ros2`]: a truncated or corrupt
+//! with the bounds-checked reader of [`crate::cdr`]: a truncated or corrupt
 //! message is an error naming the field.
 //!
 //! As a polar scan: `mono8` (or `8UC1`), one image row per azimuth and one
@@ -16,7 +16,7 @@
 
 use mmtrack_core::{PolarScan, PolarScanHeader};
 
-use crate::ros2::Cdr;
+use crate::cdr::Cdr;
 use crate::sweep::SweepTiming;
 
 /// A decoded `sensor_msgs/msg/Image`, pixels borrowed from the message.

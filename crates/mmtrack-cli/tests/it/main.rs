@@ -10,6 +10,7 @@ mod bench_mpc;
 mod cli;
 mod common;
 mod error_lines;
+mod file_cycles;
 mod fixtures;
 mod foxglove_views;
 mod independent_readers;

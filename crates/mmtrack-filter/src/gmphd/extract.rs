@@ -17,9 +17,10 @@
 
 use std::collections::BTreeMap;
 
-use super::{Component, Label};
+use super::Component;
 use crate::error::{FilterError, ensure_in_range};
 use crate::gaussian::Gaussian;
+use crate::label::Label;
 
 /// Upper bound on the copies one component yields (`round(w)` beyond it
 /// would only come from a nonsensical birth weight; it keeps memory bounded).

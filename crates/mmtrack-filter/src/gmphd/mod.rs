@@ -57,13 +57,9 @@ use crate::error::{FilterError, ensure_in_range, ensure_len};
 use crate::gating::Gate;
 use crate::gaussian::Gaussian;
 use crate::kalman::{KalmanPredictor, KalmanUpdater};
+use crate::label::Label;
 use crate::models::TransitionModel;
 use faer::Col;
-
-/// Identity of a component lineage; extracted states with the same label form
-/// a track.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct Label(pub u64);
 
 /// One weighted Gaussian of the intensity, with its label.
 #[derive(Debug, Clone, PartialEq)]

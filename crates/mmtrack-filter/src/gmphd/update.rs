@@ -21,10 +21,11 @@ use std::collections::BTreeMap;
 
 use faer::Col;
 
-use super::{Component, GmPhdParams, Label};
+use super::{Component, GmPhdParams};
 use crate::error::{FilterError, ensure_finite_vector, ensure_len};
 use crate::gating::{Gate, GateCandidate};
 use crate::kalman::KalmanUpdater;
+use crate::label::Label;
 
 /// How strongly one label was associated with one measurement in an update.
 #[derive(Debug, Clone, Copy, PartialEq)]

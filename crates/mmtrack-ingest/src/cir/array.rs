@@ -22,6 +22,20 @@ pub(crate) struct NdComplex {
     pub values: Vec<Complex64>,
 }
 
+/// A numeric MATLAB array read from a v7.3 file, in MATLAB's terms (what the
+/// libhdf5 reader, `hdf5_read.rs`, gives `hdf5.rs`).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct MatlabArray {
+    /// `MATLAB_class`: `double`, `single`, `int8`, ... (`double` when absent).
+    pub class: String,
+    /// MATLAB's dimensions (the HDF5 dimensions reversed).
+    pub dims: Vec<usize>,
+    /// Real parts in MATLAB's column-major order.
+    pub real: Vec<f64>,
+    /// Imaginary parts, for a complex array.
+    pub imag: Option<Vec<f64>>,
+}
+
 /// Element strides of an array stored in C (row-major) or Fortran (column-major) order.
 pub(crate) fn strides(dims: &[usize], column_major: bool) -> Vec<usize> {
     let mut out = vec![0; dims.len()];

@@ -48,25 +48,12 @@
 use std::io::Read;
 use std::path::Path;
 
-use super::array::NdComplex;
+use super::array::{MatlabArray, NdComplex};
 use crate::IngestError;
 use crate::error::os_err;
 
 /// The 8-byte HDF5 format signature (`\x89HDF\r\n\x1a\n`).
 pub(crate) const HDF5_SIGNATURE: [u8; 8] = [0x89, b'H', b'D', b'F', b'\r', b'\n', 0x1a, b'\n'];
-
-/// A numeric MATLAB array read from a v7.3 file, in MATLAB's terms.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) struct MatlabArray {
-    /// `MATLAB_class`: `double`, `single`, `int8`, ... (`double` when absent).
-    pub class: String,
-    /// MATLAB's dimensions (the HDF5 dimensions reversed).
-    pub dims: Vec<usize>,
-    /// Real parts in MATLAB's column-major order.
-    pub real: Vec<f64>,
-    /// Imaginary parts, for a complex array.
-    pub imag: Option<Vec<f64>>,
-}
 
 /// Whether the start of a `.mat` file (its first 520 bytes suffice) is a
 /// MATLAB v7.3 (HDF5) file rather than a v5/v7 one (see the module docs).

@@ -19,8 +19,7 @@ use h5::types::{FixedAscii, TypeDescriptor};
 use hdf5_metno as h5;
 use mmtrack_core::Complex64;
 
-use super::array::NdComplex;
-use super::hdf5::MatlabArray;
+use super::array::{MatlabArray, NdComplex};
 use crate::IngestError;
 use crate::error::os_err;
 

@@ -23,6 +23,9 @@ pub const RADAR_META_TOPIC: &str = "/radar/scan_meta";
 pub const GNSS_TOPIC: &str = "/gnss/fix";
 /// Display view of GNSS fixes.
 pub const GNSS_VIZ_TOPIC: &str = "/viz/gnss";
+/// Topic of the coordinate-frame transforms (`foxglove.FrameTransforms`; the
+/// frames are in [`super::tf`]).
+pub const TF_TOPIC: &str = "/tf";
 /// Topic of channel impulse responses.
 pub const CIR_TOPIC: &str = "/channel/cir";
 /// Topic of the true multipath components of simulated CIRs.
@@ -206,7 +209,7 @@ pub const CHANNELS: &[ChannelSpec] = &[
                   left out); same sequence number and time as the /radar/image it shows",
     },
     ChannelSpec {
-        topic: super::tf::TF_TOPIC,
+        topic: TF_TOPIC,
         schema_names: &["foxglove.FrameTransforms"],
         canonical: false,
         meaning: "coordinate frames for Foxglove's 3D panel: world -> base_link at each ground-truth pose, \

@@ -1,6 +1,7 @@
-//! Coordinate frames of a recording as Foxglove sees them: `/tf` carries
-//! `foxglove.FrameTransforms` messages, so the 3D panel can place the
-//! vehicle, its sensors and the estimates.
+//! Coordinate frames of a recording as Foxglove sees them: `/tf`
+//! ([`super::channels::TF_TOPIC`]) carries `foxglove.FrameTransforms`
+//! messages, so the 3D panel can place the vehicle, its sensors and the
+//! estimates.
 //!
 //! The tree:
 //!
@@ -29,8 +30,6 @@ use mmtrack_core::Se2;
 
 use super::channels::PoseStream;
 
-/// Topic of the transforms.
-pub const TF_TOPIC: &str = "/tf";
 /// The fixed frame of poses and ground truth.
 pub const WORLD_FRAME: &str = "world";
 /// The vehicle, as the ground truth places it.

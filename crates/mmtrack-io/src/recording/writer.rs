@@ -12,13 +12,11 @@ use super::METADATA_NAME;
 use super::cartesian::{CartesianGrid, CartesianResampler};
 use super::channels::{
     BEAM_SWEEP_TOPIC, CIR_TOPIC, GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC,
-    PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC,
+    PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC, TF_TOPIC,
 };
 use super::metadata::RecordingMetadata;
 use super::reader::RawMessage;
-use super::tf::{
-    GNSS_FRAME, RADAR_FRAME, TF_TOPIC, VEHICLE_FRAME, frame_transform, timestamp, vehicle_frame, yaw_quaternion,
-};
+use super::tf::{GNSS_FRAME, RADAR_FRAME, VEHICLE_FRAME, frame_transform, timestamp, vehicle_frame, yaw_quaternion};
 use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
