@@ -41,23 +41,12 @@ const ALLOWED_CYCLES: &[&[&str]] = &[
         "crates/mmtrack-analysis/src/tables.rs",
     ],
     &[
-        "crates/mmtrack-cli/src/beam/process.rs",
-        "crates/mmtrack-cli/src/beam/process_spebt.rs",
         "crates/mmtrack-cli/src/beam/reproduce_spebt.rs",
         "crates/mmtrack-cli/src/beam/spebt_odometry.rs",
         "crates/mmtrack-cli/src/beam/spebt_output.rs",
         "crates/mmtrack-cli/src/beam/spebt_report.rs",
-        "crates/mmtrack-cli/src/process.rs",
         "crates/mmtrack-cli/src/reproduce.rs",
-        "crates/mmtrack-cli/src/slam/process.rs",
     ],
-    &["crates/mmtrack-cli/src/beam/reproduce_shaham.rs", "crates/mmtrack-cli/src/beam/shaham_report.rs"],
-    &[
-        "crates/mmtrack-cli/src/beam/reproduce_zoechmann.rs",
-        "crates/mmtrack-cli/src/beam/zoechmann_nlos.rs",
-        "crates/mmtrack-cli/src/beam/zoechmann_report.rs",
-    ],
-    &["crates/mmtrack-cli/src/slam/kim_report.rs", "crates/mmtrack-cli/src/slam/reproduce_kim.rs"],
 ];
 
 /// Where an allowlisted cycle may be.
