@@ -4,9 +4,10 @@
 //! analyzed as usual into `<out>/run=<id>/`, then compared side by side.
 //!
 //! The comparison is a polars query over the Hive-partitioned result tables
-//! the runs just wrote: a lazy scan of
-//! `<out>/run=*/tables/<table>/sequence=*/part-0.parquet` per result table
-//! (the `run` and `sequence` columns come from the paths), group-bys per run
+//! the runs just wrote: the files
+//! `<out>/run=*/tables/<table>/sequence=*/part-0.parquet` of each result
+//! table, read with the `parquet` crate into one polars frame (the `run` and
+//! `sequence` columns come from the paths, as in a Hive scan), group-bys per run
 //! for the pooled rows, and one long table `run_comparison` (run, table,
 //! sequence, key, metric, unit, value) that the report turns into one
 //! side-by-side table per result table.
@@ -21,14 +22,12 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use anyhow::{Context, bail};
 use mmtrack_io::table::TableSpec;
 use polars::df;
 use polars::prelude::{
-    DataFrame, DataType, Expr, Field, HiveOptions, IntoLazy, LazyFrame, NULL, PlRefPath, PlSmallStr, ScanArgsParquet,
-    Schema, SortMultipleOptions, col, lit, when,
+    Column, DataFrame, DataType, Expr, IntoLazy, LazyFrame, NULL, PlSmallStr, SortMultipleOptions, col, lit, when,
 };
 
 use crate::tables::TrajectoryMetrics;
@@ -183,35 +182,112 @@ pub fn discover_runs(inputs: &[PathBuf]) -> anyhow::Result<Vec<RunTables>> {
     Ok(runs)
 }
 
-/// A lazy scan of `<out>/run=*/tables/<table>/sequence=*/part-0.parquet`
-/// with `run` and `sequence` as string columns from the paths; `None` when
-/// no run has the table.
-pub fn scan_runs(out: &Path, table: &str) -> anyhow::Result<Option<LazyFrame>> {
-    let any = std::fs::read_dir(out)
-        .with_context(|| out.display().to_string())?
-        .filter_map(Result::ok)
-        .any(|e| e.file_name().to_string_lossy().starts_with("run=") && e.path().join("tables").join(table).is_dir());
-    if !any {
-        return Ok(None);
-    }
-    let pattern = out.join("run=*").join("tables").join(table).join("sequence=*").join("part-0.parquet");
-    let pattern = pattern.to_str().with_context(|| format!("{}: not UTF-8", out.display()))?.to_string();
-    let hive_schema: Schema =
-        [Field::new("run".into(), DataType::String), Field::new("sequence".into(), DataType::String)]
-            .into_iter()
-            .collect();
-    let args = ScanArgsParquet {
-        hive_options: HiveOptions {
-            enabled: Some(true),
-            hive_start_idx: 0,
-            schema: Some(Arc::new(hive_schema)),
-            try_parse_dates: false,
-        },
-        ..ScanArgsParquet::default()
+/// The `part-0.parquet` files of `<out>/run=*/tables/<table>/sequence=*/`
+/// as (run, sequence, file), sorted.
+fn run_partitions(out: &Path, table: &str) -> anyhow::Result<Vec<(String, String, PathBuf)>> {
+    let prefixed = |dir: &Path, prefix: &str| -> anyhow::Result<Vec<(String, PathBuf)>> {
+        let mut found = Vec::new();
+        for entry in std::fs::read_dir(dir).with_context(|| dir.display().to_string())? {
+            let entry = entry.with_context(|| dir.display().to_string())?;
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if let Some(value) = name.strip_prefix(prefix)
+                && entry.path().is_dir()
+            {
+                found.push((value.to_string(), entry.path()));
+            }
+        }
+        found.sort();
+        Ok(found)
     };
-    let frame = LazyFrame::scan_parquet(PlRefPath::new(pattern.as_str()), args)
-        .with_context(|| format!("{pattern}: cannot scan"))?;
-    Ok(Some(frame))
+    let mut files = Vec::new();
+    for (run, run_dir) in prefixed(out, "run=")? {
+        let table_dir = run_dir.join("tables").join(table);
+        if !table_dir.is_dir() {
+            continue;
+        }
+        for (sequence, dir) in prefixed(&table_dir, "sequence=")? {
+            let file = dir.join("part-0.parquet");
+            if file.is_file() {
+                files.push((run.clone(), sequence, file));
+            }
+        }
+    }
+    Ok(files)
+}
+
+/// One Arrow column as a polars column; `None` for the types the
+/// comparison never reads (lists, binary).
+fn polars_column(name: &str, array: &dyn arrow_array::Array) -> Option<Column> {
+    use arrow_array::cast::AsArray;
+    use arrow_array::types::{Float64Type, Int64Type, UInt32Type, UInt64Type};
+    use arrow_schema::DataType as Arrow;
+    let name = PlSmallStr::from(name);
+    Some(match array.data_type() {
+        Arrow::Int64 => Column::new(name, array.as_primitive::<Int64Type>().iter().collect::<Vec<_>>()),
+        Arrow::UInt64 => Column::new(name, array.as_primitive::<UInt64Type>().iter().collect::<Vec<_>>()),
+        Arrow::UInt32 => Column::new(name, array.as_primitive::<UInt32Type>().iter().collect::<Vec<_>>()),
+        Arrow::Float64 => Column::new(name, array.as_primitive::<Float64Type>().iter().collect::<Vec<_>>()),
+        Arrow::Boolean => Column::new(name, array.as_boolean().iter().collect::<Vec<_>>()),
+        Arrow::Utf8 => Column::new(name, array.as_string::<i32>().iter().collect::<Vec<_>>()),
+        Arrow::LargeUtf8 => Column::new(name, array.as_string::<i64>().iter().collect::<Vec<_>>()),
+        _ => return None,
+    })
+}
+
+/// One Parquet file as a polars frame of its scalar columns (read with the
+/// `parquet` crate: polars itself is built without Parquet support).
+fn read_frame(path: &Path) -> anyhow::Result<DataFrame> {
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    let file = std::fs::File::open(path).with_context(|| path.display().to_string())?;
+    let builder = ParquetRecordBatchReaderBuilder::try_new(file).with_context(|| path.display().to_string())?;
+    // Starting from an empty batch keeps the columns of a file without rows.
+    let empty = arrow_array::RecordBatch::new_empty(builder.schema().clone());
+    let reader = builder.build().with_context(|| path.display().to_string())?;
+    let mut frame: Option<DataFrame> = None;
+    for batch in std::iter::once(Ok(empty)).chain(reader) {
+        let batch = batch.with_context(|| path.display().to_string())?;
+        let columns: Vec<Column> = batch
+            .schema()
+            .fields()
+            .iter()
+            .zip(batch.columns())
+            .filter_map(|(field, array)| polars_column(field.name(), array.as_ref()))
+            .collect();
+        let part = DataFrame::new(columns).with_context(|| path.display().to_string())?;
+        match frame.as_mut() {
+            None => frame = Some(part),
+            Some(frame) => {
+                frame.vstack_mut(&part).with_context(|| path.display().to_string())?;
+            }
+        }
+    }
+    frame.with_context(|| format!("{}: no columns", path.display()))
+}
+
+/// The rows of `<out>/run=*/tables/<table>/sequence=*/part-0.parquet`,
+/// with `run` and `sequence` as string columns from the paths (as a Hive
+/// scan gives them), as a lazy frame for the comparison queries; `None`
+/// when no run has the table. The files are read into memory (a few rows
+/// per run and sequence).
+pub fn read_runs(out: &Path, table: &str) -> anyhow::Result<Option<LazyFrame>> {
+    let mut frame: Option<DataFrame> = None;
+    for (run, sequence, file) in run_partitions(out, table)? {
+        let mut part = read_frame(&file)?;
+        let height = part.height();
+        for (name, value) in [("run", &run), ("sequence", &sequence)] {
+            part.with_column(Column::new(name.into(), vec![value.as_str(); height]))
+                .with_context(|| file.display().to_string())?;
+        }
+        match frame.as_mut() {
+            None => frame = Some(part),
+            Some(frame) => {
+                frame
+                    .vstack_mut(&part)
+                    .with_context(|| format!("{}: columns differ from the other runs' {table}", file.display()))?;
+            }
+        }
+    }
+    Ok(frame.map(IntoLazy::lazy))
 }
 
 /// `sqrt(sum(w v^2) / sum(w))`, 0 when the weights sum to 0.
@@ -374,7 +450,7 @@ fn long_rows(
 pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<RunComparisonRow>> {
     let mut rows = Vec::new();
     for compared in &COMPARED {
-        let Some(frame) = scan_runs(out, compared.spec.name)? else { continue };
+        let Some(frame) = read_runs(out, compared.spec.name)? else { continue };
         let what = || format!("{}: runs side by side", out.join("run=*/tables").join(compared.spec.name).display());
         let mut select: Vec<Expr> = vec![col("run"), col("sequence")];
         select.extend(compared.keys.iter().map(|k| col(*k)));
@@ -533,6 +609,100 @@ mod tests {
         let empty = dir.path().join("empty");
         std::fs::create_dir_all(&empty).unwrap();
         assert_eq!(discover_runs(std::slice::from_ref(&empty)).unwrap()[0].tables, empty);
+    }
+
+    fn trajectory(poses: u64, segments: u64, kitti_pct: Option<f64>, ate_m: f64) -> TrajectoryMetrics {
+        TrajectoryMetrics {
+            estimate_poses: poses,
+            associated_poses: poses,
+            interpolated_poses: 0,
+            dropped_poses: 0,
+            first_t_ns: 0,
+            last_t_ns: 1,
+            path_length_m: 100.0,
+            estimate_path_length_m: 101.0,
+            segment_lengths_m: vec![10.0],
+            step_frames: Some(1),
+            step_m: None,
+            kitti_segments: segments,
+            kitti_translational_pct: kitti_pct,
+            kitti_rotational_deg_per_m: kitti_pct.map(|p| p / 100.0),
+            kitti_rotational_deg_per_100m: kitti_pct,
+            ate_rmse_m: ate_m,
+            ate_max_m: 2.0 * ate_m,
+            x_rmse_m: ate_m,
+            y_rmse_m: ate_m,
+            position_rmse_m: ate_m,
+            yaw_rmse_rad: 0.01,
+            final_position_error_m: 5.0,
+            rpe_translation_rmse_m: 0.1,
+            rpe_yaw_rmse_rad: 0.001,
+        }
+    }
+
+    #[test]
+    fn compare_runs_reads_every_runs_partitions_and_pools_per_run() {
+        use mmtrack_io::Overwrite;
+        use mmtrack_io::table::{RunInfo, write_table};
+        let dir = tempfile::tempdir().unwrap();
+        let write = |run: &str, sequence: &str, m: &TrajectoryMetrics| {
+            let tables = dir.path().join(format!("run={run}")).join("tables");
+            write_table(&tables, sequence, std::slice::from_ref(m), &RunInfo::default(), Overwrite::Refuse).unwrap();
+        };
+        let (a1, a2) = (trajectory(11, 3, Some(1.0), 1.0), trajectory(31, 1, Some(5.0), 2.0));
+        let b1 = trajectory(5, 0, None, 1.5);
+        write("a", "s1", &a1);
+        write("a", "s2", &a2);
+        write("b", "s1", &b1);
+        // A run without the table adds no rows.
+        std::fs::create_dir_all(dir.path().join("run=c/tables")).unwrap();
+
+        let rows = compare_runs(dir.path()).unwrap();
+        let value = |run: &str, sequence: &str, metric: &str| {
+            let found: Vec<&RunComparisonRow> =
+                rows.iter().filter(|r| r.run == run && r.sequence_id == sequence && r.metric == metric).collect();
+            assert_eq!(found.len(), 1, "{run} {sequence} {metric}: {found:?}");
+            assert_eq!((found[0].source_table.as_str(), found[0].key.as_str()), ("trajectory_metrics", ""));
+            found[0].value
+        };
+        assert_eq!(rows.len(), (3 + 2 + 2) * TRAJECTORY_COMPARED.len());
+        assert!(rows.iter().all(|r| r.run != "c"));
+        assert_eq!(value("a", "s1", "ate_rmse_m"), Some(1.0));
+        assert_eq!(value("a", "s2", "kitti_translational_pct"), Some(5.0));
+        assert_eq!(value("b", "s1", "ate_rmse_m"), Some(1.5));
+        assert_eq!(value("b", "s1", "kitti_translational_pct"), None);
+        // `all`: the same pooling as one run's report; `mean`: the plain mean.
+        let pooled = pooled_trajectory_metrics(&[&a1, &a2]).unwrap().unwrap();
+        assert_eq!(value("a", "all", "ate_rmse_m"), Some(pooled.ate_rmse_m));
+        assert_eq!(value("a", "all", "kitti_translational_pct"), Some(2.0));
+        assert_eq!(value("b", "all", "kitti_translational_pct"), None);
+        assert_eq!(value("a", "mean", "ate_rmse_m"), Some(1.5));
+        assert_eq!(value("a", "mean", "kitti_translational_pct"), Some(3.0));
+        assert_eq!(value("b", "mean", "kitti_translational_pct"), None);
+        let unit = rows.iter().find(|r| r.metric == "ate_rmse_m").map(|r| r.unit.as_str());
+        assert_eq!(unit, Some("m"));
+        // Sequences first, then `all`, then `mean`; metrics in report order; runs last.
+        let order: Vec<(&str, &str, &str)> =
+            rows.iter().map(|r| (r.sequence_id.as_str(), r.metric.as_str(), r.run.as_str())).collect();
+        assert_eq!(
+            &order[..3],
+            [
+                ("s1", TRAJECTORY_COMPARED[0], "a"),
+                ("s1", TRAJECTORY_COMPARED[0], "b"),
+                ("s1", TRAJECTORY_COMPARED[1], "a")
+            ]
+        );
+        let sequences: Vec<&str> = order.iter().map(|o| o.0).collect::<Vec<_>>();
+        let mut deduped = sequences.clone();
+        deduped.dedup();
+        assert_eq!(deduped, ["s1", "s2", "all", "mean"]);
+    }
+
+    #[test]
+    fn compare_runs_without_result_tables_is_empty() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(dir.path().join("run=a/tables")).unwrap();
+        assert!(compare_runs(dir.path()).unwrap().is_empty());
     }
 
     #[test]

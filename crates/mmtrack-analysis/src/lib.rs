@@ -29,12 +29,13 @@
 //! plots + report`. It depends on `mmtrack-core` and `mmtrack-io` only, never
 //! on algorithm crates, and never prints (the CLI does).
 //!
-//! - [`campaign`]: several runs side by side, on polars: lazy scans of the
-//!   runs' Hive-partitioned result tables, group-bys per run for the pooled
-//!   rows (the pooling rules are stated there and used by every report).
+//! - [`campaign`]: several runs side by side, on polars: the runs'
+//!   Hive-partitioned result tables read into one frame, group-bys per run
+//!   for the pooled rows (the pooling rules are stated there and used by
+//!   every report).
 //!
-//! Polars stays inside this crate (ARCHITECTURE.md), with the features
-//! `lazy` and `parquet` only. The per-sequence metrics themselves (KITTI
+//! Polars stays inside this crate (ARCHITECTURE.md), with the feature `lazy`
+//! only (the `parquet` crate reads the files). The per-sequence metrics themselves (KITTI
 //! drift, RPE, ATE, MPC statistics) are algorithms on a few vectors and stay
 //! plain Rust; tables are written through `mmtrack-io`'s `TableRow` so every
 //! table carries the same units and run metadata.

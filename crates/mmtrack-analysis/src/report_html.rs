@@ -8,12 +8,14 @@
 //! (per-sequence plot columns of tables) stay relative links. No scripts,
 //! no external resources.
 //!
-//! The converter handles the Markdown the report writers produce: `#`
-//! headings, paragraphs, `-` lists, pipe tables, `![image](src)` lines and
-//! inline `code`, `**bold**` and `[links](href)`. Text is HTML-escaped.
+//! The Markdown is CommonMark with GitHub's pipe tables, converted by
+//! pulldown-cmark. Raw HTML in the Markdown is shown as text, not passed
+//! through, so the page holds only what this module writes.
 
 use std::fmt::Write as _;
 use std::path::Path;
+
+use pulldown_cmark::{CowStr, Event, HeadingLevel, Options, Parser, Tag, TagEnd};
 
 /// What produced the report, shown at the top of the page.
 #[derive(Debug, Clone, PartialEq)]
@@ -36,29 +38,37 @@ overflow-x:auto;font-size:0.85em}.missing{color:#a00}";
 /// results directory the Markdown's links are relative to).
 #[must_use]
 pub fn html(markdown: &str, dir: &Path, provenance: &Provenance<'_>) -> String {
-    let title =
-        markdown.lines().find_map(|l| l.strip_prefix("# ")).unwrap_or("mmtrack analysis report").trim().to_string();
+    let events: Vec<Event<'_>> = Parser::new_ext(markdown, Options::ENABLE_TABLES).map(raw_html_as_text).collect();
+    let title = first_title(&events).unwrap_or_else(|| "mmtrack analysis report".to_string());
+    let mut body = Vec::with_capacity(events.len() + 1);
+    let mut provenance_done = false;
+    for piece in pieces(events) {
+        match piece {
+            Piece::Event(event) => {
+                // The provenance goes right under the title.
+                let title_end = matches!(event, Event::End(TagEnd::Heading(HeadingLevel::H1)));
+                body.push(event);
+                if title_end && !provenance_done {
+                    body.push(Event::Html(provenance_html(provenance).into()));
+                    provenance_done = true;
+                }
+            }
+            Piece::Figures(images) => {
+                body.extend(images.iter().map(|image| Event::Html(image.figure(dir).into())));
+            }
+            Piece::Image(image) => body.push(Event::InlineHtml(image.inline(dir).into())),
+        }
+    }
     let mut out = format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>{}</title>\n\
          <style>{STYLE}</style>\n</head>\n<body>\n",
-        escape(&title)
+        escape(title.trim())
     );
-    let mut body = Converter { dir, out: String::new(), paragraph: Vec::new(), list: Vec::new(), table: Vec::new() };
-    let mut provenance_done = false;
-    for line in markdown.lines() {
-        body.line(line);
-        // The provenance goes right under the title.
-        if !provenance_done && line.starts_with("# ") {
-            body.out.push_str(&provenance_html(provenance));
-            provenance_done = true;
-        }
-    }
-    body.flush();
     if !provenance_done {
         out.push_str(&provenance_html(provenance));
     }
-    out.push_str(&body.out);
+    pulldown_cmark::html::push_html(&mut out, body.into_iter());
     out.push_str("</body>\n</html>\n");
     out
 }
@@ -77,165 +87,141 @@ fn provenance_html(p: &Provenance<'_>) -> String {
     out
 }
 
-/// Line-by-line Markdown to HTML for the report's subset.
-struct Converter<'a> {
-    dir: &'a Path,
-    out: String,
-    paragraph: Vec<String>,
-    list: Vec<String>,
-    table: Vec<String>,
+/// Raw HTML of the Markdown as text: an HTML block becomes a paragraph.
+fn raw_html_as_text(event: Event<'_>) -> Event<'_> {
+    match event {
+        Event::Html(text) | Event::InlineHtml(text) => Event::Text(text),
+        Event::Start(Tag::HtmlBlock) => Event::Start(Tag::Paragraph),
+        Event::End(TagEnd::HtmlBlock) => Event::End(TagEnd::Paragraph),
+        other => other,
+    }
 }
 
-impl Converter<'_> {
-    fn line(&mut self, line: &str) {
-        let trimmed = line.trim_end();
-        if trimmed.starts_with('|') {
-            self.flush_paragraph();
-            self.flush_list();
-            self.table.push(trimmed.to_string());
-            return;
-        }
-        self.flush_table();
-        if trimmed.is_empty() {
-            self.flush();
-        } else if let Some((level, text)) = heading(trimmed) {
-            self.flush();
-            let _ = writeln!(self.out, "<h{level}>{}</h{level}>", inline(text));
-        } else if let Some(item) = trimmed.strip_prefix("- ") {
-            self.flush_paragraph();
-            self.list.push(item.to_string());
-        } else if let Some((alt, src)) = whole_image(trimmed) {
-            self.flush_paragraph();
-            self.flush_list();
-            let figure = self.figure(alt, src);
-            self.out.push_str(&figure);
-        } else {
-            self.flush_list();
-            self.paragraph.push(trimmed.to_string());
+/// The plain text of the first `#` heading.
+fn first_title(events: &[Event<'_>]) -> Option<String> {
+    let start = events.iter().position(|e| matches!(e, Event::Start(Tag::Heading { level: HeadingLevel::H1, .. })))?;
+    let mut title = String::new();
+    for event in &events[start + 1..] {
+        match event {
+            Event::End(TagEnd::Heading(_)) => break,
+            Event::Text(text) | Event::Code(text) => title.push_str(text),
+            _ => {}
         }
     }
+    Some(title)
+}
 
-    fn flush(&mut self) {
-        self.flush_paragraph();
-        self.flush_list();
-        self.flush_table();
-    }
+/// An image of the Markdown: its source and the events of its alt text.
+struct Image<'a> {
+    src: CowStr<'a>,
+    alt: Vec<Event<'a>>,
+}
 
-    fn flush_paragraph(&mut self) {
-        if !self.paragraph.is_empty() {
-            let _ = writeln!(self.out, "<p>{}</p>", inline(&self.paragraph.join(" ")));
-            self.paragraph.clear();
-        }
-    }
-
-    fn flush_list(&mut self) {
-        if !self.list.is_empty() {
-            self.out.push_str("<ul>\n");
-            for item in self.list.drain(..) {
-                let _ = writeln!(self.out, "<li>{}</li>", inline(&item));
+impl Image<'_> {
+    /// The alt text as plain text, escaped for an attribute.
+    fn alt_attribute(&self) -> String {
+        let mut text = String::new();
+        for event in &self.alt {
+            if let Event::Text(t) | Event::Code(t) = event {
+                text.push_str(t);
             }
-            self.out.push_str("</ul>\n");
         }
+        escape(&text)
     }
 
-    fn flush_table(&mut self) {
-        if self.table.is_empty() {
-            return;
-        }
-        let rows: Vec<Vec<String>> = self.table.drain(..).map(|r| cells(&r)).collect();
-        let is_rule = |r: &Vec<String>| r.iter().all(|c| !c.is_empty() && c.chars().all(|ch| matches!(ch, '-' | ':')));
-        self.out.push_str("<table>\n");
-        let (header, body) = match rows.get(1) {
-            Some(rule) if is_rule(rule) => (rows.first(), &rows[2..]),
-            _ => (None, &rows[..]),
-        };
-        if let Some(header) = header {
-            self.out.push_str("<thead><tr>");
-            for c in header {
-                let _ = write!(self.out, "<th>{}</th>", inline(c));
-            }
-            self.out.push_str("</tr></thead>\n");
-        }
-        self.out.push_str("<tbody>\n");
-        for row in body {
-            self.out.push_str("<tr>");
-            for c in row {
-                let _ = write!(self.out, "<td>{}</td>", inline(c));
-            }
-            self.out.push_str("</tr>\n");
-        }
-        self.out.push_str("</tbody>\n</table>\n");
+    /// The alt text as HTML (it may hold `code` and emphasis).
+    fn alt_html(&self) -> String {
+        let mut out = String::new();
+        pulldown_cmark::html::push_html(&mut out, self.alt.iter().cloned());
+        out
     }
 
-    /// An image line: the SVG embedded, or a visible note when it is not
-    /// there.
-    fn figure(&self, alt: &str, src: &str) -> String {
-        let path = self.dir.join(src);
-        match std::fs::read(&path) {
-            Ok(bytes) if src.ends_with(".svg") => format!(
+    /// The SVG the image shows, when it is one and is there.
+    fn svg(&self, dir: &Path) -> Option<Vec<u8>> {
+        if !self.src.ends_with(".svg") {
+            return None;
+        }
+        std::fs::read(dir.join(self.src.as_ref())).ok()
+    }
+
+    /// An image alone in its paragraph: the SVG embedded as a figure, or a
+    /// visible note when it is not there.
+    fn figure(&self, dir: &Path) -> String {
+        match self.svg(dir) {
+            Some(bytes) => format!(
                 "<figure><img src=\"data:image/svg+xml;base64,{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>\n",
                 base64(&bytes),
-                escape(alt),
-                inline(alt)
+                self.alt_attribute(),
+                self.alt_html()
             ),
-            _ => format!(
+            None => format!(
                 "<p class=\"missing\">Plot not available: {} (<code>{}</code>).</p>\n",
-                inline(alt),
-                escape(src)
+                self.alt_html(),
+                escape(&self.src)
+            ),
+        }
+    }
+
+    /// An image within text: the SVG embedded, or the same note inline.
+    fn inline(&self, dir: &Path) -> String {
+        match self.svg(dir) {
+            Some(bytes) => {
+                format!("<img src=\"data:image/svg+xml;base64,{}\" alt=\"{}\">", base64(&bytes), self.alt_attribute())
+            }
+            None => format!(
+                "<span class=\"missing\">Plot not available: {} (<code>{}</code>)</span>",
+                self.alt_html(),
+                escape(&self.src)
             ),
         }
     }
 }
 
-/// `# text` -> (1, text), up to level 4.
-fn heading(line: &str) -> Option<(usize, &str)> {
-    let level = line.chars().take_while(|c| *c == '#').count();
-    (1..=4).contains(&level).then(|| line[level..].strip_prefix(' ')).flatten().map(|text| (level, text))
+/// What the page is made of: Markdown events, images within text, and
+/// paragraphs that hold nothing but images (one figure each).
+enum Piece<'a> {
+    Event(Event<'a>),
+    Image(Image<'a>),
+    Figures(Vec<Image<'a>>),
 }
 
-/// A line that is exactly `![alt](src)`.
-fn whole_image(line: &str) -> Option<(&str, &str)> {
-    let rest = line.strip_prefix("![")?;
-    let (alt, rest) = rest.split_once("](")?;
-    let src = rest.strip_suffix(')')?;
-    (!src.contains(['(', ')', ' '])).then_some((alt, src))
-}
-
-/// The cells of a pipe-table row.
-fn cells(row: &str) -> Vec<String> {
-    let inner = row.trim().trim_start_matches('|');
-    let inner = inner.strip_suffix('|').unwrap_or(inner);
-    inner.split('|').map(|c| c.trim().to_string()).collect()
-}
-
-/// Inline Markdown: `code`, **bold**, [text](href), the rest escaped.
-fn inline(text: &str) -> String {
-    let mut out = String::new();
-    let mut rest = text;
-    while !rest.is_empty() {
-        if let Some(after) = rest.strip_prefix('`')
-            && let Some((code, tail)) = after.split_once('`')
-        {
-            let _ = write!(out, "<code>{}</code>", escape(code));
-            rest = tail;
-        } else if let Some(after) = rest.strip_prefix("**")
-            && let Some((bold, tail)) = after.split_once("**")
-        {
-            let _ = write!(out, "<strong>{}</strong>", inline(bold));
-            rest = tail;
-        } else if let Some(after) = rest.strip_prefix('[')
-            && let Some((label, tail)) = after.split_once("](")
-            && let Some((href, tail)) = tail.split_once(')')
-            && !label.contains('[')
-        {
-            let _ = write!(out, "<a href=\"{}\">{}</a>", escape(href), inline(label));
-            rest = tail;
-        } else {
-            let mut chars = rest.chars();
-            if let Some(c) = chars.next() {
-                out.push_str(&escape(c.encode_utf8(&mut [0; 4])));
+/// The events with each image taken out whole, and image-only paragraphs
+/// turned into figures.
+fn pieces(events: Vec<Event<'_>>) -> Vec<Piece<'_>> {
+    let mut out = Vec::new();
+    let mut events = events.into_iter();
+    while let Some(event) = events.next() {
+        match event {
+            Event::Start(Tag::Image { dest_url, .. }) => {
+                let alt = events.by_ref().take_while(|e| !matches!(e, Event::End(TagEnd::Image))).collect();
+                out.push(Piece::Image(Image { src: dest_url, alt }));
             }
-            rest = chars.as_str();
+            Event::End(TagEnd::Paragraph) => {
+                let start = out.iter().rposition(|p| matches!(p, Piece::Event(Event::Start(Tag::Paragraph))));
+                let only_images = start.is_some_and(|start| {
+                    let inner = &out[start + 1..];
+                    inner.iter().any(|p| matches!(p, Piece::Image(_)))
+                        && inner.iter().all(|p| match p {
+                            Piece::Image(_) | Piece::Event(Event::SoftBreak | Event::HardBreak) => true,
+                            Piece::Event(Event::Text(t)) => t.trim().is_empty(),
+                            _ => false,
+                        })
+                });
+                match start {
+                    Some(start) if only_images => {
+                        let images = out
+                            .drain(start..)
+                            .filter_map(|p| match p {
+                                Piece::Image(image) => Some(image),
+                                _ => None,
+                            })
+                            .collect();
+                        out.push(Piece::Figures(images));
+                    }
+                    _ => out.push(Piece::Event(Event::End(TagEnd::Paragraph))),
+                }
+            }
+            other => out.push(Piece::Event(other)),
         }
     }
     out
@@ -288,31 +274,58 @@ mod tests {
     }
 
     #[test]
-    fn converts_the_report_subset_and_embeds_plots() {
+    fn converts_the_report_markdown_and_embeds_plots() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir_all(dir.path().join("plots/a")).unwrap();
         std::fs::write(dir.path().join("plots/a/t.svg"), "<svg xmlns=\"http://www.w3.org/2000/svg\"/>").unwrap();
         let markdown = "# mmtrack analysis report\n\n## Trajectory (table `odometry`)\n\nText with <b> & **bold**\n\
-                        and a [link](plots/a/t.svg).\n\n| a | b |\n|---|---|\n| 1 | n/a |\n\n- `s`: why\n\n\
-                        ![trajectory](plots/a/t.svg)\n![gone](plots/a/none.svg)\n";
+                        and a [link](plots/a/t.svg).\n\n| a | b |\n|---|---:|\n| 1 | n/a |\n\n- `s`: why\n\n\
+                        ![trajectory](plots/a/t.svg)\n![gone](plots/a/none.svg)\n\nInline ![`t` plot](plots/a/t.svg) \
+                        and ![lost](plots/a/lost.svg).\n\n<script>alert(1)</script>\n";
         let config = r#"{"command":"analyze","tables":"in/tables"}"#;
         let page = html(markdown, dir.path(), &Provenance { config_json: config, version: "0.1.0" });
         assert!(page.starts_with("<!DOCTYPE html>") && page.contains("<title>mmtrack analysis report</title>"));
         assert!(page.contains("<li>Software: mmtrack 0.1.0</li>") && page.contains("<code>in/tables</code>"), "{page}");
+        // The provenance right under the title, before the first section.
+        let at = |needle: &str| page.find(needle).unwrap_or_else(|| panic!("{needle} not in {page}"));
+        assert!(at("<h1>mmtrack analysis report</h1>") < at("<section id=\"provenance\">"));
+        assert!(at("</section>") < at("<h2>Trajectory"));
         assert!(page.contains("<h2>Trajectory (table <code>odometry</code>)</h2>"), "{page}");
+        // Raw HTML is text; a soft line break stays a line break in the paragraph.
         assert!(
             page.contains(
-                "<p>Text with &lt;b&gt; &amp; <strong>bold</strong> and a <a href=\"plots/a/t.svg\">link</a>.</p>"
+                "<p>Text with &lt;b&gt; &amp; <strong>bold</strong>\nand a <a href=\"plots/a/t.svg\">link</a>.</p>"
+            ),
+            "{page}"
+        );
+        assert!(page.contains("&lt;script&gt;alert(1)&lt;/script&gt;") && !page.contains("<script"), "{page}");
+        assert!(page.contains("<thead><tr><th>a</th><th style=\"text-align: right\">b</th></tr></thead>"), "{page}");
+        assert!(page.contains("<td>1</td><td style=\"text-align: right\">n/a</td>"), "{page}");
+        assert!(page.contains("<ul>\n<li><code>s</code>: why</li>\n</ul>"), "{page}");
+        // Image-only lines: a figure each, the plot embedded, or a note.
+        assert!(
+            page.contains(
+                "<figure><img src=\"data:image/svg+xml;base64,PHN2ZyB4bWxucz0iaHR0cDovL3d3dy53My5vcmcvMjAwMC9zdmciLz4=\" \
+                 alt=\"trajectory\"><figcaption>trajectory</figcaption></figure>"
             ),
             "{page}"
         );
         assert!(
-            page.contains("<thead><tr><th>a</th><th>b</th></tr></thead>") && page.contains("<td>n/a</td>"),
+            page.contains("<p class=\"missing\">Plot not available: gone (<code>plots/a/none.svg</code>).</p>"),
             "{page}"
         );
-        assert!(page.contains("<ul>\n<li><code>s</code>: why</li>\n</ul>"), "{page}");
-        assert!(page.contains("<img src=\"data:image/svg+xml;base64,PHN2ZyB4bWxucz0i"), "{page}");
-        assert!(page.contains("class=\"missing\">Plot not available: gone"), "{page}");
-        assert!(!page.contains("<script"));
+        // Images within text: embedded in place, or the note in place.
+        assert!(page.contains("<p>Inline <img src=\"data:image/svg+xml;base64,PHN2Zy"), "{page}");
+        assert!(page.contains("alt=\"t plot\"> and <span class=\"missing\">Plot not available: lost"), "{page}");
+        assert!(!page.contains("src=\"plots/"), "every shown plot is embedded: {page}");
+    }
+
+    #[test]
+    fn page_without_a_title_starts_with_the_provenance() {
+        let page = html("Just text.\n", Path::new("."), &Provenance { config_json: "not json", version: "0.1.0" });
+        assert!(page.contains("<title>mmtrack analysis report</title>"), "{page}");
+        assert!(page.contains("<pre>not json</pre>"), "{page}");
+        let at = |needle: &str| page.find(needle).unwrap_or_else(|| panic!("{needle} not in {page}"));
+        assert!(at("<section id=\"provenance\">") < at("<p>Just text.</p>"));
     }
 }
