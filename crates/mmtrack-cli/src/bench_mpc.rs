@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
+use mmtrack_core::random::standard_normal;
 use mmtrack_core::sounder::{SounderBand, cir_from_spectrum};
 use mmtrack_core::{CirSnapshot, Complex64, MpcDetection, MpcTrack};
 use mmtrack_mpc::short_term::is_full_lifetime;
@@ -139,7 +140,7 @@ impl Channel {
         let mut rng = Pcg64::seed_from_u64((SEED << 48) ^ (index + 1));
         let sigma = (10f64.powf(NOISE_DB / 10.0) / 2.0).sqrt();
         for tap in &mut taps {
-            *tap += Complex64::new(sigma * gauss(&mut rng), sigma * gauss(&mut rng));
+            *tap += Complex64::new(sigma * standard_normal(&mut rng), sigma * standard_normal(&mut rng));
         }
         CirSnapshot {
             t_ns,
@@ -167,13 +168,6 @@ impl Channel {
             })
             .collect()
     }
-}
-
-/// Standard normal by Box-Muller.
-fn gauss(rng: &mut Pcg64) -> f64 {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// The proposed method ([`MpcPipeline`]) at one thread count, with its

@@ -16,6 +16,10 @@
 //!   phase-quantised codebooks;
 //! - [`progress`]: the trait long library calls report their progress through;
 //! - [`parallel`]: order-keeping parallel maps on rayon, for every parallel stage;
+//! - [`random`]: the seeded random streams (SplitMix64 of words into `Pcg64`)
+//!   and the standard-normal, exponential and gamma draws every simulator,
+//!   filter and benchmark uses, so a seed means the same draws everywhere;
+//! - [`stats`]: quantiles (linear and nearest-rank), median and `erfc`;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
 //!
@@ -38,8 +42,10 @@ pub mod parallel;
 mod pose;
 pub mod progress;
 mod radar;
+pub mod random;
 pub mod slam;
 pub mod sounder;
+pub mod stats;
 
 pub use beam_sweep::BeamSweep;
 pub use cir::CirSnapshot;

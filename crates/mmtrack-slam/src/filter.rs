@@ -4,6 +4,7 @@
 //! III-D). See the crate docs for how this maps onto the paper.
 
 use faer::Mat;
+use mmtrack_core::random::standard_normal;
 use mmtrack_core::slam::{PathMeasurement, SlamEpoch, SourceType, UeState};
 use mmtrack_core::wrap_angle_rad;
 use rand::RngExt;
@@ -13,7 +14,7 @@ use crate::config::SlamConfig;
 use crate::error::SlamError;
 use crate::map::{Gauss3, Hypotheses, MapSource, SourceStatus, fuse};
 use crate::model::{FastPath, UE_MEAS_DIM, invert, jacobians};
-use crate::particles::{Moments, Particles, PreparedPath, STATE_DIM, normal};
+use crate::particles::{Moments, Particles, PreparedPath, STATE_DIM};
 use crate::small::{cholesky_lower, col, from3, mul, sandwich, spd_inverse, symmetrise, to3, to5};
 
 /// The UE estimate of an epoch: the posterior mean and spreads.
@@ -144,12 +145,12 @@ impl SlamFilter {
         let pos_std = c.prior_position_std_m / std::f64::consts::SQRT_2;
         let particles = Particles::draw(c.particles, c.chunk_size, p.position_m[2], seed, 0x7072_696f, move |rng| {
             let s = [
-                p.position_m[0] + pos_std * normal(rng),
-                p.position_m[1] + pos_std * normal(rng),
-                p.heading_rad + c.prior_heading_std_rad * normal(rng),
-                p.speed_mps + c.prior_speed_std_mps * normal(rng),
-                p.turn_rate_radps + c.prior_turn_rate_std_radps * normal(rng),
-                p.clock_bias_m + c.prior_clock_bias_std_m * normal(rng),
+                p.position_m[0] + pos_std * standard_normal(rng),
+                p.position_m[1] + pos_std * standard_normal(rng),
+                p.heading_rad + c.prior_heading_std_rad * standard_normal(rng),
+                p.speed_mps + c.prior_speed_std_mps * standard_normal(rng),
+                p.turn_rate_radps + c.prior_turn_rate_std_radps * standard_normal(rng),
+                p.clock_bias_m + c.prior_clock_bias_std_m * standard_normal(rng),
             ];
             (s, 0.0)
         });
@@ -443,8 +444,8 @@ impl SlamFilter {
         self.particles = Particles::draw(c.particles, c.chunk_size, z_m, seed, 0x696e_6974, move |rng| {
             let a = c.angle_std_rad;
             for _ in 0..16 {
-                let dod_az = z.dod_az_rad + a * normal(rng);
-                let dod_el = z.dod_el_rad + a * normal(rng);
+                let dod_az = z.dod_az_rad + a * standard_normal(rng);
+                let dod_el = z.dod_el_rad + a * standard_normal(rng);
                 let t = dod_el.tan();
                 let rho = (z_m - bs[2]) / t;
                 if !(rho.is_finite() && rho > 0.0 && rho < 1e5) {
@@ -452,11 +453,11 @@ impl SlamFilter {
                 }
                 let x = bs[0] + rho * dod_az.cos();
                 let y = bs[1] + rho * dod_az.sin();
-                let heading = wrap_angle_rad((bs[1] - y).atan2(bs[0] - x) - (z.doa_az_rad + a * normal(rng)));
+                let heading = wrap_angle_rad((bs[1] - y).atan2(bs[0] - x) - (z.doa_az_rad + a * standard_normal(rng)));
                 let range = ((bs[0] - x).powi(2) + (bs[1] - y).powi(2) + (bs[2] - z_m).powi(2)).sqrt();
-                let bias = z.toa_m + c.toa_std_m * normal(rng) - range;
-                let speed = p.speed_mps + c.prior_speed_std_mps * normal(rng);
-                let turn = p.turn_rate_radps + c.prior_turn_rate_std_radps * normal(rng);
+                let bias = z.toa_m + c.toa_std_m * standard_normal(rng) - range;
+                let speed = p.speed_mps + c.prior_speed_std_mps * standard_normal(rng);
+                let turn = p.turn_rate_radps + c.prior_turn_rate_std_radps * standard_normal(rng);
                 let d = [
                     x - p.position_m[0],
                     y - p.position_m[1],

@@ -4,9 +4,10 @@
 //! on the number of threads.
 
 use faer::Mat;
+use mmtrack_core::random::{keyed_stream, standard_normal, standard_normal_pair};
 use mmtrack_core::slam::ctrv_displacement_m;
 use mmtrack_core::wrap_angle_rad;
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_pcg::Pcg64;
 use rayon::prelude::*;
 
@@ -72,34 +73,9 @@ pub(crate) struct Particles {
     chunk_size: usize,
 }
 
-/// A seeded stream for `(seed, epoch, stage, chunk)`.
-pub(crate) fn stream(seed: u64, words: &[u64]) -> Pcg64 {
-    let mut h: u64 = seed ^ 0x736c_616d_5f6d_6d74;
-    for w in words {
-        h = (h ^ w).wrapping_add(0x9e37_79b9_7f4a_7c15);
-        h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        h ^= h >> 31;
-    }
-    Pcg64::seed_from_u64(h)
-}
-
-/// Standard normal by Box-Muller.
-#[inline]
-pub(crate) fn normal(rng: &mut Pcg64) -> f64 {
-    normal_pair(rng).0
-}
-
-/// Two independent standard normals by Box-Muller (both of its outputs: one
-/// logarithm, square root and `sin_cos` for two values).
-#[inline]
-pub(crate) fn normal_pair(rng: &mut Pcg64) -> (f64, f64) {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    let r = (-2.0 * u1.ln()).sqrt();
-    let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
-    (r * c, r * s)
-}
+/// The key of the filter's streams (`"slam_mmt"`): every draw comes from
+/// `keyed_stream(STREAM_KEY, seed, &[epoch or tag, stage, chunk])`.
+const STREAM_KEY: u64 = 0x736c_616d_5f6d_6d74;
 
 /// Weighted moments of the particles.
 #[derive(Debug, Clone)]
@@ -123,7 +99,7 @@ impl Particles {
         let mut chunks: Vec<Chunk> =
             (0..n.div_ceil(chunk_size)).map(|c| Chunk::with_len(chunk_size.min(n - c * chunk_size))).collect();
         chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            let mut rng = stream(seed, &[tag, c as u64]);
+            let mut rng = keyed_stream(STREAM_KEY, seed, &[tag, c as u64]);
             for i in 0..chunk.len() {
                 let (s, logw) = draw(&mut rng);
                 chunk.set(i, s);
@@ -137,16 +113,16 @@ impl Particles {
     /// noise on speed, turn rate and clock bias.
     pub(crate) fn predict(&mut self, dt_s: f64, noise: [f64; 3], seed: u64, epoch: u64) {
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            let mut rng = stream(seed, &[epoch, 0x7072_6564, c as u64]);
+            let mut rng = keyed_stream(STREAM_KEY, seed, &[epoch, 0x7072_6564, c as u64]);
             for i in 0..chunk.len() {
                 let (dx, dy) = ctrv_displacement_m(chunk.heading[i], chunk.speed[i], chunk.turn[i], dt_s);
                 chunk.x[i] += dx;
                 chunk.y[i] += dy;
                 chunk.heading[i] = wrap_angle_rad(chunk.heading[i] + chunk.turn[i] * dt_s);
-                let (a, b) = normal_pair(&mut rng);
+                let (a, b) = standard_normal_pair(&mut rng);
                 chunk.speed[i] += noise[0] * a;
                 chunk.turn[i] += noise[1] * b;
-                chunk.bias[i] += noise[2] * normal(&mut rng);
+                chunk.bias[i] += noise[2] * standard_normal(&mut rng);
             }
         });
     }
@@ -280,7 +256,7 @@ impl Particles {
     /// `L` the Cholesky factor of the weighted covariance), drawn per chunk.
     pub(crate) fn resample(&mut self, jitter_chol: Option<&Mat<f64>>, h: f64, seed: u64, words: [u64; 2]) {
         let w = self.weights();
-        let mut rng = stream(seed, &[words[0], words[1], 0x7265_7361]);
+        let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x7265_7361]);
         let u0: f64 = rng.random::<f64>() / self.n as f64;
         let flat: Vec<[f64; STATE_DIM]> = self.states().collect();
         let mut picked = Vec::with_capacity(self.n);
@@ -296,11 +272,15 @@ impl Particles {
         }
         let chunk_size = self.chunk_size;
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            let mut rng = stream(seed, &[words[0], words[1], 0x6a69_7474, c as u64]);
+            let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x6a69_7474, c as u64]);
             for i in 0..chunk.len() {
                 let mut s = picked[c * chunk_size + i];
                 if let Some(l) = jitter_chol {
-                    let pairs = [normal_pair(&mut rng), normal_pair(&mut rng), normal_pair(&mut rng)];
+                    let pairs = [
+                        standard_normal_pair(&mut rng),
+                        standard_normal_pair(&mut rng),
+                        standard_normal_pair(&mut rng),
+                    ];
                     let n: [f64; STATE_DIM] =
                         std::array::from_fn(|k| if k % 2 == 0 { pairs[k / 2].0 } else { pairs[k / 2].1 });
                     for a in 0..STATE_DIM {

@@ -19,6 +19,7 @@
 use std::collections::BTreeMap;
 
 use mmtrack_core::MpcDetection;
+use mmtrack_core::stats::quantile;
 use mmtrack_io::table::MpcSnapshotStats;
 
 /// Default dynamic range below the strongest detection within which the
@@ -121,17 +122,6 @@ pub fn summarise_first_paths(rows: &[FirstPathRow]) -> FirstPathSummary {
         median_abs_minus_hint_s: quantile(&absolute, 0.5),
         p90_abs_minus_hint_s: quantile(&absolute, 0.9),
     }
-}
-
-/// The `q` quantile of `sorted` by linear interpolation between the two
-/// nearest order statistics (numpy's default); `None` when empty.
-fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
-    let last = sorted.len().checked_sub(1)?;
-    let position = q * last as f64;
-    let below = position.floor() as usize;
-    let above = (below + 1).min(last);
-    let w = position - below as f64;
-    Some(sorted[below] * (1.0 - w) + sorted[above] * w)
 }
 
 #[cfg(test)]

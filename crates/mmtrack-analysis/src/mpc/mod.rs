@@ -493,13 +493,11 @@ fn count_distribution(counts: impl Iterator<Item = u64>) -> Vec<CountBin> {
         .collect()
 }
 
+/// The median of `values` (the mean of the middle two for an even count);
+/// 0 when there are none.
 fn median(mut values: Vec<f64>) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
     values.sort_by(f64::total_cmp);
-    let n = values.len();
-    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
+    mmtrack_core::stats::median(&values).unwrap_or(0.0)
 }
 
 fn share_below(values: impl Iterator<Item = f64>, limit: f64) -> Option<f64> {

@@ -22,7 +22,7 @@ impl Noise {
 
     fn normal(&mut self) -> f64 {
         let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+        mmtrack_core::random::box_muller(u1, u2).0
     }
 }
 

@@ -243,7 +243,7 @@ fn floors(e: &Experiment, link: &SpebtLink) -> String {
     // AoA error from the yaw errors of two slots: N(0, 2 sigma_theta^2); the
     // share of slots where it alone exceeds the threshold.
     let threshold = e.tracker.angle_threshold_deg;
-    let noise_trip = erfc(threshold / (2.0 * yaw_sigma));
+    let noise_trip = mmtrack_core::stats::erfc(threshold / (2.0 * yaw_sigma));
     format!(
         "\nWhat the pose-error model leaves to a filter that follows the poses (one power measurement per slot through \
          {}-element arrays, {:.0} deg beams, carries little angle information): the bearing error of one pose \
@@ -271,25 +271,12 @@ fn half_power_beamwidth_deg(n: usize, spacing_wavelengths: f64) -> f64 {
         .map_or(f64::NAN, |a| a.half_power_beamwidth_rad(std::f64::consts::FRAC_PI_2).to_degrees())
 }
 
-/// Complementary error function (Abramowitz and Stegun 7.1.26, absolute
-/// error below 1.5e-7), for `x >= 0`.
-fn erfc(x: f64) -> f64 {
-    let t = 1.0 / (1.0 + 0.327_591_1 * x);
-    let poly =
-        t * (0.254_829_592 + t * (-0.284_496_736 + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
-    poly * (-x * x).exp()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn erfc_matches_tabulated_values() {
-        // erfc(0) = 1, erfc(1.25) = 0.0770999, erfc(2) = 0.0046777 (tables).
-        assert!((erfc(0.0) - 1.0).abs() < 2e-7);
-        assert!((erfc(1.25) - 0.077_099_9).abs() < 2e-7);
-        assert!((erfc(2.0) - 0.004_677_7).abs() < 2e-7);
+    fn half_power_beamwidth_of_four_elements() {
         assert!((half_power_beamwidth_deg(4, 0.5) - 26.3).abs() < 0.2);
     }
 }

@@ -1,10 +1,11 @@
 //! Synthetic channels for the tests: a few paths through a known pulse plus
 //! seeded complex white noise, on the signal model of `mmtrack_core::sounder`.
 
+use mmtrack_core::random::standard_normal;
 use mmtrack_core::sounder::{SounderBand, cir_from_spectrum};
 use mmtrack_core::{CirSnapshot, Complex64};
 use mmtrack_mpc::SounderPulse;
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rand_pcg::Pcg64;
 
 /// 5.7 GHz carrier, as the paper's sounder.
@@ -48,7 +49,7 @@ pub fn snapshot(
     if let Some(noise_db) = noise_db {
         let sigma = (10f64.powf(noise_db / 10.0) / 2.0).sqrt();
         for tap in &mut taps {
-            *tap += Complex64::new(sigma * gauss(rng), sigma * gauss(rng));
+            *tap += Complex64::new(sigma * standard_normal(rng), sigma * standard_normal(rng));
         }
     }
     CirSnapshot {
@@ -67,11 +68,4 @@ pub fn snapshot(
 
 pub fn rng(seed: u64) -> Pcg64 {
     Pcg64::seed_from_u64(seed)
-}
-
-/// Standard normal by Box-Muller.
-pub fn gauss(rng: &mut Pcg64) -> f64 {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }

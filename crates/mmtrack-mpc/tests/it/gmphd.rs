@@ -27,7 +27,7 @@ impl Normal {
 
     fn sample(&mut self) -> f64 {
         let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+        mmtrack_core::random::box_muller(u1, u2).0
     }
 }
 

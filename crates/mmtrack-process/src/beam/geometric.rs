@@ -24,6 +24,7 @@ use anyhow::{Context, bail, ensure};
 use mmtrack_beam::geometric::{
     BeamSchedule, BeamSelection, DopplerBearing, GeometricTracker, GeometricTrackerConfig, RangeEstimator,
 };
+use mmtrack_core::random::standard_normal;
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
 use mmtrack_io::table::{
@@ -205,7 +206,7 @@ pub fn process_geometric(
             ensure!(range_m > 0.0, "{}: the vehicles coincide at t = {t_ns} ns", path.display());
             let azimuth_rad = p[1].atan2(p[0]);
             let range_rate = (after[0].hypot(after[1]) - before[0].hypot(before[1])) / (2.0 * epoch_s);
-            let doppler_hz = range_rate / lambda + scenario.doppler_sigma_hz * normal(&mut rng);
+            let doppler_hz = range_rate / lambda + scenario.doppler_sigma_hz * standard_normal(&mut rng);
             let best = receiver.strongest_beam(azimuth_rad);
             let projected = if k > 0 { tracker.state().map(|s| s.azimuth_rad(t_s)) } else { None };
             let selection = schedule.select(k, projected);
@@ -260,12 +261,4 @@ pub fn process_geometric(
         });
     }
     Ok(GeometricOutput { recordings: results, written })
-}
-
-/// Standard normal by Box-Muller.
-fn normal(rng: &mut Pcg64) -> f64 {
-    use rand::RngExt;
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }

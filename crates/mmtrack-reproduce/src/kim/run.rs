@@ -87,7 +87,7 @@ pub fn measure(
             .into_par_iter()
             .map(|r| {
                 let realised = scenario.realise(experiment.seed, r)?;
-                let filter_seed = experiment.seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ r;
+                let filter_seed = experiment.seed.wrapping_mul(mmtrack_core::random::SPLITMIX_GAMMA) ^ r;
                 let outcome = run_filter(
                     &realised,
                     &config,

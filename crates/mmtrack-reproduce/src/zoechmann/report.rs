@@ -14,10 +14,11 @@ use super::config::Config;
 use super::nlos;
 use super::run::{
     DOPPLER_MPS_FIRST, ESTIMATORS, FULL_SCAN_VARIANT, GATED_VARIANT, ManoeuvreResult, Measured, PLOTTED, WINDOWED,
-    WINDOWED_DOPPLER_MPS, quantile,
+    WINDOWED_DOPPLER_MPS,
 };
 use crate::common::Staged;
 use crate::model::{Claim, Metric, Rule, Verdict, verdict_rows, write_metrics};
+use mmtrack_core::stats::quantile_nearest_rank;
 
 /// The README block the summary replaces.
 pub const README_BLOCK: &str = "reproduce-zoechmann";
@@ -137,7 +138,7 @@ pub fn verdicts(experiment: &Config, results: &[ManoeuvreResult], runs: u64, ela
             r.handover_quantile(0.9).unwrap_or(f64::NAN),
             r.runs - r.handovers_s.len() as u64,
             r.runs,
-            quantile(&r.handovers_full_scan_s, 0.5).map_or("-".into(), |v| format!("{v:.2} s"))
+            quantile_nearest_rank(&r.handovers_full_scan_s, 0.5).map_or("-".into(), |v| format!("{v:.2} s"))
         ),
         _ => "-".into(),
     };
@@ -371,7 +372,7 @@ pub fn write_outputs(
             handover_median_s: r.handover_quantile(0.5),
             handover_mean_s: r.handover_mean(),
             handover_p90_s: r.handover_quantile(0.9),
-            handover_median_full_scan_s: quantile(&r.handovers_full_scan_s, 0.5),
+            handover_median_full_scan_s: quantile_nearest_rank(&r.handovers_full_scan_s, 0.5),
             beams_measured: r.beams[0].measured,
             beams_full_scan: r.beams[0].full_scan_equivalent,
             saving: r.beams[0].saving().unwrap_or(f64::NAN),

@@ -28,6 +28,7 @@ use mmtrack_beam::geometric::{
     GeometricTrackerConfig, HoChanBatch, NullspaceProjection, PolarState, RangeEstimator,
 };
 use mmtrack_core::progress::Progress;
+use mmtrack_core::stats::quantile_nearest_rank;
 use mmtrack_sim::beam::overtaking::{EpochTruth, Manoeuvre, OvertakingReceiver};
 use rayon::prelude::*;
 
@@ -142,7 +143,7 @@ impl ManoeuvreResult {
 
     /// Nearest-rank quantile `q` of the hand-over times.
     pub fn handover_quantile(&self, q: f64) -> Option<f64> {
-        quantile(&self.handovers_s, q)
+        quantile_nearest_rank(&self.handovers_s, q)
     }
 
     /// Share of windowed epochs whose window held the strongest beam, of the
@@ -234,12 +235,6 @@ pub fn measure(experiment: &Config, runs: u64, nlos_runs: u64, progress: &dyn Pr
         threads: rayon::current_num_threads(),
         load: (load_before, load_average()),
     })
-}
-
-/// Nearest-rank quantile `q` of sorted values.
-pub fn quantile(sorted: &[f64], q: f64) -> Option<f64> {
-    let n = sorted.len();
-    (n > 0).then(|| sorted[((q * n as f64).ceil() as usize).clamp(1, n) - 1])
 }
 
 /// Partial sums of a chunk of runs.

@@ -27,8 +27,7 @@
 
 use mmtrack_core::Complex64;
 use mmtrack_core::array::UniformLinearArray;
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
+use mmtrack_core::random::{standard_normal, stream};
 use serde::{Deserialize, Serialize};
 
 use crate::SimError;
@@ -167,22 +166,22 @@ impl OverpassScenario {
     pub fn realise(&self, seed: u64, run: u64) -> Result<OverpassRun, SimError> {
         self.validate()?;
         let array = self.array()?;
-        let mut rng = Pcg64::seed_from_u64(crate::radar::hash(&[seed, 0x6f76_6572, run]));
+        let mut rng = stream(seed, &[0x6f76_6572, run]);
         let sigma_n = (0.5 * self.noise_variance()).sqrt();
         let sigma_xi = (0.5 * (1.0 - self.rho * self.rho)).sqrt();
         let sqrt_half = 0.5f64.sqrt();
         let mut state = OverpassState {
             distance_m: self.initial_distance_m(),
             speed_mps: self.initial_speed_kmh / 3.6,
-            alpha: Complex64::new(sqrt_half * normal(&mut rng), sqrt_half * normal(&mut rng)),
+            alpha: Complex64::new(sqrt_half * standard_normal(&mut rng), sqrt_half * standard_normal(&mut rng)),
         };
         let mut states = Vec::with_capacity(self.blocks + 1);
         let mut noise = Vec::with_capacity(self.blocks + 1);
         for _ in 0..=self.blocks {
             states.push(state);
-            noise.push(Complex64::new(sigma_n * normal(&mut rng), sigma_n * normal(&mut rng)));
-            let w = self.speed_sigma_mps * normal(&mut rng);
-            let xi = Complex64::new(sigma_xi * normal(&mut rng), sigma_xi * normal(&mut rng));
+            noise.push(Complex64::new(sigma_n * standard_normal(&mut rng), sigma_n * standard_normal(&mut rng)));
+            let w = self.speed_sigma_mps * standard_normal(&mut rng);
+            let xi = Complex64::new(sigma_xi * standard_normal(&mut rng), sigma_xi * standard_normal(&mut rng));
             state = OverpassState {
                 distance_m: state.distance_m + (state.speed_mps + w) * self.block_s,
                 speed_mps: state.speed_mps + w,
@@ -214,14 +213,6 @@ impl OverpassRun {
         let tx = self.array.array_factor(tx_steer_u, tx_u).conj();
         state.alpha * rx * tx + self.noise[block]
     }
-}
-
-/// Standard normal by Box-Muller (one value per call; the rand crate's
-/// distributions live in another crate).
-fn normal(rng: &mut Pcg64) -> f64 {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 /// The core error's text as the `expected` of an invalid parameter.

@@ -60,8 +60,8 @@
 
 use mmtrack_core::Complex64;
 use mmtrack_core::array_uca::{UcaCodebook, UniformCircularArray};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
+use mmtrack_core::random::{hash_words, standard_normal, stream};
+use rand::RngExt;
 use serde::{Deserialize, Serialize};
 
 use crate::SimError;
@@ -230,8 +230,8 @@ impl OvertakingScenario {
     /// [`SimError::InvalidParameter`] when the scenario does not validate.
     pub fn realise(&self, manoeuvre: &Manoeuvre, seed: u64, run: u64) -> Result<OvertakingRun, SimError> {
         self.validate(manoeuvre)?;
-        let tag = manoeuvre.name.bytes().fold(0x6f76_7274_u64, |h, b| crate::radar::hash(&[h, u64::from(b)]));
-        let mut rng = Pcg64::seed_from_u64(crate::radar::hash(&[seed, tag, run]));
+        let tag = manoeuvre.name.bytes().fold(0x6f76_7274_u64, |h, b| hash_words(&[h, u64::from(b)]));
+        let mut rng = stream(seed, &[tag, run]);
         let lateral_offset_m = self.lateral_jitter_m * (2.0 * rng.random::<f64>() - 1.0);
         let heading_rad = self.heading_jitter_deg.to_radians() * (2.0 * rng.random::<f64>() - 1.0);
         let start_m = [manoeuvre.start_along_m, manoeuvre.lateral_m() + lateral_offset_m];
@@ -452,13 +452,6 @@ impl OvertakingReceiver {
             })
             .map(|(c, _)| c)
     }
-}
-
-/// Standard normal by Box-Muller (one value per call).
-pub(crate) fn standard_normal(rng: &mut Pcg64) -> f64 {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 #[cfg(test)]

@@ -21,8 +21,7 @@
 //! (drawn from `(seed, manoeuvre, run, path)`); walls have no loss or
 //! blockage here.
 
-use rand::SeedableRng;
-use rand_pcg::Pcg64;
+use mmtrack_core::random::{hash_words, standard_normal, stream};
 use serde::{Deserialize, Serialize};
 
 use super::overtaking::{EpochTruth, Manoeuvre, OvertakingScenario};
@@ -132,12 +131,12 @@ pub fn realise_paths(
         ));
     }
     let lambda = scenario.wavelength_m();
-    let tag = manoeuvre.name.bytes().fold(0x7061_7468_u64, |h, b| crate::radar::hash(&[h, u64::from(b)]));
+    let tag = manoeuvre.name.bytes().fold(0x7061_7468_u64, |h, b| hash_words(&[h, u64::from(b)]));
     Ok(PathKind::ALL
         .iter()
         .enumerate()
         .map(|(index, &kind)| {
-            let mut rng = Pcg64::seed_from_u64(crate::radar::hash(&[seed, tag, run, index as u64]));
+            let mut rng = stream(seed, &[tag, run, index as u64]);
             let wall = match kind {
                 PathKind::LineOfSight => None,
                 PathKind::LeftWall => Some(walls.left_wall_m),
@@ -164,7 +163,7 @@ pub fn realise_paths(
                     let doppler_noise_hz = if index == 0 {
                         e.doppler_noise_hz
                     } else {
-                        scenario.doppler_sigma_hz * super::overtaking::standard_normal(&mut rng)
+                        scenario.doppler_sigma_hz * standard_normal(&mut rng)
                     };
                     PathEpoch {
                         truth: EpochTruth {

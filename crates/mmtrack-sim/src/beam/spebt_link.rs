@@ -38,9 +38,8 @@
 //! depend on the thread that computes it.
 
 use mmtrack_core::array::UniformLinearArray;
+use mmtrack_core::random::{standard_normal, stream};
 use mmtrack_core::{Complex64, Se2, StampedPose, wrap_angle_rad};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
 use crate::SimError;
@@ -286,7 +285,7 @@ impl SpebtLink {
     #[must_use]
     pub fn realise(&self, seed: u64, run: u64) -> SpebtRun {
         let s = &self.scenario;
-        let mut rng = Pcg64::seed_from_u64(crate::radar::hash(&[seed, 0x0073_7065_6274, run]));
+        let mut rng = stream(seed, &[0x0073_7065_6274, run]);
         let (sigma_r, sigma_theta) = (s.position_sigma_m, s.yaw_sigma_deg.to_radians());
         let sigma_v = (0.5 * s.noise_variance_w()).sqrt();
         let mut pose_estimates = Vec::with_capacity(self.slots.len());
@@ -294,14 +293,14 @@ impl SpebtLink {
         for (k, slot) in self.slots.iter().enumerate() {
             // Draw every slot's errors even when slot 0 is exact, so the
             // noise of later slots does not depend on that option.
-            let error = [normal(&mut rng), normal(&mut rng), normal(&mut rng)];
+            let error = [standard_normal(&mut rng), standard_normal(&mut rng), standard_normal(&mut rng)];
             let p = slot.pose;
             pose_estimates.push(if k == 0 && s.exact_first_pose {
                 p
             } else {
                 Se2::new(p.x_m + sigma_r * error[0], p.y_m + sigma_r * error[1], p.yaw_rad + sigma_theta * error[2])
             });
-            noise.push(Complex64::new(sigma_v * normal(&mut rng), sigma_v * normal(&mut rng)));
+            noise.push(Complex64::new(sigma_v * standard_normal(&mut rng), sigma_v * standard_normal(&mut rng)));
         }
         SpebtRun { pose_estimates, noise }
     }
@@ -367,13 +366,6 @@ fn distance_to_segment(point: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let t =
         if length2 > 0.0 { (((point[0] - a[0]) * dx + (point[1] - a[1]) * dy) / length2).clamp(0.0, 1.0) } else { 0.0 };
     (a[0] + t * dx - point[0]).hypot(a[1] + t * dy - point[1])
-}
-
-/// Standard normal by Box-Muller (as in the overpass link).
-fn normal(rng: &mut Pcg64) -> f64 {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
 }
 
 #[cfg(test)]

@@ -11,7 +11,8 @@
 //! sharp turns, loops and revisits never puts a wall on the road.
 
 use mmtrack_core::Se2;
-use rand::{RngExt, SeedableRng};
+use mmtrack_core::random::stream;
+use rand::RngExt;
 use rand_pcg::Pcg64;
 use serde::Deserialize;
 
@@ -162,7 +163,7 @@ pub fn generate_world(
     }
     let mut out = Vec::new();
     for (side_index, side) in [1.0, -1.0].into_iter().enumerate() {
-        let mut rng = Pcg64::seed_from_u64(super::hash(&[seed, 0x0067_656e, side_index as u64]));
+        let mut rng = stream(seed, &[0x0067_656e, side_index as u64]);
         generate_side(config, &path, side, &mut rng, &mut out);
     }
     let boxes: Vec<[f64; 4]> = path.poses.iter().map(|p| [p.x_m, p.y_m, p.x_m, p.y_m]).collect();

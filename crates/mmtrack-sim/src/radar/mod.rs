@@ -108,16 +108,3 @@ pub use sensor::Sensor;
 pub use simulator::{RadarSimulator, SimOptions};
 pub use trajectory::{ConstantTurn, ScanLimits, Trajectory, scan_stamps};
 pub use world::{Material, POLE_STRENGTH_DB, ReflectorSpec, SurfaceProperties, World, point_segment_distance_m};
-
-/// SplitMix64 of a list of words: the simulator's stateless random source,
-/// so any draw depends only on its inputs (seed, sweep, row, scatterer).
-pub(crate) fn hash(words: &[u64]) -> u64 {
-    let mut h: u64 = 0x9e37_79b9_7f4a_7c15;
-    for w in words {
-        h = (h ^ w).wrapping_add(0x9e37_79b9_7f4a_7c15);
-        h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        h ^= h >> 31;
-    }
-    h
-}

@@ -5,12 +5,13 @@
 
 use std::f64::consts::TAU;
 
+use mmtrack_core::random::{box_muller, hash_words};
 use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader, Se2};
 
+use super::Sensor;
 use super::sensor::Prepared;
 use super::trajectory::Trajectory;
 use super::world::{Hit, Scratch, World};
-use super::{Sensor, hash};
 
 /// Reference range of the strengths, metres.
 const REFERENCE_RANGE_M: f64 = 10.0;
@@ -85,7 +86,7 @@ impl RenderContext<'_> {
     fn fill_noise(&self, scan: u64, a: u64, row: &mut [f32]) {
         let noise = &self.prepared.noise;
         let span = noise.len().saturating_sub(row.len()).max(1);
-        let offset = (hash(&[self.seed, 0x006e_6f69_7365, scan, a]) % span as u64) as usize;
+        let offset = (hash_words(&[self.seed, 0x006e_6f69_7365, scan, a]) % span as u64) as usize;
         let slice = noise.get(offset..offset + row.len()).unwrap_or(&[]);
         for ((r, n), f) in row.iter_mut().zip(slice).zip(&self.prepared.floor) {
             *r = n * f;
@@ -246,8 +247,8 @@ fn add_profile(row: &mut [f32], centre_bin: f64, peak: f64, tail_bins: f64, sens
 /// complex Gaussians, so consecutive sweeps of a static scene correlate by
 /// `f^2` in intensity.
 fn speckle_intensity(seed: u64, scan: u64, key: u64, static_fraction: f64) -> f64 {
-    let fixed = complex_gaussian(hash(&[seed, 0x7370_6563, key]));
-    let fresh = complex_gaussian(hash(&[seed, 0x7370_6563, key, scan]));
+    let fixed = complex_gaussian(hash_words(&[seed, 0x7370_6563, key]));
+    let fresh = complex_gaussian(hash_words(&[seed, 0x7370_6563, key, scan]));
     let (a, b) = (static_fraction.sqrt(), (1.0 - static_fraction).sqrt());
     let re = a * fixed[0] + b * fresh[0];
     let im = a * fixed[1] + b * fresh[1];
@@ -258,9 +259,8 @@ fn speckle_intensity(seed: u64, scan: u64, key: u64, static_fraction: f64) -> f6
 fn complex_gaussian(bits: u64) -> [f64; 2] {
     let u1 = ((bits >> 32) as f64 + 1.0) / 4_294_967_297.0;
     let u2 = (bits & 0xffff_ffff) as f64 / 4_294_967_296.0;
-    let r = (-2.0 * u1.ln()).sqrt();
-    let (s, c) = (TAU * u2).sin_cos();
-    [r * c, r * s]
+    let (re, im) = box_muller(u1, u2);
+    [re, im]
 }
 
 #[cfg(test)]

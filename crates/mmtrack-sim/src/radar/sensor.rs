@@ -2,7 +2,8 @@
 //! compression, with defaults calibrated on real Navtech CTS350-X scans (see
 //! the [module docs](super) for the numbers).
 
-use rand::{RngExt, SeedableRng};
+use mmtrack_core::random::{gamma, standard_normal};
+use rand::SeedableRng;
 use rand_pcg::Pcg64;
 use serde::Deserialize;
 
@@ -191,17 +192,12 @@ impl Prepared {
 fn noise_buffer(nu: f64, seed: u64, len: usize) -> Vec<f32> {
     let mut rng = Pcg64::seed_from_u64(seed ^ 0x6e6f_6973_655f_6275);
     let n = len;
-    let gauss = |rng: &mut Pcg64| -> f64 {
-        let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-        let u2: f64 = rng.random();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    };
-    let re: Vec<f64> = (0..n).map(|_| gauss(&mut rng)).collect();
-    let im: Vec<f64> = (0..n).map(|_| gauss(&mut rng)).collect();
+    let re: Vec<f64> = (0..n).map(|_| standard_normal(&mut rng)).collect();
+    let im: Vec<f64> = (0..n).map(|_| standard_normal(&mut rng)).collect();
     let smooth_re = smooth(&re, 2.0);
     let smooth_im = smooth(&im, 2.0);
-    // Texture: gamma draws every TEXTURE_STEP bins, linearly interpolated.
-    let knots: Vec<f64> = (0..=n / TEXTURE_STEP + 1).map(|_| gamma(&mut rng, nu)).collect();
+    // Texture: gamma draws (mean 1) every TEXTURE_STEP bins, linearly interpolated.
+    let knots: Vec<f64> = (0..=n / TEXTURE_STEP + 1).map(|_| gamma(&mut rng, nu) / nu).collect();
     let texture = |i: usize| {
         let (k, f) = (i / TEXTURE_STEP, (i % TEXTURE_STEP) as f64 / TEXTURE_STEP as f64);
         knots.get(k).copied().unwrap_or(1.0) * (1.0 - f) + knots.get(k + 1).copied().unwrap_or(1.0) * f
@@ -222,26 +218,6 @@ fn smooth(x: &[f64], sigma: f64) -> Vec<f64> {
             weights.iter().zip(-reach..=reach).map(|(w, d)| w * x[(i + d).rem_euclid(n) as usize]).sum::<f64>() / norm
         })
         .collect()
-}
-
-/// Gamma(shape `nu`, mean 1) by Marsaglia-Tsang (with the `nu < 1` boost).
-fn gamma(rng: &mut Pcg64, nu: f64) -> f64 {
-    let boost = if nu < 1.0 { rng.random_range(f64::MIN_POSITIVE..1.0).powf(1.0 / nu) } else { 1.0 };
-    let d = if nu < 1.0 { nu + 1.0 } else { nu } - 1.0 / 3.0;
-    let c = 1.0 / (9.0 * d).sqrt();
-    loop {
-        let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-        let u2: f64 = rng.random();
-        let x = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
-        let v = (1.0 + c * x).powi(3);
-        if v <= 0.0 {
-            continue;
-        }
-        let u: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-        if u.ln() < 0.5 * x * x + d - d * v + d * v.ln() {
-            return d * v * boost / nu;
-        }
-    }
 }
 
 #[cfg(test)]
@@ -270,7 +246,7 @@ mod tests {
     fn gamma_has_the_asked_mean() {
         let mut rng = Pcg64::seed_from_u64(5);
         for nu in [0.4, 2.0] {
-            let m = (0..20_000).map(|_| gamma(&mut rng, nu)).sum::<f64>() / 20_000.0;
+            let m = (0..20_000).map(|_| gamma(&mut rng, nu) / nu).sum::<f64>() / 20_000.0;
             // Standard error of the mean is 1/sqrt(nu * 20000) <= 0.011; 5 sigma.
             assert!((m - 1.0).abs() < 0.06, "nu {nu}: {m}");
         }

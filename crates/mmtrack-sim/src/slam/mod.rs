@@ -26,12 +26,13 @@
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
+use mmtrack_core::random::{standard_normal, stream};
 use mmtrack_core::slam::{
     PathMeasurement, PathOrigin, SlamEpoch, SourceType, UeState, dot3, incidence_point, predict_path, sub3,
     virtual_anchor,
 };
 use mmtrack_core::wrap_angle_rad;
-use rand::{RngExt, SeedableRng};
+use rand::RngExt;
 use rand_pcg::Pcg64;
 use serde::{Deserialize, Serialize};
 
@@ -258,7 +259,7 @@ impl SlamScenario {
     /// [`SimError::InvalidParameter`] when the scenario does not validate.
     pub fn realise(&self, seed: u64, run: u64) -> Result<SlamRun, SimError> {
         self.validate()?;
-        let mut rng = Pcg64::seed_from_u64(crate::radar::hash(&[seed, 0x0073_6c61_6d00, run]));
+        let mut rng = stream(seed, &[0x0073_6c61_6d00, run]);
         let world = self.draw_world(&mut rng)?;
         let mut ue = UeState::from(self.initial);
         let mut epochs = Vec::with_capacity(self.epochs);
@@ -269,9 +270,9 @@ impl SlamScenario {
             epochs.push(SlamEpoch { t_ns, paths });
             truth.push(SlamTruth { ue, origins });
             ue = ue.ctrv_step(self.epoch_s);
-            ue.speed_mps += self.speed_std_mps * normal(&mut rng);
-            ue.turn_rate_radps += self.turn_rate_std_radps * normal(&mut rng);
-            ue.clock_bias_m += self.clock_bias_std_m * normal(&mut rng);
+            ue.speed_mps += self.speed_std_mps * standard_normal(&mut rng);
+            ue.turn_rate_radps += self.turn_rate_std_radps * standard_normal(&mut rng);
+            ue.clock_bias_m += self.clock_bias_std_m * standard_normal(&mut rng);
         }
         Ok(SlamRun { world, epochs, truth })
     }
@@ -333,7 +334,7 @@ impl SlamScenario {
             // Every draw happens whether or not the path is detected, so P_D
             // does not shift the noise of the other paths.
             let detected = rng.random::<f64>() < self.detection_probability;
-            let noise: [f64; 5] = std::array::from_fn(|_| normal(rng));
+            let noise: [f64; 5] = std::array::from_fn(|_| standard_normal(rng));
             let Some(z) = predict_path(ue, world.bs_m, kind, at) else { continue };
             if origin == PathOrigin::LineOfSight {
                 los_toa_m = z.toa_m;
@@ -377,13 +378,6 @@ fn reflects(bs_m: [f64; 3], wall: Wall, va_m: [f64; 3], ue_m: [f64; 3]) -> bool 
     let side_bs = dot3(sub3(bs_m, wall.point_m), wall.normal);
     let side_ue = dot3(sub3(ue_m, wall.point_m), wall.normal);
     side_bs * side_ue > 0.0 && incidence_point(va_m, bs_m, ue_m).is_some()
-}
-
-/// Standard normal by Box-Muller (as in the beam links).
-fn normal(rng: &mut Pcg64) -> f64 {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos()
 }
 
 #[cfg(test)]

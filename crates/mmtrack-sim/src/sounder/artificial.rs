@@ -2,16 +2,15 @@
 //! MPCs of equal power approaching each other in delay over consecutive
 //! snapshots, plus a noise floor.
 
+use mmtrack_core::random::stream;
 use mmtrack_core::{CirSnapshot, Complex64, MpcTruth};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
+use rand::RngExt;
 use serde::Deserialize;
 
 use super::pulse::SounderConfig;
 use super::render::{RenderPath, SnapshotStamp, render_snapshot};
 use crate::SimError;
 use crate::error::{ensure_finite, ensure_non_negative, ensure_positive, invalid};
-use crate::radar::hash;
 
 const NOISE_STREAM: u64 = 0x6e6f_6973_6520_6172;
 
@@ -118,7 +117,7 @@ pub fn artificial_channel(
     let pulse = config.sounder.pulse.spectrum(&band);
     let sigma = config.sounder.noise_sigma();
     let magnitude = 10f64.powf(config.mpc_power_db / 20.0);
-    let mut rng = Pcg64::seed_from_u64(hash(&[seed, 0x6172_7469]));
+    let mut rng = stream(seed, &[0x6172_7469]);
     let phases: [f64; 2] = [rng.random::<f64>() * std::f64::consts::TAU, rng.random::<f64>() * std::f64::consts::TAU];
     let n = config.snapshots;
     let step_ns = (config.snapshot_interval_s * 1e9).round() as i64;

@@ -1,11 +1,8 @@
 //! Turning paths into a CIR: transfer function, inverse DFT, noise.
 
+use mmtrack_core::random::{standard_normal_pair, stream};
 use mmtrack_core::sounder::{SounderBand, cir_from_spectrum};
 use mmtrack_core::{CirSnapshot, Complex64};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
-
-use crate::radar::hash;
 
 /// Adds a path's phasors to `spectrum` as [`SounderBand::add_path`] does
 /// with a unit pulse, `S[k] += alpha exp(-j 2 pi f_k tau)`, but with the
@@ -80,14 +77,9 @@ pub(crate) fn render_snapshot(
     }
     let mut taps = cir_from_spectrum(&spectrum);
     if noise_sigma > 0.0 {
-        let mut rng = Pcg64::seed_from_u64(hash(&[
-            seed_words[0],
-            seed_words[1],
-            stamp.set_index,
-            u64::from(stamp.snapshot_index),
-        ]));
+        let mut rng = stream(seed_words[0], &[seed_words[1], stamp.set_index, u64::from(stamp.snapshot_index)]);
         for tap in &mut taps {
-            let (re, im) = gauss_pair(&mut rng);
+            let (re, im) = standard_normal_pair(&mut rng);
             *tap += Complex64::new(noise_sigma * re, noise_sigma * im);
         }
     }
@@ -103,15 +95,6 @@ pub(crate) fn render_snapshot(
         taps,
         first_path_hint_s: None,
     }
-}
-
-/// Two independent standard normal draws (Box-Muller).
-pub(crate) fn gauss_pair(rng: &mut Pcg64) -> (f64, f64) {
-    let u1: f64 = rng.random_range(f64::MIN_POSITIVE..1.0);
-    let u2: f64 = rng.random();
-    let r = (-2.0 * u1.ln()).sqrt();
-    let (s, c) = (std::f64::consts::TAU * u2).sin_cos();
-    (r * c, r * s)
 }
 
 #[cfg(test)]

@@ -3,18 +3,17 @@
 use std::collections::VecDeque;
 use std::f64::consts::{PI, TAU};
 
+use mmtrack_core::random::{self, standard_exponential, standard_normal_pair};
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{CirSnapshot, Complex64, MpcTruth, Se2, StampedPose};
-use rand::{RngExt, SeedableRng};
-use rand_pcg::Pcg64;
+use rand::RngExt;
 use rayon::prelude::*;
 
 use super::convoy::{ConvoyConfig, RoadKind};
 use super::geometry::{P2, Road, Wall, blocked, cross, dist, dot, reflection_point, sub, unit};
-use super::render::{RenderPath, SnapshotStamp, gauss_pair, render_snapshot};
+use super::render::{RenderPath, SnapshotStamp, render_snapshot};
 use super::{PathKind, SPEED_OF_LIGHT_MPS};
 use crate::SimError;
-use crate::radar::hash;
 
 /// One set of the convoy run: its snapshots, the true MPCs of every
 /// snapshot, and both cars' poses at the set's first snapshot.
@@ -141,7 +140,7 @@ impl ConvoySimulator {
         let road = Road { radius_m: (config.road.radius_m != 0.0).then_some(config.road.radius_m) };
         let v = &config.vehicles;
         let kmh = 1.0 / 3.6;
-        let mut rng = Pcg64::seed_from_u64(hash(&[seed, 0x6d6f_7469_6f6e]));
+        let mut rng = random::stream(seed, &[0x6d6f_7469_6f6e]);
         let mut motion = |s0_m: f64, range: [f64; 2]| LaneMotion {
             s0_m,
             lane_m: v.lane_m,
@@ -323,7 +322,7 @@ impl ConvoySimulator {
     }
 
     fn static_phase(&self, id: u64) -> f64 {
-        let mut rng = Pcg64::seed_from_u64(hash(&[self.seed, 0x0070_6861_7365, id]));
+        let mut rng = random::stream(self.seed, &[0x0070_6861_7365, id]);
         rng.random::<f64>() * TAU
     }
 
@@ -477,10 +476,10 @@ fn build_scatterers(
     }
     let [lo_db, hi_db] = config.diffuse.relative_power_db;
     for (side, lateral) in [config.road.half_width_m, -config.road.half_width_m].into_iter().enumerate() {
-        let mut rng = Pcg64::seed_from_u64(hash(&[seed, 0x6469_6666, side as u64]));
+        let mut rng = random::stream(seed, &[0x6469_6666, side as u64]);
         let mut s = s_min;
         loop {
-            s += -rng.random_range(f64::MIN_POSITIVE..1.0).ln() / density;
+            s += standard_exponential(&mut rng) / density;
             if s >= s_max {
                 break;
             }
@@ -497,7 +496,7 @@ fn build_scatterers(
                 }
             };
             let db = if hi_db > lo_db { rng.random_range(lo_db..hi_db) } else { lo_db };
-            let (re, im) = gauss_pair(&mut rng);
+            let (re, im) = standard_normal_pair(&mut rng);
             let rayleigh = (0.5 * (re * re + im * im)).sqrt();
             let gain = 10f64.powf(db / 20.0) * rayleigh;
             out.push(Scatterer { point, tangent, s_centre_m: s, gain, phase_rad: im.atan2(re) });
@@ -521,14 +520,14 @@ fn build_cars(config: &ConvoyConfig, seed: u64, duration_s: f64, s_min: f64, s_m
         if per_km <= 0.0 {
             continue;
         }
-        let mut rng = Pcg64::seed_from_u64(hash(&[seed, 0x7472_6166, stream as u64]));
+        let mut rng = random::stream(seed, &[0x7472_6166, stream as u64]);
         // Start positions over the stretch the cars can cross the convoy's
         // surroundings from during the run.
         let travel = speed_kmh[1] * kmh * duration_s;
         let (lo, hi) = if sign < 0.0 { (s_min, s_max + travel) } else { (s_min - travel, s_max) };
         let mut s = lo;
         loop {
-            s += -rng.random_range(f64::MIN_POSITIVE..1.0).ln() / (per_km / 1000.0);
+            s += standard_exponential(&mut rng) / (per_km / 1000.0);
             if s >= hi {
                 break;
             }
