@@ -45,33 +45,16 @@ pub struct WrittenResults {
 /// Checks, before any work, that `out` may be written: absent, or (with
 /// [`Overwrite::Replace`]) a directory holding only [`OWN_ENTRIES`].
 pub fn check_output(out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
-    if !out.exists() {
-        return Ok(());
-    }
-    if !out.is_dir() {
-        bail!("{}: exists and is not a directory; choose another output", out.display());
-    }
-    let mut foreign = Vec::new();
-    let mut any = false;
-    for entry in std::fs::read_dir(out).with_context(|| out.display().to_string())? {
-        let name = entry.with_context(|| out.display().to_string())?.file_name().to_string_lossy().into_owned();
-        any = true;
-        if !OWN_ENTRIES.contains(&name.as_str()) && !name.starts_with("run=") {
-            foreign.push(name);
+    let owns = |relative: &Path, _is_dir: bool| {
+        let top = relative.iter().next().map(|c| c.to_string_lossy()).unwrap_or_default();
+        OWN_ENTRIES.contains(&top.as_ref()) || top.starts_with("run=")
+    };
+    match mmtrack_io::check_replaceable_dir(out, "mmtrack analyze", &owns, overwrite) {
+        Err(mmtrack_io::IoError::OutputExists { .. }) => {
+            bail!("{}: holds results; use --force to replace them (nothing was written)", out.display())
         }
+        other => Ok(other?),
     }
-    if !foreign.is_empty() {
-        foreign.sort();
-        bail!(
-            "{}: holds {} which `mmtrack analyze` does not write; refusing to replace it (choose an empty or new output)",
-            out.display(),
-            foreign.join(", ")
-        );
-    }
-    if any && overwrite == Overwrite::Refuse {
-        bail!("{}: holds results; use --force to replace them (nothing was written)", out.display());
-    }
-    Ok(())
 }
 
 fn parent_dir(path: &Path) -> PathBuf {

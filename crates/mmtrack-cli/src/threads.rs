@@ -24,6 +24,13 @@ impl ThreadsArg {
     /// every loop (a wake-up across threads per MPC set or decode batch,
     /// which cost 20 % of `bench mpc` on one thread).
     pub fn install<R: Send>(self, work: impl FnOnce() -> R + Send) -> anyhow::Result<R> {
+        let limit = mmtrack_core::limits::THREADS;
+        anyhow::ensure!(
+            limit.allows_count(self.threads as u64),
+            "--threads {}: expected {} (nothing was done)",
+            self.threads,
+            limit.expected
+        );
         if self.threads == 0 && rayon::current_thread_index().is_some() {
             return Ok(work());
         }

@@ -36,6 +36,7 @@ mod beam_sweep;
 mod cir;
 pub mod error;
 mod gnss;
+pub mod limits;
 mod mpc;
 mod odometry;
 pub mod parallel;

@@ -162,6 +162,60 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
     Ok(dir)
 }
 
+/// Checks, before any work, that the directory `dir` may be written by
+/// `command`: absent or empty; or, with [`Overwrite::Replace`], holding only entries
+/// `command` writes itself (`owns(relative path, is_dir)`, asked for each
+/// entry, and for the entries of every directory it owns). A directory
+/// holding anything else is never replaced ([`IoError::ForeignEntries`],
+/// naming them), so a mistyped `-o --force` cannot delete unrelated files.
+///
+/// # Errors
+/// [`IoError::OutputExists`] (an existing `dir` without `Replace`),
+/// [`IoError::ForeignEntries`], [`IoError::NotADirectory`], or an
+/// unreadable directory.
+pub fn check_replaceable_dir(
+    dir: &Path,
+    command: &str,
+    owns: &dyn Fn(&Path, bool) -> bool,
+    overwrite: Overwrite,
+) -> Result<()> {
+    if !dir.exists() {
+        return Ok(());
+    }
+    if !dir.is_dir() {
+        return Err(IoError::NotADirectory { path: dir.to_path_buf() });
+    }
+    let mut foreign = Vec::new();
+    let mut any = false;
+    let mut pending = vec![PathBuf::new()];
+    while let Some(relative) = pending.pop() {
+        let listed = dir.join(&relative);
+        for entry in std::fs::read_dir(&listed).map_err(os_err(&listed))? {
+            let entry = entry.map_err(os_err(&listed))?;
+            any = true;
+            let name = relative.join(entry.file_name());
+            let is_dir = entry.file_type().map_err(os_err(&listed))?.is_dir();
+            if !owns(&name, is_dir) {
+                foreign.push(name.to_string_lossy().into_owned());
+            } else if is_dir {
+                pending.push(name);
+            }
+        }
+    }
+    if !foreign.is_empty() {
+        foreign.sort();
+        return Err(IoError::ForeignEntries {
+            path: dir.to_path_buf(),
+            command: command.to_string(),
+            entries: foreign,
+        });
+    }
+    if any && overwrite == Overwrite::Refuse {
+        return Err(IoError::OutputExists { path: dir.to_path_buf() });
+    }
+    Ok(())
+}
+
 /// The end of every partial output's name.
 const PARTIAL_SUFFIX: &str = ".partial";
 

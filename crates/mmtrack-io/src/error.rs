@@ -30,6 +30,26 @@ pub enum IoError {
         /// The existing output.
         path: PathBuf,
     },
+    /// The output directory exists as a file.
+    #[error("{path}: exists and is not a directory; choose another output")]
+    NotADirectory {
+        /// The file in the way.
+        path: PathBuf,
+    },
+    /// `--force` would replace a directory holding entries the command does
+    /// not write.
+    #[error(
+        "{path}: holds {} which `{command}` does not write; refusing to replace it (choose an empty or new output)",
+        .entries.join(", ")
+    )]
+    ForeignEntries {
+        /// The directory to be replaced.
+        path: PathBuf,
+        /// The command that would replace it (`mmtrack simulate radar`).
+        command: String,
+        /// The entries it does not write, relative to `path`, sorted.
+        entries: Vec<String>,
+    },
     /// The MCAP container is malformed or cut short.
     #[error("{path}: not a readable MCAP recording ({}); the file may be truncated or corrupted", printable(.detail))]
     CorruptRecording {

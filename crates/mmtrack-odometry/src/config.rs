@@ -148,11 +148,12 @@ impl OdometryConfig {
         if !positive(self.huber_delta_m) {
             return bad("huber_delta_m", self.huber_delta_m, "a positive length");
         }
-        if self.association_rounds == 0 {
-            return bad("association_rounds", self.association_rounds, "at least 1");
+        let iterations = mmtrack_core::limits::ITERATIONS;
+        if self.association_rounds == 0 || !iterations.allows_count(self.association_rounds as u64) {
+            return bad("association_rounds", self.association_rounds, iterations.expected);
         }
-        if self.max_iterations == 0 {
-            return bad("max_iterations", self.max_iterations, "at least 1");
+        if self.max_iterations == 0 || !iterations.allows_count(self.max_iterations as u64) {
+            return bad("max_iterations", self.max_iterations, iterations.expected);
         }
         if self.submap_keyframes == 0 {
             return bad("submap_keyframes", self.submap_keyframes, "at least 1");

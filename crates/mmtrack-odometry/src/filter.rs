@@ -76,8 +76,10 @@ pub fn k_strongest(scan: &PolarScan, k: usize, min_power: u8, min_range_m: f64, 
     let first_bin = ((min_range_m - header.range_offset_m) / resolution_m).ceil().max(0.0) as usize;
     let end_bin = (((max_range_m - header.range_offset_m) / resolution_m).floor() + 1.0).max(0.0) as usize;
     let end_bin = end_bin.min(header.bins_per_azimuth);
-    let mut points = Vec::with_capacity(header.azimuths.len() * k);
-    let mut strongest: Vec<(u8, usize)> = Vec::with_capacity(k + 1);
+    // No more than the bins in range are kept, whatever `k` is.
+    let kept_per_azimuth = k.min(end_bin.saturating_sub(first_bin));
+    let mut points = Vec::with_capacity(header.azimuths.len() * kept_per_azimuth);
+    let mut strongest: Vec<(u8, usize)> = Vec::with_capacity(kept_per_azimuth + 1);
     for (row_index, azimuth) in header.azimuths.iter().enumerate() {
         let Some(row) = scan.row(row_index) else { break };
         if !azimuth.valid || first_bin >= end_bin {

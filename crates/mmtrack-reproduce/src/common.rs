@@ -69,7 +69,12 @@ pub fn load_experiment<T: DeserializeOwned>(
 /// Zero runs.
 pub fn run_count(explicit: Option<u64>, tier: Tier, smoke_runs: u64, full_runs: u64) -> anyhow::Result<u64> {
     let runs = explicit.unwrap_or(if tier.is_smoke() { smoke_runs } else { full_runs });
-    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    let limit = mmtrack_core::limits::MONTE_CARLO_RUNS;
+    anyhow::ensure!(
+        runs >= 1 && limit.allows_count(runs),
+        "--runs {runs}: expected {} (nothing was done)",
+        limit.expected
+    );
     Ok(runs)
 }
 

@@ -2,6 +2,7 @@
 //! gives them; the rest (new-source density, confirmation and merging
 //! thresholds, forgetting) are ours, named and documented here.
 
+use mmtrack_core::limits;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{SlamError, ensure_non_negative, ensure_positive, invalid};
@@ -124,11 +125,11 @@ impl SlamConfig {
     /// # Errors
     /// [`SlamError::InvalidConfig`] naming the field.
     pub fn validate(&self) -> Result<(), SlamError> {
-        if self.particles < 2 {
-            return Err(invalid("particles", self.particles, "at least 2"));
+        if self.particles < 2 || !limits::PARTICLES.allows_count(self.particles as u64) {
+            return Err(invalid("particles", self.particles, limits::PARTICLES.expected));
         }
-        if self.iterations == 0 {
-            return Err(invalid("iterations", self.iterations, "at least 1"));
+        if self.iterations == 0 || !limits::ITERATIONS.allows_count(self.iterations as u64) {
+            return Err(invalid("iterations", self.iterations, limits::ITERATIONS.expected));
         }
         if self.chunk_size == 0 {
             return Err(invalid("chunk_size", self.chunk_size, "at least 1"));

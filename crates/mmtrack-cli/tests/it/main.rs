@@ -7,6 +7,7 @@ mod analyze;
 mod architecture;
 mod bad_png;
 mod bench_mpc;
+mod bounds;
 mod cli;
 mod common;
 mod error_lines;

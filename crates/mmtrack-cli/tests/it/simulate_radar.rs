@@ -116,3 +116,43 @@ fn a_drive_along_the_real_oxford_ground_truth() {
     assert_eq!(truth[0].parent_from_child, mmtrack_core::Se2::IDENTITY);
     assert!(truth[0].t_ns > 1_500_000_000_000_000_000, "a UNIX time: {}", truth[0].t_ns);
 }
+
+/// Issue 26: `--force` over a folder holding files mmtrack never wrote
+/// refuses by name and deletes nothing; over its own Oxford output it
+/// replaces it.
+#[test]
+fn oxford_force_never_deletes_foreign_files() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.toml"), SMALL).unwrap();
+    let oxford = ["simulate", "radar", "--scenario", "s.toml", "--format", "oxford", "-o", "v", "--quiet"];
+    let forced: Vec<&str> = oxford.iter().copied().chain(["--force"]).collect();
+    let out = mmtrack(dir.path(), &oxford);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let scans = std::fs::read_dir(dir.path().join("v/radar")).unwrap().count();
+    assert_eq!(scans, 3);
+
+    // Its own output is replaced.
+    let out = mmtrack(dir.path(), &forced);
+    assert!(out.status.success(), "{}", text(&out).1);
+
+    // A foreign file at the top and one inside radar/: refused, both kept.
+    std::fs::create_dir_all(dir.path().join("v/sub")).unwrap();
+    std::fs::write(dir.path().join("v/notes.txt"), "precious").unwrap();
+    std::fs::write(dir.path().join("v/radar/readme.md"), "mine").unwrap();
+    let out = mmtrack(dir.path(), &forced);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(stderr.contains("notes.txt") && stderr.contains("radar/readme.md") && stderr.contains("sub"), "{stderr}");
+    assert!(stderr.contains("refusing to replace"), "{stderr}");
+    assert_eq!(std::fs::read_to_string(dir.path().join("v/notes.txt")).unwrap(), "precious");
+    assert_eq!(std::fs::read_to_string(dir.path().join("v/radar/readme.md")).unwrap(), "mine");
+    assert_eq!(std::fs::read_dir(dir.path().join("v/radar")).unwrap().count(), scans + 1);
+    assert!(dir.path().join("v/sub").is_dir());
+    // Nothing left beside it.
+    let hidden: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+}

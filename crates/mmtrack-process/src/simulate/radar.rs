@@ -9,7 +9,7 @@ use mmtrack_core::progress::Progress;
 use mmtrack_ingest::oxford::{self, NavtechLayout};
 use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
-use mmtrack_io::{RecordingOptions, RecordingWriter};
+use mmtrack_io::{Overwrite, RecordingOptions, RecordingWriter, check_replaceable_dir};
 use mmtrack_sim::radar::{RadarSimulator, Scenario, Trajectory};
 
 /// Trajectory file formats.
@@ -118,10 +118,14 @@ pub fn read_trajectory(
 }
 
 /// Streams `simulator`'s scans into an Oxford folder at `dir` (replaced
-/// atomically: built beside it, then renamed).
+/// atomically: built beside it, then renamed). An existing `dir` is replaced
+/// only with `force` and only when it holds nothing but what this writes
+/// ([`is_oxford_output_entry`]); anything else is refused by name before any
+/// scan is rendered.
 ///
 /// # Errors
-/// An existing `dir` without `force`, or a file that cannot be written.
+/// An existing `dir` without `force`, a `dir` holding other files, or a file
+/// that cannot be written.
 pub fn write_oxford_streaming(
     scenario: &Scenario,
     simulator: RadarSimulator<'_>,
@@ -129,9 +133,8 @@ pub fn write_oxford_streaming(
     force: bool,
     progress: &dyn Progress,
 ) -> anyhow::Result<()> {
-    if dir.exists() && !force {
-        anyhow::bail!("{}: output already exists (pass --force to replace it)", dir.display());
-    }
+    let overwrite = if force { Overwrite::Replace } else { Overwrite::Refuse };
+    check_replaceable_dir(dir, "mmtrack simulate radar --format oxford", &is_oxford_output_entry, overwrite)?;
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
     let staging = mmtrack_io::staging_dir(parent, ".simulate-")?;
@@ -158,12 +161,42 @@ pub fn write_oxford_streaming(
     oxford::write_oxford_folder(staging.path(), &[], &truth, &layout)?;
     let path = staging.path().join("radar.timestamps");
     std::fs::write(&path, timestamps).with_context(|| path.display().to_string())?;
-    if dir.exists() {
-        std::fs::remove_dir_all(dir).with_context(|| dir.display().to_string())?;
+    // The old folder (checked above to hold only our own files) moves aside
+    // into a staging name first, so `dir` is never missing while a finished
+    // output exists, and is removed after the new one is in place.
+    let replaced = if dir.exists() {
+        let aside = mmtrack_io::staging_dir(parent, ".simulate-")?;
+        std::fs::rename(dir, aside.path().join("old")).with_context(|| dir.display().to_string())?;
+        Some(aside)
+    } else {
+        None
+    };
+    if let Err(error) = std::fs::rename(staging.path(), dir) {
+        if let Some(aside) = &replaced {
+            // Put the old output back; the new one goes with `staging`.
+            let _ = std::fs::rename(aside.path().join("old"), dir);
+        }
+        return Err(error).with_context(|| dir.display().to_string());
     }
-    let staged = staging.keep();
-    std::fs::rename(&staged, dir).with_context(|| dir.display().to_string())?;
+    let _ = staging.keep();
+    drop(replaced);
     Ok(())
+}
+
+/// Whether `relative` (a path inside an Oxford output folder) is something
+/// [`write_oxford_streaming`] writes: `radar/` with `<t_us>.png` scans,
+/// `radar.timestamps`, `gt/` with `radar_odometry.csv`.
+fn is_oxford_output_entry(relative: &Path, is_dir: bool) -> bool {
+    let parts: Vec<&str> = relative.iter().filter_map(|c| c.to_str()).collect();
+    match parts.as_slice() {
+        ["radar" | "gt"] => is_dir,
+        ["radar.timestamps"] => !is_dir,
+        ["radar", scan] => {
+            !is_dir && scan.strip_suffix(".png").is_some_and(|t| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()))
+        }
+        ["gt", "radar_odometry.csv"] => !is_dir,
+        _ => false,
+    }
 }
 
 fn write_recording(

@@ -91,7 +91,12 @@ impl Sweep {
 /// # Errors
 /// A detector or tracker set-up fails, or the simulator does.
 pub fn measure(config: &Config, powers_db: &[f64], runs: u64, progress: &dyn Progress) -> anyhow::Result<Sweep> {
-    anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    let limit = mmtrack_core::limits::MONTE_CARLO_RUNS;
+    anyhow::ensure!(
+        runs >= 1 && limit.allows_count(runs),
+        "--runs {runs}: expected {} (nothing was done)",
+        limit.expected
+    );
     let pulse = config.pulse.model();
     let mut sweep = Sweep {
         channel: channel_config(powers_db.first().copied().unwrap_or(-116.0), &pulse),

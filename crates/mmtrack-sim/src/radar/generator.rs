@@ -161,6 +161,18 @@ pub fn generate_world(
     if path.poses.len() < 2 {
         return Ok(Vec::new());
     }
+    // Refused before generating: an estimate of the reflectors per metre on
+    // both sides (a pole every pole_spacing_m, clutter_per_100m, one
+    // building and one block at their shortest lengths).
+    let per_m = 2.0
+        * (1.0 / config.pole_spacing_m
+            + config.clutter_per_100m / 100.0
+            + 1.0 / config.building_length_m[0]
+            + 1.0 / config.block_length_m[0]);
+    let limit = mmtrack_core::limits::REFLECTORS;
+    if !limit.allows(per_m * path.length_m()) {
+        return Err(invalid("generator.pole_spacing_m", config.pole_spacing_m, limit.expected));
+    }
     let mut out = Vec::new();
     for (side_index, side) in [1.0, -1.0].into_iter().enumerate() {
         let mut rng = stream(seed, &[0x0067_656e, side_index as u64]);

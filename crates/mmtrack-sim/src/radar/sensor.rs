@@ -82,6 +82,10 @@ impl Sensor {
         if self.bins == 0 {
             return Err(invalid("sensor.bins", 0, "at least 1 range bin"));
         }
+        let pixels = mmtrack_core::limits::SCAN_PIXELS;
+        if !pixels.allows(self.azimuths as f64 * self.bins as f64) {
+            return Err(invalid("sensor.bins", self.bins, pixels.expected));
+        }
         ensure_positive("sensor.range_resolution_m", self.range_resolution_m)?;
         ensure_positive("sensor.sweep_period_s", self.sweep_period_s)?;
         if (self.sweep_period_s * 1e9) < self.azimuths as f64 {

@@ -5,11 +5,11 @@
 //! the shortest arc in yaw: `yaw = yaw_0 + s * wrap(yaw_1 - yaw_0)` with
 //! `s = (t - t_0) / (t_1 - t_0)`.
 
-use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
+use mmtrack_core::{Se2, StampedPose, limits, wrap_angle_rad};
 use serde::Deserialize;
 
 use crate::SimError;
-use crate::error::{ensure_finite, ensure_positive};
+use crate::error::{ensure_finite, ensure_positive, invalid};
 
 /// Constant speed and yaw rate from the origin, heading along world x.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
@@ -53,10 +53,26 @@ pub enum Trajectory {
 impl Trajectory {
     /// Constant-turn motion over `duration_s` seconds from `start_t_ns`.
     pub fn constant_turn(motion: ConstantTurn, start_t_ns: i64, duration_s: f64) -> Result<Self, SimError> {
-        ensure_finite("motion.speed_mps", motion.speed_mps)?;
         ensure_finite("motion.yaw_rate_radps", motion.yaw_rate_radps)?;
+        if !limits::SPEED_MPS.allows(motion.speed_mps.abs()) {
+            return Err(invalid("motion.speed_mps", motion.speed_mps, limits::SPEED_MPS.expected));
+        }
         ensure_positive("motion.duration_s", duration_s)?;
-        Ok(Self::ConstantTurn { motion, start_t_ns, duration_ns: (duration_s * 1e9).round() as i64 })
+        if !limits::DURATION_S.allows(duration_s) {
+            return Err(invalid("motion.duration_s", duration_s, limits::DURATION_S.expected));
+        }
+        if !limits::PATH_LENGTH_M.allows(motion.speed_mps.abs() * duration_s) {
+            return Err(invalid("motion.duration_s", duration_s, limits::PATH_LENGTH_M.expected));
+        }
+        let duration_ns = (duration_s * 1e9).round() as i64;
+        if start_t_ns.checked_add(duration_ns).is_none() {
+            return Err(invalid(
+                "start_t_ns",
+                start_t_ns,
+                "a start time whose drive ends before the year 2262 (i64 ns)",
+            ));
+        }
+        Ok(Self::ConstantTurn { motion, start_t_ns, duration_ns })
     }
 
     /// A trajectory through `poses`; errors name the first bad pose.

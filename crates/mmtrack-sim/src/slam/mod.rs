@@ -26,6 +26,7 @@
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
+use mmtrack_core::limits;
 use mmtrack_core::random::{standard_normal, stream};
 use mmtrack_core::slam::{
     PathMeasurement, PathOrigin, SlamEpoch, SourceType, UeState, dot3, incidence_point, predict_path, sub3,
@@ -228,8 +229,18 @@ impl SlamScenario {
         ensure_finite("initial.turn_rate_radps", i.turn_rate_radps)?;
         ensure_finite("initial.clock_bias_m", i.clock_bias_m)?;
         ensure_positive("epoch_s", self.epoch_s)?;
-        if self.epochs == 0 {
-            return Err(invalid("epochs", 0, "at least 1"));
+        if self.epochs == 0 || !limits::SLAM_EPOCHS.allows_count(self.epochs as u64) {
+            return Err(invalid("epochs", self.epochs, limits::SLAM_EPOCHS.expected));
+        }
+        if !limits::CLUTTER_PER_EPOCH.allows_count(self.clutter_per_epoch as u64) {
+            return Err(invalid("clutter_per_epoch", self.clutter_per_epoch, limits::CLUTTER_PER_EPOCH.expected));
+        }
+        if !limits::SCATTERING_POINTS.allows_count(self.random_scattering_points as u64) {
+            return Err(invalid(
+                "random_scattering_points",
+                self.random_scattering_points,
+                limits::SCATTERING_POINTS.expected,
+            ));
         }
         ensure_non_negative("speed_std_mps", self.speed_std_mps)?;
         ensure_non_negative("turn_rate_std_radps", self.turn_rate_std_radps)?;

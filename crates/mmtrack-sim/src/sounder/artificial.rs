@@ -78,8 +78,9 @@ impl ArtificialChannelConfig {
         ensure_non_negative("artificial.start_separation_s", self.start_separation_s)?;
         ensure_non_negative("artificial.end_separation_s", self.end_separation_s)?;
         ensure_positive("artificial.snapshot_interval_s", self.snapshot_interval_s)?;
-        if self.snapshots < 2 {
-            return Err(invalid("artificial.snapshots", self.snapshots, "at least 2 snapshots"));
+        let limit = mmtrack_core::limits::SNAPSHOTS_IN_MEMORY;
+        if self.snapshots < 2 || !limit.allows_count(self.snapshots as u64) {
+            return Err(invalid("artificial.snapshots", self.snapshots, limit.expected));
         }
         if self.snapshots_per_set == Some(0) {
             return Err(invalid("artificial.snapshots_per_set", 0, "at least 1 snapshot per set"));

@@ -249,6 +249,10 @@ impl ConvoyConfig {
         if self.snapshots_per_set == 0 {
             return Err(invalid("convoy.snapshots_per_set", 0, "at least 1 snapshot per set"));
         }
+        let limit = mmtrack_core::limits::SNAPSHOTS_STREAMED;
+        if !limit.allows(self.sets as f64 * f64::from(self.snapshots_per_set)) {
+            return Err(invalid("convoy.sets", self.sets, limit.expected));
+        }
         let (snapshot_ns, set_ns) = self.intervals_ns()?;
         if i64::from(self.snapshots_per_set - 1) * snapshot_ns >= set_ns {
             return Err(invalid(

@@ -337,7 +337,8 @@ pub fn process_spebt(
 ) -> anyhow::Result<SpebtOutput> {
     let (experiment, link_source) = experiment(options)?;
     let runs = options.runs.unwrap_or(1);
-    ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+    let limit = mmtrack_core::limits::MONTE_CARLO_RUNS;
+    ensure!(runs >= 1 && limit.allows_count(runs), "--runs {runs}: expected {} (nothing was done)", limit.expected);
     let config = tracker_config(&experiment);
     let recordings = recordings.iter().map(|p| read_truth(p)).collect::<anyhow::Result<Vec<_>>>()?;
     for r in &recordings {
