@@ -48,7 +48,7 @@ ROS 2 bags) into canonical MCAP recordings, runs published algorithms on them (r
 beam tracking, mmWave SLAM) and writes Parquet tables and plots.\n\n\
 Data flow: raw files --ingest--> recording.mcap --process--> tables (Parquet) --analyze--> metrics + plots.\n\n\
 Exit codes: 0 success, 1 error (one line naming the file and the problem) or a missed paper target (reproduce, bench --check), 2 usage error, \
-130/143 interrupted by SIGINT/SIGTERM (partial outputs are removed; a run killed outright leaves a hidden \
+130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP (partial outputs are removed; a run killed outright leaves a hidden \
 .<name>.<pid>.<random>.partial file that the next run writing the same output removes).",
     after_help = "Start with `mmtrack demo`, then `mmtrack inspect out/demo/recording.mcap`."
 )]
@@ -196,20 +196,24 @@ fn one_line(error: &anyhow::Error) -> String {
     printable(&parts.join(": ")).into_owned()
 }
 
-/// On SIGINT or SIGTERM: removes the partial outputs this run is writing
+/// On SIGINT, SIGTERM or SIGHUP (a closed terminal): removes the partial outputs this run is writing
 /// (`mmtrack_io::atomic`), says so on stderr (unless `quiet`; failures
-/// always) and exits with 128 + the signal (130, 143), as a shell reports a
+/// always) and exits with 128 + the signal (130, 143, 129), as a shell reports a
 /// process the signal killed. Partials of runs killed outright (SIGKILL, an
 /// aborted allocation) are removed by the next run that writes the same
 /// output.
 fn remove_partial_outputs_on_interrupt(quiet: bool) {
-    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     // Without the handler (it could not be installed) the signals keep
     // their default action; the next run still removes the partials.
-    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else { return };
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else { return };
     std::thread::spawn(move || {
         let Some(signal) = signals.forever().next() else { return };
-        let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
+        let name = match signal {
+            SIGINT => "SIGINT",
+            SIGHUP => "SIGHUP",
+            _ => "SIGTERM",
+        };
         // Holds the registry until the exit: no new partial starts meanwhile.
         let cleanup = mmtrack_io::atomic::remove_partial_outputs();
         for (path, error) in &cleanup.failed {

@@ -11,7 +11,7 @@
 //!
 //! - every partial this process is writing is in a registry, and
 //!   [`remove_partial_outputs`] removes them all: the CLI calls it when
-//!   SIGINT or SIGTERM arrives, then exits;
+//!   SIGINT, SIGTERM or SIGHUP arrives, then exits;
 //! - a run that starts writing `<name>` (or a staging directory with a given
 //!   prefix) first removes the partials of that same name left by earlier
 //!   runs that were killed outright (SIGKILL, an aborted allocation, a power
@@ -266,7 +266,7 @@ pub fn remove_partial_outputs() -> PartialOutputsRemoved {
     for (path, kind) in registry.iter() {
         let result = match kind {
             PartialKind::File => std::fs::remove_file(path),
-            PartialKind::Directory => std::fs::remove_dir_all(path),
+            PartialKind::Directory => remove_directory_being_written(path),
         };
         match result {
             Ok(()) => removed += 1,
@@ -276,6 +276,30 @@ pub fn remove_partial_outputs() -> PartialOutputsRemoved {
         }
     }
     PartialOutputsRemoved { removed, failed, _registry: registry }
+}
+
+/// Removes a staging directory another thread may still be writing into by
+/// path: first renamed to a sibling of the same pattern (the writer's next
+/// file then fails instead of refilling it, and a later run still removes
+/// it if this fails), then removed, retried while a file that was already
+/// open lands in it.
+fn remove_directory_being_written(path: &Path) -> std::io::Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let moved = name
+        .strip_suffix(PARTIAL_SUFFIX)
+        .map(|stem| path.with_file_name(format!("{stem}x{PARTIAL_SUFFIX}")))
+        .filter(|moved| std::fs::rename(path, moved).is_ok());
+    let target = moved.as_deref().unwrap_or(path);
+    let mut attempts = 0;
+    loop {
+        match std::fs::remove_dir_all(target) {
+            Err(e) if e.kind() == std::io::ErrorKind::DirectoryNotEmpty && attempts < 100 => {
+                attempts += 1;
+                std::thread::sleep(std::time::Duration::from_millis(10));
+            }
+            result => return result,
+        }
+    }
 }
 
 /// Removes the partial outputs in `dir` named `<prefix><pid>.<random>.partial`
@@ -289,7 +313,11 @@ fn remove_stale_partials(dir: &Path, prefix: &str, live: &BTreeMap<PathBuf, Part
         let name = entry.file_name();
         let Some(pid) = name.to_str().and_then(|n| partial_writer_pid(n, prefix)) else { continue };
         let path = entry.path();
-        if live.contains_key(&path) || (pid != std::process::id() && process_may_be_running(pid)) {
+        // By name: the registry holds the paths as created (tempfile makes
+        // them absolute), `path` is as listed under `dir` (maybe relative);
+        // the pid and random part make a partial's name unique.
+        let is_live = live.keys().any(|p| p.file_name() == Some(name.as_os_str()));
+        if is_live || (pid != std::process::id() && process_may_be_running(pid)) {
             continue;
         }
         let result = match entry.file_type() {

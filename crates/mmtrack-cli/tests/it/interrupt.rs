@@ -25,9 +25,15 @@ impl Drop for Running {
 
 /// Starts `mmtrack simulate radar` on [`LONG_DRIVE`] writing `out.mcap` in `dir`.
 fn start_long_simulation(dir: &Path) -> Running {
+    start_long_simulation_into(dir, &["-o", "out.mcap"])
+}
+
+/// Starts `mmtrack simulate radar` on [`LONG_DRIVE`] with the output flags `output`.
+fn start_long_simulation_into(dir: &Path, output: &[&str]) -> Running {
     std::fs::write(dir.join("long.toml"), LONG_DRIVE).unwrap();
     let child = Command::new(env!("CARGO_BIN_EXE_mmtrack"))
-        .args(["simulate", "radar", "--scenario", "long.toml", "-o", "out.mcap"])
+        .args(["simulate", "radar", "--scenario", "long.toml"])
+        .args(output)
         .current_dir(dir)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -49,6 +55,15 @@ fn finish(mut run: Running) -> (std::process::ExitStatus, String) {
 /// The hidden partial files in `dir`.
 fn partials(dir: &Path) -> Vec<String> {
     files(dir).iter().map(|p| p.to_string_lossy().into_owned()).filter(|n| n.ends_with(".partial")).collect()
+}
+
+/// The partial files and directories directly in `dir`.
+fn partial_entries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".partial"))
+        .collect()
 }
 
 /// Waits until `run` has written a megabyte into its partial output. The
@@ -85,6 +100,36 @@ fn sigint_and_sigterm_remove_the_partial_output_and_exit_130_143() {
         assert!(stderr.contains(&format!("interrupted (SIG{signal}): removed 1 partial output")), "{stderr}");
         assert_eq!(partials(dir.path()), Vec::<String>::new(), "SIG{signal} left a partial output");
         assert!(!dir.path().join("out.mcap").exists());
+    }
+}
+
+/// Issue 26: SIGHUP is handled like SIGTERM (exit 129), and a staging
+/// directory the simulator is still filling (`--format oxford`) goes too
+/// (it used to fail with "Directory not empty" and stay).
+#[test]
+fn sighup_and_a_directory_being_written_leave_no_partial() {
+    for (signal, code) in [("HUP", 129), ("INT", 130), ("TERM", 143)] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut run = start_long_simulation_into(dir.path(), &["--format", "oxford", "-o", "v"]);
+        let mut scans = 0;
+        for _ in 0..1200 {
+            scans = partial_entries(dir.path())
+                .iter()
+                .map(|p| std::fs::read_dir(dir.path().join(p).join("radar")).map_or(0, Iterator::count))
+                .sum::<usize>();
+            if scans >= 3 || run.0.try_wait().unwrap().is_some() {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        assert!(scans >= 3, "SIG{signal}: the staging directory did not fill");
+        send(signal, &run);
+        let (status, stderr) = finish(run);
+        assert_eq!(status.code(), Some(code), "SIG{signal}: {status:?} {stderr}");
+        assert!(stderr.contains(&format!("interrupted (SIG{signal}): removed 1 partial output")), "{stderr}");
+        assert!(!stderr.contains("cannot remove"), "{stderr}");
+        assert_eq!(partial_entries(dir.path()), Vec::<String>::new(), "SIG{signal} left a partial output");
+        assert!(!dir.path().join("v").exists());
     }
 }
 
