@@ -7,12 +7,12 @@ use std::process::ExitCode;
 use clap::Args;
 use mmtrack_core::error::printable;
 use mmtrack_io::recording::{RecordingSummary, inspect_recording_with_progress};
-use mmtrack_io::table::{TableFileSummary, inspect_table_dir};
+use mmtrack_io::table::{TableFileSummary, inspect_table_dir, inspect_table_file};
 use serde_json::json;
 
 #[derive(Args)]
 pub struct InspectArgs {
-    /// An MCAP file (ours or any other, e.g. a ROS 2 bag) or a directory of Parquet tables.
+    /// An MCAP file (ours or any other, e.g. a ROS 2 bag), a directory of Parquet tables, or one `.parquet` file.
     path: PathBuf,
     /// Print JSON instead of text (metadata values whole; the text output shortens long ones).
     #[arg(long)]
@@ -115,8 +115,9 @@ fn print_tables(root: &std::path::Path, tables: &[TableFileSummary]) {
 }
 
 pub fn run(args: &InspectArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    if args.path.is_dir() {
-        let tables = inspect_table_dir(&args.path)?;
+    let is_parquet = args.path.extension().is_some_and(|e| e.eq_ignore_ascii_case("parquet"));
+    if args.path.is_dir() || is_parquet {
+        let tables = if is_parquet { vec![inspect_table_file(&args.path)?] } else { inspect_table_dir(&args.path)? };
         if tables.is_empty() {
             anyhow::bail!(
                 "{}: no Parquet tables found (expected <table>/sequence=<id>/part-0.parquet)",

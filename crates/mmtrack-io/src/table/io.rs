@@ -254,6 +254,24 @@ pub fn inspect_table_dir(root: &Path) -> Result<Vec<TableFileSummary>> {
     Ok(out)
 }
 
+/// Summarises one Parquet file: the table is named by its folder
+/// `<table>/sequence=<id>/part-0.parquet` (a known table is checked against
+/// its schema), any other file by its own name.
+///
+/// # Errors
+/// An unreadable or corrupt file, or a known table whose schema differs.
+pub fn inspect_table_file(path: &Path) -> Result<TableFileSummary> {
+    let name = |p: Option<&Path>| p.and_then(Path::file_name).map(|n| n.to_string_lossy().into_owned());
+    let parent = path.parent();
+    match name(parent).as_deref().and_then(|n| n.strip_prefix("sequence=")) {
+        Some(sequence) => {
+            let table = name(parent.and_then(Path::parent)).unwrap_or_default();
+            summarise_file(&table, sequence, path)
+        }
+        None => summarise_file(&name(Some(path)).unwrap_or_default(), "-", path),
+    }
+}
+
 /// Summarises one partition; a table mmtrack knows (by directory name) is
 /// also checked against its schema, so a missing or renamed column is an error.
 fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileSummary> {
