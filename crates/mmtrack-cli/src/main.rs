@@ -11,8 +11,6 @@
 mod analyze;
 mod beam;
 mod bench;
-mod bench_mpc;
-mod bench_odometry;
 mod demo;
 mod export;
 mod ingest;

@@ -24,10 +24,12 @@
 //!   experiments (the odometry and SPEBT experiments still live in the CLI
 //!   until the pipelines they run are a library);
 //! - [`all`]: every experiment in one call, checked against its expectations;
+//! - [`bench`]: the benchmarks of `mmtrack bench`, speed as ratios to same-run baselines;
 //! - [`common`], [`readme_block`]: output directories, experiment files,
 //!   README blocks.
 
 pub mod all;
+pub mod bench;
 pub mod common;
 pub mod expectation;
 pub mod kim;

@@ -1,7 +1,9 @@
 //! Integration tests of mmtrack-reproduce (one test binary, one module per
-//! topic): the experiments called as library functions, no binary.
+//! topic): the experiments and benchmarks called as library functions, no
+//! binary.
 
 #![allow(clippy::unwrap_used)]
 
+mod bench;
 mod experiments;
 mod overpass;

@@ -1,7 +1,7 @@
-//! `mmtrack bench mpc`: multipath-component detection plus short- and
-//! long-term tracking throughput (issue #5), against a same-run baseline of
-//! one forward + inverse FFT per snapshot, with the GM-PHD baseline tracker's
-//! time on the same detections as a ratio.
+//! Multipath-component detection plus short- and long-term tracking
+//! throughput, against a same-run baseline of one forward + inverse FFT per
+//! snapshot, with the GM-PHD baseline tracker's time on the same detections
+//! as a ratio.
 //!
 //! The input is generated in memory on the shared signal model
 //! (`mmtrack_core::sounder`): sets of 6 snapshots 0.717 ms apart, a set every
@@ -9,16 +9,13 @@
 //! delays spread over the window, powers -90..-125 dB, a slow linear delay
 //! drift (Doppler up to +-400 Hz) and seeded complex white noise at -140 dB.
 //! Generation is not timed; only [`CHUNK_SETS`] sets are held at a time (about
-//! 13 MB of taps), so memory does not grow with `--snapshots`. Every timed
-//! stage sees the same chunk.
+//! 13 MB of taps), so memory does not grow with the snapshot count. Every
+//! timed stage sees the same chunk.
 
-use std::path::PathBuf;
-use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
-use clap::Args;
 use mmtrack_core::random::standard_normal;
 use mmtrack_core::sounder::{SounderBand, cir_from_spectrum};
 use mmtrack_core::{CirSnapshot, Complex64, MpcDetection, MpcTrack};
@@ -31,17 +28,19 @@ use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
 
-use crate::readme_block::replace_block;
-// Also `crate::bench_mpc::load_average` for `bench slam`.
-pub(crate) use mmtrack_reproduce::common::load_average;
+use super::verdict_cell;
+use crate::common::load_average;
 
-/// Issue #5: this many snapshots ...
+/// The target: this many snapshots ...
 pub const MPC_TARGET_SNAPSHOTS: usize = 10_000;
 /// ... in at most this many seconds on this 2-core machine (the paper's
 /// implementation needed 95 s per 100 snapshots).
 pub const MPC_TARGET_S: f64 = 2.0;
 
-/// Taps per CIR (issue #5's benchmark size).
+/// The README block that [`markdown`] fills.
+pub const README_BLOCK: &str = "bench-mpc";
+
+/// Taps per CIR (the benchmark size).
 const TAPS: usize = 2048;
 /// 1 GHz sounder bandwidth: 1 ns taps, as the paper's sounder.
 const TAP_SPACING_S: f64 = 1e-9;
@@ -60,26 +59,24 @@ const MAX_DOPPLER_HZ: f64 = 400.0;
 /// Delays stay this far from both ends of the CIR window, seconds.
 const DELAY_MARGIN_S: f64 = 16e-9;
 /// Sets generated and held at a time.
-const CHUNK_SETS: usize = 64;
+pub const CHUNK_SETS: usize = 64;
 const SEED: u64 = 5;
 
-#[derive(Args)]
-pub struct MpcBenchArgs {
+/// What to measure.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct MpcBenchOptions {
     /// Snapshots to process (sets of 6; the last set may be shorter).
-    #[arg(long, default_value_t = MPC_TARGET_SNAPSHOTS)]
-    snapshots: usize,
+    pub snapshots: usize,
     /// Paths per snapshot.
-    #[arg(long, default_value_t = 40)]
-    mpcs: usize,
-    /// Thread counts to measure, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1,2")]
-    threads: Vec<usize>,
-    /// Exit 1 when no thread count meets the target.
-    #[arg(long)]
-    check: bool,
-    /// Replace the block `<!-- bench-mpc:begin -->` ... `end` in this file.
-    #[arg(long, value_name = "README.md")]
-    readme: Option<PathBuf>,
+    pub mpcs: usize,
+    /// Thread counts to measure, each at least 1.
+    pub threads: Vec<usize>,
+}
+
+impl Default for MpcBenchOptions {
+    fn default() -> Self {
+        Self { snapshots: MPC_TARGET_SNAPSHOTS, mpcs: 40, threads: vec![1, 2] }
+    }
 }
 
 /// One simulated path: delay at t = 0, linear delay drift and amplitude.
@@ -276,41 +273,101 @@ fn time_gmphd(set: &[CirSnapshot], found: Vec<Vec<MpcDetection>>, config: &GmPhd
     Ok(elapsed)
 }
 
-struct Measured {
-    /// 1-minute load average before and after the run (Linux), to show
-    /// when other work on the machine shared the cores.
-    load: (Option<f64>, Option<f64>),
-    snapshots: usize,
-    mpcs: usize,
-    fft_s: f64,
-    gmphd_s: f64,
-    proposed: Vec<Proposed>,
+/// The proposed method at one thread count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcRow {
+    /// Worker threads of the pool the pipeline ran in.
+    pub threads: usize,
+    /// Snapshots over `total_s`.
+    pub snapshots_per_s: f64,
+    /// Time for all the snapshots.
+    pub total_s: f64,
+    /// Time for [`MPC_TARGET_SNAPSHOTS`] at the measured rate.
+    pub s_per_target_snapshots: f64,
+    /// Detection (the pipeline's time minus the re-timed tracking).
+    pub detection_s: f64,
+    /// Short- and long-term tracking.
+    pub tracking_s: f64,
+    /// `total_s` over the FFT baseline's time.
+    pub ratio_to_fft: f64,
+    /// Detections of the pipeline per snapshot.
+    pub detections_per_snapshot: f64,
+    /// `s_per_target_snapshots <= MPC_TARGET_S`.
+    pub target_met: bool,
 }
 
-fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
-    anyhow::ensure!(args.snapshots > 0, "--snapshots must be at least 1");
+/// The measurements of one `bench mpc` run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MpcBench {
+    /// Snapshots processed.
+    pub snapshots: usize,
+    /// Simulated paths per snapshot.
+    pub mpcs: usize,
+    /// 1-minute load average before and after the run (Linux), to show
+    /// when other work on the machine shared the cores.
+    pub load_before: Option<f64>,
+    /// 1-minute load average after the run (Linux).
+    pub load_after: Option<f64>,
+    /// Cores of the machine.
+    pub cores: usize,
+    /// The FFT baseline over all the snapshots.
+    pub fft_s: f64,
+    /// The FFT baseline per snapshot.
+    pub fft_us_per_snapshot: f64,
+    /// GM-PHD (one filter per set, one thread) on the first row's detections.
+    pub gmphd_s: f64,
+    /// `gmphd_s` over the first row's tracking time; `None` when that is zero.
+    pub gmphd_ratio_to_tracking: Option<f64>,
+    /// The target: [`MPC_TARGET_SNAPSHOTS`] ...
+    pub target_snapshots: usize,
+    /// ... in at most [`MPC_TARGET_S`].
+    pub target_s: f64,
+    /// One row per thread count, in the order asked.
+    pub rows: Vec<MpcRow>,
+}
+
+impl MpcBench {
+    /// Some thread count meets the target.
+    #[must_use]
+    pub fn target_met(&self) -> bool {
+        self.rows.iter().any(|row| row.target_met)
+    }
+}
+
+/// Seconds for [`MPC_TARGET_SNAPSHOTS`] at the measured rate.
+fn per_target(seconds: f64, snapshots: usize) -> f64 {
+    seconds * MPC_TARGET_SNAPSHOTS as f64 / snapshots as f64
+}
+
+/// Runs the proposed method at each thread count, the FFT baseline and
+/// GM-PHD on the same generated snapshots.
+///
+/// # Errors
+/// No snapshots, a thread count of 0 or none, or a stage fails.
+pub fn run(options: &MpcBenchOptions) -> anyhow::Result<MpcBench> {
+    anyhow::ensure!(options.snapshots > 0, "--snapshots must be at least 1");
     let load_before = load_average();
-    anyhow::ensure!(!args.threads.is_empty() && !args.threads.contains(&0), "--threads: counts of at least 1");
-    let channel = Channel::new(args.mpcs)?;
+    anyhow::ensure!(!options.threads.is_empty() && !options.threads.contains(&0), "--threads: counts of at least 1");
+    let channel = Channel::new(options.mpcs)?;
     let config = MpcConfig::default();
     let gmphd_config = GmPhdConfig { carrier_hz: CARRIER_HZ, ..GmPhdConfig::default() };
     let mut proposed =
-        args.threads.iter().map(|&t| Proposed::new(&config, &channel, t)).collect::<anyhow::Result<Vec<_>>>()?;
+        options.threads.iter().map(|&t| Proposed::new(&config, &channel, t)).collect::<anyhow::Result<Vec<_>>>()?;
     // Each run happens in a pool of its thread count, installed around each
     // chunk of sets as `--threads` is around a command, so detection's
     // parallel loop starts inside the pool rather than handing every batch
     // over from this thread.
-    let pools = args
+    let pools = options
         .threads
         .iter()
         .map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build())
         .collect::<Result<Vec<_>, _>>()?;
     let mut fft = FftBaseline::new();
     let mut gmphd_s = 0.0;
-    let total_sets = args.snapshots.div_ceil(SNAPSHOTS_PER_SET);
+    let total_sets = options.snapshots.div_ceil(SNAPSHOTS_PER_SET);
     for first in (0..total_sets).step_by(CHUNK_SETS) {
         let count = CHUNK_SETS.min(total_sets - first);
-        let sets = channel.sets(first as u64, count, args.snapshots);
+        let sets = channel.sets(first as u64, count, options.snapshots);
         for set in &sets {
             fft.run(set);
         }
@@ -318,7 +375,8 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
             let batch = MpcPipeline::SETS_PER_THREAD * run.threads;
             pool.install(|| -> anyhow::Result<()> {
                 for batch in sets.chunks(batch) {
-                    let found = run.push_sets(batch).with_context(|| format!("sets from {}", batch[0][0].set_index))?;
+                    let first_set = batch.first().and_then(|set| set.first()).map_or(0, |s| s.set_index);
+                    let found = run.push_sets(batch).with_context(|| format!("sets from {first_set}"))?;
                     if p == 0 {
                         for (set, found) in batch.iter().zip(found) {
                             gmphd_s += time_gmphd(set, found, &gmphd_config)?;
@@ -329,88 +387,92 @@ fn measure(args: &MpcBenchArgs) -> anyhow::Result<Measured> {
             })?;
         }
     }
-    Ok(Measured {
-        load: (load_before, load_average()),
-        snapshots: args.snapshots,
-        mpcs: args.mpcs,
+    let n = options.snapshots;
+    let rows: Vec<MpcRow> = proposed
+        .iter()
+        .map(|run| {
+            let s_per_target_snapshots = per_target(run.total_s, n);
+            MpcRow {
+                threads: run.threads,
+                snapshots_per_s: n as f64 / run.total_s,
+                total_s: run.total_s,
+                s_per_target_snapshots,
+                detection_s: run.detect_s(),
+                tracking_s: run.track_s,
+                ratio_to_fft: run.total_s / fft.total_s,
+                detections_per_snapshot: run.detections as f64 / n as f64,
+                target_met: s_per_target_snapshots <= MPC_TARGET_S,
+            }
+        })
+        .collect();
+    let gmphd_ratio_to_tracking = rows.first().filter(|r| r.tracking_s > 0.0).map(|r| gmphd_s / r.tracking_s);
+    Ok(MpcBench {
+        snapshots: n,
+        mpcs: options.mpcs,
+        load_before,
+        load_after: load_average(),
+        cores: std::thread::available_parallelism().map_or(1, usize::from),
         fft_s: fft.total_s,
+        fft_us_per_snapshot: fft.total_s / n as f64 * 1e6,
         gmphd_s,
-        proposed,
+        gmphd_ratio_to_tracking,
+        target_snapshots: MPC_TARGET_SNAPSHOTS,
+        target_s: MPC_TARGET_S,
+        rows,
     })
 }
 
-/// Seconds for [`MPC_TARGET_SNAPSHOTS`] at the measured rate.
-fn per_target(seconds: f64, snapshots: usize) -> f64 {
-    seconds * MPC_TARGET_SNAPSHOTS as f64 / snapshots as f64
-}
-
-impl Measured {
-    fn met(&self, run: &Proposed) -> bool {
-        per_target(run.total_s, self.snapshots) <= MPC_TARGET_S
-    }
-
-    fn markdown(&self) -> String {
-        let n = self.snapshots;
-        let fft_us = self.fft_s / n as f64 * 1e6;
-        let mut out = format!(
-            "`mmtrack bench mpc`: {n} simulated snapshots of {TAPS} taps (1 ns, {:.1} GHz carrier) in sets of \
-             {SNAPSHOTS_PER_SET} ({:.3} ms apart, a set every {} ms), {} paths each ({:.0}..{:.0} dB, delays spread over \
-             the window, linear delay drift of up to +-{MAX_DOPPLER_HZ:.0} Hz Doppler), white noise at {NOISE_DB:.0} dB; \
-             generated in memory {CHUNK_SETS} sets at a time, not timed. Baseline in the same run: one forward + \
-             inverse {TAPS}-point FFT (rustfft) per snapshot, {fft_us:.1} us.\n\n\
-             | threads | snapshots/s | s for {n} | s per {MPC_TARGET_SNAPSHOTS} | detection s | tracking s | \
-             / FFT baseline | detections per snapshot (of {}) | target <= {MPC_TARGET_S} s per {MPC_TARGET_SNAPSHOTS} |\n\
-             |---|---|---|---|---|---|---|---|---|\n",
-            CARRIER_HZ / 1e9,
-            SNAPSHOT_PERIOD_NS as f64 / 1e6,
-            SET_PERIOD_NS / 1_000_000,
-            self.mpcs,
-            POWER_RANGE_DB.1,
-            POWER_RANGE_DB.0,
-            self.mpcs,
-        );
-        for run in &self.proposed {
-            out.push_str(&format!(
-                "| {} | {:.0} | {:.2} | {:.2} | {:.2} | {:.3} | {:.0} | {:.1} | {} |\n",
-                run.threads,
-                n as f64 / run.total_s,
-                run.total_s,
-                per_target(run.total_s, n),
-                run.detect_s(),
-                run.track_s,
-                run.total_s / self.fft_s,
-                run.detections as f64 / n as f64,
-                if self.met(run) { "met" } else { "**missed**" },
-            ));
-        }
-        if let Some(first) = self.proposed.first() {
-            let ratio = if first.track_s > 0.0 { format!("{:.1}", self.gmphd_s / first.track_s) } else { "-".into() };
-            out.push_str(&format!(
-                "\nGM-PHD baseline (Table I, one filter per set, one thread) on the same detections: {:.2} s, \
-                 {ratio} x the proposed short- and long-term tracking ({:.3} s, {} thread).\n",
-                self.gmphd_s, first.track_s, first.threads,
-            ));
-        }
-        let load = |l: Option<f64>| l.map_or_else(|| "-".to_string(), |l| format!("{l:.1}"));
+/// The Markdown table of `bench` (also the README block's body).
+#[must_use]
+pub fn markdown(bench: &MpcBench) -> String {
+    let n = bench.snapshots;
+    let (target_n, target_s) = (bench.target_snapshots, bench.target_s);
+    let mut out = format!(
+        "`mmtrack bench mpc`: {n} simulated snapshots of {TAPS} taps (1 ns, {:.1} GHz carrier) in sets of \
+         {SNAPSHOTS_PER_SET} ({:.3} ms apart, a set every {} ms), {} paths each ({:.0}..{:.0} dB, delays spread over \
+         the window, linear delay drift of up to +-{MAX_DOPPLER_HZ:.0} Hz Doppler), white noise at {NOISE_DB:.0} dB; \
+         generated in memory {CHUNK_SETS} sets at a time, not timed. Baseline in the same run: one forward + \
+         inverse {TAPS}-point FFT (rustfft) per snapshot, {:.1} us.\n\n\
+         | threads | snapshots/s | s for {n} | s per {target_n} | detection s | tracking s | \
+         / FFT baseline | detections per snapshot (of {}) | target <= {target_s} s per {target_n} |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+        CARRIER_HZ / 1e9,
+        SNAPSHOT_PERIOD_NS as f64 / 1e6,
+        SET_PERIOD_NS / 1_000_000,
+        bench.mpcs,
+        POWER_RANGE_DB.1,
+        POWER_RANGE_DB.0,
+        bench.fft_us_per_snapshot,
+        bench.mpcs,
+    );
+    for row in &bench.rows {
         out.push_str(&format!(
-            "\n1-minute load average before / after the run: {} / {} (on {} cores; above that, other work shared them).\n",
-            load(self.load.0),
-            load(self.load.1),
-            std::thread::available_parallelism().map_or(1, usize::from),
+            "| {} | {:.0} | {:.2} | {:.2} | {:.2} | {:.3} | {:.0} | {:.1} | {} |\n",
+            row.threads,
+            row.snapshots_per_s,
+            row.total_s,
+            row.s_per_target_snapshots,
+            row.detection_s,
+            row.tracking_s,
+            row.ratio_to_fft,
+            row.detections_per_snapshot,
+            verdict_cell(row.target_met),
         ));
-        out
     }
-}
-
-pub fn run(args: &MpcBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let measured = measure(args)?;
-    let text = measured.markdown();
-    if !quiet {
-        print!("{text}");
+    if let Some(first) = bench.rows.first() {
+        let ratio = bench.gmphd_ratio_to_tracking.map_or_else(|| "-".into(), |r| format!("{r:.1}"));
+        out.push_str(&format!(
+            "\nGM-PHD baseline (Table I, one filter per set, one thread) on the same detections: {:.2} s, \
+             {ratio} x the proposed short- and long-term tracking ({:.3} s, {} thread).\n",
+            bench.gmphd_s, first.tracking_s, first.threads,
+        ));
     }
-    if let Some(readme) = &args.readme {
-        replace_block(readme, "bench-mpc", &text)?;
-    }
-    let met = measured.proposed.iter().any(|run| measured.met(run));
-    Ok(if args.check && !met { ExitCode::FAILURE } else { ExitCode::SUCCESS })
+    let load = |l: Option<f64>| l.map_or_else(|| "-".to_string(), |l| format!("{l:.1}"));
+    out.push_str(&format!(
+        "\n1-minute load average before / after the run: {} / {} (on {} cores; above that, other work shared them).\n",
+        load(bench.load_before),
+        load(bench.load_after),
+        bench.cores,
+    ));
+    out
 }

@@ -1,0 +1,52 @@
+//! `mmtrack bench slam`: the arguments of [`mmtrack_reproduce::bench::slam`].
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::Args;
+use mmtrack_reproduce::bench::slam::{self, SlamBenchOptions};
+
+use super::output::{Finish, finish};
+
+#[derive(Args)]
+pub struct SlamBenchArgs {
+    /// UE particles.
+    #[arg(long, default_value_t = 2000)]
+    particles: usize,
+    /// Message-passing iterations (tempering stages and EKF relinearisations).
+    #[arg(long, default_value_t = 10)]
+    iterations: usize,
+    /// Epochs of the drive (100: one lap of the paper's road).
+    #[arg(long, default_value_t = 100)]
+    epochs: usize,
+    /// Runs per measurement; the best is reported.
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+    /// Worker threads of the measured run (0: one per core).
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Exit 1 when the target is missed.
+    #[arg(long)]
+    check: bool,
+    /// Replace the block `<!-- bench-slam:begin -->` ... `end` in this file.
+    #[arg(long, value_name = "README.md")]
+    readme: Option<PathBuf>,
+}
+
+pub fn run(args: &SlamBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    let options = SlamBenchOptions {
+        particles: args.particles,
+        iterations: args.iterations,
+        epochs: args.epochs,
+        repeats: args.repeats,
+        threads: args.threads,
+    };
+    let bench = slam::run(&options)?;
+    finish(&Finish {
+        text: &slam::markdown(&bench),
+        print: !quiet,
+        readme: args.readme.as_deref().map(|r| (r, slam::README_BLOCK)),
+        check: args.check,
+        target_met: bench.target_met(),
+    })
+}

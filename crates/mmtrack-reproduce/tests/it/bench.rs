@@ -1,0 +1,162 @@
+//! The benchmarks of `mmtrack_reproduce::bench` called as library functions
+//! at tiny sizes: the structure of each result (rows present, ratios finite
+//! and positive, each target flag agreeing with the measured value it
+//! judges) and the Markdown it renders. No time is asserted (STYLE.md:
+//! tests never assert wall-clock time); the numbers only have to be sane.
+
+use std::path::Path;
+use std::process::Command;
+
+use mmtrack_core::progress::NoProgress;
+use mmtrack_reproduce::bench::{ingest, io, mpc, odometry, slam};
+use mmtrack_sim::radar::{ConstantTurn, RadarSimulator, ScanLimits, Scenario, SimOptions, Trajectory};
+
+fn assert_positive(name: &str, value: f64) {
+    assert!(value.is_finite() && value > 0.0, "{name} = {value}");
+}
+
+/// An Oxford folder of `scans` simulated Oxford-size scans (400 x 3768) at `dir`.
+fn simulated_oxford_folder(dir: &Path, scans: usize) {
+    let scenario: Scenario = toml::from_str("seed = 3\n[generator]\n").unwrap();
+    let motion = ConstantTurn { speed_mps: 8.0, yaw_rate_radps: 0.05 };
+    let trajectory = Trajectory::constant_turn(motion, 1_700_000_000_000_000_000, scans as f64 * 0.25 + 1.0).unwrap();
+    let world = scenario.build_world(&trajectory).unwrap();
+    let options =
+        SimOptions { limits: ScanLimits { max_scans: Some(scans), max_distance_m: None }, ..scenario.options() };
+    let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options).unwrap();
+    mmtrack_process::simulate::radar::write_oxford_streaming(&scenario, simulator, dir, false, &NoProgress).unwrap();
+}
+
+#[test]
+fn bench_mpc_gives_a_row_per_thread_count_with_consistent_verdicts() {
+    let options = mpc::MpcBenchOptions { snapshots: 12, mpcs: 40, threads: vec![1, 2] };
+    let bench = mpc::run(&options).unwrap();
+    assert_eq!(bench.rows.iter().map(|r| r.threads).collect::<Vec<_>>(), [1, 2]);
+    assert_eq!((bench.target_snapshots, bench.target_s), (mpc::MPC_TARGET_SNAPSHOTS, mpc::MPC_TARGET_S));
+    assert_positive("fft_s", bench.fft_s);
+    for row in &bench.rows {
+        assert_positive("snapshots_per_s", row.snapshots_per_s);
+        assert_positive("ratio_to_fft", row.ratio_to_fft);
+        assert!(row.detection_s.is_finite() && row.tracking_s >= 0.0, "{row:?}");
+        assert_eq!(row.target_met, row.s_per_target_snapshots <= bench.target_s, "{row:?}");
+        // 40 paths, 15..50 dB over a -140 dB floor and several pulse widths
+        // apart: each is found; noise peaks above floor + 6 dB add a few (the
+        // same bound as the CLI's `bench mpc` test).
+        assert!((38.0..=60.0).contains(&row.detections_per_snapshot), "{row:?}");
+    }
+    // Both thread counts see the same snapshots and find the same detections.
+    assert_eq!(bench.rows[0].detections_per_snapshot, bench.rows[1].detections_per_snapshot);
+    assert_eq!(bench.target_met(), bench.rows.iter().any(|r| r.target_met));
+    let text = mpc::markdown(&bench);
+    assert!(text.starts_with("`mmtrack bench mpc`: 12 simulated snapshots"), "{text}");
+    assert_eq!(text.lines().filter(|l| l.starts_with("| 1 |") || l.starts_with("| 2 |")).count(), 2, "{text}");
+
+    let error = mpc::run(&mpc::MpcBenchOptions { snapshots: 0, ..options }).unwrap_err();
+    assert!(error.to_string().contains("snapshots"), "{error}");
+}
+
+#[test]
+fn bench_slam_times_one_thread_and_the_pool_with_consistent_verdicts() {
+    let options = slam::SlamBenchOptions { particles: 50, iterations: 1, epochs: 5, repeats: 1, threads: 2 };
+    let bench = slam::run(&options).unwrap();
+    assert_eq!((bench.one_thread.threads, bench.pool.threads, bench.epochs), (1, 2, 5));
+    assert_eq!(bench.target_ms_per_epoch, slam::TARGET_MS_PER_EPOCH);
+    for row in [&bench.one_thread, &bench.pool] {
+        assert_positive("ms_per_epoch", row.ms_per_epoch);
+        assert_positive("times_faster_than_real_time", row.times_faster_than_real_time);
+        // The slowest epoch is at least the mean (ms_per_epoch is the mean).
+        assert!(row.slowest_epoch_ms >= row.ms_per_epoch * (1.0 - 1e-9), "{row:?}");
+        assert_eq!(row.target_met, row.ms_per_epoch < bench.target_ms_per_epoch, "{row:?}");
+        // Real time over the measured time, by definition (to rounding).
+        assert!((row.times_faster_than_real_time * row.ms_per_epoch - bench.epoch_ms).abs() < 1e-6 * bench.epoch_ms);
+    }
+    assert_positive("speed_up", bench.speed_up);
+    assert_eq!(bench.target_met(), bench.pool.target_met);
+    let text = slam::markdown(&bench);
+    assert!(text.starts_with("`mmtrack bench slam`: the SLAM filter"), "{text}");
+    assert!(text.contains("\n| 1 | ") && text.contains("\n| 2 | "), "{text}");
+}
+
+#[test]
+fn bench_io_gives_a_row_per_compression_with_the_target_on_none_and_zstd() {
+    let dir = tempfile::tempdir().unwrap();
+    let options = io::IoBenchOptions { scans: 2, repeats: 1, dir: Some(dir.path().to_path_buf()) };
+    let bench = io::run(&options).unwrap();
+    assert_eq!(bench.rows.iter().map(|r| r.compression).collect::<Vec<_>>(), ["none", "zstd-1", "lz4"]);
+    // 400 x 3768 bytes of power per scan.
+    assert!((bench.message_mb - 400.0 * 3768.0 / 1e6).abs() < 1e-9, "{}", bench.message_mb);
+    assert_positive("copy_mb_per_s", bench.copy_mb_per_s);
+    for row in &bench.rows {
+        for (name, value) in [
+            ("file_mb", row.file_mb),
+            ("write_ratio_to_copy", row.write_ratio_to_copy),
+            ("write_fsync_ratio_to_copy_fsync", row.write_fsync_ratio_to_copy_fsync),
+            ("read_ratio_to_copy", row.read_ratio_to_copy),
+        ] {
+            assert_positive(name, value);
+        }
+        let expected_target = (row.compression != "lz4").then_some(io::WRITE_TARGET_RATIO);
+        assert_eq!(row.write_target_ratio, expected_target, "{row:?}");
+        assert_eq!(row.target_met, row.write_target_ratio.map(|t| row.write_ratio_to_copy >= t), "{row:?}");
+    }
+    let json = io::json(&bench);
+    assert_eq!(json["results"].as_array().unwrap().len(), 3);
+    assert_eq!(json["target_met_by"].as_array().unwrap().len(), bench.target_met_by().len());
+    let text = io::markdown(&bench);
+    assert_eq!(text.lines().filter(|l| l.starts_with("| none |") || l.starts_with("| lz4 |")).count(), 2, "{text}");
+}
+
+#[test]
+fn bench_ingest_and_odometry_run_on_a_small_simulated_oxford_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("oxford");
+    simulated_oxford_folder(&folder, 4);
+
+    let options = ingest::IngestBenchOptions {
+        scans: 8,
+        repeats: 1,
+        dir: Some(dir.path().to_path_buf()),
+        from: Some(folder.clone()),
+    };
+    let no_simulation = |_: &Path, _: &Path| -> Command { unreachable!("real PNGs given: nothing to simulate") };
+    let bench = ingest::run(&options, &no_simulation).unwrap();
+    assert_eq!((bench.scans, bench.small_scans, bench.real), (8, 2, true));
+    assert_eq!(ingest::readme_block(&bench), ingest::README_BLOCK_REAL);
+    for (name, value) in
+        [("folder_mb", bench.folder_mb), ("scans_per_s", bench.scans_per_s), ("ratio", bench.ratio_to_copy)]
+    {
+        assert_positive(name, value);
+    }
+    assert_eq!(bench.target_met, bench.scans_per_s >= bench.target_scans_per_s);
+    assert_eq!(bench.target_scans_per_s, ingest::INGEST_TARGET_SCANS_PER_S);
+    assert!(ingest::markdown(&bench).contains("| ingest / copy |"));
+
+    // The memory check samples whatever child the caller starts; a stand-in
+    // here (the `process odometry` child is the CLI's, tested there).
+    let stand_in = |_: &Path, _: &Path| {
+        let mut command = Command::new("sleep");
+        command.arg("0.1");
+        command
+    };
+    let options = odometry::OdometryBenchOptions { from: folder, passes: 1, memory_scans: 8 };
+    let bench = odometry::run(&options, &stand_in).unwrap();
+    assert_eq!(bench.scans_per_pass, 4);
+    let presets: Vec<&str> = bench.presets.iter().map(|r| r.preset.as_str()).collect();
+    assert_eq!(presets, mmtrack_odometry::OdometryConfig::PRESETS);
+    assert_positive("decode_only_scans_per_s", bench.decode_only_scans_per_s);
+    for row in &bench.presets {
+        assert_eq!(row.scans, 4, "{row:?}");
+        assert_positive("scans_per_s", row.scans_per_s);
+        assert_positive("ratio_to_decode_only", row.ratio_to_decode_only);
+        assert!(row.filter_ms_per_scan >= 0.0 && row.register_ms_per_scan >= 0.0, "{row:?}");
+        assert_eq!(row.target_met, row.scans_per_s >= bench.target_scans_per_s, "{row:?}");
+    }
+    let memory = &bench.memory;
+    assert_eq!((memory.short_scans, memory.long_scans), (2, 8));
+    assert_positive("growth_ratio", memory.growth_ratio);
+    assert_eq!(memory.target_met, memory.growth_ratio <= memory.growth_limit);
+    assert_eq!(bench.target_met(), bench.presets.iter().all(|r| r.target_met) && memory.target_met);
+    let text = odometry::markdown(&bench);
+    assert_eq!(text.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| preset")).count(), presets.len());
+    assert!(text.contains("\nMemory (`cfear`"), "{text}");
+}
