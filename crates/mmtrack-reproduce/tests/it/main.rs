@@ -3,5 +3,6 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod drives;
 mod experiments;
 mod overpass;
