@@ -33,8 +33,7 @@ pub fn verdicts(experiment: &SpebtExperiment, result: &ExperimentResult) -> Vec<
     let share_pct = 100.0 * result.mean_reinitialisations() / result.tracked_slots().max(1) as f64;
     let paper_share_pct = 100.0 * paper.reinitialisations as f64 / paper.slots as f64;
     let angle = |what: &str, paper_deg: f64, bound: f64, measured_deg: f64| {
-        let claim =
-            Claim::new(what, "deg", Some(paper_deg), format!("{paper_deg:.3}"), Rule::AtMost { bound });
+        let claim = Claim::new(what, "deg", Some(paper_deg), format!("{paper_deg:.3}"), Rule::AtMost { bound });
         Verdict::judged(claim, Some(measured_deg), format!("{measured_deg:.3}"))
     };
     let share = Claim::new(
@@ -44,8 +43,7 @@ pub fn verdicts(experiment: &SpebtExperiment, result: &ExperimentResult) -> Vec<
         format!("< {} of {} (< {paper_share_pct:.2} %)", paper.reinitialisations, paper.slots),
         Rule::Below { bound: targets.max_reinitialisation_share_pct },
     );
-    let share_note =
-        format!("{:.1} of {} ({share_pct:.2} %)", result.mean_reinitialisations(), result.tracked_slots());
+    let share_note = format!("{:.1} of {} ({share_pct:.2} %)", result.mean_reinitialisations(), result.tracked_slots());
     vec![
         angle("RMSE AoD (deg)", paper.rmse_aod_deg, targets.max_rmse_aod_deg, aod_deg),
         angle("RMSE AoA (deg)", paper.rmse_aoa_deg, targets.max_rmse_aoa_deg, aoa_deg),
@@ -206,7 +204,8 @@ fn experiment_section(e: &SpebtExperiment, index: usize, run: &ExperimentRun, ve
     };
     let [gain, _, _] = result.rmse();
     out.push_str("| claim | paper (Table III, 10^5 runs) | measured | target | verdict |\n|---|---|---|---|---|\n");
-    let _ = writeln!(out, "| RMSE abs(alpha) (%) | {:.3} | {:.3} | - | reported |", e.paper.rmse_gain_pct, 100.0 * gain);
+    let _ =
+        writeln!(out, "| RMSE abs(alpha) (%) | {:.3} | {:.3} | - | reported |", e.paper.rmse_gain_pct, 100.0 * gain);
     for v in verdicts {
         let _ = writeln!(
             out,
