@@ -9,7 +9,6 @@
 //! interrupted by SIGINT / SIGTERM (the partial outputs removed first).
 
 mod analyze;
-mod beam;
 mod bench;
 mod demo;
 mod export;
@@ -20,8 +19,6 @@ mod process;
 mod process_beam;
 mod progress;
 mod reproduce;
-mod reproduce_all;
-mod reproduce_common;
 mod simulate;
 mod simulate_sounder;
 mod slam;
@@ -33,7 +30,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use mmtrack_core::error::printable;
 // `crate::readme_block` for the commands that rewrite README blocks (bench,
-// and reproduce spebt until it moves to mmtrack-reproduce).
+// reproduce).
 use mmtrack_reproduce::readme_block;
 
 #[derive(Parser)]

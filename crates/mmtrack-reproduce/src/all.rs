@@ -21,26 +21,11 @@ use anyhow::Context;
 use mmtrack_core::progress::Progress;
 
 use crate::expectation::{Check, ExpectedMetric, compare, parse_expected, table};
-use crate::model::{Metric, Outcome, RunOptions, Tier};
-use crate::{kim, mpc_artificial, readme_block, shaham, zoechmann};
+use crate::model::{Outcome, RunOptions, Tier};
+use crate::{kim, mpc_artificial, odometry, readme_block, shaham, spebt, zoechmann};
 
 /// The README block that receives the table of every metric.
 pub const README_BLOCK: &str = "reproduce-all";
-
-/// How [`run_all`] runs an experiment.
-#[derive(Clone, Copy)]
-enum Runner {
-    /// An experiment of this crate: its check before the work (output
-    /// directory replaceable, README block present) and its run on the
-    /// embedded configuration.
-    Library {
-        check_start: fn(&Path, bool, Option<&Path>) -> anyhow::Result<()>,
-        run: fn(&RunOptions, &dyn Progress) -> anyhow::Result<Outcome>,
-    },
-    /// An experiment still inside the CLI, run through [`PendingExperiments`].
-    // TODO(issue 24): odometry and spebt move here once mmtrack-process exists.
-    Pending,
-}
 
 /// One experiment of [`run_all`].
 pub struct Experiment {
@@ -52,7 +37,11 @@ pub struct Experiment {
     pub expected: &'static str,
     /// The file's path in the repository, for messages.
     pub expected_path: &'static str,
-    runner: Runner,
+    /// Its check before the work (output directory replaceable, README
+    /// block present).
+    check_start: fn(&Path, bool, Option<&Path>) -> anyhow::Result<()>,
+    /// Its run on the embedded configuration.
+    run: fn(&RunOptions, &dyn Progress) -> anyhow::Result<Outcome>,
 }
 
 impl Experiment {
@@ -68,48 +57,58 @@ impl Experiment {
 /// Every experiment, in the order [`run_all`] runs them.
 pub const EXPERIMENTS: [Experiment; 6] = [
     Experiment {
-        name: "odometry",
+        name: odometry::NAME,
         readme: false,
         expected: include_str!("../../../data/reproduce/odometry.expected.toml"),
         expected_path: "data/reproduce/odometry.expected.toml",
-        runner: Runner::Pending,
+        check_start: odometry::check_start,
+        run: run_odometry,
     },
     Experiment {
         name: mpc_artificial::NAME,
         readme: true,
         expected: include_str!("../../../data/reproduce/mpc-artificial.expected.toml"),
         expected_path: "data/reproduce/mpc-artificial.expected.toml",
-        runner: Runner::Library { check_start: mpc_artificial::check_start, run: run_mpc_artificial },
+        check_start: mpc_artificial::check_start,
+        run: run_mpc_artificial,
     },
     Experiment {
         name: shaham::NAME,
         readme: true,
         expected: include_str!("../../../data/reproduce/shaham.expected.toml"),
         expected_path: "data/reproduce/shaham.expected.toml",
-        runner: Runner::Library { check_start: shaham::check_start, run: run_shaham },
+        check_start: shaham::check_start,
+        run: run_shaham,
     },
     Experiment {
-        name: "spebt",
+        name: spebt::NAME,
         readme: true,
         expected: include_str!("../../../data/reproduce/spebt.expected.toml"),
         expected_path: "data/reproduce/spebt.expected.toml",
-        runner: Runner::Pending,
+        check_start: spebt::check_start,
+        run: run_spebt,
     },
     Experiment {
         name: zoechmann::NAME,
         readme: true,
         expected: include_str!("../../../data/reproduce/zoechmann.expected.toml"),
         expected_path: "data/reproduce/zoechmann.expected.toml",
-        runner: Runner::Library { check_start: zoechmann::check_start, run: run_zoechmann },
+        check_start: zoechmann::check_start,
+        run: run_zoechmann,
     },
     Experiment {
         name: kim::NAME,
         readme: true,
         expected: include_str!("../../../data/reproduce/kim.expected.toml"),
         expected_path: "data/reproduce/kim.expected.toml",
-        runner: Runner::Library { check_start: kim::check_start, run: run_kim },
+        check_start: kim::check_start,
+        run: run_kim,
     },
 ];
+
+fn run_odometry(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    odometry::run(&odometry::Config::embedded()?, options, progress)
+}
 
 fn run_mpc_artificial(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
     mpc_artificial::run(&mpc_artificial::Config::default(), options, progress)
@@ -119,32 +118,16 @@ fn run_shaham(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<O
     shaham::run(&shaham::Config::embedded()?, options, progress)
 }
 
+fn run_spebt(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    spebt::run(&spebt::Config::embedded()?, options, progress)
+}
+
 fn run_zoechmann(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
     zoechmann::run(&zoechmann::Config::embedded()?, options, progress)
 }
 
 fn run_kim(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
     kim::run(&kim::Config::embedded()?, None, options, progress)
-}
-
-/// Runs the experiments that still live in the CLI (`odometry`, `spebt`)
-/// for [`run_all`]: a temporary hook.
-// TODO(issue 24): odometry and spebt move here once mmtrack-process exists.
-pub trait PendingExperiments {
-    /// Runs experiment `name` into `options.output_dir` (replacing an earlier
-    /// output there), at `options.tier` with its own run count, rewriting
-    /// its README block in `options.readme` when given, and returns the
-    /// metrics it measured (as written to its `metrics.json`).
-    ///
-    /// # Errors
-    /// The experiment could not run. A missed paper target is not an error.
-    fn run(&self, name: &str, options: &RunOptions) -> anyhow::Result<Vec<Metric>>;
-}
-
-impl<F: Fn(&str, &RunOptions) -> anyhow::Result<Vec<Metric>>> PendingExperiments for F {
-    fn run(&self, name: &str, options: &RunOptions) -> anyhow::Result<Vec<Metric>> {
-        self(name, options)
-    }
 }
 
 /// What [`run_all`] does.
@@ -179,18 +162,14 @@ impl AllOutcome {
 
 /// Runs every experiment of [`EXPERIMENTS`] into `options.output_dir/<name>`
 /// and checks each metric against its expectation; writes `summary.md`
-/// and, with a README, the blocks. `pending` runs the experiments still in
-/// the CLI. Progress: each experiment's stages, and a note per experiment.
+/// and, with a README, the blocks. Progress: each experiment's stages, and
+/// a note per experiment.
 ///
 /// # Errors
 /// A README without its blocks (checked before any work), an expectation
 /// file that does not parse, an experiment that fails, an output that
 /// cannot be written. Misses are not errors: see [`AllOutcome::misses`].
-pub fn run_all(
-    options: &AllOptions,
-    pending: &dyn PendingExperiments,
-    progress: &dyn Progress,
-) -> anyhow::Result<AllOutcome> {
+pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<AllOutcome> {
     anyhow::ensure!(
         !(options.tier.is_smoke() && options.readme.is_some()),
         "the README blocks come from full runs only (nothing was done)"
@@ -217,19 +196,13 @@ pub fn run_all(
         ));
         let run_options = RunOptions { tier: options.tier, runs: None, output_dir: dir, readme };
         let experiment_started = Instant::now();
-        let measured = match experiment.runner {
-            Runner::Library { check_start, run } => {
-                check_start(&run_options.output_dir, true, run_options.readme.as_deref())?;
-                let outcome = run(&run_options, progress).with_context(|| format!("reproduce {}", experiment.name))?;
-                if let Some(readme) = &run_options.readme {
-                    readme_block::replace_block(readme, outcome.readme.name, &outcome.readme.body)?;
-                }
-                outcome.metrics
-            }
-            Runner::Pending => {
-                pending.run(experiment.name, &run_options).with_context(|| format!("reproduce {}", experiment.name))?
-            }
-        };
+        (experiment.check_start)(&run_options.output_dir, true, run_options.readme.as_deref())?;
+        let outcome =
+            (experiment.run)(&run_options, progress).with_context(|| format!("reproduce {}", experiment.name))?;
+        if let Some(readme) = &run_options.readme {
+            readme_block::replace_block(readme, outcome.readme.name, &outcome.readme.body)?;
+        }
+        let measured = outcome.metrics;
         let seconds = experiment_started.elapsed().as_secs_f64();
         timings.push((experiment.name, seconds));
         let these = compare(experiment.name, &measured, expected, options.tier);

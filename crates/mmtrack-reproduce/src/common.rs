@@ -1,12 +1,15 @@
 //! What every experiment does around its Monte Carlo: refuse an existing
 //! output (without `force`) and a README without the experiment's block
 //! before any work, read the experiment file (or the embedded default),
-//! pick the run count, write the outputs into a staging directory that
-//! replaces the output whole, and note the machine's load beside timings.
+//! read the trajectory a drive follows, pick the run count, write the
+//! outputs into a staging directory that replaces the output whole, and
+//! note the machine's load beside timings.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
+use mmtrack_core::StampedPose;
+use mmtrack_process::simulate::radar::{TrajectoryFormat, read_trajectory};
 use serde::de::DeserializeOwned;
 
 use crate::model::Tier;
@@ -60,6 +63,30 @@ pub fn load_experiment<T: DeserializeOwned>(
     };
     let experiment = toml::from_str(&text).with_context(|| source.clone())?;
     Ok((source, experiment))
+}
+
+/// The trajectory the drives of the odometry and SPEBT experiments follow
+/// by default: the Oxford full-sequence ground truth
+/// (`gt/radar_odometry.csv`) among the real-data samples beside the
+/// repository, relative to the repository root.
+pub const DEFAULT_TRAJECTORY: &str = "../shared/realdata/oxford-gt-full-seq/radar_odometry.csv";
+
+/// The poses of the trajectory file at `path`.
+///
+/// # Errors
+/// The file is missing (saying where the default one lives when it is
+/// [`DEFAULT_TRAJECTORY`]), cannot be read or parsed (naming it and the pose).
+pub fn read_drive(path: &Path, format: TrajectoryFormat) -> anyhow::Result<Vec<StampedPose>> {
+    if !path.exists() {
+        if path == Path::new(DEFAULT_TRAJECTORY) {
+            bail!(
+                "default {DEFAULT_TRAJECTORY} not found (the Oxford full-sequence ground truth among the real-data \
+                 samples beside the repository; run from the repository root); pass --trajectory PATH"
+            );
+        }
+        bail!("{}: not found (--trajectory)", path.display());
+    }
+    read_trajectory(path, format, None, 0)
 }
 
 /// Monte Carlo runs: `explicit` (the CLI's `--runs`), else the

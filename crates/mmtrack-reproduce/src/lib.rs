@@ -8,9 +8,11 @@
 //! the Markdown report and the README block.
 //!
 //! It sits in the *reproduce* stage of the data flow, above the algorithms
-//! (`mmtrack-mpc`, `-beam`, `-slam`), the simulators (`mmtrack-sim`), `io`
-//! and `analysis`. It writes files (tables, figures, reports) but never
-//! prints and knows no command line: progress goes through
+//! (`mmtrack-odometry`, `-mpc`, `-beam`, `-slam`), the simulators
+//! (`mmtrack-sim`), the pipelines (`mmtrack-process`: the odometry tables,
+//! the SPEBT Monte Carlo), `io` and `analysis`. It writes files (tables,
+//! figures, reports) but never prints and knows no command line: progress
+//! goes through
 //! [`mmtrack_core::progress::Progress`], and the CLI (or Python) decides
 //! what to show and which exit code a missed target gives.
 //!
@@ -20,13 +22,13 @@
 //! - [`expectation`]: the regression check against
 //!   `data/reproduce/<experiment>.expected.toml` (separate from the
 //!   verdicts: "did our numbers move?", not "does it reproduce the paper?");
-//! - [`mpc_artificial`], [`shaham`], [`zoechmann`], [`kim`]: the
-//!   experiments (the odometry and SPEBT experiments still live in the CLI
-//!   until the pipelines they run are a library);
+//! - [`odometry`], [`mpc_artificial`], [`shaham`], [`spebt`],
+//!   [`zoechmann`], [`kim`]: the experiments, one folder each
+//!   (`config <- run <- report`, and `mod.rs` with `run()`);
 //! - [`all`]: every experiment in one call, checked against its expectations;
 //! - [`bench`]: the benchmarks of `mmtrack bench`, speed as ratios to same-run baselines;
 //! - [`common`], [`readme_block`]: output directories, experiment files,
-//!   README blocks.
+//!   trajectories, README blocks.
 
 pub mod all;
 pub mod bench;
@@ -35,8 +37,10 @@ pub mod expectation;
 pub mod kim;
 pub mod model;
 pub mod mpc_artificial;
+pub mod odometry;
 pub mod readme_block;
 pub mod shaham;
+pub mod spebt;
 pub mod zoechmann;
 
 pub use model::{Claim, Metric, Outcome, ReadmeBlock, Rule, RunOptions, Tier, Verdict};

@@ -6,51 +6,46 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use mmtrack_reproduce::{RunOptions, kim};
+use mmtrack_reproduce::kim;
 
-use super::outcome::{finish, tier};
+use super::args::{ExperimentArgs, ExperimentTexts, MonteCarloArgs, MonteCarloTexts};
+use super::outcome::finish;
 use crate::progress::IndicatifProgress;
-use crate::threads::ThreadsArg;
+
+pub struct Kim;
+
+impl ExperimentTexts for Kim {
+    const OUTPUT_DIR: &'static str = "out/reproduce/kim";
+    const OUTPUT_HELP: &'static str = "Output directory (tables/, SVG figures, reproduce.md, metrics.json)";
+    const QUICK_HELP: &'static str =
+        "The CI version: the experiment's quick_runs runs with quick_particles particles, checked with quick_tolerance";
+}
+
+impl MonteCarloTexts for Kim {
+    const RUNS_HELP: &'static str = "Monte Carlo runs per row (default: the experiment's, 20)";
+    const README_HELP: &'static str = "Replace the block `<!-- reproduce-kim:begin -->` ... `end` in this file with \
+                                       the summary (checked before the run)";
+}
 
 #[derive(Args)]
 pub struct KimArgs {
-    /// Output directory (tables/, SVG figures, reproduce.md, metrics.json).
-    #[arg(short, long, default_value = "out/reproduce/kim")]
-    output: PathBuf,
-    /// Replace a previous run's output directory.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    common: ExperimentArgs<Kim>,
+    #[command(flatten)]
+    monte_carlo: MonteCarloArgs<Kim>,
     /// Experiment file (TOML; default: the embedded data/reproduce/kim.toml).
     #[arg(long, value_name = "EXPERIMENT.toml")]
     experiment: Option<PathBuf>,
-    /// Monte Carlo runs per row (default: the experiment's, 20).
-    #[arg(long)]
-    runs: Option<u64>,
     /// UE particles (default: the filter's, 2000).
     #[arg(long)]
     particles: Option<usize>,
-    /// The CI version: the experiment's quick_runs runs with quick_particles
-    /// particles, checked with quick_tolerance.
-    #[arg(long)]
-    quick: bool,
-    /// Replace the block `<!-- reproduce-kim:begin -->` ... `end` in this
-    /// file with the summary (checked before the run).
-    #[arg(long, value_name = "README.md")]
-    readme: Option<PathBuf>,
-    #[command(flatten)]
-    threads: ThreadsArg,
 }
 
 pub fn run(args: &KimArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    kim::check_start(&args.output, args.force, args.readme.as_deref())?;
+    let options = args.common.run_options(args.monte_carlo.runs, args.monte_carlo.readme.as_deref());
+    kim::check_start(&options.output_dir, args.common.force, options.readme.as_deref())?;
     let config = kim::Config::load(args.experiment.as_deref())?;
-    let options = RunOptions {
-        tier: tier(args.quick),
-        runs: args.runs,
-        output_dir: args.output.clone(),
-        readme: args.readme.clone(),
-    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.threads.install(|| kim::run(&config, args.particles, &options, &progress))??;
-    finish(&outcome, args.readme.as_deref(), &args.output, quiet)
+    let outcome = args.common.threads.install(|| kim::run(&config, args.particles, &options, &progress))??;
+    finish(&outcome, &options, quiet)
 }

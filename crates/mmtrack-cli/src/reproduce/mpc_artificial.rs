@@ -9,7 +9,8 @@ use clap::Args;
 use mmtrack_reproduce::RunOptions;
 use mmtrack_reproduce::mpc_artificial::{self, Config, Pulse};
 
-use super::outcome::{finish, tier};
+use super::args::tier;
+use super::outcome::finish;
 use crate::progress::IndicatifProgress;
 
 #[derive(Args)]
@@ -66,5 +67,5 @@ pub fn run(args: &MpcArtificialArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let options =
         RunOptions { tier: tier(args.quick), runs: None, output_dir: args.output.clone(), readme: args.readme.clone() };
     let outcome = mpc_artificial::run(&config, &options, &IndicatifProgress::new(quiet))?;
-    finish(&outcome, args.readme.as_deref(), &args.output, quiet)
+    finish(&outcome, &options, quiet)
 }

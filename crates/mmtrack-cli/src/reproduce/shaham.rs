@@ -6,47 +6,42 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use mmtrack_reproduce::{RunOptions, shaham};
+use mmtrack_reproduce::shaham;
 
-use super::outcome::{finish, tier};
+use super::args::{ExperimentArgs, ExperimentTexts, MonteCarloArgs, MonteCarloTexts};
+use super::outcome::finish;
 use crate::progress::IndicatifProgress;
-use crate::threads::ThreadsArg;
+
+pub struct Shaham;
+
+impl ExperimentTexts for Shaham {
+    const OUTPUT_DIR: &'static str = "out/reproduce/shaham";
+    const OUTPUT_HELP: &'static str = "Output directory (tables/, three SVG figures, reproduce.md)";
+    const QUICK_HELP: &'static str = "The CI version: the experiment's quick_runs (200) runs per point";
+}
+
+impl MonteCarloTexts for Shaham {
+    const RUNS_HELP: &'static str = "Monte Carlo runs per scenario point (default: the experiment's, 3000)";
+    const README_HELP: &'static str = "Replace the block `<!-- reproduce-shaham:begin -->` ... `end` in this file \
+                                       with the summary (checked before the run)";
+}
 
 #[derive(Args)]
 pub struct ShahamArgs {
-    /// Output directory (tables/, three SVG figures, reproduce.md).
-    #[arg(short, long, default_value = "out/reproduce/shaham")]
-    output: PathBuf,
-    /// Replace a previous run's output directory.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    common: ExperimentArgs<Shaham>,
+    #[command(flatten)]
+    monte_carlo: MonteCarloArgs<Shaham>,
     /// Experiment file (TOML; default: the embedded data/reproduce/shaham.toml).
     #[arg(long, value_name = "EXPERIMENT.toml")]
     experiment: Option<PathBuf>,
-    /// Monte Carlo runs per scenario point (default: the experiment's, 3000).
-    #[arg(long)]
-    runs: Option<u64>,
-    /// The CI version: the experiment's quick_runs (200) runs per point.
-    #[arg(long)]
-    quick: bool,
-    /// Replace the block `<!-- reproduce-shaham:begin -->` ... `end` in this
-    /// file with the summary (checked before the run).
-    #[arg(long, value_name = "README.md")]
-    readme: Option<PathBuf>,
-    #[command(flatten)]
-    threads: ThreadsArg,
 }
 
 pub fn run(args: &ShahamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    shaham::check_start(&args.output, args.force, args.readme.as_deref())?;
+    let options = args.common.run_options(args.monte_carlo.runs, args.monte_carlo.readme.as_deref());
+    shaham::check_start(&options.output_dir, args.common.force, options.readme.as_deref())?;
     let config = shaham::Config::load(args.experiment.as_deref())?;
-    let options = RunOptions {
-        tier: tier(args.quick),
-        runs: args.runs,
-        output_dir: args.output.clone(),
-        readme: args.readme.clone(),
-    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.threads.install(|| shaham::run(&config, &options, &progress))??;
-    finish(&outcome, args.readme.as_deref(), &args.output, quiet)
+    let outcome = args.common.threads.install(|| shaham::run(&config, &options, &progress))??;
+    finish(&outcome, &options, quiet)
 }

@@ -6,47 +6,43 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use mmtrack_reproduce::{RunOptions, zoechmann};
+use mmtrack_reproduce::zoechmann;
 
-use super::outcome::{finish, tier};
+use super::args::{ExperimentArgs, ExperimentTexts, MonteCarloArgs, MonteCarloTexts};
+use super::outcome::finish;
 use crate::progress::IndicatifProgress;
-use crate::threads::ThreadsArg;
+
+pub struct Zoechmann;
+
+impl ExperimentTexts for Zoechmann {
+    const OUTPUT_DIR: &'static str = "out/reproduce/zoechmann";
+    const OUTPUT_HELP: &'static str =
+        "Output directory (tables/, one SVG figure per manoeuvre, nlos.svg, reproduce.md)";
+    const QUICK_HELP: &'static str = "The CI version: the experiment's quick_runs (2000) runs per manoeuvre";
+}
+
+impl MonteCarloTexts for Zoechmann {
+    const RUNS_HELP: &'static str = "Monte Carlo runs per manoeuvre (default: the experiment's, 100000)";
+    const README_HELP: &'static str = "Replace the block `<!-- reproduce-zoechmann:begin -->` ... `end` in this \
+                                       file with the summary (checked before the run)";
+}
 
 #[derive(Args)]
 pub struct ZoechmannArgs {
-    /// Output directory (tables/, one SVG figure per manoeuvre, nlos.svg, reproduce.md).
-    #[arg(short, long, default_value = "out/reproduce/zoechmann")]
-    output: PathBuf,
-    /// Replace a previous run's output directory.
-    #[arg(long)]
-    force: bool,
+    #[command(flatten)]
+    common: ExperimentArgs<Zoechmann>,
+    #[command(flatten)]
+    monte_carlo: MonteCarloArgs<Zoechmann>,
     /// Experiment file (TOML; default: the embedded data/reproduce/zoechmann.toml).
     #[arg(long, value_name = "EXPERIMENT.toml")]
     experiment: Option<PathBuf>,
-    /// Monte Carlo runs per manoeuvre (default: the experiment's, 100000).
-    #[arg(long)]
-    runs: Option<u64>,
-    /// The CI version: the experiment's quick_runs (2000) runs per manoeuvre.
-    #[arg(long)]
-    quick: bool,
-    /// Replace the block `<!-- reproduce-zoechmann:begin -->` ... `end` in
-    /// this file with the summary (checked before the run).
-    #[arg(long, value_name = "README.md")]
-    readme: Option<PathBuf>,
-    #[command(flatten)]
-    threads: ThreadsArg,
 }
 
 pub fn run(args: &ZoechmannArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    zoechmann::check_start(&args.output, args.force, args.readme.as_deref())?;
+    let options = args.common.run_options(args.monte_carlo.runs, args.monte_carlo.readme.as_deref());
+    zoechmann::check_start(&options.output_dir, args.common.force, options.readme.as_deref())?;
     let config = zoechmann::Config::load(args.experiment.as_deref())?;
-    let options = RunOptions {
-        tier: tier(args.quick),
-        runs: args.runs,
-        output_dir: args.output.clone(),
-        readme: args.readme.clone(),
-    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.threads.install(|| zoechmann::run(&config, &options, &progress))??;
-    finish(&outcome, args.readme.as_deref(), &args.output, quiet)
+    let outcome = args.common.threads.install(|| zoechmann::run(&config, &options, &progress))??;
+    finish(&outcome, &options, quiet)
 }

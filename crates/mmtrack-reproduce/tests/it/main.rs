@@ -5,5 +5,6 @@
 #![allow(clippy::unwrap_used)]
 
 mod bench;
+mod drives;
 mod experiments;
 mod overpass;

@@ -13,7 +13,7 @@
 //!   `find_odometry_table`), one slot per estimate, the ground
 //!   truth interpolated at the estimates' times, the estimates moved into the
 //!   ground truth's frame at the first slot (as `reproduce spebt` experiment
-//!   (b) does, `spebt_odometry`); or
+//!   (b) does, `mmtrack_reproduce::spebt::drive`); or
 //! - without `--odometry`: the ground truth plus the paper's pose-error model
 //!   (eq. (23), `--sigma-r-m`, `--sigma-theta-deg`, drawn per `--seed` and run),
 //!   one slot per ground-truth pose (`reproduce spebt` experiment (a)).

@@ -7,12 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-// The experiments still inside the CLI (odometry, spebt) write their
-// metrics with these.
-// TODO(issue 24): drop the re-export once they move to mmtrack-reproduce.
-use mmtrack_reproduce::Tier;
-use mmtrack_reproduce::all::{AllOptions, PendingExperiments, run_all};
-pub use mmtrack_reproduce::model::{METRICS_FILE, Metric, write_metrics};
+use mmtrack_reproduce::all::{AllOptions, run_all};
 
 use crate::progress::IndicatifProgress;
 
@@ -35,14 +30,14 @@ pub struct AllArgs {
     pub readme: Option<PathBuf>,
 }
 
-/// `reproduce --all`; `pending` runs the experiments still in the CLI.
-pub fn run(args: &AllArgs, quiet: bool, pending: &dyn PendingExperiments) -> anyhow::Result<ExitCode> {
+/// `reproduce --all`.
+pub fn run(args: &AllArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let options = AllOptions {
-        tier: if args.smoke { Tier::Smoke } else { Tier::Full },
+        tier: super::args::tier(args.smoke),
         output_dir: args.output.clone(),
         readme: args.readme.clone(),
     };
-    let outcome = run_all(&options, pending, &IndicatifProgress::new(quiet))?;
+    let outcome = run_all(&options, &IndicatifProgress::new(quiet))?;
     if !quiet {
         print!("{}", outcome.summary);
         println!("\noutputs: {}", args.output.display());

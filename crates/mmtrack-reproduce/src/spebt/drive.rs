@@ -1,27 +1,31 @@
-//! Experiment (b) of `reproduce spebt`: the pose estimates come from our own
-//! radar odometry instead of the pose-error model, as in the paper's
+//! Experiment (b) of the SPEBT experiment: the pose estimates come from our
+//! own radar odometry instead of the pose-error model, as in the paper's
 //! pipeline (Sec. III-A, Fast-CFEAR on Navtech scans).
 //!
 //! Oxford-size Navtech scans are rendered along the trajectory through the
-//! generated street scene of `reproduce odometry` (the embedded
-//! `data/reproduce/odometry-drive.toml`, its seed and sensor, without its
+//! generated street scene of the odometry experiment
+//! ([`crate::odometry::DRIVE_SCENARIO`], its seed and sensor, without its
 //! distance cap), and an odometry preset (`fast-cfear`, the paper's) runs on
 //! them. The simulator's ground truth, one pose per scan, is the drive the
 //! link follows; the odometry's estimates, moved into the ground truth's
 //! frame at the first scan (`world_from_first_truth * first_estimate^-1 *
 //! estimate`), drive the tracker.
 
+use std::time::Instant;
+
 use anyhow::Context;
+use mmtrack_core::progress::Progress;
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 use mmtrack_process::beam::spebt::monte_carlo::into_truth_frame;
+use mmtrack_process::simulate::radar::parse_scenario;
 use mmtrack_sim::radar::{RadarSimulator, Trajectory};
 
-use crate::reproduce::ODOMETRY_DRIVE_SCENARIO;
-use mmtrack_process::simulate::radar::parse_scenario;
+use crate::odometry::config::{DRIVE_SCENARIO, DRIVE_SCENARIO_NAME};
 
 /// The simulated drive and the odometry's estimates along it.
-pub(super) struct OdometryDrive {
+#[derive(Debug, Clone)]
+pub struct OdometryDrive {
     /// The odometry preset.
     pub preset: String,
     /// Ground truth, one pose per scan (the link's slots).
@@ -38,6 +42,7 @@ impl OdometryDrive {
     /// RMSE of x, y (metres) and of the wrapped yaw (degrees) of the
     /// estimates against the ground truth, without alignment beyond the
     /// first scan (the paper's Table II).
+    #[must_use]
     pub fn rmse(&self) -> (f64, f64, f64) {
         let n = self.estimates.len().max(1) as f64;
         let (mut x, mut y, mut yaw) = (0.0, 0.0, 0.0);
@@ -51,11 +56,14 @@ impl OdometryDrive {
     }
 }
 
-/// Renders scans along `poses` and runs `preset` on them.
-pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyhow::Result<OdometryDrive> {
-    let started = std::time::Instant::now();
-    let mut scenario =
-        parse_scenario(ODOMETRY_DRIVE_SCENARIO).context("embedded data/reproduce/odometry-drive.toml")?;
+/// Renders scans along `poses` and runs `preset` on them; progress in scans.
+///
+/// # Errors
+/// An unknown preset, a scene or simulator that cannot be built, an
+/// odometry failure (naming the scan), a drive of fewer than two scans.
+pub fn drive(poses: Vec<StampedPose>, preset: &str, progress: &dyn Progress) -> anyhow::Result<OdometryDrive> {
+    let started = Instant::now();
+    let mut scenario = parse_scenario(DRIVE_SCENARIO).with_context(|| format!("embedded {DRIVE_SCENARIO_NAME}"))?;
     scenario.max_distance_m = None;
     let trajectory = Trajectory::from_poses(poses)?;
     let world = scenario.build_world(&trajectory)?;
@@ -63,7 +71,7 @@ pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyho
     let config = OdometryConfig::preset(preset)
         .with_context(|| format!("odometry preset `{preset}` (expected one of {:?})", OdometryConfig::PRESETS))?;
     let mut odometry = RadarOdometry::new(config)?;
-    let bar = crate::progress::bar(simulator.len() as u64, "reproduce spebt: radar odometry", "scans", quiet);
+    progress.start("reproduce spebt: radar odometry", simulator.len() as u64, "scans");
     let (mut ground_truth, mut raw, mut low_confidence) = (Vec::new(), Vec::new(), 0);
     for (scan, pose) in simulator {
         let result = odometry
@@ -72,9 +80,9 @@ pub(super) fn drive(poses: Vec<StampedPose>, preset: &str, quiet: bool) -> anyho
         low_confidence += usize::from(result.estimate.low_confidence);
         raw.push(result.estimate.world_from_vehicle);
         ground_truth.push(pose);
-        bar.inc(1);
+        progress.advance(1);
     }
-    bar.finish_and_clear();
+    progress.finish();
     anyhow::ensure!(ground_truth.len() >= 2, "the simulated drive gave {} scans; nothing to track", ground_truth.len());
     let estimates = into_truth_frame(ground_truth[0].parent_from_child, &raw);
     Ok(OdometryDrive {
