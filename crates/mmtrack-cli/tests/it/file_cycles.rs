@@ -27,20 +27,6 @@ use std::path::Path;
 /// longer is one.
 const ALLOWED_CYCLES: &[&[&str]] = &[
     &[
-        "crates/mmtrack-analysis/src/beam/geometric_analysis.rs",
-        "crates/mmtrack-analysis/src/beam/geometric_plots.rs",
-        "crates/mmtrack-analysis/src/beam/plots.rs",
-        "crates/mmtrack-analysis/src/beam/spebt_analysis.rs",
-        "crates/mmtrack-analysis/src/beam/spebt_plots.rs",
-        "crates/mmtrack-analysis/src/beam/sweeps.rs",
-        "crates/mmtrack-analysis/src/campaign.rs",
-        "crates/mmtrack-analysis/src/pipeline.rs",
-        "crates/mmtrack-analysis/src/plots.rs",
-        "crates/mmtrack-analysis/src/slam/analysis.rs",
-        "crates/mmtrack-analysis/src/slam/plots.rs",
-        "crates/mmtrack-analysis/src/tables.rs",
-    ],
-    &[
         "crates/mmtrack-cli/src/beam/reproduce_spebt.rs",
         "crates/mmtrack-cli/src/beam/spebt_odometry.rs",
         "crates/mmtrack-cli/src/beam/spebt_output.rs",
