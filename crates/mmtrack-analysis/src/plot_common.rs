@@ -6,6 +6,7 @@ use std::ops::Range;
 
 use plotters::prelude::*;
 
+/// A plotters error as an error of this crate, prefixed `plot:`.
 pub(crate) fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow::anyhow!("plot: {e}")
 }

@@ -1,7 +1,7 @@
 //! SVG plots of a trajectory evaluation, drawn with plotters (SVG backend
 //! only: no font files, text is left to the SVG viewer). Each function returns
 //! the SVG document; writing it is the caller's job. The helpers every figure
-//! shares are in [`crate::plot_common`].
+//! shares are in `plot_common`.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;

@@ -25,15 +25,13 @@ use std::path::Path;
 /// only: each the sorted files, relative to the workspace root. The list can
 /// only shrink: the test fails on any other cycle and on an entry that no
 /// longer is one.
-const ALLOWED_CYCLES: &[&[&str]] = &[
-    &[
-        "crates/mmtrack-cli/src/beam/reproduce_spebt.rs",
-        "crates/mmtrack-cli/src/beam/spebt_odometry.rs",
-        "crates/mmtrack-cli/src/beam/spebt_output.rs",
-        "crates/mmtrack-cli/src/beam/spebt_report.rs",
-        "crates/mmtrack-cli/src/reproduce.rs",
-    ],
-];
+const ALLOWED_CYCLES: &[&[&str]] = &[&[
+    "crates/mmtrack-cli/src/beam/reproduce_spebt.rs",
+    "crates/mmtrack-cli/src/beam/spebt_odometry.rs",
+    "crates/mmtrack-cli/src/beam/spebt_output.rs",
+    "crates/mmtrack-cli/src/beam/spebt_report.rs",
+    "crates/mmtrack-cli/src/reproduce.rs",
+]];
 
 /// Where an allowlisted cycle may be.
 const ALLOWLISTABLE: &[&str] = &["crates/mmtrack-analysis/src/", "crates/mmtrack-cli/src/"];
