@@ -9,8 +9,8 @@
 //! table, read with the `parquet` crate into one polars frame (the `run` and
 //! `sequence` columns come from the paths, as in a Hive scan), group-bys per run
 //! for the pooled rows, and one long table `run_comparison` (run, table,
-//! sequence, key, metric, unit, value) that the report turns into one
-//! side-by-side table per result table.
+//! sequence, key, metric, unit, value; declared in `mmtrack_io::table`) that
+//! the report turns into one side-by-side table per result table.
 //!
 //! Pooling rules (the same for one run's report, [`pooled_trajectory_metrics`]):
 //! - sequence `all`: KITTI drift pooled over segments, as the KITTI devkit
@@ -24,36 +24,11 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use mmtrack_io::table::TableSpec;
+use mmtrack_io::table::{RunComparisonRow, TableSpec, TrajectoryMetrics};
 use polars::df;
 use polars::prelude::{
     Column, DataFrame, DataType, Expr, IntoLazy, LazyFrame, NULL, PlSmallStr, SortMultipleOptions, col, lit, when,
 };
-
-use crate::tables::TrajectoryMetrics;
-
-mmtrack_io::define_table! {
-    /// `run_comparison`: the runs of one `analyze` side by side, long format.
-    pub const RUN_COMPARISON = "run_comparison",
-        "One value of one metric of one run, in long format: the main metrics of the result tables \
-(trajectory_metrics, mpc_summary, beam_sweep_summary, spebt_summary, geometric_summary, slam_summary) of every run \
-analyzed together, plus the pooled trajectory rows (sequence `all`: KITTI drift over segments, RMSEs over poses, RPE over frame pairs; \
-sequence `mean`: the mean of the per-sequence values). Pivot on `run` for the side-by-side table.";
-    /// One row of [`RUN_COMPARISON`].
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct RunComparisonRow {
-        run: String, "", "run id (the run=<id> folder of the inputs, or the input directory's name)";
-        source_table: String, "", "result table the value comes from";
-        sequence_id: String, "", "sequence; `all` and `mean` for the pooled trajectory rows";
-        key: String, "",
-            "row within the sequence: the tracker of beam_sweep_summary, the experiment / trajectory of \
-spebt_summary, the scenario row of slam_summary; empty otherwise";
-        metric: String, "", "column of source_table";
-        unit: String, "", "unit of that column (empty for unitless)";
-        value: Option<f64>, "", "the value in that unit; null where the table has none (e.g. KITTI drift of a path \
-shorter than every segment)";
-    }
-}
 
 /// A result table and the columns compared across runs.
 #[derive(Debug, Clone, Copy)]
@@ -79,9 +54,9 @@ pub const TRAJECTORY_COMPARED: [&str; 7] = [
 
 /// What the side-by-side compares, per result table.
 pub const COMPARED: [ComparedTable; 6] = [
-    ComparedTable { spec: &crate::tables::TRAJECTORY_METRICS, keys: &[], metrics: &TRAJECTORY_COMPARED },
+    ComparedTable { spec: &mmtrack_io::table::TRAJECTORY_METRICS, keys: &[], metrics: &TRAJECTORY_COMPARED },
     ComparedTable {
-        spec: &crate::mpc_tables::MPC_SUMMARY,
+        spec: &mmtrack_io::table::MPC_SUMMARY,
         keys: &[],
         metrics: &[
             "mean_mpcs_per_set",
@@ -461,7 +436,7 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<RunComparisonRow>> {
         let wide =
             frame.clone().select(select).sort(order, SortMultipleOptions::default()).collect().with_context(what)?;
         long_rows(&wide, compared, None, &mut rows)?;
-        if compared.spec.name == crate::tables::TRAJECTORY_METRICS.name {
+        if compared.spec.name == mmtrack_io::table::TRAJECTORY_METRICS.name {
             let pooled = frame
                 .clone()
                 .group_by([col("run")])

@@ -6,20 +6,19 @@
 //! - [`trajectory`]: pure metrics on in-memory poses (no I/O): association by
 //!   time, KITTI drift as the KITTI devkit computes it, relative pose error,
 //!   absolute trajectory error after SE(2) alignment;
-//! - [`tables`]: result tables (`trajectory_metrics`, `drift_per_length`,
-//!   `relative_pose_errors`) as `mmtrack-io` [`TableRow`](mmtrack_io::table::TableRow)s,
-//!   with units; [`TABLES`] lists their specs for `schemas/`;
-//! - [`mpc`], [`mpc_tables`], [`mpc_plots`], [`mpc_report`]: multipath-component
+//! - [`mpc`], [`mpc_plots`], [`mpc_report`]: multipath-component
 //!   statistics of `process mpc` tables (Mahler et al. 2017, Figs. 7-9,
-//!   12-13), their result tables, plots and report section;
+//!   12-13), their plots and report section;
 //! - [`mpc_artificial`]: the artificial-channel experiment's results (Sec.
 //!   IV-A, Figs. 4-5) as plain data and their plots;
 //! - [`beam`]: beam-tracking results (valid tracking, Shaham et al. 2020) as
 //!   tables and figures;
-//! - [`plots`]: SVG plots (plotters, SVG backend only);
+//! - [`plots`]: SVG plots of a trajectory evaluation (plotters, SVG backend
+//!   only); `plot_common`: the helpers every figure shares;
 //! - [`report`]: the Markdown report;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
-//!   and computes them per sequence;
+//!   and computes them per sequence (it calls the analyses; they never call
+//!   it back);
 //! - [`output`]: writes tables, plots and report into an output directory
 //!   that replaces an old one only when complete;
 //! - [`export`]: trajectories as TUM, KITTI and Boreas text files for evo,
@@ -37,8 +36,12 @@
 //! Polars stays inside this crate (ARCHITECTURE.md), with the feature `lazy`
 //! only (the `parquet` crate reads the files). The per-sequence metrics themselves (KITTI
 //! drift, RPE, ATE, MPC statistics) are algorithms on a few vectors and stay
-//! plain Rust; tables are written through `mmtrack-io`'s `TableRow` so every
-//! table carries the same units and run metadata.
+//! plain Rust. Every result table (`trajectory_metrics`, `mpc_summary`,
+//! `run_comparison`, ...) is declared in `mmtrack-io`'s
+//! [`table`](mmtrack_io::table) module, with its units, and listed in
+//! [`RESULT_TABLES`](mmtrack_io::table::RESULT_TABLES) for `schemas/`: this
+//! crate computes the rows and writes them through `TableRow`, so every table
+//! carries the same units and run metadata.
 
 pub mod analyze;
 pub mod beam;
@@ -48,14 +51,11 @@ pub mod mpc;
 pub mod mpc_artificial;
 pub mod mpc_plots;
 pub mod mpc_report;
-pub mod mpc_tables;
 pub mod output;
 pub mod pipeline;
+mod plot_common;
 pub mod plots;
 pub mod report;
 pub mod report_html;
 pub mod slam;
-pub mod tables;
 pub mod trajectory;
-
-pub use tables::TABLES;

@@ -12,7 +12,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::mpc_plots::viridis;
-use crate::plots::{err, padded_range};
+use crate::plot_common::{err, padded_range};
 
 /// The trackers compared on the artificial channel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -176,7 +176,7 @@ fn legend<'a, X: Ranged<ValueType = f64>, Y: Ranged<ValueType = f64>>(
     chart: &mut Chart<'a, X, Y>,
     position: SeriesLabelPosition,
 ) -> anyhow::Result<()> {
-    crate::plots::draw_legend(chart, position)
+    crate::plot_common::draw_legend(chart, position)
 }
 
 /// The minor grid lines (plotters' default is dark and dense on a log axis).

@@ -12,7 +12,7 @@ pub const DELAY_PLOT_SETS: usize = 30;
 /// A labelled line: label, points, colour.
 type Series<'a> = (&'a str, Vec<(f64, f64)>, RGBColor);
 
-use crate::plots::{err, padded_range as padded};
+use crate::plot_common::{err, padded_range as padded};
 
 /// Empirical CDF points (sorted value, share at or below).
 fn ecdf(mut values: Vec<f64>) -> Vec<(f64, f64)> {
@@ -104,7 +104,7 @@ fn cdf_chart(
             .label(*label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
     }
-    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
+    crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     Ok(())
 }
 
@@ -143,7 +143,7 @@ pub fn birth_death_svg(result: &MpcResult) -> anyhow::Result<String> {
 pub fn power_loss_svg(result: &MpcResult) -> anyhow::Result<String> {
     let t0 = t0(result);
     let t = |t_ns: i64| (t_ns - t0) as f64 * 1e-9;
-    type Getter = fn(&crate::mpc::SetMetrics) -> Option<f64>;
+    type Getter = fn(&mmtrack_io::table::SetMetrics) -> Option<f64>;
     let gains: [(&str, Getter, RGBColor); 4] = [
         ("channel", |s| Some(s.channel_gain_db), BLACK),
         ("detected", |s| Some(s.detected_gain_db), BLUE),
@@ -191,7 +191,7 @@ pub fn power_loss_svg(result: &MpcResult) -> anyhow::Result<String> {
                     .label(label)
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
             }
-            crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+            crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
         root.present().map_err(err)?;
     }

@@ -5,13 +5,15 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use mmtrack_core::stats::rms;
 use mmtrack_core::{
     MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, OdometryEstimate, Se2, StampedPose,
 };
 use mmtrack_io::table::{
-    BEAM_SWEEPS_TRACKED, BeamSweepTracked, GROUND_TRUTH, GROUND_TRUTH_RX, GROUND_TRUTH_TX, GroundTruthPose,
-    GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_SNAPSHOTS, MPC_TRACKS,
-    MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats, ODOMETRY, TableRow, read_table, read_table_dir, table_path,
+    BEAM_SWEEPS_TRACKED, BeamSweepTracked, DriftPerLength, GEOMETRIC_PER_EPOCH, GROUND_TRUTH, GeometricEpochRow,
+    GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS,
+    MpcSnapshotStats, ODOMETRY, RelativePoseErrorRow, SLAM_UE, SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow,
+    SpebtSummaryRow, TableRow, TrajectoryMetrics, read_table, read_table_dir, table_path,
 };
 
 use crate::beam::BeamResults;
@@ -19,10 +21,6 @@ use crate::beam::geometric_analysis::{self, GeometricResults};
 use crate::beam::spebt_analysis::{self, SpebtResults};
 use crate::beam::sweeps::analyze_beam_sweeps;
 use crate::mpc::{DistanceSource, MpcInput, MpcOptions, MpcResult, analyze_mpc};
-use mmtrack_io::table::{GEOMETRIC_PER_EPOCH, GeometricEpochRow};
-use mmtrack_io::table::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow, SpebtSummaryRow};
-
-use crate::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
 use crate::trajectory::{
     Association, DriftOptions, FirstFrameStep, KittiDrift, RelativePoseError, TrajectoryError,
     absolute_trajectory_error, associate, kitti_drift, relative_pose_errors, trajectory_distances_m, unaligned_errors,
@@ -135,7 +133,7 @@ pub fn plan(inventory: &Inventory) -> Plan {
             ));
         }
     }
-    for seq in inventory.sequences(mmtrack_io::table::SLAM_UE.name) {
+    for seq in inventory.sequences(SLAM_UE.name) {
         let missing: Vec<&str> =
             crate::slam::analysis::INPUT_TABLES.into_iter().filter(|t| !inventory.sequences(t).contains(seq)).collect();
         if missing.is_empty() {
@@ -227,12 +225,6 @@ impl TrajectoryResult {
             })
             .collect()
     }
-}
-
-/// Root mean square; `None` without values.
-pub(crate) fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
-    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
-    (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
 fn path_length(poses: &[Se2]) -> f64 {
@@ -433,19 +425,6 @@ pub fn analyze_beam_all(root: &Path, plan: &Plan) -> anyhow::Result<BeamResults>
     }
     Ok(BeamResults { sweeps, spebt, geometric })
 }
-
-/// Table names `process mpc` writes, for messages.
-pub const MPC_TABLE_NAMES: [&str; 9] = [
-    MPC_DETECTIONS.name,
-    MPC_TRACKS.name,
-    MPC_TRACKS_GMPHD.name,
-    MPC_LONG_TERM.name,
-    MPC_SETS.name,
-    MPC_SNAPSHOTS.name,
-    MPC_TRUTH.name,
-    GROUND_TRUTH_TX.name,
-    GROUND_TRUTH_RX.name,
-];
 
 /// Everything one run's analysis produced (one table directory).
 #[derive(Debug, Clone, Default)]

@@ -1,49 +1,15 @@
 //! SVG plots of a trajectory evaluation, drawn with plotters (SVG backend
 //! only: no font files, text is left to the SVG viewer). Each function returns
-//! the SVG document; writing it is the caller's job.
-
-use std::ops::Range;
+//! the SVG document; writing it is the caller's job. The helpers every figure
+//! shares are in `plot_common`.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::pipeline::TrajectoryResult;
+use crate::plot_common::{draw_legend, err, padded_range};
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
-
-pub(crate) fn err(e: impl std::fmt::Display) -> anyhow::Error {
-    anyhow::anyhow!("plot: {e}")
-}
-
-/// Draws the legend of the series labelled so far at `position`: black
-/// border on a translucent white box, the look of every figure here.
-pub(crate) fn draw_legend<'a, DB, CT>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-) -> anyhow::Result<()>
-where
-    DB: DrawingBackend + 'a,
-    CT: plotters::coord::CoordTranslate,
-{
-    chart
-        .configure_series_labels()
-        .position(position)
-        .border_style(BLACK)
-        .background_style(WHITE.mix(0.85))
-        .draw()
-        .map_err(err)
-}
-
-/// `[min, max]` of `values` padded by 5 % (1 unit when flat).
-pub(crate) fn padded_range(values: impl Iterator<Item = f64>) -> Range<f64> {
-    let (lo, hi) =
-        values.filter(|v| v.is_finite()).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
-    if !lo.is_finite() {
-        return 0.0..1.0;
-    }
-    let pad = if hi > lo { 0.05 * (hi - lo) } else { 1.0 };
-    (lo - pad)..(hi + pad)
-}
 
 /// x-y view of the estimate and the ground truth (both from the identity),
 /// equal axes: a square plot area over a square range.
@@ -79,7 +45,7 @@ pub fn trajectory_svg(result: &TrajectoryResult) -> anyhow::Result<String> {
             .label(format!("estimate ({})", result.sequence))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED.stroke_width(2)));
         chart.draw_series(std::iter::once(Circle::new((0.0, 0.0), 5, BLUE.filled()))).map_err(err)?;
-        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

@@ -177,7 +177,7 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
 #[cfg(test)]
 mod tests {
     use crate::campaign::pooled_trajectory_metrics;
-    use crate::tables::TrajectoryMetrics;
+    use mmtrack_io::table::TrajectoryMetrics;
 
     fn metrics(poses: u64, segments: u64, kitti_pct: Option<f64>, ate_m: f64, rpe_m: f64) -> TrajectoryMetrics {
         TrajectoryMetrics {

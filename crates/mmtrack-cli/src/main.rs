@@ -88,7 +88,7 @@ enum Command {
 }
 
 fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyhow::Result<ExitCode> {
-    let documents = mmtrack_io::schema_docs::documents_with(mmtrack_analysis::TABLES);
+    let documents = mmtrack_io::schema_docs::documents();
     if let Some(dir) = write {
         for (relative, contents) in &documents {
             let path = dir.join(relative);

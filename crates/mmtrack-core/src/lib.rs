@@ -19,7 +19,7 @@
 //! - [`random`]: the seeded random streams (SplitMix64 of words into `Pcg64`)
 //!   and the standard-normal, exponential and gamma draws every simulator,
 //!   filter and benchmark uses, so a seed means the same draws everywhere;
-//! - [`stats`]: quantiles (linear and nearest-rank), median and `erfc`;
+//! - [`stats`]: quantiles (linear and nearest-rank), median, root mean square and `erfc`;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
 //!

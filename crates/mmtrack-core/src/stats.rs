@@ -1,5 +1,5 @@
-//! Small order statistics and special functions shared by the analyses and
-//! reports.
+//! Small order statistics, the root mean square and special functions
+//! shared by the analyses and reports.
 //!
 //! The quantiles take values already sorted ascending (by `f64::total_cmp`,
 //! so NaN sorts last) and return `None` for no values. Two rules are in use
@@ -49,6 +49,14 @@ pub fn median(sorted: &[f64]) -> Option<f64> {
         _ if n % 2 == 1 => Some(sorted[n / 2]),
         _ => Some(0.5 * (sorted[n / 2 - 1] + sorted[n / 2])),
     }
+}
+
+/// The root mean square `sqrt(sum v^2 / n)` of `values`, summed in their
+/// order; `None` for no values.
+#[must_use]
+pub fn rms(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v * v, n + 1));
+    (n > 0).then(|| (sum / n as f64).sqrt())
 }
 
 /// The complementary error function `erfc(x) = 1 - erf(x)`, for any `x`,
@@ -122,6 +130,14 @@ mod tests {
             let (m, q) = (median(&v).unwrap_or(f64::NAN), quantile(&v, 0.5).unwrap_or(f64::NAN));
             assert!((m - q).abs() <= 1e-15 * m.abs(), "{v:?}: {m} {q}");
         }
+    }
+
+    #[test]
+    fn rms_of_values_and_of_none() {
+        assert_eq!(rms(std::iter::empty()), None);
+        assert_eq!(rms([-2.0].into_iter()), Some(2.0));
+        // sqrt((1 + 4 + 4 + 16 + 25) / 5) = sqrt(10): exact inputs, one rounding in sqrt.
+        assert_eq!(rms([1.0, -2.0, 2.0, 4.0, -5.0].into_iter()), Some(10f64.sqrt()));
     }
 
     #[test]

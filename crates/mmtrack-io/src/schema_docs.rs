@@ -6,32 +6,23 @@
 
 use crate::proto::{ALL_SPECS, MessageSpec};
 use crate::recording::CHANNELS;
-use crate::table::{ALL_TABLES, TableSpec};
+use crate::table::{ALL_TABLES, RESULT_TABLES, TableSpec};
 
-/// `(relative path, contents)` of every schema document of this crate.
+/// `(relative path, contents)` of every schema document: the MCAP channels
+/// and messages, every table of [`ALL_TABLES`] and of [`RESULT_TABLES`] (the
+/// tables `mmtrack analyze` writes) and their index `tables/results.md`.
+/// `README.md` links that index without listing the result tables.
 #[must_use]
 pub fn documents() -> Vec<(String, String)> {
-    documents_with(&[])
-}
-
-/// The documents of this crate plus those of `result_tables`, the tables
-/// `mmtrack analyze` writes (specs in `mmtrack-analysis`, which this crate
-/// cannot depend on): one document each and their index `tables/results.md`.
-/// `README.md` links that index without listing it, so it is the same with
-/// or without `result_tables`.
-#[must_use]
-pub fn documents_with(result_tables: &[&TableSpec]) -> Vec<(String, String)> {
     let mut docs = vec![("README.md".to_string(), index())];
     docs.push(("mcap/channels.md".to_string(), channels()));
     for spec in ALL_SPECS {
         docs.push((format!("mcap/{}.md", spec.full_name), message(spec)));
     }
-    for spec in ALL_TABLES.iter().chain(result_tables) {
+    for spec in ALL_TABLES.iter().chain(RESULT_TABLES) {
         docs.push((format!("tables/{}.md", spec.name), table(spec)));
     }
-    if !result_tables.is_empty() {
-        docs.push(("tables/results.md".to_string(), results_index(result_tables)));
-    }
+    docs.push(("tables/results.md".to_string(), results_index()));
     docs
 }
 
@@ -55,11 +46,11 @@ fn index() -> String {
     out
 }
 
-fn results_index(tables: &[&TableSpec]) -> String {
+fn results_index() -> String {
     let mut out = format!(
-        "{GENERATED}# Result tables of `mmtrack analyze`\n\nSpecs in crates/mmtrack-analysis; layout and key-value metadata as every mmtrack table.\n\n"
+        "{GENERATED}# Result tables of `mmtrack analyze`\n\nSpecs in crates/mmtrack-io (`table::RESULT_TABLES`); layout and key-value metadata as every mmtrack table.\n\n"
     );
-    for spec in tables {
+    for spec in RESULT_TABLES {
         out.push_str(&format!("- [{0}]({0}.md): {1}\n", spec.name, spec.description));
     }
     out

@@ -23,10 +23,10 @@
 use mmtrack_io::table::{GEOMETRIC_FILTER_H_INFINITY as H_INFINITY, GEOMETRIC_FILTER_RLS as RLS};
 use std::fmt::Write;
 
+use mmtrack_core::stats::rms;
 use mmtrack_core::wrap_angle_rad;
 
 use super::geometric_plots::GeometricTrackingSeries;
-use crate::pipeline::rms;
 use mmtrack_io::table::{GEOMETRIC_PER_EPOCH, GeometricEpochRow, GeometricSummaryRow};
 
 /// The figure of one sequence, with its caption.

@@ -6,7 +6,7 @@
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use crate::plots::{err, padded_range};
+use crate::plot_common::{err, padded_range};
 
 /// One sequence against the truth, per epoch (index = epoch).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -94,7 +94,7 @@ fn shade(chart: &mut Chart<'_, '_>, s: &GeometricTrackingSeries, t_end: f64) -> 
 }
 
 fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>) -> anyhow::Result<()> {
-    crate::plots::draw_legend(chart, SeriesLabelPosition::UpperRight)
+    crate::plot_common::draw_legend(chart, SeriesLabelPosition::UpperRight)
 }
 
 /// A line with its legend entry.

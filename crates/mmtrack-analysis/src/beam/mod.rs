@@ -1,18 +1,17 @@
-//! Beam-tracking results: the valid-tracking experiment of Shaham et al.
-//! 2020 as result tables ([`tables`]) and figures ([`plots`]); measured beam
-//! sweeps (`mmtrack process beam`) summarised per sequence and pooled per
-//! site ([`sweeps`]).
+//! Beam-tracking results: figures of the valid-tracking experiment of
+//! Shaham et al. 2020 ([`plots`]); measured beam sweeps (`mmtrack process
+//! beam`) summarised per sequence and pooled per site ([`sweeps`]).
 //!
-//! Pure data in, tables and SVG documents out; the experiment itself runs in
+//! Pure data in, rows and SVG documents out; the experiment itself runs in
 //! the CLI (`mmtrack reproduce shaham`), which owns the Monte Carlo loop.
 //! The SPEBT experiment of Liu et al. 2024 (`mmtrack reproduce spebt`) has
-//! its own tables ([`spebt_tables`]) and figure ([`spebt_plots`]); `mmtrack
-//! analyze` checks and pools the tables `process beam --tracker spebt`
-//! writes ([`spebt_analysis`]). The geometric Doppler-bearing tracker of
-//! Zoechmann et al. 2019 (`mmtrack reproduce zoechmann`) has its tables
-//! ([`zoechmann_tables`]) and figures ([`zoechmann_plots`]); `mmtrack
+//! its figure ([`spebt_plots`]); `mmtrack analyze` checks and pools the
+//! tables `process beam --tracker spebt` writes ([`spebt_analysis`]). The
+//! geometric Doppler-bearing tracker of Zoechmann et al. 2019 (`mmtrack
+//! reproduce zoechmann`) has its figures ([`zoechmann_plots`]); `mmtrack
 //! analyze` summarises the table `process beam --tracker geometric` writes
-//! ([`geometric_analysis`], [`geometric_plots`]).
+//! ([`geometric_analysis`], [`geometric_plots`]). Every table these write is
+//! declared in `mmtrack_io::table`.
 
 pub mod geometric_analysis;
 pub mod geometric_plots;

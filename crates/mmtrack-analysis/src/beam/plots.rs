@@ -4,7 +4,7 @@
 
 use plotters::prelude::*;
 
-use crate::plots::{err, padded_range};
+use crate::plot_common::{err, padded_range};
 
 /// One line of a figure: its label and RMS error per block, degrees.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,7 +58,7 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
             .map_err(err)?
             .label(format!("half beamwidth ({threshold_deg:.2} deg)"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], threshold));
-        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
+        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
@@ -143,7 +143,7 @@ pub fn beam_index_svg(
                 .label(series.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
-        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
@@ -197,7 +197,7 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
                 .label(curve.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
-        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
+        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

@@ -3,7 +3,7 @@
 
 use plotters::prelude::*;
 
-use crate::plots::{err, padded_range};
+use crate::plot_common::{err, padded_range};
 
 /// One realisation against the truth, per slot (index = slot).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -129,7 +129,7 @@ where
             }
         }
     }
-    crate::plots::draw_legend(chart, SeriesLabelPosition::UpperRight)
+    crate::plot_common::draw_legend(chart, SeriesLabelPosition::UpperRight)
 }
 
 /// `(slot, value)` of the positive finite values (a log axis shows no others).

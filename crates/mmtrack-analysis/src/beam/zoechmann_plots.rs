@@ -14,7 +14,7 @@
 
 use plotters::prelude::*;
 
-use crate::plots::{err, padded_range};
+use crate::plot_common::{err, padded_range};
 use mmtrack_io::table::{ZoechmannNlosErrorRow, ZoechmannPathLabelRow};
 
 /// One NMSE curve: label and NMSE (linear) per epoch.
@@ -100,7 +100,7 @@ fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace:
         .map_err(err)?
         .label("receiver array")
         .legend(|(x, y)| Circle::new((x + 10, y), 4, BLUE.filled()));
-    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
+    crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
     Ok(())
 }
 
@@ -139,7 +139,7 @@ fn draw_nmse(
             .label(curve.label.clone())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
-    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
@@ -296,7 +296,7 @@ fn draw_nlos_errors(
             .label(format!("{path}: RMS position error"))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
-    crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+    crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 

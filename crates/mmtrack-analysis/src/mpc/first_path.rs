@@ -20,7 +20,7 @@ use std::collections::BTreeMap;
 
 use mmtrack_core::MpcDetection;
 use mmtrack_core::stats::quantile;
-use mmtrack_io::table::MpcSnapshotStats;
+use mmtrack_io::table::{FirstPathRow, MpcSnapshotStats};
 
 /// Default dynamic range below the strongest detection within which the
 /// earliest detection is the first path, dB.
@@ -36,22 +36,6 @@ pub fn first_path(detections: &[MpcDetection], dynamic_range_db: f64) -> Option<
         .iter()
         .filter(|d| d.power_db() >= strongest_db - dynamic_range_db)
         .min_by(|a, b| a.delay_s.total_cmp(&b.delay_s))
-}
-
-/// One snapshot's first path (rows of `mpc_first_path`).
-#[derive(Debug, Clone, PartialEq)]
-#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
-pub struct FirstPathRow {
-    pub t_ns: i64,
-    pub set_index: u64,
-    pub snapshot_index: u32,
-    pub detections: u64,
-    pub strongest_delay_s: Option<f64>,
-    pub strongest_power_db: Option<f64>,
-    pub first_path_delay_s: Option<f64>,
-    pub first_path_power_db: Option<f64>,
-    pub first_path_hint_s: Option<f64>,
-    pub first_path_minus_hint_s: Option<f64>,
 }
 
 /// The first path against the receiver's estimate, over a sequence.

@@ -30,9 +30,11 @@ pub mod truth;
 use std::collections::BTreeMap;
 
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
-use mmtrack_io::table::MpcSnapshotStats;
+use mmtrack_io::table::{
+    ChiClassShare, CountBin, FirstPathRow, MpcSnapshotStats, MpcSummary, SetMetrics, TrackPowerStd,
+};
 
-pub use first_path::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, FirstPathRow, FirstPathSummary};
+pub use first_path::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, FirstPathSummary};
 pub use truth::{TruthScores, match_detections, resolvable_truth};
 
 /// Choices of the MPC statistics.
@@ -130,113 +132,6 @@ pub struct MpcInput {
     pub truth: Option<Vec<MpcTruth>>,
     /// Trajectories for the distance travelled.
     pub distance: DistanceSource,
-}
-
-/// Per-set results (rows of `mpc_set_metrics`).
-#[derive(Debug, Clone, PartialEq)]
-#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
-pub struct SetMetrics {
-    pub set_index: u64,
-    pub t_ns: i64,
-    pub long_term_mpcs: u64,
-    pub detections: u64,
-    pub full_lifetime_tracks: u64,
-    pub births: Option<u64>,
-    pub deaths: Option<u64>,
-    pub distance_m: Option<f64>,
-    pub birth_rate_per_m: Option<f64>,
-    pub death_rate_per_m: Option<f64>,
-    pub birth_rate_per_s: Option<f64>,
-    pub death_rate_per_s: Option<f64>,
-    pub channel_gain_db: f64,
-    pub detected_gain_db: f64,
-    pub tracked_gain_db: f64,
-    pub full_lifetime_gain_db: f64,
-    pub gmphd_tracked_gain_db: Option<f64>,
-    pub detection_loss_db: f64,
-    pub tracking_loss_db: f64,
-    pub gmphd_tracking_loss_db: Option<f64>,
-    pub true_births: Option<u64>,
-    pub true_deaths: Option<u64>,
-}
-
-/// Per-track power spread (rows of `mpc_track_power_std`).
-#[derive(Debug, Clone, PartialEq)]
-#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
-pub struct TrackPowerStd {
-    pub track_id: u64,
-    pub set_index: u64,
-    pub detections: u64,
-    pub full_lifetime: bool,
-    pub power_std_db: f64,
-}
-
-/// Power share of one confidence class (rows of `mpc_chi_classes`).
-#[derive(Debug, Clone, PartialEq)]
-#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
-pub struct ChiClassShare {
-    pub chi_class_s: Option<f64>,
-    pub entries: u64,
-    pub power_share: f64,
-}
-
-/// One value of the number-of-MPCs distribution (rows of `mpc_count_distribution`).
-#[derive(Debug, Clone, PartialEq)]
-#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
-pub struct CountBin {
-    pub mpcs: u64,
-    pub sets: u64,
-    pub cdf: f64,
-}
-
-/// Summary of one sequence (the row of `mpc_summary`).
-#[derive(Debug, Clone, PartialEq)]
-#[allow(missing_docs)] // Fields are documented by the column meanings of the table spec.
-pub struct MpcSummary {
-    pub sets: u64,
-    pub detections: u64,
-    pub short_term_tracks: u64,
-    pub full_lifetime_tracks: u64,
-    pub long_term_tracks: u64,
-    pub mean_mpcs_per_set: f64,
-    pub median_mpcs_per_set: f64,
-    pub distance_source: String,
-    pub distance_m: Option<f64>,
-    pub duration_s: f64,
-    pub births: u64,
-    pub deaths: u64,
-    pub birth_rate_per_m: Option<f64>,
-    pub death_rate_per_m: Option<f64>,
-    pub birth_rate_per_s: Option<f64>,
-    pub death_rate_per_s: Option<f64>,
-    pub mean_detection_loss_db: Option<f64>,
-    pub mean_tracking_loss_db: Option<f64>,
-    pub mean_full_lifetime_loss_db: Option<f64>,
-    pub mean_gmphd_tracking_loss_db: Option<f64>,
-    pub full_lifetime_std_below_1db: Option<f64>,
-    pub all_tracks_std_below_1_5db: Option<f64>,
-    pub chi_0_1ns_power_share: Option<f64>,
-    pub unrelated_power_share: Option<f64>,
-    pub truth_mpcs: Option<u64>,
-    pub precision: Option<f64>,
-    pub recall: Option<f64>,
-    pub recall_above_floor: Option<f64>,
-    pub track_purity: Option<f64>,
-    pub false_track_share: Option<f64>,
-    pub false_long_term_share: Option<f64>,
-    pub births_on_true_paths: Option<u64>,
-    pub deaths_on_true_paths: Option<u64>,
-    pub long_term_tracks_per_path: Option<f64>,
-    pub true_births: Option<u64>,
-    pub true_deaths: Option<u64>,
-    pub true_birth_rate_per_m: Option<f64>,
-    pub true_death_rate_per_m: Option<f64>,
-    pub first_path_dynamic_range_db: f64,
-    pub first_path_snapshots: u64,
-    pub first_path_hint_snapshots: u64,
-    pub first_path_minus_hint_median_s: Option<f64>,
-    pub first_path_hint_abs_median_s: Option<f64>,
-    pub first_path_hint_abs_p90_s: Option<f64>,
 }
 
 /// Everything computed for one sequence.

@@ -1,7 +1,8 @@
-//! 5G mmWave SLAM results: the tables of `mmtrack process slam` and of the
-//! experiment of Kim et al. 2018 (`mmtrack reproduce kim`) ([`tables`]),
-//! the paper's metrics shared by both ([`metrics`]), the per-sequence
-//! analysis of `mmtrack analyze` ([`analysis`]) and the figures ([`plots`]).
+//! 5G mmWave SLAM results on the tables of `mmtrack process slam` and of the
+//! experiment of Kim et al. 2018 (`mmtrack reproduce kim`), declared in
+//! `mmtrack_io::table`: the paper's metrics shared by both ([`metrics`]), the
+//! per-sequence analysis of `mmtrack analyze` ([`analysis`]) and the figures
+//! ([`plots`]).
 //!
 //! Pure data in, tables and SVG documents out; the Monte Carlo loop and the
 //! filter run in the CLI.

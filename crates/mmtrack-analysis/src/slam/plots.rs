@@ -4,7 +4,7 @@
 
 use plotters::prelude::*;
 
-use crate::plots::{err, padded_range};
+use crate::plot_common::{err, padded_range};
 
 /// Points, legend, colour, filled, small.
 type Markers<'a> = (&'a [[f64; 2]], &'static str, RGBColor, bool, bool);
@@ -87,7 +87,7 @@ pub fn map_svg(title: &str, figure: &MapFigure) -> anyhow::Result<String> {
                 .label(label)
                 .legend(move |(x, y)| Circle::new((x + 10, y), size, style));
         }
-        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)
@@ -132,7 +132,7 @@ pub fn epoch_curves_svg(title: &str, y_desc: &str, curves: &[EpochCurve]) -> any
                 .label(curve.label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
         }
-        crate::plots::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

@@ -5,10 +5,12 @@
 use std::path::Path;
 use std::process::Command;
 
-use mmtrack_analysis::tables::{DriftPerLength, RelativePoseErrorRow, TrajectoryMetrics};
 use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{GroundTruthPose, RunInfo, read_table, table_path, write_table};
+use mmtrack_io::table::{
+    DriftPerLength, GroundTruthPose, RelativePoseErrorRow, RunInfo, TrajectoryMetrics, read_table, table_path,
+    write_table,
+};
 
 use super::common::{mmtrack, text};
 

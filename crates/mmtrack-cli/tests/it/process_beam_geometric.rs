@@ -2,10 +2,9 @@
 
 use std::path::Path;
 
-use mmtrack_analysis::campaign::RunComparisonRow;
 use mmtrack_core::wrap_angle_rad;
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{GeometricEpochRow, GeometricSummaryRow};
+use mmtrack_io::table::{GeometricEpochRow, GeometricSummaryRow, RunComparisonRow};
 use mmtrack_io::table::{RunInfo, read_table, write_table};
 
 use super::common::{mmtrack, root, text};

@@ -79,14 +79,14 @@ fn process_mpc_writes_every_table_refuses_to_overwrite_and_analyze_reports_mpc_s
     assert!(analysis.status.success(), "{stderr}");
     assert!(stdout.contains(&format!("{sequence}: {SETS} sets")), "{stdout}");
     let results = dir.path().join("analysis");
-    let (_, summary) = only::<mmtrack_analysis::mpc::MpcSummary>(&results.join("tables"));
+    let (_, summary) = only::<mmtrack_io::table::MpcSummary>(&results.join("tables"));
     let summary = &summary[0];
     assert_eq!(summary.sets, SETS as u64);
     assert_eq!(summary.distance_source, "ground_truth_tx+ground_truth_rx");
     // Both cars drive at tens of km/h for 70 ms: some metres, not zero.
     assert!(summary.distance_m.is_some_and(|d| d > 0.5 && d < 20.0), "{:?}", summary.distance_m);
     assert!(summary.precision.is_some() && summary.recall.is_some() && summary.track_purity.is_some());
-    let (_, per_set) = only::<mmtrack_analysis::mpc::SetMetrics>(&results.join("tables"));
+    let (_, per_set) = only::<mmtrack_io::table::SetMetrics>(&results.join("tables"));
     assert_eq!(per_set.len(), SETS);
     assert_eq!(per_set.iter().map(|s| s.long_term_mpcs).sum::<u64>(), long_term.len() as u64);
     let report = std::fs::read_to_string(results.join("report.md")).unwrap();
@@ -216,10 +216,10 @@ fn uwb_first_path_from_the_cli_lies_on_the_chips_leading_edge() {
         printed += &text(&out).0;
     }
     let results = dir.path().join("analysis/tables");
-    let (_, rows) = only::<mmtrack_analysis::mpc::FirstPathRow>(&results);
+    let (_, rows) = only::<mmtrack_io::table::FirstPathRow>(&results);
     assert_eq!(rows.len(), 252, "one row per CIR");
     assert!(rows.iter().all(|r| r.first_path_minus_hint_s.is_some()), "every CIR has a first path and an HLP");
-    let (_, summary) = only::<mmtrack_analysis::mpc::MpcSummary>(&results);
+    let (_, summary) = only::<mmtrack_io::table::MpcSummary>(&results);
     let s = &summary[0];
     let (median_ns, p90_ns) =
         (s.first_path_hint_abs_median_s.unwrap() * 1e9, s.first_path_hint_abs_p90_s.unwrap() * 1e9);

@@ -17,15 +17,18 @@
 
 mod beam_result_rows;
 mod beam_rows;
+mod campaign_rows;
 mod columns;
 mod define;
 mod geometric_rows;
 mod io;
+mod mpc_result_rows;
 mod mpc_rows;
 mod odometry_rows;
 mod rows;
 mod slam_rows;
 mod spebt_rows;
+mod trajectory_result_rows;
 
 pub use arrow_array::ArrayRef;
 pub use beam_result_rows::{
@@ -33,6 +36,7 @@ pub use beam_result_rows::{
     BeamSweepSummaryRow, BeamValidTrackingRow,
 };
 pub use beam_rows::{BEAM_SWEEPS_TRACKED, BeamSweepTracked};
+pub use campaign_rows::{RUN_COMPARISON, RunComparisonRow};
 pub use columns::{ColumnValue, Columns, ListColumn};
 pub use geometric_rows::{
     GEOMETRIC_FILTER_H_INFINITY, GEOMETRIC_FILTER_RLS, GEOMETRIC_PER_EPOCH, GEOMETRIC_SUMMARY, GeometricEpochRow,
@@ -43,17 +47,24 @@ pub use io::{
     RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, inspect_table_file, read_table,
     read_table_dir, table_path, write_table,
 };
+pub use mpc_result_rows::{
+    ChiClassShare, CountBin, FirstPathRow, MPC_CHI_CLASSES, MPC_COUNT_DISTRIBUTION, MPC_FIRST_PATH, MPC_SET_METRICS,
+    MPC_SUMMARY, MPC_TRACK_POWER_STD, MpcSummary, SetMetrics, TrackPowerStd,
+};
 pub use mpc_rows::{
     GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_LONG_TERM, MPC_SETS,
     MPC_SNAPSHOTS, MPC_TRACKS_GMPHD, MPC_TRUTH, MpcSnapshotStats,
 };
 pub use odometry_rows::{GROUND_TRUTH, GroundTruthPose, ODOMETRY, ODOMETRY_TIMING};
-pub use rows::{ALL_TABLES, CIR_SNAPSHOTS, GNSS_FIXES, MPC_DETECTIONS, MPC_TRACKS, POSES, RADAR_SCANS};
+pub use rows::{ALL_TABLES, CIR_SNAPSHOTS, GNSS_FIXES, MPC_DETECTIONS, MPC_TRACKS, POSES, RADAR_SCANS, RESULT_TABLES};
 pub use slam_rows::{
     SLAM_ASSOCIATIONS, SLAM_MAP, SLAM_PER_EPOCH, SLAM_SUMMARY, SLAM_TRUE_SOURCES, SLAM_UE, SlamAssociationRow,
     SlamMapRow, SlamPerEpochRow, SlamSummaryRow, SlamTrueSourceRow, SlamUeRow,
 };
 pub use spebt_rows::{SPEBT_PER_SLOT, SPEBT_POOLED, SPEBT_SUMMARY, SpebtPooledRow, SpebtSlotRow, SpebtSummaryRow};
+pub use trajectory_result_rows::{
+    DRIFT_PER_LENGTH, DriftPerLength, RELATIVE_POSE_ERRORS, RelativePoseErrorRow, TRAJECTORY_METRICS, TrajectoryMetrics,
+};
 
 use std::sync::Arc;
 

@@ -175,7 +175,10 @@ impl TableRow for MpcTrack {
     }
 }
 
-/// Every table of this module, for documentation and tests.
+/// The recording and processing tables (poses, odometry, ground truth,
+/// GNSS, radar scans, CIR snapshots, MPC and beam-sweep tables), for
+/// documentation, tests and the schema check of [`inspect_table_dir`](super::inspect_table_dir);
+/// the result tables (some of which `process` writes too) are [`RESULT_TABLES`].
 pub const ALL_TABLES: &[&TableSpec] = &[
     &POSES,
     &super::GROUND_TRUTH,
@@ -194,4 +197,39 @@ pub const ALL_TABLES: &[&TableSpec] = &[
     &super::GROUND_TRUTH_TX,
     &super::GROUND_TRUTH_RX,
     &super::BEAM_SWEEPS_TRACKED,
+];
+
+/// Every result table: what `mmtrack analyze` writes (and `reproduce` and
+/// `process beam`/`process slam` for the tables they share with it), in the
+/// order of `schemas/tables/results.md`.
+pub const RESULT_TABLES: &[&TableSpec] = &[
+    &super::TRAJECTORY_METRICS,
+    &super::DRIFT_PER_LENGTH,
+    &super::RELATIVE_POSE_ERRORS,
+    &super::MPC_SUMMARY,
+    &super::MPC_SET_METRICS,
+    &super::MPC_COUNT_DISTRIBUTION,
+    &super::MPC_TRACK_POWER_STD,
+    &super::MPC_CHI_CLASSES,
+    &super::MPC_FIRST_PATH,
+    &super::BEAM_RMS_PER_BLOCK,
+    &super::BEAM_VALID_TRACKING,
+    &super::BEAM_SWEEP_SUMMARY,
+    &super::BEAM_SWEEP_POOLED,
+    &super::SPEBT_SUMMARY,
+    &super::SPEBT_PER_SLOT,
+    &super::SPEBT_POOLED,
+    &super::ZOECHMANN_NMSE,
+    &super::ZOECHMANN_SUMMARY,
+    &super::ZOECHMANN_NLOS_ERROR,
+    &super::ZOECHMANN_PATH_LABELS,
+    &super::GEOMETRIC_PER_EPOCH,
+    &super::GEOMETRIC_SUMMARY,
+    &super::SLAM_SUMMARY,
+    &super::SLAM_PER_EPOCH,
+    &super::SLAM_UE,
+    &super::SLAM_MAP,
+    &super::SLAM_ASSOCIATIONS,
+    &super::SLAM_TRUE_SOURCES,
+    &super::RUN_COMPARISON,
 ];

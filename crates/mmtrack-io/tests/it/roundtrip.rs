@@ -2,7 +2,7 @@
 
 use mmtrack_core::{CirSnapshot, GnssFix, MpcDetection, MpcTrack, PolarScan, Se2, StampedPose};
 use mmtrack_io::recording::{Compression, PoseStream, inspect_recording};
-use mmtrack_io::table::{RunInfo, TableRow, read_table, read_table_dir, table_path, write_table};
+use mmtrack_io::table::{RunInfo, TableRow, TrajectoryMetrics, read_table, read_table_dir, table_path, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingOptions, RecordingReader, RecordingWriter};
 use proptest::prelude::*;
 
@@ -218,6 +218,48 @@ fn tables_round_trip_every_type_bit_exactly() {
     let empty: Vec<MpcDetection> = Vec::new();
     assert_eq!(table_round_trip(&empty), empty);
     let _: Vec<MpcTrack> = table_round_trip(&Vec::new());
+}
+
+/// The derived writer and reader of a result table with lists and nullable
+/// integers and floats give back every value, nulls included.
+#[test]
+fn trajectory_metrics_round_trip_with_and_without_nulls() {
+    let full = TrajectoryMetrics {
+        estimate_poses: u64::MAX,
+        associated_poses: 7,
+        interpolated_poses: 3,
+        dropped_poses: 0,
+        first_t_ns: i64::MIN,
+        last_t_ns: i64::MAX,
+        path_length_m: 812.5,
+        estimate_path_length_m: -0.0,
+        segment_lengths_m: vec![100.0, 200.0],
+        step_frames: Some(10),
+        step_m: None,
+        kitti_segments: 12,
+        kitti_translational_pct: Some(1.25),
+        kitti_rotational_deg_per_m: Some(0.002),
+        kitti_rotational_deg_per_100m: Some(0.2),
+        ate_rmse_m: 1.0,
+        ate_max_m: 2.0,
+        x_rmse_m: 0.5,
+        y_rmse_m: 0.25,
+        position_rmse_m: f64::INFINITY,
+        yaw_rmse_rad: 1e-300,
+        final_position_error_m: 3.0,
+        rpe_translation_rmse_m: 0.1,
+        rpe_yaw_rmse_rad: 0.01,
+    };
+    let empty = TrajectoryMetrics {
+        segment_lengths_m: Vec::new(),
+        step_frames: None,
+        step_m: Some(5.0),
+        kitti_translational_pct: None,
+        kitti_rotational_deg_per_m: None,
+        kitti_rotational_deg_per_100m: None,
+        ..full.clone()
+    };
+    assert_eq!(table_round_trip(&[full.clone(), empty.clone()]), vec![full, empty]);
 }
 
 /// A track's points are rows of `mpc_tracks`; the Parquet reader hands a

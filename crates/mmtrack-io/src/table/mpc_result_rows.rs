@@ -1,14 +1,16 @@
-//! Result tables of the MPC statistics (see [`crate::mpc`]), with units.
+//! Result tables of the multipath-component statistics (`mmtrack analyze`
+//! on the tables of `process mpc`, Mahler et al. 2017), with units: one
+//! partition per sequence.
 
-use crate::mpc::{ChiClassShare, CountBin, FirstPathRow, MpcSummary, SetMetrics, TrackPowerStd};
-
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `mpc_set_metrics`: one row per set.
     pub const MPC_SET_METRICS = "mpc_set_metrics",
         "MPC statistics of one sounder set per row, in set order: long-term MPC count (Fig. 12), births and \
 deaths across the pair (previous set, this set) and their rates (Fig. 13), channel gains and power losses (Figs. 8-9). \
 Transition columns are null for the first set.";
-    SetMetrics {
+    /// Per-set results: one row of [`MPC_SET_METRICS`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct SetMetrics {
         set_index: u64, "", "the set";
         t_ns: i64, "ns", "time of its first snapshot";
         long_term_mpcs: u64, "", "full-lifetime MPCs entered in long-term tracks in this set";
@@ -34,12 +36,14 @@ Transition columns are null for the first set.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `mpc_track_power_std`: one row per short-term track.
     pub const MPC_TRACK_POWER_STD = "mpc_track_power_std",
         "Power standard deviation of each short-term track over its set (Mahler et al. 2017, Fig. 7), in \
 the order of mpc_tracks: sample standard deviation (n - 1) of its detections' power_db, 0 for one detection.";
-    TrackPowerStd {
+    /// Per-track power spread: one row of [`MPC_TRACK_POWER_STD`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct TrackPowerStd {
         track_id: u64, "", "track_id in mpc_tracks";
         set_index: u64, "", "set of the track";
         detections: u64, "", "detections of the track";
@@ -48,38 +52,44 @@ the order of mpc_tracks: sample standard deviation (n - 1) of its detections' po
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `mpc_chi_classes`: power share per long-term confidence class.
     pub const MPC_CHI_CLASSES = "mpc_chi_classes",
         "Long-term links per confidence class chi (Mahler et al. 2017, eq. 40, Sec. VI-A), in increasing \
 chi: the share of the linked power (mean power of the entry each link leads to); a last row with a null chi gives \
 the entries related to no adjacent set and their share of all full-lifetime power.";
-    ChiClassShare {
+    /// Power share of one confidence class: one row of [`MPC_CHI_CLASSES`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct ChiClassShare {
         chi_class_s: Option<f64>, "s", "confidence class; null for the unrelated entries";
         entries: u64, "", "links of this class (or unrelated entries)";
         power_share: f64, "", "share of linked power (or of all long-term power for the null row), 0..1";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `mpc_count_distribution`: distribution of the number of MPCs per set.
     pub const MPC_COUNT_DISTRIBUTION = "mpc_count_distribution",
         "Distribution of the number of long-term (full-lifetime) MPCs per set (Mahler et al. 2017, \
 Fig. 12), one row per count that occurs, in increasing count.";
-    CountBin {
+    /// One value of the number-of-MPCs distribution: one row of [`MPC_COUNT_DISTRIBUTION`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct CountBin {
         mpcs: u64, "", "number of MPCs in a set";
         sets: u64, "", "sets with that many";
         cdf: f64, "", "share of sets with at most that many, 0..1";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `mpc_summary`: one row per sequence.
     pub const MPC_SUMMARY = "mpc_summary",
         "Summary of the MPC statistics of one sequence partition (one row). Rates per metre use the \
 distance named by distance_source (both sounder vehicles' ground truth summed, as the paper; or one trajectory); \
 they are null without one, and the per-second rates always apply. Truth columns are null without mpc_truth.";
-    MpcSummary {
+    /// Summary of one sequence: the row of [`MPC_SUMMARY`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct MpcSummary {
         sets: u64, "", "sets processed";
         detections: u64, "", "detections";
         short_term_tracks: u64, "", "short-term tracks";
@@ -132,14 +142,16 @@ they are null without one, and the per-second rates always apply. Truth columns 
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `mpc_first_path`: one row per snapshot.
     pub const MPC_FIRST_PATH = "mpc_first_path",
         "The first path of each CIR snapshot, in the order of mpc_snapshots (or of set and snapshot \
 without it): the earliest detection at most first_path_dynamic_range_db (mpc_summary) below the snapshot's \
 strongest detection, and its distance from the receiver's own first-path estimate when the recording carries one \
 (e.g. the DW1000's leading edge HLP). Delay columns are null for a snapshot without detections.";
-    FirstPathRow {
+    /// One snapshot's first path: one row of [`MPC_FIRST_PATH`].
+    #[derive(Debug, Clone, PartialEq)]
+    pub struct FirstPathRow {
         t_ns: i64, "ns", "time of the snapshot";
         set_index: u64, "", "sounder set";
         snapshot_index: u32, "", "snapshot within the set";

@@ -1,44 +1,7 @@
-//! Result tables of `mmtrack analyze`, with units. Same layout and metadata as
-//! every mmtrack table (`<out>/tables/<table>/sequence=<id>/part-0.parquet`).
-//! The sequence is the Hive partition, not a column, so readers that add
-//! partition columns (DuckDB, pyarrow, polars) see it once.
+//! Result tables of the trajectory evaluation (`mmtrack analyze` on the
+//! tables of `process odometry`), with units: one partition per sequence.
 
-use mmtrack_io::table::TableSpec;
-
-/// Every result table of this crate, for `schemas/`.
-pub const TABLES: &[&TableSpec] = &[
-    &TRAJECTORY_METRICS,
-    &DRIFT_PER_LENGTH,
-    &RELATIVE_POSE_ERRORS,
-    &crate::mpc_tables::MPC_SUMMARY,
-    &crate::mpc_tables::MPC_SET_METRICS,
-    &crate::mpc_tables::MPC_COUNT_DISTRIBUTION,
-    &crate::mpc_tables::MPC_TRACK_POWER_STD,
-    &crate::mpc_tables::MPC_CHI_CLASSES,
-    &crate::mpc_tables::MPC_FIRST_PATH,
-    &mmtrack_io::table::BEAM_RMS_PER_BLOCK,
-    &mmtrack_io::table::BEAM_VALID_TRACKING,
-    &mmtrack_io::table::BEAM_SWEEP_SUMMARY,
-    &mmtrack_io::table::BEAM_SWEEP_POOLED,
-    &mmtrack_io::table::SPEBT_SUMMARY,
-    &mmtrack_io::table::SPEBT_PER_SLOT,
-    &mmtrack_io::table::SPEBT_POOLED,
-    &mmtrack_io::table::ZOECHMANN_NMSE,
-    &mmtrack_io::table::ZOECHMANN_SUMMARY,
-    &mmtrack_io::table::ZOECHMANN_NLOS_ERROR,
-    &mmtrack_io::table::ZOECHMANN_PATH_LABELS,
-    &mmtrack_io::table::GEOMETRIC_PER_EPOCH,
-    &mmtrack_io::table::GEOMETRIC_SUMMARY,
-    &mmtrack_io::table::SLAM_SUMMARY,
-    &mmtrack_io::table::SLAM_PER_EPOCH,
-    &mmtrack_io::table::SLAM_UE,
-    &mmtrack_io::table::SLAM_MAP,
-    &mmtrack_io::table::SLAM_ASSOCIATIONS,
-    &mmtrack_io::table::SLAM_TRUE_SOURCES,
-    &crate::campaign::RUN_COMPARISON,
-];
-
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `trajectory_metrics`: one row per sequence.
     pub const TRAJECTORY_METRICS = "trajectory_metrics",
         "Summary metrics of one estimated trajectory (table odometry) against its ground truth (table \
@@ -77,7 +40,7 @@ KITTI devkit (evaluate_odometry.cpp).";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `drift_per_length`: KITTI drift per segment length.
     pub const DRIFT_PER_LENGTH = "drift_per_length",
         "KITTI drift of one sequence per segment length (the devkit's per-length plots), in segment-length \
@@ -92,7 +55,7 @@ order; lengths longer than the path are absent.";
     }
 }
 
-mmtrack_io::define_table! {
+crate::define_table! {
     /// `relative_pose_errors`: one row per frame.
     pub const RELATIVE_POSE_ERRORS = "relative_pose_errors",
         "Frame-to-frame relative pose error E_k = (gt_{k-1}^-1 gt_k)^-1 (est_{k-1}^-1 est_k) of one sequence, \
@@ -105,59 +68,5 @@ one row per associated frame k >= 1, in time order.";
         distance_m: f64, "m", "ground-truth path length from the first associated pose to frame k";
         translation_error_m: f64, "m", "length of the translation of E_k";
         yaw_error_rad: f64, "rad", "rotation of E_k, wrapped to (-pi, pi]";
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use mmtrack_io::Overwrite;
-    use mmtrack_io::table::{RunInfo, read_table_dir, write_table};
-
-    use super::*;
-
-    /// The derived writer and reader of a result table with lists and
-    /// nullable integers and floats give back every value, nulls included.
-    #[test]
-    fn trajectory_metrics_round_trip_with_and_without_nulls() {
-        let full = TrajectoryMetrics {
-            estimate_poses: u64::MAX,
-            associated_poses: 7,
-            interpolated_poses: 3,
-            dropped_poses: 0,
-            first_t_ns: i64::MIN,
-            last_t_ns: i64::MAX,
-            path_length_m: 812.5,
-            estimate_path_length_m: -0.0,
-            segment_lengths_m: vec![100.0, 200.0],
-            step_frames: Some(10),
-            step_m: None,
-            kitti_segments: 12,
-            kitti_translational_pct: Some(1.25),
-            kitti_rotational_deg_per_m: Some(0.002),
-            kitti_rotational_deg_per_100m: Some(0.2),
-            ate_rmse_m: 1.0,
-            ate_max_m: 2.0,
-            x_rmse_m: 0.5,
-            y_rmse_m: 0.25,
-            position_rmse_m: f64::INFINITY,
-            yaw_rmse_rad: 1e-300,
-            final_position_error_m: 3.0,
-            rpe_translation_rmse_m: 0.1,
-            rpe_yaw_rmse_rad: 0.01,
-        };
-        let empty = TrajectoryMetrics {
-            segment_lengths_m: Vec::new(),
-            step_frames: None,
-            step_m: Some(5.0),
-            kitti_translational_pct: None,
-            kitti_rotational_deg_per_m: None,
-            kitti_rotational_deg_per_100m: None,
-            ..full.clone()
-        };
-        let dir = tempfile::tempdir().unwrap();
-        let run = RunInfo { config_json: "{}".into() };
-        write_table(dir.path(), "seq", &[full.clone(), empty.clone()], &run, Overwrite::Refuse).unwrap();
-        let read = read_table_dir::<TrajectoryMetrics>(dir.path()).unwrap();
-        assert_eq!(read.get("seq").map(Vec::as_slice), Some(&[full, empty][..]));
     }
 }
