@@ -235,6 +235,13 @@ fn main() -> ExitCode {
     match threads::ThreadsArg::default().install(|| run(cli)).and_then(|result| result) {
         Ok(code) => code,
         Err(error) => {
+            if mmtrack_io::atomic::interrupted() {
+                // The signal thread removes the partial outputs (which is
+                // what made this command fail) and exits with 128 + signal.
+                loop {
+                    std::thread::park();
+                }
+            }
             eprintln!("error: {}", one_line(&error));
             ExitCode::FAILURE
         }

@@ -255,11 +255,25 @@ pub struct PartialOutputsRemoved {
     _registry: MutexGuard<'static, BTreeMap<PathBuf, PartialKind>>,
 }
 
+/// Set when [`remove_partial_outputs`] starts: the process is being
+/// interrupted, and writes failing from now on are its consequence.
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Whether [`remove_partial_outputs`] has started: an error a command
+/// returns now (a file vanished under it) is the interruption's, and the
+/// caller should leave the exit to the interrupting thread instead of
+/// reporting it.
+#[must_use]
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
+}
+
 /// Removes every partial output this process is writing, for a process that
 /// is being interrupted (SIGINT, SIGTERM). The result keeps the registry
 /// locked, so no new partial output can start (its writer waits) while the
 /// caller exits: keep it alive until `std::process::exit`.
 pub fn remove_partial_outputs() -> PartialOutputsRemoved {
+    INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst);
     let registry = live_partials();
     let mut removed = 0;
     let mut failed = Vec::new();
