@@ -90,11 +90,34 @@ fn maps_the_paper_world_and_tracks_the_ue() {
             r.world.virtual_anchors_m.iter().map(|t| norm3(sub3(*t, va.belief.mean_m))).fold(f64::MAX, f64::min);
         assert!(nearest < 2.0, "VA {:?} is {nearest} m from the nearest true VA", va.belief.mean_m);
     }
-    // Every confirmed SP is a real one (within 2 m).
-    for sp in filter.sources().iter().filter(|s| s.status == SourceStatus::ScatteringPoint) {
+    // Every confirmed SP is a real one (within 2 m), and every true SP
+    // the UE saw in at least 10 epochs (2 s of paths; confirmation needs 3
+    // sightings and footnote 3's drift test) is confirmed: the loop below
+    // cannot pass on an empty map.
+    let sps: Vec<_> = filter.sources().iter().filter(|s| s.status == SourceStatus::ScatteringPoint).collect();
+    for sp in &sps {
         let nearest =
             r.world.scattering_points_m.iter().map(|t| norm3(sub3(*t, sp.belief.mean_m))).fold(f64::MAX, f64::min);
         assert!(nearest < 2.0, "SP {:?} is {nearest} m from the nearest true SP", sp.belief.mean_m);
+    }
+    let mut sightings = vec![0_usize; r.world.scattering_points_m.len()];
+    for truth in &r.truth {
+        for origin in &truth.origins {
+            if let PathOrigin::ScatteringPoint(i) = origin {
+                sightings[*i] += 1;
+            }
+        }
+    }
+    let seen: Vec<usize> = (0..sightings.len()).filter(|&i| sightings[i] >= 10).collect();
+    assert!(!seen.is_empty(), "no SP in sight for 10 epochs: {sightings:?}");
+    for i in seen {
+        let truth = r.world.scattering_points_m[i];
+        let nearest = sps.iter().map(|sp| norm3(sub3(truth, sp.belief.mean_m))).fold(f64::MAX, f64::min);
+        assert!(
+            nearest < 2.0,
+            "true SP {i} seen in {} epochs has no confirmed SP within 2 m ({nearest} m)",
+            sightings[i]
+        );
     }
 }
 
