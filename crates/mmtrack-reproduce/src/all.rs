@@ -1,6 +1,13 @@
-//! `reproduce --all [--smoke]`: every paper experiment in one call, each
-//! checked against the values this code is expected to measure
-//! ([`crate::expectation`]).
+//! `reproduce --all [--smoke]`: every paper experiment in one call. Two
+//! answers, kept apart (issue 25):
+//!
+//! - against the papers: every [`Verdict`] of every experiment, headed by
+//!   "N of M paper claims met", with the paper's value, the rule and the
+//!   measured value; a missed claim is reported, never hidden, and does not
+//!   set the exit status of `--all` (each experiment's own command does);
+//! - against ourselves: each metric checked against the values this code
+//!   measured before ([`crate::expectation`]); a metric that moved is what
+//!   makes `--all` (and CI) fail.
 //!
 //! Each experiment writes, beside its own report, `metrics.json`: the
 //! numbers it measured, with units and the paper's number where the paper
@@ -21,7 +28,7 @@ use anyhow::Context;
 use mmtrack_core::progress::Progress;
 
 use crate::expectation::{Check, ExpectedMetric, compare, parse_expected, table};
-use crate::model::{Outcome, RunOptions, Tier};
+use crate::model::{Outcome, RunOptions, Tier, Verdict};
 use crate::{kim, mpc_artificial, odometry, readme_block, shaham, spebt, zoechmann};
 
 /// The README block that receives the table of every metric.
@@ -146,6 +153,9 @@ pub struct AllOptions {
 /// What [`run_all`] measured.
 #[derive(Debug, Clone)]
 pub struct AllOutcome {
+    /// Every paper claim of every experiment against what was measured:
+    /// (experiment, verdict), in run order.
+    pub claims: Vec<(&'static str, Verdict)>,
     /// Every metric against its expectation, experiment by experiment.
     pub checks: Vec<Check>,
     /// The Markdown summary (also `summary.md`, and the README block).
@@ -153,6 +163,13 @@ pub struct AllOutcome {
 }
 
 impl AllOutcome {
+    /// Target claims (informational variants excluded) and how many are met.
+    #[must_use]
+    pub fn claims_met(&self) -> (usize, usize) {
+        let targets = self.claims.iter().filter(|(_, v)| !v.claim.informational);
+        targets.fold((0, 0), |(met, all), (_, v)| (met + usize::from(v.met), all + 1))
+    }
+
     /// Metrics outside their expectation (missing and unexpected ones included).
     #[must_use]
     pub fn misses(&self) -> usize {
@@ -181,6 +198,7 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
         EXPERIMENTS.iter().map(Experiment::expectations).collect::<anyhow::Result<_>>()?;
     std::fs::create_dir_all(&options.output_dir).with_context(|| options.output_dir.display().to_string())?;
     let started = Instant::now();
+    let mut claims = Vec::new();
     let mut checks = Vec::new();
     let mut timings = Vec::new();
     for (k, (experiment, expected)) in EXPERIMENTS.iter().zip(&expectations).enumerate() {
@@ -202,6 +220,7 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
         if let Some(readme) = &run_options.readme {
             readme_block::replace_block(readme, outcome.readme.name, &outcome.readme.body)?;
         }
+        claims.extend(outcome.verdicts.into_iter().map(|v| (experiment.name, v)));
         let measured = outcome.metrics;
         let seconds = experiment_started.elapsed().as_secs_f64();
         timings.push((experiment.name, seconds));
@@ -215,11 +234,14 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
     let threads = rayon::current_num_threads();
     let timing = timings.iter().map(|(n, s)| format!("{n} {s:.1} s")).collect::<Vec<_>>().join(", ");
     let mode = if options.tier.is_smoke() { "smoke (--quick)" } else { "full" };
-    let mut summary = format!(
-        "Written by `mmtrack reproduce --all{}`: {} metrics of {} experiments, {misses} outside their expected \
-         range. Expected values (data/reproduce/<experiment>.expected.toml) are what this code measured when the \
-         results were written, with absolute tolerances; the paper's numbers beside them.\n\n",
-        if options.tier.is_smoke() { " --smoke" } else { "" },
+    let command = format!("mmtrack reproduce --all{}", if options.tier.is_smoke() { " --smoke" } else { "" });
+    let mut summary = claims_section(&claims, &command, options.tier);
+    let _ = write!(
+        summary,
+        "\n### Regression check\n\nWritten by `{command}`: {} metrics of {} experiments, {misses} outside their \
+         expected range. Expected values (data/reproduce/<experiment>.expected.toml) are what this code measured \
+         when the results were written, with absolute tolerances: \"unchanged\" says our numbers did not move, \
+         not that they match the paper (the claims above say that).\n\n",
         checks.len(),
         EXPERIMENTS.len()
     );
@@ -230,7 +252,34 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
     if let Some(readme) = &options.readme {
         readme_block::replace_block(readme, README_BLOCK, &summary)?;
     }
-    Ok(AllOutcome { checks, summary })
+    Ok(AllOutcome { claims, checks, summary })
+}
+
+/// "N of M paper claims met" and the table of every claim: experiment,
+/// claim, the paper's side, the rule, what was measured, the verdict.
+fn claims_section(claims: &[(&'static str, Verdict)], command: &str, tier: Tier) -> String {
+    let targets: Vec<&Verdict> = claims.iter().map(|(_, v)| v).filter(|v| !v.claim.informational).collect();
+    let met = targets.iter().filter(|v| v.met).count();
+    let variants = claims.len() - targets.len();
+    let mut out = format!(
+        "**{met} of {} paper claims met**{} (`{command}`; {variants} variants of ours reported beside them, not \
+         counted). Each claim is judged against the paper by its rule; a missed claim stays in the table.\n\n",
+        targets.len(),
+        if tier.is_smoke() { " in the smoke runs (fewer runs than the papers: indicative only)" } else { "" }
+    );
+    out.push_str("| experiment | claim | paper | rule | measured | verdict |\n|---|---|---|---|---|---|\n");
+    for (experiment, v) in claims {
+        let _ = writeln!(
+            out,
+            "| {experiment} | {} | {} | {} | {} | {} |",
+            v.claim.what,
+            v.claim.paper_text,
+            v.claim.rule.describe(&v.claim.unit),
+            v.note,
+            v.word()
+        );
+    }
+    out
 }
 
 /// Checks the README's `reproduce-all` block against the expectation
@@ -282,6 +331,30 @@ mod tests {
             "README.md's {README_BLOCK} block is stale (run `mmtrack reproduce --all --readme README.md`):\n{}",
             problems.join("\n")
         );
+    }
+
+    /// The summary leads with the paper verdicts: a miss is counted and
+    /// shown with its rule, variants are listed but not counted.
+    #[test]
+    fn the_summary_counts_paper_claims_and_shows_misses_with_their_rule() {
+        use crate::model::{Claim, Rule};
+        let claim = |what: &str, rule| Claim::new(what, "blocks", Some(99.0), "99 blocks", rule);
+        let claims = vec![
+            ("shaham", Verdict::judged(claim("valid tracking", Rule::AtLeast { bound: 99.0 }), Some(168.0), "168")),
+            (
+                "shaham",
+                Verdict::judged(claim("gain", Rule::Within { target: 49.0, tolerance: 7.35 }), Some(282.0), "+282 %"),
+            ),
+            ("shaham", Verdict::judged(claim("variant", Rule::AtMost { bound: 1.0 }).informational(), Some(2.0), "2")),
+        ];
+        let text = claims_section(&claims, "mmtrack reproduce --all", Tier::Full);
+        assert!(text.starts_with("**1 of 2 paper claims met** (`mmtrack reproduce --all`; 1 variants"), "{text}");
+        assert!(
+            text.contains("| shaham | gain | 99 blocks | within 49 +- 7.35 blocks | +282 % | **missed** |"),
+            "{text}"
+        );
+        assert!(text.contains("| shaham | valid tracking | 99 blocks | >= 99 blocks | 168 | met |"), "{text}");
+        assert!(text.contains("does not hold (variant, not a target)"), "{text}");
     }
 
     #[test]

@@ -134,19 +134,19 @@ fn number(v: f64) -> String {
 #[must_use]
 pub fn table(checks: &[Check]) -> String {
     let mut out = String::from(
-        "| experiment | metric | unit | measured | expected | paper | verdict |\n|---|---|---|---|---|---|---|\n",
+        "| experiment | metric | unit | measured | expected (an earlier run of this code) | regression |\n\
+         |---|---|---|---|---|---|\n",
     );
     for c in checks {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} |",
             c.experiment,
             c.key,
             c.unit,
             c.measured.map_or("not produced".into(), number),
             c.expected.map_or("no expectation".into(), |e| format!("{} +- {}", number(e.value), number(e.tolerance))),
-            c.paper.map_or("-".into(), number),
-            if c.ok() { "ok" } else { "**MISS**" }
+            if c.ok() { "unchanged" } else { "**moved**" }
         );
     }
     out
@@ -173,7 +173,7 @@ mod tests {
         let smoke = compare("e", &measured, &expected, Tier::Smoke);
         assert!(!smoke[0].ok(), "10.9 is outside 5 +- 0.5");
         let text = table(&full);
-        assert!(text.contains("| e | a | deg | 10.9000 | 10.0000 +- 1.0000 | 3.0000 | ok |"), "{text}");
+        assert!(text.contains("| e | a | deg | 10.9000 | 10.0000 +- 1.0000 | unchanged |"), "{text}");
         assert!(text.contains("| e | b |  | not produced |") && text.contains("no expectation"), "{text}");
         let err = parse_expected("x.toml", "[[metric]]\nkey = \"a\"\nfull = { value = 1.0, tolerance = -1.0 }\nsmoke = { value = 1.0, tolerance = 0.0 }\n").unwrap_err();
         assert!(format!("{err:#}").contains("x.toml: metric `a` full"), "{err:#}");

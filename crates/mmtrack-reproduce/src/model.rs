@@ -146,6 +146,31 @@ impl Rule {
     }
 }
 
+impl Rule {
+    /// The rule as the summary prints it, in `unit` ("< 6.56 %",
+    /// "within 15.00 +- 2.25 blocks", or the ordering's words).
+    #[must_use]
+    pub fn describe(&self, unit: &str) -> String {
+        let unit = if unit.is_empty() { String::new() } else { format!(" {unit}") };
+        match self {
+            Self::Below { bound } => format!("< {}{unit}", short_number(*bound)),
+            Self::AtMost { bound } => format!("<= {}{unit}", short_number(*bound)),
+            Self::AtLeast { bound } => format!(">= {}{unit}", short_number(*bound)),
+            Self::Within { target, tolerance } => {
+                format!("within {} +- {}{unit}", short_number(*target), short_number(*tolerance))
+            }
+            Self::Ordering { description } => description.clone(),
+        }
+    }
+}
+
+/// A number with at most four significant decimals and no trailing zeros.
+fn short_number(value: f64) -> String {
+    let text = format!("{value:.4}");
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    text.to_string()
+}
+
 /// A published number or statement of a paper, and how it is judged.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Claim {

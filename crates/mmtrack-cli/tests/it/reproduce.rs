@@ -159,6 +159,10 @@ fn all_smoke_runs_every_experiment_within_its_expectations() {
         .sum();
     let line = format!("{expected} metrics of 6 experiments, 0 outside their expected range");
     assert!(stdout.contains(&line), "{line}:\n{stdout}");
+    // The paper verdicts come first, counted, misses included.
+    let headline = stdout.lines().find(|l| l.contains(" paper claims met**")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(stdout.find(headline) < stdout.find(&line), "{stdout}");
+    assert!(stdout.contains("| experiment | claim | paper | rule | measured | verdict |"), "{stdout}");
     for experiment in ["odometry", "mpc-artificial", "shaham", "spebt", "zoechmann", "kim"] {
         assert!(out_dir.join(experiment).join("metrics.json").is_file(), "{experiment}");
     }

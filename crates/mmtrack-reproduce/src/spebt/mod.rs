@@ -67,7 +67,20 @@ pub fn run(config: &Config, options: &RunOptions, progress: &dyn Progress) -> an
     Ok(Outcome {
         experiment: NAME,
         metrics,
-        verdicts: per_experiment.into_iter().flatten().collect(),
+        // Named by experiment here, where they stand side by side
+        // (`reproduce --all`); the report's per-experiment tables keep the
+        // bare names.
+        verdicts: measured
+            .experiments
+            .iter()
+            .zip(per_experiment)
+            .flat_map(|(e, verdicts)| {
+                verdicts.into_iter().map(move |mut v| {
+                    v.claim.what = format!("{} ({})", v.claim.what, e.name);
+                    v
+                })
+            })
+            .collect(),
         files,
         readme: ReadmeBlock { name: README_BLOCK, body: summary.clone() },
         report: summary,
