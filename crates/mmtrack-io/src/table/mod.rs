@@ -40,8 +40,8 @@ pub use geometric_rows::{
     ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
 };
 pub use io::{
-    RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, inspect_table_file, read_table,
-    read_table_dir, table_path, write_table,
+    RunInfo, StagedTable, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, inspect_table_file,
+    publish_tables, read_table, read_table_dir, stage_table, table_path, write_table,
 };
 pub use mpc_rows::{
     GROUND_TRUTH_RX, GROUND_TRUTH_TX, GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_LONG_TERM, MPC_SETS,
