@@ -11,7 +11,12 @@
 //!
 //! - every partial this process is writing is in a registry, and
 //!   [`remove_partial_outputs`] removes them all: the CLI calls it when
-//!   SIGINT, SIGTERM or SIGHUP arrives, then exits;
+//!   SIGINT, SIGTERM or SIGHUP arrives, then exits. It holds the registry
+//!   until the exit, and everything that creates a partial or a directory
+//!   inside one ([`create_output_dirs`]) takes the registry first, so
+//!   nothing removed comes back; a command that ends meanwhile (its next
+//!   write failed) waits for the exit ([`wait_for_interruption`]) instead
+//!   of cutting the clean-up short;
 //! - a run that starts writing `<name>` (or a staging directory with a given
 //!   prefix) first removes the partials of that same name left by earlier
 //!   runs that were killed outright (SIGKILL, an aborted allocation, a power
@@ -78,7 +83,7 @@ impl AtomicFile {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        std::fs::create_dir_all(&dir).map_err(os_err(&dir))?;
+        create_output_dirs(&dir).map_err(os_err(&dir))?;
         let file_name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let prefix = format!(".{file_name}.");
         // Registered under the lock it was created under: an interruption
@@ -246,6 +251,28 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
         .tempdir_in(parent)?;
     live.insert(dir.path().to_path_buf(), PartialKind::Directory);
     Ok(dir)
+}
+
+/// Creates `dir` and its missing parents (as `create_dir_all`) for an
+/// output, holding the registry of partial outputs: never while an
+/// interruption is removing them ([`remove_partial_outputs`] holds the
+/// registry until the process exits), so a writer cannot bring back a
+/// staging directory the interruption just removed. Use it for every
+/// directory made inside a staging directory.
+///
+/// # Errors
+/// The OS error of creating it.
+pub fn create_output_dirs(dir: &Path) -> std::io::Result<()> {
+    let _live = live_partials();
+    std::fs::create_dir_all(dir)
+}
+
+/// Waits while an interruption is being handled ([`remove_partial_outputs`]
+/// holds the registry until the process exits), for a command that ends
+/// meanwhile: it must not exit, with the error of a file the clean-up just
+/// removed, before the clean-up is done. Returns at once otherwise.
+pub fn wait_for_interruption() {
+    drop(live_partials());
 }
 
 /// Checks, before any work, that the directory `dir` may be written by
