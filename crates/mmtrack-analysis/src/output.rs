@@ -157,7 +157,7 @@ impl WrittenResults {
 /// One run's tables, plots, `report.md` and `report.html` into `dir`.
 fn write_run_into(dir: &Path, results: &RunResults, options: &DriftOptions, run: &RunInfo) -> anyhow::Result<usize> {
     let RunResults { trajectory, mpc, beam, slam, skipped } = results;
-    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    mmtrack_io::create_output_dirs(dir).with_context(|| dir.display().to_string())?;
     let mut files = write_into(dir, trajectory, skipped, options, run)?;
     files += write_mpc_into(dir, mpc, run)?;
     files += write_beam_into(dir, &beam.sweeps, run)?;
@@ -215,7 +215,7 @@ fn write_into(
         write_table(&tables, seq, &r.drift_rows(), run, Overwrite::Refuse)?;
         write_table(&tables, seq, &r.rpe_rows(), run, Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
-        std::fs::create_dir_all(&plot_dir).with_context(|| plot_dir.display().to_string())?;
+        mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let plots = [
             ("trajectory.svg", plots::trajectory_svg(r)),
             ("errors_vs_distance.svg", plots::errors_vs_distance_svg(r)),
@@ -246,7 +246,7 @@ fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::R
         write_table(&tables, seq, &r.chi, run, Overwrite::Refuse)?;
         write_table(&tables, seq, &r.first_path, run, Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
-        std::fs::create_dir_all(&plot_dir).with_context(|| plot_dir.display().to_string())?;
+        mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let svgs = [
             mpc_plots::delay_tracks_svg(r),
             mpc_plots::count_svg(r),
@@ -266,7 +266,7 @@ fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::R
 
 fn write_svg(path: &Path, svg: anyhow::Result<String>, what: &str) -> anyhow::Result<()> {
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+        mmtrack_io::create_output_dirs(dir).with_context(|| dir.display().to_string())?;
     }
     let svg = svg.with_context(|| what.to_string())?;
     std::fs::write(path, svg).with_context(|| path.display().to_string())

@@ -232,16 +232,12 @@ fn main() -> ExitCode {
     // Every command runs on a thread of a rayon pool of the default size
     // (RAYON_NUM_THREADS, else one per core); `--threads N` gives a command
     // a pool of its own.
-    match threads::ThreadsArg::default().install(|| run(cli)).and_then(|result| result) {
+    let result = threads::ThreadsArg::default().install(|| run(cli)).and_then(|result| result);
+    // An interruption being handled exits with its own code once its clean-up is done.
+    mmtrack_io::atomic::wait_for_interruption();
+    match result {
         Ok(code) => code,
         Err(error) => {
-            if mmtrack_io::atomic::interrupted() {
-                // The signal thread removes the partial outputs (which is
-                // what made this command fail) and exits with 128 + signal.
-                loop {
-                    std::thread::park();
-                }
-            }
             eprintln!("error: {}", one_line(&error));
             ExitCode::FAILURE
         }

@@ -11,7 +11,12 @@
 //!
 //! - every partial this process is writing is in a registry, and
 //!   [`remove_partial_outputs`] removes them all: the CLI calls it when
-//!   SIGINT, SIGTERM or SIGHUP arrives, then exits;
+//!   SIGINT, SIGTERM or SIGHUP arrives, then exits. It holds the registry
+//!   until the exit, and everything that creates a partial or a directory
+//!   inside one ([`create_output_dirs`]) takes the registry first, so
+//!   nothing removed comes back; a command that ends meanwhile (its next
+//!   write failed) waits for the exit ([`wait_for_interruption`]) instead
+//!   of cutting the clean-up short;
 //! - a run that starts writing `<name>` (or a staging directory with a given
 //!   prefix) first removes the partials of that same name left by earlier
 //!   runs that were killed outright (SIGKILL, an aborted allocation, a power
@@ -78,7 +83,7 @@ impl AtomicFile {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        std::fs::create_dir_all(&dir).map_err(os_err(&dir))?;
+        create_output_dirs(&dir).map_err(os_err(&dir))?;
         let file_name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
         let prefix = format!(".{file_name}.");
         // Registered under the lock it was created under: an interruption
@@ -112,28 +117,114 @@ impl AtomicFile {
     /// the overwrite policy, since another process may have created the target
     /// while this one was writing. With [`Durability::Fsync`] the data reaches
     /// the disk before the rename, so a power cut cannot leave an empty file
-    /// in place of the old one.
+    /// in place of the old one. One file of [`commit_all`].
     pub fn commit(self, overwrite: Overwrite, durability: Durability) -> Result<PathBuf> {
-        let Self { target, temp, registration } = self;
-        if durability == Durability::Fsync {
-            temp.as_file().sync_all().map_err(os_err(temp.path()))?;
-        }
-        match overwrite {
-            Overwrite::Replace => {
-                temp.persist(&target).map_err(|e| IoError::Os { path: target.clone(), source: e.error })?;
-            }
-            Overwrite::Refuse => {
-                temp.persist_noclobber(&target).map_err(|e| {
-                    if e.error.kind() == std::io::ErrorKind::AlreadyExists {
-                        IoError::OutputExists { path: target.clone() }
-                    } else {
-                        IoError::Os { path: target.clone(), source: e.error }
-                    }
-                })?;
-            }
-        }
-        drop(registration);
+        let target = self.target.clone();
+        commit_all(vec![self], overwrite, durability)?;
         Ok(target)
+    }
+}
+
+/// Makes `files` visible at their targets together: either all of them are
+/// published or, on an error, none (a target published before the error is
+/// removed again, or the file it replaced is put back). Each is synced first
+/// (with [`Durability::Fsync`]); no rename starts before every file is
+/// complete, so a full disk while writing never publishes part of the set.
+///
+/// The renames run while holding the registry of partial outputs, so an
+/// interruption ([`remove_partial_outputs`]) finds either the whole set
+/// still partial (and removes it) or the whole set published. With
+/// [`Overwrite::Replace`], an existing target of every file but the last is
+/// first renamed aside (`.<name>.<pid>.<random>.replaced`), so it can be put
+/// back if a later rename fails, and is deleted once the set is in place: a
+/// reader may see that table missing for the instant between the two
+/// renames. A process killed outright in that instant leaves the aside file
+/// (never deleted by a later run: it is the previous output).
+///
+/// # Errors
+/// [`IoError::OutputExists`] for a target that appeared meanwhile (with
+/// [`Overwrite::Refuse`]), or the OS error of a sync or rename; nothing of
+/// the set is published then.
+pub fn commit_all(files: Vec<AtomicFile>, overwrite: Overwrite, durability: Durability) -> Result<Vec<PathBuf>> {
+    if durability == Durability::Fsync {
+        for file in &files {
+            file.temp.as_file().sync_all().map_err(os_err(file.temp.path()))?;
+        }
+    }
+    let last = files.len().saturating_sub(1);
+    // The registrations are dropped only after the registry lock below is
+    // released (their drop takes it).
+    let (mut registrations, mut pending) = (Vec::with_capacity(files.len()), Vec::with_capacity(files.len()));
+    for AtomicFile { target, temp, registration } in files {
+        registrations.push(registration);
+        pending.push((target, temp));
+    }
+    let live = live_partials();
+    let mut published: Vec<(PathBuf, Option<PathBuf>)> = Vec::with_capacity(pending.len());
+    let mut failure = None;
+    for (i, (target, temp)) in pending.into_iter().enumerate() {
+        match publish_one(temp, &target, overwrite, i < last) {
+            Ok(aside) => published.push((target, aside)),
+            Err(e) => {
+                failure = Some(e);
+                break;
+            }
+        }
+    }
+    if let Some(error) = failure {
+        // Newest first, so a target is restored before anything older.
+        for (target, aside) in published.iter().rev() {
+            let _ = std::fs::remove_file(target);
+            if let Some(aside) = aside {
+                let _ = std::fs::rename(aside, target);
+            }
+        }
+        drop(live);
+        return Err(error);
+    }
+    for aside in published.iter().filter_map(|(_, aside)| aside.as_ref()) {
+        // Best effort: a leftover is a hidden copy of the replaced output.
+        let _ = std::fs::remove_file(aside);
+    }
+    drop(live);
+    drop(registrations);
+    Ok(published.into_iter().map(|(target, _)| target).collect())
+}
+
+/// Renames `temp` to `target` under `overwrite`; with `keep_old` and
+/// [`Overwrite::Replace`], an existing target file is first renamed aside
+/// and that path returned.
+fn publish_one(temp: NamedTempFile, target: &Path, overwrite: Overwrite, keep_old: bool) -> Result<Option<PathBuf>> {
+    let os = |source: std::io::Error| IoError::Os { path: target.to_path_buf(), source };
+    match overwrite {
+        Overwrite::Replace => {
+            let is_file = std::fs::symlink_metadata(target).is_ok_and(|m| !m.is_dir());
+            let aside = (keep_old && is_file).then(|| {
+                let partial = temp.path().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+                let stem = partial.strip_suffix(PARTIAL_SUFFIX).unwrap_or(&partial);
+                temp.path().with_file_name(format!("{stem}{REPLACED_SUFFIX}"))
+            });
+            if let Some(aside) = &aside {
+                std::fs::rename(target, aside).map_err(os)?;
+            }
+            if let Err(e) = temp.persist(target) {
+                if let Some(aside) = &aside {
+                    let _ = std::fs::rename(aside, target);
+                }
+                return Err(os(e.error));
+            }
+            Ok(aside)
+        }
+        Overwrite::Refuse => {
+            temp.persist_noclobber(target).map_err(|e| {
+                if e.error.kind() == std::io::ErrorKind::AlreadyExists {
+                    IoError::OutputExists { path: target.to_path_buf() }
+                } else {
+                    os(e.error)
+                }
+            })?;
+            Ok(None)
+        }
     }
 }
 
@@ -160,6 +251,28 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
         .tempdir_in(parent)?;
     live.insert(dir.path().to_path_buf(), PartialKind::Directory);
     Ok(dir)
+}
+
+/// Creates `dir` and its missing parents (as `create_dir_all`) for an
+/// output, holding the registry of partial outputs: never while an
+/// interruption is removing them ([`remove_partial_outputs`] holds the
+/// registry until the process exits), so a writer cannot bring back a
+/// staging directory the interruption just removed. Use it for every
+/// directory made inside a staging directory.
+///
+/// # Errors
+/// The OS error of creating it.
+pub fn create_output_dirs(dir: &Path) -> std::io::Result<()> {
+    let _live = live_partials();
+    std::fs::create_dir_all(dir)
+}
+
+/// Waits while an interruption is being handled ([`remove_partial_outputs`]
+/// holds the registry until the process exits), for a command that ends
+/// meanwhile: it must not exit, with the error of a file the clean-up just
+/// removed, before the clean-up is done. Returns at once otherwise.
+pub fn wait_for_interruption() {
+    drop(live_partials());
 }
 
 /// Checks, before any work, that the directory `dir` may be written by
@@ -219,6 +332,10 @@ pub fn check_replaceable_dir(
 /// The end of every partial output's name.
 const PARTIAL_SUFFIX: &str = ".partial";
 
+/// The end of the name of an output moved aside by [`commit_all`] until its
+/// replacement's set is in place.
+const REPLACED_SUFFIX: &str = ".replaced";
+
 /// What a registered partial output is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum PartialKind {
@@ -255,25 +372,11 @@ pub struct PartialOutputsRemoved {
     _registry: MutexGuard<'static, BTreeMap<PathBuf, PartialKind>>,
 }
 
-/// Set when [`remove_partial_outputs`] starts: the process is being
-/// interrupted, and writes failing from now on are its consequence.
-static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Whether [`remove_partial_outputs`] has started: an error a command
-/// returns now (a file vanished under it) is the interruption's, and the
-/// caller should leave the exit to the interrupting thread instead of
-/// reporting it.
-#[must_use]
-pub fn interrupted() -> bool {
-    INTERRUPTED.load(std::sync::atomic::Ordering::SeqCst)
-}
-
 /// Removes every partial output this process is writing, for a process that
 /// is being interrupted (SIGINT, SIGTERM). The result keeps the registry
 /// locked, so no new partial output can start (its writer waits) while the
 /// caller exits: keep it alive until `std::process::exit`.
 pub fn remove_partial_outputs() -> PartialOutputsRemoved {
-    INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst);
     let registry = live_partials();
     let mut removed = 0;
     let mut failed = Vec::new();
@@ -477,6 +580,41 @@ mod tests {
         drop(second);
         first.commit(Overwrite::Refuse, Durability::PageCache).unwrap();
         assert!(!first_partial.exists() && target.exists());
+    }
+
+    /// Issue 26: a set of files is published whole or not at all; a rename
+    /// failing half-way puts back the files already replaced.
+    #[test]
+    fn a_set_that_fails_to_publish_leaves_the_old_files() {
+        let dir = tempfile::tempdir().unwrap();
+        let staged = |name: &str, text: &[u8]| {
+            let f = AtomicFile::create(&dir.path().join(name), Overwrite::Replace).unwrap();
+            let mut w = f.writer().unwrap();
+            w.write_all(text).unwrap();
+            w.flush().unwrap();
+            f
+        };
+        std::fs::write(dir.path().join("a"), b"old a").unwrap();
+        // A directory where the last file goes: its rename fails.
+        std::fs::create_dir_all(dir.path().join("c/inner")).unwrap();
+        let set = vec![staged("a", b"new a"), staged("b", b"new b"), staged("c", b"new c")];
+        assert!(commit_all(set, Overwrite::Replace, Durability::PageCache).is_err());
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["a", "c"], "no partial, aside or new file left");
+        assert_eq!(std::fs::read(dir.path().join("a")).unwrap(), b"old a");
+
+        std::fs::remove_dir_all(dir.path().join("c")).unwrap();
+        let set = vec![staged("a", b"new a"), staged("b", b"new b"), staged("c", b"new c")];
+        commit_all(set, Overwrite::Replace, Durability::PageCache).unwrap();
+        for name in ["a", "b", "c"] {
+            assert_eq!(std::fs::read(dir.path().join(name)).unwrap(), format!("new {name}").as_bytes());
+        }
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3, "the aside copy of a is gone");
+        assert!(live_partials().keys().all(|p| !p.starts_with(dir.path())), "the set left the registry");
     }
 
     #[test]

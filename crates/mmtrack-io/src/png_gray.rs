@@ -1,6 +1,11 @@
 //! Decoding of 8-bit greyscale PNGs (Navtech polar scans), header first, with
 //! errors that say what was wrong with the image rather than panicking.
 //!
+//! Memory: a decode holds one buffer of the image's size (pixels plus one
+//! filter byte per row; the filters are undone in place), and decodes
+//! running at once share a budget of one [`MAX_GRAY8_BYTES`] image, so
+//! images near the cap (PNG bombs included) decode one at a time.
+//!
 //! [`Gray8Png::open`] reads only the header (and the chunks before the image
 //! data), so a caller checks the dimensions against what it expects before a
 //! single pixel is allocated; [`Gray8Png::decode`] refuses images over
@@ -16,6 +21,7 @@
 //! pixel row with a matching Adler-32.
 
 use std::io::Cursor;
+use std::sync::{Condvar, Mutex, PoisonError};
 
 /// Largest image [`Gray8Png::decode`] decodes, bytes (= pixels): 64 MiB, 24
 /// times a Boreas scan after its 2021 radar upgrade (400 x 6859).
@@ -78,10 +84,11 @@ impl<'a> Gray8Png<'a> {
         })?;
         // Every chunk, image data included, up to IEND: structure and CRCs.
         self.reader.finish().map_err(|e| format!("PNG data is truncated or corrupt: {e}"))?;
+        let _share = DecodeShare::acquire(pixels + height);
         let mut filtered = vec![0u8; pixels + height];
         inflate_exact(&image_data(self.bytes), &mut filtered)
             .map_err(|e| format!("PNG image data ({width} x {height}) is corrupt: {e}"))?;
-        unfilter(&filtered, width)
+        unfilter(filtered, width)
     }
 }
 
@@ -155,44 +162,48 @@ fn inflate_error(error: &fdeflate::DecompressionError, filled: usize, expected: 
 }
 
 /// Undoes the PNG row filters of 8-bit, one-channel rows (`width + 1` bytes
-/// each: the filter type, then the filtered pixels).
+/// each: the filter type, then the filtered pixels), in place: each row
+/// moves one byte per row above it to the left, onto the end of the rows
+/// already done, so no second image-sized buffer is needed.
 ///
 /// # References
 /// PNG specification (W3C, 3rd ed.), section 7.3 "Filtering" and 9.4 "Filter
 /// types" (Sub, Up, Average, Paeth with one byte per pixel).
-fn unfilter(filtered: &[u8], width: usize) -> Result<Vec<u8>, String> {
-    let mut pixels = vec![0u8; filtered.len() / (width + 1) * width];
+fn unfilter(mut data: Vec<u8>, width: usize) -> Result<Vec<u8>, String> {
+    let rows = data.len() / (width + 1);
     let zeros = vec![0u8; width];
-    for (row, line) in filtered.chunks_exact(width + 1).enumerate() {
-        let (kind, data) = (line[0], &line[1..]);
-        let (done, rest) = pixels.split_at_mut(row * width);
-        let above = if row == 0 { &zeros[..] } else { &done[(row - 1) * width..] };
+    for row in 0..rows {
+        let (from, to) = (row * (width + 1), row * width);
+        let kind = data[from];
+        data.copy_within(from + 1..from + 1 + width, to);
+        let (done, rest) = data.split_at_mut(to);
+        let above = if row == 0 { &zeros[..] } else { &done[to - width..] };
         let out = &mut rest[..width];
         match kind {
-            0 => out.copy_from_slice(data),
+            0 => {}
             1 => {
                 let mut left = 0u8;
-                for (o, &x) in out.iter_mut().zip(data) {
-                    left = x.wrapping_add(left);
+                for o in out.iter_mut() {
+                    left = o.wrapping_add(left);
                     *o = left;
                 }
             }
             2 => {
-                for ((o, &x), &b) in out.iter_mut().zip(data).zip(above) {
-                    *o = x.wrapping_add(b);
+                for (o, &b) in out.iter_mut().zip(above) {
+                    *o = o.wrapping_add(b);
                 }
             }
             3 => {
                 let mut left = 0u8;
-                for ((o, &x), &b) in out.iter_mut().zip(data).zip(above) {
-                    left = x.wrapping_add(((u16::from(left) + u16::from(b)) / 2) as u8);
+                for (o, &b) in out.iter_mut().zip(above) {
+                    left = o.wrapping_add(((u16::from(left) + u16::from(b)) / 2) as u8);
                     *o = left;
                 }
             }
             4 => {
                 let (mut left, mut upper_left) = (0u8, 0u8);
-                for ((o, &x), &b) in out.iter_mut().zip(data).zip(above) {
-                    left = x.wrapping_add(paeth(left, b, upper_left));
+                for (o, &b) in out.iter_mut().zip(above) {
+                    left = o.wrapping_add(paeth(left, b, upper_left));
                     upper_left = b;
                     *o = left;
                 }
@@ -200,7 +211,43 @@ fn unfilter(filtered: &[u8], width: usize) -> Result<Vec<u8>, String> {
             other => return Err(format!("PNG row {row}: filter type {other}, expected 0-4")),
         }
     }
-    Ok(pixels)
+    data.truncate(rows * width);
+    Ok(data)
+}
+
+/// Bytes of image data the decodes running at once may hold: one image at
+/// [`MAX_GRAY8_BYTES`]. Real scans (a few MB) decode side by side on every
+/// thread; images near the cap decode one at a time, so a folder of PNG
+/// bombs costs one cap-sized buffer whatever the thread count.
+const DECODE_BUDGET_BYTES: usize = MAX_GRAY8_BYTES;
+
+/// Bytes held by the decodes running now, and the signal that some were
+/// released.
+static DECODES_IN_USE: Mutex<usize> = Mutex::new(0);
+static DECODE_RELEASED: Condvar = Condvar::new();
+
+/// A running decode's share of [`DECODE_BUDGET_BYTES`], given back on drop.
+struct DecodeShare(usize);
+
+impl DecodeShare {
+    /// Waits until `bytes` fit in the budget beside the decodes running, or
+    /// none is running (a decode alone always starts: it is under the cap).
+    fn acquire(bytes: usize) -> Self {
+        let mut in_use = DECODES_IN_USE.lock().unwrap_or_else(PoisonError::into_inner);
+        while *in_use > 0 && in_use.saturating_add(bytes) > DECODE_BUDGET_BYTES {
+            in_use = DECODE_RELEASED.wait(in_use).unwrap_or_else(PoisonError::into_inner);
+        }
+        *in_use += bytes;
+        Self(bytes)
+    }
+}
+
+impl Drop for DecodeShare {
+    fn drop(&mut self) {
+        let mut in_use = DECODES_IN_USE.lock().unwrap_or_else(PoisonError::into_inner);
+        *in_use -= self.0;
+        DECODE_RELEASED.notify_all();
+    }
 }
 
 /// The Paeth predictor: of left `a`, above `b` and upper-left `c`, the one

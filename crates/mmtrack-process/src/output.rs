@@ -12,6 +12,22 @@
 //! writes there, and records [`run_id_of`] that directory as `"run_id"` in
 //! its run configuration JSON.
 //!
+//! # A run's tables appear together
+//!
+//! A run's tables are one result: a failed run (a full disk, a bad table
+//! half-way, an interruption) must not leave some of them beside the
+//! previous run's others, nor a partition that blocks the rerun without
+//! `--force`. Every pipeline therefore writes through [`RunDir::tables`]: each
+//! table is written complete into a hidden partial file beside its final
+//! path ([`mmtrack_io::table::stage_table`]) and nothing is published until
+//! [`RunTables::publish`] renames them all into place together
+//! ([`mmtrack_io::atomic::commit_all`]: all or none, old tables put back if a
+//! rename fails). A [`RunTables`] dropped without publishing (any error on
+//! the way) removes its partial files and the directories it created that
+//! are still empty, so a failed run leaves nothing of its own and the
+//! previous tables (replaced only with `--force`) untouched. The cost: the
+//! disk holds the whole new set beside the old one until the publish.
+//!
 //! The thread count is not here: it does not change what is written (every
 //! pipeline runs on the caller's rayon pool).
 
@@ -19,7 +35,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::table_path;
+use mmtrack_io::table::{RunInfo, StagedTable, TableRow, TableWriteSummary, publish_tables, stage_table, table_path};
 
 /// Where a pipeline writes, as the front end gave it: the output directory,
 /// an optional run id and whether existing tables may be replaced.
@@ -123,6 +139,70 @@ impl RunDir {
             }
         }
         Ok(())
+    }
+}
+
+/// A run's tables while they are written: staged, then published together
+/// (see the module docs). Dropped unpublished, it leaves nothing.
+#[derive(Debug)]
+#[must_use = "nothing is published until `publish`"]
+pub struct RunTables {
+    dir: RunDir,
+    staged: Vec<StagedTable>,
+    /// Directories this run created, outermost first: removed when still
+    /// empty if the run does not publish.
+    created_dirs: Vec<PathBuf>,
+}
+
+impl RunDir {
+    /// Starts the set of tables of one run here.
+    pub fn tables(&self) -> RunTables {
+        RunTables { dir: self.clone(), staged: Vec::new(), created_dirs: Vec::new() }
+    }
+}
+
+impl RunTables {
+    /// Writes `rows` as the `sequence` partition of their table, complete but
+    /// not yet visible.
+    ///
+    /// # Errors
+    /// An existing table (without `--force`), a bad partition name, or a
+    /// table that cannot be written.
+    pub fn write<T: TableRow>(&mut self, sequence: &str, rows: &[T], run: &RunInfo) -> anyhow::Result<()> {
+        let target = table_path(&self.dir.path, T::SPEC.name, sequence)?;
+        let mut missing: Vec<PathBuf> = target
+            .ancestors()
+            .skip(1)
+            .take_while(|dir| !dir.as_os_str().is_empty() && !dir.exists())
+            .map(Path::to_path_buf)
+            .collect();
+        missing.reverse();
+        self.created_dirs.extend(missing);
+        self.staged.push(stage_table(&self.dir.path, sequence, rows, run, self.dir.overwrite)?);
+        Ok(())
+    }
+
+    /// Publishes every table written, together: all of them, or none.
+    ///
+    /// # Errors
+    /// A table that appeared meanwhile (without `--force`) or a rename that
+    /// failed; nothing of this run is left then.
+    pub fn publish(mut self) -> anyhow::Result<Vec<TableWriteSummary>> {
+        let written = publish_tables(std::mem::take(&mut self.staged), self.dir.overwrite)?;
+        self.created_dirs.clear();
+        Ok(written)
+    }
+}
+
+impl Drop for RunTables {
+    fn drop(&mut self) {
+        // The partial files first (their drop removes them), then the
+        // directories, innermost first; `remove_dir` removes only empty
+        // ones, so nothing another writer put there goes.
+        self.staged.clear();
+        for dir in self.created_dirs.iter().rev() {
+            let _ = std::fs::remove_dir(dir);
+        }
     }
 }
 

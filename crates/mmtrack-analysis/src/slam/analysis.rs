@@ -261,7 +261,7 @@ pub fn write_slam_into(dir: &Path, results: &[SlamSequenceResult], run: &RunInfo
         write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
         write_table(&tables, seq, &r.per_epoch, run, Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
-        std::fs::create_dir_all(&plot_dir).with_context(|| plot_dir.display().to_string())?;
+        mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let curve = |label: &str, f: &dyn Fn(&SlamPerEpochRow) -> f64| EpochCurve {
             label: label.to_string(),
             values: r.per_epoch.iter().map(f).collect(),

@@ -245,3 +245,72 @@ fn uwb_first_path_from_the_cli_lies_on_the_chips_leading_edge() {
     assert!(report.contains("`uwb`: no short-term tracks, so tracking and full-lifetime losses"), "{report}");
     assert!(report.contains("(first 30 of 252 sets)"), "the delay plot's subset is named: {report}");
 }
+
+/// Every entry under `dir` (relative), with a file's bytes (`None` for a
+/// directory): what a run left there.
+fn snapshot(dir: &Path) -> std::collections::BTreeMap<std::path::PathBuf, Option<Vec<u8>>> {
+    let mut out = std::collections::BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            let relative = path.strip_prefix(dir).unwrap().to_path_buf();
+            if path.is_dir() {
+                out.insert(relative, None);
+                stack.push(path);
+            } else {
+                out.insert(relative, Some(std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+    out
+}
+
+/// Issue 26: a run's tables appear together. A table that cannot be
+/// written half-way (here: a file where its directory goes, planted
+/// before the run) leaves none of the run's tables, partial files or
+/// directories, so the rerun needs no --force; with --force the previous
+/// tables stay byte for byte, whether the failure comes while writing or
+/// while renaming the set into place.
+#[test]
+fn a_failed_run_leaves_none_of_its_tables_and_the_previous_ones_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    simulate(dir.path());
+    let tables = dir.path().join("tables");
+    let run = |extra: &[&str]| {
+        let mut args = vec!["process", "mpc", "rec.mcap", "-o", "tables", "--quiet"];
+        args.extend_from_slice(extra);
+        let out = mmtrack(dir.path(), &args);
+        (out.status.success(), text(&out).1)
+    };
+
+    // ground_truth_rx is the last table written: the others are complete when it fails.
+    std::fs::create_dir(&tables).unwrap();
+    std::fs::write(tables.join("ground_truth_rx"), b"in the way").unwrap();
+    let (ok, stderr) = run(&[]);
+    assert!(!ok && stderr.contains("ground_truth_rx"), "{stderr}");
+    let left: Vec<_> = snapshot(&tables).into_keys().collect();
+    assert_eq!(left, [Path::new("ground_truth_rx")], "the failed run left some of its own");
+    std::fs::remove_file(tables.join("ground_truth_rx")).unwrap();
+    let (ok, stderr) = run(&[]);
+    assert!(ok, "the rerun without --force: {stderr}");
+    let first = snapshot(&tables);
+    let (sequence, _) = only::<MpcSetStats>(&tables);
+
+    // --force, failing while writing: the GM-PHD table (sixth of nine) cannot be staged.
+    std::fs::write(tables.join("mpc_tracks_gmphd"), b"in the way").unwrap();
+    let (ok, stderr) = run(&["--force", "--gmphd"]);
+    assert!(!ok && stderr.contains("mpc_tracks_gmphd"), "{stderr}");
+    std::fs::remove_file(tables.join("mpc_tracks_gmphd")).unwrap();
+    assert_eq!(snapshot(&tables), first, "a failed --force run changed the previous tables");
+
+    // --force, failing while publishing: a directory where the last table's file goes.
+    let last = Path::new("ground_truth_rx").join(format!("sequence={sequence}")).join("part-0.parquet");
+    std::fs::remove_file(tables.join(&last)).unwrap();
+    std::fs::create_dir(tables.join(&last)).unwrap();
+    let (ok, stderr) = run(&["--force"]);
+    assert!(!ok && stderr.contains("ground_truth_rx"), "{stderr}");
+    let mut expected = first.clone();
+    expected.insert(last.clone(), None);
+    assert_eq!(snapshot(&tables), expected, "a set that failed to publish changed the previous tables");
+}

@@ -347,7 +347,7 @@ pub fn write_oxford_folder(
     layout: &NavtechLayout,
 ) -> Result<(), IngestError> {
     let radar_dir = root.join("radar");
-    std::fs::create_dir_all(&radar_dir).map_err(os_err(&radar_dir))?;
+    mmtrack_io::create_output_dirs(&radar_dir).map_err(os_err(&radar_dir))?;
     let mut timestamps = String::new();
     for scan in scans {
         let t_us = scan.header.t_ns / 1000;
@@ -361,7 +361,7 @@ pub fn write_oxford_folder(
     std::fs::write(&path, timestamps).map_err(os_err(&path))?;
     if ground_truth.len() >= 2 {
         let gt_dir = root.join("gt");
-        std::fs::create_dir_all(&gt_dir).map_err(os_err(&gt_dir))?;
+        mmtrack_io::create_output_dirs(&gt_dir).map_err(os_err(&gt_dir))?;
         let mut csv = String::from(
             "source_timestamp,destination_timestamp,x,y,z,roll,pitch,yaw,source_radar_timestamp,destination_radar_timestamp\n",
         );

@@ -13,7 +13,7 @@ use parquet::file::properties::WriterProperties;
 
 use super::columns::{Columns, check_no_nulls};
 use super::{TableRow, TableSpec};
-use crate::atomic::{AtomicFile, Durability, Overwrite};
+use crate::atomic::{AtomicFile, Durability, Overwrite, commit_all};
 use crate::error::{IoError, Result, os_err};
 
 /// Provenance of a run, stored in every table it writes.
@@ -109,12 +109,47 @@ impl TableWriter {
 
     /// Completes the file and moves it into place.
     pub fn finish(self) -> Result<TableWriteSummary> {
+        let overwrite = self.overwrite;
+        let mut published = publish_tables(vec![self.stage()?], overwrite)?;
+        published.pop().ok_or_else(|| table_write_err(Path::new(""), "no table published"))
+    }
+
+    /// Completes the file without moving it into place: it stays a partial
+    /// output (removed when dropped) until [`publish_tables`] publishes it
+    /// with the other tables of its run.
+    pub fn stage(self) -> Result<StagedTable> {
         let path = self.file.target().to_path_buf();
         let inner = self.writer.into_inner().map_err(|e| table_write_err(&path, e))?;
         inner.into_inner().map_err(|e| IoError::Os { path: path.clone(), source: e.into_error() })?;
-        let path = self.file.commit(self.overwrite, Durability::Fsync)?;
-        Ok(TableWriteSummary { path, rows: self.rows })
+        Ok(StagedTable { file: self.file, rows: self.rows })
     }
+}
+
+/// A complete table file not yet at its path ([`TableWriter::stage`]).
+#[derive(Debug)]
+pub struct StagedTable {
+    file: AtomicFile,
+    rows: u64,
+}
+
+impl StagedTable {
+    /// Where it will be published.
+    #[must_use]
+    pub fn target(&self) -> &Path {
+        self.file.target()
+    }
+}
+
+/// Publishes `tables` together, each synced to disk first: all of them or,
+/// on an error, none ([`crate::atomic::commit_all`]).
+///
+/// # Errors
+/// A table that exists meanwhile (with [`Overwrite::Refuse`]) or an OS error
+/// of a sync or rename.
+pub fn publish_tables(tables: Vec<StagedTable>, overwrite: Overwrite) -> Result<Vec<TableWriteSummary>> {
+    let rows: Vec<u64> = tables.iter().map(|t| t.rows).collect();
+    let paths = commit_all(tables.into_iter().map(|t| t.file).collect(), overwrite, Durability::Fsync)?;
+    Ok(paths.into_iter().zip(rows).map(|(path, rows)| TableWriteSummary { path, rows }).collect())
 }
 
 /// Writes `rows` as one partition in one call.
@@ -128,6 +163,20 @@ pub fn write_table<T: TableRow>(
     let mut writer = TableWriter::create(root, T::SPEC, sequence_id, run, overwrite)?;
     writer.write(rows)?;
     writer.finish()
+}
+
+/// Writes `rows` as one partition without publishing it
+/// ([`TableWriter::stage`]).
+pub fn stage_table<T: TableRow>(
+    root: &Path,
+    sequence_id: &str,
+    rows: &[T],
+    run: &RunInfo,
+    overwrite: Overwrite,
+) -> Result<StagedTable> {
+    let mut writer = TableWriter::create(root, T::SPEC, sequence_id, run, overwrite)?;
+    writer.write(rows)?;
+    writer.stage()
 }
 
 fn table_write_err(path: &Path, e: impl std::fmt::Display) -> IoError {

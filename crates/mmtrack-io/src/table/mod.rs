@@ -44,8 +44,8 @@ pub use geometric_rows::{
     ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
 };
 pub use io::{
-    RunInfo, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, inspect_table_file, read_table,
-    read_table_dir, table_path, write_table,
+    RunInfo, StagedTable, TableFileSummary, TableWriteSummary, TableWriter, inspect_table_dir, inspect_table_file,
+    publish_tables, read_table, read_table_dir, stage_table, table_path, write_table,
 };
 pub use mpc_result_rows::{
     ChiClassShare, CountBin, FirstPathRow, MPC_CHI_CLASSES, MPC_COUNT_DISTRIBUTION, MPC_FIRST_PATH, MPC_SET_METRICS,

@@ -27,10 +27,10 @@ use mmtrack_beam::geometric::{
 use mmtrack_core::random::standard_normal;
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
+use mmtrack_io::table::RunInfo;
 use mmtrack_io::table::{
     GEOMETRIC_FILTER_H_INFINITY, GEOMETRIC_FILTER_RLS, GEOMETRIC_PER_EPOCH, GeometricEpochRow, TableWriteSummary,
 };
-use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 use mmtrack_sim::beam::overtaking::OvertakingScenario;
 use rand::SeedableRng;
@@ -168,7 +168,6 @@ pub fn process_geometric(
     out: &RunDir,
     options: &GeometricOptions,
 ) -> anyhow::Result<GeometricOutput> {
-    let output_dir = out.path.as_path();
     let scenario = OvertakingScenario::default();
     let epoch_s = options.epoch_ms.unwrap_or(1e3 * scenario.epoch_s) * 1e-3;
     ensure!(epoch_s.is_finite() && epoch_s > 0.0, "--epoch-ms must be positive (nothing was done)");
@@ -185,7 +184,7 @@ pub fn process_geometric(
         out.refuse_existing(&[GEOMETRIC_PER_EPOCH.name], &r.sequence_id)?;
     }
     let step_ns = (epoch_s * 1e9).round() as i64;
-    let (mut results, mut written) = (Vec::new(), Vec::new());
+    let (mut results, mut tables) = (Vec::new(), out.tables());
     for (path, vehicles) in &inputs {
         let start = vehicles.tx[0].t_ns.max(vehicles.rx[0].t_ns);
         let end = vehicles.tx[vehicles.tx.len() - 1].t_ns.min(vehicles.rx[vehicles.rx.len() - 1].t_ns);
@@ -252,7 +251,7 @@ pub fn process_geometric(
             })
             .to_string(),
         };
-        written.push(write_table(output_dir, &vehicles.sequence_id, &rows, &info, out.overwrite)?);
+        tables.write(&vehicles.sequence_id, &rows, &info)?;
         results.push(GeometricRecordingResult {
             sequence_id: vehicles.sequence_id.clone(),
             epochs: rows.len(),
@@ -260,5 +259,5 @@ pub fn process_geometric(
             beams_measured: rows.iter().map(|r| r.beams_measured).sum(),
         });
     }
-    Ok(GeometricOutput { recordings: results, written })
+    Ok(GeometricOutput { recordings: results, written: tables.publish()? })
 }

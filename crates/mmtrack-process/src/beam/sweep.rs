@@ -37,7 +37,7 @@ use mmtrack_beam::sweep::{
 use mmtrack_core::{BeamSweep, GnssFix};
 use mmtrack_ingest::nmea::{EnuOrigin, geodetic_to_enu_m};
 use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata};
-use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, TableWriteSummary, write_table};
+use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 
 use crate::output::OutputOptions;
@@ -437,10 +437,11 @@ pub fn process_sweeps(
         })
         .to_string(),
     };
-    let mut written = Vec::new();
+    let mut staged = out.tables();
     for (sequence, rows) in &tables {
-        written.push(write_table(&out.path, sequence, rows, &info, out.overwrite)?);
+        staged.write(sequence, rows, &info)?;
     }
+    let written = staged.publish()?;
     let sites = sites
         .iter()
         .map(|site| SiteReport {

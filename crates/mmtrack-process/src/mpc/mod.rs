@@ -23,7 +23,7 @@ use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, Mpc
 use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
 use mmtrack_io::recording::{PoseStream, RecordingItem};
 use mmtrack_io::table::{
-    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MpcSnapshotStats, RunInfo, TableWriteSummary, write_table,
+    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MpcSnapshotStats, RunInfo, TableWriteSummary,
 };
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingMetadata, RecordingReader};
 use mmtrack_mpc::{MpcConfig, MpcPipeline, SnapshotDetections, SounderPulse};
@@ -34,7 +34,7 @@ use mmtrack_io::table::{
     MPC_TRACKS_GMPHD, MPC_TRUTH,
 };
 
-use crate::output::{OutputOptions, RunDir, exists_error};
+use crate::output::{OutputOptions, RunDir, RunTables, exists_error};
 
 /// Every table `process mpc` may write.
 pub const TABLES: [&str; 9] = [
@@ -415,7 +415,6 @@ pub fn process_mpc(
     let run = read_and_process(recording, options, config, progress)?;
     let sequence = options.output.sequence_or(&run.sequence_id);
     refuse_existing(&out, &sequence)?;
-    let (output, overwrite) = (&out.path, out.overwrite);
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process mpc",
@@ -428,11 +427,11 @@ pub fn process_mpc(
         })
         .to_string(),
     };
-    let mut written = Vec::new();
+    let mut tables = out.tables();
     let mut links = Vec::new();
     for (key, partition) in partitions(&run, &sequence, options.link.is_some()) {
         let link = &run.links[&key];
-        written.extend(write_link(output, &partition, link, &run, config.run_gmphd, &info, overwrite)?);
+        write_link(&mut tables, &partition, link, &run, config.run_gmphd, &info)?;
         links.push(LinkSummary {
             partition,
             link: key,
@@ -449,7 +448,7 @@ pub fn process_mpc(
                 .into(),
         });
     }
-    Ok(MpcOutput { links, written })
+    Ok(MpcOutput { links, written: tables.publish()? })
 }
 
 /// What the records counted in a table's [`TableWriteSummary::rows`] are,
@@ -470,33 +469,30 @@ pub fn record_noun(path: &Path) -> &'static str {
 }
 
 fn write_link(
-    output: &Path,
+    tables: &mut RunTables,
     partition: &str,
     link: &LinkRun,
     run: &MpcRun,
     gmphd: bool,
     info: &RunInfo,
-    overwrite: Overwrite,
-) -> anyhow::Result<Vec<TableWriteSummary>> {
-    let mut written = vec![
-        write_table(output, partition, &link.detections, info, overwrite)?,
-        write_table(output, partition, &link.tracks, info, overwrite)?,
-        write_table(output, partition, &link.long_term, info, overwrite)?,
-        write_table(output, partition, &link.sets, info, overwrite)?,
-        write_table(output, partition, &link.snapshots, info, overwrite)?,
-    ];
+) -> anyhow::Result<()> {
+    tables.write(partition, &link.detections, info)?;
+    tables.write(partition, &link.tracks, info)?;
+    tables.write(partition, &link.long_term, info)?;
+    tables.write(partition, &link.sets, info)?;
+    tables.write(partition, &link.snapshots, info)?;
     if gmphd {
         let tracks: Vec<GmPhdTrack> = link.gmphd_tracks.iter().cloned().map(GmPhdTrack).collect();
-        written.push(write_table(output, partition, &tracks, info, overwrite)?);
+        tables.write(partition, &tracks, info)?;
     }
     if !run.truth.is_empty() {
-        written.push(write_table(output, partition, &run.truth, info, overwrite)?);
+        tables.write(partition, &run.truth, info)?;
     }
     if !run.tx.is_empty() && !run.rx.is_empty() {
         let tx: Vec<GroundTruthTxPose> = run.tx.iter().cloned().map(GroundTruthTxPose).collect();
         let rx: Vec<GroundTruthRxPose> = run.rx.iter().cloned().map(GroundTruthRxPose).collect();
-        written.push(write_table(output, partition, &tx, info, overwrite)?);
-        written.push(write_table(output, partition, &rx, info, overwrite)?);
+        tables.write(partition, &tx, info)?;
+        tables.write(partition, &rx, info)?;
     }
-    Ok(written)
+    Ok(())
 }

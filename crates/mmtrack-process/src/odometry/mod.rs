@@ -9,7 +9,7 @@ use anyhow::{Context, bail};
 use mmtrack_core::progress::Progress;
 use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose};
 use mmtrack_io::recording::PoseStream;
-use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary, write_table};
+use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingMetadata};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 
@@ -143,7 +143,8 @@ pub fn process_odometry(
 /// Every table `process odometry` may write.
 pub const TABLES: [&str; 3] = ["odometry", "odometry_timing", "ground_truth"];
 
-/// Writes the tables; each appears atomically.
+/// Writes the tables; they appear together or not at all
+/// ([`RunDir::tables`]).
 ///
 /// # Errors
 /// A table that cannot be written (or exists, without `force`).
@@ -155,7 +156,6 @@ pub fn write_outputs(
     preset: &str,
     recording: &Path,
 ) -> anyhow::Result<Vec<TableWriteSummary>> {
-    let (output, overwrite) = (&out.path, out.overwrite);
     let (estimates, frame) = in_ground_truth_frame(&run.estimates, &run.ground_truth);
     let info = RunInfo {
         config_json: serde_json::json!({
@@ -164,20 +164,19 @@ pub fn write_outputs(
             "preset": preset,
             "odometry": config,
             "frame": frame,
-            "run_id": run_id_of(output),
+            "run_id": run_id_of(&out.path),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
     };
-    let mut written = vec![
-        write_table(output, sequence, &estimates, &info, overwrite)?,
-        write_table(output, sequence, &run.timings, &info, overwrite)?,
-    ];
+    let mut tables = out.tables();
+    tables.write(sequence, &estimates, &info)?;
+    tables.write(sequence, &run.timings, &info)?;
     if !run.ground_truth.is_empty() {
         let truth: Vec<GroundTruthPose> = run.ground_truth.iter().cloned().map(GroundTruthPose).collect();
-        written.push(write_table(output, sequence, &truth, &info, overwrite)?);
+        tables.write(sequence, &truth, &info)?;
     }
-    Ok(written)
+    tables.publish()
 }
 
 /// The odometry's poses in the ground truth's frame, and the `frame` entry of

@@ -144,7 +144,7 @@ pub fn write_oxford_streaming(
         ..oxford::OXFORD
     };
     let radar_dir = staging.path().join("radar");
-    std::fs::create_dir_all(&radar_dir).with_context(|| radar_dir.display().to_string())?;
+    mmtrack_io::create_output_dirs(&radar_dir).with_context(|| radar_dir.display().to_string())?;
     let mut truth = Vec::new();
     let mut timestamps = String::new();
     for (scan, pose) in simulator {

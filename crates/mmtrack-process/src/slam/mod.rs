@@ -25,7 +25,7 @@ use anyhow::{Context, bail};
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 use mmtrack_io::RecordingEvent;
 use mmtrack_io::recording::RecordingMetadata;
-use mmtrack_io::table::{RunInfo, TableWriteSummary, write_table};
+use mmtrack_io::table::{RunInfo, TableWriteSummary};
 use mmtrack_io::table::{
     SLAM_ASSOCIATIONS, SLAM_MAP, SLAM_TRUE_SOURCES, SLAM_UE, SlamAssociationRow, SlamMapRow, SlamTrueSourceRow,
     SlamUeRow,
@@ -372,12 +372,11 @@ pub fn process_slam(recording_path: &Path, output: &Path, args: &SlamOptions) ->
         })
         .to_string(),
     };
-    let (output, overwrite) = (&out.path, out.overwrite);
-    let written: Vec<TableWriteSummary> = vec![
-        write_table(output, &sequence, &tables.ue, &info, overwrite)?,
-        write_table(output, &sequence, &tables.map, &info, overwrite)?,
-        write_table(output, &sequence, &tables.associations, &info, overwrite)?,
-        write_table(output, &sequence, &tables.true_sources, &info, overwrite)?,
-    ];
+    let mut staged = out.tables();
+    staged.write(&sequence, &tables.ue, &info)?;
+    staged.write(&sequence, &tables.map, &info)?;
+    staged.write(&sequence, &tables.associations, &info)?;
+    staged.write(&sequence, &tables.true_sources, &info)?;
+    let written: Vec<TableWriteSummary> = staged.publish()?;
     Ok(SlamOutput { config, tables, written })
 }

@@ -34,7 +34,7 @@ use anyhow::{Context, bail, ensure};
 use mmtrack_core::progress::Progress;
 use mmtrack_core::{OdometryEstimate, Se2, StampedPose, interpolate_pose};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata};
-use mmtrack_io::table::{ODOMETRY, RunInfo, read_table, table_path, write_table};
+use mmtrack_io::table::{ODOMETRY, RunInfo, read_table, table_path};
 use mmtrack_io::table::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSummaryRow, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtScenario};
@@ -373,7 +373,7 @@ pub fn process_spebt(
             .with_context(|| recording.path.display().to_string())?;
         results.push((recording, odometry_file, name, link, result));
     }
-    let mut written = Vec::new();
+    let mut staged = out.tables();
     let mut reports = Vec::new();
     for (recording, odometry_file, name, link, result) in results {
         let info = RunInfo {
@@ -400,20 +400,8 @@ pub fn process_spebt(
             .to_string(),
         };
         let summary = tables::summary_row(&experiment, &recording.path, name, &link, &result);
-        written.push(write_table(
-            &out.path,
-            &recording.sequence_id,
-            std::slice::from_ref(&summary),
-            &info,
-            out.overwrite,
-        )?);
-        written.push(write_table(
-            &out.path,
-            &recording.sequence_id,
-            &tables::slot_rows(&link, &result),
-            &info,
-            out.overwrite,
-        )?);
+        staged.write(&recording.sequence_id, std::slice::from_ref(&summary), &info)?;
+        staged.write(&recording.sequence_id, &tables::slot_rows(&link, &result), &info)?;
         reports.push(SpebtRecordingResult {
             sequence_id: recording.sequence_id.clone(),
             pose_source: name,
@@ -421,5 +409,5 @@ pub fn process_spebt(
             summary,
         });
     }
-    Ok(SpebtOutput { recordings: reports, written, dir: out.path.clone() })
+    Ok(SpebtOutput { recordings: reports, written: staged.publish()?, dir: out.path.clone() })
 }
