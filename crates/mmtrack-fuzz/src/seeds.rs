@@ -116,7 +116,13 @@ pub fn nmea(realdata: Option<&Path>) -> Vec<Vec<u8>> {
         written += &nmea_sentence(&format!("GPRMC,{time},A,4807.0380,N,01131.0000,E,022.4,084.4,{date},003.1,W,A"));
         written += &nmea_sentence(&format!("GPGST,{time},1.0,0.5,0.4,45.0,0.5,0.4,0.8"));
     }
-    let mut out = vec![written.into_bytes()];
+    // GGA + ZDA without RMC, through the leap second of 2016-12-31.
+    let mut zda = String::new();
+    for (time, date) in [("235959.00", "31,12,2016"), ("235960.00", "31,12,2016"), ("000000.00", "01,01,2017")] {
+        zda += &nmea_sentence(&format!("GNGGA,{time},4807.0380,N,01131.0000,E,4,12,0.7,545.4,M,46.9,M,,"));
+        zda += &nmea_sentence(&format!("GNZDA,{time},{date},00,00"));
+    }
+    let mut out = vec![written.into_bytes(), zda.into_bytes()];
     if let Some(dir) = realdata {
         out.extend(head(&dir.join("nmea-ublox-f9k/MTV.Local1.ublox-F9K.20200206-181434.nmea"), 6000, true));
     }

@@ -1,5 +1,12 @@
-//! NMEA 0183 GNSS logs: GGA and RMC (and GST when present) from any talker
-//! (GP, GN, GL, GA, GB, GQ, ...), one fix per epoch.
+//! NMEA 0183 GNSS logs: GGA and RMC or ZDA (and GST when present) from any
+//! talker (GP, GN, GL, GA, GB, GQ, ...), one fix per epoch.
+//!
+//! The log is read as a stream, one line at a time, so memory does not grow
+//! with the file (only with the number of fixes). A line longer than
+//! [`MAX_LINE_BYTES`] (NMEA 0183 sentences are at most 82 characters), or a
+//! file with no sentence in its first [`MAX_LINES_BEFORE_FIRST_SENTENCE`]
+//! lines, is not an NMEA log (binary data, `/dev/zero`, a wrong file): it is
+//! refused, naming the file and the line, without reading further.
 //!
 //! Each line is `$<talker:2><type:3>,<fields>*<checksum:2 hex>`, the checksum
 //! being the XOR of the bytes between `$` and `*`. Every line is accounted for
@@ -17,12 +24,14 @@
 //! - other sentence types (GSA, GSV, VTG, GLL, TXT, ...) and proprietary ones
 //!   (`$PUBX`, ...): counted as [`NmeaLog::ignored_sentences`].
 //!
-//! Epochs: consecutive GGA, RMC and GST sentences with the same time of day
-//! form one epoch, whatever their order (u-blox writes RMC before GGA, other
-//! receivers GGA before RMC). The GGA gives time of day, position, quality,
-//! satellites and altitude (an empty altitude field is a fix without
+//! Epochs: consecutive GGA, RMC, GST and ZDA sentences with the same time of
+//! day form one epoch, whatever their order (u-blox writes RMC before GGA,
+//! other receivers GGA before RMC). The GGA gives time of day, position,
+//! quality, satellites and altitude (an empty altitude field is a fix without
 //! altitude); the RMC of the same epoch gives the date, and its status `V`
-//! means no fix; the GST gives `horizontal_sigma_m`. An epoch with a valid
+//! means no fix; a ZDA gives the date (day, month, four-digit year, UTC) when
+//! there is no RMC, so receivers that log GGA + ZDA give fixes; the GST gives
+//! `horizontal_sigma_m`. An epoch with a valid
 //! RMC but no usable GGA (none, or one that does not parse) is a fix from the
 //! RMC alone, counted in [`NmeaLog::rmc_only_fixes`]: its position, its
 //! quality from the RMC mode indicator (A autonomous, D differential, E dead
@@ -32,8 +41,10 @@
 //! without its own RMC is dated from the latest known time (the latest RMC or
 //! fix), taking the day that puts it nearest, so a midnight rollover between
 //! RMCs is handled; GGAs before the first RMC are dated by that RMC the same
-//! way. A log with GGA fixes but no dated RMC at all is an error: there is no
-//! way to give UNIX times. Time is computed from the digits with integers, so
+//! way. (Here and below, "RMC" dating means an RMC or a ZDA: a ZDA whose time
+//! differs from every GGA's dates them the same way.) A log with GGA fixes
+//! but no dated RMC or ZDA at all is an error: there is no way to give UNIX
+//! times. Time is computed from the digits with integers, so
 //! fractional seconds are exact to the nanosecond.
 //!
 //! Epochs whose GGA quality is 0, or whose RMC status is `V` or mode `N`, are not fixes:
@@ -48,7 +59,16 @@
 //! [`NmeaLog::out_of_order_epochs`], the first one described in
 //! [`NmeaLog::first_out_of_order`]: the recording needs increasing time, and
 //! one such step must not reject the rest of a drive. Lines named for an
-//! epoch are those of its first GGA, RMC or GST sentence.
+//! epoch are those of its first GGA, RMC, GST or ZDA sentence.
+//!
+//! Leap seconds: an epoch at 23:59:60.f UTC has, as POSIX defines UNIX time,
+//! the UNIX time of 00:00:00.f of the next day, which belongs to the epoch
+//! that really is at 00:00:00.f (the recording's `t_ns` is UNIX time, which
+//! has no instant of its own for a leap second). Such an epoch is therefore
+//! never a fix: it is counted in [`NmeaLog::leap_second_epochs`] (the first
+//! one's line in [`NmeaLog::first_leap_second_line`]) and skipped; its date,
+//! if it carries one, still dates the epochs around it. Second 60 is accepted
+//! only at 23:59.
 //!
 //! `altitude_m` is the height above the WGS-84 ellipsoid (GGA altitude above
 //! mean sea level plus the geoid separation) when every fix with an altitude
@@ -63,14 +83,15 @@
 //! Written by hand: the `nmea` crate is not a dependency of this crate, and we
 //! need what a sentence-at-a-time parser does not give: bad checksums told
 //! apart from junk with line numbers, empty-field cold-start sentences
-//! accepted, time from the digits. GGA, RMC and GST are three short, fixed
-//! layouts (the field parsers are in the private `sentence` submodule).
+//! accepted, time from the digits. GGA, RMC, GST and ZDA are four short,
+//! fixed layouts (the field parsers are in the private `sentence` submodule).
 
 mod enu;
 mod sentence;
 #[cfg(test)]
 mod tests;
 
+use std::io::{BufRead, Read};
 use std::path::Path;
 
 use mmtrack_core::{GnssFix, GnssFixQuality};
@@ -80,6 +101,16 @@ use crate::IngestError;
 use crate::error::os_err;
 
 pub use self::enu::{EnuOrigin, geodetic_to_enu_m};
+
+/// Longest line accepted, in bytes (line end included). NMEA 0183 limits a
+/// sentence to 82 characters; the margin admits vendor extensions and long
+/// proprietary sentences, and a longer line means the file is not an NMEA
+/// log.
+pub const MAX_LINE_BYTES: usize = 4096;
+
+/// Lines read without any sentence (`$...*hh`, whatever its checksum) before
+/// the file is refused as not an NMEA log.
+pub const MAX_LINES_BEFORE_FIRST_SENTENCE: usize = 1000;
 
 /// A skipped line and why it was skipped.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -115,13 +146,18 @@ pub struct NmeaLog {
     pub duplicate_epochs: u64,
     /// Epochs earlier than the fix before them, skipped.
     pub out_of_order_epochs: u64,
+    /// Epochs with a fix at a leap second (23:59:60.f UTC), skipped: UNIX
+    /// time has no instant for them (see the module documentation).
+    pub leap_second_epochs: u64,
+    /// Line of the first leap-second epoch.
+    pub first_leap_second_line: Option<usize>,
     /// The first epoch skipped for its time, and by how much it went back.
     pub first_out_of_order: Option<SkippedLine>,
     /// `ellipsoid` or `mean sea level`; empty when no fix has an altitude.
     pub altitude_datum: &'static str,
 }
 
-/// GGA, RMC and GST sentences sharing one time of day.
+/// GGA, RMC, GST and ZDA sentences sharing one time of day.
 struct Epoch {
     time_of_day_ns: i64,
     /// Line of the epoch's first sentence.
@@ -130,12 +166,14 @@ struct Epoch {
     gga: Option<(Option<GgaPosition>, GnssFixQuality)>,
     /// The first RMC.
     rmc: Option<sentence::Rmc>,
+    /// The date of the first ZDA that gives one, days since the UNIX epoch.
+    zda_days: Option<i64>,
     horizontal_sigma_m: Option<f64>,
 }
 
 impl Epoch {
     fn new(time_of_day_ns: i64, line: usize) -> Self {
-        Self { time_of_day_ns, line, gga: None, rmc: None, horizontal_sigma_m: None }
+        Self { time_of_day_ns, line, gga: None, rmc: None, zda_days: None, horizontal_sigma_m: None }
     }
 
     /// Adds a sentence of this epoch; the first of each type wins. Returns
@@ -148,13 +186,20 @@ impl Epoch {
                 self.rmc.get_or_insert(rmc);
             }
             Part::Gst(gst) => self.horizontal_sigma_m = self.horizontal_sigma_m.or(gst.horizontal_sigma_m),
+            Part::Zda(zda) => self.zda_days = self.zda_days.or(zda.days),
         }
         false
     }
 
+    /// The epoch's date, days since the UNIX epoch: the RMC's, else the ZDA's.
+    fn days(&self) -> Option<i64> {
+        self.rmc.as_ref().and_then(|rmc| rmc.days).or(self.zda_days)
+    }
+
     /// The fix this epoch gives: from the GGA when there is one (and the RMC
     /// does not say no fix), else from a valid RMC. `Err(())` is an epoch
-    /// without a fix, `Ok(None)` one with neither GGA nor RMC (a lone GST).
+    /// without a fix, `Ok(None)` one with neither GGA nor RMC (a lone GST or
+    /// ZDA).
     fn fix(&self) -> Result<Option<Candidate>, ()> {
         let rmc_says_no_fix = self.rmc.as_ref().is_some_and(|rmc| !rmc.valid);
         let candidate = match (&self.gga, &self.rmc) {
@@ -188,6 +233,7 @@ enum Part {
     Gga(sentence::Gga),
     Rmc(sentence::Rmc),
     Gst(sentence::Gst),
+    Zda(sentence::Zda),
 }
 
 impl Part {
@@ -196,6 +242,7 @@ impl Part {
             Self::Gga(gga) => gga.time_of_day_ns,
             Self::Rmc(rmc) => rmc.time_of_day_ns,
             Self::Gst(gst) => gst.time_of_day_ns,
+            Self::Zda(zda) => zda.time_of_day_ns,
         }
     }
 }
@@ -240,10 +287,14 @@ fn clock(t_ns: i64) -> String {
 #[derive(Default)]
 struct Assembler {
     log: NmeaLog,
-    /// Line of each fix, for messages.
-    fix_lines: Vec<usize>,
-    /// Geoid separation of each fix that has an altitude (to pick the datum).
-    separations_m: Vec<Option<f64>>,
+    /// Line of the latest fix, for messages.
+    last_fix_line: Option<usize>,
+    /// Geoid separation of each fix that has an altitude, while every one
+    /// of them gives it (to move altitudes to the ellipsoid).
+    separations_m: Vec<f64>,
+    /// Whether some fix has an altitude without a geoid separation (the
+    /// datum is then mean sea level, and `separations_m` is emptied).
+    separation_missing: bool,
     /// Latest known UNIX time (an RMC's date and time, or a fix), for dating.
     reference_ns: Option<i64>,
     undated: Vec<Undated>,
@@ -251,7 +302,7 @@ struct Assembler {
 
 impl Assembler {
     fn close(&mut self, epoch: Epoch) {
-        let rmc_date = epoch.rmc.as_ref().and_then(|rmc| rmc.days);
+        let rmc_date = epoch.days();
         if let Some(days) = rmc_date {
             let reference_ns = days * NS_PER_DAY + epoch.time_of_day_ns;
             self.reference_ns = Some(reference_ns);
@@ -268,6 +319,11 @@ impl Assembler {
                 return;
             }
         };
+        if epoch.time_of_day_ns >= NS_PER_DAY {
+            self.log.leap_second_epochs += 1;
+            self.log.first_leap_second_line.get_or_insert(epoch.line);
+            return;
+        }
         let t_ns = match (rmc_date, self.reference_ns) {
             (Some(days), _) => days * NS_PER_DAY + epoch.time_of_day_ns,
             (None, Some(reference_ns)) => nearest_ns(reference_ns, epoch.time_of_day_ns),
@@ -286,7 +342,7 @@ impl Assembler {
     /// Appends a fix; returns whether it was kept (not a repeated or
     /// out-of-order epoch, which are counted instead).
     fn emit(&mut self, t_ns: i64, candidate: Candidate, horizontal_sigma_m: Option<f64>, line: usize) -> bool {
-        if let (Some(last), Some(last_line)) = (self.log.fixes.last(), self.fix_lines.last()) {
+        if let (Some(last), Some(last_line)) = (self.log.fixes.last(), self.last_fix_line) {
             if t_ns == last.t_ns {
                 self.log.duplicate_epochs += 1;
                 return false;
@@ -307,9 +363,15 @@ impl Assembler {
                 return false;
             }
         }
-        self.fix_lines.push(line);
-        if candidate.altitude_msl_m.is_some() {
-            self.separations_m.push(candidate.geoid_separation_m);
+        self.last_fix_line = Some(line);
+        if candidate.altitude_msl_m.is_some() && !self.separation_missing {
+            match candidate.geoid_separation_m {
+                Some(separation_m) => self.separations_m.push(separation_m),
+                None => {
+                    self.separation_missing = true;
+                    self.separations_m = Vec::new();
+                }
+            }
         }
         self.log.rmc_only_fixes += u64::from(candidate.rmc_only);
         self.log.fixes.push(GnssFix {
@@ -335,100 +397,150 @@ impl Assembler {
     /// altitude gives the geoid separation.
     fn finish(self) -> NmeaLog {
         let mut log = self.log;
-        if self.separations_m.is_empty() {
+        if self.separation_missing {
+            log.altitude_datum = "mean sea level";
+        } else if self.separations_m.is_empty() {
             log.altitude_datum = "";
-        } else if self.separations_m.iter().all(Option::is_some) {
-            let mut separations = self.separations_m.iter().flatten();
+        } else {
+            let mut separations = self.separations_m.iter();
             for altitude_m in log.fixes.iter_mut().filter_map(|fix| fix.altitude_m.as_mut()) {
                 *altitude_m += separations.next().copied().unwrap_or(0.0);
             }
             log.altitude_datum = "ellipsoid";
-        } else {
-            log.altitude_datum = "mean sea level";
         }
         log
     }
 }
 
-/// Parses a whole log. Fails only when there are fixes but no date;
-/// everything else is skipped and counted (see the module documentation).
-pub fn parse_nmea(path: &Path, text: &str) -> Result<NmeaLog, IngestError> {
-    let mut assembler = Assembler::default();
-    let mut current: Option<Epoch> = None;
-    for (index, raw) in text.lines().enumerate() {
-        let line_number = index + 1;
-        let (id, kind, fields) = match sentence::split_sentence(raw.trim()) {
+/// Reads a log line by line. Fails when a line is too long or no sentence
+/// comes early enough (not an NMEA log), on a read error, and when there are
+/// fixes but no date; everything else is skipped and counted (see the module
+/// documentation). Bytes that are not UTF-8 make their lines unparsable, not
+/// the log.
+pub fn parse_nmea(path: &Path, mut input: impl BufRead) -> Result<NmeaLog, IngestError> {
+    let mut parser = Parser::default();
+    let mut bytes = Vec::with_capacity(MAX_LINE_BYTES + 1);
+    let mut line_number = 0;
+    let mut seen_sentence = false;
+    loop {
+        bytes.clear();
+        let limit = MAX_LINE_BYTES as u64 + 1;
+        if input.by_ref().take(limit).read_until(b'\n', &mut bytes).map_err(os_err(path))? == 0 {
+            break;
+        }
+        line_number += 1;
+        let not_nmea = |detail: String| IngestError::BadRecord {
+            path: path.to_path_buf(),
+            record: format!("line {line_number}"),
+            field: "line".into(),
+            detail,
+        };
+        if bytes.len() > MAX_LINE_BYTES {
+            return Err(not_nmea(format!(
+                "longer than {MAX_LINE_BYTES} bytes (NMEA 0183 sentences are at most 82 characters): \
+                 not an NMEA text log (binary data?)"
+            )));
+        }
+        seen_sentence |= parser.line(line_number, String::from_utf8_lossy(&bytes).trim());
+        if !seen_sentence && line_number >= MAX_LINES_BEFORE_FIRST_SENTENCE {
+            return Err(not_nmea(format!(
+                "no NMEA sentence ($<address>,...*<checksum>) in the first {MAX_LINES_BEFORE_FIRST_SENTENCE} lines: \
+                 not an NMEA text log (binary data?)"
+            )));
+        }
+    }
+    parser.finish(path)
+}
+
+/// The epoch being read and what the closed ones gave.
+#[derive(Default)]
+struct Parser {
+    assembler: Assembler,
+    current: Option<Epoch>,
+}
+
+impl Parser {
+    /// Takes one line (trimmed); returns whether it is framed as a sentence
+    /// (`$...*hh`, whatever its checksum).
+    fn line(&mut self, line_number: usize, text: &str) -> bool {
+        let assembler = &mut self.assembler;
+        let (id, kind, fields) = match sentence::split_sentence(text) {
             Line::Sentence { id, kind, fields } => (id, kind, fields),
             Line::Proprietary => {
                 assembler.log.ignored_sentences += 1;
-                continue;
+                return true;
             }
             Line::BadChecksum => {
                 assembler.log.bad_checksum_lines += 1;
                 assembler.log.first_bad_checksum_line.get_or_insert(line_number);
-                continue;
+                return true;
             }
             Line::Junk(reason) => {
                 assembler.unparsable(line_number, || format!("not an NMEA sentence: {reason}"));
-                continue;
+                return false;
             }
         };
         let parsed = match kind {
             "GGA" => sentence::parse_gga(&fields).map(Part::Gga),
             "RMC" => sentence::parse_rmc(&fields).map(Part::Rmc),
             "GST" => sentence::parse_gst(&fields).map(Part::Gst),
+            "ZDA" => sentence::parse_zda(&fields).map(Part::Zda),
             _ => {
                 assembler.log.ignored_sentences += 1;
-                continue;
+                return true;
             }
         };
         let part = match parsed {
             Ok(part) => part,
             Err(e) => {
                 assembler.unparsable(line_number, || format!("{id}: {}: {}", e.field, e.detail));
-                continue;
+                return true;
             }
         };
         let Some(time_of_day_ns) = part.time_of_day_ns() else {
             // No time: a GGA without fix counts as such; an RMC `V` has
-            // nothing to add, nor a GST without time.
+            // nothing to add, nor a GST or ZDA without time.
             match part {
                 Part::Gga(_) => assembler.log.epochs_without_fix += 1,
-                Part::Gst(_) => assembler.log.ignored_sentences += 1,
+                Part::Gst(_) | Part::Zda(_) => assembler.log.ignored_sentences += 1,
                 Part::Rmc(_) => {}
             }
-            continue;
+            return true;
         };
-        if let Some(epoch) = current.take_if(|epoch| epoch.time_of_day_ns != time_of_day_ns) {
+        if let Some(epoch) = self.current.take_if(|epoch| epoch.time_of_day_ns != time_of_day_ns) {
             assembler.close(epoch);
         }
-        let epoch = current.get_or_insert_with(|| Epoch::new(time_of_day_ns, line_number));
+        let epoch = self.current.get_or_insert_with(|| Epoch::new(time_of_day_ns, line_number));
         if epoch.join(part) {
             assembler.log.duplicate_epochs += 1;
         }
+        true
     }
-    if let Some(epoch) = current {
-        assembler.close(epoch);
+
+    /// Closes the last epoch; fails when fixes could not be dated.
+    fn finish(mut self, path: &Path) -> Result<NmeaLog, IngestError> {
+        if let Some(epoch) = self.current.take() {
+            self.assembler.close(epoch);
+        }
+        if let Some(first) = self.assembler.undated.first() {
+            return Err(IngestError::BadLayout {
+                path: path.to_path_buf(),
+                detail: format!(
+                    "{} GGA fixes (the first at line {}) but no RMC or ZDA sentence with a date: \
+                     fixes cannot be given UNIX times",
+                    self.assembler.undated.len(),
+                    first.line
+                ),
+            });
+        }
+        Ok(self.assembler.finish())
     }
-    if let Some(first) = assembler.undated.first() {
-        return Err(IngestError::BadLayout {
-            path: path.to_path_buf(),
-            detail: format!(
-                "{} GGA fixes (the first at line {}) but no RMC sentence with a date: \
-                 fixes cannot be given UNIX times",
-                assembler.undated.len(),
-                first.line
-            ),
-        });
-    }
-    Ok(assembler.finish())
 }
 
-/// Reads and parses a log file. Bytes that are not UTF-8 make their lines
-/// unparsable, not the file.
+/// Opens and parses a log file (streamed: see [`parse_nmea`]).
 pub fn read_nmea(path: &Path) -> Result<NmeaLog, IngestError> {
-    let bytes = std::fs::read(path).map_err(os_err(path))?;
-    parse_nmea(path, &String::from_utf8_lossy(&bytes))
+    let file = std::fs::File::open(path).map_err(os_err(path))?;
+    parse_nmea(path, std::io::BufReader::new(file))
 }
 
 /// What an NMEA ingest did.
