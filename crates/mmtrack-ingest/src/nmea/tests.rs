@@ -204,7 +204,8 @@ fn a_long_line_or_a_file_without_sentences_is_refused_with_its_line() {
     // reading at most one line's cap.
     let err = parse_nmea(Path::new("zero.nmea"), std::io::BufReader::new(std::io::repeat(0))).unwrap_err().to_string();
     assert!(err.starts_with("zero.nmea: line 1: line: longer than 4096 bytes"), "{err}");
-    let long = format!("{}\n{}\n$GPTXT,{}*00\n", epoch("GN", "021417.00"), gga("GN", "021418.00", "1"), "x".repeat(5000));
+    let long =
+        format!("{}\n{}\n$GPTXT,{}*00\n", epoch("GN", "021417.00"), gga("GN", "021418.00", "1"), "x".repeat(5000));
     let err = parse(&long).unwrap_err().to_string();
     assert!(err.starts_with("drive.nmea: line 6: line: longer than 4096 bytes"), "{err}");
     // A line of exactly the cap (line end included) is a line like another.
