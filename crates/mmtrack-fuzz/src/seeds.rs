@@ -244,6 +244,12 @@ pub fn npy_files(realdata: Option<&Path>) -> Vec<Vec<u8>> {
         with_sidecar(&format!("{sidecar}variable = \"h\"\n"), &zip(&[("h.npy", c16.clone()), ("g.npy", iq)], false)),
         with_sidecar(sidecar, &zip(&[("cir.npy", c8)], true)),
     ];
+    // Beam-sweep matrices in the narrower dtypes: float32 power, big-endian
+    // int32 pass indices (`parse_npy_matrix` widens them).
+    let f4: Vec<u8> = (0..4 * 3).flat_map(|k| (k as f32 * 0.125).to_le_bytes()).collect();
+    out.push(with_sidecar(sidecar, &npy(1, "<f4", false, "(4, 3)", &f4)));
+    let i4: Vec<u8> = [1i32, 1, 2, 2].iter().flat_map(|k| k.to_be_bytes()).collect();
+    out.push(with_sidecar(sidecar, &npy(1, ">i4", false, "(4,)", &i4)));
     let Some(dir) = realdata else { return out };
     let beams = dir.join("deepsense-60ghz-beams");
     if let Ok(loc) = std::fs::read(beams.join("scenario1_unit2_loc_1-2422.npy")) {
