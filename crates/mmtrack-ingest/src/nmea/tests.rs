@@ -1,6 +1,8 @@
 use proptest::prelude::*;
 
-use super::sentence::days_from_civil;
+use mmtrack_core::GnssFixQuality;
+
+use super::sentence::{NS_PER_DAY, days_from_civil};
 use super::*;
 
 fn sentence(payload: &str) -> String {
