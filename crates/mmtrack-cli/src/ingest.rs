@@ -284,7 +284,7 @@ enum Kind {
         #[arg(long, value_enum, default_value_t = PlaneArg::Xy)]
         plane: PlaneArg,
     },
-    /// NMEA 0183 GNSS log (GGA + RMC, any talker) into a new recording or added to one.
+    /// NMEA 0183 GNSS log (GGA with RMC or ZDA, or RMC alone; any talker) into a new recording or added to one.
     Nmea {
         /// The log.
         input: PathBuf,
@@ -454,8 +454,16 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                     ),
                     None => String::new(),
                 };
+                let leap_seconds = match log.first_leap_second_line {
+                    Some(line) => format!(
+                        ", {} leap-second epoch{} (23:59:60 UTC has no UNIX time of its own; first at line {line})",
+                        log.leap_second_epochs,
+                        if log.leap_second_epochs == 1 { "" } else { "s" },
+                    ),
+                    None => String::new(),
+                };
                 println!(
-                    "{}: {} GNSS fixes{partial}; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix{out_of_order}; {} other sentences ignored",
+                    "{}: {} GNSS fixes{partial}; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix{out_of_order}{leap_seconds}; {} other sentences ignored",
                     report.output.path.display(),
                     log.fixes.len(),
                     log.bad_checksum_lines,

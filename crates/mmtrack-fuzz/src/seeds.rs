@@ -116,7 +116,13 @@ pub fn nmea(realdata: Option<&Path>) -> Vec<Vec<u8>> {
         written += &nmea_sentence(&format!("GPRMC,{time},A,4807.0380,N,01131.0000,E,022.4,084.4,{date},003.1,W,A"));
         written += &nmea_sentence(&format!("GPGST,{time},1.0,0.5,0.4,45.0,0.5,0.4,0.8"));
     }
-    let mut out = vec![written.into_bytes()];
+    // GGA + ZDA without RMC, through the leap second of 2016-12-31.
+    let mut zda = String::new();
+    for (time, date) in [("235959.00", "31,12,2016"), ("235960.00", "31,12,2016"), ("000000.00", "01,01,2017")] {
+        zda += &nmea_sentence(&format!("GNGGA,{time},4807.0380,N,01131.0000,E,4,12,0.7,545.4,M,46.9,M,,"));
+        zda += &nmea_sentence(&format!("GNZDA,{time},{date},00,00"));
+    }
+    let mut out = vec![written.into_bytes(), zda.into_bytes()];
     if let Some(dir) = realdata {
         out.extend(head(&dir.join("nmea-ublox-f9k/MTV.Local1.ublox-F9K.20200206-181434.nmea"), 6000, true));
     }
@@ -238,6 +244,12 @@ pub fn npy_files(realdata: Option<&Path>) -> Vec<Vec<u8>> {
         with_sidecar(&format!("{sidecar}variable = \"h\"\n"), &zip(&[("h.npy", c16.clone()), ("g.npy", iq)], false)),
         with_sidecar(sidecar, &zip(&[("cir.npy", c8)], true)),
     ];
+    // Beam-sweep matrices in the narrower dtypes: float32 power, big-endian
+    // int32 pass indices (`parse_npy_matrix` widens them).
+    let f4: Vec<u8> = (0..4 * 3).flat_map(|k| (k as f32 * 0.125).to_le_bytes()).collect();
+    out.push(with_sidecar(sidecar, &npy(1, "<f4", false, "(4, 3)", &f4)));
+    let i4: Vec<u8> = [1i32, 1, 2, 2].iter().flat_map(|k| k.to_be_bytes()).collect();
+    out.push(with_sidecar(sidecar, &npy(1, ">i4", false, "(4,)", &i4)));
     let Some(dir) = realdata else { return out };
     let beams = dir.join("deepsense-60ghz-beams");
     if let Ok(loc) = std::fs::read(beams.join("scenario1_unit2_loc_1-2422.npy")) {

@@ -4,7 +4,7 @@
 //! | target | entry point |
 //! |---|---|
 //! | `png` | `oxford::decode_scan_png`, with any width and with Oxford's 3768 bins |
-//! | `nmea` | `nmea::parse_nmea` (bytes made UTF-8 as `read_nmea` does) |
+//! | `nmea` | `nmea::parse_nmea` on the bytes, streamed as `read_nmea` streams a file |
 //! | `cdr` | `ros2::decode_odometry`, `decode_pose_with_covariance_stamped`, `decode_nav_sat_fix`, `ros2_image::decode_image` + `image_to_scan` |
 //! | `decawave` | `cir::parse_decawave_log_detailed`, timed by the RX timestamp and by a frame period |
 //! | `npy` | `cir::read_cir_file` as `npy`, or as `npz` when the file starts with `PK`; `cir::parse_npy_matrix` (DeepSense beam arrays) |
@@ -162,7 +162,7 @@ fn unquoted(text: &str) -> String {
 /// NMEA: a log with bad lines is still read (they are counted), so the
 /// outcome of an accepted log says what was skipped and why.
 fn nmea(_: &Scratch, input: &[u8]) -> String {
-    match parse_nmea(Path::new("fuzz.nmea"), &String::from_utf8_lossy(input)) {
+    match parse_nmea(Path::new("fuzz.nmea"), input) {
         Ok(log) => {
             let flags = [
                 log.fixes.is_empty(),
@@ -170,6 +170,7 @@ fn nmea(_: &Scratch, input: &[u8]) -> String {
                 log.first_out_of_order.is_some(),
                 log.duplicate_epochs > 0,
                 log.epochs_without_fix > 0,
+                log.leap_second_epochs > 0,
             ];
             let flags: String = flags.iter().map(|&f| if f { 'x' } else { '-' }).collect();
             let skipped = log.first_unparsable.map(|s| unquoted(&s.reason)).unwrap_or_default();

@@ -3,12 +3,19 @@
 //! front, and every field error naming the file, the line and the column. A
 //! header without a single data row is an error: every such file (ground
 //! truth, GNSS, INS) is a record of something, and an empty one means a
-//! truncated or mis-exported file, not an empty drive.
+//! truncated or mis-exported file, not an empty drive. A UTF-8 byte order
+//! mark before the header (Excel and other Windows tools write one) is not
+//! part of the first column's name.
 
 use std::collections::HashMap;
 use std::path::Path;
 
 use crate::IngestError;
+
+/// `text` without a leading UTF-8 byte order mark (U+FEFF).
+pub(crate) fn without_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
+}
 
 /// One data line, with typed access by column name.
 pub struct CsvRow<'a> {
@@ -67,7 +74,7 @@ impl<'a> CsvTable<'a> {
     /// Splits `text` into header and data lines; fails naming a missing
     /// column, or when there is no data line after the header.
     pub fn parse(path: &'a Path, text: &'a str, required: &[&str]) -> Result<Self, IngestError> {
-        let mut lines = text.lines().enumerate();
+        let mut lines = without_bom(text).lines().enumerate();
         let header = lines.next().map(|(_, l)| l).ok_or_else(|| IngestError::BadLayout {
             path: path.to_path_buf(),
             detail: "empty file: no header line".into(),
@@ -120,5 +127,14 @@ mod tests {
             assert!(err.contains("gt/radar_odometry.csv") && err.contains("no data rows after the header"), "{err}");
         }
         assert_eq!(CsvTable::parse(path, "a,b\n1,2\n", &["a"]).unwrap().rows().count(), 1);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_not_part_of_the_first_column() {
+        let path = Path::new("gps.csv");
+        let table = CsvTable::parse(path, "\u{feff}timestamp,b\n1,2\n", &["timestamp"]).unwrap();
+        assert!(table.has("timestamp"));
+        let err = CsvTable::parse(path, "\u{feff}time,b\n1,2\n", &["timestamp"]).err().unwrap().to_string();
+        assert!(err.starts_with("gps.csv: line 1 (header): timestamp: missing column"), "{err}");
     }
 }

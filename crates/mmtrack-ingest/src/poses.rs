@@ -234,18 +234,35 @@ pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPos
     Ok(poses)
 }
 
-/// Parses a KITTI `times.txt` (decimal seconds per line), plus `t0_ns`.
+/// Parses a KITTI `times.txt` (decimal seconds per line), plus `t0_ns`
+/// (`--t0-ns` of `mmtrack ingest poses`). A time that is not non-negative
+/// seconds within the i64 nanosecond range is the file's fault; a time that
+/// only overflows once `t0_ns` is added is `t0_ns`'s, and the error says so.
 pub fn parse_times(path: &Path, text: &str, t0_ns: i64) -> Result<Vec<i64>, IngestError> {
+    // Largest f64 seconds whose nanoseconds fit an i64 (2^63 ns is about 292 years).
+    const MAX_SECONDS: f64 = 9.2e9;
     let mut times = Vec::new();
     for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let raw = line.trim();
         // KITTI writes times like 1.036868e-01 as well as 0.103687.
-        let t_ns = decimal_seconds_to_ns(raw)
+        let time_ns = decimal_seconds_to_ns(raw)
             .or_else(|| {
-                raw.parse::<f64>().ok().filter(|s| s.is_finite() && *s >= 0.0).map(|s| (s * 1e9).round() as i64)
+                raw.parse::<f64>()
+                    .ok()
+                    .filter(|s| s.is_finite() && (0.0..MAX_SECONDS).contains(s))
+                    .map(|s| (s * 1e9).round() as i64)
             })
-            .and_then(|t| t.checked_add(t0_ns))
-            .ok_or_else(|| bad(path, index + 1, "time", format!("'{raw}' is not non-negative seconds")))?;
+            .ok_or_else(|| {
+                bad(path, index + 1, "time", format!("'{raw}' is not non-negative seconds below {MAX_SECONDS:e}"))
+            })?;
+        let t_ns = time_ns.checked_add(t0_ns).ok_or_else(|| {
+            bad(
+                path,
+                index + 1,
+                "t0_ns (--t0-ns)",
+                format!("{raw} s plus the offset {t0_ns} ns overflows i64 nanoseconds: the offset is too large"),
+            )
+        })?;
         times.push(t_ns);
     }
     Ok(times)
@@ -367,6 +384,22 @@ mod tests {
                 .unwrap_err()
                 .to_string();
         assert!(err.contains("line 2") && err.contains("times file has only 1"), "{err}");
+    }
+
+    #[test]
+    fn a_time_offset_that_overflows_is_named_not_the_times_file() {
+        let times = Path::new("times.txt");
+        assert_eq!(parse_times(times, "0.5\n1.5\n", 1_000).unwrap(), vec![500_001_000, 1_500_001_000]);
+        // 1.5 s plus an offset 1 s below i64::MAX overflows: the offset's fault.
+        let err = parse_times(times, "0.5\n1.5\n", i64::MAX - 1_000_000_000).unwrap_err().to_string();
+        assert!(err.starts_with("times.txt: line 2: t0_ns (--t0-ns): 1.5 s plus the offset"), "{err}");
+        assert!(err.contains("the offset is too large"), "{err}");
+        // A time beyond the i64 nanosecond range is the file's fault (it
+        // was saturated to i64::MAX and accepted).
+        for huge in ["1e300", "9300000000", "-1"] {
+            let err = parse_times(times, huge, 0).unwrap_err().to_string();
+            assert!(err.starts_with("times.txt: line 1: time:"), "{huge}: {err}");
+        }
     }
 
     #[test]

@@ -362,12 +362,15 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// A CDR little-endian writer for test messages.
-    struct Writer(Vec<u8>);
+    /// A CDR writer for test messages, little-endian unless made big-endian.
+    struct Writer(Vec<u8>, bool);
 
     impl Writer {
         fn new() -> Self {
-            Self(vec![0, 1, 0, 0])
+            Self(vec![0, 1, 0, 0], false)
+        }
+        fn big_endian() -> Self {
+            Self(vec![0, 0, 0, 0], true)
         }
         fn align(&mut self, n: usize) {
             while !(self.0.len() - 4).is_multiple_of(n) {
@@ -376,12 +379,12 @@ mod tests {
         }
         fn u32(&mut self, v: u32) -> &mut Self {
             self.align(4);
-            self.0.extend_from_slice(&v.to_le_bytes());
+            self.0.extend_from_slice(&if self.1 { v.to_be_bytes() } else { v.to_le_bytes() });
             self
         }
         fn f64(&mut self, v: f64) -> &mut Self {
             self.align(8);
-            self.0.extend_from_slice(&v.to_le_bytes());
+            self.0.extend_from_slice(&if self.1 { v.to_be_bytes() } else { v.to_le_bytes() });
             self
         }
         fn string(&mut self, s: &str) -> &mut Self {
@@ -393,7 +396,10 @@ mod tests {
     }
 
     fn odometry(yaw: f64) -> Vec<u8> {
-        let mut w = Writer::new();
+        odometry_in(Writer::new(), yaw)
+    }
+
+    fn odometry_in(mut w: Writer, yaw: f64) -> Vec<u8> {
         w.u32(12).u32(500).string("odom").string("base_link");
         w.f64(1.5).f64(-2.0).f64(0.0);
         w.f64(0.0).f64(0.0).f64((yaw / 2.0).sin()).f64((yaw / 2.0).cos());
@@ -427,6 +433,37 @@ mod tests {
         }
         w.0.push(0); // covariance type unknown
         w.0
+    }
+
+    #[test]
+    fn big_endian_payloads_decode_and_a_wrong_header_is_named() {
+        let little = decode_odometry(&odometry(0.75)).unwrap();
+        let big = odometry_in(Writer::big_endian(), 0.75);
+        assert_eq!(decode_odometry(&big).unwrap(), little);
+        // A big-endian payload under a little-endian header: the stamp's
+        // nanoseconds 500 read as 4093706240, or with nanoseconds 0, the
+        // string length 5 as 83886080 (was "field needs 83886092").
+        let mut lying = big.clone();
+        lying[1] = 0x01;
+        let err = decode_odometry(&lying).unwrap_err();
+        assert!(
+            err.starts_with("header.stamp: nanosec 4093706240 is not below one second, but 500 read big-endian"),
+            "{err}"
+        );
+        lying[8..12].copy_from_slice(&[0; 4]);
+        let err = decode_odometry(&lying).unwrap_err();
+        assert!(
+            err.starts_with("header.frame_id: length 83886080 is more than the")
+                && err.contains("but 5 read big-endian: the encapsulation header says little-endian and the payload looks big-endian"),
+            "{err}"
+        );
+        // Parameter lists and XCDR2 are refused by name.
+        for (id, name) in [(0x03, "parameter list (PL_CDR)"), (0x07, "XCDR2")] {
+            let mut other = odometry(0.75);
+            other[1] = id;
+            let err = decode_odometry(&other).unwrap_err();
+            assert!(err.contains(name) && err.contains("not supported"), "{err}");
+        }
     }
 
     #[test]

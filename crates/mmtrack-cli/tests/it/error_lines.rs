@@ -72,3 +72,15 @@ fn binary_garbage_in_a_log_is_escaped_not_printed() {
     one_clean_line(&out, "binary.nmea");
     assert!(!dir.path().join("out.mcap").exists());
 }
+
+#[test]
+fn a_log_that_is_not_text_is_refused_at_its_first_line() {
+    let dir = tempfile::tempdir().unwrap();
+    // Like /dev/zero: no line end in the first 4 KiB. Read one line's cap,
+    // not the file.
+    std::fs::write(dir.path().join("zeros.nmea"), vec![0u8; 1 << 20]).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "nmea", "zeros.nmea", "-o", "out.mcap"]);
+    let line = one_clean_line(&out, "zeros.nmea");
+    assert!(line.contains("zeros.nmea: line 1: line: longer than 4096 bytes"), "{line}");
+    assert!(!dir.path().join("out.mcap").exists());
+}

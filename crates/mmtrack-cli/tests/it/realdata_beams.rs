@@ -159,6 +159,47 @@ fn a_bad_beam_array_is_one_error_line_naming_file_row_and_field() {
     assert!(!dir.path().join("rec").exists(), "nothing written");
 }
 
+/// Two passes of 20 sweeps of `beams` beams with power `power(row, beam)`,
+/// the car driving east past the unit, ingested into `dir/rec`.
+fn ingest_written_passes(dir: &Path, beams: usize, power: impl Fn(usize, usize) -> f64) {
+    let arrays = dir.join("arrays");
+    std::fs::create_dir(&arrays).unwrap();
+    let n = 40;
+    let write =
+        |name: &str, bytes: Vec<u8>| std::fs::write(arrays.join(format!("scenario1_{name}_1-{n}.npy")), bytes).unwrap();
+    let power: Vec<f64> = (0..n).flat_map(|r| (0..beams).map(move |b| (r, b))).map(|(r, b)| power(r, b)).collect();
+    write("unit1_pwr_60ghz", npy_f8(&format!("({n}, {beams})"), &power));
+    write("unit1_loc", npy_f8(&format!("({n}, 2)"), &[33.42, -111.93].repeat(n)));
+    let car: Vec<f64> = (0..n).flat_map(|r| [33.4201, -111.9302 + (r % 20) as f64 * 1e-5]).collect();
+    write("unit2_loc", npy_f8(&format!("({n}, 2)"), &car));
+    let index: Vec<i64> = (0..n).map(|r| 1 + (r / 20) as i64).collect();
+    write("seq_index", npy("<i8", &format!("({n},)"), index.iter().map(|v| v.to_le_bytes())));
+    let out = mmtrack(dir, &["ingest", "beams", "arrays", "--format", "deepsense", "-o", "rec", "--quiet"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+}
+
+/// All-zero power or a one-beam codebook: the GNSS policies say so, not
+/// that `initial_offset_sigma_beams` (a parameter nobody set) is 0.
+#[test]
+fn flat_power_or_one_beam_names_the_cause_not_a_parameter() {
+    for (beams, expected) in [
+        (
+            64,
+            "has an RMS residual of 0 beams: their best beam is 0 in every sweep: the power does not vary across the beams",
+        ),
+        (1, "scenario1-pass01.mcap: sweeps of 1 beam: the GNSS policies fit a beam map"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        ingest_written_passes(dir.path(), beams, |_, _| 0.0);
+        for tracker in ["gnss-window", "gnss-map"] {
+            let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", tracker]);
+            let (_, stderr) = text(&out);
+            assert!(!out.status.success(), "{beams} beams, {tracker}");
+            assert!(stderr.contains(expected) && !stderr.contains("initial_offset_sigma_beams"), "{stderr}");
+        }
+    }
+}
+
 /// The window tracker run straight on the arrays of scenario 1 (no
 /// recording, no table): the records of each pass, as `mmtrack_beam`
 /// computes them (the DeepSense test of that crate drives it the same way).

@@ -1,4 +1,5 @@
-//! Ingest of a real u-blox F9K drive (google/gps-measurement-tools, Apache-2.0).
+//! Ingest of a real u-blox F9K drive (google/gps-measurement-tools, Apache-2.0),
+//! and of written GGA + ZDA logs.
 
 use mmtrack_io::{RecordingEvent, RecordingReader};
 
@@ -95,4 +96,39 @@ fn nmea_rmc_only_epochs_and_a_backward_step_are_reported_not_lost() {
             ),
         "{stdout}"
     );
+}
+
+#[test]
+fn nmea_gga_with_zda_gives_fixes_and_the_summary_counts_leap_seconds() {
+    // A receiver logging GGA + ZDA (no RMC) through the leap second at the
+    // end of 2016: three fixes, the epoch at 23:59:60 counted.
+    let mut log = String::new();
+    for (time, date) in [
+        ("235959.00", "31,12,2016"),
+        ("235960.00", "31,12,2016"),
+        ("000000.00", "01,01,2017"),
+        ("000001.00", "01,01,2017"),
+    ] {
+        log += &(signed(&format!("GNGGA,{time},4807.0380,N,01131.0000,E,4,12,0.7,545.4,M,46.9,M,,")) + "\n");
+        log += &(signed(&format!("GNZDA,{time},{date},00,00")) + "\n");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("zda.nmea"), log).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "nmea", "zda.nmea", "-o", "zda.mcap"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("3 GNSS fixes;")
+            && stdout.contains("1 leap-second epoch (23:59:60 UTC has no UNIX time of its own; first at line 3)"),
+        "{stdout}"
+    );
+    let times: Vec<i64> = RecordingReader::open(&dir.path().join("zda.mcap"))
+        .unwrap()
+        .filter_map(|e| match e.unwrap() {
+            RecordingEvent::Gnss(fix) => Some(fix.t_ns / 1_000_000_000),
+            _ => None,
+        })
+        .collect();
+    // 2017-01-01 00:00:00 UTC is UNIX second 1483228800 (`date -u -d 2017-01-01 +%s`).
+    assert_eq!(times, vec![1_483_228_799, 1_483_228_800, 1_483_228_801]);
 }

@@ -17,6 +17,10 @@
 //! | `unit2_loc_cal` | float64 (N, 2) | the car's calibrated positions (some scenarios) |
 //! | `seq_index` | int64 (N,) or (N, 1) | the pass each sweep belongs to |
 //!
+//! The dataset writes float64 and int64; float32 is accepted wherever
+//! float64 is and int32 wherever int64 is (widened exactly), in either byte
+//! order.
+//!
 //! # Recordings
 //! Each pass becomes its own recording `<out>/scenario<S>-pass<PP>.mcap`
 //! (sequence id the same, `PP` the source's pass index, zero-padded to the
@@ -222,7 +226,8 @@ fn bad(path: &Path, record: impl Into<String>, field: impl Into<String>, detail:
     IngestError::BadRecord { path: path.to_path_buf(), record: record.into(), field: field.into(), detail }
 }
 
-/// The float64 values of `matrix` with `columns` columns (any when `None`).
+/// The floating-point values (float64 or float32) of `matrix` with `columns`
+/// columns (any when `None`).
 fn floats(path: &Path, matrix: NpyMatrix, columns: Option<usize>, what: &str) -> Result<Vec<f64>, IngestError> {
     if let Some(columns) = columns
         && matrix.columns != columns
@@ -236,7 +241,12 @@ fn floats(path: &Path, matrix: NpyMatrix, columns: Option<usize>, what: &str) ->
     }
     match matrix.values {
         NpyValues::F64(values) => Ok(values),
-        NpyValues::I64(_) => Err(bad(path, "header", "descr", format!("int64, expected float64 ({what})"))),
+        NpyValues::I64(_) => Err(bad(
+            path,
+            "header",
+            "descr",
+            format!("dtype `{}`, expected float64 (`<f8`) or float32 (`<f4`) ({what})", matrix.dtype),
+        )),
     }
 }
 
@@ -281,7 +291,12 @@ fn pass_indices(path: &Path) -> Result<(usize, Vec<i64>), IngestError> {
         ));
     }
     let NpyValues::I64(pass) = matrix.values else {
-        return Err(bad(path, "header", "descr", "float64, expected int64 (pass index)".into()));
+        return Err(bad(
+            path,
+            "header",
+            "descr",
+            format!("dtype `{}`, expected int64 (`<i8`) or int32 (`<i4`) (pass index)", matrix.dtype),
+        ));
     };
     for (row, &index) in pass.iter().enumerate() {
         if index < 0 {

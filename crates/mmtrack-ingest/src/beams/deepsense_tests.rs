@@ -197,6 +197,29 @@ fn non_consecutive_passes_and_bad_positions_name_the_row() {
 }
 
 #[test]
+fn float32_power_is_read_and_integer_power_names_the_accepted_dtypes() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = arrays(&[1, 1, 2, 2]);
+    write_folder(dir.path(), 1, &a, false);
+    let power = dir.path().join("scenario1_unit1_pwr_60ghz_1-4.npy");
+    // The same power as float32: the same recordings, power rounded to f32.
+    let f4: Vec<u8> = a.power.iter().flat_map(|&v| (v as f32).to_le_bytes()).collect();
+    std::fs::write(&power, npy("<f4", "(4, 3)", false, &f4)).unwrap();
+    let passes = ingest(dir.path(), &dir.path().join("out"), &DeepsenseOptions::default()).unwrap();
+    assert_eq!(passes.len(), 2);
+    // As int64: refused, naming the dtypes that are accepted.
+    let i8_power: Vec<i64> = a.power.iter().map(|&v| (v * 100.0) as i64).collect();
+    std::fs::write(&power, npy("<i8", "(4, 3)", false, &i8(&i8_power))).unwrap();
+    let err = ingest(dir.path(), &dir.path().join("out2"), &DeepsenseOptions::default()).unwrap_err().to_string();
+    assert!(
+        err.contains(
+            "scenario1_unit1_pwr_60ghz_1-4.npy: header: descr: dtype `<i8`, expected float64 (`<f8`) or float32 (`<f4`)"
+        ),
+        "{err}"
+    );
+}
+
+#[test]
 fn npy_matrix_reads_fortran_order_big_endian_and_refuses_other_dtypes() {
     let path = Path::new("m.npy");
     // [[1, 2, 3], [4, 5, 6]] stored column by column.
@@ -207,8 +230,21 @@ fn npy_matrix_reads_fortran_order_big_endian_and_refuses_other_dtypes() {
     let big: Vec<u8> = [7i64, -2].iter().flat_map(|v| v.to_be_bytes()).collect();
     let m = parse_npy_matrix(path, &npy(">i8", "(2,)", false, &big)).unwrap();
     assert_eq!((m.rows, m.columns, m.values), (2, 1, NpyValues::I64(vec![7, -2])));
-    let text = parse_npy_matrix(path, &npy("<f4", "(2,)", false, &[0; 8])).unwrap_err().to_string();
-    assert!(text.contains("m.npy: header: descr: dtype `<f4`, expected float64"), "{text}");
+    // float32 and int32 (numpy's default integer on Windows before 2.0) are
+    // widened exactly.
+    let f4: Vec<u8> = [0.25f32, -1.5e-7].iter().flat_map(|v| v.to_le_bytes()).collect();
+    let m = parse_npy_matrix(path, &npy("<f4", "(2,)", false, &f4)).unwrap();
+    assert_eq!((m.values, m.dtype.as_str()), (NpyValues::F64(vec![0.25, f64::from(-1.5e-7f32)]), "<f4"));
+    let i4: Vec<u8> = [3i32, -4, 5, -6].iter().flat_map(|v| v.to_be_bytes()).collect();
+    let m = parse_npy_matrix(path, &npy(">i4", "(2, 2)", true, &i4)).unwrap();
+    assert_eq!(m.values, NpyValues::I64(vec![3, 5, -4, -6]));
+    let text = parse_npy_matrix(path, &npy("<f2", "(2,)", false, &[0; 4])).unwrap_err().to_string();
+    assert!(
+        text.contains(
+            "m.npy: header: descr: dtype `<f2`, expected float64 (`<f8`), float32 (`<f4`), int64 (`<i8`) or int32 (`<i4`)"
+        ),
+        "{text}"
+    );
     let text = parse_npy_matrix(path, &npy("<f8", "(2, 2, 2)", false, &[0; 64])).unwrap_err().to_string();
     assert!(text.contains("shape: [2, 2, 2], expected one or two dimensions"), "{text}");
     let text = parse_npy_matrix(path, &npy("<f8", "(3, 2)", false, &[0; 40])).unwrap_err().to_string();

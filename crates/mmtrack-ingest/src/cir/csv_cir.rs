@@ -15,7 +15,8 @@
 //!
 //! Any other column, a duplicate, a gap in the tap numbering or a row with the
 //! wrong number of fields is an error naming the line and the column. Lines
-//! starting with `#` and blank lines are skipped. Values that are NaN or
+//! starting with `#` and blank lines are skipped, and so is a UTF-8 byte
+//! order mark at the start of the file. Values that are NaN or
 //! infinite are errors (a CIR with a hole is not a CIR).
 
 use std::path::Path;
@@ -37,8 +38,11 @@ pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Re
         field: field.into(),
         detail,
     };
-    let mut lines =
-        text.lines().enumerate().map(|(i, l)| (i + 1, l.trim())).filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let mut lines = crate::csv::without_bom(text)
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
     let Some((header_line, header)) = lines.next() else {
         return Err(IngestError::BadLayout { path: path.to_path_buf(), detail: "empty: no header line".into() });
     };
@@ -198,6 +202,10 @@ mod tests {
         assert!(e.contains("tx_antenna: `-1`, expected an integer >= 0"), "{e}");
         assert!(err("# only a comment\n").contains("empty: no header line"));
         assert!(err("re_0,im_0\n").contains("no snapshot rows"));
+        // A UTF-8 byte order mark is not part of the first column's name.
+        let with_bom = parse_cir_csv(Path::new("c.csv"), "\u{feff}re_0,im_0\n1,2\n", &sidecar(SIDECAR));
+        assert_eq!(with_bom.unwrap().len(), 1);
+        assert!(err("\u{feff}time,re_0,im_0\n1,2,3\n").contains("line 1: time: column 1 is `time`"));
         let e = parse_cir_csv(Path::new("c.csv"), "re_0,im_0\n1,2\n", &sidecar("tap_spacing_s = 1e-9"));
         assert!(e.unwrap_err().to_string().contains("key `carrier_hz`"));
     }

@@ -197,7 +197,11 @@ fn read_decawave(
     }
     config.t0_ns = sidecar.t0_ns.unwrap_or(0);
     let time_base = if let Some(period) = sidecar.snapshot_period_s {
-        let period_ns = (period * 1e9).round() as i64;
+        let period_ns = (period * 1e9).round();
+        if period_ns >= i64::MAX as f64 {
+            return Err(sidecar.error("snapshot_period_s", format!("{period} s is beyond the i64 nanosecond range")));
+        }
+        let period_ns = period_ns as i64;
         if period_ns <= 0 {
             return Err(sidecar.error("snapshot_period_s", format!("{period} s rounds to 0 ns")));
         }

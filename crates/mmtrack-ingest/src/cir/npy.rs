@@ -72,14 +72,19 @@ pub(crate) fn parse_npy(path: &Path, record: &str, bytes: &[u8]) -> Result<NdCom
         .map_err(|(field, detail)| bad(path, record, field, detail))
 }
 
-/// Values of a real `.npy` matrix, in the file's dtype.
+/// Values of a real `.npy` matrix: floating point or integer, as the file's
+/// dtype (float32 and int32 widened exactly).
 #[derive(Debug, Clone, PartialEq)]
 pub enum NpyValues {
-    /// float64 (`f8`).
+    /// float64 (`f8`) or float32 (`f4`).
     F64(Vec<f64>),
-    /// int64 (`i8`).
+    /// int64 (`i8`) or int32 (`i4`).
     I64(Vec<i64>),
 }
+
+/// The dtypes [`parse_npy_matrix`] reads, for messages.
+pub const NPY_MATRIX_DTYPES: &str =
+    "float64 (`<f8`), float32 (`<f4`), int64 (`<i8`) or int32 (`<i4`), either byte order";
 
 /// A real 2-D array from a `.npy` file, row-major whatever the file's order.
 #[derive(Debug, Clone, PartialEq)]
@@ -90,11 +95,13 @@ pub struct NpyMatrix {
     pub columns: usize,
     /// `rows * columns` values, row-major.
     pub values: NpyValues,
+    /// The file's dtype (`descr`), e.g. `<f4`, for messages.
+    pub dtype: String,
 }
 
-/// Reads a `.npy` file holding a float64 or int64 array of one dimension
-/// (`(N,)`, read as `N x 1`) or two (`(N, M)`), either byte order, C or
-/// Fortran order. Other dtypes and shapes are errors naming the file and the
+/// Reads a `.npy` file holding a float64, float32, int64 or int32 array of
+/// one dimension (`(N,)`, read as `N x 1`) or two (`(N, M)`), either byte
+/// order, C or Fortran order. Other dtypes and shapes are errors naming the file and the
 /// header field.
 ///
 /// # Errors
@@ -117,34 +124,46 @@ pub fn parse_npy_matrix(path: &Path, bytes: &[u8]) -> Result<NpyMatrix, IngestEr
         Some(b'>') => (true, &header.descr[1..]),
         _ => (false, header.descr.as_str()),
     };
-    if kind != "f8" && kind != "i8" {
-        return Err(bad("descr", format!("dtype `{}`, expected float64 (`<f8`) or int64 (`<i8`)", header.descr)));
-    }
+    let size = match kind {
+        "f8" | "i8" => 8,
+        "f4" | "i4" => 4,
+        _ => return Err(bad("descr", format!("dtype `{}`, expected {NPY_MATRIX_DTYPES}", header.descr))),
+    };
     let (rows, columns) = match header.dims.as_slice() {
         [n] => (*n, 1),
         [n, m] => (*n, *m),
         other => return Err(bad("shape", format!("{other:?}, expected one or two dimensions"))),
     };
     let count = rows.checked_mul(columns).ok_or_else(|| bad("shape", format!("{:?} overflows", header.dims)))?;
-    let needed = count.checked_mul(8).ok_or_else(|| bad("shape", format!("{:?} overflows", header.dims)))?;
+    let needed = count.checked_mul(size).ok_or_else(|| bad("shape", format!("{:?} overflows", header.dims)))?;
     let Some(data) = header.data.get(..needed) else {
         return Err(bad_data(path, &header, needed));
     };
-    let words = data.chunks_exact(8).map(|chunk| {
-        let mut raw = [0u8; 8];
+    let values = match kind {
+        "f8" => NpyValues::F64(words::<8>(data, big).map(f64::from_le_bytes).collect()),
+        "f4" => NpyValues::F64(words::<4>(data, big).map(|w| f64::from(f32::from_le_bytes(w))).collect()),
+        "i8" => NpyValues::I64(words::<8>(data, big).map(i64::from_le_bytes).collect()),
+        _ => NpyValues::I64(words::<4>(data, big).map(|w| i64::from(i32::from_le_bytes(w))).collect()),
+    };
+    let fortran = header.fortran;
+    let values = match values {
+        NpyValues::F64(v) => NpyValues::F64(row_major(v, rows, columns, fortran)),
+        NpyValues::I64(v) => NpyValues::I64(row_major(v, rows, columns, fortran)),
+    };
+    Ok(NpyMatrix { rows, columns, values, dtype: header.descr.clone() })
+}
+
+/// The `N`-byte words of `data`, each in little-endian order (reversed when
+/// the file is big-endian).
+fn words<const N: usize>(data: &[u8], big_endian: bool) -> impl Iterator<Item = [u8; N]> + '_ {
+    data.chunks_exact(N).map(move |chunk| {
+        let mut raw = [0u8; N];
         raw.copy_from_slice(chunk);
-        if big {
+        if big_endian {
             raw.reverse();
         }
         raw
-    });
-    let fortran = header.fortran;
-    let values = if kind == "f8" {
-        NpyValues::F64(row_major(words.map(f64::from_le_bytes).collect(), rows, columns, fortran))
-    } else {
-        NpyValues::I64(row_major(words.map(i64::from_le_bytes).collect(), rows, columns, fortran))
-    };
-    Ok(NpyMatrix { rows, columns, values })
+    })
 }
 
 /// `values` of a `rows x columns` array in row-major order. Fortran order

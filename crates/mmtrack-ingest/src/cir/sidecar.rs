@@ -289,8 +289,21 @@ impl CirSidecar {
             ));
         };
         let offset_ns = (set as f64 * set_period + k as f64 * snapshot_period) * 1e9;
-        let t = i64::try_from(offset_ns.round() as i128).ok().and_then(|o| o.checked_add(t0));
-        let t = t.ok_or_else(|| self.error("t0_ns", format!("snapshot {s} time overflows i64 nanoseconds")))?;
+        // The offset from t0_ns overflowing is the periods' fault; the sum
+        // overflowing only once t0_ns is added is t0_ns's.
+        let offset_ns = i64::try_from(offset_ns.round() as i128).map_err(|_| {
+            let (key, period) = match self.set_period_s {
+                Some(set_period) if set > 0 => ("set_period_s", set_period),
+                _ => ("snapshot_period_s", snapshot_period),
+            };
+            self.error(
+                key,
+                format!("{period:e} s puts snapshot {s} beyond the i64 nanosecond range (about 292 years after t0_ns)"),
+            )
+        })?;
+        let t = offset_ns.checked_add(t0).ok_or_else(|| {
+            self.error("t0_ns", format!("snapshot {s} ({offset_ns} ns after t0_ns {t0}) overflows i64 nanoseconds"))
+        })?;
         Ok((t, set as u64, k as u32))
     }
 }
@@ -367,6 +380,14 @@ mod tests {
         // One snapshot needs no period; several do.
         assert_eq!(CirSidecar::empty().snapshot_time(0, 1).unwrap(), (0, 0, 0));
         assert!(CirSidecar::empty().snapshot_time(1, 2).unwrap_err().to_string().contains("snapshot_period_s"));
+        // A huge period is named, not t0_ns; a t0_ns that overflows only once
+        // the offset is added is.
+        let huge = parse("snapshot_period_s = 1e300").unwrap();
+        let err = huge.snapshot_time(1, 2).unwrap_err().to_string();
+        assert!(err.starts_with("s.toml: key `snapshot_period_s`: 1e300 s puts snapshot 1 beyond"), "{err}");
+        let late = parse("snapshot_period_s = 1.0\nt0_ns = 9223372036000000000").unwrap();
+        let err = late.snapshot_time(1, 2).unwrap_err().to_string();
+        assert!(err.starts_with("s.toml: key `t0_ns`: snapshot 1 (1000000000 ns after t0_ns"), "{err}");
     }
 
     #[test]

@@ -1,5 +1,12 @@
-//! NMEA 0183 GNSS logs: GGA and RMC (and GST when present) from any talker
-//! (GP, GN, GL, GA, GB, GQ, ...), one fix per epoch.
+//! NMEA 0183 GNSS logs: GGA and RMC or ZDA (and GST when present) from any
+//! talker (GP, GN, GL, GA, GB, GQ, ...), one fix per epoch.
+//!
+//! The log is read as a stream, one line at a time, so memory does not grow
+//! with the file (only with the number of fixes). A line longer than
+//! [`MAX_LINE_BYTES`] (NMEA 0183 sentences are at most 82 characters), or a
+//! file with no sentence in its first [`MAX_LINES_BEFORE_FIRST_SENTENCE`]
+//! lines, is not an NMEA log (binary data, `/dev/zero`, a wrong file): it is
+//! refused, naming the file and the line, without reading further.
 //!
 //! Each line is `$<talker:2><type:3>,<fields>*<checksum:2 hex>`, the checksum
 //! being the XOR of the bytes between `$` and `*`. Every line is accounted for
@@ -17,12 +24,14 @@
 //! - other sentence types (GSA, GSV, VTG, GLL, TXT, ...) and proprietary ones
 //!   (`$PUBX`, ...): counted as [`NmeaLog::ignored_sentences`].
 //!
-//! Epochs: consecutive GGA, RMC and GST sentences with the same time of day
-//! form one epoch, whatever their order (u-blox writes RMC before GGA, other
-//! receivers GGA before RMC). The GGA gives time of day, position, quality,
-//! satellites and altitude (an empty altitude field is a fix without
+//! Epochs: consecutive GGA, RMC, GST and ZDA sentences with the same time of
+//! day form one epoch, whatever their order (u-blox writes RMC before GGA,
+//! other receivers GGA before RMC). The GGA gives time of day, position,
+//! quality, satellites and altitude (an empty altitude field is a fix without
 //! altitude); the RMC of the same epoch gives the date, and its status `V`
-//! means no fix; the GST gives `horizontal_sigma_m`. An epoch with a valid
+//! means no fix; a ZDA gives the date (day, month, four-digit year, UTC) when
+//! there is no RMC, so receivers that log GGA + ZDA give fixes; the GST gives
+//! `horizontal_sigma_m`. An epoch with a valid
 //! RMC but no usable GGA (none, or one that does not parse) is a fix from the
 //! RMC alone, counted in [`NmeaLog::rmc_only_fixes`]: its position, its
 //! quality from the RMC mode indicator (A autonomous, D differential, E dead
@@ -32,8 +41,10 @@
 //! without its own RMC is dated from the latest known time (the latest RMC or
 //! fix), taking the day that puts it nearest, so a midnight rollover between
 //! RMCs is handled; GGAs before the first RMC are dated by that RMC the same
-//! way. A log with GGA fixes but no dated RMC at all is an error: there is no
-//! way to give UNIX times. Time is computed from the digits with integers, so
+//! way. (Here and below, "RMC" dating means an RMC or a ZDA: a ZDA whose time
+//! differs from every GGA's dates them the same way.) A log with GGA fixes
+//! but no dated RMC or ZDA at all is an error: there is no way to give UNIX
+//! times. Time is computed from the digits with integers, so
 //! fractional seconds are exact to the nanosecond.
 //!
 //! Epochs whose GGA quality is 0, or whose RMC status is `V` or mode `N`, are not fixes:
@@ -48,7 +59,16 @@
 //! [`NmeaLog::out_of_order_epochs`], the first one described in
 //! [`NmeaLog::first_out_of_order`]: the recording needs increasing time, and
 //! one such step must not reject the rest of a drive. Lines named for an
-//! epoch are those of its first GGA, RMC or GST sentence.
+//! epoch are those of its first GGA, RMC, GST or ZDA sentence.
+//!
+//! Leap seconds: an epoch at 23:59:60.f UTC has, as POSIX defines UNIX time,
+//! the UNIX time of 00:00:00.f of the next day, which belongs to the epoch
+//! that really is at 00:00:00.f (the recording's `t_ns` is UNIX time, which
+//! has no instant of its own for a leap second). Such an epoch is therefore
+//! never a fix: it is counted in [`NmeaLog::leap_second_epochs`] (the first
+//! one's line in [`NmeaLog::first_leap_second_line`]) and skipped; its date,
+//! if it carries one, still dates the epochs around it. Second 60 is accepted
+//! only at 23:59.
 //!
 //! `altitude_m` is the height above the WGS-84 ellipsoid (GGA altitude above
 //! mean sea level plus the geoid separation) when every fix with an altitude
@@ -63,23 +83,37 @@
 //! Written by hand: the `nmea` crate is not a dependency of this crate, and we
 //! need what a sentence-at-a-time parser does not give: bad checksums told
 //! apart from junk with line numbers, empty-field cold-start sentences
-//! accepted, time from the digits. GGA, RMC and GST are three short, fixed
-//! layouts (the field parsers are in the private `sentence` submodule).
+//! accepted, time from the digits. GGA, RMC, GST and ZDA are four short,
+//! fixed layouts (the field parsers are in the private `sentence` submodule,
+//! the joining and dating of epochs in `epoch`).
 
 mod enu;
+mod epoch;
 mod sentence;
 #[cfg(test)]
 mod tests;
 
+use std::io::{BufRead, Read};
 use std::path::Path;
 
-use mmtrack_core::{GnssFix, GnssFixQuality};
+use mmtrack_core::GnssFix;
 
-use self::sentence::{GgaPosition, Line, NS_PER_DAY};
+use self::epoch::{Assembler, Epoch, Part};
+use self::sentence::Line;
 use crate::IngestError;
 use crate::error::os_err;
 
 pub use self::enu::{EnuOrigin, geodetic_to_enu_m};
+
+/// Longest line accepted, in bytes (line end included). NMEA 0183 limits a
+/// sentence to 82 characters; the margin admits vendor extensions and long
+/// proprietary sentences, and a longer line means the file is not an NMEA
+/// log.
+pub const MAX_LINE_BYTES: usize = 4096;
+
+/// Lines read without any sentence (`$...*hh`, whatever its checksum) before
+/// the file is refused as not an NMEA log.
+pub const MAX_LINES_BEFORE_FIRST_SENTENCE: usize = 1000;
 
 /// A skipped line and why it was skipped.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -115,320 +149,146 @@ pub struct NmeaLog {
     pub duplicate_epochs: u64,
     /// Epochs earlier than the fix before them, skipped.
     pub out_of_order_epochs: u64,
+    /// Epochs with a fix at a leap second (23:59:60.f UTC), skipped: UNIX
+    /// time has no instant for them (see the module documentation).
+    pub leap_second_epochs: u64,
+    /// Line of the first leap-second epoch.
+    pub first_leap_second_line: Option<usize>,
     /// The first epoch skipped for its time, and by how much it went back.
     pub first_out_of_order: Option<SkippedLine>,
     /// `ellipsoid` or `mean sea level`; empty when no fix has an altitude.
     pub altitude_datum: &'static str,
 }
 
-/// GGA, RMC and GST sentences sharing one time of day.
-struct Epoch {
-    time_of_day_ns: i64,
-    /// Line of the epoch's first sentence.
-    line: usize,
-    /// The first GGA: its position (`None`: quality 0, no fix) and quality.
-    gga: Option<(Option<GgaPosition>, GnssFixQuality)>,
-    /// The first RMC.
-    rmc: Option<sentence::Rmc>,
-    horizontal_sigma_m: Option<f64>,
-}
-
-impl Epoch {
-    fn new(time_of_day_ns: i64, line: usize) -> Self {
-        Self { time_of_day_ns, line, gga: None, rmc: None, horizontal_sigma_m: None }
-    }
-
-    /// Adds a sentence of this epoch; the first of each type wins. Returns
-    /// whether it was a second GGA (a duplicate epoch).
-    fn join(&mut self, part: Part) -> bool {
-        match part {
-            Part::Gga(gga) if self.gga.is_none() => self.gga = Some((gga.position, gga.quality)),
-            Part::Gga(_) => return true,
-            Part::Rmc(rmc) => {
-                self.rmc.get_or_insert(rmc);
-            }
-            Part::Gst(gst) => self.horizontal_sigma_m = self.horizontal_sigma_m.or(gst.horizontal_sigma_m),
+/// Reads a log line by line. Fails when a line is too long or no sentence
+/// comes early enough (not an NMEA log), on a read error, and when there are
+/// fixes but no date; everything else is skipped and counted (see the module
+/// documentation). Bytes that are not UTF-8 make their lines unparsable, not
+/// the log.
+pub fn parse_nmea(path: &Path, mut input: impl BufRead) -> Result<NmeaLog, IngestError> {
+    let mut parser = Parser::default();
+    let mut bytes = Vec::with_capacity(MAX_LINE_BYTES + 1);
+    let mut line_number = 0;
+    let mut seen_sentence = false;
+    loop {
+        bytes.clear();
+        let limit = MAX_LINE_BYTES as u64 + 1;
+        if input.by_ref().take(limit).read_until(b'\n', &mut bytes).map_err(os_err(path))? == 0 {
+            break;
         }
-        false
-    }
-
-    /// The fix this epoch gives: from the GGA when there is one (and the RMC
-    /// does not say no fix), else from a valid RMC. `Err(())` is an epoch
-    /// without a fix, `Ok(None)` one with neither GGA nor RMC (a lone GST).
-    fn fix(&self) -> Result<Option<Candidate>, ()> {
-        let rmc_says_no_fix = self.rmc.as_ref().is_some_and(|rmc| !rmc.valid);
-        let candidate = match (&self.gga, &self.rmc) {
-            (Some((Some(p), quality)), _) if !rmc_says_no_fix => Candidate {
-                latitude_deg: p.latitude_deg,
-                longitude_deg: p.longitude_deg,
-                altitude_msl_m: p.altitude_msl_m,
-                geoid_separation_m: p.geoid_separation_m,
-                num_satellites: p.num_satellites,
-                quality: *quality,
-                rmc_only: false,
-            },
-            (None, Some(sentence::Rmc { position: Some(p), .. })) => Candidate {
-                latitude_deg: p.latitude_deg,
-                longitude_deg: p.longitude_deg,
-                altitude_msl_m: None,
-                geoid_separation_m: None,
-                num_satellites: None,
-                quality: p.quality,
-                rmc_only: true,
-            },
-            (None, None) => return Ok(None),
-            _ => return Err(()),
+        line_number += 1;
+        let not_nmea = |detail: String| IngestError::BadRecord {
+            path: path.to_path_buf(),
+            record: format!("line {line_number}"),
+            field: "line".into(),
+            detail,
         };
-        Ok(Some(candidate))
-    }
-}
-
-/// A parsed sentence of a type we use.
-enum Part {
-    Gga(sentence::Gga),
-    Rmc(sentence::Rmc),
-    Gst(sentence::Gst),
-}
-
-impl Part {
-    fn time_of_day_ns(&self) -> Option<i64> {
-        match self {
-            Self::Gga(gga) => gga.time_of_day_ns,
-            Self::Rmc(rmc) => rmc.time_of_day_ns,
-            Self::Gst(gst) => gst.time_of_day_ns,
+        if bytes.len() > MAX_LINE_BYTES {
+            return Err(not_nmea(format!(
+                "longer than {MAX_LINE_BYTES} bytes (NMEA 0183 sentences are at most 82 characters): \
+                 not an NMEA text log (binary data?)"
+            )));
+        }
+        seen_sentence |= parser.line(line_number, String::from_utf8_lossy(&bytes).trim());
+        if !seen_sentence && line_number >= MAX_LINES_BEFORE_FIRST_SENTENCE {
+            return Err(not_nmea(format!(
+                "no NMEA sentence ($<address>,...*<checksum>) in the first {MAX_LINES_BEFORE_FIRST_SENTENCE} lines: \
+                 not an NMEA text log (binary data?)"
+            )));
         }
     }
+    parser.finish(path)
 }
 
-/// What an epoch's fix is made of, before it has a UNIX time.
-struct Candidate {
-    latitude_deg: f64,
-    longitude_deg: f64,
-    altitude_msl_m: Option<f64>,
-    geoid_separation_m: Option<f64>,
-    num_satellites: Option<u32>,
-    quality: GnssFixQuality,
-    /// From an RMC without a usable GGA.
-    rmc_only: bool,
-}
-
-/// A fix whose date is not known yet (GGAs before the first RMC).
-struct Undated {
-    time_of_day_ns: i64,
-    candidate: Candidate,
-    horizontal_sigma_m: Option<f64>,
-    line: usize,
-}
-
-/// The time `time_of_day_ns` on the day that puts it nearest `reference_ns`.
-fn nearest_ns(reference_ns: i64, time_of_day_ns: i64) -> i64 {
-    let midnight = reference_ns.div_euclid(NS_PER_DAY) * NS_PER_DAY;
-    [midnight - NS_PER_DAY, midnight, midnight + NS_PER_DAY]
-        .map(|day| day + time_of_day_ns)
-        .into_iter()
-        .min_by_key(|t| t.abs_diff(reference_ns))
-        .unwrap_or(midnight + time_of_day_ns)
-}
-
-/// `hhmmss.sssssssss` of a time in nanoseconds, for messages.
-fn clock(t_ns: i64) -> String {
-    let ns = t_ns.rem_euclid(NS_PER_DAY);
-    let s = ns / 1_000_000_000;
-    format!("{:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, ns % 1_000_000_000)
-}
-
+/// The epoch being read and what the closed ones gave.
 #[derive(Default)]
-struct Assembler {
-    log: NmeaLog,
-    /// Line of each fix, for messages.
-    fix_lines: Vec<usize>,
-    /// Geoid separation of each fix that has an altitude (to pick the datum).
-    separations_m: Vec<Option<f64>>,
-    /// Latest known UNIX time (an RMC's date and time, or a fix), for dating.
-    reference_ns: Option<i64>,
-    undated: Vec<Undated>,
+struct Parser {
+    assembler: Assembler,
+    current: Option<Epoch>,
 }
 
-impl Assembler {
-    fn close(&mut self, epoch: Epoch) {
-        let rmc_date = epoch.rmc.as_ref().and_then(|rmc| rmc.days);
-        if let Some(days) = rmc_date {
-            let reference_ns = days * NS_PER_DAY + epoch.time_of_day_ns;
-            self.reference_ns = Some(reference_ns);
-            for undated in std::mem::take(&mut self.undated) {
-                let t_ns = nearest_ns(reference_ns, undated.time_of_day_ns);
-                self.emit(t_ns, undated.candidate, undated.horizontal_sigma_m, undated.line);
-            }
-        }
-        let candidate = match epoch.fix() {
-            Ok(Some(candidate)) => candidate,
-            Ok(None) => return,
-            Err(()) => {
-                self.log.epochs_without_fix += 1;
-                return;
-            }
-        };
-        let t_ns = match (rmc_date, self.reference_ns) {
-            (Some(days), _) => days * NS_PER_DAY + epoch.time_of_day_ns,
-            (None, Some(reference_ns)) => nearest_ns(reference_ns, epoch.time_of_day_ns),
-            (None, None) => {
-                let (time_of_day_ns, horizontal_sigma_m, line) =
-                    (epoch.time_of_day_ns, epoch.horizontal_sigma_m, epoch.line);
-                self.undated.push(Undated { time_of_day_ns, candidate, horizontal_sigma_m, line });
-                return;
-            }
-        };
-        if self.emit(t_ns, candidate, epoch.horizontal_sigma_m, epoch.line) {
-            self.reference_ns = Some(t_ns);
-        }
-    }
-
-    /// Appends a fix; returns whether it was kept (not a repeated or
-    /// out-of-order epoch, which are counted instead).
-    fn emit(&mut self, t_ns: i64, candidate: Candidate, horizontal_sigma_m: Option<f64>, line: usize) -> bool {
-        if let (Some(last), Some(last_line)) = (self.log.fixes.last(), self.fix_lines.last()) {
-            if t_ns == last.t_ns {
-                self.log.duplicate_epochs += 1;
-                return false;
-            }
-            if t_ns < last.t_ns {
-                self.log.out_of_order_epochs += 1;
-                if self.log.first_out_of_order.is_none() {
-                    let back_ns = last.t_ns - t_ns;
-                    let reason = format!(
-                        "fix at {} UTC is {}.{:09} s before the previous fix ({} UTC, line {last_line})",
-                        clock(t_ns),
-                        back_ns / 1_000_000_000,
-                        back_ns % 1_000_000_000,
-                        clock(last.t_ns),
-                    );
-                    self.log.first_out_of_order = Some(SkippedLine { line, reason });
-                }
-                return false;
-            }
-        }
-        self.fix_lines.push(line);
-        if candidate.altitude_msl_m.is_some() {
-            self.separations_m.push(candidate.geoid_separation_m);
-        }
-        self.log.rmc_only_fixes += u64::from(candidate.rmc_only);
-        self.log.fixes.push(GnssFix {
-            t_ns,
-            latitude_deg: candidate.latitude_deg,
-            longitude_deg: candidate.longitude_deg,
-            altitude_m: candidate.altitude_msl_m,
-            horizontal_sigma_m,
-            num_satellites: candidate.num_satellites,
-            quality: candidate.quality,
-        });
-        true
-    }
-
-    fn unparsable(&mut self, line: usize, reason: impl FnOnce() -> String) {
-        self.log.unparsable_lines += 1;
-        if self.log.first_unparsable.is_none() {
-            self.log.first_unparsable = Some(SkippedLine { line, reason: reason() });
-        }
-    }
-
-    /// The log, altitudes moved to the ellipsoid when every fix with an
-    /// altitude gives the geoid separation.
-    fn finish(self) -> NmeaLog {
-        let mut log = self.log;
-        if self.separations_m.is_empty() {
-            log.altitude_datum = "";
-        } else if self.separations_m.iter().all(Option::is_some) {
-            let mut separations = self.separations_m.iter().flatten();
-            for altitude_m in log.fixes.iter_mut().filter_map(|fix| fix.altitude_m.as_mut()) {
-                *altitude_m += separations.next().copied().unwrap_or(0.0);
-            }
-            log.altitude_datum = "ellipsoid";
-        } else {
-            log.altitude_datum = "mean sea level";
-        }
-        log
-    }
-}
-
-/// Parses a whole log. Fails only when there are fixes but no date;
-/// everything else is skipped and counted (see the module documentation).
-pub fn parse_nmea(path: &Path, text: &str) -> Result<NmeaLog, IngestError> {
-    let mut assembler = Assembler::default();
-    let mut current: Option<Epoch> = None;
-    for (index, raw) in text.lines().enumerate() {
-        let line_number = index + 1;
-        let (id, kind, fields) = match sentence::split_sentence(raw.trim()) {
+impl Parser {
+    /// Takes one line (trimmed); returns whether it is framed as a sentence
+    /// (`$...*hh`, whatever its checksum).
+    fn line(&mut self, line_number: usize, text: &str) -> bool {
+        let assembler = &mut self.assembler;
+        let (id, kind, fields) = match sentence::split_sentence(text) {
             Line::Sentence { id, kind, fields } => (id, kind, fields),
             Line::Proprietary => {
                 assembler.log.ignored_sentences += 1;
-                continue;
+                return true;
             }
             Line::BadChecksum => {
                 assembler.log.bad_checksum_lines += 1;
                 assembler.log.first_bad_checksum_line.get_or_insert(line_number);
-                continue;
+                return true;
             }
             Line::Junk(reason) => {
                 assembler.unparsable(line_number, || format!("not an NMEA sentence: {reason}"));
-                continue;
+                return false;
             }
         };
         let parsed = match kind {
             "GGA" => sentence::parse_gga(&fields).map(Part::Gga),
             "RMC" => sentence::parse_rmc(&fields).map(Part::Rmc),
             "GST" => sentence::parse_gst(&fields).map(Part::Gst),
+            "ZDA" => sentence::parse_zda(&fields).map(Part::Zda),
             _ => {
                 assembler.log.ignored_sentences += 1;
-                continue;
+                return true;
             }
         };
         let part = match parsed {
             Ok(part) => part,
             Err(e) => {
                 assembler.unparsable(line_number, || format!("{id}: {}: {}", e.field, e.detail));
-                continue;
+                return true;
             }
         };
         let Some(time_of_day_ns) = part.time_of_day_ns() else {
             // No time: a GGA without fix counts as such; an RMC `V` has
-            // nothing to add, nor a GST without time.
+            // nothing to add, nor a GST or ZDA without time.
             match part {
                 Part::Gga(_) => assembler.log.epochs_without_fix += 1,
-                Part::Gst(_) => assembler.log.ignored_sentences += 1,
+                Part::Gst(_) | Part::Zda(_) => assembler.log.ignored_sentences += 1,
                 Part::Rmc(_) => {}
             }
-            continue;
+            return true;
         };
-        if let Some(epoch) = current.take_if(|epoch| epoch.time_of_day_ns != time_of_day_ns) {
+        if let Some(epoch) = self.current.take_if(|epoch| epoch.time_of_day_ns != time_of_day_ns) {
             assembler.close(epoch);
         }
-        let epoch = current.get_or_insert_with(|| Epoch::new(time_of_day_ns, line_number));
+        let epoch = self.current.get_or_insert_with(|| Epoch::new(time_of_day_ns, line_number));
         if epoch.join(part) {
             assembler.log.duplicate_epochs += 1;
         }
+        true
     }
-    if let Some(epoch) = current {
-        assembler.close(epoch);
+
+    /// Closes the last epoch; fails when fixes could not be dated.
+    fn finish(mut self, path: &Path) -> Result<NmeaLog, IngestError> {
+        if let Some(epoch) = self.current.take() {
+            self.assembler.close(epoch);
+        }
+        if let Some(first) = self.assembler.undated.first() {
+            return Err(IngestError::BadLayout {
+                path: path.to_path_buf(),
+                detail: format!(
+                    "{} GGA fixes (the first at line {}) but no RMC or ZDA sentence with a date: \
+                     fixes cannot be given UNIX times",
+                    self.assembler.undated.len(),
+                    first.line
+                ),
+            });
+        }
+        Ok(self.assembler.finish())
     }
-    if let Some(first) = assembler.undated.first() {
-        return Err(IngestError::BadLayout {
-            path: path.to_path_buf(),
-            detail: format!(
-                "{} GGA fixes (the first at line {}) but no RMC sentence with a date: \
-                 fixes cannot be given UNIX times",
-                assembler.undated.len(),
-                first.line
-            ),
-        });
-    }
-    Ok(assembler.finish())
 }
 
-/// Reads and parses a log file. Bytes that are not UTF-8 make their lines
-/// unparsable, not the file.
+/// Opens and parses a log file (streamed: see [`parse_nmea`]).
 pub fn read_nmea(path: &Path) -> Result<NmeaLog, IngestError> {
-    let bytes = std::fs::read(path).map_err(os_err(path))?;
-    parse_nmea(path, &String::from_utf8_lossy(&bytes))
+    let file = std::fs::File::open(path).map_err(os_err(path))?;
+    parse_nmea(path, std::io::BufReader::new(file))
 }
 
 /// What an NMEA ingest did.

@@ -1,4 +1,4 @@
-//! One line: framing and checksum, then the fields of GGA, RMC and GST.
+//! One line: framing and checksum, then the fields of GGA, RMC, GST and ZDA.
 //!
 //! Every parser here is total: it returns a value or says which field is
 //! wrong and what was expected, and never panics, whatever the bytes.
@@ -88,15 +88,15 @@ fn digits_value(text: &str) -> Option<i64> {
 }
 
 /// `hhmmss[.f...]` to nanoseconds since midnight, from the digits (exact to
-/// the nanosecond; digits past the ninth are dropped). Second 60 (a leap
-/// second) is accepted.
+/// the nanosecond; digits past the ninth are dropped). Second 60 is accepted
+/// at 23:59 only (a leap second; its time of day is then a day or more).
 pub(super) fn time_of_day_ns(text: &str) -> Option<i64> {
     let (whole, fraction) = text.split_once('.').unwrap_or((text, ""));
     if whole.len() != 6 {
         return None;
     }
     let (h, m, s) = (digits_value(whole.get(0..2)?)?, digits_value(whole.get(2..4)?)?, digits_value(whole.get(4..6)?)?);
-    if h > 23 || m > 59 || s > 60 {
+    if h > 23 || m > 59 || s > 60 || (s == 60 && (h, m) != (23, 59)) {
         return None;
     }
     let mut sub_ns = 0i64;
@@ -363,6 +363,44 @@ pub(super) fn parse_gst(fields: &[&str]) -> Result<Gst, FieldError> {
     Ok(Gst { time_of_day_ns, horizontal_sigma_m })
 }
 
+/// A ZDA sentence (UTC time and date).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Zda {
+    /// Time of day; empty before the receiver knows the time.
+    pub time_of_day_ns: Option<i64>,
+    /// Date, days since the UNIX epoch; `None` when the day, month and year
+    /// fields are all empty.
+    pub days: Option<i64>,
+}
+
+/// ZDA: `time, day (dd), month (mm), year (yyyy), local zone hours, local
+/// zone minutes`. The time and date are UTC; the local zone is not used.
+pub(super) fn parse_zda(fields: &[&str]) -> Result<Zda, FieldError> {
+    let time_text = get(fields, 1);
+    let time_of_day_ns = match time_text {
+        "" => None,
+        _ => Some(
+            time_of_day_ns(time_text)
+                .ok_or_else(|| field_error("time", format!("'{time_text}' is not hhmmss[.ss] (UTC)")))?,
+        ),
+    };
+    let (day, month, year) = (get(fields, 2), get(fields, 3), get(fields, 4));
+    let days = match (day, month, year) {
+        ("", "", "") => None,
+        _ => {
+            let parsed = (day.len() == 2 && month.len() == 2 && year.len() == 4)
+                .then(|| Some((digits_value(day)?, digits_value(month)?, digits_value(year)?)))
+                .flatten()
+                .filter(|&(d, m, y)| (1..=12).contains(&m) && d >= 1 && d <= days_in_month(y, m));
+            let (d, m, y) = parsed.ok_or_else(|| {
+                field_error("date", format!("'{day},{month},{year}' is not dd,mm,yyyy (a calendar date)"))
+            })?;
+            Some(days_from_civil(y, m, d))
+        }
+    };
+    Ok(Zda { time_of_day_ns, days })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -387,7 +425,8 @@ mod tests {
         assert_eq!(time_of_day_ns("021417.1"), Some((2 * 3600 + 14 * 60 + 17) * 1_000_000_000 + 100_000_000));
         // An empty fraction ("021417.") is whole seconds.
         assert_eq!(time_of_day_ns("021417."), time_of_day_ns("021417"));
-        for bad in ["", "2414", "240000", "026000", "0214+7", "021417.x", "021417.-1", "02141\u{ff17}"] {
+        assert_eq!(time_of_day_ns("235960.5"), Some(NS_PER_DAY + 500_000_000));
+        for bad in ["", "2414", "240000", "026000", "021460", "0214+7", "021417.x", "021417.-1", "02141\u{ff17}"] {
             assert_eq!(time_of_day_ns(bad), None, "{bad}");
         }
         assert_eq!(date_days("010170"), Some(days_from_civil(2070, 1, 1)));
@@ -416,6 +455,19 @@ mod tests {
         // A valid RMC must carry its date.
         let err = parse_rmc(&"GPRMC,021417.00,A,3725.5,N,12205.6,W,0,0,,,,A".split(',').collect::<Vec<_>>());
         assert_eq!(err.unwrap_err().field, "date");
+    }
+
+    #[test]
+    fn zda_gives_the_utc_date() {
+        let fields = |text: &'static str| text.split(',').collect::<Vec<_>>();
+        let zda = parse_zda(&fields("GNZDA,021417.00,07,02,2020,00,00")).unwrap();
+        assert_eq!(zda, Zda { time_of_day_ns: time_of_day_ns("021417.00"), days: Some(days_from_civil(2020, 2, 7)) });
+        // Before the receiver knows the time: nothing, not an error.
+        assert_eq!(parse_zda(&fields("GNZDA,,,,,00,00")).unwrap(), Zda { time_of_day_ns: None, days: None });
+        for bad in ["GNZDA,021417.00,30,02,2020,,", "GNZDA,021417.00,7,2,2020,,", "GNZDA,021417.00,07,02,20,,"] {
+            assert_eq!(parse_zda(&fields(bad)).unwrap_err().field, "date", "{bad}");
+        }
+        assert_eq!(parse_zda(&fields("GNZDA,021460.00,07,02,2020,,")).unwrap_err().field, "time");
     }
 
     #[test]

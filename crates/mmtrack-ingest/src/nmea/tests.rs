@@ -1,6 +1,8 @@
 use proptest::prelude::*;
 
-use super::sentence::days_from_civil;
+use mmtrack_core::GnssFixQuality;
+
+use super::sentence::{NS_PER_DAY, days_from_civil};
 use super::*;
 
 fn sentence(payload: &str) -> String {
@@ -26,7 +28,7 @@ fn epoch(talker: &str, hhmmss: &str) -> String {
 }
 
 fn parse(text: &str) -> Result<NmeaLog, IngestError> {
-    parse_nmea(Path::new("drive.nmea"), text)
+    parse_nmea(Path::new("drive.nmea"), text.as_bytes())
 }
 
 /// 2020-02-07 02:14:17 UTC in UNIX seconds (`date -u -d @1581041657`).
@@ -127,6 +129,108 @@ fn gga_without_rmc_is_an_error() {
     // Without any fix there is nothing to date: not an error.
     let log = parse(&gga("GN", "021417.00", "0")).unwrap();
     assert_eq!((log.fixes.len(), log.epochs_without_fix), (0, 1));
+}
+
+fn zda(talker: &str, hhmmss: &str, dd_mm_yyyy: &str) -> String {
+    sentence(&format!("{talker}ZDA,{hhmmss},{dd_mm_yyyy},00,00"))
+}
+
+#[test]
+fn gga_with_zda_and_no_rmc_gives_fixes() {
+    // GGA then ZDA of the same epoch, across midnight; then a GGA whose
+    // epoch has no ZDA (dated from the previous fix).
+    let lines = [
+        gga("GP", "235959.00", "1"),
+        zda("GP", "235959.00", "31,01,2020"),
+        gga("GP", "000000.00", "4"),
+        zda("GP", "000000.00", "01,02,2020"),
+        gga("GP", "000001.00", "4"),
+        // Before the receiver knows the time: ignored.
+        sentence("GPZDA,,,,,00,00"),
+    ];
+    let log = parse(&lines.join("\n")).unwrap();
+    let midnight_s = days_from_civil(2020, 2, 1) * 86_400;
+    let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000_000 - midnight_s).collect();
+    assert_eq!(times, vec![-1, 0, 1]);
+    assert_eq!((log.rmc_only_fixes, log.unparsable_lines, log.ignored_sentences), (0, 0, 1));
+    assert!(log.fixes.iter().all(|f| f.altitude_m.is_some() && f.num_satellites == Some(12)));
+    // ZDA first, and at 1 Hz beside 5 Hz GGAs: the ZDA dates the GGAs before and after it.
+    let lines = [
+        gga("GN", "021416.80", "1"),
+        zda("GN", "021417.00", "07,02,2020"),
+        gga("GN", "021417.00", "1"),
+        gga("GN", "021417.20", "1"),
+    ];
+    let log = parse(&lines.join("\n")).unwrap();
+    let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000 - T0_S * 1000).collect();
+    assert_eq!(times, vec![-200, 0, 200]);
+    // A ZDA with a date that is not a calendar date is counted, not used.
+    let text = gga("GN", "021417.00", "1") + "\n" + &zda("GN", "021417.00", "30,02,2020");
+    let err = parse(&text).unwrap_err().to_string();
+    assert!(err.contains("no RMC or ZDA sentence with a date"), "{err}");
+}
+
+#[test]
+fn a_leap_second_epoch_is_counted_and_skipped() {
+    // 2016-12-31 23:59:60 UTC was a leap second. UNIX time gives 23:59:60.f
+    // the time of 00:00:00.f, which belongs to the next epoch: the leap
+    // second's fix is skipped and counted, every other fix kept.
+    let lines = [
+        gga("GP", "235959.00", "1"),
+        rmc("GP", "235959.00", "A", "311216"),
+        gga("GP", "235960.00", "1"),
+        rmc("GP", "235960.00", "A", "311216"),
+        gga("GP", "000000.00", "1"),
+        rmc("GP", "000000.00", "A", "010117"),
+    ];
+    let log = parse(&lines.join("\n")).unwrap();
+    let midnight_s = days_from_civil(2017, 1, 1) * 86_400;
+    let times: Vec<i64> = log.fixes.iter().map(|f| f.t_ns / 1_000_000_000 - midnight_s).collect();
+    assert_eq!(times, vec![-1, 0]);
+    assert_eq!((log.leap_second_epochs, log.first_leap_second_line, log.duplicate_epochs), (1, Some(3), 0));
+    // At 10 Hz, GGA + ZDA: the ten epochs of the leap second are counted; the
+    // ZDA of the leap second dates the GGAs after it.
+    let mut text = String::new();
+    for tenth in 0..10 {
+        text += &(gga("GN", &format!("235960.{tenth}0"), "1") + "\n");
+    }
+    text += &(zda("GN", "235960.90", "31,12,2016") + "\n" + &gga("GN", "000000.00", "1") + "\n");
+    let log = parse(&text).unwrap();
+    assert_eq!(log.fixes.iter().map(|f| f.t_ns).collect::<Vec<_>>(), vec![midnight_s * 1_000_000_000]);
+    assert_eq!((log.leap_second_epochs, log.first_leap_second_line), (10, Some(1)));
+}
+
+#[test]
+fn a_long_line_or_a_file_without_sentences_is_refused_with_its_line() {
+    // /dev/zero, a binary file without line ends: refused at line 1 after
+    // reading at most one line's cap.
+    let err = parse_nmea(Path::new("zero.nmea"), std::io::BufReader::new(std::io::repeat(0))).unwrap_err().to_string();
+    assert!(err.starts_with("zero.nmea: line 1: line: longer than 4096 bytes"), "{err}");
+    let long =
+        format!("{}\n{}\n$GPTXT,{}*00\n", epoch("GN", "021417.00"), gga("GN", "021418.00", "1"), "x".repeat(5000));
+    let err = parse(&long).unwrap_err().to_string();
+    assert!(err.starts_with("drive.nmea: line 6: line: longer than 4096 bytes"), "{err}");
+    // A line of exactly the cap (line end included) is a line like another.
+    let at_cap = format!("{}\n{}", "x".repeat(MAX_LINE_BYTES - 1), epoch("GN", "021417.00"));
+    assert_eq!(parse(&at_cap).unwrap().fixes.len(), 1);
+    // Binary data with line ends (bytes of a xorshift generator): no
+    // sentence in the first 1000 lines.
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let noise: Vec<u8> = (0..400_000)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 56) as u8
+        })
+        .filter(|&b| b != b'$')
+        .collect();
+    let err = parse_nmea(Path::new("noise.bin"), noise.as_slice()).unwrap_err().to_string();
+    assert!(err.starts_with("noise.bin: line 1000: line: no NMEA sentence"), "{err}");
+    // Junk lines before the first sentence, fewer than the cap, are counted.
+    let text = "header\n".repeat(MAX_LINES_BEFORE_FIRST_SENTENCE - 1) + &epoch("GN", "021417.00");
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.unparsable_lines), (1, 999));
 }
 
 #[test]
@@ -345,6 +449,37 @@ fn real_drive_without_usable_gga_still_gives_every_fix() {
     let log = parse(&no_height).unwrap();
     assert_eq!((log.fixes.len(), log.unparsable_lines, log.rmc_only_fixes), (1653, 0, 0));
     assert!(log.fixes.iter().all(|f| f.altitude_m.is_none() && f.num_satellites.is_some()));
+}
+
+#[test]
+fn real_drive_as_gga_and_zda_gives_the_same_fixes() {
+    let Some(text) = real_log() else { return };
+    let with_rmc = parse(&text).unwrap();
+    // Each RMC replaced by a ZDA of the same time and date, written after the
+    // GGA (as receivers that log GGA + ZDA do): the same 1653 fixes, field
+    // for field.
+    let mut zda_log = String::new();
+    let mut pending_zda = None;
+    for line in text.lines() {
+        let payload = line.strip_prefix('$').and_then(|b| b.rsplit_once('*')).map(|(p, _)| p);
+        match payload.map(|p| p.split(',').collect::<Vec<_>>()) {
+            Some(fields) if fields[0].ends_with("RMC") && fields.len() > 9 => {
+                let date = fields[9];
+                let dd_mm_yyyy = format!("{},{},20{}", &date[0..2], &date[2..4], &date[4..6]);
+                pending_zda = Some(zda("GN", fields[1], &dd_mm_yyyy));
+                continue;
+            }
+            Some(fields) if fields[0].ends_with("GGA") => {
+                zda_log += &format!("{line}\n");
+                zda_log += &(pending_zda.take().unwrap() + "\n");
+                continue;
+            }
+            _ => zda_log += &format!("{line}\n"),
+        }
+    }
+    let log = parse(&zda_log).unwrap();
+    assert_eq!(log.fixes, with_rmc.fixes);
+    assert_eq!((log.rmc_only_fixes, log.bad_checksum_lines, log.unparsable_lines), (0, 13, 0));
 }
 
 #[test]

@@ -233,6 +233,13 @@ fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
         );
     }
     let beam_count = passes[0].sweeps[0].beam_count();
+    if beam_count < 2 {
+        bail!(
+            "{}: sweeps of {beam_count} beam: the GNSS policies fit a beam map (beam index against the car's \
+             bearing), which needs a codebook of at least 2 beams",
+            passes[0].path.display()
+        );
+    }
     let t_ns: Vec<Vec<i64>> = passes.iter().map(|p| p.sweeps.iter().map(BeamSweep::t_ns).collect()).collect();
     let positions: Vec<Vec<[f64; 2]>> = passes.iter().map(|p| east_north_m(p)).collect::<Result<_, _>>()?;
     let best: Vec<Vec<usize>> =
@@ -243,6 +250,29 @@ fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
     let config = BeamMapConfig::default();
     let per_pass = BeamMap::fit_leave_one_pass_out(&map_passes, beam_count, &config)
         .with_context(|| format!("site {site}: beam map"))?;
+    for (i, map) in per_pass.iter().enumerate() {
+        // Zero when the other passes' best beam never changes: the map then
+        // predicts nothing, and the GNSS window (whose first sigma is this
+        // residual) would have no width.
+        if map.rms_residual_beams() > 0.0 {
+            continue;
+        }
+        let mut others: Vec<usize> =
+            best.iter().enumerate().filter(|&(j, _)| j != i).flat_map(|(_, b)| b.iter().copied()).collect();
+        others.sort_unstable();
+        others.dedup();
+        let cause = match others.as_slice() {
+            [beam] => format!(
+                "their best beam is {beam} in every sweep: the power does not vary across the beams (all zero, or \
+                 equal), so the beam does not follow the car's bearing"
+            ),
+            _ => "the best beams lie exactly on the map, which leaves the GNSS window no first width".to_string(),
+        };
+        bail!(
+            "site {site}: the beam map for {} (fitted on the other recordings) has an RMS residual of 0 beams: {cause}",
+            passes[i].path.display()
+        );
+    }
     let all = BeamMap::fit(&map_passes, beam_count, &config).with_context(|| format!("site {site}: beam map"))?;
     let gnss_beam = per_pass
         .iter()
