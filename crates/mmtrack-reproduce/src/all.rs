@@ -235,10 +235,10 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
     let timing = timings.iter().map(|(n, s)| format!("{n} {s:.1} s")).collect::<Vec<_>>().join(", ");
     let mode = if options.tier.is_smoke() { "smoke (--quick)" } else { "full" };
     let command = format!("mmtrack reproduce --all{}", if options.tier.is_smoke() { " --smoke" } else { "" });
-    let mut summary = claims_section(&claims, &command, options.tier);
+    let mut summary = format!("#### Paper verdicts\n\n{}", claims_section(&claims, &command, options.tier));
     let _ = write!(
         summary,
-        "\n### Regression check\n\nWritten by `{command}`: {} metrics of {} experiments, {misses} outside their \
+        "\n#### Regression check\n\nWritten by `{command}`: {} metrics of {} experiments, {misses} outside their \
          expected range. Expected values (data/reproduce/<experiment>.expected.toml) are what this code measured \
          when the results were written, with absolute tolerances: \"unchanged\" says our numbers did not move, \
          not that they match the paper (the claims above say that).\n\n",

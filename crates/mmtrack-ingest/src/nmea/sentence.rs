@@ -215,14 +215,7 @@ pub(super) fn parse_gga(fields: &[&str]) -> Result<Gga, FieldError> {
         "6" => GnssFixQuality::DeadReckoning,
         _ => GnssFixQuality::Unknown,
     };
-    let time_text = get(fields, 1);
-    let time_of_day_ns = match time_text {
-        "" if quality == GnssFixQuality::NoFix => None,
-        _ => Some(
-            time_of_day_ns(time_text)
-                .ok_or_else(|| field_error("time", format!("'{time_text}' is not hhmmss[.ss] (UTC)")))?,
-        ),
-    };
+    let time_of_day_ns = utc_time_field(fields, quality == GnssFixQuality::NoFix)?;
     if quality == GnssFixQuality::NoFix {
         return Ok(Gga { time_of_day_ns, quality, position: None });
     }
@@ -295,14 +288,7 @@ pub(super) fn parse_rmc(fields: &[&str]) -> Result<Rmc, FieldError> {
         "V" => false,
         other => return Err(field_error("status", format!("'{other}' is not A (valid) or V (no fix)"))),
     };
-    let time_text = get(fields, 1);
-    let time_of_day_ns = match time_text {
-        "" if !valid => None,
-        _ => Some(
-            time_of_day_ns(time_text)
-                .ok_or_else(|| field_error("time", format!("'{time_text}' is not hhmmss[.ss] (UTC)")))?,
-        ),
-    };
+    let time_of_day_ns = utc_time_field(fields, !valid)?;
     let date_text = get(fields, 9);
     let days = match date_text {
         "" if !valid => None,
@@ -331,6 +317,19 @@ pub(super) fn parse_rmc(fields: &[&str]) -> Result<Rmc, FieldError> {
     Ok(Rmc { time_of_day_ns, valid, days, position: Some(RmcPosition { latitude_deg, longitude_deg, quality }) })
 }
 
+/// The UTC time of day of field 1 (`hhmmss[.ss]`, every sentence type
+/// here), nanoseconds; `None` when the field is empty and `may_be_empty`
+/// (a receiver without a fix, or before it knows the time).
+fn utc_time_field(fields: &[&str], may_be_empty: bool) -> Result<Option<i64>, FieldError> {
+    let time_text = get(fields, 1);
+    if time_text.is_empty() && may_be_empty {
+        return Ok(None);
+    }
+    time_of_day_ns(time_text)
+        .map(Some)
+        .ok_or_else(|| field_error("time", format!("'{time_text}' is not hhmmss[.ss] (UTC)")))
+}
+
 /// A GST sentence (pseudorange error statistics).
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct Gst {
@@ -341,14 +340,7 @@ pub(super) struct Gst {
 
 /// GST: `time, rms, semi-major, semi-minor, orientation, sigma lat, sigma lon, sigma alt`.
 pub(super) fn parse_gst(fields: &[&str]) -> Result<Gst, FieldError> {
-    let time_text = get(fields, 1);
-    let time_of_day_ns = match time_text {
-        "" => None,
-        _ => Some(
-            time_of_day_ns(time_text)
-                .ok_or_else(|| field_error("time", format!("'{time_text}' is not hhmmss[.ss] (UTC)")))?,
-        ),
-    };
+    let time_of_day_ns = utc_time_field(fields, true)?;
     let sigma = |index: usize, field: &'static str| match get(fields, index) {
         "" => Ok(None),
         text => finite(text)
@@ -376,14 +368,7 @@ pub(super) struct Zda {
 /// ZDA: `time, day (dd), month (mm), year (yyyy), local zone hours, local
 /// zone minutes`. The time and date are UTC; the local zone is not used.
 pub(super) fn parse_zda(fields: &[&str]) -> Result<Zda, FieldError> {
-    let time_text = get(fields, 1);
-    let time_of_day_ns = match time_text {
-        "" => None,
-        _ => Some(
-            time_of_day_ns(time_text)
-                .ok_or_else(|| field_error("time", format!("'{time_text}' is not hhmmss[.ss] (UTC)")))?,
-        ),
-    };
+    let time_of_day_ns = utc_time_field(fields, true)?;
     let (day, month, year) = (get(fields, 2), get(fields, 3), get(fields, 4));
     let days = match (day, month, year) {
         ("", "", "") => None,
