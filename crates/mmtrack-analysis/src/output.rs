@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{RunInfo, write_table};
 
@@ -49,12 +49,7 @@ pub fn check_output(out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
         let top = relative.iter().next().map(|c| c.to_string_lossy()).unwrap_or_default();
         OWN_ENTRIES.contains(&top.as_ref()) || top.starts_with("run=")
     };
-    match mmtrack_io::check_replaceable_dir(out, "mmtrack analyze", &owns, overwrite) {
-        Err(mmtrack_io::IoError::OutputExists { .. }) => {
-            bail!("{}: holds results; use --force to replace them (nothing was written)", out.display())
-        }
-        other => Ok(other?),
-    }
+    Ok(mmtrack_io::check_replaceable_dir(out, "mmtrack analyze", &owns, overwrite)?)
 }
 
 fn parent_dir(path: &Path) -> PathBuf {

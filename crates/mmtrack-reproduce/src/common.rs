@@ -105,6 +105,20 @@ pub fn run_count(explicit: Option<u64>, tier: Tier, smoke_runs: u64, full_runs: 
     Ok(runs)
 }
 
+/// The report line beside a run's timings: the 1-minute load average
+/// before and after it (`(before, after)`, from [`load_average`]) on
+/// `threads` threads.
+#[must_use]
+pub fn load_sentence(load: (Option<f64>, Option<f64>), threads: usize) -> String {
+    let text = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
+    format!(
+        "1-minute load average before / after the run: {} / {} (on {threads} threads; above that, other work shared \
+         the cores and the times are longer).\n",
+        text(load.0),
+        text(load.1)
+    )
+}
+
 /// The 1-minute load average (`/proc/loadavg`, Linux; `None` elsewhere),
 /// printed beside timings: other work on the machine makes them longer.
 #[must_use]

@@ -119,21 +119,20 @@ pub fn read_trajectory(
 
 /// Streams `simulator`'s scans into an Oxford folder at `dir` (replaced
 /// atomically: built beside it, then renamed). An existing `dir` is replaced
-/// only with `force` and only when it holds nothing but what this writes
+/// only with [`Overwrite::Replace`] and only when it holds nothing but what this writes
 /// ([`is_oxford_output_entry`]); anything else is refused by name before any
 /// scan is rendered.
 ///
 /// # Errors
-/// An existing `dir` without `force`, a `dir` holding other files, or a file
+/// An existing `dir` without [`Overwrite::Replace`], a `dir` holding other files, or a file
 /// that cannot be written.
 pub fn write_oxford_streaming(
     scenario: &Scenario,
     simulator: RadarSimulator<'_>,
     dir: &Path,
-    force: bool,
+    overwrite: Overwrite,
     progress: &dyn Progress,
 ) -> anyhow::Result<()> {
-    let overwrite = if force { Overwrite::Replace } else { Overwrite::Refuse };
     check_replaceable_dir(dir, "mmtrack simulate radar --format oxford", &is_oxford_output_entry, overwrite)?;
     let parent = dir.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(parent).with_context(|| parent.display().to_string())?;
@@ -268,8 +267,7 @@ pub fn simulate_radar(args: &RadarSimulation, progress: &dyn Progress) -> anyhow
     progress.start("simulate radar", total as u64, "scans");
     match args.layout {
         RadarLayout::Oxford => {
-            let force = args.recording.overwrite == mmtrack_io::Overwrite::Replace;
-            write_oxford_streaming(&scenario, simulator, &args.output, force, progress)?;
+            write_oxford_streaming(&scenario, simulator, &args.output, args.recording.overwrite, progress)?;
         }
         RadarLayout::Recording => write_recording(args, &scenario, simulator, progress)?,
     }

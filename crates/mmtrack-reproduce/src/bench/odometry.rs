@@ -285,7 +285,13 @@ fn simulated_recording(scans: usize, dir: &Path) -> anyhow::Result<PathBuf> {
         SimOptions { limits: ScanLimits { max_scans: Some(scans), max_distance_m: None }, ..scenario.options() };
     let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options)?;
     let folder = dir.join(format!("drive-{scans}"));
-    mmtrack_process::simulate::radar::write_oxford_streaming(&scenario, simulator, &folder, true, &NoProgress)?;
+    mmtrack_process::simulate::radar::write_oxford_streaming(
+        &scenario,
+        simulator,
+        &folder,
+        mmtrack_io::Overwrite::Replace,
+        &NoProgress,
+    )?;
     let recording = dir.join(format!("drive-{scans}.mcap"));
     ingest_quietly(&folder, &recording)?;
     std::fs::remove_dir_all(&folder)?;

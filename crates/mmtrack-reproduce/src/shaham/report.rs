@@ -12,7 +12,7 @@ use mmtrack_io::table::{RunInfo, write_table};
 
 use super::config::{Config, TRACKERS};
 use super::run::{Measured, PointResult};
-use crate::common::Staged;
+use crate::common::{Staged, load_sentence};
 use crate::model::{Claim, Metric, Rule, Verdict, verdict_rows, write_metrics};
 
 /// The README block the summary replaces.
@@ -179,13 +179,7 @@ pub fn summary(experiment: &Config, measured: &Measured, verdicts: &[Verdict]) -
         experiment.blocks,
         speeds.join(", ")
     ));
-    let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
-    out.push_str(&format!(
-        "1-minute load average before / after the run: {} / {} (on {threads} threads; above that, other work shared \
-         the cores and the times are longer).\n",
-        fmt(load.0),
-        fmt(load.1)
-    ));
+    out.push_str(&load_sentence(*load, threads));
     out
 }
 

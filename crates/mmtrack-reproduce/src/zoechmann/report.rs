@@ -16,7 +16,7 @@ use super::run::{
     DOPPLER_MPS_FIRST, ESTIMATORS, FULL_SCAN_VARIANT, GATED_VARIANT, ManoeuvreResult, Measured, PLOTTED, WINDOWED,
     WINDOWED_DOPPLER_MPS,
 };
-use crate::common::Staged;
+use crate::common::{Staged, load_sentence};
 use crate::model::{Claim, Metric, Rule, Verdict, verdict_rows, write_metrics};
 use mmtrack_core::stats::quantile_nearest_rank;
 
@@ -243,13 +243,7 @@ pub fn summary(experiment: &Config, measured: &Measured, verdicts: &[Verdict]) -
         ESTIMATORS.len(),
         runs as f64 * results.len() as f64 / elapsed_s.max(1e-9),
     ));
-    let fmt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.1}"));
-    out.push_str(&format!(
-        "1-minute load average before / after the run: {} / {} (on {threads} threads; above that, other work shared \
-         the cores and the times are longer).\n",
-        fmt(load.0),
-        fmt(load.1)
-    ));
+    out.push_str(&load_sentence(*load, threads));
     out.push_str(&nlos::summary(&measured.nlos, &experiment.nlos, experiment.scenario.epoch_s));
     out
 }

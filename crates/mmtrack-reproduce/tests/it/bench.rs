@@ -24,7 +24,14 @@ fn simulated_oxford_folder(dir: &Path, scans: usize) {
     let options =
         SimOptions { limits: ScanLimits { max_scans: Some(scans), max_distance_m: None }, ..scenario.options() };
     let simulator = RadarSimulator::new(&world, &scenario.sensor, &trajectory, options).unwrap();
-    mmtrack_process::simulate::radar::write_oxford_streaming(&scenario, simulator, dir, false, &NoProgress).unwrap();
+    mmtrack_process::simulate::radar::write_oxford_streaming(
+        &scenario,
+        simulator,
+        dir,
+        mmtrack_io::Overwrite::Refuse,
+        &NoProgress,
+    )
+    .unwrap();
 }
 
 #[test]
