@@ -346,9 +346,9 @@ fn write_geometric_into(dir: &Path, results: &GeometricResults, run: &RunInfo) -
     Ok(2 * results.sequences.len())
 }
 
-/// Moves the complete `staged` directory to `out`. An existing `out` is
-/// first moved aside and deleted only after the new one is in place; if the
-/// second rename fails, the old one is moved back.
+/// Moves the complete `staged` directory to `out` ([`mmtrack_io::publish_dir`]:
+/// an existing `out` is moved aside and deleted only after the new one is in
+/// place, with no window in which an interruption leaves `out` missing).
 fn publish(staged: PathBuf, out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
     let result = publish_inner(&staged, out, overwrite);
     if result.is_err() {
@@ -358,21 +358,7 @@ fn publish(staged: PathBuf, out: &Path, overwrite: Overwrite) -> anyhow::Result<
 }
 
 fn publish_inner(staged: &Path, out: &Path, overwrite: Overwrite) -> anyhow::Result<()> {
-    if !out.exists() {
-        return std::fs::rename(staged, out)
-            .with_context(|| format!("{}: cannot move results into place", out.display()));
-    }
     // Re-check: another process may have written here while we worked.
     check_output(out, overwrite)?;
-    let name = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let aside = parent_dir(out).join(format!(".{name}.replaced-{}", std::process::id()));
-    if aside.exists() {
-        std::fs::remove_dir_all(&aside).with_context(|| aside.display().to_string())?;
-    }
-    std::fs::rename(out, &aside).with_context(|| format!("{}: cannot move the old results aside", out.display()))?;
-    if let Err(e) = std::fs::rename(staged, out) {
-        let _ = std::fs::rename(&aside, out);
-        return Err(e).with_context(|| format!("{}: cannot move results into place (old results kept)", out.display()));
-    }
-    std::fs::remove_dir_all(&aside).with_context(|| format!("{}: new results in place; old copy left", aside.display()))
+    mmtrack_io::publish_dir(staged, out).with_context(|| format!("{}: cannot move results into place", out.display()))
 }

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use mmtrack_core::plausible::{ANGLE_RAD, COORDINATE_M};
 use mmtrack_core::stats::rms;
 use mmtrack_core::{
     MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, OdometryEstimate, Se2, StampedPose,
@@ -302,12 +303,32 @@ pub fn read_trajectories(root: &Path) -> anyhow::Result<BTreeMap<String, Traject
         read_table_dir::<GroundTruthPose>(root)?
     };
     for (sequence, rows) in estimates {
-        let estimate =
+        let estimate: Vec<StampedPose> =
             rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
-        let ground_truth = truths.remove(&sequence).map(|g| g.into_iter().map(|p| p.0).collect());
+        check_plausible_poses(&table_path(root, ODOMETRY.name, &sequence)?, &estimate)?;
+        let ground_truth: Option<Vec<StampedPose>> =
+            truths.remove(&sequence).map(|g| g.into_iter().map(|p| p.0).collect());
+        if let Some(truth) = &ground_truth {
+            check_plausible_poses(&table_path(root, GROUND_TRUTH.name, &sequence)?, truth)?;
+        }
         out.insert(sequence, TrajectoryInput { estimate, ground_truth });
     }
     Ok(out)
+}
+
+/// Refuses poses beyond the plausibility bounds of
+/// [`mmtrack_core::plausible`], naming the file, the row and the column:
+/// coordinates of 1e308 gave NaN and infinite metrics with exit 0.
+fn check_plausible_poses(path: &Path, poses: &[StampedPose]) -> anyhow::Result<()> {
+    for (row, pose) in poses.iter().enumerate() {
+        let p = pose.parent_from_child;
+        for (column, bound, value) in
+            [("x_m", &COORDINATE_M, p.x_m), ("y_m", &COORDINATE_M, p.y_m), ("yaw_rad", &ANGLE_RAD, p.yaw_rad)]
+        {
+            bound.check(value).map_err(|e| anyhow::anyhow!("{}: row {row}: {column}: {e}", path.display()))?;
+        }
+    }
+    Ok(())
 }
 
 /// Analyzes every sequence of `plan`; an error names the sequence and the

@@ -19,6 +19,8 @@
 //! - [`random`]: the seeded random streams (SplitMix64 of words into `Pcg64`)
 //!   and the standard-normal, exponential and gamma draws every simulator,
 //!   filter and benchmark uses, so a seed means the same draws everywhere;
+//! - [`plausible`]: the bounds every reader checks values from files against
+//!   (latitude, altitude, coordinates, angles, rotations, scan row times);
 //! - [`stats`]: quantiles (linear and nearest-rank), median, root mean square and `erfc`;
 //! - [`sounder`]: the channel-sounder signal model (frequency grid, Kaiser
 //!   window, path spectra) shared by the sounder simulator and the MPC detector.
@@ -40,6 +42,7 @@ pub mod limits;
 mod mpc;
 mod odometry;
 pub mod parallel;
+pub mod plausible;
 mod pose;
 pub mod progress;
 mod radar;

@@ -96,6 +96,24 @@ pub const REFLECTORS: Limit = Limit {
 /// `max_iterations`): each round is a full solve; published values are <= 100.
 pub const ITERATIONS: Limit = Limit { max: 10_000.0, expected: "between 1 and 10000 iterations" };
 
+/// Size of a text input read whole (CSV ground truth and GNSS, timestamps,
+/// pose files, sidecars, DecaWave logs, CIR CSV), bytes: 1 GiB, five times
+/// the largest such file of the supported datasets (a Boreas
+/// `gps_post_process.csv` of an hour at 200 Hz, about 200 MB). NMEA logs are
+/// streamed and have no bound.
+pub const TEXT_FILE_BYTES: Limit =
+    Limit { max: 1_073_741_824.0, expected: "a text file of at most 1073741824 bytes (1 GiB)" };
+
+/// Size of a binary array input read whole (`.npy`, `.npz`, `.mat`, SigMF
+/// data), bytes: 4 GiB.
+pub const ARRAY_FILE_BYTES: Limit =
+    Limit { max: 4_294_967_296.0, expected: "an array file of at most 4294967296 bytes (4 GiB)" };
+
+/// Size of one radar scan PNG read whole, bytes: 128 MiB, twice the
+/// [`SCAN_PIXELS`] image stored without compression.
+pub const SCAN_PNG_BYTES: Limit =
+    Limit { max: 134_217_728.0, expected: "a scan PNG of at most 134217728 bytes (128 MiB)" };
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -116,6 +134,9 @@ mod tests {
             DURATION_S,
             REFLECTORS,
             ITERATIONS,
+            TEXT_FILE_BYTES,
+            ARRAY_FILE_BYTES,
+            SCAN_PNG_BYTES,
         ];
         for limit in limits {
             assert!(limit.expected.contains(&format!("{}", limit.max)), "{limit:?}");

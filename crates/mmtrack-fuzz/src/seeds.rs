@@ -48,16 +48,19 @@ fn head(path: &Path, max: usize, lines: bool) -> Option<Vec<u8>> {
 }
 
 /// A scan of `rows` azimuths and `bins` bins with increasing times and angles.
+/// Stamp of the seed scans (the real Oxford sample's first scan), ns.
+pub const SCAN_T0_NS: i64 = 1_547_131_046_353_776_000;
+
 fn scan(rows: usize, bins: usize) -> PolarScan {
     let azimuths = (0..rows)
         .map(|i| AzimuthSample {
-            t_ns: 1_547_131_046_353_776_000 + i as i64 * 625_000,
+            t_ns: SCAN_T0_NS + i as i64 * 625_000,
             azimuth_rad: i as f64 * std::f64::consts::TAU / 400.0,
             valid: i % 3 != 2,
         })
         .collect();
     let header = PolarScanHeader {
-        t_ns: 1_547_131_046_353_776_000,
+        t_ns: SCAN_T0_NS,
         range_resolution_m: OXFORD.range_resolution_m,
         range_offset_m: 0.0,
         bins_per_azimuth: bins,
@@ -85,7 +88,10 @@ pub fn png(realdata: Option<&Path>) -> Vec<Vec<u8>> {
         return out;
     };
     out.extend(head(&first, 4096, false));
-    let Some(real) = std::fs::read(&first).ok().and_then(|b| decode_scan_png(&first, &b, 1, &OXFORD).ok()) else {
+    // The file name is the scan's stamp in microseconds (the row times must lie near it).
+    let stamp_ns = first.file_stem().and_then(|s| s.to_str()?.parse::<i64>().ok()).map_or(0, |us| us * 1000);
+    let Some(real) = std::fs::read(&first).ok().and_then(|b| decode_scan_png(&first, &b, stamp_ns, &OXFORD).ok())
+    else {
         return out;
     };
     let real = real.into_scan();

@@ -52,6 +52,13 @@ impl CsvRow<'_> {
             .ok_or_else(|| self.bad(name, format!("'{raw}' is not a finite number")))
     }
 
+    /// A finite number within a plausibility bound
+    /// ([`mmtrack_core::plausible`]), e.g. `COORDINATE_M` for a position.
+    pub fn bounded(&self, name: &str, bound: &mmtrack_core::plausible::Bound) -> Result<f64, IngestError> {
+        let value = self.finite(name)?;
+        bound.check(value).map_err(|e| self.bad(name, e.to_string()))
+    }
+
     /// A positive UNIX time in microseconds, as nanoseconds.
     pub fn micros_ns(&self, name: &str) -> Result<i64, IngestError> {
         let raw = self.text(name)?;

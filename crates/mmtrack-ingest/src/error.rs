@@ -72,3 +72,103 @@ pub enum IngestError {
 pub(crate) fn os_err(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> IngestError + '_ {
     move |source| IngestError::Os { path: path.to_path_buf(), source }
 }
+
+/// `value` if it is within `bound` (see [`mmtrack_core::plausible`]), else
+/// the error naming the file, the record and the field. Every reader checks
+/// positions, angles, latitudes and altitudes through this.
+pub(crate) fn check_plausible(
+    path: &std::path::Path,
+    record: impl FnOnce() -> String,
+    field: &str,
+    bound: &mmtrack_core::plausible::Bound,
+    value: f64,
+) -> Result<f64, IngestError> {
+    bound.check(value).map_err(|e| IngestError::BadRecord {
+        path: path.to_path_buf(),
+        record: record(),
+        field: field.to_string(),
+        detail: e.to_string(),
+    })
+}
+
+/// Reads a whole input file, refusing one over `limit` before reading it, and
+/// stopping one byte past the limit where the OS reports no size (a pipe,
+/// `/dev/zero`), so no input makes the reader allocate beyond its limit.
+pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::Limit) -> Result<Vec<u8>, IngestError> {
+    use std::io::Read as _;
+    let max_bytes = limit.max as u64;
+    let too_large = |size: String| IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: format!("{size} bytes is too large: expected {}", limit.expected),
+    };
+    let file = std::fs::File::open(path).map_err(os_err(path))?;
+    let metadata = file.metadata().map_err(os_err(path))?;
+    if is_device(&metadata) {
+        return Err(IngestError::BadLayout {
+            path: path.to_path_buf(),
+            detail: "is a device, not a file or a pipe: nothing to read a recording from".into(),
+        });
+    }
+    let size = metadata.len();
+    if size > max_bytes {
+        return Err(too_large(size.to_string()));
+    }
+    let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
+    file.take(max_bytes + 1).read_to_end(&mut bytes).map_err(os_err(path))?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(format!("more than {max_bytes}")));
+    }
+    Ok(bytes)
+}
+
+/// [`read_capped`] at [`mmtrack_core::limits::TEXT_FILE_BYTES`], as UTF-8
+/// text; invalid UTF-8 is an error naming the byte offset.
+pub(crate) fn read_text(path: &std::path::Path) -> Result<String, IngestError> {
+    let bytes = read_capped(path, &mmtrack_core::limits::TEXT_FILE_BYTES)?;
+    String::from_utf8(bytes).map_err(|e| IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: format!("not UTF-8 text: invalid byte at offset {}", e.utf8_error().valid_up_to()),
+    })
+}
+
+/// Whether `metadata` is of a character or block device (`/dev/zero`,
+/// `/dev/urandom`): endless input no reader should take.
+fn is_device(metadata: &std::fs::Metadata) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt as _;
+        metadata.file_type().is_char_device() || metadata.file_type().is_block_device()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = metadata;
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mmtrack_core::limits::Limit;
+
+    /// Before: text inputs were read whole whatever their size; `/dev/zero`
+    /// as an input grew without bound.
+    #[test]
+    fn inputs_over_their_limit_and_devices_are_refused_before_reading() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gt.csv");
+        std::fs::write(&path, "0123456789").unwrap();
+        let ten = Limit { max: 10.0, expected: "at most 10 bytes" };
+        let nine = Limit { max: 9.0, expected: "at most 9 bytes" };
+        assert_eq!(read_capped(&path, &ten).unwrap(), b"0123456789");
+        let err = read_capped(&path, &nine).unwrap_err().to_string();
+        assert!(err.contains("gt.csv") && err.contains("10 bytes is too large: expected at most 9 bytes"), "{err}");
+        if std::path::Path::new("/dev/zero").exists() {
+            let err = read_text(std::path::Path::new("/dev/zero")).unwrap_err().to_string();
+            assert!(err.starts_with("/dev/zero") && err.contains("is a device"), "{err}");
+        }
+        std::fs::write(&path, b"ok\xff").unwrap();
+        let err = read_text(&path).unwrap_err().to_string();
+        assert!(err.contains("not UTF-8 text: invalid byte at offset 2"), "{err}");
+    }
+}

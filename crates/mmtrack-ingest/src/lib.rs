@@ -18,6 +18,7 @@
 
 pub mod beams;
 pub mod boreas;
+mod calendar;
 pub mod cdr;
 pub mod cir;
 mod csv;

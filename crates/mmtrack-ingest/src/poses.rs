@@ -21,10 +21,13 @@
 //! quaternion is normalised first.
 //!
 //! A file without a single pose is an error, and so is a plane that leaves
-//! the motion on the dropped axis (see [`check_plane`]).
+//! the motion on the dropped axis (see [`check_plane`]), a coordinate beyond
+//! [`COORDINATE_M`] or a KITTI rotation that is not orthonormal
+//! ([`plausible::check_rotation`]).
 
 use std::path::Path;
 
+use mmtrack_core::plausible::{self, COORDINATE_M};
 use mmtrack_core::{Se2, StampedPose};
 use std::collections::BTreeMap;
 
@@ -32,7 +35,7 @@ use mmtrack_io::RecordingOptions;
 use mmtrack_io::recording::{PoseStream, WriteSummary};
 
 use crate::IngestError;
-use crate::error::os_err;
+use crate::error::check_plausible;
 
 /// Which plane of a 3D trajectory is the ground.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -181,6 +184,14 @@ fn numbers<const N: usize>(path: &Path, line: usize, text: &str, names: &[&str; 
     Ok(out)
 }
 
+/// Checks a position's coordinates against [`COORDINATE_M`].
+fn check_position(path: &Path, line: usize, names: [&str; 3], position_m: [f64; 3]) -> Result<(), IngestError> {
+    for (name, value) in names.into_iter().zip(position_m) {
+        check_plausible(path, || format!("line {line}"), name, &COORDINATE_M, value)?;
+    }
+    Ok(())
+}
+
 fn yaw_from_quaternion(q: [f64; 4]) -> f64 {
     let [x, y, z, w] = q;
     (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z))
@@ -212,6 +223,7 @@ pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPos
         let rest = line[stamp.len()..].trim();
         let [tx, ty, tz, qx, qy, qz, qw] =
             numbers(path, line_number, rest, &["tx", "ty", "tz", "qx", "qy", "qz", "qw"])?;
+        check_position(path, line_number, ["tx", "ty", "tz"], [tx, ty, tz])?;
         let [qx, qy, qz, qw] =
             unit_quaternion([qx, qy, qz, qw]).map_err(|detail| bad(path, line_number, "qx qy qz qw", detail))?;
         let pose = match plane {
@@ -276,7 +288,10 @@ pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> R
     let mut positions_m = Vec::new();
     for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let line_number = index + 1;
-        let [r11, _r12, r13, tx, r21, _r22, _r23, ty, _r31, _r32, r33, tz] = numbers(path, line_number, line, &names)?;
+        let [r11, r12, r13, tx, r21, r22, r23, ty, r31, r32, r33, tz] = numbers(path, line_number, line, &names)?;
+        check_position(path, line_number, ["tx", "ty", "tz"], [tx, ty, tz])?;
+        plausible::check_rotation(&[[r11, r12, r13], [r21, r22, r23], [r31, r32, r33]])
+            .map_err(|detail| bad(path, line_number, "r11..r33", detail))?;
         let t_ns = *times_ns.get(poses.len()).ok_or_else(|| {
             bad(path, line_number, "time", format!("the times file has only {} lines for more poses", times_ns.len()))
         })?;
@@ -303,7 +318,7 @@ pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> R
 
 /// Reads a file as text.
 pub fn read_text(path: &Path) -> Result<String, IngestError> {
-    std::fs::read_to_string(path).map_err(os_err(path))
+    crate::error::read_text(path)
 }
 
 /// Writes `poses` as `stream` into `out`: a new recording, or, with `extend`,
@@ -384,6 +399,23 @@ mod tests {
                 .unwrap_err()
                 .to_string();
         assert!(err.contains("line 2") && err.contains("times file has only 1"), "{err}");
+    }
+
+    /// Before: a KITTI rotation of 2 x identity and TUM coordinates of 1e300
+    /// were ingested (exit 0) and broke every metric downstream.
+    #[test]
+    fn implausible_coordinates_and_rotations_are_refused() {
+        let err = parse_tum(Path::new("t.txt"), "1.0 1e300 2 3 0 0 0 1\n", Plane::Xy).unwrap_err().to_string();
+        assert!(err.starts_with("t.txt: line 1: tx: 1e300 is not a coordinate within +-1e8 m"), "{err}");
+        let twice = "2 0 0 0 0 2 0 0 0 0 2 0\n";
+        let err = parse_kitti(Path::new("p.txt"), twice, &[1], Plane::Xy).unwrap_err().to_string();
+        assert!(err.starts_with("p.txt: line 1: r11..r33: the rotation is not orthonormal"), "{err}");
+        let mirror = "1 0 0 0 0 -1 0 0 0 0 1 0\n";
+        let err = parse_kitti(Path::new("p.txt"), mirror, &[1], Plane::Xy).unwrap_err().to_string();
+        assert!(err.contains("reflection"), "{err}");
+        let far = "1 0 0 0 0 1 0 -2e8 0 0 1 0\n";
+        let err = parse_kitti(Path::new("p.txt"), far, &[1], Plane::Xy).unwrap_err().to_string();
+        assert!(err.starts_with("p.txt: line 1: ty: -200000000 is not a coordinate"), "{err}");
     }
 
     #[test]

@@ -14,6 +14,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use mmtrack_core::plausible::{ALTITUDE_M, COORDINATE_M, LATITUDE_DEG, LONGITUDE_DEG};
 use mmtrack_core::{GnssFix, GnssFixQuality, Se2, StampedPose};
 use mmtrack_io::recording::{PoseStream, RawReader, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
@@ -46,8 +47,9 @@ fn planar_pose(cdr: &mut Cdr<'_>) -> Result<Se2, String> {
     let q =
         [cdr.f64("orientation.x")?, cdr.f64("orientation.y")?, cdr.f64("orientation.z")?, cdr.f64("orientation.w")?];
     let q = crate::poses::unit_quaternion(q).map_err(|e| format!("pose.orientation: {e}"))?;
-    let pose = Se2::new(x, y, (2.0 * (q[3] * q[2] + q[0] * q[1])).atan2(1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2])));
-    if pose.is_finite() { Ok(pose) } else { Err("pose is not finite".into()) }
+    let x = COORDINATE_M.check(x).map_err(|e| format!("pose.position.x: {e}"))?;
+    let y = COORDINATE_M.check(y).map_err(|e| format!("pose.position.y: {e}"))?;
+    Ok(Se2::new(x, y, (2.0 * (q[3] * q[2] + q[0] * q[1])).atan2(1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2]))))
 }
 
 /// Decodes `nav_msgs/msg/Odometry` (the pose part).
@@ -88,13 +90,12 @@ pub fn decode_nav_sat_fix(data: &[u8]) -> Result<Option<GnssFix>, String> {
     if status < 0 {
         return Ok(None);
     }
-    if !(latitude_deg.is_finite() && longitude_deg.is_finite()) {
-        return Err(format!("latitude/longitude: ({latitude_deg}, {longitude_deg}) is not finite"));
-    }
+    let latitude_deg = LATITUDE_DEG.check(latitude_deg).map_err(|e| format!("latitude: {e}"))?;
+    let longitude_deg = LONGITUDE_DEG.check(longitude_deg).map_err(|e| format!("longitude: {e}"))?;
+    // NaN is the message's "unknown altitude".
     let altitude_m = match altitude {
         a if a.is_nan() => None,
-        a if a.is_finite() => Some(a),
-        a => return Err(format!("altitude: {a} is not finite (NaN when unknown)")),
+        a => Some(ALTITUDE_M.check(a).map_err(|e| format!("altitude: {e} (NaN when unknown)"))?),
     };
     let sigma =
         (covariance_type != 0).then(|| ((covariance[0] + covariance[4]) / 2.0).sqrt()).filter(|s| s.is_finite());
@@ -420,6 +421,10 @@ mod tests {
     }
 
     fn nav_sat_fix(altitude: f64) -> Vec<u8> {
+        nav_sat_fix_at(37.4, altitude)
+    }
+
+    fn nav_sat_fix_at(latitude: f64, altitude: f64) -> Vec<u8> {
         let mut w = Writer::new();
         w.u32(12).u32(500).string("gnss");
         // status.status = 0 (fix) at an odd offset, then status.service = 1
@@ -427,7 +432,7 @@ mod tests {
         assert_eq!(w.0.len() % 2, 1);
         w.0.push(0);
         w.0.extend_from_slice(&1u16.to_le_bytes());
-        w.f64(37.4).f64(-122.1).f64(altitude);
+        w.f64(latitude).f64(-122.1).f64(altitude);
         for _ in 0..9 {
             w.f64(0.0);
         }
@@ -476,6 +481,22 @@ mod tests {
         assert_eq!(decode_nav_sat_fix(&nav_sat_fix(f64::NAN)).unwrap().unwrap().altitude_m, None);
         let err = decode_nav_sat_fix(&nav_sat_fix(f64::INFINITY)).unwrap_err();
         assert!(err.contains("altitude: inf"), "{err}");
+    }
+
+    /// Before: a NavSatFix latitude of 200 and an altitude of 1e300 were
+    /// ingested as fixes.
+    #[test]
+    fn nav_sat_fix_latitude_and_altitude_out_of_range_are_refused() {
+        let err = decode_nav_sat_fix(&nav_sat_fix_at(200.0, 12.5)).unwrap_err();
+        assert_eq!(err, "latitude: 200 is not a latitude within [-90, 90] deg");
+        let err = decode_nav_sat_fix(&nav_sat_fix(1e300)).unwrap_err();
+        assert!(err.starts_with("altitude: 1e300 is not an altitude within"), "{err}");
+        let mut w = Writer::new();
+        w.u32(12).u32(500).string("odom").string("base_link");
+        w.f64(1e300).f64(-2.0).f64(0.0);
+        w.f64(0.0).f64(0.0).f64(0.0).f64(1.0);
+        let err = decode_odometry(&w.0).unwrap_err();
+        assert!(err.starts_with("pose.position.x: 1e300 is not a coordinate"), "{err}");
     }
 
     #[test]

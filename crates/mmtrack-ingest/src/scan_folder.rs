@@ -155,6 +155,39 @@ pub fn decode_in_order<T: Send>(
     )
 }
 
+/// The items of a ground-truth or GNSS file that fall within the scans'
+/// time span (first to last scan stamp), which is what a recording keeps.
+///
+/// A file with items but none within the span is refused, naming both
+/// spans: its times are in another unit, on another clock or of another
+/// drive, and a recording without them would look complete (issue 26: Boreas
+/// poses that missed every scan became "0 ground-truth poses" without a word).
+pub(crate) fn within_scan_span<'a, T>(
+    scans: &[ScanFile],
+    what: &str,
+    source: &str,
+    items: &'a [T],
+    t_ns: impl Fn(&T) -> i64,
+) -> Result<Vec<&'a T>, IngestError> {
+    let (Some(first), Some(last)) = (scans.first(), scans.last()) else { return Ok(Vec::new()) };
+    let kept: Vec<&T> = items.iter().filter(|item| (first.t_ns..=last.t_ns).contains(&t_ns(item))).collect();
+    if let (true, Some(earliest), Some(latest)) = (kept.is_empty(), items.first(), items.last()) {
+        return Err(IngestError::BadLayout {
+            path: PathBuf::from(source),
+            detail: format!(
+                "none of its {} {what} falls within the scans' time span ({} to {} ns): its times run from {} to {} ns \
+                 (another unit, clock or drive?)",
+                items.len(),
+                first.t_ns,
+                last.t_ns,
+                t_ns(earliest),
+                t_ns(latest),
+            ),
+        });
+    }
+    Ok(kept)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -253,6 +253,37 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
     Ok(dir)
 }
 
+/// Moves the complete staging directory `staged` (from [`staging_dir`],
+/// beside `out`) to `out`, replacing an existing `out`: that one is first
+/// renamed aside (`<staging name>.replaced`, so a later run never mistakes
+/// it for a partial), put back if the second rename fails, and deleted once
+/// the new one is in place. The renames run while holding the registry of
+/// partial outputs, so an interruption ([`remove_partial_outputs`]) finds
+/// the staging directory still partial (and removes it, `out` untouched) or
+/// the new `out` in place, never `out` missing with the old results hidden
+/// aside. The caller checks first that `out` may be replaced
+/// ([`check_replaceable_dir`]).
+///
+/// # Errors
+/// The OS error of a rename (nothing changed then), or of deleting the old
+/// copy after the new one is in place (the error names the copy left).
+pub fn publish_dir(staged: &Path, out: &Path) -> Result<()> {
+    let live = live_partials();
+    if std::fs::symlink_metadata(out).is_err() {
+        return std::fs::rename(staged, out).map_err(os_err(out));
+    }
+    let name = staged.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let stem = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(&name);
+    let aside = staged.with_file_name(format!("{stem}{REPLACED_SUFFIX}"));
+    std::fs::rename(out, &aside).map_err(os_err(out))?;
+    if let Err(e) = std::fs::rename(staged, out) {
+        let _ = std::fs::rename(&aside, out);
+        return Err(IoError::Os { path: out.to_path_buf(), source: e });
+    }
+    drop(live);
+    std::fs::remove_dir_all(&aside).map_err(os_err(&aside))
+}
+
 /// Creates `dir` and its missing parents (as `create_dir_all`) for an
 /// output, holding the registry of partial outputs: never while an
 /// interruption is removing them ([`remove_partial_outputs`] holds the

@@ -23,7 +23,9 @@ pub mod schema_docs;
 pub mod table;
 pub mod table_kv;
 
-pub use atomic::{AtomicFile, Durability, Overwrite, check_replaceable_dir, create_output_dirs, staging_dir};
+pub use atomic::{
+    AtomicFile, Durability, Overwrite, check_replaceable_dir, create_output_dirs, publish_dir, staging_dir,
+};
 pub use error::{IoError, Result};
 pub use png_gray::{Gray8Png, MAX_GRAY8_BYTES, decode_gray8};
 pub use recording::{RecordingEvent, RecordingMetadata, RecordingOptions, RecordingReader, RecordingWriter};

@@ -120,10 +120,17 @@ fn image_data(png: &[u8]) -> Vec<&[u8]> {
 }
 
 /// Inflates the zlib stream split over `chunks` into `out`, which it must
-/// fill exactly; the stream's Adler-32 is verified.
+/// fill exactly; the stream's Adler-32 is verified, and no byte may follow
+/// it in the image data.
+///
+/// `fdeflate` reads up to 7 bytes ahead of what it decodes, so whether the
+/// stream ends at the last byte cannot be told from what it consumed: the
+/// checksum is verified here instead, and its position among the last
+/// bytes consumed is where the stream ends.
 fn inflate_exact(chunks: &[&[u8]], out: &mut [u8]) -> Result<(), String> {
     let mut inflater = fdeflate::Decompressor::new();
-    let mut filled = 0;
+    inflater.ignore_adler32();
+    let (mut filled, mut consumed_total) = (0, 0);
     for (index, chunk) in chunks.iter().enumerate() {
         let last = index + 1 == chunks.len();
         let mut input = *chunk;
@@ -135,6 +142,10 @@ fn inflate_exact(chunks: &[&[u8]], out: &mut [u8]) -> Result<(), String> {
             }
             input = &input[consumed..];
             filled += produced;
+            consumed_total += consumed;
+        }
+        if inflater.is_done() {
+            break;
         }
     }
     if !inflater.is_done() {
@@ -145,6 +156,29 @@ fn inflate_exact(chunks: &[&[u8]], out: &mut [u8]) -> Result<(), String> {
     }
     if filled != out.len() {
         return Err(format!("the zlib stream holds {filled} bytes, expected {} for the pixel rows", out.len()));
+    }
+    let mut adler = simd_adler32::Adler32::new();
+    adler.write(out);
+    let trailer = adler.finish().to_be_bytes();
+    let byte = |mut at: usize| {
+        chunks.iter().find_map(|c| {
+            if at < c.len() {
+                Some(c[at])
+            } else {
+                at -= c.len();
+                None
+            }
+        })
+    };
+    let stream_end = (0..8)
+        .filter_map(|ahead| consumed_total.checked_sub(ahead).filter(|&end| end >= 4))
+        .find(|&end| (0..4).all(|j| byte(end - 4 + j) == Some(trailer[j])))
+        .ok_or("the zlib stream's Adler-32 checksum does not match its data")?;
+    let after = chunks.iter().map(|c| c.len()).sum::<usize>() - stream_end;
+    if after > 0 {
+        return Err(format!(
+            "{after} bytes follow the end of the zlib stream (its Adler-32 checksum) in the image data"
+        ));
     }
     Ok(())
 }
@@ -402,6 +436,33 @@ mod tests {
         assert!(err.contains("holds 186 bytes, expected 217"), "{err}");
         // The png crate took the longer stream: it stops at the last row.
         assert!(png_crate_decode(&repack(30, 5, &idat)).is_ok());
+    }
+
+    /// Before: 64 junk bytes after the zlib stream's end inside IDAT were
+    /// accepted, though the stream must end exactly after the last row.
+    #[test]
+    fn bytes_after_the_end_of_the_zlib_stream_are_refused() {
+        let pixels = noise(30 * 6, 5);
+        let idat = image_data(&encode(30, 6, &pixels, png::Filter::Sub, png::Compression::Fast)).concat();
+        assert_eq!(decode_gray8(&repack(30, 6, &idat)).unwrap().2, pixels);
+        // Counted exactly, also under the 7 bytes fdeflate reads ahead.
+        for n in [1, 2, 3, 7, 8, 64] {
+            let mut junk = idat.clone();
+            junk.extend(std::iter::repeat_n(0xAB, n));
+            let err = decode_gray8(&repack(30, 6, &junk)).unwrap_err();
+            assert!(err.contains(&format!(": {n} bytes follow the end of the zlib stream")), "{n}: {err}");
+        }
+        // The same junk in an IDAT chunk of its own after the stream.
+        let mut two = Vec::new();
+        let mut encoder = png::Encoder::new(&mut two, 30, 6);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_chunk(png::chunk::IDAT, &idat).unwrap();
+        writer.write_chunk(png::chunk::IDAT, &[0xAB; 64]).unwrap();
+        drop(writer);
+        let err = decode_gray8(&two).unwrap_err();
+        assert!(err.contains("64 bytes follow the end of the zlib stream"), "{err}");
     }
 
     #[test]

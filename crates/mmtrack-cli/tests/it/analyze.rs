@@ -223,7 +223,10 @@ fn analyze_says_what_it_looked_for_and_what_is_wrong() {
     let out = mmtrack(dir.path(), &["analyze", "nan", "-o", "res"]);
     let (_, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(1));
-    assert!(stderr.contains("ground truth: row 3") && stderr.contains("ground_truth/sequence=s3"), "{stderr}");
+    assert!(
+        stderr.contains("ground_truth/sequence=s3/part-0.parquet: row 3: y_m: NaN is not a coordinate"),
+        "{stderr}"
+    );
     assert!(!dir.path().join("res").exists());
 }
 
@@ -379,4 +382,25 @@ fn analyze_puts_runs_side_by_side_with_pooled_rows_a_duckdb_query_reproduces() {
     assert_eq!(out.status.code(), Some(1));
     assert!(text(&out).1.contains("run id `a` twice"), "{}", text(&out).1);
     assert!(!dir.path().join("cmp2").exists());
+}
+
+/// Before: `analyze` on coordinates of 1e308 wrote NaN and infinite metrics
+/// and exited 0. Now the pose is refused naming file, row and column, and
+/// `export` refuses it the same way.
+#[test]
+fn analyze_and_export_refuse_implausible_coordinates() {
+    let dir = tempfile::tempdir().unwrap();
+    let (mut estimate, truth) = drive(200);
+    estimate[7].world_from_vehicle = Se2::new(1e308, 0.0, 0.0);
+    write_pair(&dir.path().join("tables"), "drive-a", &estimate, Some(&truth));
+    for args in [&["analyze", "tables", "-o", "analysis"][..], &["export", "--format", "tum", "tables", "-o", "tum"]] {
+        let out = mmtrack(dir.path(), args);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("odometry/sequence=drive-a/part-0.parquet: row 7: x_m: 1e308 is not a coordinate"),
+            "{args:?}: {stderr}"
+        );
+    }
+    assert!(!dir.path().join("analysis").exists() && !dir.path().join("tum").exists());
 }

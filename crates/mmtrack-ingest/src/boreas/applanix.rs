@@ -28,6 +28,7 @@
 
 use std::path::Path;
 
+use mmtrack_core::plausible::{ANGLE_RAD, COORDINATE_M};
 use mmtrack_core::{Se2, StampedPose};
 
 use crate::IngestError;
@@ -100,9 +101,13 @@ pub fn planar_yaw_rad(roll_rad: f64, pitch_rad: f64, heading_rad: f64) -> Option
 }
 
 fn row_pose(row: &CsvRow<'_>, position: &[&str; 3]) -> Result<([f64; 3], f64), IngestError> {
-    let xyz = [row.finite(position[0])?, row.finite(position[1])?, row.finite(position[2])?];
-    let (roll, pitch) = (row.finite("roll")?, row.finite("pitch")?);
-    let heading = row.finite("heading")?;
+    let xyz = [
+        row.bounded(position[0], &COORDINATE_M)?,
+        row.bounded(position[1], &COORDINATE_M)?,
+        row.bounded(position[2], &COORDINATE_M)?,
+    ];
+    let (roll, pitch) = (row.bounded("roll", &ANGLE_RAD)?, row.bounded("pitch", &ANGLE_RAD)?);
+    let heading = row.bounded("heading", &ANGLE_RAD)?;
     let yaw_rad = planar_yaw_rad(roll, pitch, heading).ok_or_else(|| {
         row.bad("pitch", format!("{pitch} rad points the x axis straight up or down: no planar heading"))
     })?;

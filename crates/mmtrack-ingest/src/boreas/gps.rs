@@ -9,11 +9,11 @@
 
 use std::path::Path;
 
+use mmtrack_core::plausible::ALTITUDE_M;
 use mmtrack_core::{GnssFix, GnssFixQuality};
 
 use crate::IngestError;
 use crate::csv::CsvTable;
-use crate::error::os_err;
 
 const COLUMNS: [&str; 4] = ["GPSTime", "latitude", "longitude", "altitude"];
 
@@ -52,7 +52,7 @@ pub fn parse_boreas_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
             t_ns,
             latitude_deg: latitude_rad.to_degrees(),
             longitude_deg: longitude_rad.to_degrees(),
-            altitude_m: Some(row.finite("altitude")?),
+            altitude_m: Some(row.bounded("altitude", &ALTITUDE_M)?),
             horizontal_sigma_m: None,
             num_satellites: None,
             quality: GnssFixQuality::Unknown,
@@ -63,7 +63,7 @@ pub fn parse_boreas_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
 
 /// Reads `gps_post_process.csv`.
 pub fn read_boreas_gps(path: &Path) -> Result<Vec<GnssFix>, IngestError> {
-    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    let text = crate::error::read_text(path)?;
     parse_boreas_gps(path, &text)
 }
 

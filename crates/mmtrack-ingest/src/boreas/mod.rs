@@ -20,7 +20,9 @@
 //!   as pyboreas does; `range_resolution_m` overrides both. The metadata says
 //!   which rule decided (`radar.range_resolution_source`). The folder name is
 //!   the local (Toronto) start time, so the two rules could only disagree for
-//!   a drive started on the evening of 2021-09-20, and no sequence was;
+//!   a drive started on the evening of 2021-09-20, and no sequence was; a
+//!   folder date other than the first scan's UTC date or the day before is
+//!   refused, naming both (the folder name would pick the range bin);
 //! - range offset -0.31 m (`range_offset_m` of every scan, and
 //!   `radar.range_offset_m` in the metadata);
 //! - byte 10 is documented as unused in Boreas (the Oxford valid flag), so
@@ -35,12 +37,14 @@ pub mod gps;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use mmtrack_core::NS_PER_S;
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
+use crate::calendar::{civil_from_days, days_from_civil};
 use crate::error::os_err;
 use crate::oxford::{NavtechLayout, OXFORD, write_navtech_scans};
-use crate::scan_folder::{ScanFile, StampUnit, folder_name, list_scan_pngs};
+use crate::scan_folder::{ScanFile, StampUnit, folder_name, list_scan_pngs, within_scan_span};
 use crate::{IngestError, Progress};
 
 /// Range bin before the radar upgrade of 2021-09-21, metres.
@@ -51,6 +55,9 @@ pub const RESOLUTION_AFTER_UPGRADE_M: f64 = 0.04381;
 pub const UPGRADE_DATE: (u32, u32, u32) = (2021, 9, 21);
 /// pyboreas's switch time, UNIX seconds (2021-09-21 00:00 UTC).
 pub const UPGRADE_UNIX_S: i64 = 1_632_182_400;
+/// Nanoseconds per day.
+const NS_PER_DAY: i64 = 86_400 * NS_PER_S;
+
 /// Range of bin 0, metres.
 pub const RANGE_OFFSET_M: f64 = -0.31;
 
@@ -124,25 +131,39 @@ impl BoreasFolder {
     }
 
     /// Range resolution by recording date, and the rule that chose it.
-    #[must_use]
-    pub fn range_resolution(&self) -> (f64, String) {
+    ///
+    /// The folder name is the drive's local (Toronto) start time, so its
+    /// date is the first scan's UTC date or the day before. A folder date
+    /// further from the scans than that contradicts the data, and since the
+    /// date picks the range bin, the folder is refused naming both dates.
+    pub fn range_resolution(&self) -> Result<(f64, String), IngestError> {
         let name = self.sequence_id();
         let pick = |after: bool| if after { RESOLUTION_AFTER_UPGRADE_M } else { RESOLUTION_BEFORE_UPGRADE_M };
+        let first_ns = self.scans.first().map_or(0, |s| s.t_ns);
         match sequence_date(&name) {
             Some(date) => {
                 let (y, m, d) = date;
-                (pick(date >= UPGRADE_DATE), format!("folder date {y:04}-{m:02}-{d:02} (upgrade 2021-09-21)"))
+                let folder_day = days_from_civil(i64::from(y), i64::from(m), i64::from(d));
+                let scan_day = first_ns.div_euclid(NS_PER_DAY);
+                if !(0..=1).contains(&(scan_day - folder_day)) {
+                    let (sy, sm, sd) = civil_from_days(scan_day);
+                    return Err(IngestError::BadLayout {
+                        path: self.root.clone(),
+                        detail: format!(
+                            "the folder name says the drive started on {y:04}-{m:02}-{d:02} (local time), but the \
+                             first scan is stamped {} us, on {sy:04}-{sm:02}-{sd:02} UTC; the date picks the range \
+                             bin ({RESOLUTION_BEFORE_UPGRADE_M} m before 2021-09-21, {RESOLUTION_AFTER_UPGRADE_M} m \
+                             from then on): rename the folder or give --range-resolution-m",
+                            first_ns / 1000
+                        ),
+                    });
+                }
+                Ok((pick(date >= UPGRADE_DATE), format!("folder date {y:04}-{m:02}-{d:02} (upgrade 2021-09-21)")))
             }
-            None => {
-                let first_ns = self.scans.first().map_or(0, |s| s.t_ns);
-                (
-                    pick(first_ns >= UPGRADE_UNIX_S * 1_000_000_000),
-                    format!(
-                        "first scan time {} us (folder name '{name}' is not boreas-YYYY-MM-DD-HH-MM)",
-                        first_ns / 1000
-                    ),
-                )
-            }
+            None => Ok((
+                pick(first_ns >= UPGRADE_UNIX_S * 1_000_000_000),
+                format!("first scan time {} us (folder name '{name}' is not boreas-YYYY-MM-DD-HH-MM)", first_ns / 1000),
+            )),
         }
     }
 }
@@ -185,7 +206,7 @@ pub fn ingest_boreas(
 ) -> Result<BoreasReport, IngestError> {
     let (range_resolution_m, source) = match options.range_resolution_m {
         Some(given) => (given, "given by the caller".to_string()),
-        None => folder.range_resolution(),
+        None => folder.range_resolution()?,
     };
     let layout = NavtechLayout {
         range_resolution_m,
@@ -207,7 +228,7 @@ pub fn ingest_boreas(
     ]);
     let truth = match &folder.poses {
         Some((path, sensor)) => {
-            let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+            let text = crate::error::read_text(path)?;
             let parsed = applanix::parse_applanix_poses(path, &text)?;
             extra.insert("ground_truth.source".into(), path.display().to_string());
             extra.insert("ground_truth.frame".into(), sensor.clone());
@@ -227,6 +248,16 @@ pub fn ingest_boreas(
         }
         None => Vec::new(),
     };
+    // Checked before anything is written.
+    let truth = match &truth {
+        Some((poses, sensor)) => {
+            let source = folder.poses.as_ref().map(|(path, _)| path.display().to_string()).unwrap_or_default();
+            Some((within_scan_span(&folder.scans, "poses", &source, poses, |p| p.t_ns)?, *sensor))
+        }
+        None => None,
+    };
+    let gps_source = folder.gps.as_ref().map(|path| path.display().to_string()).unwrap_or_default();
+    let fixes = within_scan_span(&folder.scans, "fixes", &gps_source, &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("boreas:{}", folder.root.display()),
@@ -235,23 +266,20 @@ pub fn ingest_boreas(
     };
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;
     write_navtech_scans(&mut writer, &folder.scans, &layout, !options.decode, progress)?;
-    let (first, last) = (folder.scans[0].t_ns, folder.scans[folder.scans.len() - 1].t_ns);
     let mut ground_truth_poses = 0;
     if let Some((poses, sensor)) = &truth {
-        for pose in poses.iter().filter(|p| (first..=last).contains(&p.t_ns)) {
+        for pose in poses {
             writer.write_pose(PoseStream::GroundTruth, pose, "world", sensor)?;
-            ground_truth_poses += 1;
         }
+        ground_truth_poses = poses.len() as u64;
     }
-    let mut gnss_fixes = 0;
-    for fix in fixes.iter().filter(|f| (first..=last).contains(&f.t_ns)) {
+    for fix in &fixes {
         writer.write_gnss_fix(fix)?;
-        gnss_fixes += 1;
     }
     Ok(BoreasReport {
         scans: folder.scans.len() as u64,
         ground_truth_poses,
-        gnss_fixes,
+        gnss_fixes: fixes.len() as u64,
         range_resolution_m,
         range_resolution_source: source,
         output: writer.finish()?,

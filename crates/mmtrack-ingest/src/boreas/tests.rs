@@ -36,12 +36,18 @@ fn scan(t_us: i64, azimuths: usize, bins: usize) -> PolarScan {
 
 /// A Boreas folder of three scans and a radar_poses.csv; returns its path.
 fn folder(parent: &Path, name: &str, bins: usize) -> PathBuf {
+    folder_shifted(parent, name, bins, 0)
+}
+
+/// [`folder`] with every time (scans, poses, GNSS) `shift_s` seconds later.
+fn folder_shifted(parent: &Path, name: &str, bins: usize, shift_s: i64) -> PathBuf {
     let root = parent.join(name);
     std::fs::create_dir_all(root.join("radar")).unwrap();
     std::fs::create_dir_all(root.join("applanix")).unwrap();
     let mut csv = format!("{POSES_HEADER}\n");
     for (i, t_us) in [1_630_597_345_560_134i64, 1_630_597_345_810_747, 1_630_597_346_061_361].iter().enumerate() {
-        let png = encode_scan_png(&scan(*t_us, 16, bins), &OXFORD).unwrap();
+        let t_us = t_us + shift_s * 1_000_000;
+        let png = encode_scan_png(&scan(t_us, 16, bins), &OXFORD).unwrap();
         std::fs::write(root.join("radar").join(format!("{t_us}.png")), png).unwrap();
         csv.push_str(&format!("{t_us},{},4848823.0,154.5,4,0,0,3.14159,0,0.1,0,0,0\n", 623450.0 + i as f64));
     }
@@ -50,8 +56,9 @@ fn folder(parent: &Path, name: &str, bins: usize) -> PathBuf {
     let mut gps = String::from(
         "GPSTime,easting,northing,altitude,vel_east,vel_north,vel_up,roll,pitch,heading,angvel_z,angvel_y,angvel_x,accelz,accely,accelx,latitude,longitude\n",
     );
-    for t in ["1630597345.3", "1630597345.6", "1630597345.85", "1630597346.05", "1630597346.3", "1630597346.55"] {
-        gps.push_str(&format!("{t},0,0,154.5,0,0,0,0,0,0,0,0,0,0,0,0,0.7641224,-1.3869569\n"));
+    for (whole_s, fraction) in [(345, "3"), (345, "6"), (345, "85"), (346, "05"), (346, "3"), (346, "55")] {
+        let t_s = 1_630_597_000 + whole_s + shift_s;
+        gps.push_str(&format!("{t_s}.{fraction},0,0,154.5,0,0,0,0,0,0,0,0,0,0,0,0,0.7641224,-1.3869569\n"));
     }
     std::fs::write(root.join("applanix/gps_post_process.csv"), gps).unwrap();
     root
@@ -87,10 +94,11 @@ fn sequence_dates_parse_only_from_the_boreas_pattern() {
 #[test]
 fn folder_gives_scans_with_width_from_file_resolution_by_date_and_local_poses() {
     let dir = tempfile::tempdir().unwrap();
-    for (name, bins, resolution_m) in
-        [("boreas-2021-09-02-11-42", 40, 0.0596), ("boreas-2021-09-21-08-00", 57, 0.04381)]
+    // The second drive 19 days (1 641 600 s) later: 2021-09-21.
+    for (name, bins, resolution_m, shift_s) in
+        [("boreas-2021-09-02-11-42", 40, 0.0596, 0), ("boreas-2021-09-21-08-00", 57, 0.04381, 1_641_600)]
     {
-        let root = folder(dir.path(), name, bins);
+        let root = folder_shifted(dir.path(), name, bins, shift_s);
         let out = dir.path().join(format!("{name}.mcap"));
         let report = ingest(&root, &out, &BoreasOptions::default()).unwrap();
         assert_eq!((report.scans, report.ground_truth_poses, report.gnss_fixes), (3, 3, 3));
@@ -106,7 +114,7 @@ fn folder_gives_scans_with_width_from_file_resolution_by_date_and_local_poses() 
             s.header.check_azimuth_times().unwrap();
         }
         // Middle azimuth (index 16 / 2 - 1) at the file's stamp.
-        assert_eq!(scans[1].header.azimuths[7].t_ns, 1_630_597_345_810_747_000);
+        assert_eq!(scans[1].header.azimuths[7].t_ns, 1_630_597_345_810_747_000 + shift_s * 1_000_000_000);
         assert_eq!(metadata["radar.range_offset_m"], "-0.31");
         assert_eq!(metadata["ground_truth.origin_east_m"], "623450");
         assert!(metadata["radar.range_resolution_source"].contains("folder date"));
@@ -215,4 +223,50 @@ fn nanosecond_radar_poses_match_the_microsecond_scan_names() {
     let report = ingest(&root, &out, &BoreasOptions::default()).unwrap();
     assert_eq!(report.ground_truth_poses, 3);
     assert_eq!(read(&out).1, micro_poses);
+}
+
+/// Before: a folder named for one date whose scans are stamped on another
+/// was ingested with the folder date's range bin and no word.
+#[test]
+fn a_folder_date_that_contradicts_the_scans_is_refused_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    // Scans of 2021-09-02 in a folder that says 2021-09-21 (after the upgrade).
+    let root = folder(dir.path(), "boreas-2021-09-21-08-00", 20);
+    let err = ingest(&root, &dir.path().join("a.mcap"), &BoreasOptions::default()).unwrap_err().to_string();
+    assert!(
+        err.contains("boreas-2021-09-21-08-00: the folder name says the drive started on 2021-09-21")
+            && err.contains("on 2021-09-02 UTC")
+            && err.contains("--range-resolution-m"),
+        "{err}"
+    );
+    assert!(!dir.path().join("a.mcap").exists());
+    // The range bin given: the date no longer matters.
+    let options = BoreasOptions { range_resolution_m: Some(0.0596), ..BoreasOptions::default() };
+    assert!(ingest(&root, &dir.path().join("b.mcap"), &options).is_ok());
+    // A local evening start is the next UTC day: accepted.
+    let evening = folder(dir.path(), "boreas-2021-09-01-20-30", 20);
+    assert!(ingest(&evening, &dir.path().join("c.mcap"), &BoreasOptions::default()).is_ok());
+}
+
+/// Before: poses whose times missed every scan were all dropped ("0
+/// ground-truth poses") without a warning.
+#[test]
+fn poses_or_fixes_that_miss_every_scan_are_refused_naming_both_spans() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = folder(dir.path(), "boreas-2021-09-02-11-42", 20);
+    // The poses file of a drive an hour later.
+    let other = folder_shifted(&dir.path().join("other"), "boreas-2021-09-02-11-42", 20, 3600);
+    std::fs::copy(other.join("applanix/radar_poses.csv"), root.join("applanix/radar_poses.csv")).unwrap();
+    let err = ingest(&root, &dir.path().join("a.mcap"), &BoreasOptions::default()).unwrap_err().to_string();
+    assert!(
+        err.contains("radar_poses.csv: none of its 3 poses falls within the scans' time span")
+            && err.contains("1630597345560134000 to 1630597346061361000 ns")
+            && err.contains("1630600945560134000 to 1630600946061361000 ns"),
+        "{err}"
+    );
+    assert!(!dir.path().join("a.mcap").exists());
+    std::fs::copy(other.join("applanix/gps_post_process.csv"), root.join("applanix/gps_post_process.csv")).unwrap();
+    std::fs::remove_file(root.join("applanix/radar_poses.csv")).unwrap();
+    let err = ingest(&root, &dir.path().join("b.mcap"), &BoreasOptions::default()).unwrap_err().to_string();
+    assert!(err.contains("gps_post_process.csv: none of its 6 fixes falls within"), "{err}");
 }

@@ -56,7 +56,6 @@ use std::path::Path;
 use mmtrack_core::{CirSnapshot, Complex64};
 
 use crate::IngestError;
-use crate::error::os_err;
 
 /// DW1000 accumulator sample rate, hertz (2 x 499.2 MHz).
 pub const DW1000_ACCUMULATOR_RATE_HZ: f64 = 998.4e6;
@@ -163,7 +162,7 @@ pub fn parse_decawave_log(path: &Path, text: &str, config: &DecawaveConfig) -> R
 /// Reads and parses a DecaRanging log file. Bytes that are not UTF-8 are
 /// replaced (they only occur in lines this reader ignores or rejects).
 pub fn read_decawave_log(path: &Path, config: &DecawaveConfig) -> Result<DecawaveLog, IngestError> {
-    let bytes = std::fs::read(path).map_err(os_err(path))?;
+    let bytes = crate::error::read_capped(path, &mmtrack_core::limits::TEXT_FILE_BYTES)?;
     parse_decawave_log_detailed(path, &String::from_utf8_lossy(&bytes), config)
 }
 

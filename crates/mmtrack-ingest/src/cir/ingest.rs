@@ -18,7 +18,6 @@ use mmtrack_io::recording::channels::CIR_TOPIC;
 use super::array::{NdComplex, cut_snapshots, resolve_axes};
 use super::decawave::{DecawaveConfig, DecawaveTimeBase, read_decawave_log};
 use super::sidecar::{CirSidecar, Domain, TapSpacing};
-use crate::error::os_err;
 use crate::{IngestError, Progress};
 
 /// The formats `mmtrack ingest cir --format` reads.
@@ -117,7 +116,7 @@ pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSideca
     let (snapshots, skipped) = match format {
         CirFormat::Decawave => return read_decawave(input, sidecar, metadata),
         CirFormat::Csv => {
-            let text = std::fs::read_to_string(input).map_err(os_err(input))?;
+            let text = crate::error::read_text(input)?;
             (super::csv_cir::parse_cir_csv(input, &text, sidecar)?, 0)
         }
         CirFormat::Sigmf => {
@@ -155,11 +154,11 @@ pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSideca
 fn read_array(format: CirFormat, input: &Path, sidecar: &CirSidecar) -> Result<(String, NdComplex), IngestError> {
     match format {
         CirFormat::Npy => {
-            let bytes = std::fs::read(input).map_err(os_err(input))?;
+            let bytes = crate::error::read_capped(input, &mmtrack_core::limits::ARRAY_FILE_BYTES)?;
             Ok(("array".into(), super::npy::parse_npy(input, "array", &bytes)?))
         }
         CirFormat::Npz => {
-            let bytes = std::fs::read(input).map_err(os_err(input))?;
+            let bytes = crate::error::read_capped(input, &mmtrack_core::limits::ARRAY_FILE_BYTES)?;
             let (name, array) = super::npy::parse_npz(input, &bytes, sidecar.variable.as_deref())?;
             Ok((format!("member `{name}.npy`"), array))
         }

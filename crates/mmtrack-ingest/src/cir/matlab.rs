@@ -60,7 +60,6 @@ use mmtrack_core::{CirSnapshot, Complex64};
 
 use super::inflate::{INFLATE_LIMIT_HINT, inflate_limit, zlib_decompress};
 use crate::IngestError;
-use crate::error::os_err;
 
 /// What a `.mat` file does not say about a CIR array.
 #[derive(Debug, Clone, PartialEq)]
@@ -125,7 +124,7 @@ fn load_variable(path: &Path, variable: &str) -> Result<MatArray, IngestError> {
             imag: array.imag,
         });
     }
-    let bytes = std::fs::read(path).map_err(os_err(path))?;
+    let bytes = crate::error::read_capped(path, &mmtrack_core::limits::ARRAY_FILE_BYTES)?;
     find_variable(path, &bytes, variable)
 }
 

@@ -108,7 +108,7 @@ pub struct NpyMatrix {
 /// [`IngestError::Os`] when the file cannot be read; [`IngestError::BadRecord`]
 /// for a bad magic, header, dtype, shape or truncated data.
 pub fn read_npy_matrix(path: &Path) -> Result<NpyMatrix, IngestError> {
-    let bytes = std::fs::read(path).map_err(|source| IngestError::Os { path: path.to_path_buf(), source })?;
+    let bytes = crate::error::read_capped(path, &mmtrack_core::limits::ARRAY_FILE_BYTES)?;
     parse_npy_matrix(path, &bytes)
 }
 

@@ -29,7 +29,6 @@
 use std::path::{Path, PathBuf};
 
 use crate::IngestError;
-use crate::error::os_err;
 
 /// Whether the file holds impulse responses or frequency responses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -173,7 +172,7 @@ impl CirSidecar {
 
     /// Reads and validates a sidecar file.
     pub fn read(path: &Path) -> Result<Self, IngestError> {
-        let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+        let text = crate::error::read_text(path)?;
         Self::parse(path, &text)
     }
 

@@ -17,7 +17,6 @@ use serde_json::Value;
 use super::array::NdComplex;
 use super::sidecar::CirSidecar;
 use crate::IngestError;
-use crate::error::os_err;
 
 /// A SigMF recording as an array `[snapshot, tap]` plus what its meta says.
 pub(crate) struct SigmfCirs {
@@ -40,8 +39,8 @@ pub(crate) fn sigmf_paths(input: &Path) -> (PathBuf, PathBuf) {
 /// Reads a SigMF recording of CIRs.
 pub(crate) fn read_sigmf(input: &Path, sidecar: &CirSidecar) -> Result<SigmfCirs, IngestError> {
     let (meta_path, data_path) = sigmf_paths(input);
-    let meta_text = std::fs::read_to_string(&meta_path).map_err(os_err(&meta_path))?;
-    let data = std::fs::read(&data_path).map_err(os_err(&data_path))?;
+    let meta_text = crate::error::read_text(&meta_path)?;
+    let data = crate::error::read_capped(&data_path, &mmtrack_core::limits::ARRAY_FILE_BYTES)?;
     parse_sigmf(&meta_path, &meta_text, &data_path, &data, sidecar)
 }
 

@@ -11,9 +11,11 @@
 
 use std::path::Path;
 
+use mmtrack_core::plausible::{self, COORDINATE_M};
 use mmtrack_core::{Se2, StampedPose};
 
 use crate::IngestError;
+use crate::error::check_plausible;
 
 /// Poses in a local frame and where that frame's origin is.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,6 +56,11 @@ fn parse_line(path: &Path, line: usize, text: &str) -> Result<(i64, [f64; 12]), 
             .filter(|v| v.is_finite())
             .ok_or_else(|| bad(path, line, name, format!("'{value}' is not a finite number")))?;
     }
+    for k in [3, 7, 11] {
+        check_plausible(path, || format!("line {line}"), NAMES[k + 1], &COORDINATE_M, m[k])?;
+    }
+    plausible::check_rotation(&[[m[0], m[1], m[2]], [m[4], m[5], m[6]], [m[8], m[9], m[10]]])
+        .map_err(|detail| bad(path, line, "rotation", detail))?;
     Ok((t_ns, m))
 }
 
@@ -130,8 +137,14 @@ mod tests {
         assert!(err.contains("line 2: t_ns") && err.contains("does not increase"), "{err}");
         let err = parse_global_pose(path, "timestamp,r11\n").unwrap_err().to_string();
         assert!(err.contains("line 1: columns"), "{err}");
-        let err = parse_global_pose(path, "5,0,0,0,1,0,0,0,2,0,0,1,0\n").unwrap_err().to_string();
+        // A rotation whose x axis points straight up (90 deg about y): no planar heading.
+        let err = parse_global_pose(path, "5,0,0,1,1,0,1,0,2,-1,0,0,0\n").unwrap_err().to_string();
         assert!(err.contains("r11/r21"), "{err}");
+        // Not a rotation at all (before: accepted, its yaw taken from r11/r21).
+        let err = parse_global_pose(path, "5,2,0,0,1,0,2,0,2,0,0,2,0\n").unwrap_err().to_string();
+        assert!(err.starts_with("global_pose.csv: line 1: rotation: the rotation is not orthonormal"), "{err}");
+        let err = parse_global_pose(path, "5,1,0,0,1e300,0,1,0,2,0,0,1,0\n").unwrap_err().to_string();
+        assert!(err.starts_with("global_pose.csv: line 1: tx: 1e300 is not a coordinate"), "{err}");
         assert!(parse_global_pose(path, "\n").unwrap_err().to_string().contains("no pose lines"));
     }
 }

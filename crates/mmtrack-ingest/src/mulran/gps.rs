@@ -11,10 +11,11 @@
 
 use std::path::Path;
 
+use mmtrack_core::plausible::ALTITUDE_M;
 use mmtrack_core::{GnssFix, GnssFixQuality};
 
 use crate::IngestError;
-use crate::error::os_err;
+use crate::error::check_plausible;
 
 /// Fields per line.
 const FIELDS: usize = 13;
@@ -74,7 +75,8 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
                 format!("({latitude_deg}, {longitude_deg}) is not a geodetic position in degrees"),
             ));
         }
-        let altitude_m = value(3, NAMES[3])?;
+        let altitude_m =
+            check_plausible(path, || format!("line {number}"), NAMES[3], &ALTITUDE_M, value(3, NAMES[3])?)?;
         let mut covariance = [0.0; 9];
         for (k, c) in covariance.iter_mut().enumerate() {
             *c = value(4 + k, &format!("covariance[{k}]"))?;
@@ -101,7 +103,7 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
 
 /// Reads `gps.csv`.
 pub fn read_mulran_gps(path: &Path) -> Result<Vec<GnssFix>, IngestError> {
-    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    let text = crate::error::read_text(path)?;
     parse_mulran_gps(path, &text)
 }
 

@@ -31,8 +31,9 @@ use mmtrack_core::{PolarScan, PolarScanHeader};
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
-use crate::error::os_err;
-use crate::scan_folder::{SameSize, ScanFile, StampUnit, decode_in_order, folder_name, list_scan_pngs};
+use crate::scan_folder::{
+    SameSize, ScanFile, StampUnit, decode_in_order, folder_name, list_scan_pngs, within_scan_span,
+};
 use crate::sweep::SweepTiming;
 use crate::{IngestError, Progress};
 
@@ -199,7 +200,7 @@ fn metadata(
         ("radar.stamp_at".to_string(), timing.stamp_at.name().to_string()),
     ]);
     let Some(path) = &folder.global_pose else { return Ok((extra, Vec::new())) };
-    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    let text = crate::error::read_text(path)?;
     let parsed = global_pose::parse_global_pose(path, &text)?;
     extra.insert("ground_truth.source".into(), path.display().to_string());
     extra.insert("ground_truth.frame".into(), "vehicle".into());
@@ -225,6 +226,10 @@ pub fn ingest_mulran(
         }
         None => Vec::new(),
     };
+    // Checked before anything is written.
+    let source = |path: &Option<std::path::PathBuf>| path.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
+    let truth = within_scan_span(&folder.scans, "poses", &source(&folder.global_pose), &truth, |p| p.t_ns)?;
+    let fixes = within_scan_span(&folder.scans, "fixes", &source(&folder.gps), &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("mulran:{}", folder.root.display()),
@@ -236,7 +241,7 @@ pub fn ingest_mulran(
     // The Cartesian view is resampled on the decoding threads too.
     let resampler = writer.cartesian_resampler().cloned();
     let decode = |scan: &ScanFile| -> Result<(PolarScan, Option<Vec<u8>>), IngestError> {
-        let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
+        let bytes = crate::error::read_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?;
         let polar = decode_mulran_png(&scan.path, &bytes, scan.t_ns, options)?;
         let view =
             match &resampler {
@@ -259,18 +264,18 @@ pub fn ingest_mulran(
         progress(index as u64 + 1, total);
         Ok(())
     })?;
-    let (first, last) = (folder.scans[0].t_ns, folder.scans[folder.scans.len() - 1].t_ns);
-    let mut ground_truth_poses = 0;
-    for pose in truth.iter().filter(|p| (first..=last).contains(&p.t_ns)) {
+    for pose in &truth {
         writer.write_pose(PoseStream::GroundTruth, pose, "world", "vehicle")?;
-        ground_truth_poses += 1;
     }
-    let mut gnss_fixes = 0;
-    for fix in fixes.iter().filter(|f| (first..=last).contains(&f.t_ns)) {
+    for fix in &fixes {
         writer.write_gnss_fix(fix)?;
-        gnss_fixes += 1;
     }
-    Ok(MulranReport { scans: total, ground_truth_poses, gnss_fixes, output: writer.finish()? })
+    Ok(MulranReport {
+        scans: total,
+        ground_truth_poses: truth.len() as u64,
+        gnss_fixes: fixes.len() as u64,
+        output: writer.finish()?,
+    })
 }
 
 #[cfg(test)]

@@ -5,6 +5,9 @@
 
 use mmtrack_core::GnssFixQuality;
 
+pub(super) use crate::calendar::days_from_civil;
+use mmtrack_core::plausible::{ALTITUDE_M, LATITUDE_DEG, LONGITUDE_DEG};
+
 /// Nanoseconds in a day.
 pub(super) const NS_PER_DAY: i64 = 86_400_000_000_000;
 
@@ -110,18 +113,6 @@ pub(super) fn time_of_day_ns(text: &str) -> Option<i64> {
     Some(((h * 60 + m) * 60 + s) * 1_000_000_000 + sub_ns)
 }
 
-/// Days since 1970-01-01 of a proleptic Gregorian date (Howard Hinnant's
-/// `days_from_civil`).
-pub(super) fn days_from_civil(year: i64, month: i64, day: i64) -> i64 {
-    let y = if month <= 2 { year - 1 } else { year };
-    let era = y.div_euclid(400);
-    let yoe = y - era * 400;
-    let mp = (month + 9) % 12;
-    let doy = (153 * mp + 2) / 5 + day - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    era * 146_097 + doe - 719_468
-}
-
 fn days_in_month(year: i64, month: i64) -> i64 {
     match month {
         2 if (year % 4 == 0 && year % 100 != 0) || year % 400 == 0 => 29,
@@ -219,29 +210,28 @@ pub(super) fn parse_gga(fields: &[&str]) -> Result<Gga, FieldError> {
     if quality == GnssFixQuality::NoFix {
         return Ok(Gga { time_of_day_ns, quality, position: None });
     }
-    let latitude_deg = coordinate_deg(get(fields, 2), get(fields, 3), 2, 90.0).ok_or_else(|| {
+    let latitude_deg = coordinate_deg(get(fields, 2), get(fields, 3), 2, LATITUDE_DEG.max).ok_or_else(|| {
         field_error("latitude", format!("'{},{}' is not ddmm.mm,N|S within 90 degrees", get(fields, 2), get(fields, 3)))
     })?;
-    let longitude_deg = coordinate_deg(get(fields, 4), get(fields, 5), 3, 180.0).ok_or_else(|| {
+    let longitude_deg = coordinate_deg(get(fields, 4), get(fields, 5), 3, LONGITUDE_DEG.max).ok_or_else(|| {
         field_error(
             "longitude",
             format!("'{},{}' is not dddmm.mm,E|W within 180 degrees", get(fields, 4), get(fields, 5)),
         )
     })?;
-    let altitude_msl_m = match get(fields, 9) {
-        "" => None,
-        text => Some(
-            finite(text)
-                .ok_or_else(|| field_error("altitude", format!("'{text}' is not a finite number of metres")))?,
-        ),
+    // The first fix's altitude becomes the recording's map origin: bounded.
+    let metres = |index: usize, field: &'static str| -> Result<Option<f64>, FieldError> {
+        match get(fields, index) {
+            "" => Ok(None),
+            text => {
+                let value = finite(text)
+                    .ok_or_else(|| field_error(field, format!("'{text}' is not a finite number of metres")))?;
+                ALTITUDE_M.check(value).map(Some).map_err(|e| field_error(field, e.to_string()))
+            }
+        }
     };
-    let geoid_separation_m = match get(fields, 11) {
-        "" => None,
-        text => Some(
-            finite(text)
-                .ok_or_else(|| field_error("geoid separation", format!("'{text}' is not a finite number of metres")))?,
-        ),
-    };
+    let altitude_msl_m = metres(9, "altitude")?;
+    let geoid_separation_m = metres(11, "geoid separation")?;
     Ok(Gga {
         time_of_day_ns,
         quality,
@@ -297,10 +287,10 @@ pub(super) fn parse_rmc(fields: &[&str]) -> Result<Rmc, FieldError> {
     if !valid {
         return Ok(Rmc { time_of_day_ns, valid, days, position: None });
     }
-    let latitude_deg = coordinate_deg(get(fields, 3), get(fields, 4), 2, 90.0).ok_or_else(|| {
+    let latitude_deg = coordinate_deg(get(fields, 3), get(fields, 4), 2, LATITUDE_DEG.max).ok_or_else(|| {
         field_error("latitude", format!("'{},{}' is not ddmm.mm,N|S within 90 degrees", get(fields, 3), get(fields, 4)))
     })?;
-    let longitude_deg = coordinate_deg(get(fields, 5), get(fields, 6), 3, 180.0).ok_or_else(|| {
+    let longitude_deg = coordinate_deg(get(fields, 5), get(fields, 6), 3, LONGITUDE_DEG.max).ok_or_else(|| {
         field_error(
             "longitude",
             format!("'{},{}' is not dddmm.mm,E|W within 180 degrees", get(fields, 5), get(fields, 6)),

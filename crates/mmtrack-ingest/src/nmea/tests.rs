@@ -603,3 +603,17 @@ proptest! {
         prop_assert!((fix.altitude_m.unwrap() - altitude_m).abs() < 1e-9);
     }
 }
+
+/// Before: a GGA altitude of 1e300 was taken, and as the first fix's
+/// altitude it became the recording's map origin. Now the GGA is skipped and
+/// reported like any unparsable line; its epoch keeps the RMC's position.
+#[test]
+fn an_implausible_altitude_is_skipped_and_reported() {
+    let huge = gga("GN", "021417.00", "1").replace(",4.4,M,", ",1e300,M,");
+    let text = rmc("GN", "021417.00", "A", "070220") + "\n" + &sentence(&huge[1..huge.len() - 3]) + "\n";
+    let log = parse(&text).unwrap();
+    assert_eq!((log.fixes.len(), log.unparsable_lines), (1, 1));
+    assert_eq!(log.fixes[0].altitude_m, None);
+    let reason = log.first_unparsable.unwrap().reason;
+    assert!(reason.contains("altitude") && reason.contains("1e300 is not an altitude within"), "{reason}");
+}

@@ -13,11 +13,11 @@
 
 use std::path::Path;
 
+use mmtrack_core::plausible::{ALTITUDE_M, COORDINATE_M, LATITUDE_DEG, LONGITUDE_DEG};
 use mmtrack_core::{GnssFix, GnssFixQuality};
 
 use crate::IngestError;
 use crate::csv::CsvTable;
-use crate::error::os_err;
 
 /// One row: the fix and the UTM position the file also gives.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,20 +58,15 @@ pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, Inges
             ));
         }
         let satellites = row.text("num_satellites")?;
-        let latitude_deg = row.finite("latitude")?;
-        let longitude_deg = row.finite("longitude")?;
-        if !(-90.0..=90.0).contains(&latitude_deg) || !(-180.0..=180.0).contains(&longitude_deg) {
-            return Err(
-                row.bad("latitude/longitude", format!("({latitude_deg}, {longitude_deg}) is not a geodetic position"))
-            );
-        }
+        let latitude_deg = row.bounded("latitude", &LATITUDE_DEG)?;
+        let longitude_deg = row.bounded("longitude", &LONGITUDE_DEG)?;
         let (sigma_lat_m, sigma_lon_m) = (row.finite("latitude_sigma")?, row.finite("longitude_sigma")?);
         rows.push(OxfordGpsRow {
             fix: GnssFix {
                 t_ns,
                 latitude_deg,
                 longitude_deg,
-                altitude_m: Some(row.finite("altitude")?),
+                altitude_m: Some(row.bounded("altitude", &ALTITUDE_M)?),
                 horizontal_sigma_m: Some(((sigma_lat_m * sigma_lat_m + sigma_lon_m * sigma_lon_m) / 2.0).sqrt()),
                 num_satellites: Some(
                     satellites
@@ -80,8 +75,8 @@ pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, Inges
                 ),
                 quality: GnssFixQuality::Unknown,
             },
-            northing_m: row.finite("northing")?,
-            easting_m: row.finite("easting")?,
+            northing_m: row.bounded("northing", &COORDINATE_M)?,
+            easting_m: row.bounded("easting", &COORDINATE_M)?,
         });
     }
     Ok(rows)
@@ -89,7 +84,7 @@ pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, Inges
 
 /// Reads `gps.csv`.
 pub fn read_gps_csv(path: &Path) -> Result<Vec<OxfordGpsRow>, IngestError> {
-    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    let text = crate::error::read_text(path)?;
     parse_gps_csv(path, &text)
 }
 
@@ -125,5 +120,21 @@ mod tests {
         let backwards = format!("{HEADER}\n5,7,51,-1,65,0.6,0.8,0.9,1,2,3,30U\n4,7,51,-1,65,0.6,0.8,0.9,1,2,3,30U\n");
         let err = parse_gps_csv(Path::new("gps.csv"), &backwards).unwrap_err().to_string();
         assert!(err.contains("line 3") && err.contains("does not increase"), "{err}");
+    }
+
+    /// Before: latitude 200 and an altitude of 1e300 (which becomes the
+    /// recording's map origin) were ingested.
+    #[test]
+    fn implausible_latitude_altitude_and_northing_are_refused() {
+        let good = "1,7,51.76,-1.26,65,0.6,0.8,0.9,5736000,619890,-65,30U";
+        for (bad, field) in [
+            (good.replace("51.76", "200"), "latitude: 200 is not a latitude within [-90, 90] deg"),
+            (good.replace(",65,", ",1e300,"), "altitude: 1e300 is not an altitude"),
+            (good.replace("5736000", "1e300"), "northing: 1e300 is not a coordinate"),
+        ] {
+            let err = parse_gps_csv(Path::new("gps.csv"), &format!("{HEADER}\n{bad}\n")).unwrap_err().to_string();
+            assert!(err.starts_with(&format!("gps.csv: line 2: {field}")), "{err}");
+        }
+        assert!(parse_gps_csv(Path::new("gps.csv"), &format!("{HEADER}\n{good}\n")).is_ok());
     }
 }

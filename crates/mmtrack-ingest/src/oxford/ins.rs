@@ -21,11 +21,11 @@
 use std::f64::consts::FRAC_PI_2;
 use std::path::Path;
 
+use mmtrack_core::plausible::{ALTITUDE_M, ANGLE_RAD, COORDINATE_M, LATITUDE_DEG, LONGITUDE_DEG};
 use mmtrack_core::{GnssFix, GnssFixQuality, Se2, StampedPose};
 
 use crate::IngestError;
 use crate::csv::CsvTable;
-use crate::error::os_err;
 
 /// The usable rows of an `ins.csv`.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -64,27 +64,27 @@ pub fn parse_ins_csv(path: &Path, text: &str) -> Result<InsSolution, IngestError
             out.skipped_not_good += 1;
             continue;
         }
-        let (latitude_deg, longitude_deg) = (row.finite("latitude")?, row.finite("longitude")?);
-        if !(-90.0..=90.0).contains(&latitude_deg) || !(-180.0..=180.0).contains(&longitude_deg) {
-            return Err(
-                row.bad("latitude/longitude", format!("({latitude_deg}, {longitude_deg}) is not a geodetic position"))
-            );
-        }
+        let (latitude_deg, longitude_deg) =
+            (row.bounded("latitude", &LATITUDE_DEG)?, row.bounded("longitude", &LONGITUDE_DEG)?);
         out.fixes.push(GnssFix {
             t_ns,
             latitude_deg,
             longitude_deg,
-            altitude_m: Some(row.finite("altitude")?),
+            altitude_m: Some(row.bounded("altitude", &ALTITUDE_M)?),
             horizontal_sigma_m: None,
             num_satellites: None,
             quality: GnssFixQuality::Unknown,
         });
-        let (east, north, up) = (row.finite("easting")?, row.finite("northing")?, -row.finite("down")?);
+        let (east, north, up) = (
+            row.bounded("easting", &COORDINATE_M)?,
+            row.bounded("northing", &COORDINATE_M)?,
+            -row.bounded("down", &COORDINATE_M)?,
+        );
         if out.poses.is_empty() {
             out.origin = [east, north, up];
             out.utm_zone = if table.has("utm_zone") { row.text("utm_zone")?.to_string() } else { String::new() };
         }
-        let yaw_ned = row.finite("yaw")?;
+        let yaw_ned = row.bounded("yaw", &ANGLE_RAD)?;
         out.poses.push(StampedPose {
             t_ns,
             parent_from_child: Se2::new(east - out.origin[0], north - out.origin[1], FRAC_PI_2 - yaw_ned),
@@ -95,7 +95,7 @@ pub fn parse_ins_csv(path: &Path, text: &str) -> Result<InsSolution, IngestError
 
 /// Reads `ins.csv`.
 pub fn read_ins_csv(path: &Path) -> Result<InsSolution, IngestError> {
-    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    let text = crate::error::read_text(path)?;
     parse_ins_csv(path, &text)
 }
 

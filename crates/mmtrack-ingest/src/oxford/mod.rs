@@ -27,7 +27,9 @@ use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummar
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
 use crate::error::os_err;
-use crate::scan_folder::{SameSize, StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check};
+use crate::scan_folder::{
+    SameSize, StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check, within_scan_span,
+};
 use crate::{IngestError, Progress};
 pub use png_scan::{DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
 
@@ -74,7 +76,7 @@ impl OxfordFolder {
         let mut scans = Vec::new();
         let mut unlisted_pngs = Vec::new();
         if timestamps.is_file() {
-            let text = std::fs::read_to_string(&timestamps).map_err(os_err(&timestamps))?;
+            let text = crate::error::read_text(&timestamps)?;
             let mut listed = BTreeSet::new();
             for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
                 let mut parts = line.split_whitespace();
@@ -253,6 +255,11 @@ pub fn ingest_oxford(
         ("radar.carried_png".to_string(), options.carry_png.to_string()),
     ]);
     let aux = read_auxiliary(folder, &mut extra)?;
+    // Checked before anything is written.
+    let source = |key: &str| extra.get(key).cloned().unwrap_or_default();
+    let in_span =
+        within_scan_span(&folder.scans, "poses", &source("ground_truth.source"), &aux.ground_truth, |p| p.t_ns)?;
+    let fixes_in_span = within_scan_span(&folder.scans, "fixes", &source("gnss.source"), &aux.fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
         source: format!("oxford:{}", folder.root.display()),
@@ -262,12 +269,9 @@ pub fn ingest_oxford(
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;
     let total = folder.scans.len() as u64;
     write_navtech_scans(&mut writer, &folder.scans, layout, options.carry_png, progress)?;
-    let (first, last) = (folder.scans[0].t_ns, folder.scans[folder.scans.len() - 1].t_ns);
-    let in_span: Vec<&StampedPose> = aux.ground_truth.iter().filter(|p| (first..=last).contains(&p.t_ns)).collect();
     for pose in &in_span {
         writer.write_pose(PoseStream::GroundTruth, pose, "world", aux.ground_truth_frame)?;
     }
-    let fixes_in_span: Vec<&GnssFix> = aux.fixes.iter().filter(|fix| (first..=last).contains(&fix.t_ns)).collect();
     for fix in &fixes_in_span {
         writer.write_gnss_fix(fix)?;
     }
@@ -306,7 +310,7 @@ pub(crate) fn write_navtech_scans(
     // decoded image with its header columns skipped.
     let resampler = writer.cartesian_resampler().cloned();
     let decode = |scan: &ScanFile| -> Result<DecodedScan, IngestError> {
-        let bytes = std::fs::read(&scan.path).map_err(os_err(&scan.path))?;
+        let bytes = crate::error::read_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?;
         let decoded = decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?;
         let cartesian =
             match &resampler {

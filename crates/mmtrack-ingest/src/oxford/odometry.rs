@@ -22,11 +22,11 @@
 
 use std::path::Path;
 
+use mmtrack_core::plausible::{ANGLE_RAD, COORDINATE_M};
 use mmtrack_core::{Se2, StampedPose};
 
 use crate::IngestError;
 use crate::csv::CsvTable;
-use crate::error::os_err;
 
 /// One parsed row.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,7 +57,11 @@ pub fn parse_radar_odometry(path: &Path, text: &str) -> Result<Vec<RelativePose>
                 source_t_ns: row.micros_ns(source_col)?,
                 destination_t_ns: row.micros_ns(destination_col)?,
                 // x forward / y right / z down -> x forward / y left / z up.
-                destination_from_source: Se2::new(row.finite("x")?, -row.finite("y")?, -row.finite("yaw")?),
+                destination_from_source: Se2::new(
+                    row.bounded("x", &COORDINATE_M)?,
+                    -row.bounded("y", &COORDINATE_M)?,
+                    -row.bounded("yaw", &ANGLE_RAD)?,
+                ),
             })
         })
         .collect()
@@ -104,7 +108,7 @@ pub fn chain(path: &Path, rows: &[RelativePose]) -> Result<Vec<StampedPose>, Ing
 
 /// Reads and chains a `radar_odometry.csv` file.
 pub fn read_radar_odometry(path: &Path) -> Result<Vec<StampedPose>, IngestError> {
-    let text = std::fs::read_to_string(path).map_err(os_err(path))?;
+    let text = crate::error::read_text(path)?;
     chain(path, &parse_radar_odometry(path, &text)?)
 }
 

@@ -10,7 +10,7 @@
 use std::f64::consts::TAU;
 use std::path::Path;
 
-use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader};
+use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader, plausible};
 
 use crate::IngestError;
 
@@ -107,7 +107,8 @@ fn check_size(path: &Path, width: usize, height: usize, layout: &NavtechLayout) 
 }
 
 /// Decodes one scan PNG and parses its row headers. `scan_t_ns` is the scan's
-/// own stamp (the file name). The size in the PNG header is checked against
+/// own stamp (the file name); every row time must lie within
+/// [`plausible::SCAN_ROW_TIME_TOLERANCE_NS`] of it. The size in the PNG header is checked against
 /// the layout before any pixel is decoded. Errors name the file, the row and
 /// the field.
 pub fn decode_scan_png(
@@ -131,6 +132,20 @@ pub fn decode_scan_png(
         let t_ns = t_us.checked_mul(1000).filter(|t| *t > 0).ok_or_else(|| {
             bad(path, record(), "timestamp (bytes 0-7)", format!("{t_us} us is not a valid UNIX time"))
         })?;
+        if !plausible::time_near(t_ns, scan_t_ns, plausible::SCAN_ROW_TIME_TOLERANCE_NS) {
+            return Err(bad(
+                path,
+                record(),
+                "timestamp (bytes 0-7)",
+                format!(
+                    "{t_us} us is {:.3} s from the scan's own stamp {} us (the file name); a sweep lasts 0.25 s, \
+                     so its row times must lie within {} s of it",
+                    (t_ns as f64 - scan_t_ns as f64) * 1e-9,
+                    scan_t_ns / 1000,
+                    plausible::SCAN_ROW_TIME_TOLERANCE_NS / 1_000_000_000
+                ),
+            ));
+        }
         let counts = u16::from_le_bytes([row[8], row[9]]);
         if counts >= layout.counts_per_turn {
             return Err(bad(
@@ -198,17 +213,20 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// The first real scan's stamp (Oxford sample), ns.
+    const T0_NS: i64 = 1_547_131_046_353_776_000;
+
     fn scan(azimuths: usize, bins: usize) -> PolarScan {
         let azimuths: Vec<AzimuthSample> = (0..azimuths)
             .map(|a| AzimuthSample {
-                t_ns: 1_547_131_046_353_776_000 + a as i64 * 625_000,
+                t_ns: T0_NS + a as i64 * 625_000,
                 azimuth_rad: a as f64 * TAU / 400.0,
                 valid: a != 3,
             })
             .collect();
         let power = (0..azimuths.len() * bins).map(|i| (i % 251) as u8).collect();
         let header = PolarScanHeader {
-            t_ns: 1,
+            t_ns: T0_NS,
             range_resolution_m: 0.0432,
             range_offset_m: 0.0,
             bins_per_azimuth: bins,
@@ -234,7 +252,7 @@ mod tests {
     fn encode_decode_round_trip_keeps_rows_and_headers() {
         let original = scan(20, 30);
         let png = encode_scan_png(&original, &layout(30)).unwrap();
-        let decoded = decode_scan_png(Path::new("s.png"), &png, 1, &layout(30)).unwrap().into_scan();
+        let decoded = decode_scan_png(Path::new("s.png"), &png, T0_NS, &layout(30)).unwrap().into_scan();
         assert_eq!(decoded.power, original.power);
         for (a, b) in decoded.header.azimuths.iter().zip(&original.header.azimuths) {
             // The format keeps microseconds and encoder counts (2 pi / 5600 rad).
@@ -247,17 +265,17 @@ mod tests {
     #[test]
     fn wrong_width_depth_and_time_are_named() {
         let png = encode_scan_png(&scan(4, 30), &layout(30)).unwrap();
-        let err = decode_scan_png(Path::new("s.png"), &png, 1, &layout(3768)).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("s.png"), &png, T0_NS, &layout(3768)).unwrap_err().to_string();
         assert!(err.contains("s.png") && err.contains("width") && err.contains("3768"), "{err}");
 
         let sixteen = gray_png(41, 4, png::BitDepth::Sixteen, &vec![0; 41 * 4 * 2]);
-        let err = decode_scan_png(Path::new("s.png"), &sixteen, 1, &layout(30)).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("s.png"), &sixteen, T0_NS, &layout(30)).unwrap_err().to_string();
         assert!(err.contains("16-bit") && err.contains("8-bit greyscale"), "{err}");
 
         let mut backwards = scan(4, 30);
         backwards.header.azimuths[2].t_ns = backwards.header.azimuths[1].t_ns - 1000;
         let png = encode_scan_png(&backwards, &layout(30)).unwrap();
-        let err = decode_scan_png(Path::new("s.png"), &png, 1, &layout(30)).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("s.png"), &png, T0_NS, &layout(30)).unwrap_err().to_string();
         assert!(
             err.contains("azimuth row 2") && err.contains("timestamp") && err.contains("does not increase"),
             "{err}"
@@ -266,10 +284,34 @@ mod tests {
         let mut pixels = vec![0u8; 41 * 2];
         pixels[..8].copy_from_slice(&1_000_000i64.to_le_bytes());
         pixels[8..10].copy_from_slice(&6000u16.to_le_bytes());
-        let err = decode_scan_png(Path::new("s.png"), &gray_png(41, 2, png::BitDepth::Eight, &pixels), 1, &layout(30))
-            .unwrap_err()
-            .to_string();
+        let err = decode_scan_png(
+            Path::new("s.png"),
+            &gray_png(41, 2, png::BitDepth::Eight, &pixels),
+            1_000_000_000,
+            &layout(30),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(err.contains("azimuth row 0") && err.contains("encoder") && err.contains("5600"), "{err}");
+    }
+
+    /// Before: row times in 1970, in 2200 or an hour off the file name were
+    /// ingested, and odometry reported a 10.3 m path instead of 19.2 m.
+    #[test]
+    fn row_times_far_from_the_file_stamp_are_refused() {
+        let png = encode_scan_png(&scan(4, 30), &layout(30)).unwrap();
+        // The last row is 1.875 ms after the first: within a sweep of the stamp.
+        assert!(decode_scan_png(Path::new("s.png"), &png, T0_NS + 200_000_000, &layout(30)).is_ok());
+        for (stamp_ns, offset) in [(T0_NS + 3_600_000_000_000, "-3600.000 s"), (T0_NS - 2_000_000_000, "2.000 s")] {
+            let err = decode_scan_png(Path::new("s.png"), &png, stamp_ns, &layout(30)).unwrap_err().to_string();
+            assert!(err.contains("s.png: azimuth row 0: timestamp (bytes 0-7)") && err.contains(offset), "{err}");
+        }
+        let mut old = scan(4, 30);
+        old.header.azimuths[2].t_ns = 1_000_000_000;
+        old.header.azimuths[3].t_ns = 2_000_000_000;
+        let png = encode_scan_png(&old, &layout(30)).unwrap();
+        let err = decode_scan_png(Path::new("s.png"), &png, T0_NS, &layout(30)).unwrap_err().to_string();
+        assert!(err.contains("azimuth row 2") && err.contains("from the scan's own stamp"), "{err}");
     }
 
     /// The data of a PNG's IDAT chunks, concatenated (the zlib stream).
@@ -306,26 +348,27 @@ mod tests {
         let tiny = idat(&gray_png(1, 1, png::BitDepth::Eight, &[0]));
         let huge = png_with_image_data(100_000, 100_000, &tiny);
         assert!(huge.len() < 100);
-        let err = decode_scan_png(Path::new("radar/1547131046353776.png"), &huge, 1, &OXFORD).unwrap_err().to_string();
+        let err =
+            decode_scan_png(Path::new("radar/1547131046353776.png"), &huge, T0_NS, &OXFORD).unwrap_err().to_string();
         assert!(
             err.contains("radar/1547131046353776.png: image: width: 100000 columns") && err.contains("11 + 3768"),
             "{err}"
         );
         // Right width, 100000 rows: the height is refused, still from the header.
         let tall = png_with_image_data(3779, 100_000, &tiny);
-        let err = decode_scan_png(Path::new("t.png"), &tall, 1, &OXFORD).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("t.png"), &tall, T0_NS, &OXFORD).unwrap_err().to_string();
         assert!(err.contains("t.png: image: height: 100000 rows; expected 400 azimuth rows"), "{err}");
         // A layout that takes the size from the file: the reader's cap.
         let auto = NavtechLayout { expected_bins: None, expected_azimuths: None, ..OXFORD };
-        let err = decode_scan_png(Path::new("t.png"), &huge, 1, &auto).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("t.png"), &huge, T0_NS, &auto).unwrap_err().to_string();
         assert!(err.contains("t.png: image: PNG data: 100000 x 100000 pixels is over the 64 MiB"), "{err}");
 
         let full = NavtechLayout { expected_bins: Some(30), ..OXFORD };
         let png = encode_scan_png(&scan(399, 30), &full).unwrap();
-        let err = decode_scan_png(Path::new("s.png"), &png, 1, &full).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("s.png"), &png, T0_NS, &full).unwrap_err().to_string();
         assert!(err.contains("s.png: image: height: 399 rows; expected 400 azimuth rows"), "{err}");
         assert!(
-            decode_scan_png(Path::new("s.png"), &encode_scan_png(&scan(400, 30), &full).unwrap(), 1, &full).is_ok()
+            decode_scan_png(Path::new("s.png"), &encode_scan_png(&scan(400, 30), &full).unwrap(), T0_NS, &full).is_ok()
         );
     }
 
@@ -339,7 +382,7 @@ mod tests {
         let middle = zlib.len() / 2;
         zlib[middle] ^= 0x04;
         let bad = png_with_image_data(41, 20, &zlib);
-        let err = decode_scan_png(Path::new("s.png"), &bad, 1, &layout).unwrap_err().to_string();
+        let err = decode_scan_png(Path::new("s.png"), &bad, T0_NS, &layout).unwrap_err().to_string();
         assert!(err.contains("s.png: image: PNG data") && err.contains("corrupt"), "{err}");
     }
 
@@ -408,19 +451,20 @@ mod tests {
                                           junk in proptest::collection::vec(any::<u8>(), 0..300)) {
             let pixels: Vec<u8> = rows.concat();
             let png = gray_png(14, rows.len() as u32, png::BitDepth::Eight, &pixels);
-            let _ = decode_scan_png(Path::new("p.png"), &png, 1, &layout(3));
-            let _ = decode_scan_png(Path::new("p.png"), &junk, 1, &layout(3));
+            let _ = decode_scan_png(Path::new("p.png"), &png, T0_NS, &layout(3));
+            let _ = decode_scan_png(Path::new("p.png"), &junk, T0_NS, &layout(3));
             let mut cut = png.clone();
             cut.truncate(junk.len().min(png.len()));
-            let _ = decode_scan_png(Path::new("p.png"), &cut, 1, &layout(3));
+            let _ = decode_scan_png(Path::new("p.png"), &cut, T0_NS, &layout(3));
         }
 
-        /// Any scan the format can hold (increasing microsecond times, angles
-        /// in [0, 2 pi), any valid flags and power) decodes to itself, up to the
-        /// encoder-count quantisation of the angle.
+        /// Any scan the format can hold (increasing microsecond times within
+        /// a second of the scan's stamp, angles in [0, 2 pi), any valid flags
+        /// and power) decodes to itself, up to the encoder-count quantisation
+        /// of the angle.
         #[test]
         fn row_headers_round_trip(
-            rows in proptest::collection::vec((1i64..2_000_000, 0.0f64..TAU, any::<bool>()), 1..24),
+            rows in proptest::collection::vec((1i64..40_000, 0.0f64..TAU, any::<bool>()), 1..24),
             bins in 1usize..9,
             t0_us in 1i64..4_000_000_000_000_000,
             seed in any::<u8>(),
@@ -434,10 +478,10 @@ mod tests {
                 })
                 .collect();
             let power: Vec<u8> = (0..azimuths.len() * bins).map(|i| (i as u8).wrapping_mul(31) ^ seed).collect();
-            let header = PolarScanHeader { t_ns: 7, range_resolution_m: 0.0432, range_offset_m: 0.0, bins_per_azimuth: bins, azimuths };
+            let header = PolarScanHeader { t_ns: t0_us * 1000, range_resolution_m: 0.0432, range_offset_m: 0.0, bins_per_azimuth: bins, azimuths };
             let original = PolarScan::new(header, power).unwrap();
             let png = encode_scan_png(&original, &layout(bins)).unwrap();
-            let decoded = decode_scan_png(Path::new("p.png"), &png, 7, &layout(bins)).unwrap().into_scan();
+            let decoded = decode_scan_png(Path::new("p.png"), &png, t0_us * 1000, &layout(bins)).unwrap().into_scan();
             prop_assert_eq!(&decoded.power, &original.power);
             for (a, b) in decoded.header.azimuths.iter().zip(&original.header.azimuths) {
                 prop_assert_eq!(a.t_ns, b.t_ns);
