@@ -39,13 +39,13 @@ test-hdf5:
 test:
     cargo test --workspace -- --show-output
 
-# Benchmarks in release mode; refresh the README's results blocks.
+# Benchmarks in release mode; refresh the results blocks of docs/benchmarks.md.
 bench:
-    cargo run -q --release -p mmtrack-cli -- bench io --check --readme README.md
-    cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md --from ../shared/realdata/oxford-radar-tiny
-    cargo run -q --release -p mmtrack-cli -- bench ingest --readme README.md
-    cargo run -q --release -p mmtrack-cli -- bench odometry --readme README.md
-    cargo run -q --release -p mmtrack-cli -- bench mpc --readme README.md
+    cargo run -q --release -p mmtrack-cli -- bench io --check --readme docs/benchmarks.md
+    cargo run -q --release -p mmtrack-cli -- bench ingest --readme docs/benchmarks.md --from ../shared/realdata/oxford-radar-tiny
+    cargo run -q --release -p mmtrack-cli -- bench ingest --readme docs/benchmarks.md
+    cargo run -q --release -p mmtrack-cli -- bench odometry --readme docs/benchmarks.md
+    cargo run -q --release -p mmtrack-cli -- bench mpc --readme docs/benchmarks.md
 
 # Issue #5's convoy evaluation: the paper's 1666 simulated sets, MPC detection
 # and tracking, statistics against the simulator's truth (report:

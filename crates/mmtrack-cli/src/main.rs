@@ -66,7 +66,8 @@ enum Command {
     Process(process::ProcessArgs),
     /// Compute metrics, result tables and plots from Parquet tables.
     Analyze(analyze::AnalyzeArgs),
-    /// Write trajectory tables as standard text (TUM, KITTI) for evo, pyboreas or the KITTI devkit.
+    /// Write trajectory tables as TUM, KITTI or Boreas text (evo, the KITTI devkit, pyboreas), or as MCAP: a copy of
+    /// the recording with the estimate added (Foxglove).
     Export(export::ExportArgs),
     /// Re-run a paper's experiment and compare with its published numbers.
     Reproduce(reproduce::ReproduceArgs),

@@ -54,8 +54,9 @@ enum Experiment {
     /// error below 0.03 ns at -116 dB and two tracks in every run down to
     /// -126 dB (proposed tracker, Kaiser window). Writes results.csv,
     /// results_by_separation.csv, reproduce.md and SVG figures (Figs. 4-5,
-    /// error vs separation); `--readme` rewrites the README's block; exits 1
-    /// when a target is missed. `--quick` is the CI version.
+    /// error vs separation); `--readme docs/results/multipath.md` rewrites
+    /// its block there; exits 1 when a target is missed. `--quick` is the CI
+    /// version.
     #[command(verbatim_doc_comment)]
     MpcArtificial(mpc_artificial::MpcArtificialArgs),
     /// Valid beam tracking on the overpass link of Shaham et al. 2020, Figs. 2-4 and Table I
@@ -71,8 +72,9 @@ enum Experiment {
     /// (PAPERS.md section 3): 99/142/193 and 109/100/91/83 blocks within
     /// 15 %, both orderings, and at least 49 % longer than the angle-state
     /// EKF. Writes Parquet tables (RMS error per block, valid tracking),
-    /// three SVG figures and reproduce.md; `--readme` rewrites the README's
-    /// block; exits 1 when a target is missed. `--quick` is the CI version.
+    /// three SVG figures and reproduce.md; `--readme docs/results/shaham.md`
+    /// rewrites its block there; exits 1 when a target is missed. `--quick` is
+    /// the CI version.
     #[command(verbatim_doc_comment)]
     Shaham(shaham::ShahamArgs),
     /// SPEBT beam tracking driven by pose estimates, Liu et al. 2024, Table III and Fig. 5
@@ -92,8 +94,8 @@ enum Experiment {
     /// 4.616 deg and < 300 of 6388. Targets (PAPERS.md section 1): AoD <=
     /// 0.22 deg, AoA <= 4.6 deg, re-initialisations < 5 % of slots. Writes
     /// Parquet tables (summary, per slot), Fig. 5-style figures and
-    /// reproduce.md; `--readme` rewrites the README's block; exits 1 when a
-    /// target is missed. `--quick` is the CI version.
+    /// reproduce.md; `--readme docs/results/spebt.md` rewrites its block
+    /// there; exits 1 when a target is missed. `--quick` is the CI version.
     #[command(verbatim_doc_comment)]
     Spebt(spebt::SpebtArgs),
     /// Geometric Doppler-bearing tracking of Zoechmann et al. 2019, Figs. 4-5
@@ -111,8 +113,9 @@ enum Experiment {
     /// full-overtaking hand-over after about 0.5 s; 128/3 = 43x fewer beam
     /// measurements per tracked epoch; 100 000 runs in under 60 s. Writes
     /// Parquet tables (NMSE per epoch, summary), one Fig. 4/5-style SVG per
-    /// manoeuvre and reproduce.md; `--readme` rewrites the README's block;
-    /// exits 1 when a target is missed. `--quick` is the CI version.
+    /// manoeuvre and reproduce.md; `--readme docs/results/zoechmann.md`
+    /// rewrites its block there; exits 1 when a target is missed. `--quick`
+    /// is the CI version.
     #[command(verbatim_doc_comment)]
     Zoechmann(zoechmann::ZoechmannArgs),
     /// 5G mmWave vehicular SLAM of Kim et al. 2018, Sec. V
@@ -127,8 +130,9 @@ enum Experiment {
     /// UE errors 0.5 m / 0.02 rad / 0.3 m, VA 0.8 m, SP 0.6 m, all VAs
     /// confirmed by epoch 26 and all SPs by epoch 91. Writes Parquet tables
     /// (summary, per epoch), SVG figures (map, errors, confirmed sources),
-    /// reproduce.md and metrics.json; `--readme` rewrites the README's
-    /// block; exits 1 when a target is missed. `--quick` is the CI version.
+    /// reproduce.md and metrics.json; `--readme docs/results/kim.md`
+    /// rewrites its block there; exits 1 when a target is missed. `--quick`
+    /// is the CI version.
     #[command(verbatim_doc_comment)]
     Kim(kim::KimArgs),
 }

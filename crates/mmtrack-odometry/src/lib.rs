@@ -15,8 +15,9 @@
 //!    SE(2) (eq. (9)), from a constant-velocity guess.
 //!
 //! Presets: [`OdometryConfig::fast_cfear`] (the paper's Table I) and
-//! [`OdometryConfig::cfear`]. The README's results table says how each does on
-//! the real Oxford sample and on simulated drives.
+//! [`OdometryConfig::cfear`]. The results table of
+//! docs/results/radar-odometry.md says how each does on the real Oxford
+//! sample and on simulated drives.
 //!
 //! Differences from the authors' C++ code, on purpose: (a) association is done
 //! with the current scan placed at the initial guess (the authors' code

@@ -15,10 +15,12 @@
 //! tolerance, a metric the expectation names but the run did not produce,
 //! and a metric without an expectation are misses (the CLI exits 1).
 //!
-//! With a README (full runs only) the experiments that have a README block
-//! rewrite it, and the block `reproduce-all` receives the table of every
-//! metric; a test checks that block against the expectation files, so a
-//! README that no longer matches them fails CI.
+//! With `--readme docs/results/README.md` (full runs only) the block
+//! `reproduce-all` there receives the table of every metric, and each
+//! experiment that has a block rewrites it in the page beside it that holds
+//! it ([`readme_block::locate_block`]); a test checks the `reproduce-all`
+//! block against the expectation files, so a results page that no longer
+//! matches them fails CI.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -31,15 +33,17 @@ use crate::expectation::{Check, ExpectedMetric, compare, parse_expected, table};
 use crate::model::{Outcome, RunOptions, Tier, Verdict};
 use crate::{kim, mpc_artificial, odometry, readme_block, shaham, spebt, zoechmann};
 
-/// The README block that receives the table of every metric.
+/// The block (in docs/results/README.md) that receives the table of every
+/// metric.
 pub const README_BLOCK: &str = "reproduce-all";
 
 /// One experiment of [`run_all`].
 pub struct Experiment {
     /// Its name (the CLI's subcommand).
     pub name: &'static str,
-    /// Whether it has a README block of its own.
-    pub readme: bool,
+    /// The name of its own generated block (in its page under
+    /// docs/results/), if it has one.
+    pub block: Option<&'static str>,
     /// Its expectation file (embedded: the call runs from anywhere).
     pub expected: &'static str,
     /// The file's path in the repository, for messages.
@@ -65,7 +69,7 @@ impl Experiment {
 pub const EXPERIMENTS: [Experiment; 6] = [
     Experiment {
         name: odometry::NAME,
-        readme: false,
+        block: None,
         expected: include_str!("../../../data/reproduce/odometry.expected.toml"),
         expected_path: "data/reproduce/odometry.expected.toml",
         check_start: odometry::check_start,
@@ -73,7 +77,7 @@ pub const EXPERIMENTS: [Experiment; 6] = [
     },
     Experiment {
         name: mpc_artificial::NAME,
-        readme: true,
+        block: Some(mpc_artificial::README_BLOCK),
         expected: include_str!("../../../data/reproduce/mpc-artificial.expected.toml"),
         expected_path: "data/reproduce/mpc-artificial.expected.toml",
         check_start: mpc_artificial::check_start,
@@ -81,7 +85,7 @@ pub const EXPERIMENTS: [Experiment; 6] = [
     },
     Experiment {
         name: shaham::NAME,
-        readme: true,
+        block: Some(shaham::README_BLOCK),
         expected: include_str!("../../../data/reproduce/shaham.expected.toml"),
         expected_path: "data/reproduce/shaham.expected.toml",
         check_start: shaham::check_start,
@@ -89,7 +93,7 @@ pub const EXPERIMENTS: [Experiment; 6] = [
     },
     Experiment {
         name: spebt::NAME,
-        readme: true,
+        block: Some(spebt::README_BLOCK),
         expected: include_str!("../../../data/reproduce/spebt.expected.toml"),
         expected_path: "data/reproduce/spebt.expected.toml",
         check_start: spebt::check_start,
@@ -97,7 +101,7 @@ pub const EXPERIMENTS: [Experiment; 6] = [
     },
     Experiment {
         name: zoechmann::NAME,
-        readme: true,
+        block: Some(zoechmann::README_BLOCK),
         expected: include_str!("../../../data/reproduce/zoechmann.expected.toml"),
         expected_path: "data/reproduce/zoechmann.expected.toml",
         check_start: zoechmann::check_start,
@@ -105,7 +109,7 @@ pub const EXPERIMENTS: [Experiment; 6] = [
     },
     Experiment {
         name: kim::NAME,
-        readme: true,
+        block: Some(kim::README_BLOCK),
         expected: include_str!("../../../data/reproduce/kim.expected.toml"),
         expected_path: "data/reproduce/kim.expected.toml",
         check_start: kim::check_start,
@@ -145,8 +149,9 @@ pub struct AllOptions {
     pub tier: Tier,
     /// One subdirectory per experiment, and `summary.md`.
     pub output_dir: PathBuf,
-    /// The README whose experiment blocks and `reproduce-all` block are
-    /// rewritten (full runs only).
+    /// The file whose `reproduce-all` block is rewritten
+    /// (docs/results/README.md), the experiments' blocks in the Markdown
+    /// files beside it (full runs only).
     pub readme: Option<PathBuf>,
 }
 
@@ -158,7 +163,7 @@ pub struct AllOutcome {
     pub claims: Vec<(&'static str, Verdict)>,
     /// Every metric against its expectation, experiment by experiment.
     pub checks: Vec<Check>,
-    /// The Markdown summary (also `summary.md`, and the README block).
+    /// The Markdown summary (also `summary.md`, and the `reproduce-all` block).
     pub summary: String,
 }
 
@@ -179,11 +184,11 @@ impl AllOutcome {
 
 /// Runs every experiment of [`EXPERIMENTS`] into `options.output_dir/<name>`
 /// and checks each metric against its expectation; writes `summary.md`
-/// and, with a README, the blocks. Progress: each experiment's stages, and
-/// a note per experiment.
+/// and, with `options.readme`, the blocks. Progress: each experiment's
+/// stages, and a note per experiment.
 ///
 /// # Errors
-/// A README without its blocks (checked before any work), an expectation
+/// A block that is missing or found twice (checked before any work), an expectation
 /// file that does not parse, an experiment that fails, an output that
 /// cannot be written. Misses are not errors: see [`AllOutcome::misses`].
 pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<AllOutcome> {
@@ -194,6 +199,14 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
     if let Some(readme) = &options.readme {
         readme_block::check_block(readme, README_BLOCK)?;
     }
+    // Each experiment's block: in `readme` or the page beside it that holds it.
+    let block_files: Vec<Option<PathBuf>> = EXPERIMENTS
+        .iter()
+        .map(|e| match (&options.readme, e.block) {
+            (Some(readme), Some(block)) => readme_block::locate_block(readme, block).map(Some),
+            _ => Ok(None),
+        })
+        .collect::<anyhow::Result<_>>()?;
     let expectations: Vec<Vec<ExpectedMetric>> =
         EXPERIMENTS.iter().map(Experiment::expectations).collect::<anyhow::Result<_>>()?;
     std::fs::create_dir_all(&options.output_dir).with_context(|| options.output_dir.display().to_string())?;
@@ -203,7 +216,7 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
     let mut timings = Vec::new();
     for (k, (experiment, expected)) in EXPERIMENTS.iter().zip(&expectations).enumerate() {
         let dir = options.output_dir.join(experiment.name);
-        let readme = options.readme.clone().filter(|_| experiment.readme);
+        let readme = block_files[k].clone();
         progress.note(&format!(
             "[{}/{}] reproduce {}{} -> {}",
             k + 1,
@@ -282,7 +295,7 @@ fn claims_section(claims: &[(&'static str, Verdict)], command: &str, tier: Tier)
     out
 }
 
-/// Checks the README's `reproduce-all` block against the expectation
+/// Checks the `reproduce-all` block (docs/results/README.md) against the expectation
 /// files: every full-run expectation appears as a row whose measured value
 /// lies within its tolerance. Returns the problems (empty when current).
 #[must_use]
@@ -291,7 +304,7 @@ pub fn stale_readme_rows(readme: &str) -> Vec<String> {
     let begin = format!("<!-- {README_BLOCK}:begin -->");
     let end = format!("<!-- {README_BLOCK}:end -->");
     let Some(block) = readme.split(&begin).nth(1).and_then(|rest| rest.split(&end).next()) else {
-        return vec![format!("README has no {begin} ... {end} block")];
+        return vec![format!("no {begin} ... {end} block")];
     };
     let mut problems = Vec::new();
     for spec in &EXPERIMENTS {
@@ -305,7 +318,7 @@ pub fn stale_readme_rows(readme: &str) -> Vec<String> {
             match measured {
                 None => problems.push(format!("{} `{}`: no row with a measured value", spec.name, e.key)),
                 Some(m) if (m - e.full.value).abs() > e.full.tolerance => problems.push(format!(
-                    "{} `{}`: README says {m}, {} expects {} +- {}",
+                    "{} `{}`: the block says {m}, {} expects {} +- {}",
                     spec.name, e.key, spec.expected_path, e.full.value, e.full.tolerance
                 )),
                 Some(_) => {}
@@ -319,16 +332,18 @@ pub fn stale_readme_rows(readme: &str) -> Vec<String> {
 mod tests {
     use super::*;
 
-    /// The README's `reproduce-all` table agrees with the expectation
-    /// files (written by `reproduce --all --readme README.md`).
+    /// The `reproduce-all` table of docs/results/README.md agrees with the
+    /// expectation files (written by `reproduce --all --readme
+    /// docs/results/README.md`).
     #[test]
-    fn the_readme_table_matches_the_expectation_files() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../README.md");
+    fn the_results_table_matches_the_expectation_files() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../docs/results/README.md");
         let readme = std::fs::read_to_string(&path).unwrap();
         let problems = stale_readme_rows(&readme);
         assert!(
             problems.is_empty(),
-            "README.md's {README_BLOCK} block is stale (run `mmtrack reproduce --all --readme README.md`):\n{}",
+            "docs/results/README.md's {README_BLOCK} block is stale (run `mmtrack reproduce --all --readme \
+             docs/results/README.md`):\n{}",
             problems.join("\n")
         );
     }

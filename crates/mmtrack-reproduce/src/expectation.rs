@@ -4,9 +4,9 @@
 //! Beside each experiment's configuration in `data/reproduce/` lies
 //! `<experiment>.expected.toml`: for every metric the value expected from
 //! the full run and from the smoke run, each with an absolute tolerance.
-//! Expected values are what this code measured when the README's results
-//! were written, not the paper's numbers (which several experiments miss,
-//! with the reasons in the README); the paper's number is printed beside
+//! Expected values are what this code measured when the results pages
+//! (docs/results/) were written, not the paper's numbers (which several
+//! experiments miss, with the reasons on those pages); the paper's number is printed beside
 //! them. A metric outside its tolerance, a metric the expectation names but
 //! the run did not produce, and a metric without an expectation are misses.
 

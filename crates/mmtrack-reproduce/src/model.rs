@@ -25,7 +25,7 @@ pub enum Tier {
     /// The CI version (the CLI's `--quick`, `reproduce --all --smoke`):
     /// fewer runs or points, checked against the smoke expectations.
     Smoke,
-    /// The run the README's results come from.
+    /// The run the results pages (docs/results/) come from.
     Full,
 }
 

@@ -2,11 +2,12 @@
 //! `<!-- {name}:end -->`, replaced by `bench ... --readme` and `reproduce ...
 //! --readme` so that the results tables are written by the runs, never typed.
 //!
+//! The blocks live in the docs (`docs/results/*.md`, `docs/benchmarks.md`).
 //! Everything outside the block is left byte for byte. A file without exactly
 //! one pair of markers, in that order, is refused and left untouched.
 
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
@@ -39,6 +40,52 @@ fn body_span(text: &str, path: &Path, name: &str) -> anyhow::Result<Range<usize>
 pub fn check_block(path: &Path, name: &str) -> anyhow::Result<()> {
     let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
     body_span(&text, path, name).map(drop)
+}
+
+/// The file that holds block `name`: `readme` itself when it has the block's
+/// begin marker, else the one Markdown file in the same directory that has
+/// it. So `reproduce --all --readme docs/results/README.md` writes its own
+/// table there and each experiment's block into that experiment's page
+/// beside it. Checked before any work, like [`check_block`].
+///
+/// # Errors
+/// `readme` cannot be read; no file, or more than one file beside it, has
+/// the begin marker (all are named).
+pub fn locate_block(readme: &Path, name: &str) -> anyhow::Result<PathBuf> {
+    let begin = format!("<!-- {name}:begin -->");
+    let text = std::fs::read_to_string(readme).with_context(|| readme.display().to_string())?;
+    if text.contains(&begin) {
+        return Ok(readme.to_path_buf());
+    }
+    let dir = match readme.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let mut found = Vec::new();
+    for entry in std::fs::read_dir(dir).with_context(|| dir.display().to_string())? {
+        let path = entry.with_context(|| dir.display().to_string())?.path();
+        if path.extension().is_some_and(|e| e == "md") && path.is_file() {
+            let other = std::fs::read_to_string(&path).with_context(|| path.display().to_string())?;
+            if other.contains(&begin) {
+                found.push(path);
+            }
+        }
+    }
+    found.sort();
+    match found.len() {
+        1 => Ok(found.remove(0)),
+        0 => anyhow::bail!(
+            "marker {begin} found neither in {} nor in another .md file of {} (nothing was done)",
+            readme.display(),
+            dir.display()
+        ),
+        _ => anyhow::bail!(
+            "marker {begin} found in {} files beside {}: {} (nothing was done)",
+            found.len(),
+            readme.display(),
+            found.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        ),
+    }
 }
 
 /// Replaces the body of block `name` in `path` by `body` (a newline is added
@@ -82,5 +129,22 @@ mod tests {
             assert!(check_block(&path, "x").is_err());
             assert_eq!(std::fs::read_to_string(&path).unwrap(), text);
         }
+    }
+
+    #[test]
+    fn a_block_is_found_in_the_file_or_the_one_page_beside_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let index = dir.path().join("README.md");
+        let page = dir.path().join("shaham.md");
+        std::fs::write(&index, "<!-- all:begin -->\n<!-- all:end -->\n").unwrap();
+        std::fs::write(&page, "# S\n<!-- reproduce-shaham:begin -->\nold\n<!-- reproduce-shaham:end -->\n").unwrap();
+        std::fs::write(dir.path().join("notes.txt"), "<!-- reproduce-kim:begin -->\n").unwrap();
+        assert_eq!(locate_block(&index, "all").unwrap(), index);
+        assert_eq!(locate_block(&index, "reproduce-shaham").unwrap(), page);
+        let none = format!("{:#}", locate_block(&index, "reproduce-kim").unwrap_err());
+        assert!(none.contains("found neither in") && none.contains("README.md"), "{none}");
+        std::fs::write(dir.path().join("copy.md"), std::fs::read_to_string(&page).unwrap()).unwrap();
+        let two = format!("{:#}", locate_block(&index, "reproduce-shaham").unwrap_err());
+        assert!(two.contains("found in 2 files") && two.contains("copy.md") && two.contains("shaham.md"), "{two}");
     }
 }

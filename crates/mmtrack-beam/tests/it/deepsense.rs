@@ -287,7 +287,7 @@ fn search(s: &Setting) -> SearchConfig {
 /// each tracker's setting is chosen on one scenario alone (lowest mean loss
 /// among the grid's settings with at most 5 beams per sweep) and evaluated
 /// on the other, against that scenario's last-full-sweep baseline. Printed
-/// in both directions; the README reports it.
+/// in both directions; docs/results/deepsense.md reports it.
 #[test]
 fn defaults_chosen_on_one_scenario_hold_on_the_other() {
     let Some(dir) = realdata("deepsense-60ghz-beams") else { return };
@@ -352,7 +352,7 @@ fn defaults_chosen_on_one_scenario_hold_on_the_other() {
             }
         }
     }
-    // Reported, not asserted (README): the beam budget does not always
+    // Reported, not asserted (docs/results/deepsense.md): the beam budget does not always
     // transfer (measured: the window tracker tuned on scenario 1 reads 5.74
     // beams per sweep on scenario 3).
     println!("  over the 5-beam budget out of sample: {over_budget:?}");

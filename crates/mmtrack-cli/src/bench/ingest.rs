@@ -24,8 +24,9 @@ pub struct IngestBenchArgs {
     /// Directory for the temporary files (default: the system temp dir).
     #[arg(long)]
     dir: Option<PathBuf>,
-    /// Replace the block `<!-- bench-ingest-real:begin -->` (with --from) or `bench-ingest-simulated` in this file.
-    #[arg(long, value_name = "README.md")]
+    /// Replace the block `<!-- bench-ingest-real:begin -->` (with --from) or `bench-ingest-simulated` in this file
+    /// (docs/benchmarks.md).
+    #[arg(long, value_name = "FILE.md")]
     readme: Option<PathBuf>,
     /// Build the folders from this Oxford folder's real PNG bytes, repeated under new
     /// stamps (e.g. ../shared/realdata/oxford-radar-tiny); default: simulated scans.

@@ -25,8 +25,9 @@ pub struct IoBenchArgs {
     /// Directory for the temporary files (default: the system temp dir).
     #[arg(long)]
     dir: Option<PathBuf>,
-    /// Replace the block between `<!-- bench-io:begin -->` and `<!-- bench-io:end -->` in this file.
-    #[arg(long, value_name = "README.md")]
+    /// Replace the block between `<!-- bench-io:begin -->` and `<!-- bench-io:end -->` in this file
+    /// (docs/benchmarks.md).
+    #[arg(long, value_name = "FILE.md")]
     readme: Option<PathBuf>,
 }
 

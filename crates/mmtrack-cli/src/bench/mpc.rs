@@ -22,8 +22,8 @@ pub struct MpcBenchArgs {
     /// Exit 1 when no thread count meets the target.
     #[arg(long)]
     check: bool,
-    /// Replace the block `<!-- bench-mpc:begin -->` ... `end` in this file.
-    #[arg(long, value_name = "README.md")]
+    /// Replace the block `<!-- bench-mpc:begin -->` ... `end` in this file (docs/benchmarks.md).
+    #[arg(long, value_name = "FILE.md")]
     readme: Option<PathBuf>,
 }
 

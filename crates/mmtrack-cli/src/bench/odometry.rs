@@ -29,8 +29,8 @@ pub struct OdometryBenchArgs {
     /// Scans of the long simulated drive of the memory check (laps of 100 scans; one lap is the short drive).
     #[arg(long, default_value_t = 1200)]
     memory_scans: usize,
-    /// Replace the block `<!-- bench-odometry:begin -->` ... `end` in this file.
-    #[arg(long, value_name = "README.md")]
+    /// Replace the block `<!-- bench-odometry:begin -->` ... `end` in this file (docs/benchmarks.md).
+    #[arg(long, value_name = "FILE.md")]
     readme: Option<PathBuf>,
 }
 

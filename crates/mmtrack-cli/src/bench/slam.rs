@@ -28,8 +28,8 @@ pub struct SlamBenchArgs {
     /// Exit 1 when the target is missed.
     #[arg(long)]
     check: bool,
-    /// Replace the block `<!-- bench-slam:begin -->` ... `end` in this file.
-    #[arg(long, value_name = "README.md")]
+    /// Replace the block `<!-- bench-slam:begin -->` ... `end` in this file (docs/benchmarks.md).
+    #[arg(long, value_name = "FILE.md")]
     readme: Option<PathBuf>,
 }
 

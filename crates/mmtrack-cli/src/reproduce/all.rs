@@ -27,9 +27,9 @@ pub struct AllArgs {
     /// With --all: output directory (one subdirectory per experiment, summary.md).
     #[arg(short, long, value_name = "DIR", default_value = "out/reproduce/all", requires = "all")]
     pub output: PathBuf,
-    /// With --all (full runs only): rewrite the README blocks of the experiments and the
-    /// `reproduce-all` table in this file.
-    #[arg(long, value_name = "README.md", requires = "all", conflicts_with = "smoke")]
+    /// With --all (full runs only): rewrite the `reproduce-all` table in this file (docs/results/README.md) and
+    /// each experiment's block in the Markdown file beside it that holds it (docs/results/<experiment>.md).
+    #[arg(long, value_name = "FILE.md", requires = "all", conflicts_with = "smoke")]
     pub readme: Option<PathBuf>,
 }
 

@@ -52,7 +52,7 @@ pub struct ExperimentArgs<T: ExperimentTexts> {
 pub struct MonteCarloArgs<T: MonteCarloTexts> {
     #[arg(long, help = T::RUNS_HELP)]
     pub runs: Option<u64>,
-    #[arg(long, value_name = "README.md", help = T::README_HELP)]
+    #[arg(long, value_name = "FILE.md", help = T::README_HELP)]
     pub readme: Option<PathBuf>,
     #[arg(skip)]
     texts: PhantomData<T>,

@@ -23,8 +23,8 @@ impl ExperimentTexts for Kim {
 
 impl MonteCarloTexts for Kim {
     const RUNS_HELP: &'static str = "Monte Carlo runs per row (default: the experiment's, 20)";
-    const README_HELP: &'static str = "Replace the block `<!-- reproduce-kim:begin -->` ... `end` in this file with \
-                                       the summary (checked before the run)";
+    const README_HELP: &'static str = "Replace the block `<!-- reproduce-kim:begin -->` ... `end` in this file \
+                                       (docs/results/kim.md) with the summary (checked before the run)";
 }
 
 #[derive(Args)]

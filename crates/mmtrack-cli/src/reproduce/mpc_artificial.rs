@@ -39,8 +39,9 @@ pub struct MpcArtificialArgs {
     #[arg(long)]
     quick: bool,
     /// Replace the block `<!-- reproduce-mpc-artificial:begin -->` ... `end`
-    /// in this file with the summary (checked before the run).
-    #[arg(long, value_name = "README.md")]
+    /// in this file (docs/results/multipath.md) with the summary (checked
+    /// before the run).
+    #[arg(long, value_name = "FILE.md")]
     readme: Option<PathBuf>,
 }
 

@@ -23,7 +23,7 @@ impl ExperimentTexts for Shaham {
 impl MonteCarloTexts for Shaham {
     const RUNS_HELP: &'static str = "Monte Carlo runs per scenario point (default: the experiment's, 3000)";
     const README_HELP: &'static str = "Replace the block `<!-- reproduce-shaham:begin -->` ... `end` in this file \
-                                       with the summary (checked before the run)";
+                                       (docs/results/shaham.md) with the summary (checked before the run)";
 }
 
 #[derive(Args)]

@@ -28,7 +28,7 @@ impl MonteCarloTexts for Spebt {
                                      the pose-error model and 100 with radar odometry, whose pose estimates are the \
                                      same in every run)";
     const README_HELP: &'static str = "Replace the block `<!-- reproduce-spebt:begin -->` ... `end` in this file \
-                                       with the summary (checked before the run)";
+                                       (docs/results/spebt.md) with the summary (checked before the run)";
 }
 
 #[derive(Args)]

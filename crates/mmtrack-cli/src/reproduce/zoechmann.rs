@@ -24,7 +24,7 @@ impl ExperimentTexts for Zoechmann {
 impl MonteCarloTexts for Zoechmann {
     const RUNS_HELP: &'static str = "Monte Carlo runs per manoeuvre (default: the experiment's, 100000)";
     const README_HELP: &'static str = "Replace the block `<!-- reproduce-zoechmann:begin -->` ... `end` in this \
-                                       file with the summary (checked before the run)";
+                                       file (docs/results/zoechmann.md) with the summary (checked before the run)";
 }
 
 #[derive(Args)]

@@ -12,6 +12,23 @@ fn help_explains_every_subcommand() {
     }
 }
 
+/// `export` offers four formats (issue 28: its summary named two).
+#[test]
+fn export_help_names_every_format() {
+    let (stdout, _) = text(&mmtrack(&root(), &["--help"]));
+    // The export entry, wrapped over lines, up to the next subcommand.
+    let entry = stdout.split("\n  export ").nth(1).and_then(|rest| rest.split("\n  reproduce ").next()).unwrap();
+    for format in ["TUM", "KITTI", "Boreas", "MCAP"] {
+        assert!(entry.contains(format), "`mmtrack --help` export entry lacks {format}: {entry}");
+    }
+    let out = mmtrack(&root(), &["export", "--help"]);
+    assert!(out.status.success());
+    let (stdout, _) = text(&out);
+    for format in ["tum", "kitti", "boreas", "mcap"] {
+        assert!(stdout.contains(&format!("- {format}:")), "`mmtrack export --help` lacks {format}:\n{stdout}");
+    }
+}
+
 #[test]
 fn demo_writes_a_recording_and_a_table_and_says_where() {
     let dir = tempfile::tempdir().unwrap();

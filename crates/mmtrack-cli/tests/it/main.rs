@@ -10,6 +10,7 @@ mod bench_mpc;
 mod bounds;
 mod cli;
 mod common;
+mod doc_links;
 mod error_lines;
 mod file_cycles;
 mod fixtures;

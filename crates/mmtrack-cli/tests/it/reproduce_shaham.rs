@@ -29,8 +29,8 @@ fn quick_shaham_writes_tables_figures_verdicts_and_its_readme_block() {
         let row = valid.iter().find(|r| r.tracker == tracker && r.snr_db == snr && r.speed_kmh == speed).unwrap();
         row.valid_blocks.unwrap_or(u64::MAX)
     };
-    // What holds at any run count (the full run's margins are wide, see the
-    // README): the position-velocity EKF tracks longer than the angle-state
+    // What holds at any run count (the full run's margins are wide, see
+    // docs/results/shaham.md): the position-velocity EKF tracks longer than the angle-state
     // EKF at every point, by more than the paper's 49 % at 0 dB, 60 km/h
     // (3.5x at 3000 runs).
     for row in valid.iter().filter(|r| r.tracker == "pv-ekf") {

@@ -33,7 +33,7 @@ fn quick_zoechmann_writes_tables_figures_verdicts_and_its_readme_block() {
     assert_eq!(nmse.len(), (101 + 201) * 11, "epochs 0..=100 and 0..=200, 11 estimators");
     assert!(nmse.iter().all(|r| r.runs == 2000), "every estimator counted in every run and epoch");
     // What holds at 2000 runs with wide margins (full-run numbers in the
-    // README): on half overtaking the proposed tracker ends within 2 dB of
+    // docs/results/zoechmann.md): on half overtaking the proposed tracker ends within 2 dB of
     // the error-free genie (0.4 dB measured) and more than 10 dB below the
     // Ho-Chan baseline (14 dB), and the nullspace genie ends below the
     // error-free genie.
@@ -43,11 +43,11 @@ fn quick_zoechmann_writes_tables_figures_verdicts_and_its_readme_block() {
     assert!(half("nullspace-genie") < half("error-free-genie"), "{report}");
     // On full overtaking the tracker on full-scan azimuths converges (below
     // -30 dB at the end, -37 dB measured); the paper's literal beam schedule
-    // does not (README).
+    // does not (docs/results/zoechmann.md).
     let full = |e: &str| 10.0 * final_nmse(&nmse, "full-overtaking", e).log10();
     assert!(full("proposed-full-scan") < -30.0, "{report}");
     assert!(full("nullspace-genie") < full("error-free-genie"), "{report}");
-    // The diagnostics of that miss (full-run numbers in the README): with the
+    // The diagnostics of that miss (full-run numbers in docs/results/zoechmann.md): with the
     // Doppler equation in m/s the genie gains several dB (7.3 measured) and
     // the tracker on full-scan azimuths ends below the baseline (1.7 dB);
     // the baseline on true azimuths gains about 1 dB on full overtaking, 8 on

@@ -144,7 +144,7 @@ fn paper_operating_point_delay_error_below_three_hundredths_of_a_nanosecond() {
     let mean_error_ns = total_error_s / f64::from(total_count) * 1e9;
     let verdict = if mean_error_ns < 0.03 { "met" } else { "missed" };
     println!("separations 20..2.5 ns: mean delay error {mean_error_ns:.4} ns (paper: below 0.03 ns): {verdict}");
-    // Regression bound, not the paper's target: the README reports the
+    // Regression bound, not the paper's target: docs/results/multipath.md reports the
     // measured value (0.035 ns at this seed) against the paper's 0.03 ns and
     // why (zeroing below the threshold costs accuracy; see detect.rs docs).
     assert!(mean_error_ns < 0.04, "{mean_error_ns} ns");

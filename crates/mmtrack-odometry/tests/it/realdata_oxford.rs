@@ -71,7 +71,7 @@ fn report(name: &str, errors: &[(f64, f64, f64, f64)]) -> (f64, f64) {
 const TARGET_CFEAR_TRANSLATION_M: f64 = 0.05;
 const TARGET_CFEAR_YAW_DEG: f64 = 0.2;
 
-/// Regression bounds: the measured means (README results table) plus about
+/// Regression bounds: the measured means (docs/results/radar-odometry.md) plus about
 /// 15 % margin for platform differences in floating point. They guard what we
 /// have; the targets above are what we aim for and are reported beside them.
 const BOUND_CFEAR_TRANSLATION_M: f64 = 0.095;
@@ -104,7 +104,7 @@ fn oxford_sample_pairs_against_ground_truth() {
 
 /// Which range resolution fits the ground truth better: the SDK's 0.0432 m or
 /// CFEAR's 0.0438 m. Estimated over true path length of the 10 pairs, per
-/// preset; printed for the README (the scale differs by 1.4 %, about what
+/// preset; printed for docs/results/radar-odometry.md (the scale differs by 1.4 %, about what
 /// the estimates' own bias is, so the sample cannot settle it).
 #[test]
 fn oxford_range_resolution_scale() {

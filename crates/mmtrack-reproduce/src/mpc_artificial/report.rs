@@ -306,7 +306,7 @@ pub fn markdown(sweep: &Sweep) -> String {
 #[must_use]
 pub fn readme_summary(sweep: &Sweep, figures: &FiguresAt) -> String {
     let mut out = format!(
-        "Written by `mmtrack reproduce mpc-artificial --readme README.md`. {}\n\n{}\n",
+        "Written by `mmtrack reproduce mpc-artificial --readme docs/results/multipath.md`. {}\n\n{}\n",
         description(sweep),
         verdict_table(sweep)
     );

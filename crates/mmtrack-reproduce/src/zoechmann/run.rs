@@ -38,7 +38,7 @@ use crate::common::load_average;
 
 /// The estimators, in table order: the paper's four, two variants of the
 /// proposed tracker's beam schedule, and four diagnostics of the
-/// full-overtaking miss (README "Beam tracking II"):
+/// full-overtaking miss (docs/results/zoechmann.md):
 /// - `ho-chan-true-azimuth`: the baseline on the true azimuths (what its
 ///   quantisation bias costs);
 /// - `*-doppler-mps`: the same estimators with the Doppler equation (5)
