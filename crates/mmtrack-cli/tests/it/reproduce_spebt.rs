@@ -35,8 +35,9 @@ fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
     println!("{report}");
     let missed = report.matches("| **missed** |").count();
     assert_eq!(out.status.success(), missed == 0, "exit status must follow the verdicts:\n{stderr}");
-    // Three targets per experiment: AoD, AoA, re-initialisation share; |alpha| is reported only.
-    assert_eq!(report.matches("| met |").count() + missed, 2 * 3, "{report}");
+    // Five targets per experiment: AoD and AoA after and before re-initialisation, re-initialisation
+    // share; |alpha| is reported only.
+    assert_eq!(report.matches("| met |").count() + missed, 2 * 5, "{report}");
     assert_eq!(report.matches("| RMSE abs(alpha) (%) | 1.580 |").count(), 2, "{report}");
 
     // (a) on the 6388 Oxford slots, 8 runs; (b) on the simulator's scans along the first 480 poses, 4 runs.

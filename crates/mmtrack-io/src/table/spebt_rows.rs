@@ -26,6 +26,11 @@ process beam: the recording, whose ground truth it is)";
         rmse_gain_pct: f64, "%", "RMS of the relative error of abs(alpha): (estimate - truth) / truth";
         rmse_aod_deg: f64, "deg", "RMS of the wrapped AoD error";
         rmse_aoa_deg: f64, "deg", "RMS of the wrapped AoA error";
+        rmse_gain_before_reset_pct: f64, "%",
+            "rmse_gain_pct of the estimate after each slot's update, before any re-initialisation (the error that \
+fired the deviation test counts, not the re-initialised estimate)";
+        rmse_aod_before_reset_deg: f64, "deg", "rmse_aod_deg before any re-initialisation";
+        rmse_aoa_before_reset_deg: f64, "deg", "rmse_aoa_deg before any re-initialisation";
         reinitialisations_mean: f64, "", "re-initialisations per run, mean over runs";
         reinitialisations_min: u64, "", "fewest re-initialisations of a run";
         reinitialisations_max: u64, "", "most re-initialisations of a run";

@@ -23,12 +23,18 @@ use crate::model::{Claim, Metric, Rule, Verdict, write_metrics};
 /// The README block the summary replaces.
 pub const README_BLOCK: &str = "reproduce-spebt";
 
-/// The three targets of one experiment: AoD and AoA RMSE, re-initialisation
-/// share of the tracked slots (Table III).
+/// The targets of one experiment (Table III): AoD and AoA RMSE, each of the
+/// estimate after the slot (re-initialised where the deviation test fired)
+/// and of the estimate before any re-initialisation, and the
+/// re-initialisation share of the tracked slots. The paper does not say
+/// which estimate its RMSE counts; a re-initialisation replaces the slot's
+/// largest errors by the initial access, so the first is the lenient reading
+/// and both are judged.
 #[must_use]
 pub fn verdicts(experiment: &SpebtExperiment, result: &ExperimentResult) -> Vec<Verdict> {
     let [_, aod, aoa] = result.rmse();
     let (aod_deg, aoa_deg) = (aod.to_degrees(), aoa.to_degrees());
+    let [_, aod_before, aoa_before] = result.rmse_before_reset();
     let (paper, targets) = (&experiment.paper, &experiment.targets);
     let share_pct = 100.0 * result.mean_reinitialisations() / result.tracked_slots().max(1) as f64;
     let paper_share_pct = 100.0 * paper.reinitialisations as f64 / paper.slots as f64;
@@ -47,6 +53,18 @@ pub fn verdicts(experiment: &SpebtExperiment, result: &ExperimentResult) -> Vec<
     vec![
         angle("RMSE AoD (deg)", paper.rmse_aod_deg, targets.max_rmse_aod_deg, aod_deg),
         angle("RMSE AoA (deg)", paper.rmse_aoa_deg, targets.max_rmse_aoa_deg, aoa_deg),
+        angle(
+            "RMSE AoD before re-initialisation (deg)",
+            paper.rmse_aod_deg,
+            targets.max_rmse_aod_deg,
+            aod_before.to_degrees(),
+        ),
+        angle(
+            "RMSE AoA before re-initialisation (deg)",
+            paper.rmse_aoa_deg,
+            targets.max_rmse_aoa_deg,
+            aoa_before.to_degrees(),
+        ),
         Verdict::judged(share, Some(share_pct), share_note),
     ]
 }
@@ -228,6 +246,12 @@ fn experiment_section(e: &SpebtExperiment, index: usize, run: &ExperimentRun, ve
         cause(0),
         cause(1),
         cause(2),
+    );
+    out.push_str(
+        "\nThe RMSE rows count each slot's final estimate: where the deviation test fired, the re-initialised one (the \
+         initial access, nearly the truth), which replaces the slot's largest errors; the rows \"before \
+         re-initialisation\" count the estimate that fired the test instead. The paper does not say which its Table \
+         III counts, so both are judged.\n",
     );
     match &run.drive {
         None => out.push_str(&floors(e, link)),

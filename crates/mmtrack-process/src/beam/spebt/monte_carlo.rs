@@ -116,8 +116,13 @@ pub struct ExperimentResult {
     /// Runs merged.
     pub runs: u64,
     /// Per slot, per component (|alpha| relative, AoD, AoA): sum over runs
-    /// of the squared error.
+    /// of the squared error of the slot's final estimate (after a
+    /// re-initialisation where one happened).
     pub sum_squared: [Vec<f64>; 3],
+    /// The same for the estimate after the slot's update, before any
+    /// re-initialisation: the error that made the deviation test fire
+    /// counts here, where the re-initialised estimate replaces it above.
+    pub sum_squared_before_reset: [Vec<f64>; 3],
     /// Per slot: runs re-initialised there.
     pub reinitialised_runs: Vec<u64>,
     /// Re-initialisations of each run, run order.
@@ -137,6 +142,7 @@ impl ExperimentResult {
         Self {
             runs: 0,
             sum_squared: std::array::from_fn(|_| vec![0.0; slots]),
+            sum_squared_before_reset: std::array::from_fn(|_| vec![0.0; slots]),
             reinitialised_runs: vec![0; slots],
             reinitialisations: Vec::new(),
             causes: [0; 3],
@@ -147,7 +153,12 @@ impl ExperimentResult {
 
     /// Adds `other`'s runs (after this one's: run 0 stays the first).
     pub fn merge(&mut self, other: ExperimentResult) {
-        for (mine, theirs) in self.sum_squared.iter_mut().zip(&other.sum_squared) {
+        for (mine, theirs) in self
+            .sum_squared
+            .iter_mut()
+            .chain(self.sum_squared_before_reset.iter_mut())
+            .zip(other.sum_squared.iter().chain(&other.sum_squared_before_reset))
+        {
             for (a, b) in mine.iter_mut().zip(theirs) {
                 *a += b;
             }
@@ -176,8 +187,19 @@ impl ExperimentResult {
     /// |alpha|, radians for the angles).
     #[must_use]
     pub fn rmse(&self) -> [f64; 3] {
+        self.rmse_of(&self.sum_squared)
+    }
+
+    /// [`ExperimentResult::rmse`] of the estimates before any
+    /// re-initialisation (see [`ExperimentResult::sum_squared_before_reset`]).
+    #[must_use]
+    pub fn rmse_before_reset(&self) -> [f64; 3] {
+        self.rmse_of(&self.sum_squared_before_reset)
+    }
+
+    fn rmse_of(&self, sum_squared: &[Vec<f64>; 3]) -> [f64; 3] {
         let n = (self.tracked_slots() as f64 * self.runs as f64).max(1.0);
-        self.sum_squared.each_ref().map(|sums| (sums.iter().skip(1).sum::<f64>() / n).sqrt())
+        sum_squared.each_ref().map(|sums| (sums.iter().skip(1).sum::<f64>() / n).sqrt())
     }
 
     /// Mean re-initialisations per run.
@@ -291,6 +313,9 @@ fn run_chunk(
             let beams = ekf.predict(&poses[k]).with_context(|| format!("run {run_index}"))?;
             let pilot = link.pilot(k, beams.rx_steer_u, beams.tx_steer_u, realisation.noise[k]);
             let deviation = ekf.update(pilot).with_context(|| format!("run {run_index}"))?;
+            for (sums, e) in chunk.sum_squared_before_reset.iter_mut().zip(estimate_errors(&ekf.estimate(), slot)) {
+                sums[k] += e * e;
+            }
             let reinitialised = if let Deviation::Exceeded { gain, aod, aoa } = deviation {
                 ekf.reinitialise(initial_access(slot))?;
                 for (count, fired) in chunk.causes.iter_mut().zip([gain, aod, aoa]) {
@@ -303,13 +328,7 @@ fn run_chunk(
                 false
             };
             let estimate = ekf.estimate();
-            let true_gain = slot.gain.norm();
-            let errors = [
-                (estimate.gain_magnitude - true_gain) / true_gain,
-                wrap_angle_rad(estimate.aod_rad - slot.aod_rad),
-                wrap_angle_rad(estimate.aoa_rad - slot.aoa_rad),
-            ];
-            for (sums, e) in chunk.sum_squared.iter_mut().zip(errors) {
+            for (sums, e) in chunk.sum_squared.iter_mut().zip(estimate_errors(&estimate, slot)) {
                 sums[k] += e * e;
             }
             if keep {
@@ -321,6 +340,17 @@ fn run_chunk(
         chunk.runs += 1;
     }
     Ok(chunk)
+}
+
+/// The errors of an estimate against the slot's true channel: relative for
+/// |alpha|, wrapped radians for AoD and AoA.
+fn estimate_errors(estimate: &SpebtState, slot: &SpebtSlot) -> [f64; 3] {
+    let true_gain = slot.gain.norm();
+    [
+        (estimate.gain_magnitude - true_gain) / true_gain,
+        wrap_angle_rad(estimate.aod_rad - slot.aod_rad),
+        wrap_angle_rad(estimate.aoa_rad - slot.aoa_rad),
+    ]
 }
 
 /// Odometry estimates (their world frame is the first scan's pose) moved

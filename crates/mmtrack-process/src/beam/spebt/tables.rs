@@ -20,6 +20,7 @@ pub fn summary_row(
     r: &ExperimentResult,
 ) -> SpebtSummaryRow {
     let [gain, aod, aoa] = r.rmse();
+    let [gain_before, aod_before, aoa_before] = r.rmse_before_reset();
     let total: u64 = r.reinitialisations.iter().sum();
     let cause = |i: usize| 100.0 * r.causes[i] as f64 / total.max(1) as f64;
     let paper = &experiment.paper;
@@ -32,6 +33,9 @@ pub fn summary_row(
         rmse_gain_pct: 100.0 * gain,
         rmse_aod_deg: aod.to_degrees(),
         rmse_aoa_deg: aoa.to_degrees(),
+        rmse_gain_before_reset_pct: 100.0 * gain_before,
+        rmse_aod_before_reset_deg: aod_before.to_degrees(),
+        rmse_aoa_before_reset_deg: aoa_before.to_degrees(),
         reinitialisations_mean: r.mean_reinitialisations(),
         reinitialisations_min: r.reinitialisations.iter().copied().min().unwrap_or(0),
         reinitialisations_max: r.reinitialisations.iter().copied().max().unwrap_or(0),
