@@ -714,7 +714,11 @@ fn table_file_metadata(py: Python<'_>, path: PathBuf) -> PyResult<BTreeMap<Strin
 #[pyfunction]
 fn recording_metadata(py: Python<'_>, path: PathBuf) -> PyResult<BTreeMap<String, String>> {
     run(py, 0, || {
-        let reader = mmtrack_io::RecordingReader::open(&path)?;
+        let mut reader = mmtrack_io::RecordingReader::open(&path)?;
+        // Complete once the first item is read (writers put it first).
+        if let Some(item) = reader.next_item() {
+            item?;
+        }
         Ok(reader.metadata().cloned().unwrap_or_default())
     })
 }
