@@ -256,3 +256,17 @@ def test_errors_carry_the_cli_line(tmp_path: Path) -> None:
         mmtrack.table_spec("no_such_table")
     with pytest.raises(TypeError, match="unexpected keyword"):
         mmtrack.process("odometry", missing, tmp_path / "out", presett="cfear")
+
+
+def test_stubs_name_every_native_function_and_the_package_is_typed() -> None:
+    import ast
+
+    import mmtrack._native as native
+
+    package = Path(mmtrack.__file__).parent
+    assert (package / "py.typed").is_file()
+    tree = ast.parse((package / "_native.pyi").read_text())
+    stubbed = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    exported = {name for name in dir(native) if not name.startswith("_")}
+    assert stubbed == exported
+    assert set(mmtrack.__all__) <= set(dir(mmtrack))
