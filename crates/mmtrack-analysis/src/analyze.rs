@@ -29,6 +29,40 @@ pub struct AnalyzeOptions {
     pub overwrite: Overwrite,
 }
 
+impl AnalyzeOptions {
+    /// The options of `mmtrack analyze`'s flags (the Python keywords are the
+    /// same words): `--segment-lengths-m` (default the devkit's 100..800 m),
+    /// `--step-frames` or `--step-m` (default a first frame every 10
+    /// frames, as the devkit), `--first-path-range-db`, `--force`.
+    ///
+    /// # Errors
+    /// Both steps given.
+    pub fn from_flags(
+        segment_lengths_m: Option<Vec<f64>>,
+        step_frames: Option<usize>,
+        step_m: Option<f64>,
+        first_path_range_db: f64,
+        force: bool,
+    ) -> anyhow::Result<Self> {
+        use crate::trajectory::{FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
+        let step = match (step_m, step_frames) {
+            (Some(_), Some(_)) => {
+                bail!("--step-frames and --step-m: give one (a first frame every N frames or every X metres)")
+            }
+            (Some(m), None) => FirstFrameStep::Metres(m),
+            (None, n) => FirstFrameStep::Frames(n.unwrap_or(KITTI_STEP_FRAMES)),
+        };
+        Ok(Self {
+            drift: DriftOptions {
+                segment_lengths_m: segment_lengths_m.unwrap_or_else(|| KITTI_SEGMENT_LENGTHS_M.to_vec()),
+                step,
+            },
+            mpc: MpcOptions { first_path_dynamic_range_db: first_path_range_db },
+            overwrite: if force { Overwrite::Replace } else { Overwrite::Refuse },
+        })
+    }
+}
+
 /// What [`analyze`] wrote.
 pub enum Analyzed {
     /// One run, written straight into the output.

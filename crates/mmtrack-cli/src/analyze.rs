@@ -7,11 +7,9 @@ use std::process::ExitCode;
 
 use clap::Args;
 use mmtrack_analysis::analyze::{AnalyzeOptions, Analyzed, analyze};
-use mmtrack_analysis::mpc::{DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB, MpcOptions};
+use mmtrack_analysis::mpc::DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB;
 use mmtrack_analysis::pipeline::RunResults;
 use mmtrack_analysis::report::one_line;
-use mmtrack_analysis::trajectory::{DriftOptions, FirstFrameStep, KITTI_SEGMENT_LENGTHS_M, KITTI_STEP_FRAMES};
-use mmtrack_io::Overwrite;
 
 #[derive(Args)]
 #[command(
@@ -90,27 +88,19 @@ pub struct AnalyzeArgs {
     first_path_range_db: f64,
 }
 
-fn drift_options(args: &AnalyzeArgs) -> DriftOptions {
-    DriftOptions {
-        segment_lengths_m: args.segment_lengths_m.clone().unwrap_or_else(|| KITTI_SEGMENT_LENGTHS_M.to_vec()),
-        step: match (args.step_m, args.step_frames) {
-            (Some(m), _) => FirstFrameStep::Metres(m),
-            (None, n) => FirstFrameStep::Frames(n.unwrap_or(KITTI_STEP_FRAMES)),
-        },
-    }
-}
-
-/// The library's options of `args`.
-pub fn options(args: &AnalyzeArgs) -> AnalyzeOptions {
-    AnalyzeOptions {
-        drift: drift_options(args),
-        mpc: MpcOptions { first_path_dynamic_range_db: args.first_path_range_db },
-        overwrite: if args.force { Overwrite::Replace } else { Overwrite::Refuse },
-    }
+/// The library's options of `args` ([`AnalyzeOptions::from_flags`]).
+pub fn options(args: &AnalyzeArgs) -> anyhow::Result<AnalyzeOptions> {
+    AnalyzeOptions::from_flags(
+        args.segment_lengths_m.clone(),
+        args.step_frames,
+        args.step_m,
+        args.first_path_range_db,
+        args.force,
+    )
 }
 
 pub fn run(args: &AnalyzeArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let analyzed = analyze(&args.tables, &args.output, &options(args))?;
+    let analyzed = analyze(&args.tables, &args.output, &options(args)?)?;
     if !quiet {
         print_analyzed(&analyzed);
     }

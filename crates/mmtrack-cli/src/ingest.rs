@@ -12,10 +12,10 @@ use mmtrack_ingest::mulran::{self, MulranOptions};
 use mmtrack_ingest::oxford::{self, OxfordOptions};
 use mmtrack_ingest::poses::{self, Plane};
 use mmtrack_ingest::ros2::{RadarTopic, Ros2Topics};
-use mmtrack_io::recording::Compression;
+use mmtrack_io::RecordingOptions;
 use mmtrack_io::recording::PoseStream;
+use mmtrack_io::recording::RecordingFlags;
 use mmtrack_io::recording::cartesian::{CartesianGrid, MAX_CARTESIAN_SIZE_PX};
-use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use crate::progress;
 use crate::threads::ThreadsArg;
@@ -72,22 +72,24 @@ pub enum CompressionArg {
 }
 
 impl OutputArgs {
-    pub fn recording_options(&self) -> RecordingOptions {
-        RecordingOptions {
+    /// The writer's options ([`RecordingFlags::options`]).
+    pub fn recording_options(&self) -> anyhow::Result<RecordingOptions> {
+        let flags = RecordingFlags {
+            force: self.force,
             compression: match self.compression {
-                CompressionArg::None => Compression::None,
-                CompressionArg::Zstd => Compression::Zstd { level: self.zstd_level },
-                CompressionArg::Lz4 => Compression::Lz4,
-            },
-            overwrite: if self.force { Overwrite::Replace } else { Overwrite::Refuse },
-            foxglove_views: !self.no_foxglove_views,
-            durability: if self.no_sync { Durability::PageCache } else { Durability::Fsync },
-            radar_cartesian: (!self.no_radar_cartesian && !self.no_foxglove_views).then_some(CartesianGrid {
-                metres_per_pixel: self.radar_cartesian_m_per_px,
-                size_px: self.radar_cartesian_size_px,
-            }),
-            ..RecordingOptions::default()
-        }
+                CompressionArg::None => "none",
+                CompressionArg::Zstd => "zstd",
+                CompressionArg::Lz4 => "lz4",
+            }
+            .to_string(),
+            zstd_level: self.zstd_level,
+            no_foxglove_views: self.no_foxglove_views,
+            no_radar_cartesian: self.no_radar_cartesian,
+            radar_cartesian_m_per_px: self.radar_cartesian_m_per_px,
+            radar_cartesian_size_px: self.radar_cartesian_size_px,
+            no_sync: self.no_sync,
+        };
+        flags.options().map_err(anyhow::Error::msg)
     }
 }
 
@@ -114,7 +116,7 @@ impl PoseFormat {
         }
     }
 
-    fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Self::Tum => "tum",
             Self::Kitti => "kitti",
@@ -373,10 +375,7 @@ enum Kind {
 pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     match args.kind {
         Kind::Oxford { input, output, threads, range_resolution_m, bins, decode, sequence_id } => {
-            let expected_bins = match bins.as_str() {
-                "auto" => None,
-                n => Some(n.parse::<usize>().with_context(|| format!("--bins '{n}': expected a number or `auto`"))?),
-            };
+            let expected_bins = mmtrack_ingest::flags::parse_bins(&bins).map_err(anyhow::Error::msg)?;
             positive_metres("--range-resolution-m", range_resolution_m)?;
             let options = OxfordOptions {
                 layout: oxford::NavtechLayout { range_resolution_m, expected_bins, ..oxford::OXFORD },
@@ -421,7 +420,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 &source,
                 add_to.as_deref(),
                 &output.output,
-                &output.recording_options(),
+                &output.recording_options()?,
             )?;
             if !quiet {
                 println!("{}: {} poses on {}", summary.path.display(), trajectory.len(), stream.topic());
@@ -434,7 +433,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 &input,
                 &output.output,
                 add_to.as_deref(),
-                &output.recording_options(),
+                &output.recording_options()?,
             )?;
             let log = &report.log;
             if !quiet {
@@ -479,9 +478,6 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             cir_file(&input, format.format(), sidecar.as_deref(), &output, quiet)
         }
         Kind::Beams { input, format: BeamFormatArg::Deepsense, scenario, positions, sweep_period_s, output } => {
-            if !(sweep_period_s.is_finite() && sweep_period_s > 0.0 && sweep_period_s < 3600.0) {
-                anyhow::bail!("--sweep-period-s {sweep_period_s}: expected a positive number of seconds below 3600");
-            }
             let options = DeepsenseOptions {
                 scenario,
                 positions: match positions {
@@ -489,7 +485,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                     PositionsArg::Calibrated => VehiclePositions::Calibrated,
                     PositionsArg::Auto => VehiclePositions::Auto,
                 },
-                sweep_period_ns: (sweep_period_s * 1e9).round() as i64,
+                sweep_period_ns: mmtrack_ingest::flags::sweep_period_ns(sweep_period_s).map_err(anyhow::Error::msg)?,
             };
             deepsense_folder(&input, &output, &options, quiet)
         }
@@ -523,11 +519,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 
 /// Adding to the output file itself replaces it, once the new one is complete.
 fn allow_in_place(add_to: Option<&std::path::Path>, output: &mut OutputArgs) {
-    if let Some(existing) = add_to
-        && existing.canonicalize().ok() == output.output.canonicalize().ok()
-    {
-        output.force = true;
-    }
+    output.force = mmtrack_ingest::flags::replaces_output(add_to, &output.output, output.force);
 }
 
 /// Ingests one CIR file, with a progress bar.
@@ -539,10 +531,11 @@ fn cir_file(
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
     let bar = progress::bar(0, "ingest cir", "snapshots", quiet);
-    let report = ingest_cir(format, input, sidecar, &output.output, &output.recording_options(), &mut |done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    });
+    let report =
+        ingest_cir(format, input, sidecar, &output.output, &output.recording_options()?, &mut |done, total| {
+            bar.set_length(total);
+            bar.set_position(done);
+        });
     bar.finish_and_clear();
     let report = report?;
     if !quiet {

@@ -29,9 +29,6 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use mmtrack_core::error::printable;
-// `crate::readme_block` for the commands that rewrite README blocks (bench,
-// reproduce).
-use mmtrack_reproduce::readme_block;
 
 #[derive(Parser)]
 #[command(
@@ -162,34 +159,9 @@ fn exit_quietly_on_a_closed_pipe() {
     }));
 }
 
-/// The error and its causes as one line, `outer: inner: innermost`, each part
-/// once, with no control characters.
-///
-/// Our error types name only their own part and leave the wrapped error to the
-/// chain, but a context may repeat what the error below it says (a path given
-/// as context to an error that names the path), and other crates' errors may
-/// repeat their source in their message. So, for each cause after the first:
-/// it is left out when the part before it already ends with it (or equals it),
-/// and it replaces the part before it when it starts with that part. Quoted
-/// input was escaped where it was quoted; [`printable`] again here keeps
-/// multi-line messages of other crates (TOML parse errors) on one line.
+/// The error and its causes as one line ([`mmtrack_core::error::one_line`]).
 fn one_line(error: &anyhow::Error) -> String {
-    let mut parts: Vec<String> = Vec::new();
-    for cause in error.chain() {
-        let text = cause.to_string().trim_end().to_string();
-        if text.is_empty() {
-            continue;
-        }
-        match parts.last() {
-            Some(last) if *last == text || last.ends_with(&format!(": {text}")) => continue,
-            Some(last) if text.starts_with(&format!("{last}: ")) => {
-                parts.pop();
-            }
-            _ => {}
-        }
-        parts.push(text);
-    }
-    printable(&parts.join(": ")).into_owned()
+    mmtrack_core::error::one_line(error.chain())
 }
 
 /// On SIGINT, SIGTERM or SIGHUP (a closed terminal): removes the partial outputs this run is writing

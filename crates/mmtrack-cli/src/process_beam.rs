@@ -3,12 +3,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::bail;
 use clap::{Args, ValueEnum};
 use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, SPEBT_PER_SLOT, SPEBT_SUMMARY};
-use mmtrack_process::beam::geometric::{self, GeometricOptions, Schedule};
+use mmtrack_process::beam::geometric::{GeometricOptions, Schedule};
 use mmtrack_process::beam::spebt::{self, SpebtOptions};
-use mmtrack_process::beam::sweep::{self, Reacquire, SweepOutput, SweepTrackerKind};
+use mmtrack_process::beam::sweep::{Reacquire, SweepOutput, SweepTrackerKind};
+use mmtrack_process::beam::{BeamOutput, BeamRequest, BeamTracker, process_beam};
 
 use crate::output_args::RunOutputArgs;
 use crate::progress::IndicatifProgress;
@@ -150,20 +150,34 @@ impl GeometricArgs {
 }
 
 pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<()> {
-    let out = args.output_args.options().resolve(&args.output)?;
-    let mut kinds = args.tracker.clone();
-    kinds.sort();
-    kinds.dedup();
-    let files = sweep::expand(&args.recordings)?;
-    let (spebt_options, geometric_options) = (args.spebt.options(), args.geometric.options());
-    if kinds.contains(&TrackerArg::Geometric) {
-        if kinds.len() > 1 {
-            bail!(
-                "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
-            );
-        }
-        let done = geometric::process_geometric(&files, &out, &geometric_options)?;
-        if !quiet {
+    let request = BeamRequest {
+        recordings: args.recordings.clone(),
+        trackers: args
+            .tracker
+            .iter()
+            .map(|k| match k {
+                TrackerArg::Window => BeamTracker::Sweep(SweepTrackerKind::Window),
+                TrackerArg::GnssWindow => BeamTracker::Sweep(SweepTrackerKind::GnssWindow),
+                TrackerArg::LastFullSweep => BeamTracker::Sweep(SweepTrackerKind::LastFullSweep),
+                TrackerArg::GnssMap => BeamTracker::Sweep(SweepTrackerKind::GnssMap),
+                TrackerArg::Spebt => BeamTracker::Spebt,
+                TrackerArg::Geometric => BeamTracker::Geometric,
+            })
+            .collect(),
+        reacquire: match args.reacquire {
+            ReacquireArg::Coarse => Reacquire::Coarse,
+            ReacquireArg::Full => Reacquire::Full,
+        },
+        output: args.output_args.options(),
+        spebt: args.spebt.options(),
+        geometric: args.geometric.options(),
+    };
+    let done = process_beam(&args.output, &request, &IndicatifProgress::new(quiet))?;
+    if quiet {
+        return Ok(());
+    }
+    match done {
+        BeamOutput::Geometric(done) => {
             for r in &done.recordings {
                 println!(
                     "{}: {} epochs, {}; last epoch range {:.2} m (true {:.2} m), {} beams measured in all",
@@ -171,45 +185,16 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<()> {
                 );
             }
         }
-        return Ok(());
-    }
-    if let Some(flag) = geometric_options.given().first() {
-        bail!("{flag} is an option of --tracker geometric only");
-    }
-    if kinds.contains(&TrackerArg::Spebt) {
-        if kinds.len() > 1 {
-            bail!(
-                "--tracker spebt runs alone (it tracks a simulated link along the ground truth, not measured sweeps); \
-                 give the sweep trackers in another call"
+        BeamOutput::Spebt(done) => print_spebt(&done),
+        BeamOutput::Sweeps(done) => {
+            print_summary(&done);
+            println!(
+                "wrote {} {} partitions under {}",
+                done.written.len(),
+                BEAM_SWEEPS_TRACKED.name,
+                done.dir.display()
             );
         }
-        let done = spebt::process_spebt(&files, &out, &spebt_options, &IndicatifProgress::new(quiet))?;
-        if !quiet {
-            print_spebt(&done);
-        }
-        return Ok(());
-    }
-    if let Some(flag) = spebt_options.given().first() {
-        bail!("{flag} is an option of --tracker spebt only");
-    }
-    let sweep_kinds: Vec<SweepTrackerKind> = kinds
-        .iter()
-        .filter_map(|k| match k {
-            TrackerArg::Window => Some(SweepTrackerKind::Window),
-            TrackerArg::GnssWindow => Some(SweepTrackerKind::GnssWindow),
-            TrackerArg::LastFullSweep => Some(SweepTrackerKind::LastFullSweep),
-            TrackerArg::GnssMap => Some(SweepTrackerKind::GnssMap),
-            TrackerArg::Spebt | TrackerArg::Geometric => None,
-        })
-        .collect();
-    let reacquire = match args.reacquire {
-        ReacquireArg::Coarse => Reacquire::Coarse,
-        ReacquireArg::Full => Reacquire::Full,
-    };
-    let done = sweep::process_sweeps(&files, &args.output, &sweep_kinds, reacquire, &args.output_args.options())?;
-    if !quiet {
-        print_summary(&done);
-        println!("wrote {} {} partitions under {}", done.written.len(), BEAM_SWEEPS_TRACKED.name, done.dir.display());
     }
     Ok(())
 }

@@ -107,7 +107,7 @@ fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
             Format::Oxford => RadarLayout::Oxford,
         },
         output: args.output.output.clone(),
-        recording: args.output.recording_options(),
+        recording: args.output.recording_options()?,
     };
     let done = simulate_radar(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {

@@ -30,7 +30,7 @@ pub fn run_sounder(args: &SounderArgs, quiet: bool) -> anyhow::Result<()> {
         scenario: args.scenario.clone(),
         sets: args.sets,
         output: args.output.output.clone(),
-        recording: args.output.recording_options(),
+        recording: args.output.recording_options()?,
     };
     let written = simulate_sounder(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {

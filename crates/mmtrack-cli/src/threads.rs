@@ -4,7 +4,6 @@
 //! simulators' rendering) runs on the current rayon pool, so one flag sizes
 //! them all; outputs are identical for any thread count.
 
-use anyhow::Context;
 use clap::Args;
 
 /// The `--threads` flag of commands with parallel stages.
@@ -17,27 +16,9 @@ pub struct ThreadsArg {
 }
 
 impl ThreadsArg {
-    /// Runs `work` on a thread of a pool of `--threads` threads; for 0, on
-    /// the current pool when called from one, else on a new pool of rayon's
-    /// default size. Commands run inside their pool, so parallel loops start
-    /// on a pool thread instead of handing work over from the main thread at
-    /// every loop (a wake-up across threads per MPC set or decode batch,
-    /// which cost 20 % of `bench mpc` on one thread).
+    /// Runs `work` on a pool of `--threads` threads
+    /// ([`mmtrack_process::threads::install`]).
     pub fn install<R: Send>(self, work: impl FnOnce() -> R + Send) -> anyhow::Result<R> {
-        let limit = mmtrack_core::limits::THREADS;
-        anyhow::ensure!(
-            limit.allows_count(self.threads as u64),
-            "--threads {}: expected {} (nothing was done)",
-            self.threads,
-            limit.expected
-        );
-        if self.threads == 0 && rayon::current_thread_index().is_some() {
-            return Ok(work());
-        }
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(self.threads)
-            .build()
-            .with_context(|| format!("--threads {}: cannot start the thread pool", self.threads))?;
-        Ok(pool.install(work))
+        mmtrack_process::threads::install(self.threads, work)
     }
 }

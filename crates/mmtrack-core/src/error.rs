@@ -112,6 +112,44 @@ pub fn printable<T: AsRef<[u8]> + ?Sized>(input: &T) -> Cow<'_, str> {
     Cow::Owned(out)
 }
 
+/// An error and its causes as one line, `outer: inner: innermost`, each part
+/// once, with no control characters: the message of every front end (the
+/// CLI's `error:` line, the Python package's exceptions).
+///
+/// Our error types name only their own part and leave the wrapped error to the
+/// chain, but a context may repeat what the error below it says (a path given
+/// as context to an error that names the path), and other crates' errors may
+/// repeat their source in their message. So, for each cause after the first:
+/// it is left out when the part before it already ends with it (or equals it),
+/// and it replaces the part before it when it starts with that part. Quoted
+/// input was escaped where it was quoted; [`printable`] again here keeps
+/// multi-line messages of other crates (TOML parse errors) on one line.
+///
+/// `chain` is the error's own message followed by its causes', outermost
+/// first (`anyhow::Error::chain`, or [`std::error::Error::source`] followed).
+pub fn one_line<I, D>(chain: I) -> String
+where
+    I: IntoIterator<Item = D>,
+    D: std::fmt::Display,
+{
+    let mut parts: Vec<String> = Vec::new();
+    for cause in chain {
+        let text = cause.to_string().trim_end().to_string();
+        if text.is_empty() {
+            continue;
+        }
+        match parts.last() {
+            Some(last) if *last == text || last.ends_with(&format!(": {text}")) => continue,
+            Some(last) if text.starts_with(&format!("{last}: ")) => {
+                parts.pop();
+            }
+            _ => {}
+        }
+        parts.push(text);
+    }
+    printable(&parts.join(": ")).into_owned()
+}
+
 /// Characters that must not reach a terminal as they are: C0/C1 controls and
 /// DEL, and the bidirectional-text overrides that reorder what is shown.
 fn needs_escape(c: char) -> bool {

@@ -23,6 +23,7 @@ pub mod cdr;
 pub mod cir;
 mod csv;
 mod error;
+pub mod flags;
 pub mod mulran;
 pub mod nmea;
 pub mod oxford;

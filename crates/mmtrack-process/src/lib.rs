@@ -18,7 +18,8 @@
 //! - [`output`]: where a pipeline writes (`--run-id`, `--force`,
 //!   `--sequence`), shared by all;
 //! - [`events`]: a recording read as a stream, scans decoded ahead in
-//!   parallel.
+//!   parallel;
+//! - [`threads`]: the worker pool of a call (`--threads`).
 //!
 //! Every pipeline runs on the caller's rayon pool (the thread count never
 //! changes a table), refuses existing tables before any work unless forced,
@@ -32,3 +33,4 @@ pub mod odometry;
 pub mod output;
 pub mod simulate;
 pub mod slam;
+pub mod threads;

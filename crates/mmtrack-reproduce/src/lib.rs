@@ -39,6 +39,7 @@ pub mod model;
 pub mod mpc_artificial;
 pub mod odometry;
 pub mod readme_block;
+pub mod request;
 pub mod shaham;
 pub mod spebt;
 pub mod zoechmann;

@@ -8,10 +8,11 @@ use std::process::ExitCode;
 use clap::{Args, ValueEnum};
 use mmtrack_ingest::beams::{DeepsenseOptions, ingest_deepsense};
 use mmtrack_ingest::boreas::{BoreasFolder, BoreasOptions, ingest_boreas};
+use mmtrack_ingest::flags;
 use mmtrack_ingest::mulran::{MulranFolder, MulranOptions, ingest_mulran};
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_ingest::ros2::{self, Ros2Topics};
-use mmtrack_ingest::sweep::{StampAt, SweepTiming};
+use mmtrack_ingest::sweep::SweepTiming;
 
 use super::OutputArgs;
 use crate::progress;
@@ -38,26 +39,18 @@ pub struct SweepArgs {
 
 impl SweepArgs {
     pub(super) fn timing(&self) -> anyhow::Result<SweepTiming> {
-        if !(self.scan_period_s.is_finite() && self.scan_period_s > 0.0 && self.scan_period_s < 60.0) {
-            anyhow::bail!("--scan-period-s {}: expected a positive number of seconds below 60", self.scan_period_s);
-        }
-        Ok(SweepTiming {
-            period_ns: (self.scan_period_s * 1e9).round() as i64,
-            stamp_at: match self.stamp_at {
-                StampAtArg::Start => StampAt::Start,
-                StampAtArg::End => StampAt::End,
-            },
-        })
+        let stamp_at = match self.stamp_at {
+            StampAtArg::Start => "start",
+            StampAtArg::End => "end",
+        };
+        flags::sweep_timing(stamp_at, self.scan_period_s).map_err(anyhow::Error::msg)
     }
 }
 
-/// Checks that a length flag is a positive, finite number of metres.
+/// Checks that a length flag is a positive, finite number of metres
+/// ([`flags::positive_metres`]).
 pub(super) fn positive_metres(flag: &str, value: f64) -> anyhow::Result<()> {
-    if value.is_finite() && value > 0.0 {
-        Ok(())
-    } else {
-        anyhow::bail!("{flag} {value}: expected a positive number of metres")
-    }
+    flags::positive_metres(flag, value).map(|_| ()).map_err(anyhow::Error::msg)
 }
 
 /// Ingests one Boreas folder, with a progress bar.
@@ -69,7 +62,7 @@ pub(super) fn boreas_folder(
 ) -> anyhow::Result<ExitCode> {
     let folder = BoreasFolder::open(input)?;
     let bar = progress::bar(folder.scans.len() as u64, "ingest boreas", "scans", quiet);
-    let report = ingest_boreas(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+    let report = ingest_boreas(&folder, &output.output, options, &output.recording_options()?, &mut |done, _| {
         bar.set_position(done);
     });
     bar.finish_and_clear();
@@ -98,7 +91,7 @@ pub(super) fn mulran_folder(
 ) -> anyhow::Result<ExitCode> {
     let folder = MulranFolder::open(input)?;
     let bar = progress::bar(folder.scans.len() as u64, "ingest mulran", "scans", quiet);
-    let report = ingest_mulran(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+    let report = ingest_mulran(&folder, &output.output, options, &output.recording_options()?, &mut |done, _| {
         bar.set_position(done);
     });
     bar.finish_and_clear();
@@ -127,7 +120,7 @@ pub fn oxford_folder(
     let folder = OxfordFolder::open(input)?;
     let bar = progress::bar(folder.scans.len() as u64, "ingest oxford", "scans", quiet);
     let report =
-        oxford::ingest_oxford(&folder, &output.output, options, &output.recording_options(), &mut |done, _| {
+        oxford::ingest_oxford(&folder, &output.output, options, &output.recording_options()?, &mut |done, _| {
             bar.set_position(done);
         })?;
     bar.finish_and_clear();
@@ -192,7 +185,7 @@ pub(super) fn ros2_bag(
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
     let bar = progress::bytes_bar("ingest ros2", quiet);
-    let report = ros2::ingest_ros2(input, &output.output, topics, &output.recording_options(), &mut |done, total| {
+    let report = ros2::ingest_ros2(input, &output.output, topics, &output.recording_options()?, &mut |done, total| {
         bar.set_length(total);
         bar.set_position(done);
     });
@@ -229,18 +222,20 @@ pub struct RecordingDirArgs {
 }
 
 impl RecordingDirArgs {
-    fn recording_options(&self) -> mmtrack_io::RecordingOptions {
-        mmtrack_io::RecordingOptions {
-            overwrite: if self.force { mmtrack_io::Overwrite::Replace } else { mmtrack_io::Overwrite::Refuse },
-            foxglove_views: !self.no_foxglove_views,
-            durability: if self.no_sync { mmtrack_io::Durability::PageCache } else { mmtrack_io::Durability::Fsync },
-            ..mmtrack_io::RecordingOptions::default()
-        }
+    /// The writer's options ([`mmtrack_io::recording::RecordingFlags`]; beam
+    /// recordings have no radar view).
+    fn recording_options(&self) -> anyhow::Result<mmtrack_io::RecordingOptions> {
+        let flags = mmtrack_io::recording::RecordingFlags {
+            force: self.force,
+            no_foxglove_views: self.no_foxglove_views,
+            no_radar_cartesian: true,
+            no_sync: self.no_sync,
+            ..Default::default()
+        };
+        flags.options().map_err(anyhow::Error::msg)
     }
 }
 
-/// Ingests the DeepSense beam arrays of a folder (one recording per pass),
-/// with a progress bar and one summary line per scenario.
 pub(super) fn deepsense_folder(
     input: &Path,
     output: &RecordingDirArgs,
@@ -248,7 +243,7 @@ pub(super) fn deepsense_folder(
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
     let bar = progress::bar(0, "ingest beams", "sweeps", quiet);
-    let written = ingest_deepsense(input, &output.output, options, &output.recording_options(), &mut |done, total| {
+    let written = ingest_deepsense(input, &output.output, options, &output.recording_options()?, &mut |done, total| {
         bar.set_length(total);
         bar.set_position(done);
     });

@@ -1,15 +1,16 @@
 //! The flags every `mmtrack reproduce <experiment>` shares, declared once
-//! with their one conversion to the library's [`RunOptions`]. Each
+//! with their one conversion to the library's [`ExperimentRequest`]. Each
 //! experiment gives the texts that name its own files and counts (its
 //! default output directory, what `--quick` and `--runs` mean for it) by
 //! implementing [`ExperimentTexts`] (and [`MonteCarloTexts`]) on a marker
 //! type.
 
 use std::marker::PhantomData;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use clap::Args;
-use mmtrack_reproduce::{RunOptions, Tier};
+use mmtrack_reproduce::Tier;
+use mmtrack_reproduce::request::ExperimentRequest;
 
 use crate::threads::ThreadsArg;
 
@@ -59,15 +60,14 @@ pub struct MonteCarloArgs<T: MonteCarloTexts> {
 }
 
 impl<T: ExperimentTexts> ExperimentArgs<T> {
-    /// The library's options: the tier of `--quick`, the output directory,
-    /// and `runs` and `readme` from [`MonteCarloArgs`] where the experiment
-    /// has them.
-    pub fn run_options(&self, runs: Option<u64>, readme: Option<&Path>) -> RunOptions {
-        RunOptions {
-            tier: tier(self.quick),
-            runs,
-            output_dir: self.output.clone(),
-            readme: readme.map(Path::to_path_buf),
+    /// The library's request with `-o`, `--force` and `--quick`; the
+    /// experiment adds its own flags.
+    pub fn request(&self) -> ExperimentRequest {
+        ExperimentRequest {
+            output_dir: Some(self.output.clone()),
+            force: self.force,
+            quick: self.quick,
+            ..ExperimentRequest::default()
         }
     }
 }

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 use mmtrack_reproduce::kim;
+use mmtrack_reproduce::request::{ExperimentRequest, run_experiment};
 
 use super::args::{ExperimentArgs, ExperimentTexts, MonteCarloArgs, MonteCarloTexts};
 use super::outcome::finish;
@@ -42,10 +43,14 @@ pub struct KimArgs {
 }
 
 pub fn run(args: &KimArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let options = args.common.run_options(args.monte_carlo.runs, args.monte_carlo.readme.as_deref());
-    kim::check_start(&options.output_dir, args.common.force, options.readme.as_deref())?;
-    let config = kim::Config::load(args.experiment.as_deref())?;
+    let request = ExperimentRequest {
+        runs: args.monte_carlo.runs,
+        readme: args.monte_carlo.readme.clone(),
+        experiment_file: args.experiment.clone(),
+        particles: args.particles,
+        ..args.common.request()
+    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.common.threads.install(|| kim::run(&config, args.particles, &options, &progress))??;
-    finish(&outcome, &options, quiet)
+    let outcome = args.common.threads.install(|| run_experiment(kim::NAME, &request, &progress))??;
+    Ok(finish(&outcome, &args.common.output, quiet))
 }

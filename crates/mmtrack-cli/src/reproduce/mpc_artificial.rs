@@ -6,10 +6,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
-use mmtrack_reproduce::RunOptions;
-use mmtrack_reproduce::mpc_artificial::{self, Config, Pulse};
+use mmtrack_reproduce::mpc_artificial;
+use mmtrack_reproduce::request::{ExperimentRequest, run_experiment};
 
-use super::args::tier;
 use super::outcome::finish;
 use crate::progress::IndicatifProgress;
 
@@ -51,22 +50,27 @@ enum PulseChoice {
     Flat,
 }
 
-impl From<PulseChoice> for Pulse {
-    fn from(choice: PulseChoice) -> Self {
-        match choice {
-            PulseChoice::MeasuredLike => Self::MeasuredLike,
-            PulseChoice::Flat => Self::Flat,
+impl PulseChoice {
+    /// The library's name of the pulse.
+    fn name(self) -> &'static str {
+        match self {
+            Self::MeasuredLike => "measured-like",
+            Self::Flat => "flat",
         }
     }
 }
 
 pub fn run(args: &MpcArtificialArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    anyhow::ensure!(args.runs >= 1, "--runs must be at least 1 (nothing was done)");
-    mpc_artificial::check_start(&args.output, args.force, args.readme.as_deref())?;
-    let config =
-        Config { runs: args.runs, pulse: args.pulse.into(), zero_below_threshold: !args.keep_taps_below_threshold };
-    let options =
-        RunOptions { tier: tier(args.quick), runs: None, output_dir: args.output.clone(), readme: args.readme.clone() };
-    let outcome = mpc_artificial::run(&config, &options, &IndicatifProgress::new(quiet))?;
-    finish(&outcome, &options, quiet)
+    let request = ExperimentRequest {
+        output_dir: Some(args.output.clone()),
+        force: args.force,
+        quick: args.quick,
+        runs: Some(args.runs),
+        readme: args.readme.clone(),
+        pulse: Some(args.pulse.name().to_string()),
+        keep_taps_below_threshold: args.keep_taps_below_threshold,
+        ..ExperimentRequest::default()
+    };
+    let outcome = run_experiment(mpc_artificial::NAME, &request, &IndicatifProgress::new(quiet))?;
+    Ok(finish(&outcome, &args.output, quiet))
 }

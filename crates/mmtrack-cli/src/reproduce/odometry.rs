@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use clap::Args;
 use mmtrack_reproduce::common::DEFAULT_TRAJECTORY;
 use mmtrack_reproduce::odometry;
+use mmtrack_reproduce::request::{ExperimentRequest, run_experiment};
 
 use super::args::{ExperimentArgs, ExperimentTexts};
 use super::outcome::finish;
@@ -43,15 +44,14 @@ pub struct OdometryArgs {
 }
 
 pub fn run(args: &OdometryArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let options = args.common.run_options(None, None);
-    odometry::check_start(&options.output_dir, args.common.force, None)?;
-    let mut config = odometry::Config::load(
-        args.scenario.as_deref(),
-        args.trajectory.clone(),
-        args.trajectory_format.trajectory_format(),
-    )?;
-    config.max_distance_m = args.max_distance_m;
+    let request = ExperimentRequest {
+        scenario: args.scenario.clone(),
+        trajectory: Some(args.trajectory.clone()),
+        trajectory_format: Some(args.trajectory_format.name().to_string()),
+        max_distance_m: args.max_distance_m,
+        ..args.common.request()
+    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.common.threads.install(|| odometry::run(&config, &options, &progress))??;
-    finish(&outcome, &options, quiet)
+    let outcome = args.common.threads.install(|| run_experiment(odometry::NAME, &request, &progress))??;
+    Ok(finish(&outcome, &args.common.output, quiet))
 }

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
+use mmtrack_reproduce::request::{ExperimentRequest, run_experiment};
 use mmtrack_reproduce::shaham;
 
 use super::args::{ExperimentArgs, ExperimentTexts, MonteCarloArgs, MonteCarloTexts};
@@ -38,10 +39,13 @@ pub struct ShahamArgs {
 }
 
 pub fn run(args: &ShahamArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let options = args.common.run_options(args.monte_carlo.runs, args.monte_carlo.readme.as_deref());
-    shaham::check_start(&options.output_dir, args.common.force, options.readme.as_deref())?;
-    let config = shaham::Config::load(args.experiment.as_deref())?;
+    let request = ExperimentRequest {
+        runs: args.monte_carlo.runs,
+        readme: args.monte_carlo.readme.clone(),
+        experiment_file: args.experiment.clone(),
+        ..args.common.request()
+    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.common.threads.install(|| shaham::run(&config, &options, &progress))??;
-    finish(&outcome, &options, quiet)
+    let outcome = args.common.threads.install(|| run_experiment(shaham::NAME, &request, &progress))??;
+    Ok(finish(&outcome, &args.common.output, quiet))
 }

@@ -7,6 +7,7 @@ use std::process::ExitCode;
 
 use clap::Args;
 use mmtrack_reproduce::common::DEFAULT_TRAJECTORY;
+use mmtrack_reproduce::request::{ExperimentRequest, run_experiment};
 use mmtrack_reproduce::spebt;
 
 use super::args::{ExperimentArgs, ExperimentTexts, MonteCarloArgs, MonteCarloTexts};
@@ -55,15 +56,16 @@ pub struct SpebtArgs {
 }
 
 pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let options = args.common.run_options(args.monte_carlo.runs, args.monte_carlo.readme.as_deref());
-    spebt::check_start(&options.output_dir, args.common.force, options.readme.as_deref())?;
-    let mut config = spebt::Config::load(
-        args.experiment.as_deref(),
-        args.trajectory.clone(),
-        args.trajectory_format.trajectory_format(),
-    )?;
-    config.skip_odometry = args.skip_odometry;
+    let request = ExperimentRequest {
+        runs: args.monte_carlo.runs,
+        readme: args.monte_carlo.readme.clone(),
+        experiment_file: args.experiment.clone(),
+        trajectory: Some(args.trajectory.clone()),
+        trajectory_format: Some(args.trajectory_format.name().to_string()),
+        skip_odometry: args.skip_odometry,
+        ..args.common.request()
+    };
     let progress = IndicatifProgress::new(quiet);
-    let outcome = args.common.threads.install(|| spebt::run(&config, &options, &progress))??;
-    finish(&outcome, &options, quiet)
+    let outcome = args.common.threads.install(|| run_experiment(spebt::NAME, &request, &progress))??;
+    Ok(finish(&outcome, &args.common.output, quiet))
 }

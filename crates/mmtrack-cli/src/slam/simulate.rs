@@ -38,7 +38,7 @@ pub fn run_slam(args: &SlamSimArgs, quiet: bool) -> anyhow::Result<()> {
         seed: args.seed,
         epochs: args.epochs,
         output: args.output.output.clone(),
-        recording: args.output.recording_options(),
+        recording: args.output.recording_options()?,
     };
     let done = simulate_slam(&simulation)?;
     if !quiet {

@@ -41,6 +41,18 @@ fn allowed_internal(name: &str) -> Option<&'static [&'static str]> {
             "mmtrack-process",
         ],
         "mmtrack-cli" => ANY,
+        // The Python package: a front end over the libraries, as the CLI
+        // (never the CLI itself: nothing re-enters it through argv).
+        "mmtrack-py" => &[
+            "mmtrack-core",
+            "mmtrack-io",
+            "mmtrack-ingest",
+            "mmtrack-process",
+            "mmtrack-analysis",
+            "mmtrack-reproduce",
+            "mmtrack-mpc",
+            "mmtrack-beam",
+        ],
         // Dev-only fuzzing of the readers (publish = false).
         "mmtrack-fuzz" => &["mmtrack-core", "mmtrack-io", "mmtrack-ingest"],
         _ => return None,
@@ -84,6 +96,9 @@ fn crates_follow_the_dependency_rule() {
             if dep_name.starts_with("polars") && name != "mmtrack-analysis" {
                 violations.push(format!("{name} depends on {dep_name}: polars lives in mmtrack-analysis only"));
             }
+            if dep_name.starts_with("pyo3") && name != "mmtrack-py" {
+                violations.push(format!("{name} depends on {dep_name}: the Python bindings live in mmtrack-py only"));
+            }
             if dev || allowed == ANY {
                 continue;
             }
@@ -103,13 +118,18 @@ fn crates_follow_the_dependency_rule() {
             if pure && is_io_crate(dep_name) {
                 violations.push(format!("{name} depends on {dep_name}: algorithms and simulators do no I/O"));
             }
-            let library = matches!(name, "mmtrack-reproduce" | "mmtrack-process");
+            // The libraries, and the Python front end: only the CLI parses
+            // arguments or draws progress.
+            let library = matches!(name, "mmtrack-reproduce" | "mmtrack-process" | "mmtrack-py");
             if library && TERMINAL_CRATES.iter().any(|c| dep_name == *c || dep_name.starts_with(&format!("{c}_"))) {
                 violations
                     .push(format!("{name} depends on {dep_name}: only the CLI parses arguments or draws progress"));
             }
         }
     }
-    assert!(seen.contains_key("mmtrack-core") && seen.contains_key("mmtrack-cli"), "metadata lists our crates");
+    assert!(
+        seen.contains_key("mmtrack-core") && seen.contains_key("mmtrack-cli") && seen.contains_key("mmtrack-py"),
+        "metadata lists our crates"
+    );
     assert!(violations.is_empty(), "dependency rule broken:\n{}", violations.join("\n"));
 }

@@ -34,7 +34,7 @@ pub use reader::{
     ChannelInfo, ChannelSummary, EncodedScan, RawMessage, RawReader, RecordingEvent, RecordingItem, RecordingReader,
     RecordingSummary, inspect_recording, inspect_recording_with_progress,
 };
-pub use writer::{Compression, RecordingOptions, RecordingWriter, WriteSummary};
+pub use writer::{Compression, RecordingFlags, RecordingOptions, RecordingWriter, WriteSummary};
 
 /// Name of the MCAP metadata record that holds [`RecordingMetadata`].
 pub const METADATA_NAME: &str = "mmtrack.recording";

@@ -58,6 +58,87 @@ pub struct RecordingOptions {
     pub radar_cartesian: Option<CartesianGrid>,
 }
 
+/// The output flags of every ingest and simulate call, as the front ends
+/// name them (`--force`, `--compression`, ...; the Python keywords are the
+/// same words), turned into [`RecordingOptions`] in one place.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordingFlags {
+    /// Replace an existing output (atomically, once the new one is complete).
+    pub force: bool,
+    /// `none`, `zstd` or `lz4`.
+    pub compression: String,
+    /// zstd level, 1 (fast) ..= 19 (small).
+    pub zstd_level: u32,
+    /// Omit the Foxglove display channels (`/viz/...`, `/tf`, `/radar/cartesian`).
+    pub no_foxglove_views: bool,
+    /// Omit the Cartesian radar view (`/radar/cartesian`).
+    pub no_radar_cartesian: bool,
+    /// Pixel size of the Cartesian radar view, metres.
+    pub radar_cartesian_m_per_px: f64,
+    /// Width and height of the Cartesian radar view, pixels.
+    pub radar_cartesian_size_px: u32,
+    /// Skip the fsync before the final rename.
+    pub no_sync: bool,
+}
+
+impl Default for RecordingFlags {
+    fn default() -> Self {
+        Self {
+            force: false,
+            compression: "zstd".into(),
+            zstd_level: 1,
+            no_foxglove_views: false,
+            no_radar_cartesian: false,
+            radar_cartesian_m_per_px: CartesianGrid::default().metres_per_pixel,
+            radar_cartesian_size_px: CartesianGrid::default().size_px,
+            no_sync: false,
+        }
+    }
+}
+
+impl RecordingFlags {
+    /// The compression names of `--compression`.
+    pub const COMPRESSIONS: [&'static str; 3] = ["none", "zstd", "lz4"];
+
+    /// The writer's options.
+    ///
+    /// # Errors
+    /// An unknown compression, a zstd level outside 1..=19, a Cartesian size
+    /// outside 1..=[`super::cartesian::MAX_CARTESIAN_SIZE_PX`] or a pixel size
+    /// that is not a positive number of metres, naming the flag.
+    pub fn options(&self) -> std::result::Result<RecordingOptions, String> {
+        if !(1..=19).contains(&self.zstd_level) {
+            return Err(format!("--zstd-level {}: expected 1 (fast) ..= 19 (small)", self.zstd_level));
+        }
+        let max = super::cartesian::MAX_CARTESIAN_SIZE_PX;
+        if !(1..=max).contains(&self.radar_cartesian_size_px) {
+            return Err(format!(
+                "--radar-cartesian-size-px {}: expected 1..={max} pixels",
+                self.radar_cartesian_size_px
+            ));
+        }
+        let m = self.radar_cartesian_m_per_px;
+        if !(m.is_finite() && m > 0.0) {
+            return Err(format!("--radar-cartesian-m-per-px {m}: expected a positive number of metres"));
+        }
+        let compression = match self.compression.as_str() {
+            "none" => Compression::None,
+            "zstd" => Compression::Zstd { level: self.zstd_level },
+            "lz4" => Compression::Lz4,
+            other => return Err(format!("--compression '{other}': expected one of none, zstd, lz4")),
+        };
+        Ok(RecordingOptions {
+            compression,
+            overwrite: if self.force { Overwrite::Replace } else { Overwrite::Refuse },
+            foxglove_views: !self.no_foxglove_views,
+            durability: if self.no_sync { Durability::PageCache } else { Durability::Fsync },
+            radar_cartesian: (!self.no_radar_cartesian && !self.no_foxglove_views)
+                .then_some(CartesianGrid { metres_per_pixel: m, size_px: self.radar_cartesian_size_px }),
+            ..RecordingOptions::default()
+        })
+    }
+}
+
 impl Default for RecordingOptions {
     fn default() -> Self {
         Self {

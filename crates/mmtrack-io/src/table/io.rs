@@ -49,6 +49,49 @@ pub struct TableWriteSummary {
     pub rows: u64,
 }
 
+/// The Arrow schema (units on each field, the key-value pairs on the
+/// schema) and the writer properties (zstd, the key-value pairs in the file
+/// footer) of every file of `spec`: `units`, `mmtrack.table`,
+/// `mmtrack.version`, `mmtrack.run_config`.
+fn schema_and_properties(
+    spec: &TableSpec,
+    run: &RunInfo,
+) -> std::result::Result<(Arc<arrow_schema::Schema>, WriterProperties), parquet::errors::ParquetError> {
+    let metadata = vec![
+        KeyValue::new("units".to_string(), spec.units_json()),
+        KeyValue::new("mmtrack.table".to_string(), spec.name.to_string()),
+        KeyValue::new("mmtrack.version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
+        KeyValue::new("mmtrack.run_config".to_string(), run.config_json.clone()),
+    ];
+    // The same pairs on the Arrow schema, where pyarrow and pandas users
+    // look (`pq.read_table(f).schema.metadata`), and in the file footer.
+    let schema_metadata: std::collections::HashMap<String, String> =
+        metadata.iter().map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default())).collect();
+    let level = ZstdLevel::try_new(3)?;
+    let props = WriterProperties::builder()
+        .set_compression(Compression::ZSTD(level))
+        .set_key_value_metadata(Some(metadata))
+        .build();
+    Ok((Arc::new(spec.arrow_schema().with_metadata(schema_metadata)), props))
+}
+
+/// `rows` as the bytes of a Parquet file of their table, exactly as
+/// [`write_table`] writes it (schema, units, key-value metadata), but in
+/// memory: for front ends that hand results over without a file (the
+/// Python package's array calls, read back with `polars.read_parquet`).
+///
+/// # Errors
+/// An encoding error of the Parquet writer.
+pub fn table_bytes<T: TableRow>(rows: &[T], run: &RunInfo) -> Result<Vec<u8>> {
+    let path = Path::new(T::SPEC.name);
+    let (schema, props) = schema_and_properties(T::SPEC, run).map_err(|e| table_write_err(path, e))?;
+    let mut writer =
+        ArrowWriter::try_new(Vec::new(), schema.clone(), Some(props)).map_err(|e| table_write_err(path, e))?;
+    let batch = RecordBatch::try_new(schema, T::to_columns(rows)).map_err(|e| table_write_err(path, e))?;
+    writer.write(&batch).map_err(|e| table_write_err(path, e))?;
+    writer.into_inner().map_err(|e| table_write_err(path, e))
+}
+
 /// Writes one partition of one table; nothing appears until [`TableWriter::finish`].
 pub struct TableWriter {
     spec: &'static TableSpec,
@@ -70,22 +113,7 @@ impl TableWriter {
     ) -> Result<Self> {
         let path = table_path(root, spec.name, sequence_id)?;
         let file = AtomicFile::create(&path, overwrite)?;
-        let metadata = vec![
-            KeyValue::new("units".to_string(), spec.units_json()),
-            KeyValue::new("mmtrack.table".to_string(), spec.name.to_string()),
-            KeyValue::new("mmtrack.version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
-            KeyValue::new("mmtrack.run_config".to_string(), run.config_json.clone()),
-        ];
-        // The same pairs on the Arrow schema, where pyarrow and pandas users
-        // look (`pq.read_table(f).schema.metadata`), and in the file footer.
-        let schema_metadata: std::collections::HashMap<String, String> =
-            metadata.iter().map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default())).collect();
-        let level = ZstdLevel::try_new(3).map_err(|e| table_write_err(&path, e))?;
-        let props = WriterProperties::builder()
-            .set_compression(Compression::ZSTD(level))
-            .set_key_value_metadata(Some(metadata))
-            .build();
-        let schema = Arc::new(spec.arrow_schema().with_metadata(schema_metadata));
+        let (schema, props) = schema_and_properties(spec, run).map_err(|e| table_write_err(&path, e))?;
         let writer =
             ArrowWriter::try_new(file.writer()?, schema.clone(), Some(props)).map_err(|e| table_write_err(&path, e))?;
         Ok(Self { spec, schema, file, overwrite, writer, rows: 0 })

@@ -5,3 +5,136 @@
 pub mod geometric;
 pub mod spebt;
 pub mod sweep;
+
+use std::path::{Path, PathBuf};
+
+use anyhow::bail;
+use mmtrack_core::progress::Progress;
+
+use crate::output::OutputOptions;
+use geometric::{GeometricOptions, GeometricOutput};
+use spebt::{SpebtOptions, SpebtOutput};
+use sweep::{Reacquire, SweepOutput, SweepTrackerKind};
+
+/// A tracker of `process beam --tracker`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum BeamTracker {
+    /// A beam-sweep policy on measured sweeps.
+    Sweep(SweepTrackerKind),
+    /// SPEBT along a recording's ground truth (Liu et al. 2024).
+    Spebt,
+    /// Geometric Doppler-bearing tracking between two vehicles (Zoechmann et al. 2019).
+    Geometric,
+}
+
+impl BeamTracker {
+    /// Every tracker name, in `--tracker` order.
+    pub const NAMES: [&'static str; 6] = ["window", "gnss-window", "last-full-sweep", "gnss-map", "spebt", "geometric"];
+
+    /// The tracker of a `--tracker` name.
+    ///
+    /// # Errors
+    /// An unknown name, listing the known ones.
+    pub fn parse(name: &str) -> anyhow::Result<Self> {
+        Ok(match name {
+            "window" => Self::Sweep(SweepTrackerKind::Window),
+            "gnss-window" => Self::Sweep(SweepTrackerKind::GnssWindow),
+            "last-full-sweep" => Self::Sweep(SweepTrackerKind::LastFullSweep),
+            "gnss-map" => Self::Sweep(SweepTrackerKind::GnssMap),
+            "spebt" => Self::Spebt,
+            "geometric" => Self::Geometric,
+            other => bail!("--tracker '{other}': expected one of {}", Self::NAMES.join(", ")),
+        })
+    }
+}
+
+impl Reacquire {
+    /// The re-acquisition of a `--reacquire` name (`coarse` or `full`).
+    ///
+    /// # Errors
+    /// Any other name.
+    pub fn parse(name: &str) -> anyhow::Result<Self> {
+        match name {
+            "coarse" => Ok(Self::Coarse),
+            "full" => Ok(Self::Full),
+            other => bail!("--reacquire '{other}': expected coarse or full"),
+        }
+    }
+}
+
+/// Everything `process beam` is asked to do.
+#[derive(Debug, Clone)]
+pub struct BeamRequest {
+    /// Recordings, or directories of them ([`sweep::expand`]).
+    pub recordings: Vec<PathBuf>,
+    /// The trackers: sweep policies together, or `spebt` alone, or
+    /// `geometric` alone.
+    pub trackers: Vec<BeamTracker>,
+    /// How the window trackers re-acquire the beam.
+    pub reacquire: Reacquire,
+    /// `--force`, `--run-id`.
+    pub output: OutputOptions,
+    /// The options of `spebt`.
+    pub spebt: SpebtOptions,
+    /// The options of `geometric`.
+    pub geometric: GeometricOptions,
+}
+
+/// What [`process_beam`] did, by kind of tracker.
+#[derive(Debug, Clone)]
+pub enum BeamOutput {
+    /// The sweep policies.
+    Sweeps(SweepOutput),
+    /// SPEBT.
+    Spebt(SpebtOutput),
+    /// Geometric tracking.
+    Geometric(GeometricOutput),
+}
+
+/// `mmtrack process beam`: the trackers of `request` on its recordings,
+/// tables under `output`.
+///
+/// # Errors
+/// `spebt` or `geometric` given with other trackers, an option of one
+/// tracker given to another, and the errors of the tracker's own call.
+pub fn process_beam(output: &Path, request: &BeamRequest, progress: &dyn Progress) -> anyhow::Result<BeamOutput> {
+    let out = request.output.resolve(output)?;
+    let mut kinds = request.trackers.clone();
+    kinds.sort();
+    kinds.dedup();
+    if kinds.is_empty() {
+        bail!("--tracker: name at least one of {}", BeamTracker::NAMES.join(", "));
+    }
+    let files = sweep::expand(&request.recordings)?;
+    if kinds.contains(&BeamTracker::Geometric) {
+        if kinds.len() > 1 {
+            bail!(
+                "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
+            );
+        }
+        return Ok(BeamOutput::Geometric(geometric::process_geometric(&files, &out, &request.geometric)?));
+    }
+    if let Some(flag) = request.geometric.given().first() {
+        bail!("{flag} is an option of --tracker geometric only");
+    }
+    if kinds.contains(&BeamTracker::Spebt) {
+        if kinds.len() > 1 {
+            bail!(
+                "--tracker spebt runs alone (it tracks a simulated link along the ground truth, not measured sweeps); \
+                 give the sweep trackers in another call"
+            );
+        }
+        return Ok(BeamOutput::Spebt(spebt::process_spebt(&files, &out, &request.spebt, progress)?));
+    }
+    if let Some(flag) = request.spebt.given().first() {
+        bail!("{flag} is an option of --tracker spebt only");
+    }
+    let sweep_kinds: Vec<SweepTrackerKind> = kinds
+        .iter()
+        .filter_map(|k| match k {
+            BeamTracker::Sweep(kind) => Some(*kind),
+            BeamTracker::Spebt | BeamTracker::Geometric => None,
+        })
+        .collect();
+    Ok(BeamOutput::Sweeps(sweep::process_sweeps(&files, output, &sweep_kinds, request.reacquire, &request.output)?))
+}

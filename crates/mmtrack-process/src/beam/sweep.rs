@@ -483,3 +483,44 @@ pub fn process_sweeps(
         .collect();
     Ok(SweepOutput { sites, summaries, written, dir: out.path })
 }
+
+/// One pass of full sweeps through one measurement-only policy (`window` or
+/// `last-full-sweep`), without files: the `beam_sweeps_tracked` rows that
+/// `process beam` writes for the same sweeps (site `site`). The sweeps are
+/// the rows of a power array: sweep `i` at `t_ns[i]`, every beam measured.
+/// The GNSS policies need the beam map fitted from both units' positions over
+/// several passes, so they run on recordings only ([`process_sweeps`]).
+///
+/// # Errors
+/// A GNSS policy; sweeps that are not full, of different beam counts or not
+/// increasing in time; the tracker's errors.
+pub fn track_pass(
+    kind: SweepTrackerKind,
+    reacquire: Reacquire,
+    site: &str,
+    sweeps: &[BeamSweep],
+) -> anyhow::Result<Vec<BeamSweepTracked>> {
+    if kind.needs_map() {
+        bail!(
+            "--tracker {}: the GNSS policies need the beam map fitted from the car's and the array's GNSS positions \
+             over several passes; run `process beam` on recordings for them (here: window or last-full-sweep)",
+            kind.name()
+        );
+    }
+    let mut policy = tracker(kind, reacquire, None)?;
+    let records = evaluate(policy.as_mut(), &[SweepPass { sweeps, gnss_beam: None }])?;
+    Ok(rows(kind, site, sweeps, &records, None))
+}
+
+impl SweepTrackerKind {
+    /// The policy of a `--tracker` name.
+    ///
+    /// # Errors
+    /// Not a sweep policy's name.
+    pub fn parse(name: &str) -> anyhow::Result<Self> {
+        match super::BeamTracker::parse(name)? {
+            super::BeamTracker::Sweep(kind) => Ok(kind),
+            _ => bail!("--tracker '{name}': not a beam-sweep policy (window, gnss-window, last-full-sweep, gnss-map)"),
+        }
+    }
+}

@@ -1,0 +1,272 @@
+"""The Python package against the CLI: the same calls give the same files and
+tables, the array calls reproduce the CLI's tables to 1e-12, errors carry the
+CLI's one line.
+
+Environment: ``MMTRACK_BIN`` is the ``mmtrack`` binary to compare with (the
+Rust test that runs this suite sets it); ``MMTRACK_REALDATA`` the real-data
+samples (default ``../shared/realdata`` beside the workspace).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import polars as pl
+import pytest
+
+import mmtrack
+
+ROOT = Path(__file__).resolve().parents[3]
+DEMO_FOLDER = ROOT / "data/demo/oxford-demo"
+TOL = 1e-12
+
+
+def cli(*args: object, cwd: Path | None = None, ok: bool = True) -> subprocess.CompletedProcess[str]:
+    binary = os.environ.get("MMTRACK_BIN")
+    if not binary:
+        pytest.fail("MMTRACK_BIN is not set: the path of the mmtrack binary to compare with")
+    done = subprocess.run([binary, *map(str, args)], capture_output=True, text=True, cwd=cwd)
+    if ok:
+        assert done.returncode == 0, done.stderr
+    return done
+
+
+def cli_error(*args: object) -> str:
+    """The CLI's error line without `error: `."""
+    done = cli(*args, ok=False)
+    assert done.returncode == 1, (done.returncode, done.stderr)
+    lines = [line for line in done.stderr.splitlines() if line.startswith("error: ")]
+    assert len(lines) == 1, done.stderr
+    return lines[0][len("error: ") :]
+
+
+def realdata(name: str) -> Path:
+    base = Path(os.environ.get("MMTRACK_REALDATA", ROOT.parent / "shared/realdata"))
+    path = base / name
+    if not path.is_dir():
+        pytest.skip(f"real data {path} not found (set MMTRACK_REALDATA)")
+    return path
+
+
+def assert_frames_close(a: pl.DataFrame, b: pl.DataFrame, tol: float = TOL) -> None:
+    """Same columns, dtypes and rows; floats within `tol` (absolute and relative)."""
+    assert a.columns == b.columns
+    assert a.dtypes == b.dtypes
+    assert a.height == b.height
+    assert a.height > 0
+    for name in a.columns:
+        x, y = a[name], b[name]
+        if x.dtype.is_float():
+            xa, ya = x.to_numpy(), y.to_numpy()
+            assert np.array_equal(np.isnan(xa), np.isnan(ya)), name
+            keep = ~np.isnan(xa)
+            np.testing.assert_allclose(xa[keep], ya[keep], rtol=tol, atol=tol, err_msg=name)
+        else:
+            assert x.to_list() == y.to_list(), name
+
+
+@pytest.fixture(scope="session")
+def demo(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """The demo drive ingested and processed by the CLI, analyzed by the CLI."""
+    d = tmp_path_factory.mktemp("demo")
+    cli("ingest", "oxford", DEMO_FOLDER, "-o", d / "cli.mcap", "--bins", "auto")
+    cli("process", "odometry", d / "cli.mcap", "-o", d / "cli-tables")
+    cli("analyze", d / "cli-tables", "-o", d / "cli-analysis", "--segment-lengths-m", "2,4,6,8")
+    return {"dir": d, "recording": d / "cli.mcap", "tables": d / "cli-tables", "analysis": d / "cli-analysis"}
+
+
+def test_version_is_the_crates() -> None:
+    version = cli("--version").stdout.split()[-1]
+    assert mmtrack.__version__ == version
+
+
+def test_ingest_and_process_write_what_the_cli_writes(demo: dict[str, Path]) -> None:
+    d = demo["dir"]
+    done = mmtrack.ingest("oxford", DEMO_FOLDER, d / "py.mcap", bins="auto")
+    assert done["scans"] == 8 and done["path"] == str(d / "py.mcap")
+    assert (d / "py.mcap").read_bytes() == demo["recording"].read_bytes()
+
+    written = mmtrack.process("odometry", demo["recording"], d / "py-tables")
+    assert written["scans"] == 8 and written["sequence"] == "oxford-demo"
+    names = sorted(Path(t["path"]).parts[-3] for t in written["tables"])
+    assert names == ["ground_truth", "odometry", "odometry_timing"]
+    for table in ("odometry", "ground_truth"):
+        # The run configuration names the recording path as given; the rows are the CLI's.
+        ours = mmtrack.read_table(d / "py-tables", table).collect()
+        theirs = mmtrack.read_table(demo["tables"], table).collect()
+        assert ours.equals(theirs), table
+
+
+def test_tables_are_lazy_frames_with_units_time_base_and_frame(demo: dict[str, Path]) -> None:
+    all_tables = mmtrack.tables(demo["tables"])
+    assert sorted(all_tables) == ["ground_truth", "odometry", "odometry_timing"]
+    odometry = all_tables["odometry"]
+    assert isinstance(odometry, pl.LazyFrame)
+    frame = odometry.collect()
+    spec = mmtrack.table_spec("odometry")
+    assert frame.columns == [c.name for c in spec.columns] + ["sequence"]
+    assert frame["sequence"].unique().to_list() == ["oxford-demo"]
+    assert frame.height == 8
+    assert spec.units["x_m"] == "m" and spec.units["yaw_rad"] == "rad" and spec.units["t_ns"] == "ns"
+    info = mmtrack.table_info(demo["tables"], "odometry")
+    assert info.units == {c.name: c.unit for c in spec.columns}
+    assert info.frame is not None
+    assert info.run_config["command"] == "process odometry"
+    # The recording's time base (the demo's simulated drive starts at a UNIX time).
+    assert info.time_base == "unix_epoch"
+    pandas = pytest.importorskip("pandas")
+    assert isinstance(frame.to_pandas(), pandas.DataFrame)
+    assert "trajectory_metrics" in mmtrack.table_names()
+
+
+def test_analyze_writes_the_cli_results(demo: dict[str, Path]) -> None:
+    out = demo["dir"] / "py-analysis"
+    done = mmtrack.analyze(demo["tables"], out, segment_lengths_m=[2, 4, 6, 8])
+    assert done["runs"] == [] and Path(done["report"]).is_file()
+    for name in ("trajectory_metrics", "drift_per_length", "relative_pose_errors"):
+        ours = mmtrack.read_table(out / "tables", name).collect()
+        theirs = mmtrack.read_table(demo["analysis"] / "tables", name).collect()
+        assert ours.equals(theirs), name
+
+
+def test_trajectory_metrics_on_arrays_match_analyze(demo: dict[str, Path]) -> None:
+    estimate = mmtrack.read_table(demo["tables"], "odometry").collect()
+    truth = mmtrack.read_table(demo["tables"], "ground_truth").collect()
+    got = mmtrack.trajectory_metrics(estimate, truth, segment_lengths_m=[2, 4, 6, 8], sequence="oxford-demo")
+    cli_tables = demo["analysis"] / "tables"
+    expected = mmtrack.read_table(cli_tables, "trajectory_metrics").collect().drop("sequence")
+    assert_frames_close(got.table, expected)
+    assert got.metrics["kitti_segments"] > 0
+    assert_frames_close(
+        got.drift_per_length, mmtrack.read_table(cli_tables, "drift_per_length").collect().drop("sequence")
+    )
+    assert_frames_close(
+        got.relative_pose_errors, mmtrack.read_table(cli_tables, "relative_pose_errors").collect().drop("sequence")
+    )
+    # The same from plain arrays: (t_ns, [x_m, y_m, yaw_rad]).
+    as_arrays = mmtrack.trajectory_metrics(
+        (estimate["t_ns"].to_numpy(), estimate.select("x_m", "y_m", "yaw_rad").to_numpy()),
+        (truth["t_ns"].to_numpy(), truth.select("x_m", "y_m", "yaw_rad").to_numpy()),
+        segment_lengths_m=[2, 4, 6, 8],
+        sequence="oxford-demo",
+    )
+    assert as_arrays.table.equals(got.table)
+
+
+def test_detect_mpc_on_a_cir_array_matches_process_mpc(tmp_path: Path) -> None:
+    rng = np.random.default_rng(27)
+    snapshots, taps, spacing = 12, 128, 1e-9
+    k = np.arange(taps)
+    cir = np.zeros((snapshots, taps), dtype=np.complex128)
+    for s in range(snapshots):
+        for delay_taps, gain in ((20.3 + 0.05 * s, 1.0), (41.7 - 0.03 * s, 0.4j), (77.2, 0.1)):
+            cir[s] += gain * np.sinc(k - delay_taps)
+    cir += (rng.normal(size=cir.shape) + 1j * rng.normal(size=cir.shape)) * 1e-4
+    np.save(tmp_path / "cir.npy", cir)
+    (tmp_path / "cir.toml").write_text(
+        f'carrier_hz = 5.9e9\ntap_spacing_s = {spacing}\nsnapshot_period_s = 1e-3\nsnapshots_per_set = 4\n'
+        't0_ns = 1700000000000000000\naxes = ["snapshot", "tap"]\n'
+    )
+    cli("ingest", "cir", tmp_path / "cir.npy", "--format", "npy", "--sidecar", tmp_path / "cir.toml", "-o", tmp_path / "cir.mcap")
+    cli("process", "mpc", tmp_path / "cir.mcap", "-o", tmp_path / "tables")
+    expected = mmtrack.read_table(tmp_path / "tables", "mpc_detections").collect().drop("sequence")
+    labels = mmtrack.read_table(tmp_path / "tables", "mpc_snapshots").collect().sort("t_ns")
+    assert labels.height == snapshots
+    got = mmtrack.detect_mpc(
+        cir,
+        tap_spacing_s=spacing,
+        t_ns=labels["t_ns"].to_numpy(),
+        set_index=labels["set_index"].to_numpy(),
+        snapshot_index=labels["snapshot_index"].to_numpy(),
+    )
+    assert_frames_close(got.table, expected)
+    assert got.delay_s.shape == got.amplitude.shape == got.snapshot.shape
+    first = got.snapshot == 0
+    strongest = int(np.argmax(np.abs(got.amplitude[first])))
+    assert abs(got.delay_s[first][strongest] - 20.3e-9) < 0.1e-9
+
+
+def test_track_beams_on_a_power_array_matches_process_beam(tmp_path: Path) -> None:
+    folder = realdata("deepsense-60ghz-beams")
+    passes = mmtrack.ingest("beams", folder, tmp_path / "rec", scenario=3)
+    assert len(passes) >= 2
+    cli("process", "beam", tmp_path / "rec", "-o", tmp_path / "tables", "--tracker", "window,last-full-sweep")
+    tracked = mmtrack.read_table(tmp_path / "tables", "beam_sweeps_tracked").collect()
+    seq_index = np.load(folder / "scenario3_seq_index_1-1487.npy").ravel()
+    power = np.load(folder / "scenario3_unit1_pwr_60ghz_1-1487.npy")
+    for p in passes[:2]:
+        expected = tracked.filter(pl.col("sequence") == p["sequence_id"]).drop("sequence")
+        rows = power[seq_index == p["pass"]]
+        window = expected.filter(pl.col("tracker") == "window")
+        got = mmtrack.track_beams(
+            rows,
+            tracker=["window", "last-full-sweep"],
+            t_ns=window["t_ns"].to_numpy(),
+            site=window["site"][0],
+        )
+        assert_frames_close(got.sort("tracker", maintain_order=True), expected.sort("tracker", maintain_order=True))
+
+
+def test_reproduce_returns_the_claims_the_cli_reports(tmp_path: Path) -> None:
+    done = mmtrack.reproduce("zoechmann", quick=True, output=tmp_path / "py")
+    cli("reproduce", "zoechmann", "--quick", "-o", tmp_path / "cli", ok=False)
+    assert done.claims and done.experiment == "zoechmann"
+    report = (tmp_path / "cli" / "reproduce.md").read_text()
+    for claim in done.claims:
+        assert f"| {claim.claim} | {claim.paper} |" in report
+        assert claim.verdict in ("met", "missed", "holds (variant, not a target)", "does not hold (variant, not a target)")
+    assert done.targets_met == all(c.met or c.informational for c in done.claims)
+    assert any(c.paper_value is not None and c.measured is not None for c in done.claims)
+    # The measured numbers are the CLI's (seeded), except wall-clock times.
+    theirs = json.loads((tmp_path / "cli" / "metrics.json").read_text())
+    assert [m["key"] for m in done.metrics] == [m["key"] for m in theirs]
+    compared = 0
+    for ours, cli_metric in zip(done.metrics, theirs):
+        if ours["unit"] == "s":
+            continue
+        assert ours["value"] == pytest.approx(cli_metric["value"], rel=TOL, abs=TOL), ours["key"]
+        compared += 1
+    assert compared > 0
+
+
+def test_errors_carry_the_cli_line(tmp_path: Path) -> None:
+    missing = tmp_path / "missing.mcap"
+    with pytest.raises(mmtrack.MmtrackError) as caught:
+        mmtrack.process("odometry", missing, tmp_path / "out")
+    assert str(caught.value) == cli_error("process", "odometry", missing, "-o", tmp_path / "out")
+
+    with pytest.raises(mmtrack.MmtrackError) as caught:
+        mmtrack.ingest("oxford", DEMO_FOLDER, tmp_path / "x.mcap", bins="many")
+    assert str(caught.value) == cli_error("ingest", "oxford", DEMO_FOLDER, "-o", tmp_path / "x.mcap", "--bins", "many")
+
+    with pytest.raises(mmtrack.MmtrackError) as caught:
+        mmtrack.analyze(tmp_path / "no-tables", tmp_path / "analysis")
+    assert str(caught.value) == cli_error("analyze", tmp_path / "no-tables", "-o", tmp_path / "analysis")
+
+    with pytest.raises(mmtrack.MmtrackError, match="--tracker gnss-map: the GNSS policies need the beam map"):
+        mmtrack.track_beams(np.ones((3, 4)), tracker="gnss-map")
+    with pytest.raises(mmtrack.MmtrackError, match="estimate: row 1: t_ns 0 does not increase"):
+        t = np.array([0, 0, 1], dtype=np.int64)
+        mmtrack.trajectory_metrics((t, np.zeros((3, 3))), (t + 5, np.zeros((3, 3))))
+    with pytest.raises(mmtrack.MmtrackError, match="unknown table"):
+        mmtrack.table_spec("no_such_table")
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        mmtrack.process("odometry", missing, tmp_path / "out", presett="cfear")
+
+
+def test_stubs_name_every_native_function_and_the_package_is_typed() -> None:
+    import ast
+
+    import mmtrack._native as native
+
+    package = Path(mmtrack.__file__).parent
+    assert (package / "py.typed").is_file()
+    tree = ast.parse((package / "_native.pyi").read_text())
+    stubbed = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.ClassDef))}
+    exported = {name for name in dir(native) if not name.startswith("_")}
+    assert stubbed == exported
+    assert set(mmtrack.__all__) <= set(dir(mmtrack))
