@@ -18,6 +18,9 @@ pub struct GridIndex {
     /// Points of cell `c` (row-major, x-major) are `order[start[c]..start[c + 1]]`.
     start: Vec<u32>,
     order: Vec<u32>,
+    /// `xy_m[k]` is the position of point `order[k]`: a query reads the
+    /// cells' coordinates contiguously instead of gathering them by index.
+    xy_m: Vec<[f64; 2]>,
 }
 
 /// Largest grid kept dense; sparser point sets use coarser cells (never
@@ -30,21 +33,26 @@ impl GridIndex {
     /// any distance of them).
     #[must_use]
     pub fn new(points: impl Iterator<Item = [f64; 2]>, cell_m: f64) -> Self {
-        let points: Vec<(u32, [f64; 2])> = points
-            .enumerate()
-            .filter(|(_, p)| p[0].is_finite() && p[1].is_finite())
-            .map(|(i, p)| (i as u32, p))
-            .collect();
+        // One pass: the finite points with their indices, sized up front.
+        let mut finite: Vec<(u32, [f64; 2])> = Vec::with_capacity(points.size_hint().0);
+        for (i, p) in points.enumerate() {
+            if p[0].is_finite() && p[1].is_finite() {
+                finite.push((i as u32, p));
+            }
+        }
+        if finite.is_empty() {
+            return Self { cell_m, origin: (0, 0), size: (0, 0), start: vec![0], order: Vec::new(), xy_m: Vec::new() };
+        }
         let mut cell_m = cell_m;
+        let mut keys: Vec<(i64, i64)> = Vec::with_capacity(finite.len());
         loop {
-            let keys: Vec<(i64, i64)> = points.iter().map(|(_, p)| cell_of(*p, cell_m)).collect();
+            keys.clear();
             let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
-            for &(x, y) in &keys {
+            for (_, p) in &finite {
+                let (x, y) = cell_of(*p, cell_m);
                 lo = (lo.0.min(x), lo.1.min(y));
                 hi = (hi.0.max(x), hi.1.max(y));
-            }
-            if keys.is_empty() {
-                return Self { cell_m, origin: (0, 0), size: (0, 0), start: vec![0], order: Vec::new() };
+                keys.push((x, y));
             }
             let size = (hi.0.saturating_sub(lo.0).saturating_add(1), hi.1.saturating_sub(lo.1).saturating_add(1));
             if size.0.saturating_mul(size.1) > MAX_CELLS {
@@ -52,47 +60,84 @@ impl GridIndex {
                 continue;
             }
             let cells = (size.0 * size.1) as usize;
-            let flat = |(x, y): (i64, i64)| ((x - lo.0) * size.1 + (y - lo.1)) as usize;
+            // Flat cell of every point, computed once for both passes below.
+            let flat: Vec<u32> = keys.iter().map(|&(x, y)| ((x - lo.0) * size.1 + (y - lo.1)) as u32).collect();
             let mut start = vec![0u32; cells + 1];
-            for &k in &keys {
-                start[flat(k) + 1] += 1;
+            for &c in &flat {
+                start[c as usize + 1] += 1;
             }
             for c in 0..cells {
                 start[c + 1] += start[c];
             }
             let mut next = start.clone();
-            let mut order = vec![0u32; keys.len()];
-            for (&(index, _), &k) in points.iter().zip(&keys) {
-                let slot = &mut next[flat(k)];
+            let mut order = vec![0u32; flat.len()];
+            let mut xy_m = vec![[0.0; 2]; flat.len()];
+            for (&(index, p), &c) in finite.iter().zip(&flat) {
+                let slot = &mut next[c as usize];
                 order[*slot as usize] = index;
+                xy_m[*slot as usize] = p;
                 *slot += 1;
             }
-            return Self { cell_m, origin: lo, size, start, order };
+            return Self { cell_m, origin: lo, size, start, order, xy_m };
         }
     }
 
     /// Indices of the points in one cell (empty outside the grid).
-    fn cell(&self, (x, y): (i64, i64)) -> &[u32] {
+    #[cfg(test)]
+    fn cell(&self, xy: (i64, i64)) -> &[u32] {
+        &self.order[self.cell_range(xy)]
+    }
+
+    /// The range of `order` (and `xy_m`) holding one cell (empty outside the grid).
+    fn cell_range(&self, (x, y): (i64, i64)) -> std::ops::Range<usize> {
         let (x, y) = (x - self.origin.0, y - self.origin.1);
         if x < 0 || y < 0 || x >= self.size.0 || y >= self.size.1 {
-            return &[];
+            return 0..0;
         }
         let c = (x * self.size.1 + y) as usize;
-        &self.order[self.start[c] as usize..self.start[c + 1] as usize]
+        self.start[c] as usize..self.start[c + 1] as usize
     }
 
     /// Indices of the points in the 3 x 3 cells around `p`: a superset of the
     /// points within `cell_m` of `p`; callers check the distance.
+    #[cfg(test)]
     pub fn candidates(&self, p: [f64; 2]) -> impl Iterator<Item = usize> + '_ {
         let (cx, cy) = cell_of(p, self.cell_m);
         (-1..=1)
             .flat_map(move |dy| (-1..=1).flat_map(move |dx| self.cell((cx + dx, cy + dy)).iter().map(|&i| i as usize)))
     }
 
+    /// Calls `visit(index, position)` for the points of the 3 x 3 cells
+    /// around `p` (a superset of the points within `cell_m` of `p`; callers
+    /// check the distance), in the order of [`GridIndex::candidates`]: rows
+    /// of cells from below, each from the left, each cell's points in
+    /// insertion order. Plain loops over the cells' contiguous slices, so
+    /// the compiler sees the whole loop (the nested iterator adaptors it
+    /// replaces cost about as much as the distance tests).
+    #[inline]
+    pub fn for_each_candidate(&self, p: [f64; 2], mut visit: impl FnMut(usize, [f64; 2])) {
+        let (cx, cy) = cell_of(p, self.cell_m);
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let range = self.cell_range((cx + dx, cy + dy));
+                for (&i, &q) in self.order[range.clone()].iter().zip(&self.xy_m[range]) {
+                    visit(i as usize, q);
+                }
+            }
+        }
+    }
+
     /// Non-empty cells in (x, y) order, each as its points' indices in
     /// insertion order.
+    #[cfg(test)]
     pub fn occupied_cells(&self) -> impl Iterator<Item = &[u32]> + '_ {
         self.start.windows(2).filter(|w| w[1] > w[0]).map(|w| &self.order[w[0] as usize..w[1] as usize])
+    }
+
+    /// Non-empty cells in (x, y) order, each as its points' positions in
+    /// insertion order (those of [`GridIndex::occupied_cells`]).
+    pub fn occupied_cell_positions(&self) -> impl Iterator<Item = &[[f64; 2]]> + '_ {
+        self.start.windows(2).filter(|w| w[1] > w[0]).map(|w| &self.xy_m[w[0] as usize..w[1] as usize])
     }
 
     /// Side of the cells actually used, metres (at least the requested side).
@@ -104,8 +149,19 @@ impl GridIndex {
 
 /// The cell holding `p`.
 #[must_use]
+#[inline]
 pub fn cell_of(p: [f64; 2], cell_m: f64) -> (i64, i64) {
-    ((p[0] / cell_m).floor() as i64, (p[1] / cell_m).floor() as i64)
+    (floor_to_i64(p[0] / cell_m), floor_to_i64(p[1] / cell_m))
+}
+
+/// `x.floor() as i64` (saturating, NaN to 0) without the call to libm's
+/// `floor` that the baseline x86-64 target makes for it (no SSE4.1 `round`):
+/// truncate, then step down when truncation went up. The same value for
+/// every input, tested.
+#[inline]
+fn floor_to_i64(x: f64) -> i64 {
+    let truncated = x as i64;
+    if (truncated as f64) > x { truncated.saturating_sub(1) } else { truncated }
 }
 
 #[cfg(test)]
@@ -128,11 +184,61 @@ mod tests {
     }
 
     #[test]
+    fn for_each_candidate_visits_the_candidates_in_their_order_with_their_positions() {
+        let points: Vec<[f64; 2]> =
+            (0..300).map(|i| [((i * 41) % 89) as f64 * 0.4 - 9.0, ((i * 29) % 83) as f64 * 0.35 - 12.0]).collect();
+        let index = GridIndex::new(points.iter().copied(), 2.0);
+        for q in [[0.0, 0.0], [-8.5, -11.0], [20.0, 20.0], [5.3, 1.7]] {
+            let mut visited = Vec::new();
+            index.for_each_candidate(q, |i, p| visited.push((i, p)));
+            let expected: Vec<(usize, [f64; 2])> = index.candidates(q).map(|i| (i, points[i])).collect();
+            assert_eq!(visited, expected, "query {q:?}");
+        }
+        let mut visited = 0;
+        index.for_each_candidate([0.0, 0.0], |_, _| visited += 1);
+        assert!(visited > 0, "the query at the centre finds points");
+    }
+
+    #[test]
+    fn floor_to_i64_is_floor_then_a_saturating_cast() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.999_999_999_999_999_6,
+            -2.999_999_999_999_999_6,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9.3e18,
+            -9.3e18,
+            -9223372036854775808.0,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+        ];
+        values.extend((-2000..2000).map(|i| i as f64 * 0.37 / 3.0));
+        for x in values {
+            assert_eq!(floor_to_i64(x), x.floor() as i64, "{x:e}");
+        }
+    }
+
+    #[test]
     fn occupied_cells_come_in_x_then_y_order_with_points_in_insertion_order() {
         let points = [[5.0, 0.5], [0.5, 5.0], [0.2, 0.2], [0.4, 0.1], [5.5, -3.0]];
         let index = GridIndex::new(points.iter().copied(), 1.0);
         let cells: Vec<Vec<u32>> = index.occupied_cells().map(<[u32]>::to_vec).collect();
         assert_eq!(cells, vec![vec![2, 3], vec![1], vec![4], vec![0]]);
+        let positions: Vec<Vec<[f64; 2]>> = index.occupied_cell_positions().map(<[[f64; 2]]>::to_vec).collect();
+        let expected: Vec<Vec<[f64; 2]>> =
+            cells.iter().map(|cell| cell.iter().map(|&i| points[i as usize]).collect()).collect();
+        assert_eq!(positions, expected);
     }
 
     #[test]

@@ -84,7 +84,7 @@ pub fn associate(
         let placed = transform(s, world_from_scan);
         for &reference in references {
             let mut best: Option<(f64, usize)> = None;
-            for j in reference.index.candidates(placed.mean_m) {
+            reference.index.for_each_candidate(placed.mean_m, |j, _| {
                 let r = &reference.points[j];
                 let (dx, dy) = (r.mean_m[0] - placed.mean_m[0], r.mean_m[1] - placed.mean_m[1]);
                 let distance_sq = dx * dx + dy * dy;
@@ -92,7 +92,7 @@ pub fn associate(
                 if distance_sq <= radius_sq && cos >= min_cos && best.is_none_or(|(d, _)| distance_sq < d) {
                     best = Some((distance_sq, j));
                 }
-            }
+            });
             if let Some((_, j)) = best {
                 let r = &reference.points[j];
                 out.push(Correspondence { source_m: s.mean_m, target_m: r.mean_m, normal: r.normal });

@@ -10,9 +10,10 @@ use super::output::{Finish, finish};
 
 #[derive(Args)]
 pub struct SlamBenchArgs {
-    /// UE particles.
-    #[arg(long, default_value_t = 2000)]
-    particles: usize,
+    /// UE particle counts, comma-separated: one pair of rows (one thread, the pool) each; the targets
+    /// apply at 2000.
+    #[arg(long, value_delimiter = ',', default_values_t = [500, 2000, 8000])]
+    particles: Vec<usize>,
     /// Message-passing iterations (tempering stages and EKF relinearisations).
     #[arg(long, default_value_t = 10)]
     iterations: usize,
@@ -35,7 +36,7 @@ pub struct SlamBenchArgs {
 
 pub fn run(args: &SlamBenchArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let options = SlamBenchOptions {
-        particles: args.particles,
+        particles: args.particles.clone(),
         iterations: args.iterations,
         epochs: args.epochs,
         repeats: args.repeats,

@@ -63,25 +63,41 @@ fn bench_mpc_gives_a_row_per_thread_count_with_consistent_verdicts() {
 }
 
 #[test]
-fn bench_slam_times_one_thread_and_the_pool_with_consistent_verdicts() {
-    let options = slam::SlamBenchOptions { particles: 50, iterations: 1, epochs: 5, repeats: 1, threads: 2 };
+fn bench_slam_times_one_thread_and_the_pool_per_particle_count_with_consistent_verdicts() {
+    let options = slam::SlamBenchOptions { particles: vec![50, 120], iterations: 1, epochs: 5, repeats: 1, threads: 2 };
     let bench = slam::run(&options).unwrap();
-    assert_eq!((bench.one_thread.threads, bench.pool.threads, bench.epochs), (1, 2, 5));
+    assert_eq!((bench.threads, bench.epochs), (2, 5));
+    assert_eq!(bench.rows.iter().map(|r| r.particles).collect::<Vec<_>>(), [50, 120]);
     assert_eq!(bench.target_ms_per_epoch, slam::TARGET_MS_PER_EPOCH);
-    for row in [&bench.one_thread, &bench.pool] {
-        assert_positive("ms_per_epoch", row.ms_per_epoch);
-        assert_positive("times_faster_than_real_time", row.times_faster_than_real_time);
-        // The slowest epoch is at least the mean (ms_per_epoch is the mean).
-        assert!(row.slowest_epoch_ms >= row.ms_per_epoch * (1.0 - 1e-9), "{row:?}");
-        assert_eq!(row.target_met, row.ms_per_epoch < bench.target_ms_per_epoch, "{row:?}");
-        // Real time over the measured time, by definition (to rounding).
-        assert!((row.times_faster_than_real_time * row.ms_per_epoch - bench.epoch_ms).abs() < 1e-6 * bench.epoch_ms);
+    assert_eq!(bench.target_speed_up, slam::TARGET_SPEED_UP);
+    for rows in &bench.rows {
+        assert_eq!((rows.one_thread.threads, rows.pool.threads), (1, 2));
+        assert!(!rows.is_target, "{rows:?}");
+        for row in [&rows.one_thread, &rows.pool] {
+            assert_positive("ms_per_epoch", row.ms_per_epoch);
+            assert_positive("times_faster_than_real_time", row.times_faster_than_real_time);
+            // The slowest epoch is at least the mean (ms_per_epoch is the mean).
+            assert!(row.slowest_epoch_ms >= row.ms_per_epoch * (1.0 - 1e-9), "{row:?}");
+            assert_eq!(row.target_met, row.ms_per_epoch < bench.target_ms_per_epoch, "{row:?}");
+            // Real time over the measured time, by definition (to rounding).
+            assert!(
+                (row.times_faster_than_real_time * row.ms_per_epoch - bench.epoch_ms).abs() < 1e-6 * bench.epoch_ms
+            );
+        }
+        assert!((rows.speed_up - rows.one_thread.ms_per_epoch / rows.pool.ms_per_epoch).abs() < 1e-9 * rows.speed_up);
     }
-    assert_positive("speed_up", bench.speed_up);
-    assert_eq!(bench.target_met(), bench.pool.target_met);
+    // No row at the target's particle count: the target is not met.
+    assert!(!bench.target_met());
     let text = slam::markdown(&bench);
     assert!(text.starts_with("`mmtrack bench slam`: the SLAM filter"), "{text}");
-    assert!(text.contains("\n| 1 | ") && text.contains("\n| 2 | "), "{text}");
+    assert!(
+        text.contains("\n| 50 | 1 | ") && text.contains("\n| 50 | 2 | ") && text.contains("\n| 120 | 2 | "),
+        "{text}"
+    );
+    assert!(!text.contains("**target**"), "{text}");
+
+    let error = slam::run(&slam::SlamBenchOptions { particles: Vec::new(), ..options }).unwrap_err();
+    assert!(error.to_string().contains("particle"), "{error}");
 }
 
 #[test]
@@ -157,12 +173,17 @@ fn bench_ingest_and_odometry_run_on_a_small_simulated_oxford_folder() {
         assert_positive("ratio_to_decode_only", row.ratio_to_decode_only);
         assert!(row.filter_ms_per_scan >= 0.0 && row.register_ms_per_scan >= 0.0, "{row:?}");
         assert_eq!(row.target_met, row.scans_per_s >= bench.target_scans_per_s, "{row:?}");
+        let ratio_met = row.ratio_to_decode_only >= odometry::CFEAR_TARGET_RATIO_TO_DECODE_ONLY;
+        let expected = (row.preset == odometry::RATIO_TARGET_PRESET).then_some(ratio_met);
+        assert_eq!(row.ratio_target_met, expected, "{row:?}");
     }
+    assert_eq!(bench.presets.iter().filter(|r| r.ratio_target_met.is_some()).count(), 1);
     let memory = &bench.memory;
     assert_eq!((memory.short_scans, memory.long_scans), (2, 8));
     assert_positive("growth_ratio", memory.growth_ratio);
     assert_eq!(memory.target_met, memory.growth_ratio <= memory.growth_limit);
-    assert_eq!(bench.target_met(), bench.presets.iter().all(|r| r.target_met) && memory.target_met);
+    let presets_met = bench.presets.iter().all(|r| r.target_met && r.ratio_target_met != Some(false));
+    assert_eq!(bench.target_met(), presets_met && memory.target_met);
     let text = odometry::markdown(&bench);
     assert_eq!(text.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| preset")).count(), presets.len());
     assert!(text.contains("\nMemory (`cfear`"), "{text}");
