@@ -164,33 +164,26 @@ impl Particles {
         self.chunks.par_iter().map(f).collect()
     }
 
-    // Which passes run in parallel: those with enough work per call to
-    // repay a fork-join, which on this 2-core VM costs some 20 us (the
-    // likelihood, the prediction, the resampling with its jitter, the
-    // weights' exponentials with the headings' sines and cosines, the
-    // covariance sums), one parallel region each. A pass of a few
-    // arithmetic operations per particle (maxima, sums, `absorb`,
-    // deviations) and the effective sample size stay on the calling
+    // Which passes run in parallel: only those with a transcendental
+    // function per particle (the exponentials of the weights, the heading's
+    // sine and cosine; the likelihood, the prediction and the jitter
+    // elsewhere), one parallel region each. A pass of a few arithmetic
+    // operations per particle (maxima, sums, `absorb`, deviations) takes a
+    // microsecond or two on one core for 2000 particles, less than handing
+    // work to another thread and waiting for it, so it stays on the calling
     // thread. Every sum runs over the particles in order, as one flat loop
     // would: the results are the same for any thread count.
 
     /// Effective sample size of `logw + delta * ll`: `(sum e)^2 / sum e^2`
-    /// with `e = exp(logw + delta ll - max)`, on the calling thread: the
-    /// bisection of the tempering calls it about ten times in a row, and a
-    /// parallel region per call (tried) cost more than it saved (2 threads,
-    /// 2000 particles: 1.04x over one thread with it, 1.40x without, at
-    /// real-time priority on this 2-core VM).
+    /// with `e = exp(logw + delta ll - max)`, the exponentials per chunk in
+    /// parallel.
     pub(crate) fn ess_with(&self, delta: f64) -> f64 {
         let max = self.fold_max(delta);
         if !max.is_finite() {
             return 0.0;
         }
-        let (s, s2) = self
-            .chunks
-            .iter()
-            .flat_map(|c| c.logw.iter().zip(&c.ll))
-            .map(|(w, l)| (w + delta * l - max).exp())
-            .fold((0.0, 0.0), |a, e| (a.0 + e, a.1 + e * e));
+        let e = self.per_chunk(|c| c.logw.iter().zip(&c.ll).map(|(w, l)| (w + delta * l - max).exp()).collect());
+        let (s, s2) = e.iter().flat_map(|v: &Vec<f64>| v.iter()).fold((0.0, 0.0), |a, &e| (a.0 + e, a.1 + e * e));
         if s2 > 0.0 { s * s / s2 } else { 0.0 }
     }
 
