@@ -8,7 +8,6 @@ use mmtrack_core::random::standard_normal;
 use mmtrack_core::slam::{PathMeasurement, SlamEpoch, SourceType, UeState};
 use mmtrack_core::wrap_angle_rad;
 use rand::RngExt;
-use rayon::prelude::*;
 
 use crate::association::associate;
 use crate::config::SlamConfig;
@@ -93,16 +92,6 @@ pub struct SlamFilter {
     initialised: bool,
     prior_mean: UeState,
     sigma_var: [f64; 5],
-}
-
-/// What one path does to its source, computed before any source changes.
-enum SourceUpdate {
-    /// Nothing (the base station, or the path that initialised the UE).
-    None,
-    /// The iterated EKF of a confirmed source (`None`: no update).
-    Ekf(Option<Gauss3>),
-    /// The VA and SP hypotheses of the path, for an unconfirmed or a new source.
-    Hypotheses((Option<Gauss3>, Option<Gauss3>)),
 }
 
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
@@ -298,49 +287,18 @@ impl SlamFilter {
         // by their two hypotheses.
         let post_mean = ue_of(&post.mean, self.particles.z_m);
         let pre_cov = meas_cov(&ue_now.cov);
-        // The update each path brings (an EKF of its confirmed source, or
-        // the hypotheses of an unconfirmed or new one) depends only on that
-        // source, the UE beliefs and the particles: the assignment gives
-        // each source at most one path, so they are computed in parallel,
-        // then applied in path order.
-        let updates: Vec<SourceUpdate> = assignment
-            .par_iter()
-            .enumerate()
-            .map(|(l, (column, _))| {
-                let z = &paths[l];
-                match *column {
-                    _ if Some(l) == init_path => SourceUpdate::None,
-                    Some(m) => match self.sources[m].status {
-                        SourceStatus::BaseStation => SourceUpdate::None,
-                        status @ (SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint) => {
-                            let kind = if status == SourceStatus::VirtualAnchor {
-                                SourceType::VirtualAnchor
-                            } else {
-                                SourceType::ScatteringPoint
-                            };
-                            SourceUpdate::Ekf(self.ekf_source(&self.sources[m].belief, kind, z, &ue_mean, &pre_cov))
-                        }
-                        SourceStatus::Unconfirmed => {
-                            SourceUpdate::Hypotheses(self.hypotheses_of(z, &post_mean, &weights))
-                        }
-                    },
-                    None => SourceUpdate::Hypotheses(self.hypotheses_of(z, &post_mean, &weights)),
-                }
-            })
-            .collect();
         let mut confirmed = Vec::new();
-        for ((l, (column, score)), update) in assignment.iter().enumerate().zip(updates) {
+        for (l, (column, score)) in assignment.iter().enumerate() {
+            let z = &paths[l];
             let decision = if Some(l) == init_path {
                 self.sources[0].sightings += 1;
                 self.sources[0].last_seen_epoch = k;
                 Decision::Initialisation
             } else if let Some(m) = *column {
-                self.observe_source(m, update, k, &mut confirmed);
+                self.observe_source(m, z, (&ue_mean, &pre_cov), &post_mean, &weights, k, &mut confirmed);
                 Decision::Source(self.sources[m].id)
             } else {
-                // A path without a source was given its hypotheses above.
-                let (va, sp) = if let SourceUpdate::Hypotheses(h) = update { h } else { (None, None) };
-                let id = self.create_source(va, sp, k);
+                let id = self.create_source(z, &post_mean, &weights, k);
                 Decision::NewSource(id)
             };
             associations.push(PathAssociation { path: path_index[l], decision, log_score: *score });
@@ -393,41 +351,36 @@ impl SlamFilter {
         let ue = ue_of(&prior.mean, self.particles.z_m);
         let p_s = meas_cov(&prior.cov);
         let log_pd = (self.config.detection_probability / (1.0 - self.config.detection_probability)).ln();
-        // Per source: its hypotheses as (weight, eta, S^-1, ln det S); the
-        // sources are independent (numerical Jacobians and a 5x5 inverse
-        // each), so they are predicted in parallel, collected in map order.
-        let predicted: Vec<Vec<Hypothesis>> = self
-            .sources
-            .par_iter()
-            .map(|source| {
-                let mut hyps = Vec::new();
-                let mut push = |w: f64, kind: SourceType, g: &Gauss3| {
-                    if let Some((eta, h_ue, h_src)) = jacobians(&ue, self.config.bs_m, kind, g.mean_m) {
-                        let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
-                        for i in 0..5 {
-                            s[(i, i)] += self.sigma_var[i];
-                        }
-                        if let Some((inv, log_det)) = spd_inverse(&s) {
-                            hyps.push((w, eta, to5(&inv), log_det));
-                        }
+        // Per source: its hypotheses as (weight, eta, S^-1, ln det S).
+        let mut predicted: Vec<Vec<Hypothesis>> = Vec::with_capacity(self.sources.len());
+        for source in &self.sources {
+            let mut hyps = Vec::new();
+            let mut push = |w: f64, kind: SourceType, g: &Gauss3| {
+                if let Some((eta, h_ue, h_src)) = jacobians(&ue, self.config.bs_m, kind, g.mean_m) {
+                    let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
+                    for i in 0..5 {
+                        s[(i, i)] += self.sigma_var[i];
                     }
-                };
-                match source.status {
-                    SourceStatus::BaseStation => push(1.0, SourceType::BaseStation, &source.belief),
-                    SourceStatus::VirtualAnchor => push(1.0, SourceType::VirtualAnchor, &source.belief),
-                    SourceStatus::ScatteringPoint => push(1.0, SourceType::ScatteringPoint, &source.belief),
-                    SourceStatus::Unconfirmed => {
-                        if let Some(h) = &source.hypotheses {
-                            push(0.5, SourceType::VirtualAnchor, &h.va_last);
-                            if let Some(sp) = &h.sp_last {
-                                push(0.5, SourceType::ScatteringPoint, sp);
-                            }
+                    if let Some((inv, log_det)) = spd_inverse(&s) {
+                        hyps.push((w, eta, to5(&inv), log_det));
+                    }
+                }
+            };
+            match source.status {
+                SourceStatus::BaseStation => push(1.0, SourceType::BaseStation, &source.belief),
+                SourceStatus::VirtualAnchor => push(1.0, SourceType::VirtualAnchor, &source.belief),
+                SourceStatus::ScatteringPoint => push(1.0, SourceType::ScatteringPoint, &source.belief),
+                SourceStatus::Unconfirmed => {
+                    if let Some(h) = &source.hypotheses {
+                        push(0.5, SourceType::VirtualAnchor, &h.va_last);
+                        if let Some(sp) = &h.sp_last {
+                            push(0.5, SourceType::ScatteringPoint, sp);
                         }
                     }
                 }
-                hyps
-            })
-            .collect();
+            }
+            predicted.push(hyps);
+        }
         let norm = 2.5 * std::f64::consts::TAU.ln();
         // Before the UE is initialised only the BS is in the map, and a wrong
         // LOS cannot be undone: the LOS must be the shortest path (triangle
@@ -590,18 +543,35 @@ impl SlamFilter {
         Ok(())
     }
 
-    /// A path from an existing source, with the update computed for it:
-    /// the iterated EKF of a confirmed source (the message from the UE is
-    /// its posterior, Gaussian), or the hypotheses of an unconfirmed one and
-    /// footnote 3's test.
-    fn observe_source(&mut self, m: usize, update: SourceUpdate, k: usize, confirmed: &mut Vec<u64>) {
-        match (self.sources[m].status, update) {
-            (SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint, SourceUpdate::Ekf(ekf)) => {
-                if let Some(g) = ekf {
+    /// A path from an existing source: the iterated EKF of a confirmed
+    /// source (the message from the UE is its posterior, Gaussian), or the
+    /// hypotheses of an unconfirmed one and footnote 3's test.
+    #[allow(clippy::too_many_arguments)]
+    fn observe_source(
+        &mut self,
+        m: usize,
+        z: &PathMeasurement,
+        (ue_prior, p_prior): (&UeState, &Mat<f64>),
+        ue: &UeState,
+        weights: &[f64],
+        k: usize,
+        confirmed: &mut Vec<u64>,
+    ) {
+        let status = self.sources[m].status;
+        match status {
+            SourceStatus::BaseStation => {}
+            SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint => {
+                let kind = if status == SourceStatus::VirtualAnchor {
+                    SourceType::VirtualAnchor
+                } else {
+                    SourceType::ScatteringPoint
+                };
+                if let Some(g) = self.ekf_source(&self.sources[m].belief, kind, z, ue_prior, p_prior) {
                     self.sources[m].belief = g;
                 }
             }
-            (SourceStatus::Unconfirmed, SourceUpdate::Hypotheses((va, sp))) => {
+            SourceStatus::Unconfirmed => {
+                let (va, sp) = self.hypotheses_of(z, ue, weights);
                 let c = &self.config;
                 let (ratio, min_drift, min_sightings) = (c.confirm_ratio, c.confirm_min_drift, c.confirm_min_sightings);
                 let source = &mut self.sources[m];
@@ -628,8 +598,6 @@ impl SlamFilter {
                     }
                 }
             }
-            // The base station, and no other pairing: the update was made for this status.
-            _ => {}
         }
         let source = &mut self.sources[m];
         source.sightings += 1;
@@ -755,10 +723,10 @@ impl SlamFilter {
         (finish(&acc[0], 0), finish(&acc[1], 1))
     }
 
-    /// A new source from a path's hypotheses ([`SlamFilter::hypotheses_of`]).
-    fn create_source(&mut self, va: Option<Gauss3>, sp: Option<Gauss3>, k: usize) -> u64 {
+    fn create_source(&mut self, z: &PathMeasurement, ue: &UeState, weights: &[f64], k: usize) -> u64 {
         let id = self.next_id;
         self.next_id += 1;
+        let (va, sp) = self.hypotheses_of(z, ue, weights);
         let Some(va) = va else { return id };
         let h = Hypotheses::new(va, sp);
         self.sources.push(MapSource {

@@ -42,7 +42,6 @@ impl Chunk {
         self.x.len()
     }
 
-    #[inline]
     fn get(&self, i: usize) -> [f64; STATE_DIM] {
         [self.x[i], self.y[i], self.heading[i], self.speed[i], self.turn[i], self.bias[i]]
     }
@@ -270,26 +269,17 @@ impl Particles {
             }
         }
         mean[2] = wrap_angle_rad(mean[2] + heading);
-        // The 21 sums of the upper triangle in two groups of rows (11 and
-        // 10 entries), each summed over the particles in order, side by side.
-        let rows = |first: usize, end: usize| {
-            let mut sums = [[0.0; STATE_DIM]; STATE_DIM];
-            for (s, wi) in self.states().zip(&w) {
-                let d: [f64; STATE_DIM] =
-                    std::array::from_fn(|k| if k == 2 { wrap_angle_rad(s[2] - mean[2]) } else { s[k] - mean[k] });
-                for a in first..end {
-                    for b in a..STATE_DIM {
-                        sums[a][b] += wi * d[a] * d[b];
-                    }
+        let mut cov = [[0.0; STATE_DIM]; STATE_DIM];
+        for (s, wi) in self.states().zip(&w) {
+            let d: [f64; STATE_DIM] =
+                std::array::from_fn(|k| if k == 2 { wrap_angle_rad(s[2] - mean[2]) } else { s[k] - mean[k] });
+            for a in 0..STATE_DIM {
+                for b in a..STATE_DIM {
+                    cov[a][b] += wi * d[a] * d[b];
                 }
             }
-            sums
-        };
-        let (upper, lower) = rayon::join(|| rows(0, 2), || rows(2, STATE_DIM));
-        let cov = Mat::from_fn(STATE_DIM, STATE_DIM, |a, b| {
-            let (a, b) = (a.min(b), a.max(b));
-            if a < 2 { upper[a][b] } else { lower[a][b] }
-        });
+        }
+        let cov = Mat::from_fn(STATE_DIM, STATE_DIM, |a, b| cov[a.min(b)][a.max(b)]);
         (Moments { mean, cov }, w)
     }
 
