@@ -281,7 +281,8 @@ impl SlamFilter {
             }
         }
         let stages = self.update_particles(&prepared, k)?;
-        let (post, weights) = self.particles.moments_and_weights();
+        let post = self.particles.moments();
+        let weights = self.particles.weights();
 
         // Sources: confirmed ones by an iterated EKF, unconfirmed and new ones
         // by their two hypotheses.
@@ -536,10 +537,10 @@ impl SlamFilter {
     }
 
     fn regularised_resample(&mut self, h: f64, k: usize, stage: usize) -> Result<(), SlamError> {
-        let (m, weights) = self.particles.moments_and_weights();
+        let m = self.particles.moments();
         let l = cholesky_lower(&m.cov, 1e-12)
             .ok_or(SlamError::NotPositiveDefinite { epoch: k, what: "particle covariance" })?;
-        self.particles.resample(&weights, Some(&l), h, self.seed, [k as u64, stage as u64]);
+        self.particles.resample(Some(&l), h, self.seed, [k as u64, stage as u64]);
         Ok(())
     }
 
