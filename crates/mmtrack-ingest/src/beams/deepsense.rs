@@ -51,11 +51,13 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use mmtrack_core::plausible::{LATITUDE_DEG, LONGITUDE_DEG};
 use mmtrack_core::{BeamSweep, GnssFix, GnssFixQuality};
 use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{IoError, Overwrite, RecordingOptions, RecordingWriter};
 
 use crate::cir::{NpyMatrix, NpyValues, read_npy_matrix};
+use crate::error::check_plausible;
 use crate::{IngestError, Progress};
 
 /// Which of the car's positions a recording carries.
@@ -256,23 +258,9 @@ fn positions(path: &Path, what: &str) -> Result<(usize, Vec<[f64; 2]>), IngestEr
     let rows = matrix.rows;
     let values = floats(path, matrix, Some(2), what)?;
     let pairs: Vec<[f64; 2]> = values.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
-    for (row, [lat, lon]) in pairs.iter().enumerate() {
-        if !(lat.is_finite() && lat.abs() <= 90.0) {
-            return Err(bad(
-                path,
-                format!("row {row}"),
-                "latitude (column 0)",
-                format!("{lat}, expected degrees in [-90, 90]"),
-            ));
-        }
-        if !(lon.is_finite() && lon.abs() <= 180.0) {
-            return Err(bad(
-                path,
-                format!("row {row}"),
-                "longitude (column 1)",
-                format!("{lon}, expected degrees in [-180, 180]"),
-            ));
-        }
+    for (row, &[lat, lon]) in pairs.iter().enumerate() {
+        check_plausible(path, || format!("row {row}"), "latitude (column 0)", &LATITUDE_DEG, lat)?;
+        check_plausible(path, || format!("row {row}"), "longitude (column 1)", &LONGITUDE_DEG, lon)?;
     }
     Ok((rows, pairs))
 }

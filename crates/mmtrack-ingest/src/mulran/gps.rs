@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use mmtrack_core::plausible::ALTITUDE_M;
+use mmtrack_core::plausible::{ALTITUDE_M, LATITUDE_DEG, LONGITUDE_DEG};
 use mmtrack_core::{GnssFix, GnssFixQuality};
 
 use crate::IngestError;
@@ -66,17 +66,10 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
                 .filter(|v| v.is_finite())
                 .ok_or_else(|| bad(path, number, name, format!("'{}' is not a finite number", fields[i])))
         };
-        let (latitude_deg, longitude_deg) = (value(1, NAMES[1])?, value(2, NAMES[2])?);
-        if !(-90.0..=90.0).contains(&latitude_deg) || !(-180.0..=180.0).contains(&longitude_deg) {
-            return Err(bad(
-                path,
-                number,
-                "latitude/longitude",
-                format!("({latitude_deg}, {longitude_deg}) is not a geodetic position in degrees"),
-            ));
-        }
-        let altitude_m =
-            check_plausible(path, || format!("line {number}"), NAMES[3], &ALTITUDE_M, value(3, NAMES[3])?)?;
+        let record = || format!("line {number}");
+        let latitude_deg = check_plausible(path, record, NAMES[1], &LATITUDE_DEG, value(1, NAMES[1])?)?;
+        let longitude_deg = check_plausible(path, record, NAMES[2], &LONGITUDE_DEG, value(2, NAMES[2])?)?;
+        let altitude_m = check_plausible(path, record, NAMES[3], &ALTITUDE_M, value(3, NAMES[3])?)?;
         let mut covariance = [0.0; 9];
         for (k, c) in covariance.iter_mut().enumerate() {
             *c = value(4 + k, &format!("covariance[{k}]"))?;
@@ -135,7 +128,7 @@ mod tests {
         let backwards = err(&format!("{ROW}\n{ROW}\n"));
         assert!(backwards.contains("line 2") && backwards.contains("does not increase"), "{backwards}");
         let radians = err("5,0.65,2.2,82.5,0,0,0,0,0,0,0,0,0\n6,91,2.2,82.5,0,0,0,0,0,0,0,0,0\n");
-        assert!(radians.contains("line 2") && radians.contains("not a geodetic position"), "{radians}");
+        assert!(radians.contains("line 2: latitude: 91 is not a latitude within [-90, 90] deg"), "{radians}");
         for empty in ["", "\n \n"] {
             let message = err(empty);
             assert!(message.contains("gps.csv") && message.contains("no fixes"), "{message}");
