@@ -313,7 +313,8 @@ fn run_chunk(
             let beams = ekf.predict(&poses[k]).with_context(|| format!("run {run_index}"))?;
             let pilot = link.pilot(k, beams.rx_steer_u, beams.tx_steer_u, realisation.noise[k]);
             let deviation = ekf.update(pilot).with_context(|| format!("run {run_index}"))?;
-            for (sums, e) in chunk.sum_squared_before_reset.iter_mut().zip(estimate_errors(&ekf.estimate(), slot)) {
+            let errors_before_reset = estimate_errors(&ekf.estimate(), slot);
+            for (sums, e) in chunk.sum_squared_before_reset.iter_mut().zip(errors_before_reset) {
                 sums[k] += e * e;
             }
             let reinitialised = if let Deviation::Exceeded { gain, aod, aoa } = deviation {
@@ -328,7 +329,8 @@ fn run_chunk(
                 false
             };
             let estimate = ekf.estimate();
-            for (sums, e) in chunk.sum_squared.iter_mut().zip(estimate_errors(&estimate, slot)) {
+            let errors = if reinitialised { estimate_errors(&estimate, slot) } else { errors_before_reset };
+            for (sums, e) in chunk.sum_squared.iter_mut().zip(errors) {
                 sums[k] += e * e;
             }
             if keep {
