@@ -10,6 +10,7 @@
 
 mod analyze;
 mod bench;
+mod check;
 mod demo;
 mod export;
 mod ingest;
@@ -68,6 +69,8 @@ enum Command {
     Export(export::ExportArgs),
     /// Re-run a paper's experiment and compare with its published numbers.
     Reproduce(reproduce::ReproduceArgs),
+    /// Run a dataset regression suite: its steps on your fixtures, its metrics against their expectations.
+    Check(check::CheckArgs),
     /// Show what a recording (.mcap, including ROS 2 bags) or a table directory contains.
     Inspect(inspect::InspectArgs),
     /// Run the whole chain on the embedded demo data and print where the outputs are.
@@ -137,6 +140,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Analyze(args) => analyze::run(&args, quiet),
         Command::Export(args) => export::run(&args, quiet),
         Command::Reproduce(args) => reproduce::run(&args, quiet),
+        Command::Check(args) => check::run(&args, quiet),
         Command::Inspect(args) => inspect::run(&args, quiet),
         Command::Demo(args) => demo::run(&args, quiet),
         Command::Schemas { write, check } => schemas(write, check, quiet),

@@ -26,6 +26,8 @@
 //!   [`zoechmann`], [`kim`]: the experiments, one folder each
 //!   (`config <- run <- report`, and `mod.rs` with `run()`);
 //! - [`all`]: every experiment in one call, checked against its expectations;
+//! - [`suite`]: dataset regression suites (`mmtrack check`): a user's own steps and
+//!   metrics checked with the same expectation model;
 //! - [`bench`]: the benchmarks of `mmtrack bench`, speed as ratios to same-run baselines;
 //! - [`common`], [`readme_block`]: output directories, experiment files,
 //!   trajectories, README blocks.
@@ -42,6 +44,7 @@ pub mod readme_block;
 pub mod request;
 pub mod shaham;
 pub mod spebt;
+pub mod suite;
 pub mod zoechmann;
 
 pub use model::{Claim, Metric, Outcome, ReadmeBlock, Rule, RunOptions, Tier, Verdict};

@@ -7,7 +7,9 @@ fn help_explains_every_subcommand() {
     let out = mmtrack(&root(), &["--help"]);
     assert!(out.status.success());
     let (stdout, _) = text(&out);
-    for sub in ["ingest", "simulate", "process", "analyze", "reproduce", "inspect", "demo", "bench", "Exit codes"] {
+    for sub in
+        ["ingest", "simulate", "process", "analyze", "reproduce", "check", "inspect", "demo", "bench", "Exit codes"]
+    {
         assert!(stdout.contains(sub), "--help lacks {sub}:\n{stdout}");
     }
 }

@@ -8,6 +8,7 @@ mod architecture;
 mod bad_png;
 mod bench_mpc;
 mod bounds;
+mod check;
 mod cli;
 mod common;
 mod doc_links;
