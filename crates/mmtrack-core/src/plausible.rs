@@ -104,10 +104,12 @@ pub fn check_rotation(r: &[[f64; 3]; 3]) -> Result<(), String> {
         for j in 0..3 {
             let dot: f64 = (0..3).map(|k| r[k][i] * r[k][j]).sum();
             let identity = if i == j { 1.0 } else { 0.0 };
-            worst = worst.max((dot - identity).abs());
+            // NaN (entries so large that their products overflow) counts as the worst.
+            let deviation = (dot - identity).abs();
+            worst = if deviation.is_nan() { f64::INFINITY } else { worst.max(deviation) };
         }
     }
-    if !(worst <= ROTATION_ORTHONORMAL_TOLERANCE) {
+    if worst > ROTATION_ORTHONORMAL_TOLERANCE {
         return Err(format!(
             "the rotation is not orthonormal: R^T R differs from the identity by {worst:.3e} \
              (at most {ROTATION_ORTHONORMAL_TOLERANCE:e} for a rotation written out)"

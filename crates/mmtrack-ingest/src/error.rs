@@ -69,6 +69,14 @@ pub enum IngestError {
     Io(#[from] mmtrack_io::IoError),
 }
 
+impl IngestError {
+    /// [`IngestError::BadRecord`] of a text file's line `line` (1-based).
+    #[must_use]
+    pub fn bad_line(path: &std::path::Path, line: usize, field: &str, detail: String) -> Self {
+        Self::BadRecord { path: path.to_path_buf(), record: format!("line {line}"), field: field.into(), detail }
+    }
+}
+
 pub(crate) fn os_err(path: &std::path::Path) -> impl FnOnce(std::io::Error) -> IngestError + '_ {
     move |source| IngestError::Os { path: path.to_path_buf(), source }
 }

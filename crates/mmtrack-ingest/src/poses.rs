@@ -149,10 +149,6 @@ fn no_poses(path: &Path, what: &str) -> IngestError {
     IngestError::BadLayout { path: path.to_path_buf(), detail: format!("no poses ({what})") }
 }
 
-fn bad(path: &Path, line: usize, field: &str, detail: String) -> IngestError {
-    IngestError::BadRecord { path: path.to_path_buf(), record: format!("line {line}"), field: field.into(), detail }
-}
-
 /// Decimal seconds (`"1305031102.175304"`) to nanoseconds, exactly.
 #[must_use]
 pub fn decimal_seconds_to_ns(text: &str) -> Option<i64> {
@@ -171,7 +167,12 @@ pub fn decimal_seconds_to_ns(text: &str) -> Option<i64> {
 fn numbers<const N: usize>(path: &Path, line: usize, text: &str, names: &[&str; N]) -> Result<[f64; N], IngestError> {
     let fields: Vec<&str> = text.split_whitespace().collect();
     if fields.len() != N {
-        return Err(bad(path, line, "columns", format!("{} values, expected {N} ({})", fields.len(), names.join(" "))));
+        return Err(IngestError::bad_line(
+            path,
+            line,
+            "columns",
+            format!("{} values, expected {N} ({})", fields.len(), names.join(" ")),
+        ));
     }
     let mut out = [0.0; N];
     for (i, (field, name)) in fields.iter().zip(names).enumerate() {
@@ -179,7 +180,7 @@ fn numbers<const N: usize>(path: &Path, line: usize, text: &str, names: &[&str; 
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| bad(path, line, name, format!("'{field}' is not a finite number")))?;
+            .ok_or_else(|| IngestError::bad_line(path, line, name, format!("'{field}' is not a finite number")))?;
     }
     Ok(out)
 }
@@ -199,9 +200,12 @@ fn yaw_from_quaternion(q: [f64; 4]) -> f64 {
 
 fn check_increasing(path: &Path, poses: &[StampedPose], line: usize, t_ns: i64) -> Result<(), IngestError> {
     match poses.last() {
-        Some(previous) if t_ns <= previous.t_ns => {
-            Err(bad(path, line, "timestamp", format!("{t_ns} ns does not increase (previous {} ns)", previous.t_ns)))
-        }
+        Some(previous) if t_ns <= previous.t_ns => Err(IngestError::bad_line(
+            path,
+            line,
+            "timestamp",
+            format!("{t_ns} ns does not increase (previous {} ns)", previous.t_ns),
+        )),
         _ => Ok(()),
     }
 }
@@ -218,14 +222,15 @@ pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPos
             continue;
         }
         let stamp = line.split_whitespace().next().unwrap_or("");
-        let t_ns = decimal_seconds_to_ns(stamp)
-            .ok_or_else(|| bad(path, line_number, "timestamp", format!("'{stamp}' is not decimal seconds")))?;
+        let t_ns = decimal_seconds_to_ns(stamp).ok_or_else(|| {
+            IngestError::bad_line(path, line_number, "timestamp", format!("'{stamp}' is not decimal seconds"))
+        })?;
         let rest = line[stamp.len()..].trim();
         let [tx, ty, tz, qx, qy, qz, qw] =
             numbers(path, line_number, rest, &["tx", "ty", "tz", "qx", "qy", "qz", "qw"])?;
         check_position(path, line_number, ["tx", "ty", "tz"], [tx, ty, tz])?;
-        let [qx, qy, qz, qw] =
-            unit_quaternion([qx, qy, qz, qw]).map_err(|detail| bad(path, line_number, "qx qy qz qw", detail))?;
+        let [qx, qy, qz, qw] = unit_quaternion([qx, qy, qz, qw])
+            .map_err(|detail| IngestError::bad_line(path, line_number, "qx qy qz qw", detail))?;
         let pose = match plane {
             Plane::Xy => Se2::new(tx, ty, yaw_from_quaternion([qx, qy, qz, qw])),
             Plane::XzCamera => {
@@ -265,10 +270,15 @@ pub fn parse_times(path: &Path, text: &str, t0_ns: i64) -> Result<Vec<i64>, Inge
                     .map(|s| (s * 1e9).round() as i64)
             })
             .ok_or_else(|| {
-                bad(path, index + 1, "time", format!("'{raw}' is not non-negative seconds below {MAX_SECONDS:e}"))
+                IngestError::bad_line(
+                    path,
+                    index + 1,
+                    "time",
+                    format!("'{raw}' is not non-negative seconds below {MAX_SECONDS:e}"),
+                )
             })?;
         let t_ns = time_ns.checked_add(t0_ns).ok_or_else(|| {
-            bad(
+            IngestError::bad_line(
                 path,
                 index + 1,
                 "t0_ns (--t0-ns)",
@@ -291,9 +301,14 @@ pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> R
         let [r11, r12, r13, tx, r21, r22, r23, ty, r31, r32, r33, tz] = numbers(path, line_number, line, &names)?;
         check_position(path, line_number, ["tx", "ty", "tz"], [tx, ty, tz])?;
         plausible::check_rotation(&[[r11, r12, r13], [r21, r22, r23], [r31, r32, r33]])
-            .map_err(|detail| bad(path, line_number, "r11..r33", detail))?;
+            .map_err(|detail| IngestError::bad_line(path, line_number, "r11..r33", detail))?;
         let t_ns = *times_ns.get(poses.len()).ok_or_else(|| {
-            bad(path, line_number, "time", format!("the times file has only {} lines for more poses", times_ns.len()))
+            IngestError::bad_line(
+                path,
+                line_number,
+                "time",
+                format!("the times file has only {} lines for more poses", times_ns.len()),
+            )
         })?;
         let pose = match plane {
             Plane::Xy => Se2::new(tx, ty, r21.atan2(r11)),

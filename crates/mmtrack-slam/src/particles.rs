@@ -64,6 +64,13 @@ pub(crate) struct PreparedPath {
     pub(crate) information: [[f64; 5]; 5],
 }
 
+/// `logw + delta * ll`, the tempered log-weight of one stage; `logw` alone
+/// at `delta = 0`, also where `ll` is `-inf` (a particle no path can come
+/// from), where `0 * -inf` would make it NaN.
+fn tempered(logw: f64, ll: f64, delta: f64) -> f64 {
+    if delta == 0.0 { logw } else { logw + delta * ll }
+}
+
 /// The particle set.
 #[derive(Debug, Clone)]
 pub(crate) struct Particles {
@@ -169,7 +176,7 @@ impl Particles {
             .iter()
             .flat_map(|c| c.logw.iter().zip(&c.ll))
             .map(|(w, l)| {
-                let e = (w + delta * l - max).exp();
+                let e = (tempered(*w, *l, delta) - max).exp();
                 (e, e * e)
             })
             .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
@@ -180,7 +187,7 @@ impl Particles {
         self.chunks
             .iter()
             .flat_map(|c| c.logw.iter().zip(&c.ll))
-            .map(|(w, l)| if delta == 0.0 { *w } else { w + delta * l })
+            .map(|(w, l)| tempered(*w, *l, delta))
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
@@ -188,7 +195,7 @@ impl Particles {
     pub(crate) fn absorb(&mut self, delta: f64) {
         for c in &mut self.chunks {
             for (w, l) in c.logw.iter_mut().zip(&c.ll) {
-                *w += delta * l;
+                *w = tempered(*w, *l, delta);
             }
         }
         let max = self.fold_max(0.0);
@@ -295,5 +302,29 @@ impl Particles {
                 chunk.logw[i] = 0.0;
             }
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Three equal weights; one particle no path can come from (`ll = -inf`).
+    fn three() -> Particles {
+        let mut chunk = Chunk::with_len(3);
+        chunk.ll = vec![f64::NEG_INFINITY, -1.0, -1.0];
+        Particles { chunks: vec![chunk], z_m: 0.0, n: 3, chunk_size: 3 }
+    }
+
+    #[test]
+    fn a_particle_with_minus_infinite_likelihood_keeps_the_untempered_ess() {
+        let particles = three();
+        // Untempered: three equal weights, ESS 3 (it was NaN: 0 * -inf).
+        assert_eq!(particles.ess_with(0.0), 3.0);
+        // Tempered: the -inf particle drops out, two equal weights remain.
+        assert_eq!(particles.ess_with(0.5), 2.0);
+        let mut absorbed = particles.clone();
+        absorbed.absorb(0.0);
+        assert_eq!(absorbed.chunks[0].logw, [0.0, 0.0, 0.0]);
     }
 }

@@ -32,12 +32,7 @@ const INDEX_COLUMNS: [&str; 5] = ["t_ns", "set_index", "snapshot_index", "tx_ant
 
 /// Parses CSV text into snapshots (see the module docs).
 pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Result<Vec<CirSnapshot>, IngestError> {
-    let bad = |line: usize, field: &str, detail: String| IngestError::BadRecord {
-        path: path.to_path_buf(),
-        record: format!("line {line}"),
-        field: field.into(),
-        detail,
-    };
+    let bad = |line: usize, field: &str, detail: String| IngestError::bad_line(path, line, field, detail);
     let mut lines = crate::csv::without_bom(text)
         .lines()
         .enumerate()

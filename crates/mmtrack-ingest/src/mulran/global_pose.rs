@@ -28,39 +28,33 @@ pub struct GlobalPoses {
 
 const NAMES: [&str; 13] = ["t_ns", "r11", "r12", "r13", "tx", "r21", "r22", "r23", "ty", "r31", "r32", "r33", "tz"];
 
-fn bad(path: &Path, line: usize, field: &str, detail: String) -> IngestError {
-    IngestError::BadRecord { path: path.to_path_buf(), record: format!("line {line}"), field: field.into(), detail }
-}
-
 /// Parses one line into its time and 12 matrix entries.
 fn parse_line(path: &Path, line: usize, text: &str) -> Result<(i64, [f64; 12]), IngestError> {
     let fields: Vec<&str> = text.split(',').map(str::trim).collect();
     if fields.len() != NAMES.len() {
-        return Err(bad(
+        return Err(IngestError::bad_line(
             path,
             line,
             "columns",
             format!("{} values, expected 13 (t_ns and a 3x4 row-major pose matrix)", fields.len()),
         ));
     }
-    let t_ns = fields[0]
-        .parse::<i64>()
-        .ok()
-        .filter(|t| *t > 0)
-        .ok_or_else(|| bad(path, line, "t_ns", format!("'{}' is not a nanosecond UNIX timestamp", fields[0])))?;
+    let t_ns = fields[0].parse::<i64>().ok().filter(|t| *t > 0).ok_or_else(|| {
+        IngestError::bad_line(path, line, "t_ns", format!("'{}' is not a nanosecond UNIX timestamp", fields[0]))
+    })?;
     let mut m = [0.0; 12];
     for (k, (value, name)) in fields[1..].iter().zip(&NAMES[1..]).enumerate() {
         m[k] = value
             .parse::<f64>()
             .ok()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| bad(path, line, name, format!("'{value}' is not a finite number")))?;
+            .ok_or_else(|| IngestError::bad_line(path, line, name, format!("'{value}' is not a finite number")))?;
     }
     for k in [3, 7, 11] {
         check_plausible(path, || format!("line {line}"), NAMES[k + 1], &COORDINATE_M, m[k])?;
     }
     plausible::check_rotation(&[[m[0], m[1], m[2]], [m[4], m[5], m[6]], [m[8], m[9], m[10]]])
-        .map_err(|detail| bad(path, line, "rotation", detail))?;
+        .map_err(|detail| IngestError::bad_line(path, line, "rotation", detail))?;
     Ok((t_ns, m))
 }
 
@@ -74,7 +68,7 @@ pub fn parse_global_pose(path: &Path, text: &str) -> Result<GlobalPoses, IngestE
         if let Some(previous) = poses.last()
             && t_ns <= previous.t_ns
         {
-            return Err(bad(
+            return Err(IngestError::bad_line(
                 path,
                 line,
                 "t_ns",
@@ -83,7 +77,7 @@ pub fn parse_global_pose(path: &Path, text: &str) -> Result<GlobalPoses, IngestE
         }
         let (r11, r21) = (m[0], m[4]);
         if !(0.5..=1.5).contains(&r11.hypot(r21)) {
-            return Err(bad(
+            return Err(IngestError::bad_line(
                 path,
                 line,
                 "r11/r21",

@@ -22,10 +22,6 @@ const FIELDS: usize = 13;
 /// Field names, for errors.
 const NAMES: [&str; 4] = ["timestamp", "latitude", "longitude", "altitude"];
 
-fn bad(path: &Path, line: usize, field: &str, detail: String) -> IngestError {
-    IngestError::BadRecord { path: path.to_path_buf(), record: format!("line {line}"), field: field.into(), detail }
-}
-
 /// Parses `gps.csv` text. Times must increase strictly; an empty file is an
 /// error.
 pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestError> {
@@ -34,7 +30,7 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
         let number = index + 1;
         let fields: Vec<&str> = line.split(',').map(str::trim).collect();
         if fields.len() != FIELDS {
-            return Err(bad(
+            return Err(IngestError::bad_line(
                 path,
                 number,
                 "line",
@@ -44,15 +40,13 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
                 ),
             ));
         }
-        let t_ns = fields[0]
-            .parse::<i64>()
-            .ok()
-            .filter(|t| *t > 0)
-            .ok_or_else(|| bad(path, number, NAMES[0], format!("'{}' is not a nanosecond UNIX time", fields[0])))?;
+        let t_ns = fields[0].parse::<i64>().ok().filter(|t| *t > 0).ok_or_else(|| {
+            IngestError::bad_line(path, number, NAMES[0], format!("'{}' is not a nanosecond UNIX time", fields[0]))
+        })?;
         if let Some(previous) = fixes.last()
             && t_ns <= previous.t_ns
         {
-            return Err(bad(
+            return Err(IngestError::bad_line(
                 path,
                 number,
                 NAMES[0],
@@ -60,11 +54,9 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
             ));
         }
         let value = |i: usize, name: &str| {
-            fields[i]
-                .parse::<f64>()
-                .ok()
-                .filter(|v| v.is_finite())
-                .ok_or_else(|| bad(path, number, name, format!("'{}' is not a finite number", fields[i])))
+            fields[i].parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+                IngestError::bad_line(path, number, name, format!("'{}' is not a finite number", fields[i]))
+            })
         };
         let record = || format!("line {number}");
         let latitude_deg = check_plausible(path, record, NAMES[1], &LATITUDE_DEG, value(1, NAMES[1])?)?;
@@ -76,7 +68,12 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
         }
         let horizontal = (covariance[0] + covariance[4]) / 2.0;
         if horizontal < 0.0 {
-            return Err(bad(path, number, "covariance", format!("negative horizontal variance {horizontal} m^2")));
+            return Err(IngestError::bad_line(
+                path,
+                number,
+                "covariance",
+                format!("negative horizontal variance {horizontal} m^2"),
+            ));
         }
         fixes.push(GnssFix {
             t_ns,

@@ -478,7 +478,7 @@ pub fn process_sweeps(
             name: site.name.clone(),
             passes: site.passes.len(),
             sweeps: site.passes.iter().map(|p| p.sweeps.len()).sum(),
-            map: site.maps.as_ref().map(|m| m.all.clone()),
+            map: site.maps.as_ref().map(|m| m.all),
         })
         .collect();
     Ok(SweepOutput { sites, summaries, written, dir: out.path })

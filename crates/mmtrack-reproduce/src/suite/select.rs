@@ -149,9 +149,12 @@ fn subdirectories(dir: &Path) -> Vec<String> {
     names
 }
 
-/// Every `*.parquet` under `dir` with the `key=value` partitions of its
-/// path, in path order. Hidden entries (partials being written) are skipped.
-fn parquet_files(dir: &Path) -> anyhow::Result<Vec<(Vec<(String, String)>, PathBuf)>> {
+/// The `key=value` folders of a file's path, outermost first.
+type Partitions = Vec<(String, String)>;
+
+/// Every `*.parquet` under `dir` with the partitions of its path, in path
+/// order. Hidden entries (partials being written) are skipped.
+fn parquet_files(dir: &Path) -> anyhow::Result<Vec<(Partitions, PathBuf)>> {
     let mut out = Vec::new();
     let mut stack = vec![(Vec::new(), dir.to_path_buf())];
     while let Some((partitions, d)) = stack.pop() {
@@ -167,7 +170,7 @@ fn parquet_files(dir: &Path) -> anyhow::Result<Vec<(Vec<(String, String)>, PathB
             }
             let path = entry.path();
             if path.is_dir() {
-                let mut inner: Vec<(String, String)> = partitions.clone();
+                let mut inner: Partitions = partitions.clone();
                 if let Some((key, value)) = name.split_once('=') {
                     inner.push((key.to_string(), value.to_string()));
                 }
