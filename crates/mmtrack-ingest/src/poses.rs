@@ -357,7 +357,7 @@ pub fn write_poses(
         recording,
     )?;
     for pose in poses {
-        writer.write_pose(stream, pose, "world", "vehicle")?;
+        writer.write_pose(stream, pose, "world")?;
     }
     Ok(writer.finish()?)
 }

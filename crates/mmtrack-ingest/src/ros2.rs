@@ -222,8 +222,7 @@ impl Sink<'_> {
                 Ok(d) => d,
                 Err(e) => return Ok(Err(e)),
             };
-            let child = if decoded.child_frame_id.is_empty() { "vehicle" } else { decoded.child_frame_id.as_str() };
-            self.writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id, child)?;
+            self.writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id)?;
             self.poses += 1;
         } else if topics.gnss_topic.as_deref() == Some(topic) {
             match decode_nav_sat_fix(data) {

@@ -259,7 +259,7 @@ define_message! {
     "A planar rigid transform parent_from_child (SE(2)) valid at t_ns: p_parent = R(yaw) p_child + (x, y).";
     required int64 t_ns = 1, "ns", "time of validity, nanoseconds since the UNIX epoch (or scenario start)";
     required string parent_frame = 2, "", "frame the pose is expressed in, e.g. world";
-    required string child_frame = 3, "", "frame being located, e.g. vehicle or radar";
+    required string child_frame = 3, "", "frame being located: base_link (ground truth), estimate, tx or rx, the frame /tf moves";
     required double x_m = 4, "m", "translation along the parent x axis";
     required double y_m = 5, "m", "translation along the parent y axis";
     required double yaw_rad = 6, "rad", "rotation about z, counter-clockwise positive";

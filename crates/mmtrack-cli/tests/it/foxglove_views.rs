@@ -34,11 +34,13 @@ from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 
 path = sys.argv[1]
-counts, parents, cartesian = {}, {}, 0
+counts, parents, cartesian, static, pose_children, tf_children = {}, {}, 0, [], {}, set()
 with open(path, "rb") as f:
     reader = make_reader(f, decoder_factories=[DecoderFactory()])
     metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
     for schema, channel, message, decoded in reader.iter_decoded_messages():
+        if schema.name == "mmtrack.Pose2D":
+            pose_children.setdefault(channel.topic, set()).add(decoded.child_frame)
         if not schema.name.startswith("foxglove."):
             continue
         # Decoded against the FileDescriptorSet embedded in the file.
@@ -49,6 +51,11 @@ with open(path, "rb") as f:
                 q = t.rotation
                 norm = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w
                 assert abs(norm - 1.0) < 1e-12, norm
+                if channel.topic == "/tf_static":
+                    static.append(f"{t.parent_frame_id}->{t.child_frame_id}")
+                else:
+                    assert channel.topic == "/tf", channel.topic
+                    tf_children.add(t.child_frame_id)
                 previous = parents.setdefault(t.child_frame_id, t.parent_frame_id)
                 assert previous == t.parent_frame_id, (t.child_frame_id, previous, t.parent_frame_id)
         if channel.topic == "/radar/cartesian":
@@ -66,7 +73,13 @@ def root(frame):
         seen.append(frame)
     return seen
 
+# One frame naming: a pose's child frame is the frame /tf moves.
+for topic, children in pose_children.items():
+    assert children <= tf_children, (topic, children, tf_children)
+
 print(json.dumps({
+    "static": static,
+    "pose_children": {topic: sorted(children) for topic, children in pose_children.items()},
     "counts": counts,
     "cartesian": cartesian,
     "chains": {f: root(f) for f in sorted(set(parents) | set(parents.values()))},
@@ -117,6 +130,14 @@ fn foxglove_messages_decode_frames_chain_and_estimates_are_added_to_a_copy() {
     assert_eq!(est["counts"]["foxglove.FrameTransforms"], 8 + 8 + 1, "{est}");
     assert_eq!(est["counts"]["foxglove.PoseInFrame"], 16, "{est}");
     assert_eq!(chain(&est, "radar"), ["radar", "base_link", "world"], "{est}");
+    // The mount is static, on /tf_static, once; the poses name the frames /tf moves.
+    assert_eq!(sim["static"], serde_json::json!(["base_link->radar"]), "{sim}");
+    assert_eq!(est["static"], serde_json::json!(["base_link->radar"]), "{est}");
+    assert_eq!(
+        est["pose_children"],
+        serde_json::json!({"/ground_truth/pose": ["base_link"], "/estimate/pose": ["estimate"]}),
+        "{est}"
+    );
     assert_eq!(chain(&est, "estimate"), ["estimate", "world"], "{est}");
     assert_eq!(est["metadata"]["time_base"], "unix_epoch");
     assert!(est["metadata"]["estimate.source"].as_str().unwrap().contains("odometry"), "{est}");

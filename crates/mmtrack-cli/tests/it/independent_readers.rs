@@ -30,7 +30,7 @@ fn write_samples(dir: &Path) {
             t_ns: 1_000_000_000 + i * 100_000_000,
             parent_from_child: Se2::new(i as f64, -0.5, 0.1 * i as f64),
         };
-        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "vehicle").unwrap();
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world").unwrap();
     }
     writer
         .write_gnss_fix(&GnssFix {

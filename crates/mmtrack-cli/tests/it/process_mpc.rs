@@ -110,7 +110,7 @@ fn a_recording_without_cir_snapshots_is_named_in_the_error() {
     let mut writer = RecordingWriter::create(&path, &metadata, &RecordingOptions::default()).unwrap();
     for i in 0..3i64 {
         let pose = StampedPose { t_ns: i * 1_000_000, parent_from_child: Se2::new(i as f64, 0.0, 0.0) };
-        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "vehicle").unwrap();
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world").unwrap();
     }
     writer.finish().unwrap();
     let out = mmtrack(dir.path(), &["process", "mpc", "poses.mcap", "-o", "tables"]);

@@ -114,7 +114,7 @@ fn beam_recording(path: &Path) {
         let power = (0..16i64).map(|b| 1.0 / (1.0 + (b - best).pow(2) as f64)).collect();
         writer.write_beam_sweep(&BeamSweep::full(t_ns, power).unwrap(), None).unwrap();
         let pose = StampedPose { t_ns, parent_from_child: Se2::new(2.0 * k as f64, 0.0, 0.0) };
-        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "vehicle").unwrap();
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world").unwrap();
     }
     writer.finish().unwrap();
 }

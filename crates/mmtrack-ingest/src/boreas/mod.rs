@@ -267,9 +267,9 @@ pub fn ingest_boreas(
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;
     write_navtech_scans(&mut writer, &folder.scans, &layout, !options.decode, progress)?;
     let mut ground_truth_poses = 0;
-    if let Some((poses, sensor)) = &truth {
+    if let Some((poses, _)) = &truth {
         for pose in poses {
-            writer.write_pose(PoseStream::GroundTruth, pose, "world", sensor)?;
+            writer.write_pose(PoseStream::GroundTruth, pose, "world")?;
         }
         ground_truth_poses = poses.len() as u64;
     }

@@ -265,7 +265,7 @@ pub fn ingest_mulran(
         Ok(())
     })?;
     for pose in &truth {
-        writer.write_pose(PoseStream::GroundTruth, pose, "world", "vehicle")?;
+        writer.write_pose(PoseStream::GroundTruth, pose, "world")?;
     }
     for fix in &fixes {
         writer.write_gnss_fix(fix)?;

@@ -182,7 +182,6 @@ pub struct IngestReport {
 /// Ground truth and GNSS fixes of a folder, from whichever files it has.
 struct Auxiliary {
     ground_truth: Vec<StampedPose>,
-    ground_truth_frame: &'static str,
     fixes: Vec<GnssFix>,
     ins_used_as: Option<String>,
     ins_rows_not_good: u64,
@@ -191,15 +190,10 @@ struct Auxiliary {
 /// Reads `radar_odometry.csv`, `gps.csv` and `ins.csv` (each when present);
 /// `ins.csv` fills in for whichever of the other two is missing.
 fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -> Result<Auxiliary, IngestError> {
-    let mut aux = Auxiliary {
-        ground_truth: Vec::new(),
-        ground_truth_frame: "radar",
-        fixes: Vec::new(),
-        ins_used_as: None,
-        ins_rows_not_good: 0,
-    };
+    let mut aux = Auxiliary { ground_truth: Vec::new(), fixes: Vec::new(), ins_used_as: None, ins_rows_not_good: 0 };
     if let Some(path) = &folder.ground_truth {
         extra.insert("ground_truth.source".into(), path.display().to_string());
+        extra.insert("ground_truth.frame".into(), "radar".into());
         aux.ground_truth = odometry::read_radar_odometry(path)?;
     }
     if let Some(path) = &folder.gps {
@@ -218,7 +212,6 @@ fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -
         }
         extra.insert("ground_truth.origin_utm_zone".into(), solution.utm_zone.clone());
         aux.ground_truth = solution.poses;
-        aux.ground_truth_frame = "ins";
         used.push("ground truth");
     }
     if folder.gps.is_none() {
@@ -270,7 +263,7 @@ pub fn ingest_oxford(
     let total = folder.scans.len() as u64;
     write_navtech_scans(&mut writer, &folder.scans, layout, options.carry_png, progress)?;
     for pose in &in_span {
-        writer.write_pose(PoseStream::GroundTruth, pose, "world", aux.ground_truth_frame)?;
+        writer.write_pose(PoseStream::GroundTruth, pose, "world")?;
     }
     for fix in &fixes_in_span {
         writer.write_gnss_fix(fix)?;

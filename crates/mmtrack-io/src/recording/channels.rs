@@ -26,6 +26,9 @@ pub const GNSS_VIZ_TOPIC: &str = "/viz/gnss";
 /// Topic of the coordinate-frame transforms (`foxglove.FrameTransforms`; the
 /// frames are in [`super::tf`]).
 pub const TF_TOPIC: &str = "/tf";
+/// Topic of the fixed transforms (the sensor mounts), written once
+/// (`foxglove.FrameTransforms`, as ROS's `/tf_static`).
+pub const TF_STATIC_TOPIC: &str = "/tf_static";
 /// Topic of channel impulse responses.
 pub const CIR_TOPIC: &str = "/channel/cir";
 /// Topic of the true multipath components of simulated CIRs.
@@ -214,8 +217,14 @@ pub const CHANNELS: &[ChannelSpec] = &[
         canonical: false,
         meaning: "coordinate frames for Foxglove's 3D panel: world -> base_link at each ground-truth pose, \
                   world -> estimate at each estimated pose, world -> tx / rx at each sounder car pose (parent: the \
-                  pose's parent frame), and once, at the first log time, the static sensor mounts base_link -> radar \
-                  and base_link -> gnss (identity: the ground truth is the radar's pose)",
+                  pose's parent frame; child: the same frame as the pose's child_frame)",
+    },
+    ChannelSpec {
+        topic: TF_STATIC_TOPIC,
+        schema_names: &["foxglove.FrameTransforms"],
+        canonical: false,
+        meaning: "the fixed sensor mounts, once, at the first log time: base_link -> radar and base_link -> gnss \
+                  (identity: the ground truth is the pose of the sensor the metadata key ground_truth.frame names)",
     },
     ChannelSpec {
         topic: "/viz/ground_truth",

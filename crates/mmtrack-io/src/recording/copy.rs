@@ -10,7 +10,6 @@ use mmtrack_core::StampedPose;
 
 use super::channels::PoseStream;
 use super::metadata::RecordingMetadata;
-use super::tf::ESTIMATE_FRAME;
 use super::writer::{RecordingOptions, RecordingWriter, WriteSummary};
 use super::{METADATA_NAME, RawReader};
 use crate::error::{IoError, Result};
@@ -85,7 +84,7 @@ pub fn copy_with_estimate(
         writer.copy_message(&message)?;
     }
     for pose in estimate.poses {
-        writer.write_pose(PoseStream::Estimate, pose, estimate.parent_frame, ESTIMATE_FRAME)?;
+        writer.write_pose(PoseStream::Estimate, pose, estimate.parent_frame)?;
     }
     writer.finish()
 }

@@ -16,8 +16,10 @@
 //! its time; `world -> estimate` each estimated pose (`/estimate/pose`);
 //! `world -> tx` / `world -> rx` the sounder cars' poses. The parent is the
 //! parent frame the pose is written with (`world` for every writer of ours;
-//! a ROS 2 bag's poses keep their own, e.g. `odom`). The sensor mounts are
-//! written once, at the recording's first log time, as
+//! a ROS 2 bag's poses keep their own, e.g. `odom`); the child is always the
+//! stream's frame ([`vehicle_frame`]), also in the poses' own `child_frame`
+//! field. The sensor mounts are written once, at the recording's first log
+//! time, on `/tf_static` ([`super::channels::TF_STATIC_TOPIC`]), as
 //! identity transforms: the ground truth of our sources is the pose of the
 //! radar itself (Oxford `radar_odometry.csv`, the simulators), so
 //! `base_link` and `radar` coincide. Where the ground truth is another

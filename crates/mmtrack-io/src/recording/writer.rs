@@ -12,7 +12,7 @@ use super::METADATA_NAME;
 use super::cartesian::{CartesianGrid, CartesianResampler};
 use super::channels::{
     BEAM_SWEEP_TOPIC, CIR_TOPIC, GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC,
-    PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC, TF_TOPIC,
+    PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC, TF_STATIC_TOPIC, TF_TOPIC,
 };
 use super::metadata::RecordingMetadata;
 use super::reader::RawMessage;
@@ -266,7 +266,7 @@ impl RecordingWriter {
             GNSS_TOPIC => {
                 self.mounts_needed.insert(GNSS_FRAME);
             }
-            TF_TOPIC if message.channel.schema_name == "foxglove.FrameTransforms" => {
+            TF_TOPIC | TF_STATIC_TOPIC if message.channel.schema_name == "foxglove.FrameTransforms" => {
                 if let Ok(tf) = <FrameTransforms as Message>::decode(message.data.clone()) {
                     for t in tf.transforms.into_iter().filter(|t| t.parent_frame_id == VEHICLE_FRAME) {
                         self.mounts_present.insert(t.child_frame_id);
@@ -525,15 +525,14 @@ impl RecordingWriter {
         Ok(())
     }
 
-    /// Writes a pose of a trajectory (and its Foxglove display copy).
-    pub fn write_pose(
-        &mut self,
-        stream: PoseStream,
-        pose: &StampedPose,
-        parent_frame: &str,
-        child_frame: &str,
-    ) -> Result<()> {
+    /// Writes a pose of a trajectory (and its Foxglove display copy and
+    /// `/tf` transform). Its child frame is the stream's frame in `/tf`
+    /// ([`vehicle_frame`]: `base_link`, `estimate`, `tx`, `rx`), one name
+    /// for the vehicle on every channel; which sensor's pose the ground truth
+    /// is goes in the metadata (`ground_truth.frame`).
+    pub fn write_pose(&mut self, stream: PoseStream, pose: &StampedPose, parent_frame: &str) -> Result<()> {
         let p = pose.parent_from_child;
+        let child_frame = vehicle_frame(stream);
         let message = proto::Pose2D {
             t_ns: pose.t_ns,
             parent_frame: parent_frame.into(),
@@ -553,9 +552,7 @@ impl RecordingWriter {
                 }),
             };
             self.write_foxglove(stream.viz_topic(), pose.t_ns, &view, None)?;
-            let tf = FrameTransforms {
-                transforms: vec![frame_transform(pose.t_ns, parent_frame, vehicle_frame(stream), p)],
-            };
+            let tf = FrameTransforms { transforms: vec![frame_transform(pose.t_ns, parent_frame, child_frame, p)] };
             self.write_foxglove(TF_TOPIC, pose.t_ns, &tf, None)?;
         }
         Ok(())
@@ -667,8 +664,8 @@ impl RecordingWriter {
     }
 
     /// Writes the sensor mounts `base_link -> radar` / `base_link -> gnss`
-    /// (identity, see [`super::tf`]) on `/tf` at the first log time, for the
-    /// sensors written and not already mounted in a copied `/tf`.
+    /// (identity, see [`super::tf`]) on `/tf_static` at the first log time, for the
+    /// sensors written and not already mounted in a copied `/tf` or `/tf_static`.
     fn write_mounts(&mut self) -> Result<()> {
         let Some(first_ns) = self.first_log_time_ns else { return Ok(()) };
         let t_ns = i64::try_from(first_ns).map_err(|_| IoError::RecordingWrite {
@@ -684,11 +681,11 @@ impl RecordingWriter {
         if transforms.is_empty() {
             return Ok(());
         }
-        self.write_foxglove(TF_TOPIC, t_ns, &FrameTransforms { transforms }, None)?;
+        self.write_foxglove(TF_STATIC_TOPIC, t_ns, &FrameTransforms { transforms }, None)?;
         Ok(())
     }
 
-    /// Completes the file (sensor mounts on `/tf`, summary, index, footer) and
+    /// Completes the file (sensor mounts on `/tf_static`, summary, index, footer) and
     /// moves it into place.
     pub fn finish(mut self) -> Result<WriteSummary> {
         if self.foxglove_views {

@@ -17,7 +17,7 @@ fn recording(dir: &std::path::Path) -> std::path::PathBuf {
     let mut writer = RecordingWriter::create(&path, &samples::metadata(), &RecordingOptions::default()).unwrap();
     for p in samples::poses() {
         writer.write_radar_scan(&samples::scan(p.t_ns, 50, 500)).unwrap();
-        writer.write_pose(PoseStream::GroundTruth, &p, "world", "vehicle").unwrap();
+        writer.write_pose(PoseStream::GroundTruth, &p, "world").unwrap();
     }
     writer.finish().unwrap();
     path
@@ -80,7 +80,7 @@ fn negative_time_is_refused_with_the_field_named() {
     let mut writer = RecordingWriter::create(&path, &samples::metadata(), &RecordingOptions::default()).unwrap();
     let mut pose = samples::poses()[0].clone();
     pose.t_ns = -5;
-    let err = writer.write_pose(PoseStream::GroundTruth, &pose, "world", "vehicle").unwrap_err();
+    let err = writer.write_pose(PoseStream::GroundTruth, &pose, "world").unwrap_err();
     assert!(err.to_string().contains("t_ns"), "{err}");
 }
 

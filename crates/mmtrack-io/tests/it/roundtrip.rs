@@ -23,9 +23,9 @@ fn write_everything(path: &std::path::Path, options: &RecordingOptions) -> mmtra
     let mut writer = RecordingWriter::create(path, &samples::metadata(), options).unwrap();
     for (i, pose) in samples::poses().iter().enumerate() {
         writer.write_radar_scan(&samples::scan(pose.t_ns, 40, 64 + i)).unwrap();
-        writer.write_pose(PoseStream::GroundTruth, pose, "world", "vehicle").unwrap();
+        writer.write_pose(PoseStream::GroundTruth, pose, "world").unwrap();
     }
-    writer.write_pose(PoseStream::Estimate, &samples::poses()[0], "world", "vehicle").unwrap();
+    writer.write_pose(PoseStream::Estimate, &samples::poses()[0], "world").unwrap();
     for fix in samples::gnss_fixes() {
         writer.write_gnss_fix(&fix).unwrap();
     }
@@ -92,8 +92,8 @@ fn sounder_truth_and_both_vehicles_round_trip_bit_exactly() {
     let poses = samples::poses();
     for (i, truth) in samples::mpc_truth().iter().enumerate() {
         if truth.snapshot_index == 0 {
-            writer.write_pose(PoseStream::GroundTruthTx, &poses[i / 6], "world", "tx").unwrap();
-            writer.write_pose(PoseStream::GroundTruthRx, &poses[i / 6 + 2], "world", "rx").unwrap();
+            writer.write_pose(PoseStream::GroundTruthTx, &poses[i / 6], "world").unwrap();
+            writer.write_pose(PoseStream::GroundTruthRx, &poses[i / 6 + 2], "world").unwrap();
         }
         writer.write_mpc_truth(truth).unwrap();
     }
@@ -314,7 +314,7 @@ proptest! {
         let path = dir.path().join("p.mcap");
         let mut writer = RecordingWriter::create(&path, &samples::metadata(), &RecordingOptions::default()).unwrap();
         for p in &poses {
-            writer.write_pose(PoseStream::Estimate, p, "world", "radar").unwrap();
+            writer.write_pose(PoseStream::Estimate, p, "world").unwrap();
         }
         writer.finish().unwrap();
         let back: Vec<StampedPose> = read_everything(&path).into_iter().filter_map(|e| match e {

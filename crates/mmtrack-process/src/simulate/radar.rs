@@ -230,7 +230,7 @@ fn write_recording(
     let mut writer = RecordingWriter::create(&sim.output, &metadata, &sim.recording)?;
     for (scan, pose) in simulator {
         writer.write_radar_scan(&scan)?;
-        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "radar")?;
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world")?;
         progress.advance(1);
     }
     writer.finish()?;

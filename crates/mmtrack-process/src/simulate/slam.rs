@@ -100,7 +100,7 @@ pub fn write_run(writer: &mut RecordingWriter, run: &SlamRun) -> anyhow::Result<
             t_ns: epoch.t_ns,
             parent_from_child: Se2::new(ue.position_m[0], ue.position_m[1], ue.heading_rad),
         };
-        writer.write_pose(PoseStream::GroundTruth, &pose, "world", "ue")?;
+        writer.write_pose(PoseStream::GroundTruth, &pose, "world")?;
     }
     Ok(())
 }

@@ -117,8 +117,8 @@ fn write_convoy(
     progress.start("simulate sounder", sets as u64, "sets");
     let mut written = SounderSimulated { sets: 0, snapshots: 0, truths: 0, detail };
     for set in simulator.take(sets) {
-        writer.write_pose(PoseStream::GroundTruthTx, &set.tx_pose, "world", "tx")?;
-        writer.write_pose(PoseStream::GroundTruthRx, &set.rx_pose, "world", "rx")?;
+        writer.write_pose(PoseStream::GroundTruthTx, &set.tx_pose, "world")?;
+        writer.write_pose(PoseStream::GroundTruthRx, &set.rx_pose, "world")?;
         for cir in &set.snapshots {
             write_snapshot(&mut writer, cir, &set.truth)?;
         }
