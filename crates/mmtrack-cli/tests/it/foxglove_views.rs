@@ -235,7 +235,8 @@ for meta, polar, view in zip(metas, polars, views):
     wb = b - b0
     near = power[r0, b0] + wb * (power[r0, b1] - power[r0, b0])
     far = power[r1, b0] + wb * (power[r1, b1] - power[r1, b0])
-    expected = np.where(inside, near + wr * (far - near), 0)
+    # Display gain 2, saturating at 255 (the SDK's play_radar shows cart_img * 2).
+    expected = np.minimum(255, 2 * np.where(inside, near + wr * (far - near), 0))
     got = np.frombuffer(view.data, np.uint8).reshape(view.height, view.width).astype(float)
     diff = np.abs(got - expected)
     worst, mean = max(worst, float(diff.max())), mean + float(diff.mean()) / len(views)
@@ -262,13 +263,15 @@ fn the_cartesian_view_of_real_oxford_scans_matches_a_numpy_resampling() {
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stdout}\n{stderr}");
     let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    eprintln!("numpy resampling against the view: {json}");
     assert_eq!(json["scans"], 11, "{json}");
-    // The view rounds bilinear weights to 1/256 and the result to a count:
-    // at most 1/256 of a 255-count step per axis plus 0.5 of rounding, so
-    // under 2.5 counts anywhere. A view that read the 11 header bytes as
-    // bins, or flipped left and right, is off by tens of counts (measured:
-    // 250 and 131 at most, 8.4 and 15.3 on average). Rounding to a count
-    // alone gives a mean of 0.25 (measured 0.225, max 0.89).
+    // The view rounds bilinear weights to 1/256 and the gained result to a
+    // count: at most 2 x 1/256 of a 255-count step per axis plus 0.5 of
+    // rounding, so under 4.5 counts anywhere (the bound kept below is the
+    // gain-1 one, 2.5, which still holds: measured 1.15). A view that read the
+    // 11 header bytes as bins, or flipped left and right, is off by tens of
+    // counts (at gain 1: 250 and 131 at most, 8.4 and 15.3 on average).
+    // Rounding to a count alone gives a mean of 0.25 (measured 0.228).
     assert!(json["max_abs_diff"].as_f64().unwrap() < 2.5, "{json}");
     assert!(json["mean_abs_diff"].as_f64().unwrap() < 0.3, "{json}");
 }

@@ -29,6 +29,15 @@
 //! `radar_polar_to_cartesian` (bilinear in azimuth and range), whose example
 //! defaults the grid's defaults follow (0.25 m per pixel, 501 pixels: 62.6 m
 //! around the sensor).
+//!
+//! # Display scaling
+//!
+//! The resampled power is multiplied by [`DISPLAY_GAIN`] and saturates at
+//! 255, as the SDK's `play_radar` example shows its images (`cart_img * 2`):
+//! Navtech power is already logarithmic (0.5 dB per count), so a linear
+//! gain keeps equal steps in dB, and at gain 1 the view is nearly black
+//! (real Oxford scans: mean 14 of 255, 99th percentile 78; the demo's
+//! simulated ones mean 4). The polar `/radar/image` keeps the counts as read.
 
 use mmtrack_core::PolarScanHeader;
 
@@ -48,6 +57,10 @@ impl Default for CartesianGrid {
         Self { metres_per_pixel: 0.25, size_px: 501 }
     }
 }
+
+/// Factor from resampled power counts to display counts (module docs,
+/// "Display scaling"); the result saturates at 255.
+pub const DISPLAY_GAIN: u32 = 2;
 
 /// Largest image edge, pixels (4096 x 4096 is 16 MiB per scan).
 pub const MAX_CARTESIAN_SIZE_PX: u32 = 4096;
@@ -134,7 +147,8 @@ impl CartesianResampler {
     /// bytes per azimuth row, the range bins starting `column_offset` bytes
     /// into each row (11 for a carried Oxford PNG, whose rows start with the
     /// per-azimuth header; 0 for bare power). Returns `size_px * size_px`
-    /// bytes, row-major; the error says which size does not fit.
+    /// bytes, row-major, scaled by [`DISPLAY_GAIN`]; the error says which
+    /// size does not fit.
     pub fn resample(
         &self,
         header: &PolarScanHeader,
@@ -189,8 +203,9 @@ impl CartesianResampler {
             let near = u32::from(near[b0]) * (256 - wb) + u32::from(near[b1]) * wb;
             let far = u32::from(far[b0]) * (256 - wb) + u32::from(far[b1]) * wb;
             if let Some(value) = out.get_mut(index as usize) {
-                // At most 255 * 2^16 before the shift.
-                *value = ((near * (256 - wr) + far * wr + (1 << 15)) >> 16) as u8;
+                // At most 255 * 2^16 * DISPLAY_GAIN before the shift.
+                let display = (DISPLAY_GAIN * (near * (256 - wr) + far * wr) + (1 << 15)) >> 16;
+                *value = display.min(255) as u8;
             }
         }
         Ok(out)
@@ -236,8 +251,9 @@ mod tests {
         assert_eq!(image.len(), 21 * 21);
         let at = |row: usize, col: usize| image[row * 21 + col];
         // Centre pixel (10, 10); 5 m forward is row 5, column 10; 3 m right is row 10, column 13.
-        assert_eq!(at(5, 10), 200);
-        assert_eq!(at(10, 13), 100);
+        // Display gain 2: 100 shows as 200, 200 saturates at 255.
+        assert_eq!(at(5, 10), 255);
+        assert_eq!(at(10, 13), 200);
         // Nothing behind or on the left.
         assert_eq!(at(15, 10), 0);
         assert_eq!(at(10, 7), 0);
@@ -255,9 +271,9 @@ mod tests {
         let mut h = header(n, bins, 1.0);
         let resampler = CartesianResampler::new(CartesianGrid { metres_per_pixel: 1.0, size_px: 31 }).unwrap();
         let image = resampler.resample(&h, &rows, stride, offset).unwrap();
-        // Within range every pixel is 7 (never a header byte), beyond it 0.
-        assert!(image.iter().all(|&v| v == 7 || v == 0), "{image:?}");
-        assert_eq!(image[15 * 31 + 15], 7);
+        // Within range every pixel is 7 x 2 (never a header byte), beyond it 0.
+        assert!(image.iter().all(|&v| v == 14 || v == 0), "{image:?}");
+        assert_eq!(image[15 * 31 + 15], 14);
         assert_eq!(image[0], 0, "the corner is 21.2 m out, past the last bin (19 m)");
         for a in &mut h.azimuths {
             a.valid = false;

@@ -209,7 +209,8 @@ pub const CHANNELS: &[ChannelSpec] = &[
         meaning: "display copy of a radar scan resampled onto a Cartesian grid (mono8, frame radar, the sensor at the \
                   centre pixel, image up = forward, image left = left; metres per pixel and size in the recording \
                   options, default 0.25 m x 501 px; bilinear in azimuth and range, header columns and invalid rows \
-                  left out); same sequence number and time as the /radar/image it shows",
+                  left out; power x 2, saturating at 255, for viewing, as the Oxford SDK shows it); same sequence \
+                  number and time as the /radar/image it shows",
     },
     ChannelSpec {
         topic: TF_TOPIC,
