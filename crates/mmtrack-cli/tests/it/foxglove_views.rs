@@ -35,12 +35,23 @@ from mcap_protobuf.decoder import DecoderFactory
 
 path = sys.argv[1]
 counts, parents, cartesian, static, pose_children, tf_children = {}, {}, 0, [], {}, set()
+scene_ids, sources, truths, path_lines = {}, {}, [], []
 with open(path, "rb") as f:
     reader = make_reader(f, decoder_factories=[DecoderFactory()])
     metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
     for schema, channel, message, decoded in reader.iter_decoded_messages():
         if schema.name == "mmtrack.Pose2D":
             pose_children.setdefault(channel.topic, set()).add(decoded.child_frame)
+        if channel.topic == "/slam/sources":
+            sources[(decoded.kind, decoded.index)] = (decoded.x_m, decoded.y_m, decoded.z_m)
+        if channel.topic == "/slam/ue_truth":
+            truths.append(decoded)
+        if schema.name == "foxglove.SceneUpdate":
+            for e in decoded.entities:
+                assert e.frame_id == "world", e.frame_id
+                scene_ids.setdefault(channel.topic, []).append(e.id)
+                if channel.topic == "/viz/slam_paths":
+                    path_lines.append([(l.color.r, [(p.x, p.y, p.z) for p in l.points]) for l in e.lines])
         if not schema.name.startswith("foxglove."):
             continue
         # Decoded against the FileDescriptorSet embedded in the file.
@@ -73,12 +84,29 @@ def root(frame):
         seen.append(frame)
     return seen
 
+# SLAM path markers against the truth, epoch by epoch: line of sight
+# BS -> UE, a VA's path VA -> UE, a scattering point's BS -> SP -> UE.
+assert len(path_lines) == len(truths), (len(path_lines), len(truths))
+segments = 0
+for truth, lines in zip(truths, path_lines):
+    ue = (truth.x_m, truth.y_m, truth.z_m)
+    wanted = sorted(
+        [sources[("bs", 0)], ue] if kind == "bs" else [sources[("va", i)], ue] if kind == "va"
+        else [sources[("bs", 0)], sources[("sp", i)], sources[("sp", i)], ue]
+        for kind, i in zip(truth.path_source, truth.path_source_index) if kind != "clutter")
+    drawn = [points[k:k + (4 if color == 0.17 else 2)] for color, points in lines
+             for k in range(0, len(points), 4 if color == 0.17 else 2)]
+    assert sorted(drawn) == wanted, (drawn, wanted)
+    segments += sum(len(p) // 2 for p in drawn)
+
 # One frame naming: a pose's child frame is the frame /tf moves.
 for topic, children in pose_children.items():
     assert children <= tf_children, (topic, children, tf_children)
 
 print(json.dumps({
     "static": static,
+    "scene_ids": scene_ids,
+    "path_segments": segments,
     "pose_children": {topic: sorted(children) for topic, children in pose_children.items()},
     "counts": counts,
     "cartesian": cartesian,
@@ -173,6 +201,33 @@ fn sounder_recordings_name_their_scenario_time_base() {
     // Both cars move in /tf.
     assert_eq!(chain(&json, "tx"), ["tx", "world"], "{json}");
     assert_eq!(chain(&json, "rx"), ["rx", "world"], "{json}");
+}
+
+/// Issue 28: SLAM recordings show their sources and each epoch's true
+/// paths in the 3D panel (`foxglove.SceneUpdate`), checked against the
+/// truth channels by the script.
+#[test]
+fn slam_recordings_mark_their_sources_and_true_paths() {
+    let python = venv_python().expect("Python 3 with pip access to PyPI (the mcap and protobuf readers) is needed");
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let out = mmtrack(d, &["simulate", "slam", "--epochs", "5", "-o", "s.mcap"]);
+    let stdout = text(&out).0;
+    assert!(out.status.success(), "{}", text(&out).1);
+    assert!(stdout.contains("5 epochs, 29 paths; BS, 4 virtual anchors, 10 scattering points"), "{stdout}");
+    let json = check(&python, d, &d.join("s.mcap"));
+    let mut ids: Vec<String> = serde_json::from_value(json["scene_ids"]["/viz/slam_sources"].clone()).unwrap();
+    ids.sort();
+    let mut expected: Vec<String> = std::iter::once("bs-0".to_string())
+        .chain((0..4).map(|i| format!("va-{i}")))
+        .chain((0..10).map(|i| format!("sp-{i}")))
+        .collect();
+    expected.sort();
+    assert_eq!(ids, expected, "{json}");
+    assert_eq!(json["scene_ids"]["/viz/slam_paths"], serde_json::json!(vec!["paths"; 5]), "{json}");
+    // 29 paths (the script matched each to /slam/ue_truth): 5 line of
+    // sight, 20 VA and 4 SP paths (two segments each).
+    assert_eq!(json["path_segments"], 5 + 20 + 2 * 4, "{json}");
 }
 
 #[test]

@@ -46,6 +46,10 @@ pub const SLAM_PATHS_TOPIC: &str = "/slam/paths";
 pub const SLAM_UE_TRUTH_TOPIC: &str = "/slam/ue_truth";
 /// Topic of the sources of the SLAM paths (base station, true VAs and SPs).
 pub const SLAM_SOURCES_TOPIC: &str = "/slam/sources";
+/// Display markers of the SLAM sources (`foxglove.SceneUpdate`).
+pub const SLAM_SOURCES_VIZ_TOPIC: &str = "/viz/slam_sources";
+/// Display markers of each epoch's true paths (`foxglove.SceneUpdate`).
+pub const SLAM_PATHS_VIZ_TOPIC: &str = "/viz/slam_paths";
 /// Recording metadata key naming the site of a beam-sweep recording: one
 /// array at one place (e.g. `deepsense-scenario1`). Recordings of one site
 /// share the array's boresight and codebook, so a beam map fitted on some of
@@ -201,6 +205,23 @@ pub const CHANNELS: &[ChannelSpec] = &[
         canonical: true,
         meaning: "one source of the SLAM paths, written once: the base station (known to the UE) and, as ground \
                   truth, each virtual anchor and scattering point",
+    },
+    ChannelSpec {
+        topic: SLAM_SOURCES_VIZ_TOPIC,
+        schema_names: &["foxglove.SceneUpdate"],
+        canonical: false,
+        meaning: "display copy of /slam/sources for Foxglove's 3D panel (frame world): one entity per source, id \
+                  <kind>-<index>, a sphere 1.5 m across (base station blue, virtual anchors orange, scattering \
+                  points green) and its label, without lifetime",
+    },
+    ChannelSpec {
+        topic: SLAM_PATHS_VIZ_TOPIC,
+        schema_names: &["foxglove.SceneUpdate"],
+        canonical: false,
+        meaning: "the true paths of each epoch from /slam/ue_truth as lines in the 3D panel (frame world; entity \
+                  paths, replaced every epoch): line of sight base station -> UE, a virtual anchor's path VA -> UE \
+                  (the unfolded reflection, as long as the path), a scattering point's base station -> SP -> UE; \
+                  clutter has no line",
     },
     ChannelSpec {
         topic: RADAR_CARTESIAN_TOPIC,

@@ -193,6 +193,9 @@ pub struct RecordingWriter {
     mounts_needed: BTreeSet<&'static str>,
     /// Mounts `base_link -> sensor` already in the file (copied `/tf`).
     mounts_present: BTreeSet<String>,
+    /// Positions of the SLAM sources written, by kind (`bs`, `va`, `sp`) and
+    /// index, for the path markers of later epochs.
+    slam_sources_m: BTreeMap<(&'static str, usize), [f64; 3]>,
 }
 
 impl RecordingWriter {
@@ -241,6 +244,7 @@ impl RecordingWriter {
             first_log_time_ns: None,
             mounts_needed: BTreeSet::new(),
             mounts_present: BTreeSet::new(),
+            slam_sources_m: BTreeMap::new(),
         })
     }
 
@@ -374,7 +378,7 @@ impl RecordingWriter {
         self.emit(topic, id, t_ns, sequence)
     }
 
-    fn write_foxglove<M: Encode + Message>(
+    pub(super) fn write_foxglove<M: Encode + Message>(
         &mut self,
         topic: &'static str,
         t_ns: i64,

@@ -1,12 +1,35 @@
 //! Writing 5G mmWave SLAM epochs: path measurements, the simulator's truth
 //! and the sources of the paths.
 
+use foxglove::schemas::{
+    Color, LinePrimitive, Point3, Pose, SceneEntity, SceneUpdate, SpherePrimitive, TextPrimitive, Vector3,
+};
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 
 use super::RecordingWriter;
 use crate::error::{IoError, Result};
 use crate::proto;
-use crate::recording::channels::{SLAM_PATHS_TOPIC, SLAM_SOURCES_TOPIC, SLAM_UE_TRUTH_TOPIC};
+use crate::recording::channels::{
+    SLAM_PATHS_TOPIC, SLAM_PATHS_VIZ_TOPIC, SLAM_SOURCES_TOPIC, SLAM_SOURCES_VIZ_TOPIC, SLAM_UE_TRUTH_TOPIC,
+};
+use crate::recording::tf::{WORLD_FRAME, timestamp};
+
+/// Diameter of a source's sphere in the 3D panel, metres.
+const SOURCE_MARKER_M: f64 = 1.5;
+
+/// The display colour of a kind of source (`bs`, `va`, `sp`).
+fn kind_color(kind: &str) -> Color {
+    let (r, g, b) = match kind {
+        "bs" => (0.12, 0.47, 0.71),
+        "va" => (1.0, 0.50, 0.05),
+        _ => (0.17, 0.63, 0.17),
+    };
+    Color { r, g, b, a: 1.0 }
+}
+
+fn point(p: [f64; 3]) -> Point3 {
+    Point3 { x: p[0], y: p[1], z: p[2] }
+}
 
 impl RecordingWriter {
     /// Writes the path measurements of one epoch (`mmtrack.PathMeasurements`
@@ -61,7 +84,49 @@ impl RecordingWriter {
             path_source_index,
         };
         self.write_spec(SLAM_UE_TRUTH_TOPIC, t_ns, &message, None)?;
+        if self.foxglove_views {
+            let update = self.path_markers(t_ns, ue.position_m, origins);
+            self.write_foxglove(SLAM_PATHS_VIZ_TOPIC, t_ns, &update, None)?;
+        }
         Ok(())
+    }
+
+    /// The epoch's true paths as line segments, one line list per kind of
+    /// source (channel docs of `/viz/slam_paths`); a path whose source was
+    /// not written has no line.
+    fn path_markers(&self, t_ns: i64, ue_m: [f64; 3], origins: &[PathOrigin]) -> SceneUpdate {
+        let source = |kind: &'static str, index: usize| self.slam_sources_m.get(&(kind, index)).copied();
+        let mut lines: Vec<(&str, Vec<Point3>)> = vec![("bs", Vec::new()), ("va", Vec::new()), ("sp", Vec::new())];
+        for origin in origins {
+            let (slot, segments) = match *origin {
+                PathOrigin::LineOfSight => (0, source("bs", 0).map(|bs| vec![bs, ue_m])),
+                PathOrigin::VirtualAnchor(v) => (1, source("va", v).map(|va| vec![va, ue_m])),
+                PathOrigin::ScatteringPoint(s) => {
+                    (2, source("bs", 0).zip(source("sp", s)).map(|(bs, sp)| vec![bs, sp, sp, ue_m]))
+                }
+                PathOrigin::Clutter => continue,
+            };
+            lines[slot].1.extend(segments.unwrap_or_default().into_iter().map(point));
+        }
+        let entity = SceneEntity {
+            timestamp: timestamp(t_ns),
+            frame_id: WORLD_FRAME.into(),
+            id: "paths".into(),
+            lines: lines
+                .into_iter()
+                .filter(|(_, points)| !points.is_empty())
+                .map(|(kind, points)| LinePrimitive {
+                    r#type: 2, // LINE_LIST: segments 0-1, 2-3, ...
+                    thickness: 2.0,
+                    scale_invariant: true,
+                    points,
+                    color: Some(kind_color(kind)),
+                    ..Default::default()
+                })
+                .collect(),
+            ..Default::default()
+        };
+        SceneUpdate { deletions: vec![], entities: vec![entity] }
     }
 
     /// Writes one source of the paths (`mmtrack.SlamSource` on
@@ -83,6 +148,43 @@ impl RecordingWriter {
             z_m: position_m[2],
         };
         self.write_spec(SLAM_SOURCES_TOPIC, t_ns, &message, None)?;
+        self.slam_sources_m.insert((kind.name(), index), position_m);
+        if self.foxglove_views {
+            let label = match kind {
+                SourceType::BaseStation => "BS".to_string(),
+                SourceType::VirtualAnchor => format!("VA {index}"),
+                SourceType::ScatteringPoint => format!("SP {index}"),
+            };
+            let pose = |lift_m: f64| Pose {
+                position: Some(Vector3 { x: position_m[0], y: position_m[1], z: position_m[2] + lift_m }),
+                orientation: Some(crate::recording::tf::yaw_quaternion(0.0)),
+            };
+            let entity = SceneEntity {
+                timestamp: timestamp(t_ns),
+                frame_id: WORLD_FRAME.into(),
+                id: format!("{}-{index}", kind.name()),
+                spheres: vec![SpherePrimitive {
+                    pose: Some(pose(0.0)),
+                    size: Some(Vector3 { x: SOURCE_MARKER_M, y: SOURCE_MARKER_M, z: SOURCE_MARKER_M }),
+                    color: Some(kind_color(kind.name())),
+                }],
+                texts: vec![TextPrimitive {
+                    pose: Some(pose(SOURCE_MARKER_M)),
+                    billboard: true,
+                    font_size: 14.0,
+                    scale_invariant: true,
+                    color: Some(Color { r: 1.0, g: 1.0, b: 1.0, a: 1.0 }),
+                    text: label,
+                }],
+                ..Default::default()
+            };
+            self.write_foxglove(
+                SLAM_SOURCES_VIZ_TOPIC,
+                t_ns,
+                &SceneUpdate { deletions: vec![], entities: vec![entity] },
+                None,
+            )?;
+        }
         Ok(())
     }
 }
