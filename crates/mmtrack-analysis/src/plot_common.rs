@@ -6,6 +6,15 @@ use std::ops::Range;
 
 use plotters::prelude::*;
 
+/// Font of tick labels. plotters' SVG backend writes `font-size` as the
+/// size / 1.24, so 16 gives 12.9 px text at the SVG's natural size (its
+/// default, 12, gave 9.7 px); the report shows plots at natural size.
+pub(crate) const TICK_FONT: (&str, u32) = ("sans-serif", 16);
+/// Font of axis descriptions (name and unit): 14.5 px.
+pub(crate) const AXIS_FONT: (&str, u32) = ("sans-serif", 18);
+/// Font of legends: 12.9 px.
+pub(crate) const LEGEND_FONT: (&str, u32) = ("sans-serif", 16);
+
 /// A plotters error as an error of this crate, prefixed `plot:`.
 pub(crate) fn err(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow::anyhow!("plot: {e}")
@@ -26,6 +35,7 @@ where
         .position(position)
         .border_style(BLACK)
         .background_style(WHITE.mix(0.85))
+        .label_font(LEGEND_FONT)
         .draw()
         .map_err(err)
 }
