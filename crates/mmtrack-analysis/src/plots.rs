@@ -261,11 +261,11 @@ mod tests {
         let table = trajectory_svg(&result).unwrap();
         let ticks = x_ticks(&table);
         let (lo, hi) = (ticks.iter().copied().fold(f64::INFINITY, f64::min), ticks.iter().copied().fold(0.0, f64::max));
-        assert!(lo >= 140.0 && lo <= 152.0 && hi >= 168.0 && hi <= 180.0, "{ticks:?}");
+        assert!((140.0..=152.0).contains(&lo) && (168.0..=180.0).contains(&hi), "{ticks:?}");
         assert!(table.contains("x (m), table frame"), "the frame is named");
         let relative = trajectory_relative_svg(&result).unwrap();
         let ticks = x_ticks(&relative);
-        assert!(ticks.iter().any(|t| *t == 0.0) && ticks.iter().all(|t| *t < 30.0), "{ticks:?}");
+        assert!(ticks.contains(&0.0) && ticks.iter().all(|t| *t < 30.0), "{ticks:?}");
         assert!(relative.contains("x (m), relative to each first pose"), "labelled as relative");
         // Two runs overlaid: both estimates and the truth, in the tables' frame.
         let overlay = trajectory_overlay_svg(&[("a", &result), ("b", &result)]).unwrap();

@@ -77,8 +77,13 @@ fn is_number(text: &str) -> bool {
 struct Axes {
     /// (y tick labels, x tick labels) per panel.
     ticks: Vec<(usize, usize)>,
+    /// Axis descriptions (y: rotated; x: plotters' bottom-aligned middle text).
+    descriptions: Vec<String>,
     min_font_px: f64,
 }
+
+/// Axis names without a unit: counts, indices and probabilities.
+const UNITLESS_AXES: [&str; 5] = ["CDF", "sets", "MPCs per set", "sources", "slot"];
 
 /// Reads the axes of a plotters SVG: each panel's y-axis description is the
 /// one rotated text; y tick labels are numeric texts anchored at their end,
@@ -90,6 +95,7 @@ fn axes(svg: &str) -> Axes {
     let mut panels: Vec<(f64, f64)> = Vec::new();
     let mut ticks: Vec<(bool, f64, f64)> = Vec::new();
     let mut min_font_px = f64::INFINITY;
+    let mut descriptions = Vec::new();
     for t in doc.descendants().filter(|n| n.has_tag_name(("http://www.w3.org/2000/svg", "text"))) {
         let content: String = t.descendants().filter(roxmltree::Node::is_text).filter_map(|n| n.text()).collect();
         if content.trim().is_empty() {
@@ -99,6 +105,9 @@ fn axes(svg: &str) -> Axes {
         let (x, y) = (at(&t, "x"), at(&t, "y"));
         if t.attribute("transform").is_some_and(|tr| tr.contains("rotate")) {
             panels.push((x, y));
+            descriptions.push(content.trim().to_string());
+        } else if t.attribute("dy") == Some("-0.5ex") && !is_number(&content) {
+            descriptions.push(content.trim().to_string());
         } else if is_number(&content) {
             match t.attribute("text-anchor") {
                 Some("end") => ticks.push((true, x, y)),
@@ -117,7 +126,7 @@ fn axes(svg: &str) -> Axes {
             if is_y { per_panel[k].0 += 1 } else { per_panel[k].1 += 1 }
         }
     }
-    Axes { ticks: per_panel, min_font_px }
+    Axes { ticks: per_panel, descriptions, min_font_px }
 }
 
 /// Appended to a copy of the page: after load, measures what the reader
@@ -183,6 +192,10 @@ fn check_page(browser: &str, page_path: &Path, shots: &Path, name: &str) -> BTre
         assert!(!a.ticks.is_empty(), "{name}: plot {k} has no y-axis description: {a:?}");
         assert!(a.ticks.iter().all(|&(y, x)| y >= 2 && x >= 2), "{name}: plot {k}: an axis without tick labels: {a:?}");
         assert!(a.min_font_px >= 12.0, "{name}: plot {k}: text of {} px", a.min_font_px);
+        assert!(a.descriptions.len() >= 2 * a.ticks.len(), "{name}: plot {k}: an axis without a name: {a:?}");
+        for d in &a.descriptions {
+            assert!(d.contains('(') || UNITLESS_AXES.contains(&d.as_str()), "{name}: plot {k}: axis `{d}` has no unit");
+        }
     }
     // Provenance.
     let at_epoch = "2023-11-14 22:13:20 UTC (SOURCE_DATE_EPOCH)";
