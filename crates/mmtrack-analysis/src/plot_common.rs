@@ -40,6 +40,17 @@ where
         .map_err(err)
 }
 
+/// Decimals that tell ticks over `range` apart: plotters places about ten
+/// ticks at steps of 1, 2 or 5 x 10^k, so a tenth of the span, rounded down
+/// to its power of ten, sets the last digit shown (0 to 6 decimals).
+pub(crate) fn tick_decimals(range: &Range<f64>) -> usize {
+    let step = (range.end - range.start).abs() / 10.0;
+    if !(step.is_finite() && step > 0.0) {
+        return 0;
+    }
+    (-step.log10().floor()).clamp(0.0, 6.0) as usize
+}
+
 /// `[min, max]` of `values` padded by 5 % (1 unit when flat).
 pub(crate) fn padded_range(values: impl Iterator<Item = f64>) -> Range<f64> {
     let (lo, hi) =
@@ -49,4 +60,20 @@ pub(crate) fn padded_range(values: impl Iterator<Item = f64>) -> Range<f64> {
     }
     let pad = if hi > lo { 0.05 * (hi - lo) } else { 1.0 };
     (lo - pad)..(hi + pad)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tick_decimals_resolve_a_tenth_of_the_span() {
+        // -113.6..-111.9 dB: steps of 0.2 dB need one decimal (with none,
+        // five ticks all read -113).
+        assert_eq!(tick_decimals(&(-113.6..-111.9)), 1);
+        assert_eq!(tick_decimals(&(70.5..76.5)), 1);
+        assert_eq!(tick_decimals(&(-180.0..180.0)), 0);
+        assert_eq!(tick_decimals(&(0.0..0.003)), 4);
+        assert_eq!(tick_decimals(&(1.0..1.0)), 0);
+    }
 }

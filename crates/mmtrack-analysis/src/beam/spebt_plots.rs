@@ -3,7 +3,7 @@
 
 use plotters::prelude::*;
 
-use crate::plot_common::{err, padded_range};
+use crate::plot_common::{err, padded_range, tick_decimals};
 
 /// One realisation against the truth, per slot (index = slot).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -61,7 +61,7 @@ pub fn spebt_tracking_svg(title: &str, series: &SpebtTrackingSeries) -> anyhow::
             .axis_desc_style(crate::plot_common::AXIS_FONT)
             .x_desc("slot")
             .y_desc("|alpha| (dB, 20 log10)")
-            .y_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.decimals$}", decimals = tick_decimals(&range)))
             .draw()
             .map_err(err)?;
         let tick = range.start + 0.03 * (range.end - range.start);
@@ -83,7 +83,7 @@ pub fn spebt_tracking_svg(title: &str, series: &SpebtTrackingSeries) -> anyhow::
                 .axis_desc_style(crate::plot_common::AXIS_FONT)
                 .x_desc("slot")
                 .y_desc(label)
-                .y_label_formatter(&|v| format!("{v:.0}"))
+                .y_label_formatter(&|v| format!("{v:.decimals$}", decimals = tick_decimals(&range)))
                 .draw()
                 .map_err(err)?;
             let tick = range.start + 0.03 * (range.end - range.start);

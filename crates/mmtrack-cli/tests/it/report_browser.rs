@@ -77,6 +77,9 @@ fn is_number(text: &str) -> bool {
 struct Axes {
     /// (y tick labels, x tick labels) per panel.
     ticks: Vec<(usize, usize)>,
+    /// Tick labels that repeat another of their axis (e.g. `-113` five times
+    /// where the steps are 0.2 dB).
+    repeated: Vec<String>,
     /// Axis descriptions (y: rotated; x: plotters' bottom-aligned middle text).
     descriptions: Vec<String>,
     min_font_px: f64,
@@ -93,7 +96,7 @@ fn axes(svg: &str) -> Axes {
     let doc = roxmltree::Document::parse(svg).unwrap_or_else(|e| panic!("not well-formed SVG: {e}"));
     let at = |n: &roxmltree::Node, a: &str| n.attribute(a).and_then(|v| v.parse::<f64>().ok()).unwrap_or(f64::NAN);
     let mut panels: Vec<(f64, f64)> = Vec::new();
-    let mut ticks: Vec<(bool, f64, f64)> = Vec::new();
+    let mut ticks: Vec<(bool, f64, f64, String)> = Vec::new();
     let mut min_font_px = f64::INFINITY;
     let mut descriptions = Vec::new();
     for t in doc.descendants().filter(|n| n.has_tag_name(("http://www.w3.org/2000/svg", "text"))) {
@@ -110,23 +113,30 @@ fn axes(svg: &str) -> Axes {
             descriptions.push(content.trim().to_string());
         } else if is_number(&content) {
             match t.attribute("text-anchor") {
-                Some("end") => ticks.push((true, x, y)),
-                Some("middle") => ticks.push((false, x, y)),
+                Some("end") => ticks.push((true, x, y, content.trim().to_string())),
+                Some("middle") => ticks.push((false, x, y, content.trim().to_string())),
                 _ => {}
             }
         }
     }
     let mut per_panel = vec![(0, 0); panels.len()];
-    for (is_y, x, y) in ticks {
+    let mut labels: BTreeMap<(usize, bool), Vec<String>> = BTreeMap::new();
+    let mut repeated = Vec::new();
+    for (is_y, x, y, label) in ticks {
         let nearest = (0..panels.len()).min_by(|&a, &b| {
             let d = |k: usize| (panels[k].0 - x).hypot(panels[k].1 - y);
             d(a).total_cmp(&d(b))
         });
         if let Some(k) = nearest {
+            let axis = labels.entry((k, is_y)).or_default();
+            if axis.contains(&label) {
+                repeated.push(label.clone());
+            }
+            axis.push(label);
             if is_y { per_panel[k].0 += 1 } else { per_panel[k].1 += 1 }
         }
     }
-    Axes { ticks: per_panel, descriptions, min_font_px }
+    Axes { ticks: per_panel, repeated, descriptions, min_font_px }
 }
 
 /// Appended to a copy of the page: after load, measures what the reader
@@ -192,6 +202,7 @@ fn check_page(browser: &str, page_path: &Path, shots: &Path, name: &str) -> BTre
         assert!(!a.ticks.is_empty(), "{name}: plot {k} has no y-axis description: {a:?}");
         assert!(a.ticks.iter().all(|&(y, x)| y >= 2 && x >= 2), "{name}: plot {k}: an axis without tick labels: {a:?}");
         assert!(a.min_font_px >= 12.0, "{name}: plot {k}: text of {} px", a.min_font_px);
+        assert!(a.repeated.is_empty(), "{name}: plot {k}: tick labels repeat on one axis: {:?}", a.repeated);
         assert!(a.descriptions.len() >= 2 * a.ticks.len(), "{name}: plot {k}: an axis without a name: {a:?}");
         for d in &a.descriptions {
             assert!(d.contains('(') || UNITLESS_AXES.contains(&d.as_str()), "{name}: plot {k}: axis `{d}` has no unit");
