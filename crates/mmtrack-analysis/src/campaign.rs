@@ -491,23 +491,63 @@ fn cell(value: Option<f64>) -> String {
     }
 }
 
+/// `B - A` of two values, `n/a` when either is missing.
+fn difference(a: Option<f64>, b: Option<f64>) -> String {
+    match (a, b) {
+        (Some(a), Some(b)) => {
+            let d = b - a;
+            match cell(Some(d.abs())) {
+                text if d < 0.0 => format!("-{text}"),
+                text if d > 0.0 => format!("+{text}"),
+                text => text,
+            }
+        }
+        _ => "n/a".into(),
+    }
+}
+
+/// `(B - A) / |A|` in percent, where meaningful: both values there, `A`
+/// not 0, and a unit on a ratio scale (a difference of dB values is already
+/// a ratio, so dB metrics get none).
+fn relative(a: Option<f64>, b: Option<f64>, unit: &str) -> String {
+    match (a, b) {
+        (Some(a), Some(b)) if a != 0.0 && !unit.contains("dB") => format!("{:+.1} %", 100.0 * (b - a) / a.abs()),
+        _ => "-".into(),
+    }
+}
+
 /// The side-by-side section of the campaign report: one Markdown table per
-/// compared result table, a column per run.
+/// compared result table, a column per run and, for every run after the
+/// first, its difference to the first (`B - A`) and the relative difference
+/// where meaningful ([`relative`]). The pooled rows `all` and `mean` are
+/// left out of a table where no run has more than one sequence (they would
+/// repeat the sequence's row).
 #[must_use]
 pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
     use std::fmt::Write;
     let mut text = String::from("## Runs side by side\n\n");
+    let baseline = runs.first().cloned().unwrap_or_default();
     let _ = writeln!(
         text,
         "Runs: {}. Every value is the run's own result table (`run=<id>/tables/...`); the same numbers are in \
-         `tables/run_comparison` (long format). Pooled trajectory rows: `all` pools KITTI drift over the segments of \
-         every sequence (as the KITTI devkit pools a dataset), the RMSEs and ATE over the associated poses and the \
-         RPE over the frame pairs; `mean` is the plain mean of the per-sequence values.\n",
+         `tables/run_comparison` (long format). Differences are against the first run, `{baseline}`: `B - A` in the \
+         metric's unit, and relative to `{baseline}`'s value where that is meaningful (not for dB values, whose \
+         difference is already a ratio, nor against 0). Pooled trajectory rows (runs with several sequences): `all` \
+         pools KITTI drift over the segments of every sequence (as the KITTI devkit pools a dataset), the RMSEs and \
+         ATE over the associated poses and the RPE over the frame pairs; `mean` is the plain mean of the \
+         per-sequence values.\n",
         runs.iter().map(|r| format!("`{r}`")).collect::<Vec<_>>().join(", ")
     );
     let tables: BTreeSet<&str> = rows.iter().map(|r| r.source_table.as_str()).collect();
+    let pooled = |s: &str| s == "all" || s == "mean";
     for compared in COMPARED.iter().filter(|c| tables.contains(c.spec.name)) {
         let _ = writeln!(text, "### {}\n", compared.spec.name);
+        let of_table: Vec<&RunComparisonRow> = rows.iter().filter(|r| r.source_table == compared.spec.name).collect();
+        let mut sequences_per_run: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
+        for row in of_table.iter().filter(|r| !pooled(&r.sequence_id)) {
+            sequences_per_run.entry(row.run.as_str()).or_default().insert(row.sequence_id.as_str());
+        }
+        let show_pooled = sequences_per_run.values().any(|s| s.len() > 1);
         let mut header = String::from("| sequence |");
         let mut rule = String::from("|---|");
         if !compared.keys.is_empty() {
@@ -516,14 +556,18 @@ pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
         }
         header.push_str(" metric | unit |");
         rule.push_str("---|---|");
-        for run in runs {
+        for (k, run) in runs.iter().enumerate() {
             header.push_str(&format!(" {run} |"));
             rule.push_str("---:|");
+            if k > 0 {
+                header.push_str(&format!(" {run} - {baseline} | {run} vs {baseline} |"));
+                rule.push_str("---:|---:|");
+            }
         }
         let _ = writeln!(text, "{header}\n{rule}");
         // (sequence, key, metric) in row order -> run -> value.
         let mut lines: Vec<(LineId, BTreeMap<String, Option<f64>>)> = Vec::new();
-        for row in rows.iter().filter(|r| r.source_table == compared.spec.name) {
+        for row in of_table.iter().filter(|r| show_pooled || !pooled(&r.sequence_id)) {
             let id = (row.sequence_id.clone(), row.key.clone(), row.metric.clone(), row.unit.clone());
             match lines.last_mut() {
                 Some((last, values)) if *last == id => {
@@ -538,9 +582,14 @@ pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
                 line.push_str(&format!(" {key} |"));
             }
             line.push_str(&format!(" {metric} | {unit} |"));
-            for run in runs {
+            let a = values.get(&baseline).copied().flatten();
+            for (k, run) in runs.iter().enumerate() {
                 let value = values.get(run).map_or_else(|| "-".to_string(), |v| cell(*v));
                 line.push_str(&format!(" {value} |"));
+                if k > 0 {
+                    let b = values.get(run).copied().flatten();
+                    line.push_str(&format!(" {} | {} |", difference(a, b), relative(a, b, &unit)));
+                }
             }
             let _ = writeln!(text, "{line}");
         }
@@ -549,7 +598,10 @@ pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
     if tables.is_empty() {
         text.push_str("No run has a result table with compared metrics.\n\n");
     }
-    text.push_str("`-`: the run has no such row; `n/a`: the table holds no value (see that run's report for why).\n\n");
+    text.push_str(
+        "`-`: the run has no such row (or no relative difference is meaningful); `n/a`: the table holds no value \
+         (see that run's report for why).\n\n",
+    );
     text
 }
 
@@ -693,7 +745,23 @@ mod tests {
         };
         let rows = [row("a", "s1", Some(1.5)), row("b", "s1", None), row("a", "s2", Some(2.0))];
         let text = section(&rows, &["a".into(), "b".into()]);
-        assert!(text.contains("| s1 | ate_rmse_m | m | 1.5000 | n/a |"), "{text}");
-        assert!(text.contains("| s2 | ate_rmse_m | m | 2.0000 | - |"), "{text}");
+        assert!(text.contains("| sequence | metric | unit | a | b | b - a | b vs a |"), "{text}");
+        assert!(text.contains("| s1 | ate_rmse_m | m | 1.5000 | n/a | n/a | - |"), "{text}");
+        assert!(text.contains("| s2 | ate_rmse_m | m | 2.0000 | - | n/a | - |"), "{text}");
+        // B - A and (B - A) / A by hand: 1.2 - 1.5 = -0.3, -20 %; none for dB.
+        let rows = [
+            row("a", "s1", Some(1.5)),
+            row("b", "s1", Some(1.2)),
+            row("a", "all", Some(1.5)),
+            row("b", "all", Some(1.2)),
+        ];
+        let text = section(&rows, &["a".into(), "b".into()]);
+        assert!(text.contains("| s1 | ate_rmse_m | m | 1.5000 | 1.2000 | -0.3000 | -20.0 % |"), "{text}");
+        // One sequence per run: the pooled row would repeat it and is left out.
+        assert!(!text.contains("| all |"), "{text}");
+        assert_eq!(relative(Some(-2.0), Some(-1.0), "dB"), "-");
+        assert_eq!(relative(Some(0.0), Some(1.0), "m"), "-");
+        assert_eq!(relative(Some(-2.0), Some(-1.0), "m"), "+50.0 %");
+        assert_eq!(difference(Some(1.0), Some(1.0)), "0.0000");
     }
 }

@@ -111,12 +111,15 @@ fn frame_aligned(input: &TrajectoryInput) -> anyhow::Result<Association> {
         return Ok(associate(&input.estimate, truth)?);
     }
     validate_trajectory("estimate", &input.estimate)?;
-    let first = input.estimate[0].parent_from_child.inverse();
+    let estimate_first = input.estimate[0].parent_from_child;
+    let first = estimate_first.inverse();
     let estimate: Vec<Se2> = input.estimate.iter().map(|p| first * p.parent_from_child).collect();
     Ok(Association {
         t_ns: input.estimate.iter().map(|p| p.t_ns).collect(),
         estimate,
         ground_truth: Vec::new(),
+        estimate_first,
+        ground_truth_first: Se2::IDENTITY,
         exact_matches: 0,
         interpolated: 0,
         dropped_before: 0,

@@ -28,6 +28,7 @@
 //! plots + report`. It depends on `mmtrack-core` and `mmtrack-io` only, never
 //! on algorithm crates, and never prints (the CLI does).
 //!
+//! - [`compare_plots`]: the compare report's overlays of several runs.
 //! - [`campaign`]: several runs side by side, on polars: the runs'
 //!   Hive-partitioned result tables read into one frame, group-bys per run
 //!   for the pooled rows (the pooling rules are stated there and used by
@@ -46,6 +47,7 @@
 pub mod analyze;
 pub mod beam;
 pub mod campaign;
+pub mod compare_plots;
 pub mod export;
 pub mod mpc;
 pub mod mpc_artificial;

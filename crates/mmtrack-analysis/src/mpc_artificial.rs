@@ -230,6 +230,8 @@ pub fn tracks_vs_power_svg(points: &[SweepPoint], two_tracks_down_to_db: f64) ->
             .map_err(err)?;
         chart
             .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
             .light_line_style(LIGHT_LINES)
             .x_desc("MPC power (dB)")
             .y_desc("mean number of tracks")
@@ -283,6 +285,8 @@ pub fn delay_error_vs_power_svg(
             .map_err(err)?;
         chart
             .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
             .light_line_style(LIGHT_LINES)
             .x_desc("MPC power (dB)")
             .y_desc("mean delay error (ns)")
@@ -353,6 +357,8 @@ pub fn delay_error_vs_separation_svg(
             .map_err(err)?;
         chart
             .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
             .light_line_style(LIGHT_LINES)
             .x_desc("separation of the two MPCs (ns, band centre)")
             .y_desc("mean delay error (ns)")

@@ -121,6 +121,9 @@ pub fn write_campaign(
     }
     text.push('\n');
     text.push_str(&crate::campaign::section(&rows, &ids));
+    let (plots, overlays) = crate::compare_plots::compare_plots(runs)?;
+    text.push_str(&overlays);
+    files += crate::compare_plots::write_compare_plots(staging.path(), &plots)?;
     let report_path = staging.path().join("report.md");
     std::fs::write(&report_path, text).with_context(|| report_path.display().to_string())?;
     files += 1 + write_html(staging.path(), run)?;
@@ -184,15 +187,42 @@ fn write_run_into(dir: &Path, results: &RunResults, options: &DriftOptions, run:
     Ok(files)
 }
 
-/// `report.html` beside the staged `report.md`, its plots embedded.
+/// `report.html` beside the staged `report.md`, its plots embedded, with
+/// the provenance: version, build commit, time (`SOURCE_DATE_EPOCH` when
+/// set, [`report_html::report_time`]) and this process's command line. The
+/// time and command line are in `report.html` only: tables and `report.md`
+/// stay byte-identical for the same input, configuration and seed.
 fn write_html(dir: &Path, run: &RunInfo) -> anyhow::Result<usize> {
     let markdown_path = dir.join("report.md");
     let markdown = std::fs::read_to_string(&markdown_path).with_context(|| markdown_path.display().to_string())?;
-    let provenance = report_html::Provenance { config_json: &run.config_json, version: env!("CARGO_PKG_VERSION") };
+    let now_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| i64::try_from(d.as_secs()).unwrap_or(i64::MAX));
+    let generated = report_html::report_time(std::env::var("SOURCE_DATE_EPOCH").ok().as_deref(), now_s);
+    // The program by its file name (`mmtrack`, or `python3` for the Python
+    // package), as typed; its directory says nothing about the run.
+    let command_line = shell_words(std::env::args_os().enumerate().map(|(k, a)| {
+        let word = if k == 0 { Path::new(&a).file_name().map_or_else(|| a.clone(), ToOwned::to_owned) } else { a };
+        word.to_string_lossy().into_owned()
+    }));
+    let provenance = report_html::Provenance {
+        config_json: &run.config_json,
+        version: env!("CARGO_PKG_VERSION"),
+        commit: report_html::BUILD_COMMIT,
+        generated: &generated,
+        command_line: &command_line,
+    };
     let path = dir.join("report.html");
     std::fs::write(&path, report_html::html(&markdown, dir, &provenance))
         .with_context(|| path.display().to_string())?;
     Ok(1)
+}
+
+/// Words as a shell would need them typed: plain words as they are, others
+/// in single quotes.
+fn shell_words(words: impl Iterator<Item = String>) -> String {
+    let plain = |w: &str| !w.is_empty() && w.chars().all(|c| c.is_ascii_alphanumeric() || "-_./=,:@+%".contains(c));
+    words.map(|w| if plain(&w) { w } else { format!("'{}'", w.replace('\'', "'\\''")) }).collect::<Vec<_>>().join(" ")
 }
 
 fn write_into(
@@ -213,6 +243,7 @@ fn write_into(
         mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let plots = [
             ("trajectory.svg", plots::trajectory_svg(r)),
+            ("trajectory_relative.svg", plots::trajectory_relative_svg(r)),
             ("errors_vs_distance.svg", plots::errors_vs_distance_svg(r)),
             ("drift_per_length.svg", plots::drift_per_length_svg(r)),
         ];
@@ -221,7 +252,7 @@ fn write_into(
             let svg = svg.with_context(|| format!("sequence {seq}: {file}"))?;
             std::fs::write(&path, svg).with_context(|| path.display().to_string())?;
         }
-        files += 6;
+        files += 7;
     }
     let report_path = dir.join("report.md");
     std::fs::write(&report_path, report::markdown(results, skipped, options)?)

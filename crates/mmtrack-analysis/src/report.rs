@@ -85,7 +85,9 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
     let _ = write!(
         out,
         "## Trajectory (table `odometry` against `ground_truth`)\n\n\
-         Both trajectories are associated by time (ground truth interpolated) and start at the identity. \
+         Both trajectories are associated by time (ground truth interpolated); the metrics compare them from \
+         their first associated pose on (both re-expressed relative to it). Per sequence, the first plot shows \
+         them as the tables hold them, the second relative to each first pose. \
          KITTI drift follows the KITTI odometry devkit: segment lengths {} m, first frames {}; mean over all segments. \
          ATE is the position RMSE after the least-squares SE(2) alignment; x/y/yaw RMSE are without alignment; RPE \
          is the RMSE of the frame-to-frame relative translation and yaw errors. The pooled row (several sequences) \
@@ -167,7 +169,9 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
         let s = &r.sequence;
         let _ = writeln!(
             out,
-            "![trajectory](plots/{s}/trajectory.svg)\n![errors vs distance](plots/{s}/errors_vs_distance.svg)\n\
+            "![trajectory in the tables' frame (as `odometry` and `ground_truth` hold it)](plots/{s}/trajectory.svg)\n\
+             ![trajectory relative to each first pose (the frame of KITTI drift and RPE)](plots/{s}/trajectory_relative.svg)\n\
+             ![errors vs distance](plots/{s}/errors_vs_distance.svg)\n\
              ![drift per length](plots/{s}/drift_per_length.svg)\n"
         );
     }

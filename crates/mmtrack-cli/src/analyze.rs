@@ -47,16 +47,17 @@ Output: <OUT>/tables/{trajectory_metrics,drift_per_length,relative_pose_errors,m
 mpc_count_distribution,mpc_track_power_std,mpc_chi_classes,mpc_first_path,beam_sweep_summary,spebt_summary,\
 geometric_summary,slam_summary,slam_per_epoch}/sequence=<id>/part-0.parquet, \
 <OUT>/tables/{beam_sweep_pooled,spebt_pooled}/sequence=all/part-0.parquet, \
-<OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md and <OUT>/report.html (the same report as one self-contained page: plots embedded, with the software version, inputs and configuration). The directory appears whole or not at all; an existing one is replaced \
+<OUT>/plots/<id>/*.svg, <OUT>/plots/site=<site>/loss_cdf.svg, <OUT>/report.md and <OUT>/report.html (the same report as one self-contained page: plots inline, a table of contents with anchors, and the provenance: version, build commit, time (SOURCE_DATE_EPOCH when set), command line, inputs and configuration). The directory appears whole or not at all; an existing one is replaced \
 only with --force and only if it holds nothing but earlier results.\n\n\
 Several runs (several TABLES directories, or run=<ID> folders written by `mmtrack process ... --run-id <ID>`; a \
 directory holding tables directly is a run named after the directory): each run is analyzed as above into \
 <OUT>/run=<ID>/, then the runs are compared side by side with polars (lazy scans of the runs' result tables, \
 group-bys per run): <OUT>/tables/run_comparison/sequence=all/part-0.parquet (long format: run, source_table, \
-sequence_id, key, metric, unit, value) and <OUT>/report.md / report.html with one table per result table and a \
-column per run. Pooled trajectory rows per run: `all` pools KITTI drift over the segments of every sequence (as the \
+sequence_id, key, metric, unit, value) and <OUT>/report.md / report.html with one table per result table, a \
+column per run and the difference of each run to the first (B - A, and relative where meaningful), and the runs' \
+curves overlaid per sequence (trajectories, errors against distance, beam-sweep loss CDFs). Pooled trajectory rows per run: `all` pools KITTI drift over the segments of every sequence (as the \
 KITTI devkit pools a dataset), RMSEs and ATE over poses, RPE over frame pairs; `mean` is the mean of the \
-per-sequence values.",
+per-sequence values (in the report where a run has several sequences).",
     after_help = "Examples:\n  mmtrack analyze out/tables -o out/analysis --segment-lengths-m 10,20,30,40,50,60,70,80\n  \
 mmtrack process odometry rec.mcap -o out/runs --preset cfear --run-id cfear\n  \
 mmtrack process odometry rec.mcap -o out/runs --preset fast-cfear --run-id fast-cfear\n  \

@@ -191,14 +191,14 @@ pub fn section(out: &mut String, results: &GeometricResults) {
          handed over (the range is unobservable while the azimuth stays in one beam: not converged, not scored). \
          Beams: measured against a full scan at every epoch.\n\n\
          | sequence | epochs | duration (s) | hand-over (s) | RLS epochs (%) | range RMSE (m) | final range error \
-         (m) | azimuth RMSE (deg) | final azimuth error (deg) | beams measured / full scan | saving | plot |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         (m) | azimuth RMSE (deg) | final azimuth error (deg) | beams measured / full scan | saving |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in &results.sequences {
         let s = &r.summary;
         let _ = writeln!(
             out,
-            "| {} | {} | {:.2} | {} | {:.1} | {} | {} | {} | {} | {} / {} | {:.1} | [{}](plots/{}/{}) |",
+            "| {} | {} | {:.2} | {} | {:.1} | {} | {} | {} | {} | {} / {} | {:.1} |",
             r.sequence,
             s.epochs,
             s.duration_s,
@@ -211,12 +211,16 @@ pub fn section(out: &mut String, results: &GeometricResults) {
             s.beams_measured,
             s.beams_full_scan,
             s.saving,
-            SEQUENCE_PLOT.1,
-            r.sequence,
-            SEQUENCE_PLOT.0
         );
     }
     out.push('\n');
+    for r in &results.sequences {
+        let _ = writeln!(
+            out,
+            "### `{}` (geometric)\n\n![{}](plots/{}/{})\n",
+            r.sequence, SEQUENCE_PLOT.1, r.sequence, SEQUENCE_PLOT.0
+        );
+    }
 }
 
 /// One line per sequence, as the CLI prints it.

@@ -37,7 +37,14 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
             .y_label_area_size(65)
             .build_cartesian_2d(0f64..(blocks - 1) as f64, (y_lo..y_hi).log_scale())
             .map_err(err)?;
-        chart.configure_mesh().x_desc("block (1 ms)").y_desc("RMS AoD error (deg)").draw().map_err(err)?;
+        chart
+            .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
+            .x_desc("block (1 ms)")
+            .y_desc("RMS AoD error (deg)")
+            .draw()
+            .map_err(err)?;
         for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
             let points = curve
                 .rms_deg
@@ -118,7 +125,14 @@ pub fn beam_index_svg(
             .y_label_area_size(55)
             .build_cartesian_2d(0f64..t_end, -0.5..beams + 0.5)
             .map_err(err)?;
-        chart.configure_mesh().x_desc("time (s)").y_desc("beam index").draw().map_err(err)?;
+        chart
+            .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
+            .x_desc("time (s)")
+            .y_desc("beam index")
+            .draw()
+            .map_err(err)?;
         let dots = best.t_s.iter().zip(&best.beam).map(|(&t, &b)| Circle::new((t, b), 3, BLACK.filled()));
         chart
             .draw_series(dots)
@@ -178,7 +192,14 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
             .y_label_area_size(55)
             .build_cartesian_2d(0f64..x_end, 0f64..1.0)
             .map_err(err)?;
-        chart.configure_mesh().x_desc("received-power loss (dB)").y_desc("CDF").draw().map_err(err)?;
+        chart
+            .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
+            .x_desc("received-power loss (dB)")
+            .y_desc("CDF")
+            .draw()
+            .map_err(err)?;
         for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
             let mut sorted: Vec<f64> = curve.loss_db.iter().copied().filter(|v| v.is_finite()).collect();
             sorted.sort_by(f64::total_cmp);

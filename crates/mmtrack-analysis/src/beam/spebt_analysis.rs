@@ -208,13 +208,13 @@ pub fn section(out: &mut String, results: &SpebtResults) {
     }
     out.push_str(
         "\n### Per sequence\n\n| sequence | experiment | slots | runs | abs(alpha) RMSE (%) | AoD RMSE (deg) | \
-         AoA RMSE (deg) | re-initialisations (%) | plot |\n|---|---|---|---|---|---|---|---|---|\n",
+         AoA RMSE (deg) | re-initialisations (%) |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in &results.sequences {
         let s = &r.summary;
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {:.2} | {:.3} | {:.2} | {:.2} | [{}](plots/{}/{}) |",
+            "| {} | {} | {} | {} | {:.2} | {:.3} | {:.2} | {:.2} |",
             r.sequence,
             s.experiment,
             s.slots,
@@ -223,12 +223,16 @@ pub fn section(out: &mut String, results: &SpebtResults) {
             s.rmse_aod_deg,
             s.rmse_aoa_deg,
             s.reinitialisation_share_pct,
-            SEQUENCE_PLOT.1,
-            r.sequence,
-            SEQUENCE_PLOT.0
         );
     }
     out.push('\n');
+    for r in &results.sequences {
+        let _ = writeln!(
+            out,
+            "### `{}` (SPEBT)\n\n![{}](plots/{}/{})\n",
+            r.sequence, SEQUENCE_PLOT.1, r.sequence, SEQUENCE_PLOT.0
+        );
+    }
 }
 
 /// One line per experiment kind, as the CLI prints it.

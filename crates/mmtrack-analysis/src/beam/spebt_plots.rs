@@ -3,7 +3,7 @@
 
 use plotters::prelude::*;
 
-use crate::plot_common::{err, padded_range};
+use crate::plot_common::{err, padded_range, tick_decimals};
 
 /// One realisation against the truth, per slot (index = slot).
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -24,7 +24,7 @@ pub struct SpebtTrackingSeries {
     pub reinitialised: Vec<bool>,
 }
 
-/// Three stacked panels (`|alpha|` on a log axis, AoD, AoA against the
+/// Three stacked panels (`|alpha|` in dB, AoD, AoA against the
 /// slot), the truth in black and the estimate in red, re-initialisations as
 /// blue ticks along the bottom of each panel. Angle lines break where the
 /// angle wraps through +-180 deg.
@@ -41,32 +41,31 @@ pub fn spebt_tracking_svg(title: &str, series: &SpebtTrackingSeries) -> anyhow::
         let root = root.titled(title, ("sans-serif", 20)).map_err(err)?;
         let areas = root.split_evenly((3, 1));
         let x_range = 0f64..(slots - 1) as f64;
-        // |alpha| spans decades along a drive: a log axis shows relative errors.
-        let positive = || s.true_gain.iter().chain(&s.estimate_gain).copied().filter(|v| *v > 0.0 && v.is_finite());
-        let (lo, hi) = positive().fold((f64::INFINITY, 0.0f64), |(a, b), v| (a.min(v), b.max(v)));
-        let (lo, hi) = if lo.is_finite() { (lo / 1.5, hi * 1.5) } else { (1e-9, 1e-3) };
+        // |alpha| spans decades along a drive: in dB (20 log10 |alpha|, a
+        // linear axis with ticks) the distance between the lines is the
+        // relative error. plotters' log axis drew no tick labels within a decade.
+        let db = |values: &[f64]| -> Vec<f64> {
+            values.iter().map(|v| if *v > 0.0 && v.is_finite() { 20.0 * v.log10() } else { f64::NAN }).collect()
+        };
+        let (true_db, estimate_db) = (db(&s.true_gain), db(&s.estimate_gain));
+        let range = padded_range(true_db.iter().chain(&estimate_db).copied());
         let mut chart = ChartBuilder::on(&areas[0])
             .margin(10)
-            .x_label_area_size(35)
+            .x_label_area_size(45)
             .y_label_area_size(80)
-            .build_cartesian_2d(x_range.clone(), (lo..hi).log_scale())
+            .build_cartesian_2d(x_range.clone(), range.clone())
             .map_err(err)?;
         chart
             .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
             .x_desc("slot")
-            .y_desc("|alpha|")
-            .y_label_formatter(&|v| format!("{v:.1e}"))
+            .y_desc("|alpha| (dB, 20 log10)")
+            .y_label_formatter(&|v| format!("{v:.decimals$}", decimals = tick_decimals(&range)))
             .draw()
             .map_err(err)?;
-        let gain_segments = |values: &[f64]| vec![positive_points(values)];
-        draw_panel(
-            &mut chart,
-            s,
-            gain_segments(&s.true_gain),
-            gain_segments(&s.estimate_gain),
-            lo,
-            lo * (hi / lo).powf(0.03),
-        )?;
+        let tick = range.start + 0.03 * (range.end - range.start);
+        draw_panel(&mut chart, s, vec![finite_points(&true_db)], vec![finite_points(&estimate_db)], range.start, tick)?;
         for (area, label, truth, estimate) in [
             (&areas[1], "AoD (deg)", &s.true_aod_deg, &s.estimate_aod_deg),
             (&areas[2], "AoA (deg)", &s.true_aoa_deg, &s.estimate_aoa_deg),
@@ -74,15 +73,17 @@ pub fn spebt_tracking_svg(title: &str, series: &SpebtTrackingSeries) -> anyhow::
             let range = padded_range(truth.iter().chain(estimate.iter()).copied());
             let mut chart = ChartBuilder::on(area)
                 .margin(10)
-                .x_label_area_size(35)
+                .x_label_area_size(45)
                 .y_label_area_size(80)
                 .build_cartesian_2d(x_range.clone(), range.clone())
                 .map_err(err)?;
             chart
                 .configure_mesh()
+                .label_style(crate::plot_common::TICK_FONT)
+                .axis_desc_style(crate::plot_common::AXIS_FONT)
                 .x_desc("slot")
                 .y_desc(label)
-                .y_label_formatter(&|v| format!("{v:.0}"))
+                .y_label_formatter(&|v| format!("{v:.decimals$}", decimals = tick_decimals(&range)))
                 .draw()
                 .map_err(err)?;
             let tick = range.start + 0.03 * (range.end - range.start);
@@ -132,9 +133,9 @@ where
     crate::plot_common::draw_legend(chart, SeriesLabelPosition::UpperRight)
 }
 
-/// `(slot, value)` of the positive finite values (a log axis shows no others).
-fn positive_points(values: &[f64]) -> Vec<(f64, f64)> {
-    values.iter().enumerate().filter(|(_, v)| v.is_finite() && **v > 0.0).map(|(k, v)| (k as f64, *v)).collect()
+/// `(slot, value)` of the finite values.
+fn finite_points(values: &[f64]) -> Vec<(f64, f64)> {
+    values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(k, v)| (k as f64, *v)).collect()
 }
 
 /// `(slot, degrees)` runs of finite values, split where consecutive values

@@ -235,23 +235,21 @@ pub fn section(out: &mut String, results: &BeamSweepResults) {
     }
     out.push_str(
         "\n### Per sequence\n\n| sequence | tracker | sweeps | mean loss (dB) | median loss (dB) | p90 loss (dB) | top-1 \
-         | within one | beams per sweep | re-initialisations | plots |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+         | within one | beams per sweep | re-initialisations |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in &results.sequences {
-        for (k, s) in r.summary.iter().enumerate() {
-            let plots = if k == 0 {
-                SEQUENCE_PLOTS
-                    .iter()
-                    .map(|(file, caption)| format!("[{caption}](plots/{}/{file})", r.sequence))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            } else {
-                String::new()
-            };
-            let _ = writeln!(out, "| {} | {} | {} | {} | {plots} |", r.sequence, s.tracker, s.sweeps, summary_cells(s));
+        for s in &r.summary {
+            let _ = writeln!(out, "| {} | {} | {} | {} |", r.sequence, s.tracker, s.sweeps, summary_cells(s));
         }
     }
     out.push('\n');
+    for r in &results.sequences {
+        let _ = writeln!(out, "### `{}` (beam sweeps)\n", r.sequence);
+        for (file, caption) in SEQUENCE_PLOTS {
+            let _ = writeln!(out, "![{caption}](plots/{}/{file})", r.sequence);
+        }
+        out.push('\n');
+    }
 }
 
 /// One line per site and tracker, as the CLI prints it.

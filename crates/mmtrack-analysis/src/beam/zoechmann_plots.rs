@@ -79,7 +79,14 @@ fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace:
         .y_label_area_size(55)
         .build_cartesian_2d(x, y)
         .map_err(err)?;
-    chart.configure_mesh().x_desc("x along the receiver's heading (m)").y_desc("y (m)").draw().map_err(err)?;
+    chart
+        .configure_mesh()
+        .label_style(crate::plot_common::TICK_FONT)
+        .axis_desc_style(crate::plot_common::AXIS_FONT)
+        .x_desc("x along the receiver's heading (m)")
+        .y_desc("y (m)")
+        .draw()
+        .map_err(err)?;
     let truth = BLACK.stroke_width(2);
     chart
         .draw_series(LineSeries::new(trace.truth_m.iter().map(|p| (p[0], p[1])), truth))
@@ -121,7 +128,14 @@ fn draw_nmse(
         .y_label_area_size(55)
         .build_cartesian_2d(0f64..t_end, y.clone())
         .map_err(err)?;
-    chart.configure_mesh().x_desc("time (s)").y_desc("NMSE of the range (dB)").draw().map_err(err)?;
+    chart
+        .configure_mesh()
+        .label_style(crate::plot_common::TICK_FONT)
+        .axis_desc_style(crate::plot_common::AXIS_FONT)
+        .x_desc("time (s)")
+        .y_desc("NMSE of the range (dB)")
+        .draw()
+        .map_err(err)?;
     // Variants (after the paper's four) thin and first, so the four stay on top.
     let order: Vec<usize> = (4..curves.len()).chain(0..curves.len().min(4)).collect();
     for index in order {
@@ -206,7 +220,14 @@ fn draw_nlos_map(
         .y_label_area_size(55)
         .build_cartesian_2d(x.clone(), y.clone())
         .map_err(err)?;
-    chart.configure_mesh().x_desc("x along the receiver's heading (m)").y_desc("y (m)").draw().map_err(err)?;
+    chart
+        .configure_mesh()
+        .label_style(crate::plot_common::TICK_FONT)
+        .axis_desc_style(crate::plot_common::AXIS_FONT)
+        .x_desc("x along the receiver's heading (m)")
+        .y_desc("y (m)")
+        .draw()
+        .map_err(err)?;
     let wall = BLACK.stroke_width(3);
     for (i, wall_y) in walls_y_m.into_iter().enumerate() {
         let drawn = chart.draw_series(LineSeries::new([(x.start, wall_y), (x.end, wall_y)], wall)).map_err(err)?;
@@ -256,7 +277,7 @@ fn draw_nlos_map(
         .position(SeriesLabelPosition::UpperLeft)
         .border_style(BLACK)
         .background_style(WHITE.mix(0.85))
-        .label_font(("sans-serif", 12))
+        .label_font(crate::plot_common::LEGEND_FONT)
         .draw()
         .map_err(err)?;
     Ok(())
@@ -282,6 +303,8 @@ fn draw_nlos_errors(
         .map_err(err)?;
     chart
         .configure_mesh()
+        .label_style(crate::plot_common::TICK_FONT)
+        .axis_desc_style(crate::plot_common::AXIS_FONT)
         .x_desc("time (s)")
         .y_desc("RMS position error (m)")
         .y_label_formatter(&|v| format!("{v:.2}"))

@@ -309,15 +309,14 @@ pub fn section(out: &mut String, results: &[SlamSequenceResult]) {
          epochs at which every VA and every SP seen in at least 3 epochs were confirmed. The paper's targets: UE 0.5 m, \
          0.02 rad, 0.3 m; VA 0.8 m; SP 0.6 m; all VAs by epoch 26, all SPs by epoch 91.\n\n\
          | sequence | epochs | particles | UE position (m) | heading (rad) | clock bias (m) | VA (m) | SP (m) | all VAs \
-         at epoch | all SPs at epoch | false sources | skipped paths | plots |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         at epoch | all SPs at epoch | false sources | skipped paths |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
         let s = &r.summary;
-        let plots: Vec<String> = PLOTS.iter().map(|(f, _)| format!("[{f}](plots/{}/{f})", r.sequence)).collect();
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {:.3} | {:.4} | {:.3} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {:.3} | {:.4} | {:.3} | {} | {} | {} | {} | {} | {} |",
             r.sequence,
             s.epochs,
             s.particles,
@@ -330,10 +329,16 @@ pub fn section(out: &mut String, results: &[SlamSequenceResult]) {
             epoch(s.all_sp_epoch_max, s.epochs),
             s.false_sources,
             s.skipped_paths,
-            plots.join(", ")
         );
     }
     out.push('\n');
+    for r in results {
+        let _ = writeln!(out, "### `{}` (SLAM)\n", r.sequence);
+        for (file, caption) in PLOTS {
+            let _ = writeln!(out, "![{caption}](plots/{}/{file})", r.sequence);
+        }
+        out.push('\n');
+    }
 }
 
 /// One line per sequence for the terminal.

@@ -58,7 +58,14 @@ pub fn map_svg(title: &str, figure: &MapFigure) -> anyhow::Result<String> {
             .y_label_area_size(55)
             .build_cartesian_2d((cx - half)..(cx + half), (cy - half)..(cy + half))
             .map_err(err)?;
-        chart.configure_mesh().x_desc("x (m)").y_desc("y (m)").draw().map_err(err)?;
+        chart
+            .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
+            .x_desc("x (m)")
+            .y_desc("y (m)")
+            .draw()
+            .map_err(err)?;
         let track = |points: &[[f64; 2]]| points.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>();
         let grey = RGBColor(120, 120, 120);
         chart
@@ -121,7 +128,14 @@ pub fn epoch_curves_svg(title: &str, y_desc: &str, curves: &[EpochCurve]) -> any
             .y_label_area_size(65)
             .build_cartesian_2d(1f64..epochs as f64, 0f64.min(range.start)..range.end)
             .map_err(err)?;
-        chart.configure_mesh().x_desc("epoch k (200 ms)").y_desc(y_desc).draw().map_err(err)?;
+        chart
+            .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
+            .x_desc("epoch k (200 ms)")
+            .y_desc(y_desc)
+            .draw()
+            .map_err(err)?;
         for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
             let points =
                 curve.values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(k, v)| ((k + 1) as f64, *v));

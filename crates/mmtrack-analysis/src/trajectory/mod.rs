@@ -129,6 +129,12 @@ pub struct Association {
     pub estimate: Vec<Se2>,
     /// `first_from_vehicle` of the ground truth: `gt0.inverse() * gt_k`.
     pub ground_truth: Vec<Se2>,
+    /// `est0`: the first associated estimate pose in the estimate table's
+    /// frame (`est0 * estimate[k]` is pose k as the table holds it).
+    pub estimate_first: Se2,
+    /// `gt0`: the first associated ground-truth pose in the ground-truth
+    /// table's frame.
+    pub ground_truth_first: Se2,
     /// Estimate poses whose time matched a ground-truth time exactly.
     pub exact_matches: usize,
     /// Estimate poses whose ground truth was interpolated.
@@ -140,6 +146,19 @@ pub struct Association {
 }
 
 impl Association {
+    /// The estimate as its table holds it (`est0 * estimate[k]`).
+    #[must_use]
+    pub fn estimate_in_table_frame(&self) -> Vec<Se2> {
+        self.estimate.iter().map(|p| self.estimate_first * *p).collect()
+    }
+
+    /// The ground truth as its table holds it (`gt0 * ground_truth[k]`,
+    /// interpolated at the estimate's times).
+    #[must_use]
+    pub fn ground_truth_in_table_frame(&self) -> Vec<Se2> {
+        self.ground_truth.iter().map(|p| self.ground_truth_first * *p).collect()
+    }
+
     /// Number of associated poses.
     #[must_use]
     pub fn len(&self) -> usize {
@@ -180,6 +199,8 @@ pub fn associate(estimate: &[StampedPose], ground_truth: &[StampedPose]) -> Resu
         t_ns: Vec::new(),
         estimate: Vec::new(),
         ground_truth: Vec::new(),
+        estimate_first: Se2::IDENTITY,
+        ground_truth_first: Se2::IDENTITY,
         exact_matches: 0,
         interpolated: 0,
         dropped_before: 0,
@@ -219,6 +240,8 @@ pub fn associate(estimate: &[StampedPose], ground_truth: &[StampedPose]) -> Resu
             gt_last_ns: gt_last,
         });
     }
+    out.estimate_first = out.estimate[0];
+    out.ground_truth_first = out.ground_truth[0];
     relative_to_first(&mut out.estimate);
     relative_to_first(&mut out.ground_truth);
     Ok(out)

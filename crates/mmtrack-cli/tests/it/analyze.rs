@@ -341,11 +341,22 @@ fn analyze_puts_runs_side_by_side_with_pooled_rows_a_duckdb_query_reproduces() {
         assert!(report.is_file() && dir.path().join(format!("cmp/run={run}/report.html")).is_file(), "{run}");
     }
     let report = std::fs::read_to_string(dir.path().join("cmp/report.md")).unwrap();
-    assert!(report.contains("## Runs side by side") && report.contains("| a | b | baseline |"), "{report}");
+    assert!(
+        report.contains("## Runs side by side")
+            && report.contains("| a | b | b - a | b vs a | baseline | baseline - a | baseline vs a |"),
+        "{report}"
+    );
     assert!(report.contains("| all | kitti_translational_pct | % |"), "{report}");
     // Run baseline has no `long` sequence.
     let long_ate = report.lines().find(|l| l.starts_with("| long | ate_rmse_m |")).unwrap();
-    assert!(long_ate.ends_with("| - |"), "{long_ate}");
+    assert!(long_ate.ends_with("| - | n/a | - |"), "{long_ate}");
+    // The runs' curves overlaid, per sequence.
+    for sequence in ["long", "short"] {
+        for plot in ["trajectory_overlay.svg", "errors_overlay.svg"] {
+            assert!(report.contains(&format!("](plots/{sequence}/{plot})")), "{sequence} {plot}: {report}");
+            assert!(dir.path().join(format!("cmp/plots/{sequence}/{plot}")).is_file(), "{sequence} {plot}");
+        }
+    }
 
     // Independent check: DuckDB pools the runs' own tables by the stated rules.
     let checked = Command::new(python).args(["-c", CAMPAIGN_QUERY]).arg(dir.path().join("cmp")).output().unwrap();

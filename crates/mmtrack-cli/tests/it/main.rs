@@ -30,6 +30,7 @@ mod realdata_beams;
 mod realdata_nmea;
 mod realdata_oxford;
 mod realdata_ros2;
+mod report_browser;
 mod reproduce;
 mod reproduce_kim;
 mod reproduce_shaham;

@@ -131,3 +131,62 @@ fn oxford_full_sequence_ground_truth_chains_to_9_km() {
     let length_km = path_length_m(&poses) / 1000.0;
     assert!((length_km - 9.024_648_272_136_93).abs() < 1e-9, "{length_km} km");
 }
+
+/// Issue 28: the report's trajectory plot is in the tables' frame (the
+/// Oxford ground truth starts about 147 m east of its origin; re-anchored at
+/// the origin the plot showed x 0-20 m beside a table of 147-166 m), and the
+/// plot relative to the first poses says so.
+#[test]
+fn oxford_report_trajectory_plot_is_in_the_frame_of_the_tables() {
+    use mmtrack_core::OdometryEstimate;
+    use mmtrack_io::table::{GroundTruthPose, read_table};
+    let Some(realdata) = super::common::realdata("oxford_report_frame") else { return };
+    let input = realdata.join("oxford-radar-tiny");
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["ingest", "oxford", input.to_str().unwrap(), "-o", "tiny.mcap", "--quiet"][..],
+        &["process", "odometry", "tiny.mcap", "-o", "tables", "--quiet"],
+        &["analyze", "tables", "-o", "an", "--segment-lengths-m", "2,4,8", "--step-frames", "1", "--quiet"],
+    ] {
+        let out = mmtrack(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+    }
+    let part = |table: &str| dir.path().join(format!("tables/{table}/sequence=oxford-radar-tiny/part-0.parquet"));
+    let truth: Vec<f64> = read_table::<GroundTruthPose>(&part("ground_truth"))
+        .unwrap()
+        .iter()
+        .map(|p| p.0.parent_from_child.x_m)
+        .collect();
+    let estimate: Vec<f64> =
+        read_table::<OdometryEstimate>(&part("odometry")).unwrap().iter().map(|e| e.world_from_vehicle.x_m).collect();
+    let range = |v: &[f64]| {
+        (v.iter().copied().fold(f64::INFINITY, f64::min), v.iter().copied().fold(f64::NEG_INFINITY, f64::max))
+    };
+    let ((t_lo, t_hi), (e_lo, e_hi)) = (range(&truth), range(&estimate));
+    assert!(t_lo > 100.0, "the sample's ground truth starts away from the origin: {t_lo} m");
+    // The x tick labels of a plot (numeric texts anchored in the middle).
+    let x_ticks = |file: &str| -> (f64, f64) {
+        let svg = std::fs::read_to_string(dir.path().join("an/plots/oxford-radar-tiny").join(file)).unwrap();
+        let ticks: Vec<f64> = svg
+            .split("text-anchor=\"middle\"")
+            .skip(1)
+            .filter_map(|rest| rest.split('>').nth(1)?.split('<').next()?.trim().parse().ok())
+            .collect();
+        range(&ticks)
+    };
+    let (lo, hi) = x_ticks("trajectory.svg");
+    // The axis spans both tables' x (padded by 5 %, square axes) and no more than twice it.
+    let (span_lo, span_hi) = (t_lo.min(e_lo), t_hi.max(e_hi));
+    assert!(
+        lo <= span_lo + 2.0 && hi >= span_hi - 2.0 && hi - lo <= 2.0 * (span_hi - span_lo),
+        "x ticks {lo}..{hi}, tables {span_lo}..{span_hi}"
+    );
+    let (lo, hi) = x_ticks("trajectory_relative.svg");
+    assert!(lo <= 0.0 && hi < 50.0, "relative plot from 0: {lo}..{hi}");
+    let report = std::fs::read_to_string(dir.path().join("an/report.md")).unwrap();
+    assert!(report.contains("![trajectory relative to each first pose"), "{report}");
+    eprintln!(
+        "oxford sample: tables x {span_lo:.1}..{span_hi:.1} m, trajectory.svg x ticks {:?}",
+        x_ticks("trajectory.svg")
+    );
+}
