@@ -40,8 +40,11 @@ def check_all_types(root):
     expected = {
         ("/ground_truth/pose", "mmtrack.Pose2D"): 5,
         ("/viz/ground_truth", "foxglove.PoseInFrame"): 5,
-        # world -> base_link per pose, and once the mount base_link -> gnss.
-        ("/tf", "foxglove.FrameTransforms"): 6,
+        # world -> base_link per pose; once, the static mount base_link -> gnss.
+        ("/tf", "foxglove.FrameTransforms"): 5,
+        ("/tf_static", "foxglove.FrameTransforms"): 1,
+        # The delay x time view of the one CIR set.
+        ("/viz/cir", "foxglove.RawImage"): 1,
         ("/gnss/fix", "mmtrack.GnssFix"): 1,
         ("/viz/gnss", "foxglove.LocationFix"): 1,
         ("/channel/cir", "mmtrack.CirSnapshot"): 1,
@@ -50,7 +53,7 @@ def check_all_types(root):
     check(dict(counts) == expected, f"channel counts {dict(counts)}")
     poses = [d for t, _, _, d in messages if t == "/ground_truth/pose"]
     check([p.x_m for p in poses] == [0.0, 1.0, 2.0, 3.0, 4.0], "pose x_m")
-    check(poses[3].yaw_rad == 0.1 * 3 and poses[0].child_frame == "vehicle", "pose yaw/frame")
+    check(poses[3].yaw_rad == 0.1 * 3 and poses[0].child_frame == "base_link", "pose yaw/frame")
     viz = [d for t, _, _, d in messages if t == "/viz/ground_truth"]
     yaw = 2 * math.atan2(viz[3].pose.orientation.z, viz[3].pose.orientation.w)
     check(abs(yaw - 0.3) < 1e-12 and viz[3].frame_id == "world", "foxglove pose view")

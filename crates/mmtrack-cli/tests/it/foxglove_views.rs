@@ -186,6 +186,45 @@ fn foxglove_messages_decode_frames_chain_and_estimates_are_added_to_a_copy() {
     assert_eq!(plain["counts"]["foxglove.RawImage"], 8, "{plain}");
 }
 
+/// NumPy re-implementation of the documented CIR waterfall (`/viz/cir`):
+/// every image against the power delay profiles of the last 64 sets.
+const CIR_VIEW: &str = r#"
+import json, sys
+import numpy as np
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+with open(sys.argv[1], "rb") as f:
+    reader = make_reader(f, decoder_factories=[DecoderFactory()])
+    snapshots, images = [], []
+    for _, channel, _, d in reader.iter_decoded_messages(topics=["/channel/cir", "/viz/cir"]):
+        (snapshots if channel.topic == "/channel/cir" else images).append(d)
+sets = {}
+for s in snapshots:
+    power = np.array(s.taps_re) ** 2 + np.array(s.taps_im) ** 2
+    sets.setdefault(s.set_index, []).append(power)
+order = sorted(sets)
+taps = len(sets[order[0]][0])
+per_column = max(1, -(-taps // 256))
+rows = []
+for k in order:
+    pdp = np.mean(sets[k], axis=0)
+    columns = [pdp[i:i + per_column].max() for i in range(0, taps, per_column)]
+    with np.errstate(divide="ignore"):
+        rows.append(10 * np.log10(columns))
+assert len(images) == len(order), (len(images), len(order))
+worst = 0
+for n, image in enumerate(images):
+    shown = np.array(rows[max(0, n + 1 - 64):n + 1])
+    level = (shown - (shown.max() - 60)) / 60
+    expected = np.where(level > 0, np.round(255 * np.minimum(level, 1)), 0)
+    got = np.frombuffer(image.data, np.uint8).reshape(image.height, image.width)
+    assert got.shape == expected.shape, (got.shape, expected.shape)
+    worst = max(worst, int(np.abs(got - expected).max()))
+print(json.dumps({"sets": len(order), "images": len(images), "taps": taps, "width": images[-1].width,
+                  "max_abs_diff": worst, "bright": int((np.frombuffer(images[-1].data, np.uint8) > 128).sum())}))
+"#;
+
 #[test]
 fn sounder_recordings_name_their_scenario_time_base() {
     let python = venv_python().expect("Python 3 with pip access to PyPI (the mcap and protobuf readers) is needed");
@@ -201,6 +240,20 @@ fn sounder_recordings_name_their_scenario_time_base() {
     // Both cars move in /tf.
     assert_eq!(chain(&json, "tx"), ["tx", "world"], "{json}");
     assert_eq!(chain(&json, "rx"), ["rx", "world"], "{json}");
+
+    // Issue 28: the delay x time view, image by image against NumPy (one
+    // grey level at most: summation order can move a value across a rounding edge).
+    let script = d.join("cir_view.py");
+    std::fs::write(&script, CIR_VIEW).unwrap();
+    let out = Command::new(&python).arg(&script).arg(d.join("s.mcap")).output().unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let view: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    eprintln!("CIR view against NumPy: {view}");
+    assert_eq!(view["sets"], 3, "{view}");
+    assert_eq!(view["images"], 3, "{view}");
+    assert!(view["max_abs_diff"].as_u64().unwrap() <= 1, "{view}");
+    assert!(view["bright"].as_u64().unwrap() > 0, "a blank view: {view}");
 }
 
 /// Issue 28: SLAM recordings show their sources and each epoch's true

@@ -31,6 +31,8 @@ pub const TF_TOPIC: &str = "/tf";
 pub const TF_STATIC_TOPIC: &str = "/tf_static";
 /// Topic of channel impulse responses.
 pub const CIR_TOPIC: &str = "/channel/cir";
+/// Display view of the CIRs: a delay x time image (`foxglove.RawImage`).
+pub const CIR_VIZ_TOPIC: &str = "/viz/cir";
 /// Topic of the true multipath components of simulated CIRs.
 pub const MPC_TRUTH_TOPIC: &str = "/channel/mpc_truth";
 /// Topic of beam sweeps of a measured codebook.
@@ -205,6 +207,15 @@ pub const CHANNELS: &[ChannelSpec] = &[
         canonical: true,
         meaning: "one source of the SLAM paths, written once: the base station (known to the UE) and, as ground \
                   truth, each virtual anchor and scattering point",
+    },
+    ChannelSpec {
+        topic: CIR_VIZ_TOPIC,
+        schema_names: &["foxglove.RawImage"],
+        canonical: false,
+        meaning: "display view of /channel/cir for Foxglove's image panel: a delay x time waterfall (mono8, frame \
+                  rx), one image per completed snapshot set holding the last 64 sets, newest at the bottom; a row is \
+                  the set's power delay profile (mean |h|^2 over its snapshots), a column up to ceil(taps / 256) taps \
+                  (their largest power); grey 255 = the image's strongest tap, 0 = 60 dB below it or weaker",
     },
     ChannelSpec {
         topic: SLAM_SOURCES_VIZ_TOPIC,

@@ -17,6 +17,7 @@
 
 pub mod cartesian;
 pub mod channels;
+pub mod cir_view;
 mod copy;
 mod metadata;
 pub mod pulse;

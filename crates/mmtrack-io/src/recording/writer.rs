@@ -11,9 +11,10 @@ use prost::Message;
 use super::METADATA_NAME;
 use super::cartesian::{CartesianGrid, CartesianResampler};
 use super::channels::{
-    BEAM_SWEEP_TOPIC, CIR_TOPIC, GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC, MPC_TRUTH_TOPIC,
-    PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC, TF_STATIC_TOPIC, TF_TOPIC,
+    BEAM_SWEEP_TOPIC, CIR_TOPIC, CIR_VIZ_TOPIC, GNSS_ARRAY_TOPIC, GNSS_ARRAY_VIZ_TOPIC, GNSS_TOPIC, GNSS_VIZ_TOPIC,
+    MPC_TRUTH_TOPIC, PoseStream, RADAR_CARTESIAN_TOPIC, RADAR_IMAGE_TOPIC, RADAR_META_TOPIC, TF_STATIC_TOPIC, TF_TOPIC,
 };
+use super::cir_view::{CirWaterfall, WaterfallImage};
 use super::metadata::RecordingMetadata;
 use super::reader::RawMessage;
 use super::tf::{GNSS_FRAME, RADAR_FRAME, VEHICLE_FRAME, frame_transform, timestamp, vehicle_frame, yaw_quaternion};
@@ -196,6 +197,10 @@ pub struct RecordingWriter {
     /// Positions of the SLAM sources written, by kind (`bs`, `va`, `sp`) and
     /// index, for the path markers of later epochs.
     slam_sources_m: BTreeMap<(&'static str, usize), [f64; 3]>,
+    /// The delay x time view of the CIR snapshots (`/viz/cir`) and the time
+    /// of the last snapshot added to it.
+    cir_waterfall: CirWaterfall,
+    cir_last_t_ns: i64,
 }
 
 impl RecordingWriter {
@@ -245,6 +250,8 @@ impl RecordingWriter {
             mounts_needed: BTreeSet::new(),
             mounts_present: BTreeSet::new(),
             slam_sources_m: BTreeMap::new(),
+            cir_waterfall: CirWaterfall::default(),
+            cir_last_t_ns: 0,
         })
     }
 
@@ -626,6 +633,29 @@ impl RecordingWriter {
             first_path_hint_s: cir.first_path_hint_s,
         };
         self.write_spec(CIR_TOPIC, cir.t_ns, &message, None)?;
+        if self.foxglove_views {
+            if let Some(image) = self.cir_waterfall.add(cir.set_index, cir.taps.iter().map(|t| t.norm_sqr())) {
+                self.write_cir_view(self.cir_last_t_ns, &image)?;
+            }
+            self.cir_last_t_ns = cir.t_ns;
+        }
+        Ok(())
+    }
+
+    /// Writes one image of the CIR waterfall on `/viz/cir` (mono8
+    /// `foxglove.RawImage`, frame `rx`), at the time of its newest set's
+    /// last snapshot ([`super::cir_view`]).
+    fn write_cir_view(&mut self, t_ns: i64, image: &WaterfallImage) -> Result<()> {
+        let view = RawImage {
+            timestamp: timestamp(t_ns),
+            frame_id: "rx".into(),
+            width: image.width,
+            height: image.height,
+            encoding: "mono8".into(),
+            step: image.width,
+            data: bytes::Bytes::copy_from_slice(&image.pixels),
+        };
+        self.write_foxglove(CIR_VIZ_TOPIC, t_ns, &view, None)?;
         Ok(())
     }
 
@@ -694,6 +724,9 @@ impl RecordingWriter {
     pub fn finish(mut self) -> Result<WriteSummary> {
         if self.foxglove_views {
             self.write_mounts()?;
+            if let Some(image) = self.cir_waterfall.finish_set() {
+                self.write_cir_view(self.cir_last_t_ns, &image)?;
+            }
         }
         let path = self.file.target().to_path_buf();
         self.mcap.finish().map_err(|e| write_err(&path, e))?;
