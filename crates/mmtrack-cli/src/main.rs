@@ -14,6 +14,7 @@ mod demo;
 mod export;
 mod ingest;
 mod inspect;
+mod manifest;
 mod output_args;
 mod process;
 mod process_beam;
@@ -147,6 +148,24 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 /// Ends the process quietly when stdout is a pipe whose reader has gone
 /// (`mmtrack inspect x.mcap | head -1`): Rust ignores SIGPIPE, so `println!`
 /// panics on the EPIPE error; every other panic keeps the default report.
+/// Runs the words (after `mmtrack`) of a manifest's ingest or analyze task,
+/// quietly, on the current pool.
+///
+/// # Errors
+/// A usage error (one line), another command, or the command's own error.
+fn run_words(words: &[String]) -> anyhow::Result<()> {
+    let argv = std::iter::once("mmtrack").chain(words.iter().map(String::as_str)).chain(["--quiet"]);
+    let cli = Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
+    if !matches!(cli.command, Command::Ingest(_) | Command::Analyze(_)) {
+        anyhow::bail!("a manifest task runs ingest, process or analyze");
+    }
+    let code = run(cli)?;
+    if code != ExitCode::SUCCESS {
+        anyhow::bail!("exited with {code:?}");
+    }
+    Ok(())
+}
+
 fn exit_quietly_on_a_closed_pipe() {
     let default_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
