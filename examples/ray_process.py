@@ -80,7 +80,8 @@ def main():
     if address:
         ray.init(address=address, log_to_driver=False)
     else:
-        ray.init(num_cpus=args.num_cpus, include_dashboard=False, log_to_driver=False)
+        # "local": a new Ray of its own, even when `ray start` runs a cluster on this machine.
+        ray.init(address="local", num_cpus=args.num_cpus, include_dashboard=False, log_to_driver=False)
     largest = max(node["Resources"].get("CPU", 0) for node in ray.nodes() if node["Alive"])
     for task in tasks:
         task["threads"] = task["threads"] or args.threads

@@ -504,8 +504,9 @@ impl Drop for RayHead {
 /// Issue 27: `examples/ray_process.py` against a Ray head started on the
 /// loopback address (`RAY_ADDRESS`), on a campaign of ingest, process and
 /// analyze steps: the tables are byte-identical to the local `process
-/// manifest`; a task that fails once is retried and succeeds; run again
-/// with `--skip-existing`, every task is skipped.
+/// manifest`; a task that fails once is retried and succeeds. Run again
+/// with `--skip-existing` and without `RAY_ADDRESS` (a local Ray of its
+/// own), every task is skipped.
 #[test]
 fn ray_script_on_a_loopback_head_gives_the_local_tables() {
     let python = ray_python();
@@ -537,20 +538,23 @@ fn ray_script_on_a_loopback_head_gives_the_local_tables() {
     let head = RayHead::start(&python);
     let head_started_s = started.elapsed().as_secs_f64();
     let example = root().join("examples/ray_process.py");
-    let run = |extra: &[&str]| {
-        let out = Command::new(&python)
+    let run = |extra: &[&str], address: Option<&str>| {
+        let mut command = Command::new(&python);
+        command
             .arg(&example)
             .args(["steps.toml", "ray", "--mmtrack", wrapper.to_str().unwrap(), "--retries", "2"])
             .args(extra)
-            .env("RAY_ADDRESS", &head.address)
-            .current_dir(d)
-            .output()
-            .unwrap();
+            .current_dir(d);
+        match address {
+            Some(address) => command.env("RAY_ADDRESS", address),
+            None => command.env_remove("RAY_ADDRESS"),
+        };
+        let out = command.output().unwrap();
         let (stdout, stderr) = text(&out);
         assert!(out.status.success(), "{stdout}\n{stderr}");
         stdout
     };
-    let stdout = run(&[]);
+    let stdout = run(&[], Some(&head.address));
     assert!(stdout.contains("4 of 4 tasks done on Ray (0 skipped as complete)"), "{stdout}");
     assert!(table_bytes(&d.join("ray")) == reference, "the Ray run differs from the local one");
     assert!(d.join("analysis/report.md").is_file());
@@ -561,9 +565,11 @@ fn ray_script_on_a_loopback_head_gives_the_local_tables() {
     assert!(calls.contains("--task 2 --threads 2"), "{calls}");
     assert!(calls.contains("--task 0 --threads 1"), "{calls}");
 
-    let again = run(&["--skip-existing"]);
-    assert!(again.contains("4 of 4 tasks done on Ray (4 skipped as complete)"), "{again}");
     drop(head);
+    // Without RAY_ADDRESS the script starts a Ray of its own; resumed, every
+    // task is complete.
+    let again = run(&["--skip-existing", "--num-cpus", "2"], None);
+    assert!(again.contains("4 of 4 tasks done on Ray (4 skipped as complete)"), "{again}");
     eprintln!("ray head started in {head_started_s:.1} s; test {:.1} s", started.elapsed().as_secs_f64());
 }
 

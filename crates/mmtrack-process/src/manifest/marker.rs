@@ -189,7 +189,8 @@ mod tests {
 
         let out = tables.join("out.bin");
         std::fs::write(&out, b"12345").unwrap();
-        let done = Record { command: command.clone(), state: State::Done, outputs: outputs_of(&[out.clone()]) };
+        let done =
+            Record { command: command.clone(), state: State::Done, outputs: outputs_of(std::slice::from_ref(&out)) };
         assert_eq!(done.outputs[0].bytes, 5);
         write(tables, &done).unwrap();
         assert_eq!(resume(read(tables, &command).unwrap().as_ref()), Resume::Skip);
