@@ -148,22 +148,25 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 /// Ends the process quietly when stdout is a pipe whose reader has gone
 /// (`mmtrack inspect x.mcap | head -1`): Rust ignores SIGPIPE, so `println!`
 /// panics on the EPIPE error; every other panic keeps the default report.
-/// Runs the words (after `mmtrack`) of a manifest's ingest or analyze task,
-/// quietly, on the current pool.
+/// Runs the words (after `mmtrack`) of a manifest task (ingest, process or
+/// analyze), quietly, on the current pool; for a process task, the table
+/// files it wrote.
 ///
 /// # Errors
 /// A usage error (one line), another command, or the command's own error.
-fn run_words(words: &[String]) -> anyhow::Result<()> {
+fn run_words(words: &[String]) -> anyhow::Result<Option<Vec<PathBuf>>> {
     let argv = std::iter::once("mmtrack").chain(words.iter().map(String::as_str)).chain(["--quiet"]);
     let cli = Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
-    if !matches!(cli.command, Command::Ingest(_) | Command::Analyze(_)) {
-        anyhow::bail!("a manifest task runs ingest, process or analyze");
+    match &cli.command {
+        Command::Process(args) => return process::run_pipeline(args, true).map(Some),
+        Command::Ingest(_) | Command::Analyze(_) => {}
+        _ => anyhow::bail!("a manifest task runs ingest, process or analyze"),
     }
     let code = run(cli)?;
     if code != ExitCode::SUCCESS {
         anyhow::bail!("exited with {code:?}");
     }
-    Ok(())
+    Ok(None)
 }
 
 fn exit_quietly_on_a_closed_pipe() {

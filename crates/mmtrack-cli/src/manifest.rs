@@ -13,7 +13,7 @@ use mmtrack_io::Overwrite;
 use mmtrack_io::atomic::{AtomicFile, Durability};
 use mmtrack_process::manifest::from_dataset::{self, Layout};
 use mmtrack_process::manifest::marker::{self, Record, Resume, State};
-use mmtrack_process::manifest::{self, Manifest, Outcome, Step, Task};
+use mmtrack_process::manifest::{self, Manifest, Outcome, Task};
 
 use crate::threads::ThreadsArg;
 
@@ -111,7 +111,7 @@ pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             bail!("{file}: --task {n}: the manifest has tasks 0 to {}", manifest.tasks.len() - 1);
         };
         check_needs_done(&manifest, task, &output, &file.to_string())?;
-        let outcome = args.threads.install(|| run_one(task, &output, args))?;
+        let outcome = args.threads.install(|| run_one(&manifest, task, &output, args))?;
         let line = shown(&task.command_line(&output, false));
         return match outcome {
             Ok(ran) => {
@@ -123,7 +123,8 @@ pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             Err(e) => Err(e.context(format!("{}: mmtrack {line}", task.label()))),
         };
     }
-    let outcomes = args.threads.install(|| manifest::run_levels(&manifest, |task| run_one(task, &output, args)))?;
+    let outcomes =
+        args.threads.install(|| manifest::run_levels(&manifest, |task| run_one(&manifest, task, &output, args)))?;
     let (mut ran, mut skipped, mut failed) = (0, 0, 0);
     for (task, outcome) in manifest.tasks.iter().zip(&outcomes) {
         let line = shown(&task.command_line(&output, false));
@@ -183,15 +184,26 @@ fn check_needs_done(manifest: &Manifest, task: &Task, output: &str, file: &str) 
 }
 
 /// Runs one task with its completion record ([`marker`]); `Ok(false)` when
-/// `--skip-existing` skipped it.
-fn run_one(task: &Task, output: &str, args: &ManifestArgs) -> anyhow::Result<bool> {
+/// `--skip-existing` skipped it: complete, and no task it needs finished
+/// after it (a need redone since means its inputs changed: it is redone).
+fn run_one(manifest: &Manifest, task: &Task, output: &str, args: &ManifestArgs) -> anyhow::Result<bool> {
     let tables = Path::new(output);
     let key = task.command_line(output, false);
     let previous = marker::read(tables, &key)?;
     let mut force = args.force;
     if args.skip_existing {
         match marker::resume(previous.as_ref()) {
-            Resume::Skip => return Ok(false),
+            Resume::Skip => {
+                let own = marker::written_at(tables, &key);
+                let stale = task
+                    .needs
+                    .iter()
+                    .any(|&n| marker::written_at(tables, &manifest.tasks[n].command_line(output, false)) > own);
+                if !stale {
+                    return Ok(false);
+                }
+                force = true;
+            }
             Resume::Redo => force = true,
             Resume::Run => {}
         }
@@ -215,24 +227,12 @@ fn run_one(task: &Task, output: &str, args: &ManifestArgs) -> anyhow::Result<boo
     }
 }
 
-/// Runs one task's words (after `mmtrack`) quietly; returns what it wrote.
+/// Runs one task's words (after `mmtrack`) quietly; returns what it wrote:
+/// a process task's table files, an ingest or analyze task's `-o`.
 fn run_words(task: &Task, words: &[String], output: &str) -> anyhow::Result<Vec<PathBuf>> {
     let words: Vec<String> = words.iter().filter(|w| *w != "--quiet" && *w != "-q").cloned().collect();
-    match task.step {
-        Step::Process => {
-            use clap::FromArgMatches;
-            let command =
-                crate::process::ProcessArgs::augment_args(clap::Command::new("mmtrack process")).no_binary_name(true);
-            let usage = |e: clap::Error| anyhow::anyhow!("{}", e.to_string().trim());
-            let matches = command.try_get_matches_from(&words[1..]).map_err(usage)?;
-            let args = crate::process::ProcessArgs::from_arg_matches(&matches).map_err(usage)?;
-            crate::process::run_pipeline(&args, true)
-        }
-        Step::Ingest | Step::Analyze => {
-            crate::run_words(&words)?;
-            Ok(task.own_output(output).into_iter().map(PathBuf::from).collect())
-        }
-    }
+    let written = crate::run_words(&words)?;
+    Ok(written.unwrap_or_else(|| task.own_output(output).into_iter().map(PathBuf::from).collect()))
 }
 
 /// `--from`: writes the manifest of the sequences under `root`.

@@ -197,7 +197,7 @@ pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
 }
 
 /// Runs one pipeline (not a manifest); returns the table files written.
-pub(crate) fn run_pipeline(args: &ProcessArgs, quiet: bool) -> anyhow::Result<Vec<PathBuf>> {
+pub fn run_pipeline(args: &ProcessArgs, quiet: bool) -> anyhow::Result<Vec<PathBuf>> {
     let written = |w: Vec<TableWriteSummary>| w.into_iter().map(|w| w.path).collect();
     Ok(match &args.pipeline {
         Pipeline::Odometry(odometry_args) => written(run_odometry(odometry_args, quiet)?),

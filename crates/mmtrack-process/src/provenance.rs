@@ -61,12 +61,15 @@ pub fn input_file(path: &Path) -> anyhow::Result<InputFile> {
     Ok(InputFile { path: canonical(path), bytes, crc32: format!("{:08x}", hasher.finalize()) })
 }
 
-/// [`input_file`] of every path, in order.
+/// [`input_file`] of every path that names a file, in order. A source that
+/// is no file (a recording simulated in memory by `reproduce`, named by its
+/// scenario, e.g. `embedded data/reproduce/odometry-drive.toml`) is left
+/// out: there is no content to record.
 ///
 /// # Errors
 /// The first file that cannot be read.
 pub fn input_files<P: AsRef<Path>>(paths: &[P]) -> anyhow::Result<Vec<InputFile>> {
-    paths.iter().map(|p| input_file(p.as_ref())).collect()
+    paths.iter().map(AsRef::as_ref).filter(|p| p.is_file()).map(input_file).collect()
 }
 
 #[cfg(test)]
@@ -86,5 +89,8 @@ mod tests {
         assert_eq!((direct.bytes, direct.crc32.as_str()), (9, "cbf43926"));
         let err = input_file(&dir.path().join("missing")).unwrap_err();
         assert!(format!("{err:#}").contains("missing: cannot read the input"), "{err:#}");
+        // A described source that is no file has nothing to record.
+        let described = Path::new("embedded data/reproduce/odometry-drive.toml");
+        assert_eq!(input_files(&[dir.path().join("a.bin").as_path(), described]).unwrap(), vec![direct]);
     }
 }

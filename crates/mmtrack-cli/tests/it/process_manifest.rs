@@ -256,6 +256,18 @@ fn steps_run_in_the_order_of_their_needs() {
     assert!(d.join("rec/demo.mcap").is_file());
     assert!(d.join("t/odometry/sequence=oxford-demo/part-0.parquet").is_file());
     assert!(d.join("analysis/tables/trajectory_metrics/sequence=oxford-demo/part-0.parquet").is_file());
+    // Resumed after one output went missing: the odometry runs again, and
+    // so does the analysis that reads it; the ingest and MPC are skipped.
+    let before =
+        std::fs::read(d.join("analysis/tables/trajectory_metrics/sequence=oxford-demo/part-0.parquet")).unwrap();
+    std::fs::remove_file(d.join("t/ground_truth/sequence=oxford-demo/part-0.parquet")).unwrap();
+    let resumed = ok(d, &["process", "manifest", "steps.toml", "-o", "t", "--skip-existing"]);
+    assert!(resumed.contains("4 of 4 tasks done (2 ran, 2 skipped as complete)"), "{resumed}");
+    assert!(resumed.contains("ok       mmtrack analyze t -o analysis"), "{resumed}");
+    assert!(resumed.contains("skipped  mmtrack ingest oxford"), "{resumed}");
+    let after =
+        std::fs::read(d.join("analysis/tables/trajectory_metrics/sequence=oxford-demo/part-0.parquet")).unwrap();
+    assert!(before == after, "the analysis of the same tables differs");
     // Refusals name the file, the task and the key.
     std::fs::write(d.join("typo.toml"), STEPS.replace("needs = [\"ingest-demo\"]", "need = [\"ingest-demo\"]"))
         .unwrap();

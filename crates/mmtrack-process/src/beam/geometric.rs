@@ -242,7 +242,7 @@ pub fn process_geometric(
                 "command": "process beam",
                 "tracker": "geometric",
                 "recording": crate::provenance::canonical(path),
-                "inputs": [crate::provenance::input_file(path)?],
+                "inputs": crate::provenance::input_files(&[path])?,
                 "beam_schedule": format!("{schedule_arg:?}"),
                 "epoch_s": epoch_s,
                 "doppler_seed": seed,

@@ -132,6 +132,14 @@ pub fn remove(tables: &Path, command: &[String]) -> anyhow::Result<()> {
     }
 }
 
+/// When the record of `command` was last written, if there is one: a task
+/// whose need's record is newer than its own read outputs that changed
+/// after it ran, so `--skip-existing` redoes it.
+#[must_use]
+pub fn written_at(tables: &Path, command: &[String]) -> Option<std::time::SystemTime> {
+    std::fs::metadata(path(tables, command)).ok()?.modified().ok()
+}
+
 /// The size of `path`: a file's length, a directory's files summed; `None`
 /// when it is missing or cannot be read.
 #[must_use]

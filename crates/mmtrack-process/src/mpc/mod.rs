@@ -419,7 +419,7 @@ pub fn process_mpc(
         config_json: serde_json::json!({
             "command": "process mpc",
             "recording": crate::provenance::canonical(recording),
-            "inputs": [crate::provenance::input_file(recording)?],
+            "inputs": crate::provenance::input_files(&[recording])?,
             "pulse": options.pulse.as_deref().map_or_else(|| "recording metadata, else flat".into(), |p| {
                 if p == "flat" { p.to_string() } else { crate::provenance::canonical(std::path::Path::new(p)) }
             }),

@@ -157,12 +157,11 @@ pub fn write_outputs(
     recording: &Path,
 ) -> anyhow::Result<Vec<TableWriteSummary>> {
     let (estimates, frame) = in_ground_truth_frame(&run.estimates, &run.ground_truth);
-    let input = crate::provenance::input_file(recording)?;
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process odometry",
-            "recording": input.path,
-            "inputs": [input],
+            "recording": crate::provenance::canonical(recording),
+            "inputs": crate::provenance::input_files(&[recording])?,
             "preset": preset,
             "odometry": config,
             "frame": frame,

@@ -362,7 +362,7 @@ pub fn process_slam(recording_path: &Path, output: &Path, args: &SlamOptions) ->
         config_json: serde_json::json!({
             "command": "process slam",
             "recording": crate::provenance::canonical(recording_path),
-            "inputs": [crate::provenance::input_file(recording_path)?],
+            "inputs": crate::provenance::input_files(&[recording_path])?,
             "seed": args.seed,
             "prior": [prior.position_m[0], prior.position_m[1], prior.position_m[2], prior.heading_rad,
                       prior.speed_mps, prior.turn_rate_radps, prior.clock_bias_m],
