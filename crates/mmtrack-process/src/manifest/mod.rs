@@ -184,21 +184,26 @@ impl Manifest {
     /// it finished; within a level, in index order.
     #[must_use]
     pub fn levels(&self) -> Vec<Vec<usize>> {
-        let mut level = vec![0_usize; self.tasks.len()];
-        // `read_manifest` refused cycles, so the needs form a DAG; visiting
-        // in topological order (repeated relaxation until stable, at most
-        // `tasks` rounds) gives every task the longest chain below it.
-        for _ in 0..self.tasks.len() {
-            let mut changed = false;
-            for task in &self.tasks {
-                let wanted = task.needs.iter().map(|&n| level[n] + 1).max().unwrap_or(0);
-                if wanted > level[task.index] {
-                    level[task.index] = wanted;
-                    changed = true;
-                }
+        // `read_manifest` refused cycles, so the needs form a DAG: in Kahn's
+        // order (a task after everything it needs) each task's level is
+        // final once its needs are; O(tasks + needs).
+        let n = self.tasks.len();
+        let mut level = vec![0_usize; n];
+        let mut waiting: Vec<usize> = self.tasks.iter().map(|t| t.needs.len()).collect();
+        let mut dependents = vec![Vec::new(); n];
+        for task in &self.tasks {
+            for &need in &task.needs {
+                dependents[need].push(task.index);
             }
-            if !changed {
-                break;
+        }
+        let mut ready: Vec<usize> = (0..n).filter(|&i| waiting[i] == 0).collect();
+        while let Some(i) = ready.pop() {
+            for &d in &dependents[i] {
+                level[d] = level[d].max(level[i] + 1);
+                waiting[d] -= 1;
+                if waiting[d] == 0 {
+                    ready.push(d);
+                }
             }
         }
         let depth = level.iter().max().map_or(0, |&m| m + 1);
