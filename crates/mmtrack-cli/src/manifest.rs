@@ -41,8 +41,9 @@ pub struct ManifestArgs {
     /// Pass --force to every task (replace their earlier outputs); with --from, replace the manifest file.
     #[arg(long)]
     pub force: bool,
-    /// Resume a campaign: skip every task whose completion record says done with its outputs intact, redo the
-    /// tasks an interrupted run left started (replacing only their own outputs), run the others as given.
+    /// Resume a campaign: skip every task whose completion record says done with its outputs intact; redo the
+    /// tasks an interrupted run left started, and those whose outputs changed or whose needs finished again since
+    /// (replacing only their own outputs); run the others as given.
     #[arg(long, conflicts_with = "force")]
     pub skip_existing: bool,
     /// Run task N alone (from 0, manifest order), as a cluster job does; the tasks it needs must be done (their
