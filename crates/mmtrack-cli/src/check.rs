@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use clap::{Args, Parser};
+use clap::Args;
 use mmtrack_io::atomic::{AtomicFile, Durability, Overwrite};
 use mmtrack_reproduce::suite::{self, Suite, SuiteCheck};
 
@@ -71,19 +71,6 @@ fn work_dir(asked: Option<&Path>) -> anyhow::Result<WorkDir> {
     Ok(WorkDir::Kept(std::path::absolute(dir).with_context(|| dir.display().to_string())?))
 }
 
-/// Runs one step's words in this process, quietly: parsed as a command
-/// line of `mmtrack` (a suite's steps are the user's command lines, the
-/// one interface they share with the shell) and run by the same code.
-fn run_step(words: &[String]) -> anyhow::Result<()> {
-    let argv = std::iter::once("mmtrack").chain(words.iter().map(String::as_str)).chain(std::iter::once("--quiet"));
-    let cli = crate::Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
-    let code = crate::run(cli)?;
-    if code != ExitCode::SUCCESS {
-        bail!("exited with {code:?}");
-    }
-    Ok(())
-}
-
 pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let suite: Suite = suite::read_suite(&args.suite)?;
     let suite_name = args.suite.display().to_string();
@@ -103,7 +90,8 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         if !quiet {
             println!("step {}/{steps}: mmtrack {shown}", i + 1);
         }
-        run_step(&words).with_context(|| format!("{suite_name}: step {} (mmtrack {shown})", i + 1))?;
+        crate::run_words(&words, &suite::STEP_COMMANDS)
+            .with_context(|| format!("{suite_name}: step {} (mmtrack {shown})", i + 1))?;
     }
     let checks = suite::measure(&suite, work.path());
     if !quiet || checks.iter().any(|c| !c.ok()) {

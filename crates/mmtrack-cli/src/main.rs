@@ -15,6 +15,7 @@ mod demo;
 mod export;
 mod ingest;
 mod inspect;
+mod manifest;
 mod output_args;
 mod process;
 mod process_beam;
@@ -146,6 +147,32 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Schemas { write, check } => schemas(write, check, quiet),
         Command::Bench(args) => bench::run(&args, quiet),
     }
+}
+
+/// Runs the words (after `mmtrack`) of a user's command line from a file (a
+/// manifest task, a suite step), quietly, on the current pool: the one
+/// interface those files share with the shell. `allowed` names the
+/// commands the file may run. For a process command, the table files it
+/// wrote.
+///
+/// # Errors
+/// A usage error (one line), a command not in `allowed`, or the command's
+/// own error.
+fn run_words(words: &[String], allowed: &[&str]) -> anyhow::Result<Option<Vec<PathBuf>>> {
+    let command = words.first().map_or("", String::as_str);
+    if !allowed.contains(&command) {
+        anyhow::bail!("`{command}`: runs one of {}", allowed.join(", "));
+    }
+    let argv = std::iter::once("mmtrack").chain(words.iter().map(String::as_str)).chain(["--quiet"]);
+    let cli = Cli::try_parse_from(argv).map_err(|e| anyhow::anyhow!("{}", e.to_string().trim()))?;
+    if let Command::Process(args) = &cli.command {
+        return process::run_pipeline(args, true).map(Some);
+    }
+    let code = run(cli)?;
+    if code != ExitCode::SUCCESS {
+        anyhow::bail!("exited with {code:?}");
+    }
+    Ok(None)
 }
 
 /// Ends the process quietly when stdout is a pipe whose reader has gone

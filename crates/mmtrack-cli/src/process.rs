@@ -9,7 +9,7 @@ use clap::{Args, Subcommand};
 use mmtrack_core::{OdometryTiming, StampedPose, path_length_m};
 use mmtrack_io::table::TableWriteSummary;
 use mmtrack_odometry::OdometryConfig;
-use mmtrack_process::{manifest, mpc, odometry, slam};
+use mmtrack_process::{mpc, odometry, slam};
 
 use crate::output_args::OutputArgs;
 use crate::progress::IndicatifProgress;
@@ -74,21 +74,26 @@ enum Pipeline {
     /// with --strict. Then run `mmtrack analyze <out>`.
     #[command(verbatim_doc_comment)]
     Slam(SlamArgs),
-    /// Many sequences at once: every `mmtrack process` command line of a manifest as its own task.
+    /// A campaign: the ingest, process and analyze tasks of a manifest, each an independent task.
     ///
-    /// The manifest (TOML) lists `[[task]]` tables, each with `args`: a
-    /// `mmtrack process` command line without `mmtrack process` and `-o`,
-    /// e.g. `args = ["odometry", "runs/a.mcap", "--preset", "cfear"]`.
-    /// Every task writes its sequence partitions into the same `-o`
-    /// directory and runs as an independent task on the thread pool; the
+    /// The manifest (TOML) lists `[[task]]` tables, each with `args`: the
+    /// words after `mmtrack process` (default), `mmtrack ingest` or
+    /// `mmtrack analyze` (`step = "ingest"` / `"analyze"`), e.g.
+    /// `args = ["odometry", "runs/a.mcap", "--preset", "cfear"]`. Process
+    /// tasks get `-o <output>`; ingest and analyze tasks give their own -o;
+    /// `{tables}` stands for the output. `name` and `needs = ["<name>", ..]`
+    /// order tasks: a task runs after those it needs (ingest, then process,
+    /// then analyze; cycles and unknown keys are refused).
+    /// Tasks run level by level as independent tasks on the thread pool; the
     /// tables do not depend on the order or the thread count. A failed task
-    /// is reported and the others finish (exit 1). A task's `--run-id ID`
-    /// puts its tables under `<output>/run=<ID>/`, so several runs of one
-    /// sequence fit in one manifest. `--print-commands` prints
-    /// the per-sequence command lines, one cluster job each (see
-    /// examples/ray_process.py).
+    /// is reported, the tasks needing it are not run, the others finish
+    /// (exit 1). `--skip-existing` resumes an interrupted campaign.
+    /// `--task N` runs one task (a cluster job: examples/ray_process.py,
+    /// examples/slurm_campaign.sh); `--print-commands`, `--print-tasks` and
+    /// `--print-levels` show the tasks; `--from <dataset> --layout ...`
+    /// writes a manifest from a dataset folder. See docs/campaigns.md.
     #[command(verbatim_doc_comment)]
-    Manifest(ManifestArgs),
+    Manifest(crate::manifest::ManifestArgs),
 }
 
 #[derive(Args)]
@@ -183,40 +188,31 @@ pub struct SlamArgs {
     pub threads: ThreadsArg,
 }
 
-#[derive(Args)]
-pub struct ManifestArgs {
-    /// Manifest TOML: `[[task]]` tables, each with `args`, a `mmtrack process` command line without `mmtrack
-    /// process` and without `-o` (paths as typed in the directory you run from).
-    pub manifest: PathBuf,
-    /// Output table directory every task writes into (its own sequence partitions).
-    #[arg(short, long, required_unless_present = "print_commands")]
-    pub output: Option<PathBuf>,
-    /// Pass --force to every task (replace their earlier partitions).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the per-sequence command lines (what a cluster runs, one job each) and exit.
-    #[arg(long)]
-    pub print_commands: bool,
-    #[command(flatten)]
-    pub threads: ThreadsArg,
-}
-
 pub fn run(args: &ProcessArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    match &args.pipeline {
-        Pipeline::Odometry(odometry_args) => run_odometry(odometry_args, quiet)?,
-        Pipeline::Mpc(mpc_args) => run_mpc(mpc_args, quiet)?,
-        Pipeline::Beam(beam_args) => crate::process_beam::run(beam_args, quiet)?,
-        Pipeline::Slam(slam_args) => run_slam(slam_args, quiet)?,
-        Pipeline::Manifest(manifest_args) => return run_manifest(manifest_args, quiet),
+    if let Pipeline::Manifest(manifest_args) = &args.pipeline {
+        return crate::manifest::run(manifest_args, quiet);
     }
+    run_pipeline(args, quiet)?;
     Ok(ExitCode::SUCCESS)
 }
 
-fn run_odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
+/// Runs one pipeline (not a manifest); returns the table files written.
+pub fn run_pipeline(args: &ProcessArgs, quiet: bool) -> anyhow::Result<Vec<PathBuf>> {
+    let written = |w: Vec<TableWriteSummary>| w.into_iter().map(|w| w.path).collect();
+    Ok(match &args.pipeline {
+        Pipeline::Odometry(odometry_args) => written(run_odometry(odometry_args, quiet)?),
+        Pipeline::Mpc(mpc_args) => written(run_mpc(mpc_args, quiet)?),
+        Pipeline::Beam(beam_args) => crate::process_beam::run(beam_args, quiet)?,
+        Pipeline::Slam(slam_args) => written(run_slam(slam_args, quiet)?),
+        Pipeline::Manifest(_) => bail!("a manifest cannot run a manifest"),
+    })
+}
+
+fn run_odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>> {
     let config = odometry::effective_config(&args.preset, args.config.as_deref())?;
     if args.print_config {
         print!("{}", toml::to_string(&config)?);
-        return Ok(());
+        return Ok(Vec::new());
     }
     // clap requires both unless --print-config.
     let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
@@ -230,7 +226,7 @@ fn run_odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<()> {
     if !quiet {
         print_odometry(&done.run, &args.preset, &done.written);
     }
-    Ok(())
+    Ok(done.written)
 }
 
 pub(crate) fn print_odometry(run: &odometry::OdometryRun, preset: &str, written: &[TableWriteSummary]) {
@@ -260,12 +256,12 @@ pub(crate) fn print_odometry(run: &odometry::OdometryRun, preset: &str, written:
     }
 }
 
-fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
+fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>> {
     let mut config = mpc::effective_config(args.config.as_deref())?;
     config.run_gmphd |= args.gmphd;
     if args.print_config {
         print!("{}", toml::to_string(&config)?);
-        return Ok(());
+        return Ok(Vec::new());
     }
     // clap requires both unless --print-config.
     let (Some(recording), Some(output)) = (&args.recording, &args.output) else {
@@ -279,7 +275,7 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     let progress = IndicatifProgress::new(quiet);
     let done = args.threads.install(|| mpc::process_mpc(recording, output, &config, &options, &progress))??;
     if quiet {
-        return Ok(());
+        return Ok(done.written);
     }
     for link in &done.links {
         println!(
@@ -298,10 +294,10 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<()> {
     for w in &done.written {
         println!("  wrote {} ({} {})", w.path.display(), w.rows, mpc::record_noun(&w.path));
     }
-    Ok(())
+    Ok(done.written)
 }
 
-fn run_slam(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
+fn run_slam(args: &SlamArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>> {
     let options = slam::SlamOptions {
         config: args.config.clone(),
         particles: args.particles,
@@ -326,55 +322,5 @@ fn run_slam(args: &SlamArgs, quiet: bool) -> anyhow::Result<()> {
             println!("  wrote {} ({} rows)", w.path.display(), w.rows);
         }
     }
-    Ok(())
-}
-
-/// One manifest task (`process <pipeline> ...`): its words parsed as the
-/// arguments of `mmtrack process` and run by the library call of its
-/// pipeline, quietly (a `--quiet` among them is accepted).
-fn run_task(line: &[String]) -> anyhow::Result<()> {
-    use clap::FromArgMatches;
-    let words = line.iter().skip(1).filter(|w| *w != "--quiet" && *w != "-q");
-    let command = ProcessArgs::augment_args(clap::Command::new("mmtrack process")).no_binary_name(true);
-    let usage = |e: clap::Error| anyhow::anyhow!("{}", e.to_string().trim());
-    let args = ProcessArgs::from_arg_matches(&command.try_get_matches_from(words).map_err(usage)?).map_err(usage)?;
-    if matches!(args.pipeline, Pipeline::Manifest(_)) {
-        bail!("a manifest cannot run a manifest");
-    }
-    run(&args, true).map(|_| ())
-}
-
-fn run_manifest(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
-    let tasks = manifest::read_manifest(&args.manifest)?;
-    let output = match &args.output {
-        Some(o) => crate::path_word(o)?,
-        None => "<tables>".to_string(),
-    };
-    let lines: Vec<Vec<String>> = tasks.iter().map(|t| manifest::command_line(t, &output, args.force)).collect();
-    let shown = |line: &[String]| line.iter().map(|w| manifest::shell_word(w)).collect::<Vec<_>>().join(" ");
-    if args.print_commands {
-        for line in &lines {
-            println!("mmtrack {}", shown(line));
-        }
-        return Ok(ExitCode::SUCCESS);
-    }
-    let outcomes = args.threads.install(|| manifest::run_tasks(&lines, |line| run_task(line)))?;
-    let mut failed = 0;
-    for (line, outcome) in lines.iter().zip(&outcomes) {
-        match outcome {
-            Ok(()) => {
-                if !quiet {
-                    println!("ok      mmtrack {}", shown(line));
-                }
-            }
-            Err(e) => {
-                failed += 1;
-                eprintln!("failed  mmtrack {}: {}", shown(line), crate::one_line(e));
-            }
-        }
-    }
-    if !quiet {
-        println!("{} of {} tasks done; tables under {output}", tasks.len() - failed, tasks.len());
-    }
-    Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    Ok(done.written)
 }

@@ -149,7 +149,8 @@ impl GeometricArgs {
     }
 }
 
-pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<()> {
+/// Runs `process beam`; returns the table files written.
+pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<Vec<std::path::PathBuf>> {
     let request = BeamRequest {
         recordings: args.recordings.clone(),
         trackers: args
@@ -173,8 +174,14 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<()> {
         geometric: args.geometric.options(),
     };
     let done = process_beam(&args.output, &request, &IndicatifProgress::new(quiet))?;
+    let written = match &done {
+        BeamOutput::Geometric(d) => &d.written,
+        BeamOutput::Spebt(d) => &d.written,
+        BeamOutput::Sweeps(d) => &d.written,
+    };
+    let written = written.iter().map(|w| w.path.clone()).collect();
     if quiet {
-        return Ok(());
+        return Ok(written);
     }
     match done {
         BeamOutput::Geometric(done) => {
@@ -196,7 +203,7 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<()> {
             );
         }
     }
-    Ok(())
+    Ok(written)
 }
 
 fn print_spebt(done: &spebt::SpebtOutput) {

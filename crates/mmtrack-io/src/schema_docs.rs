@@ -36,7 +36,7 @@ fn index() -> String {
     for spec in ALL_SPECS {
         out.push_str(&format!("- [{0}](mcap/{0}.md): {1}\n", spec.full_name, spec.description));
     }
-    out.push_str("\n## Parquet tables\n\nLayout: `<root>/<table>/sequence=<id>/part-0.parquet`, zstd; key-value metadata `units` (JSON column -> unit), `mmtrack.table`, `mmtrack.version`, `mmtrack.run_config` (JSON).\n\n");
+    out.push_str("\n## Parquet tables\n\nLayout: `<root>/<table>/sequence=<id>/part-0.parquet`, zstd; key-value metadata `units` (JSON column -> unit), `mmtrack.table`, `mmtrack.version`, `mmtrack.run_config` (JSON: the full configuration of the run, and for `process` runs its `inputs`: canonical absolute path, bytes, CRC-32).\n\n");
     for spec in ALL_TABLES {
         out.push_str(&format!("- [{0}](tables/{0}.md): {1}\n", spec.name, spec.description));
     }

@@ -17,13 +17,16 @@
 //! - [`manifest`]: many sequences, each an independent task;
 //! - [`output`]: where a pipeline writes (`--run-id`, `--force`,
 //!   `--sequence`), shared by all;
+//! - [`provenance`]: the input files a run records (canonical path, size,
+//!   CRC-32);
 //! - [`events`]: a recording read as a stream, scans decoded ahead in
 //!   parallel;
 //! - [`threads`]: the worker pool of a call (`--threads`).
 //!
 //! Every pipeline runs on the caller's rayon pool (the thread count never
 //! changes a table), refuses existing tables before any work unless forced,
-//! and records its full configuration in the tables' metadata.
+//! and records its full configuration and its inputs ([`provenance`]) in
+//! the tables' metadata.
 
 pub mod beam;
 pub mod events;
@@ -31,6 +34,7 @@ pub mod manifest;
 pub mod mpc;
 pub mod odometry;
 pub mod output;
+pub mod provenance;
 pub mod simulate;
 pub mod slam;
 pub mod threads;

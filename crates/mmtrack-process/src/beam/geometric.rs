@@ -241,7 +241,8 @@ pub fn process_geometric(
             config_json: serde_json::json!({
                 "command": "process beam",
                 "tracker": "geometric",
-                "recording": path.display().to_string(),
+                "recording": crate::provenance::canonical(path),
+                "inputs": crate::provenance::input_files(&[path])?,
                 "beam_schedule": format!("{schedule_arg:?}"),
                 "epoch_s": epoch_s,
                 "doppler_seed": seed,

@@ -455,7 +455,8 @@ pub fn process_sweeps(
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process beam",
-            "recordings": files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+            "recordings": files.iter().map(|f| crate::provenance::canonical(f)).collect::<Vec<_>>(),
+            "inputs": crate::provenance::input_files(files)?,
             "trackers": kinds.iter().map(|k| k.name()).collect::<Vec<_>>(),
             "reacquire": format!("{:?}", search(reacquire).reacquisition),
             "search": format!("{:?}", search(reacquire)),

@@ -1,90 +1,410 @@
-//! The manifest runner (`mmtrack process manifest`): many sequences, each an
-//! independent task.
+//! The manifest runner (`mmtrack process manifest`): a campaign of ingest,
+//! process and analyze steps, each an independent task.
 //!
-//! A manifest lists `mmtrack process` command lines, one per sequence:
+//! A manifest lists command lines, one per task:
 //!
 //! ```toml
-//! [[task]]
+//! [[task]]                      # step = "process" unless given
 //! args = ["odometry", "out/demo/recording.mcap", "--preset", "cfear"]
+//!
 //! [[task]]
-//! args = ["mpc", "out/demo/sounder.mcap", "--gmphd"]
+//! name = "ingest-a"
+//! step = "ingest"
+//! args = ["oxford", "data/a", "-o", "recordings/a.mcap"]
+//! [[task]]
+//! name = "odometry-a"
+//! needs = ["ingest-a"]
+//! args = ["odometry", "recordings/a.mcap"]
+//! [[task]]
+//! step = "analyze"
+//! needs = ["odometry-a"]
+//! args = ["{tables}", "-o", "analysis"]
 //! ```
 //!
-//! Every task gets `-o <tables>` (and `--force` when given) and runs as its
-//! own task on the rayon pool; tasks write different sequence partitions
-//! of the same table directory, each atomically, so the result does not
-//! depend on the order or the number of threads. A failed task is reported
-//! and the others still finish; the command then exits 1.
+//! - `step`: `ingest`, `process` (default) or `analyze`: the words after
+//!   `mmtrack ingest` / `mmtrack process` / `mmtrack analyze`. Process
+//!   tasks get `-o <tables>` from the manifest command; ingest and analyze
+//!   tasks name their own `-o` (the recording, the analysis directory). The
+//!   word `{tables}` in any task stands for the manifest's `-o`.
+//! - `name`: optional, unique; what other tasks' `needs` refer to.
+//! - `needs`: the names of the tasks whose outputs this one reads. A task
+//!   runs after every task it needs finished; a step may need only steps of
+//!   its own kind or an earlier one (ingest, process, analyze: a SPEBT run
+//!   may need an odometry run), and cycles are refused ([`read_manifest`]).
+//!   The dependencies are explicit rather than guessed from paths: a task
+//!   names what it needs, and nothing else orders the tasks.
 //!
-//! A task's own flags pass through unchanged, `--run-id` included: tasks of
-//! one sequence with different run ids write side by side under
-//! `<tables>/run=<ID>/` ([`crate::output`]), each refusing only its own
-//! existing partitions.
+//! Tasks run level by level ([`Manifest::levels`]: a task's level is one
+//! more than the highest level it needs), each level's tasks as independent
+//! tasks on the rayon pool; tasks write different sequence partitions (and
+//! files) atomically, so the result does not depend on the order or the
+//! number of threads. A failed task is reported, the tasks that need it are
+//! not run, and the others still finish; the command then exits 1.
 //!
-//! The front end parses each task's command line ([`command_line`]) and
-//! runs it with [`run_tasks`]; `--print-commands` prints the lines instead
-//! ([`shell_word`]): exactly what a cluster runs, one job per line (see
-//! `examples/ray_process.py`).
+//! # Resuming
+//!
+//! Every task run by the manifest command leaves a completion record
+//! ([`marker`]) under `<tables>/.mmtrack-tasks/`: `started` before the task
+//! runs, `done` with its output files and sizes once it succeeded, removed
+//! when it failed (a failed task leaves no output of its own). With
+//! `--skip-existing` a task whose record says `done` with every output
+//! still there at its size is skipped; one whose record says `started` was
+//! interrupted and is redone with `--force` (it replaces only what it
+//! writes itself); one without a record runs as given, so an output that
+//! task did not write is refused as without `--skip-existing`.
+//!
+//! `--print-commands` prints the command lines ([`shell_word`]), one per
+//! task; `--task N` runs task N alone (what a cluster job runs, see
+//! `examples/ray_process.py` and `examples/slurm_campaign.sh`).
 
+pub mod from_dataset;
+pub mod marker;
+
+use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::{Context, bail};
 use rayon::prelude::*;
 use serde::Deserialize;
 
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Manifest {
-    task: Vec<Task>,
+/// Tasks of one manifest: far above any campaign (a task per sequence of
+/// every public radar dataset is a few thousand), far below a table that
+/// would take minutes to parse.
+pub const MAX_TASKS: usize = 100_000;
+
+/// Words of one task's command line.
+pub const MAX_WORDS: usize = 1_000;
+
+/// The placeholder of the manifest's `-o` in a task's words.
+pub const TABLES_PLACEHOLDER: &str = "{tables}";
+
+/// The kind of a task: which `mmtrack` command its words follow.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Step {
+    /// `mmtrack ingest ...`
+    Ingest,
+    /// `mmtrack process ...`
+    Process,
+    /// `mmtrack analyze ...`
+    Analyze,
 }
 
-/// One task: a `mmtrack process` command line without `mmtrack process`
-/// and without `-o`.
-#[derive(Debug, Clone, Deserialize)]
+impl Step {
+    /// The `mmtrack` subcommand.
+    #[must_use]
+    pub fn command(self) -> &'static str {
+        match self {
+            Self::Ingest => "ingest",
+            Self::Process => "process",
+            Self::Analyze => "analyze",
+        }
+    }
+}
+
+const TASK_KEYS: &[&str] = &["name", "step", "needs", "args"];
+
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
+struct RawTask {
+    name: Option<String>,
+    step: Option<Step>,
+    #[serde(default)]
+    needs: Vec<String>,
+    args: Vec<String>,
+}
+
+/// One task of a manifest, checked.
+#[derive(Debug, Clone, PartialEq)]
 pub struct Task {
-    /// The words, e.g. `["odometry", "runs/a.mcap", "--preset", "cfear"]`.
+    /// Its position in the manifest, from 0 (`--task N`).
+    pub index: usize,
+    /// Its `name`, if given.
+    pub name: Option<String>,
+    /// Which command its words follow.
+    pub step: Step,
+    /// The tasks it needs, as indices, in the order given.
+    pub needs: Vec<usize>,
+    /// The words after `mmtrack <step>`, e.g.
+    /// `["odometry", "runs/a.mcap", "--preset", "cfear"]`.
     pub args: Vec<String>,
 }
 
-/// The tasks of `path`, checked: at least one, each naming a pipeline and
-/// leaving `-o` to the manifest command.
-///
-/// # Errors
-/// The file cannot be read or parsed, has no task, a task is empty, runs
-/// a manifest or gives `-o`; naming the file and the task.
-pub fn read_manifest(path: &Path) -> anyhow::Result<Vec<Task>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("{}: cannot read the manifest", path.display()))?;
-    let manifest: Manifest = toml::from_str(&text).with_context(|| path.display().to_string())?;
-    if manifest.task.is_empty() {
-        bail!("{}: no [[task]] entries", path.display());
-    }
-    for (i, task) in manifest.task.iter().enumerate() {
-        let Some(pipeline) = task.args.first() else { bail!("{}: task {i}: empty args", path.display()) };
-        if pipeline == "manifest" {
-            bail!("{}: task {i}: a manifest cannot run a manifest", path.display());
-        }
-        if task.args.iter().any(|a| a == "-o" || a == "--output" || a.starts_with("--output=")) {
-            bail!(
-                "{}: task {i}: leave -o/--output out (the manifest command gives every task the same one)",
-                path.display()
-            );
+impl Task {
+    /// `task N` or `task N (name)`, as errors and reports name it.
+    #[must_use]
+    pub fn label(&self) -> String {
+        match &self.name {
+            Some(name) => format!("task {} ({name})", self.index),
+            None => format!("task {}", self.index),
         }
     }
-    Ok(manifest.task)
+
+    /// The `--threads` the task gives itself, if any.
+    #[must_use]
+    pub fn threads(&self) -> Option<usize> {
+        threads_of(&self.args).and_then(|t| t.ok())
+    }
+
+    /// The task's full command line after `mmtrack`: `{tables}` replaced by
+    /// `output`, and for process tasks `-o <output>` added; `--force` when
+    /// `force`.
+    #[must_use]
+    pub fn command_line(&self, output: &str, force: bool) -> Vec<String> {
+        let mut line = vec![self.step.command().to_string()];
+        line.extend(self.args.iter().map(|w| if w == TABLES_PLACEHOLDER { output.to_string() } else { w.clone() }));
+        if self.step == Step::Process {
+            line.extend(["-o".to_string(), output.to_string()]);
+        }
+        if force {
+            line.push("--force".into());
+        }
+        line
+    }
+
+    /// The output a task names itself (`-o`/`--output` of ingest and
+    /// analyze tasks), `{tables}` replaced by `output`.
+    #[must_use]
+    pub fn own_output(&self, output: &str) -> Option<String> {
+        let words = self.command_line(output, false);
+        output_flag(&words[1..]).map(str::to_string)
+    }
 }
 
-/// One task's full command line after `mmtrack`.
-#[must_use]
-pub fn command_line(task: &Task, output: &str, force: bool) -> Vec<String> {
-    let mut line = vec!["process".to_string()];
-    line.extend(task.args.iter().cloned());
-    line.extend(["-o".to_string(), output.to_string()]);
-    if force {
-        line.push("--force".into());
+/// A checked manifest: its tasks in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Manifest {
+    /// The tasks, `tasks[i].index == i`.
+    pub tasks: Vec<Task>,
+}
+
+impl Manifest {
+    /// The tasks by level: level 0 needs nothing, level k+1 needs tasks of
+    /// level k at most. Every task of a level can run once the levels before
+    /// it finished; within a level, in index order.
+    #[must_use]
+    pub fn levels(&self) -> Vec<Vec<usize>> {
+        // `read_manifest` refused cycles, so the needs form a DAG: in Kahn's
+        // order (a task after everything it needs) each task's level is
+        // final once its needs are; O(tasks + needs).
+        let n = self.tasks.len();
+        let mut level = vec![0_usize; n];
+        let mut waiting: Vec<usize> = self.tasks.iter().map(|t| t.needs.len()).collect();
+        let mut dependents = vec![Vec::new(); n];
+        for task in &self.tasks {
+            for &need in &task.needs {
+                dependents[need].push(task.index);
+            }
+        }
+        let mut ready: Vec<usize> = (0..n).filter(|&i| waiting[i] == 0).collect();
+        while let Some(i) = ready.pop() {
+            for &d in &dependents[i] {
+                level[d] = level[d].max(level[i] + 1);
+                waiting[d] -= 1;
+                if waiting[d] == 0 {
+                    ready.push(d);
+                }
+            }
+        }
+        let depth = level.iter().max().map_or(0, |&m| m + 1);
+        let mut levels = vec![Vec::new(); depth];
+        for (i, &l) in level.iter().enumerate() {
+            levels[l].push(i);
+        }
+        levels
     }
-    line
+}
+
+/// The value of the last `-o`/`--output` flag among `words`.
+fn output_flag(words: &[String]) -> Option<&str> {
+    let mut found = None;
+    let mut it = words.iter();
+    while let Some(word) = it.next() {
+        if word == "-o" || word == "--output" {
+            found = it.next().map(String::as_str);
+        } else if let Some(value) = word.strip_prefix("--output=") {
+            found = Some(value);
+        }
+    }
+    found
+}
+
+/// The `--threads` value among `words`: none, or the parsed number.
+fn threads_of(words: &[String]) -> Option<Result<usize, String>> {
+    let mut found = None;
+    let mut it = words.iter();
+    while let Some(word) = it.next() {
+        let value =
+            if word == "--threads" { it.next().cloned() } else { word.strip_prefix("--threads=").map(str::to_string) };
+        if let Some(value) = value {
+            found = Some(value.parse::<usize>().map_err(|_| value));
+        }
+    }
+    found
+}
+
+/// The checked manifest at `path`.
+///
+/// # Errors
+/// The file cannot be read or parsed; it has a key other than `task`, no
+/// task or more than [`MAX_TASKS`]; a task has an unknown key, no `args` or
+/// more than [`MAX_WORDS`] words, a bad or duplicate `name`, a `needs` that
+/// names no task, itself, or a later step, a `--threads` beyond
+/// [`mmtrack_core::limits::THREADS`], a process task that runs a manifest
+/// or gives `-o`, an ingest or analyze task without `-o`; or the needs form
+/// a cycle. Each error names the file, the task and the key.
+pub fn read_manifest(path: &Path) -> anyhow::Result<Manifest> {
+    let file = path.display();
+    let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read the manifest"))?;
+    let table: toml::Table = toml::from_str(&text).with_context(|| file.to_string())?;
+    if let Some(key) = table.keys().find(|k| *k != "task") {
+        bail!("{file}: unknown key `{key}` (a manifest holds [[task]] tables only)");
+    }
+    let Some(entries) = table.get("task") else { bail!("{file}: no [[task]] entries") };
+    let Some(entries) = entries.as_array() else { bail!("{file}: key `task`: expected [[task]] tables") };
+    if entries.is_empty() {
+        bail!("{file}: no [[task]] entries");
+    }
+    if entries.len() > MAX_TASKS {
+        bail!("{file}: key `task`: {} tasks; expected at most {MAX_TASKS}", entries.len());
+    }
+    let mut raw = Vec::with_capacity(entries.len());
+    for (i, entry) in entries.iter().enumerate() {
+        let Some(keys) = entry.as_table() else { bail!("{file}: task {i}: expected a [[task]] table") };
+        if let Some(key) = keys.keys().find(|k| !TASK_KEYS.contains(&k.as_str())) {
+            bail!("{file}: task {i}: unknown key `{key}` (expected one of {})", TASK_KEYS.join(", "));
+        }
+        let task: RawTask = entry
+            .clone()
+            .try_into()
+            .map_err(|e: toml::de::Error| anyhow::anyhow!("{file}: task {i}: {}", e.message()))?;
+        raw.push(task);
+    }
+    let mut names = BTreeMap::new();
+    for (i, task) in raw.iter().enumerate() {
+        if let Some(name) = &task.name {
+            let valid = !name.is_empty()
+                && name.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+                && name.parse::<usize>().is_err();
+            if !valid {
+                bail!("{file}: task {i}: key `name`: '{name}' (use letters, digits, '-', '_', '.'; not a bare number)");
+            }
+            if let Some(first) = names.insert(name.clone(), i) {
+                bail!("{file}: task {i}: key `name`: '{name}' is already task {first}'s");
+            }
+        }
+    }
+    let mut tasks = Vec::with_capacity(raw.len());
+    for (i, task) in raw.into_iter().enumerate() {
+        let step = task.step.unwrap_or(Step::Process);
+        let label = match &task.name {
+            Some(name) => format!("{file}: task {i} ({name})"),
+            None => format!("{file}: task {i}"),
+        };
+        let mut needs = Vec::with_capacity(task.needs.len());
+        for need in &task.needs {
+            let Some(&n) = names.get(need) else { bail!("{label}: key `needs`: no task is named '{need}'") };
+            if n == i {
+                bail!("{label}: key `needs`: a task cannot need itself");
+            }
+            if needs.contains(&n) {
+                bail!("{label}: key `needs`: '{need}' listed twice");
+            }
+            needs.push(n);
+        }
+        check_args(&label, step, &task.args)?;
+        tasks.push(Task { index: i, name: task.name, step, needs, args: task.args });
+    }
+    for task in &tasks {
+        for &n in &task.needs {
+            if tasks[n].step > task.step {
+                bail!(
+                    "{file}: {}: key `needs`: {} is a later step ({}); steps run ingest, then process, then analyze",
+                    task.label(),
+                    tasks[n].label(),
+                    tasks[n].step.command()
+                );
+            }
+        }
+    }
+    if let Some(cycle) = find_cycle(&tasks) {
+        let path: Vec<String> = cycle.iter().map(|&i| tasks[i].label()).collect();
+        bail!("{file}: {}: key `needs`: a cycle: {}", tasks[cycle[0]].label(), path.join(" -> "));
+    }
+    Ok(Manifest { tasks })
+}
+
+/// Checks one task's words: at most [`MAX_WORDS`], a plausible `--threads`,
+/// and the `-o` rule of its step.
+fn check_args(label: &str, step: Step, args: &[String]) -> anyhow::Result<()> {
+    let Some(first) = args.first() else { bail!("{label}: key `args`: empty") };
+    if args.len() > MAX_WORDS {
+        bail!("{label}: key `args`: {} words; expected at most {MAX_WORDS}", args.len());
+    }
+    if let Some(threads) = threads_of(args) {
+        let limit = mmtrack_core::limits::THREADS;
+        match threads {
+            Ok(t) if limit.allows_count(t as u64) => {}
+            Ok(t) => bail!("{label}: key `args`: --threads {t}: expected {}", limit.expected),
+            Err(raw) => bail!("{label}: key `args`: --threads '{raw}': expected a number"),
+        }
+    }
+    let has_output = output_flag(args).is_some();
+    match step {
+        Step::Process => {
+            if first == "manifest" {
+                bail!("{label}: key `args`: a manifest cannot run a manifest");
+            }
+            if has_output {
+                bail!(
+                    "{label}: key `args`: leave -o/--output out of a process task (the manifest command gives \
+                     every process task the same one)"
+                );
+            }
+        }
+        Step::Ingest | Step::Analyze => {
+            if !has_output {
+                bail!("{label}: key `args`: an {} task names its output with -o", step.command());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A cycle among the tasks' needs, as task indices from its first task
+/// back to it, if there is one.
+fn find_cycle(tasks: &[Task]) -> Option<Vec<usize>> {
+    // Iterative depth-first search; 0 unvisited, 1 on the stack, 2 done.
+    let mut state = vec![0_u8; tasks.len()];
+    for start in 0..tasks.len() {
+        if state[start] != 0 {
+            continue;
+        }
+        let mut stack: Vec<(usize, usize)> = vec![(start, 0)];
+        state[start] = 1;
+        while let Some(&mut (task, ref mut next)) = stack.last_mut() {
+            if let Some(&need) = tasks[task].needs.get(*next) {
+                *next += 1;
+                match state[need] {
+                    0 => {
+                        state[need] = 1;
+                        stack.push((need, 0));
+                    }
+                    1 => {
+                        let from = stack.iter().position(|&(t, _)| t == need).unwrap_or(0);
+                        let mut cycle: Vec<usize> = stack[from..].iter().map(|&(t, _)| t).collect();
+                        cycle.push(need);
+                        return Some(cycle);
+                    }
+                    _ => {}
+                }
+            } else {
+                state[task] = 2;
+                stack.pop();
+            }
+        }
+    }
+    None
 }
 
 /// Shell-quotes `word` when it needs it.
@@ -97,38 +417,87 @@ pub fn shell_word(word: &str) -> String {
     }
 }
 
-/// Runs `run` on every task as its own task on the current rayon pool;
-/// one result per task, in task order. A failed task does not stop the
-/// others.
-pub fn run_tasks<T: Sync>(
-    tasks: &[T],
-    run: impl Fn(&T) -> anyhow::Result<()> + Send + Sync,
-) -> Vec<anyhow::Result<()>> {
-    tasks.par_iter().map(run).collect()
+/// What became of one task of a run.
+#[derive(Debug)]
+pub enum Outcome {
+    /// It ran and succeeded.
+    Done,
+    /// `--skip-existing` found it complete ([`marker`]).
+    Skipped,
+    /// It ran and failed.
+    Failed(anyhow::Error),
+    /// It did not run: a task it needs (this one) did not finish.
+    NotRun(usize),
+}
+
+/// Runs the tasks of `manifest` level by level ([`Manifest::levels`]), each
+/// level's tasks as independent tasks on the current rayon pool; `run`
+/// runs one task and says whether it ran or was skipped. A task whose
+/// need did not finish is not run. One outcome per task, in task order.
+pub fn run_levels(manifest: &Manifest, run: impl Fn(&Task) -> anyhow::Result<bool> + Send + Sync) -> Vec<Outcome> {
+    let mut outcomes: Vec<Option<Outcome>> = (0..manifest.tasks.len()).map(|_| None).collect();
+    for level in manifest.levels() {
+        let ready: Vec<(usize, Option<usize>)> = level
+            .iter()
+            .map(|&i| {
+                let blocked = manifest.tasks[i]
+                    .needs
+                    .iter()
+                    .copied()
+                    .find(|&n| !matches!(outcomes[n], Some(Outcome::Done | Outcome::Skipped)));
+                (i, blocked)
+            })
+            .collect();
+        let results: Vec<(usize, Outcome)> = ready
+            .par_iter()
+            .map(|&(i, blocked)| {
+                let outcome = match blocked {
+                    Some(n) => Outcome::NotRun(n),
+                    None => match run(&manifest.tasks[i]) {
+                        Ok(true) => Outcome::Done,
+                        Ok(false) => Outcome::Skipped,
+                        Err(e) => Outcome::Failed(e),
+                    },
+                };
+                (i, outcome)
+            })
+            .collect();
+        for (i, outcome) in results {
+            outcomes[i] = Some(outcome);
+        }
+    }
+    outcomes.into_iter().map(|o| o.unwrap_or(Outcome::NotRun(usize::MAX))).collect()
+}
+
+/// The manifest's tasks as lines of JSON, one per task: index, name, step,
+/// level, needs (indices), threads (the task's own `--threads`, else
+/// null) and the command line after `mmtrack` (what
+/// `--print-tasks` prints for a scheduler).
+#[must_use]
+pub fn task_lines(manifest: &Manifest, output: &str) -> Vec<String> {
+    let mut level_of = vec![0; manifest.tasks.len()];
+    for (l, level) in manifest.levels().iter().enumerate() {
+        for &i in level {
+            level_of[i] = l;
+        }
+    }
+    manifest
+        .tasks
+        .iter()
+        .map(|t| {
+            serde_json::json!({
+                "index": t.index,
+                "name": t.name,
+                "step": t.step.command(),
+                "level": level_of[t.index],
+                "needs": t.needs,
+                "threads": t.threads(),
+                "command": t.command_line(output, false),
+            })
+            .to_string()
+        })
+        .collect()
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn manifests_are_checked_and_lines_built() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("m.toml");
-        std::fs::write(&path, "[[task]]\nargs = [\"odometry\", \"a b.mcap\", \"--preset\", \"cfear\"]\n").unwrap();
-        let tasks = read_manifest(&path).unwrap();
-        let line = command_line(&tasks[0], "t", true);
-        assert_eq!(line, ["process", "odometry", "a b.mcap", "--preset", "cfear", "-o", "t", "--force"]);
-        assert_eq!(shell_word("a b.mcap"), "'a b.mcap'");
-        for (text, message) in [
-            ("task = []\n", "no [[task]] entries"),
-            ("[[task]]\nargs = []\n", "task 0: empty args"),
-            ("[[task]]\nargs = [\"mpc\", \"x.mcap\", \"-o\", \"y\"]\n", "leave -o/--output out"),
-            ("[[task]]\nargs = [\"manifest\", \"m.toml\"]\n", "cannot run a manifest"),
-        ] {
-            std::fs::write(&path, text).unwrap();
-            let err = read_manifest(&path).err().map(|e| format!("{e:#}")).unwrap_or_default();
-            assert!(err.contains(message), "{text}: {err}");
-        }
-    }
-}
+mod tests;

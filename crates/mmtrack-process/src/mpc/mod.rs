@@ -418,8 +418,11 @@ pub fn process_mpc(
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process mpc",
-            "recording": recording.display().to_string(),
-            "pulse": options.pulse.clone().unwrap_or_else(|| "recording metadata, else flat".into()),
+            "recording": crate::provenance::canonical(recording),
+            "inputs": crate::provenance::input_files(&[recording])?,
+            "pulse": options.pulse.as_deref().map_or_else(|| "recording metadata, else flat".into(), |p| {
+                if p == "flat" { p.to_string() } else { crate::provenance::canonical(std::path::Path::new(p)) }
+            }),
             "link": options.link.map(|(tx, rx)| format!("{tx}:{rx}")),
             "mpc": config,
             "run_id": out.run_id(),

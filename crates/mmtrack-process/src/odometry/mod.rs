@@ -160,7 +160,8 @@ pub fn write_outputs(
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process odometry",
-            "recording": recording.display().to_string(),
+            "recording": crate::provenance::canonical(recording),
+            "inputs": crate::provenance::input_files(&[recording])?,
             "preset": preset,
             "odometry": config,
             "frame": frame,

@@ -361,7 +361,8 @@ pub fn process_slam(recording_path: &Path, output: &Path, args: &SlamOptions) ->
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process slam",
-            "recording": recording_path.display().to_string(),
+            "recording": crate::provenance::canonical(recording_path),
+            "inputs": crate::provenance::input_files(&[recording_path])?,
             "seed": args.seed,
             "prior": [prior.position_m[0], prior.position_m[1], prior.position_m[2], prior.heading_rad,
                       prior.speed_mps, prior.turn_rate_radps, prior.clock_bias_m],

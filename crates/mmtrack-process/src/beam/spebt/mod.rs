@@ -272,7 +272,7 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(SpebtExperiment, String
         if let Some(tracker) = link.tracker {
             experiment.tracker = tracker;
         }
-        source = path.display().to_string();
+        source = crate::provenance::canonical(path);
     }
     if let Some(sigma_r_m) = options.sigma_r_m {
         ensure!(sigma_r_m.is_finite() && sigma_r_m >= 0.0, "--sigma-r-m {sigma_r_m}: need a finite value >= 0");
@@ -380,8 +380,9 @@ pub fn process_spebt(
             config_json: serde_json::json!({
                 "command": "process beam",
                 "tracker": "spebt",
-                "recording": recording.path.display().to_string(),
-                "odometry": odometry_file.as_ref().map(|f| f.display().to_string()),
+                "recording": crate::provenance::canonical(&recording.path),
+                "odometry": odometry_file.as_deref().map(crate::provenance::canonical),
+                "inputs": crate::provenance::input_files(&[Some(recording.path.as_path()), odometry_file.as_deref()].into_iter().flatten().collect::<Vec<_>>())?,
                 "pose_source": name,
                 "link_file": link_source,
                 "runs": result.runs,
