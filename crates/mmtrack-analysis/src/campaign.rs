@@ -618,11 +618,19 @@ mod tests {
     #[test]
     fn compare_runs_reads_every_runs_partitions_and_pools_per_run() {
         use mmtrack_io::Overwrite;
-        use mmtrack_io::table::{RunInfo, write_table};
+        use mmtrack_io::table::write_table;
         let dir = tempfile::tempdir().unwrap();
         let write = |run: &str, sequence: &str, m: &TrajectoryMetrics| {
             let tables = dir.path().join(format!("run={run}")).join("tables");
-            write_table(&tables, sequence, std::slice::from_ref(m), &RunInfo::default(), Overwrite::Refuse).unwrap();
+            write_table(
+                &tables,
+                sequence,
+                std::slice::from_ref(m),
+                &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+                    .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+                Overwrite::Refuse,
+            )
+            .unwrap();
         };
         let (a1, a2) = (trajectory(11, 3, Some(1.0), 1.0), trajectory(31, 1, Some(5.0), 2.0));
         let b1 = trajectory(5, 0, None, 1.5);

@@ -69,7 +69,8 @@ fn drive(gt_frames: usize) -> (Vec<OdometryEstimate>, Vec<GroundTruthPose>) {
 }
 
 fn write_pair(root: &Path, sequence: &str, estimate: &[OdometryEstimate], truth: Option<&[GroundTruthPose]>) {
-    let run = RunInfo { config_json: "{}".into() };
+    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(root, sequence, estimate, &run, Overwrite::Refuse).unwrap();
     if let Some(truth) = truth {
         write_table(root, sequence, truth, &run, Overwrite::Refuse).unwrap();

@@ -134,7 +134,8 @@ fn analyze_geometric(dir: &Path, rows: &[GeometricEpochRow]) {
         .iter()
         .map(|r| GeometricEpochRow { filter: if r.epoch >= 40 { "rls" } else { "h-infinity" }.into(), ..r.clone() })
         .collect();
-    let run = RunInfo { config_json: "{}".into() };
+    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&dir.join("h"), "handover", &handed_over, &run, Overwrite::Refuse).unwrap();
     let out = mmtrack(dir, &["analyze", "h", "-o", "b"]);
     assert!(out.status.success(), "{}", text(&out).1);

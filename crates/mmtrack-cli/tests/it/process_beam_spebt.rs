@@ -46,7 +46,8 @@ const ODOMETRY: &str = "tables/odometry/sequence=drive/part-0.parquet";
 fn corrupt(dir: &Path, edit: impl FnOnce(&mut Vec<OdometryEstimate>)) {
     let mut rows = read_table::<OdometryEstimate>(&dir.join(ODOMETRY)).unwrap();
     edit(&mut rows);
-    let info = RunInfo { config_json: "{}".into() };
+    let info = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&dir.join("bad"), "drive", &rows, &info, Overwrite::Replace).unwrap();
 }
 
@@ -135,7 +136,8 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     let mut other =
         read_table::<SpebtSummaryRow>(&d.join("model/spebt_summary/sequence=drive/part-0.parquet")).unwrap();
     other[0].rmse_aod_deg += 1.0;
-    let info = RunInfo { config_json: "{}".into() };
+    let info = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&d.join("model"), "drive", &other, &info, Overwrite::Replace).unwrap();
     let (ok, _, stderr) = run(d, &["analyze", "model", "-o", "mixed"]);
     assert!(!ok && stderr.contains("sequence drive: spebt_summary.rmse_aod_deg is"), "{stderr}");
@@ -211,7 +213,8 @@ fn the_odometry_table_is_found_in_its_run_folder_and_several_runs_are_named() {
     let mut rows =
         read_table::<OdometryEstimate>(&d.join("tables/run=a/odometry/sequence=drive/part-0.parquet")).unwrap();
     rows[12..].iter_mut().for_each(|r| r.world_from_vehicle.yaw_rad += 30f64.to_radians());
-    let info = RunInfo { config_json: "{}".into() };
+    let info = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&d.join("tables/run=b"), "drive", &rows, &info, Overwrite::Refuse).unwrap();
     // A run of another sequence only does not count.
     write_table(&d.join("tables/run=other"), "elsewhere", &rows, &info, Overwrite::Refuse).unwrap();

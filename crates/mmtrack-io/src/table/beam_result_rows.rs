@@ -1,11 +1,14 @@
 //! Result tables of the beam trackers, with units.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `beam_rms_per_block`: RMS pointing error per block.
     pub const BEAM_RMS_PER_BLOCK = "beam_rms_per_block",
         "RMS transmit-beam pointing error over the Monte Carlo runs of one scenario point, per block and tracker \
 (Shaham et al. 2020, Figs. 2-4): sqrt(E[(phi[k] - phi_bar[k])^2]), phi the true AoD and phi_bar the beam the tracker \
-pointed from its prediction; block 0 is the channel estimate the trackers start from.";
+pointed from its prediction; block 0 is the channel estimate the trackers start from.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`BEAM_RMS_PER_BLOCK`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamRmsRow {
@@ -22,7 +25,8 @@ crate::define_table! {
     pub const BEAM_VALID_TRACKING = "beam_valid_tracking",
         "Valid-tracking duration per scenario point and tracker (Shaham et al. 2020, Sec. IV): the first block \
 whose RMS AoD error exceeds half the beamwidth, null when no simulated block does; beside the paper's number \
-where it gives one.";
+where it gives one.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`BEAM_VALID_TRACKING`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamValidTrackingRow {
@@ -42,7 +46,8 @@ crate::define_table! {
     pub const BEAM_SWEEP_SUMMARY = "beam_sweep_summary",
         "Beam-training accounting of one sequence (a vehicle pass) per tracker, from table beam_sweeps_tracked: \
 received-power loss of the chosen beam against each full sweep's best beam, how often the chosen beam is the best or \
-its neighbour, beams measured per sweep (a full sweep counts all beams) and re-initialisations.";
+its neighbour, beams measured per sweep (a full sweep counts all beams) and re-initialisations.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`BEAM_SWEEP_SUMMARY`] (and of [`BEAM_SWEEP_POOLED`]).
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamSweepSummaryRow {
@@ -69,6 +74,7 @@ crate::define_table! {
     /// `beam_sweep_pooled`: per site and tracker, every sequence pooled.
     pub const BEAM_SWEEP_POOLED = "beam_sweep_pooled",
         "Beam-training accounting pooled over every sequence of a site, one row per site and tracker (partition \
-sequence=all): the columns of beam_sweep_summary, each sweep weighted once.";
+sequence=all): the columns of beam_sweep_summary, each sweep weighted once.",
+        frame: TableFrame::NotApplicable;
     BeamSweepPooledRow(BeamSweepSummaryRow);
 }

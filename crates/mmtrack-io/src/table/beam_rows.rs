@@ -1,12 +1,15 @@
 //! Tables of the beam-sweep pipeline: what each tracker chose for each
 //! measured sweep, and what that cost against the sweep's best beam.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `beam_sweeps_tracked`: one tracked sweep per row.
     pub const BEAM_SWEEPS_TRACKED = "beam_sweeps_tracked",
         "One beam sweep of one sequence (a vehicle pass) as one beam-sweep tracker handled it: the beam it chose, \
 the best beam of the full sweep, how many beams it measured and the received-power loss; rows of one tracker are \
-consecutive and in time order. Trackers see only the beams they measure; the full sweep scores them.";
+consecutive and in time order. Trackers see only the beams they measure; the full sweep scores them.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`BEAM_SWEEPS_TRACKED`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamSweepTracked {

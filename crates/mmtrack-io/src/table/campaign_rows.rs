@@ -1,13 +1,16 @@
 //! The run-comparison table of `mmtrack analyze` over several runs, with
 //! units (in the column `unit`: one table holds every metric).
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `run_comparison`: the runs of one `analyze` side by side, long format.
     pub const RUN_COMPARISON = "run_comparison",
         "One value of one metric of one run, in long format: the main metrics of the result tables \
 (trajectory_metrics, mpc_summary, beam_sweep_summary, spebt_summary, geometric_summary, slam_summary) of every run \
 analyzed together, plus the pooled trajectory rows (sequence `all`: KITTI drift over segments, RMSEs over poses, RPE over frame pairs; \
-sequence `mean`: the mean of the per-sequence values). Pivot on `run` for the side-by-side table.";
+sequence `mean`: the mean of the per-sequence values). Pivot on `run` for the side-by-side table.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`RUN_COMPARISON`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct RunComparisonRow {

@@ -2,12 +2,15 @@
 //! on the tables of `process mpc`, Mahler et al. 2017), with units: one
 //! partition per sequence.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `mpc_set_metrics`: one row per set.
     pub const MPC_SET_METRICS = "mpc_set_metrics",
         "MPC statistics of one sounder set per row, in set order: long-term MPC count (Fig. 12), births and \
 deaths across the pair (previous set, this set) and their rates (Fig. 13), channel gains and power losses (Figs. 8-9). \
-Transition columns are null for the first set.";
+Transition columns are null for the first set.",
+        frame: TableFrame::NotApplicable;
     /// Per-set results: one row of [`MPC_SET_METRICS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SetMetrics {
@@ -40,7 +43,8 @@ crate::define_table! {
     /// `mpc_track_power_std`: one row per short-term track.
     pub const MPC_TRACK_POWER_STD = "mpc_track_power_std",
         "Power standard deviation of each short-term track over its set (Mahler et al. 2017, Fig. 7), in \
-the order of mpc_tracks: sample standard deviation (n - 1) of its detections' power_db, 0 for one detection.";
+the order of mpc_tracks: sample standard deviation (n - 1) of its detections' power_db, 0 for one detection.",
+        frame: TableFrame::NotApplicable;
     /// Per-track power spread: one row of [`MPC_TRACK_POWER_STD`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct TrackPowerStd {
@@ -57,7 +61,8 @@ crate::define_table! {
     pub const MPC_CHI_CLASSES = "mpc_chi_classes",
         "Long-term links per confidence class chi (Mahler et al. 2017, eq. 40, Sec. VI-A), in increasing \
 chi: the share of the linked power (mean power of the entry each link leads to); a last row with a null chi gives \
-the entries related to no adjacent set and their share of all full-lifetime power.";
+the entries related to no adjacent set and their share of all full-lifetime power.",
+        frame: TableFrame::NotApplicable;
     /// Power share of one confidence class: one row of [`MPC_CHI_CLASSES`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct ChiClassShare {
@@ -71,7 +76,8 @@ crate::define_table! {
     /// `mpc_count_distribution`: distribution of the number of MPCs per set.
     pub const MPC_COUNT_DISTRIBUTION = "mpc_count_distribution",
         "Distribution of the number of long-term (full-lifetime) MPCs per set (Mahler et al. 2017, \
-Fig. 12), one row per count that occurs, in increasing count.";
+Fig. 12), one row per count that occurs, in increasing count.",
+        frame: TableFrame::NotApplicable;
     /// One value of the number-of-MPCs distribution: one row of [`MPC_COUNT_DISTRIBUTION`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct CountBin {
@@ -86,7 +92,8 @@ crate::define_table! {
     pub const MPC_SUMMARY = "mpc_summary",
         "Summary of the MPC statistics of one sequence partition (one row). Rates per metre use the \
 distance named by distance_source (both sounder vehicles' ground truth summed, as the paper; or one trajectory); \
-they are null without one, and the per-second rates always apply. Truth columns are null without mpc_truth.";
+they are null without one, and the per-second rates always apply. Truth columns are null without mpc_truth.",
+        frame: TableFrame::NotApplicable;
     /// Summary of one sequence: the row of [`MPC_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct MpcSummary {
@@ -148,7 +155,8 @@ crate::define_table! {
         "The first path of each CIR snapshot, in the order of mpc_snapshots (or of set and snapshot \
 without it): the earliest detection at most first_path_dynamic_range_db (mpc_summary) below the snapshot's \
 strongest detection, and its distance from the receiver's own first-path estimate when the recording carries one \
-(e.g. the DW1000's leading edge HLP). Delay columns are null for a snapshot without detections.";
+(e.g. the DW1000's leading edge HLP). Delay columns are null for a snapshot without detections.",
+        frame: TableFrame::NotApplicable;
     /// One snapshot's first path: one row of [`MPC_FIRST_PATH`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct FirstPathRow {

@@ -3,6 +3,8 @@
 //! per-snapshot statistics, the simulator's true MPCs and both sounder vehicles' ground
 //! truth (Mahler et al. 2017, Secs. III-VI).
 
+use super::TableFrame;
+
 use mmtrack_core::{Complex64, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
 
 /// A track of the GM-PHD baseline: the columns of `mpc_tracks`, in its own
@@ -14,7 +16,8 @@ crate::define_table! {
     /// `mpc_tracks_gmphd`: tracks of the GM-PHD baseline.
     pub const MPC_TRACKS_GMPHD = "mpc_tracks_gmphd",
         "One associated detection of a GM-PHD baseline track (Mahler et al. 2017, Table I) per row; the \
-columns of mpc_tracks; rows of a track are consecutive and in time order.";
+columns of mpc_tracks; rows of a track are consecutive and in time order.",
+        frame: TableFrame::NotApplicable;
     GmPhdTrack(MpcTrack);
 }
 
@@ -22,7 +25,8 @@ crate::define_table! {
     /// `mpc_long_term`: long-term tracks across sets.
     pub const MPC_LONG_TERM = "mpc_long_term",
         "One full-lifetime short-term track as an entry of a long-term track per row (Mahler et al. 2017, \
-Sec. V), ordered by set then long-term track; a long-term track is the rows sharing long_track_id.";
+Sec. V), ordered by set then long-term track; a long-term track is the rows sharing long_track_id.",
+        frame: TableFrame::NotApplicable;
     MpcLongTermEntry {
         long_track_id: u64, "", "long-term track identifier, unique within the run";
         set_index: u64, "", "sounder set of this entry";
@@ -43,7 +47,8 @@ crate::define_table! {
     pub const MPC_SETS = "mpc_sets",
         "One sounder set per row, in set order: counts of detections and tracks and the channel gains \
 (Mahler et al. 2017, Figs. 8-9); gains are means over the set's snapshots of sum |a|^2 in dB, -inf when nothing \
-was captured.";
+was captured.",
+        frame: TableFrame::NotApplicable;
     MpcSetStats {
         set_index: u64, "", "the set";
         t_ns: i64, "ns", "time of its first snapshot";
@@ -66,7 +71,8 @@ crate::define_table! {
     /// `mpc_snapshots`: per-snapshot detection statistics.
     pub const MPC_SNAPSHOTS = "mpc_snapshots",
         "One CIR snapshot per row, in recording order: what detection found in it (Mahler et al. 2017, \
-Sec. III-A) and the receiver's own first-path estimate carried in the recording, for comparing first paths.";
+Sec. III-A) and the receiver's own first-path estimate carried in the recording, for comparing first paths.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`MPC_SNAPSHOTS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct MpcSnapshotStats {
@@ -87,7 +93,8 @@ crate::define_table! {
     /// `mpc_truth`: the true MPCs of a simulated recording.
     pub const MPC_TRUTH = "mpc_truth",
         "One true multipath component of one snapshot per row, as the simulator knows it, in recording \
-order; path_id is stable while the propagation path exists.";
+order; path_id is stable while the propagation path exists.",
+        frame: TableFrame::NotApplicable;
     MpcTruth {
         t_ns: i64, "ns", "time of the snapshot";
         set_index: u64, "", "sounder set";
@@ -116,7 +123,8 @@ crate::define_table! {
     /// `ground_truth_tx`: the transmitter car's trajectory.
     pub const GROUND_TRUTH_TX = "ground_truth_tx",
         "One ground-truth pose world_from_vehicle of a channel sounder's transmitter car per row, in time \
-order (recording topic /ground_truth/tx); the columns of poses.";
+order (recording topic /ground_truth/tx); the columns of poses.",
+        frame: TableFrame::Run;
     GroundTruthTxPose(StampedPose);
 }
 
@@ -124,6 +132,7 @@ crate::define_table! {
     /// `ground_truth_rx`: the receiver car's trajectory.
     pub const GROUND_TRUTH_RX = "ground_truth_rx",
         "One ground-truth pose world_from_vehicle of a channel sounder's receiver car per row, in time \
-order (recording topic /ground_truth/rx); the columns of poses.";
+order (recording topic /ground_truth/rx); the columns of poses.",
+        frame: TableFrame::Run;
     GroundTruthRxPose(StampedPose);
 }

@@ -3,6 +3,8 @@
 //! (partitions named by experiment) and by `mmtrack process beam --tracker
 //! spebt` (partitions named by the recording's sequence).
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `spebt_summary`: one row per experiment (or recording).
     pub const SPEBT_SUMMARY = "spebt_summary",
@@ -10,7 +12,8 @@ crate::define_table! {
 Table III): RMSE over every tracked slot (1..slots-1) of every run of the estimate after the slot's update (after a re-initialisation \
 where one happened) against the true channel, the re-initialisations per run (Algorithm 1 steps 14-15) and the \
 paper's numbers beside them. Written by `reproduce spebt` (one partition per experiment) and `process beam --tracker \
-spebt` (one per recording).";
+spebt` (one per recording).",
+        frame: TableFrame::NotApplicable;
     /// One row of [`SPEBT_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SpebtSummaryRow {
@@ -50,7 +53,11 @@ crate::define_table! {
     /// `spebt_per_slot`: truth, one run's estimate and the RMSE over runs per slot.
     pub const SPEBT_PER_SLOT = "spebt_per_slot",
         "Per slot of one SPEBT experiment: the true pose and channel, the estimate of run 0 (the realisation of \
-Liu et al. 2024, Fig. 5) and the RMSE over all runs at that slot.";
+Liu et al. 2024, Fig. 5) and the RMSE over all runs at that slot.",
+        frame: TableFrame::Fixed {
+            id: "first_pose",
+            meaning: "x_m, y_m: the vehicle's true position minus its first position, along the world axes of the trajectory (reproduce spebt: the simulator's, process beam: the recording's ground truth); yaw_rad counter-clockwise from world x; AoD from the base-station array axis (world x); AoA from the vehicle's heading",
+        };
     /// One row of [`SPEBT_PER_SLOT`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SpebtSlotRow {
@@ -80,7 +87,8 @@ crate::define_table! {
         "SPEBT accuracy pooled over every sequence analysed (partition sequence=all), one row per experiment kind: \
 each sequence's RMSE weighted by its tracked estimates ((slots - 1) x runs), so the pooled RMSE is the RMS over every \
 estimate of every sequence; the re-initialisation share is every re-initialisation over every tracked slot. Written \
-by `mmtrack analyze` from spebt_summary.";
+by `mmtrack analyze` from spebt_summary.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`SPEBT_POOLED`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SpebtPooledRow {

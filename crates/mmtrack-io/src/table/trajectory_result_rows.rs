@@ -1,12 +1,15 @@
 //! Result tables of the trajectory evaluation (`mmtrack analyze` on the
 //! tables of `process odometry`), with units: one partition per sequence.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `trajectory_metrics`: one row per sequence.
     pub const TRAJECTORY_METRICS = "trajectory_metrics",
         "Summary metrics of one estimated trajectory (table odometry) against its ground truth (table \
 ground_truth), one row per sequence. Both are associated by time and start at the identity; KITTI drift follows the \
-KITTI devkit (evaluate_odometry.cpp).";
+KITTI devkit (evaluate_odometry.cpp).",
+        frame: TableFrame::NotApplicable;
     /// One row of [`TRAJECTORY_METRICS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct TrajectoryMetrics {
@@ -44,7 +47,8 @@ crate::define_table! {
     /// `drift_per_length`: KITTI drift per segment length.
     pub const DRIFT_PER_LENGTH = "drift_per_length",
         "KITTI drift of one sequence per segment length (the devkit's per-length plots), in segment-length \
-order; lengths longer than the path are absent.";
+order; lengths longer than the path are absent.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`DRIFT_PER_LENGTH`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct DriftPerLength {
@@ -59,7 +63,8 @@ crate::define_table! {
     /// `relative_pose_errors`: one row per frame.
     pub const RELATIVE_POSE_ERRORS = "relative_pose_errors",
         "Frame-to-frame relative pose error E_k = (gt_{k-1}^-1 gt_k)^-1 (est_{k-1}^-1 est_k) of one sequence, \
-one row per associated frame k >= 1, in time order.";
+one row per associated frame k >= 1, in time order.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`RELATIVE_POSE_ERRORS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct RelativePoseErrorRow {

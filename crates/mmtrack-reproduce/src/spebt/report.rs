@@ -9,6 +9,7 @@ use anyhow::Context as _;
 use mmtrack_analysis::beam::spebt_plots::{SpebtTrackingSeries, spebt_tracking_svg};
 use mmtrack_core::{StampedPose, path_length_m, wrap_angle_rad};
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, SpebtSummaryRow, write_table};
 use mmtrack_process::beam::spebt::monte_carlo::{ExperimentResult, SpebtExperiment};
 use mmtrack_process::beam::spebt::tables::{slot_rows, summary_row};
@@ -373,6 +374,11 @@ pub fn write_outputs(
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),
+            // The trajectory's clock, by the simulator's rule (`simulate radar`): UNIX time
+            // when the trajectory puts the drive at a date, scenario time otherwise.
+            time_base: TimeBase::unix_or(run.link.slots().first().map_or(0, |s| s.t_ns), TimeBase::ScenarioStart)
+                .into(),
+            frame: None,
         };
         write_table(&tables, run.name, &[summary_row_of(config, run)], &info, Overwrite::Refuse)?;
         write_table(&tables, run.name, &slot_rows(&run.link, &run.result), &info, Overwrite::Refuse)?;

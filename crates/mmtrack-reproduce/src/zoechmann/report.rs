@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use mmtrack_analysis::beam::zoechmann_plots::{NmseCurve, zoechmann_figure_svg, zoechmann_nlos_svg};
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::table::{ZoechmannNmseRow, ZoechmannSummaryRow};
 
@@ -339,6 +340,9 @@ pub fn write_outputs(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        // A simulated experiment: times count from the start of its scenario.
+        time_base: TimeBase::ScenarioStart.into(),
+        frame: None,
     };
     let epoch_s = experiment.scenario.epoch_s;
     let mut nmse_rows = Vec::new();
