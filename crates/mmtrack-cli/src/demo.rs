@@ -205,7 +205,12 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if !quiet {
         for r in &done.recordings {
             let s = &r.summary;
-            println!("{}: SPEBT RMSE AoD {:.3} deg, AoA {:.3} deg", r.sequence_id, s.rmse_aod_deg, s.rmse_aoa_deg);
+            println!(
+                "{}: SPEBT RMSE AoD {:.3} deg, AoA {:.3} deg",
+                r.sequence_id,
+                s.rmse_aod_rad.to_degrees(),
+                s.rmse_aoa_rad.to_degrees()
+            );
         }
     }
 

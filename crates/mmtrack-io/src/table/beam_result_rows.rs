@@ -16,7 +16,7 @@ pointed from its prediction; block 0 is the channel estimate the trackers start 
         snr_db: f64, "dB", "received SNR of the scenario point";
         speed_kmh: f64, "km/h", "initial speed of the scenario point";
         block: u64, "", "block index (1 ms each)";
-        rms_aod_deg: f64, "deg", "RMS AoD pointing error over the runs";
+        rms_aod_rad: f64, "rad", "RMS AoD pointing error over the runs";
     }
 }
 
@@ -35,7 +35,7 @@ where it gives one.",
         speed_kmh: f64, "km/h", "initial speed";
         runs: u64, "", "Monte Carlo runs";
         blocks_simulated: u64, "", "blocks per run";
-        threshold_deg: f64, "deg", "half the half-power beamwidth at the initial AoD";
+        threshold_rad: f64, "rad", "half the half-power beamwidth at the initial AoD";
         valid_blocks: Option<u64>, "", "first block with RMS AoD error above the threshold; null if none";
         paper_blocks: Option<u64>, "", "the paper's number for this point and tracker; null where it gives none";
     }

@@ -25,7 +25,7 @@ ho-chan-true-azimuth (the baseline on the true azimuths), ho-chan-doppler-mps, e
 proposed-full-scan-doppler-mps (the Doppler equation (5) multiplied by the wavelength, i.e. in m/s), \
 proposed-doppler-mps (the same for the proposed tracker with its own beam window)";
         epoch: u64, "", "epoch index (20 ms each)";
-        t_s: f64, "s", "time since the start of the manoeuvre";
+        t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         runs: u64, "", "Monte Carlo runs with an estimate at this epoch";
         nmse: f64, "", "sum (r_est - r)^2 / sum r^2";
         nmse_db: f64, "dB", "10 log10(nmse)";
@@ -78,7 +78,7 @@ single wall bounces, image method), per epoch: RMS error over the Monte Carlo ru
     pub struct ZoechmannNlosErrorRow {
         path: String, "", "los, left-wall or right-wall";
         epoch: u64, "", "epoch index (20 ms each)";
-        t_s: f64, "s", "time since the start of the manoeuvre";
+        t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         runs: u64, "", "runs with an estimate at this epoch";
         position_rmse_m: f64, "m", "RMS distance between estimated and true apparent source";
         velocity_rmse_mps: f64, "m/s", "RMS norm of the relative-velocity error";
@@ -99,7 +99,7 @@ y to the left) and its relative velocity, per epoch, beside the simulator's trut
     #[derive(Debug, Clone, PartialEq)]
     pub struct ZoechmannPathLabelRow {
         path: String, "", "los, left-wall or right-wall";
-        t_s: f64, "s", "time since the start of the manoeuvre";
+        t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         x_m: f64, "m", "estimated x of the apparent source";
         y_m: f64, "m", "estimated y of the apparent source";
         vx_mps: f64, "m/s", "estimated relative velocity, x";

@@ -69,7 +69,7 @@ fn odometry_writes_one_pose_per_scan_refuses_existing_tables_and_keeps_runs_apar
     assert_eq!(spebt.recordings[0].pose_source, RADAR_ODOMETRY);
     let rows: Vec<SpebtSummaryRow> = read_table(&spebt.written[0].path).unwrap();
     assert_eq!((rows[0].slots, rows[0].runs), (6, 2));
-    assert!(rows[0].rmse_aod_deg.is_finite());
+    assert!(rows[0].rmse_aod_rad.is_finite());
 }
 
 #[test]

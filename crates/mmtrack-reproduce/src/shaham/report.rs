@@ -226,7 +226,7 @@ pub fn write_outputs(
                     snr_db: point.snr_db,
                     speed_kmh: point.speed_kmh,
                     block: block as u64,
-                    rms_aod_deg: rms.to_degrees(),
+                    rms_aod_rad: *rms,
                 });
             }
             let paper = experiment
@@ -241,7 +241,7 @@ pub fn write_outputs(
                 speed_kmh: point.speed_kmh,
                 runs,
                 blocks_simulated: experiment.blocks as u64,
-                threshold_deg: threshold_rad.to_degrees(),
+                threshold_rad,
                 valid_blocks: point.valid_blocks[t].map(|b| b as u64),
                 paper_blocks: paper,
             });

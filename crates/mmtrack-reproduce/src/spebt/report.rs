@@ -82,6 +82,12 @@ fn target_text(claim: &Claim) -> String {
     }
 }
 
+/// A paper's number, stored in radians, back in the degrees the paper prints
+/// (rounded to 9 decimals, so 0.22 deg reads 0.22 again).
+fn paper_deg(rad: f64) -> f64 {
+    (rad.to_degrees() * 1e9).round() / 1e9
+}
+
 /// The numbers `reproduce --all` checks for one experiment: RMSE of
 /// |alpha|, AoD and AoA and the re-initialisation share, with the paper's.
 #[must_use]
@@ -89,8 +95,19 @@ pub fn metrics(row: &SpebtSummaryRow) -> Vec<Metric> {
     let e = &row.experiment;
     vec![
         Metric::new(format!("{e} RMSE abs(alpha)"), row.rmse_gain_pct, "%", Some(row.paper_rmse_gain_pct)),
-        Metric::new(format!("{e} RMSE AoD"), row.rmse_aod_deg, "deg", Some(row.paper_rmse_aod_deg)),
-        Metric::new(format!("{e} RMSE AoA"), row.rmse_aoa_deg, "deg", Some(row.paper_rmse_aoa_deg)),
+        // In degrees, as the paper reports them (the table holds radians).
+        Metric::new(
+            format!("{e} RMSE AoD"),
+            row.rmse_aod_rad.to_degrees(),
+            "deg",
+            Some(paper_deg(row.paper_rmse_aod_rad)),
+        ),
+        Metric::new(
+            format!("{e} RMSE AoA"),
+            row.rmse_aoa_rad.to_degrees(),
+            "deg",
+            Some(paper_deg(row.paper_rmse_aoa_rad)),
+        ),
         Metric::new(
             format!("{e} re-initialisation share"),
             row.reinitialisation_share_pct,

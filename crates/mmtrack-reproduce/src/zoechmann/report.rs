@@ -354,7 +354,7 @@ pub fn write_outputs(
                     manoeuvre: r.manoeuvre.name.clone(),
                     estimator: (*name).to_string(),
                     epoch: k as u64,
-                    t_s: k as f64 * epoch_s,
+                    t_ns: (k as f64 * epoch_s * 1e9).round() as i64,
                     runs: r.counted[e][k],
                     nmse,
                     nmse_db: 10.0 * nmse.log10(),
