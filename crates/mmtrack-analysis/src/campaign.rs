@@ -298,11 +298,7 @@ pub fn pooled_trajectory_exprs() -> Vec<Expr> {
             .map(|c| col(c).sum())
             .collect();
     exprs.extend(["path_length_m", "estimate_path_length_m"].into_iter().map(|c| col(c).sum()));
-    exprs.extend(
-        ["kitti_translational_pct", "kitti_rotational_deg_per_m", "kitti_rotational_deg_per_100m"]
-            .into_iter()
-            .map(by_segments),
-    );
+    exprs.extend(["kitti_translational_pct", "kitti_rotational_deg_per_100m"].into_iter().map(by_segments));
     exprs.extend(
         ["ate_rmse_m", "x_rmse_m", "y_rmse_m", "position_rmse_m", "yaw_rmse_rad"]
             .into_iter()
@@ -342,7 +338,6 @@ pub fn pooled_trajectory_metrics(ms: &[&TrajectoryMetrics]) -> anyhow::Result<Op
         "path_length_m" => v(|m| m.path_length_m),
         "estimate_path_length_m" => v(|m| m.estimate_path_length_m),
         "kitti_translational_pct" => o(|m| m.kitti_translational_pct),
-        "kitti_rotational_deg_per_m" => o(|m| m.kitti_rotational_deg_per_m),
         "kitti_rotational_deg_per_100m" => o(|m| m.kitti_rotational_deg_per_100m),
         "ate_rmse_m" => v(|m| m.ate_rmse_m),
         "x_rmse_m" => v(|m| m.x_rmse_m),
@@ -365,7 +360,6 @@ pub fn pooled_trajectory_metrics(ms: &[&TrajectoryMetrics]) -> anyhow::Result<Op
         estimate_path_length_m: f("estimate_path_length_m")?.unwrap_or(0.0),
         kitti_segments: n("kitti_segments")?,
         kitti_translational_pct: f("kitti_translational_pct")?,
-        kitti_rotational_deg_per_m: f("kitti_rotational_deg_per_m")?,
         kitti_rotational_deg_per_100m: f("kitti_rotational_deg_per_100m")?,
         ate_rmse_m: f("ate_rmse_m")?.unwrap_or(0.0),
         ate_max_m: f("ate_max_m")?.unwrap_or(0.0),
@@ -601,7 +595,6 @@ mod tests {
             step_m: None,
             kitti_segments: segments,
             kitti_translational_pct: kitti_pct,
-            kitti_rotational_deg_per_m: kitti_pct.map(|p| p / 100.0),
             kitti_rotational_deg_per_100m: kitti_pct,
             ate_rmse_m: ate_m,
             ate_max_m: 2.0 * ate_m,

@@ -207,7 +207,7 @@ impl TrajectoryResult {
                 length_m: l.length_m,
                 segments: l.segments as u64,
                 translational_pct: l.translational_pct,
-                rotational_deg_per_m: l.rotational_deg_per_m,
+                rotational_deg_per_100m: 100.0 * l.rotational_deg_per_m,
             })
             .collect()
     }
@@ -264,7 +264,6 @@ pub fn analyze_trajectory(
         step_m,
         kitti_segments: drift.segments.len() as u64,
         kitti_translational_pct: summary.map(|s| s.translational_pct),
-        kitti_rotational_deg_per_m: summary.map(|s| s.rotational_deg_per_m),
         kitti_rotational_deg_per_100m: summary.map(|s| s.rotational_deg_per_100m()),
         ate_rmse_m: ate.position_rmse_m,
         ate_max_m: ate.position_max_m,

@@ -144,7 +144,8 @@ fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
     let t = devkit["t_err"].as_f64().unwrap() * 100.0;
     let r = devkit["r_err"].as_f64().unwrap().to_degrees();
     assert!(relative_diff(t, t_pct) < 1e-9, "translational {t} % (devkit) vs {t_pct} %");
-    let ours_r = m.kitti_rotational_deg_per_m.unwrap();
+    // The devkit's deg/m, ours per 100 m.
+    let ours_r = m.kitti_rotational_deg_per_100m.unwrap() / 100.0;
     assert!(relative_diff(r, ours_r) < 1e-9, "rotational {r} deg/m (devkit) vs {ours_r} deg/m");
     let theirs = devkit["per_length"].as_array().unwrap();
     assert_eq!(theirs.len(), per_length.len());
@@ -153,7 +154,7 @@ fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
         let t = d["t_err"].as_f64().unwrap() * 100.0;
         assert!(relative_diff(t, ours.translational_pct) < 1e-9, "{d} vs {ours:?}");
         let r = d["r_err"].as_f64().unwrap().to_degrees();
-        assert!(relative_diff(r, ours.rotational_deg_per_m) < 1e-9, "{d} vs {ours:?}");
+        assert!(relative_diff(r, ours.rotational_deg_per_100m / 100.0) < 1e-9, "{d} vs {ours:?}");
     }
 }
 

@@ -28,9 +28,9 @@ KITTI devkit (evaluate_odometry.cpp).",
         kitti_segments: u64, "", "segments evaluated; 0 when the path is shorter than every length";
         kitti_translational_pct: Option<f64>, "%",
             "KITTI translational drift, mean over all segments; null without segments";
-        kitti_rotational_deg_per_m: Option<f64>, "deg/m",
-            "KITTI rotational drift, mean over all segments; null without segments";
-        kitti_rotational_deg_per_100m: Option<f64>, "deg/100m", "the same in degrees per 100 m";
+        kitti_rotational_deg_per_100m: Option<f64>, "deg/100m",
+            "KITTI rotational drift, mean over all segments, in degrees per 100 m (the unit the radar-odometry \
+papers report, CFEAR's 0.60 deg/100 m; the devkit's deg/m times 100); null without segments";
         ate_rmse_m: f64, "m", "absolute trajectory error: position RMSE after least-squares SE(2) alignment";
         ate_max_m: f64, "m", "largest position error after alignment";
         x_rmse_m: f64, "m", "RMSE of x without alignment";
@@ -55,7 +55,7 @@ order; lengths longer than the path are absent.",
         length_m: f64, "m", "nominal segment length";
         segments: u64, "", "segments of this length";
         translational_pct: f64, "%", "mean translational error / length";
-        rotational_deg_per_m: f64, "deg/m", "mean rotational error / length";
+        rotational_deg_per_100m: f64, "deg/100m", "mean rotational error / length, in degrees per 100 m";
     }
 }
 

@@ -239,7 +239,6 @@ fn trajectory_metrics_round_trip_with_and_without_nulls() {
         step_m: None,
         kitti_segments: 12,
         kitti_translational_pct: Some(1.25),
-        kitti_rotational_deg_per_m: Some(0.002),
         kitti_rotational_deg_per_100m: Some(0.2),
         ate_rmse_m: 1.0,
         ate_max_m: 2.0,
@@ -256,7 +255,6 @@ fn trajectory_metrics_round_trip_with_and_without_nulls() {
         step_frames: None,
         step_m: Some(5.0),
         kitti_translational_pct: None,
-        kitti_rotational_deg_per_m: None,
         kitti_rotational_deg_per_100m: None,
         ..full.clone()
     };
