@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{RunInfo, write_table};
+use std::collections::BTreeMap;
+
+use mmtrack_io::table::{RunComparisonRow, RunInfo, write_table};
 
 use crate::sequence_run::SequenceRun;
 
@@ -93,7 +95,8 @@ pub fn write_all_results(
 /// Writes several runs into `out`: each run's results as [`write_all_results`]
 /// would, into `<out>/run=<id>/`, then the runs side by side (polars over
 /// the runs' result tables, [`crate::campaign`]): table
-/// `<out>/tables/run_comparison/sequence=all/part-0.parquet` and
+/// `<out>/tables/run_comparison/sequence=<id>/part-0.parquet` (one partition
+/// per sequence, `all` and `mean` for the pooled rows) and
 /// `<out>/report.md` / `report.html` linking each run's own report.
 pub fn write_campaign(
     out: &Path,
@@ -111,7 +114,14 @@ pub fn write_campaign(
     }
     let rows = crate::campaign::compare_runs(staging.path())?;
     let tables = staging.path().join("tables");
-    write_table(&tables, "all", &rows, run, Overwrite::Refuse)?;
+    // One partition per sequence, so the Hive column `sequence` filters the table.
+    let mut by_sequence: BTreeMap<&str, Vec<RunComparisonRow>> = BTreeMap::new();
+    for compared in &rows {
+        by_sequence.entry(compared.sequence.as_str()).or_default().push(compared.row.clone());
+    }
+    for (sequence, partition) in &by_sequence {
+        write_table(&tables, sequence, partition, run, Overwrite::Refuse)?;
+    }
     let ids: Vec<String> = runs.iter().map(|(r, _)| r.id.clone()).collect();
     let mut text = String::from("# mmtrack campaign report\n\n");
     text.push_str("| run | tables | report |\n|---|---|---|\n");

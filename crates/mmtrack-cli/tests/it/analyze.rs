@@ -303,14 +303,22 @@ mine = con.execute(f"""
 """).fetchall()
 theirs = con.execute(f"""
     SELECT run,
-        max(CASE WHEN sequence_id = 'all' AND metric = 'kitti_translational_pct' THEN value END),
-        max(CASE WHEN sequence_id = 'all' AND metric = 'ate_rmse_m' THEN value END),
-        max(CASE WHEN sequence_id = 'all' AND metric = 'rpe_translation_rmse_m' THEN value END),
-        max(CASE WHEN sequence_id = 'mean' AND metric = 'position_rmse_m' THEN value END),
-        count(DISTINCT sequence_id) - 2
+        max(CASE WHEN sequence = 'all' AND metric = 'kitti_translational_pct' THEN value END),
+        max(CASE WHEN sequence = 'all' AND metric = 'ate_rmse_m' THEN value END),
+        max(CASE WHEN sequence = 'all' AND metric = 'rpe_translation_rmse_m' THEN value END),
+        max(CASE WHEN sequence = 'mean' AND metric = 'position_rmse_m' THEN value END),
+        count(DISTINCT sequence) - 2
     FROM {comparison} WHERE source_table = 'trajectory_metrics' GROUP BY run ORDER BY run
 """).fetchall()
-print(json.dumps({"duckdb": [list(r) for r in mine], "run_comparison": [list(r) for r in theirs]}))
+# Issue 28: filtering on the sequence (the Hive column) finds the rows, in DuckDB and in pyarrow.
+import pyarrow.dataset as ds
+dataset = ds.dataset(f"{root}/tables/run_comparison", format="parquet", partitioning="hive")
+filtered = {}
+for sequence in ["long", "short", "all", "mean"]:
+    duck = con.execute(f"SELECT count(*) FROM {comparison} WHERE sequence = '{sequence}'").fetchone()[0]
+    arrow = dataset.to_table(filter=ds.field("sequence") == sequence).num_rows
+    filtered[sequence] = [duck, arrow]
+print(json.dumps({"duckdb": [list(r) for r in mine], "run_comparison": [list(r) for r in theirs], "filtered": filtered}))
 "#;
 
 #[test]
@@ -365,6 +373,16 @@ fn analyze_puts_runs_side_by_side_with_pooled_rows_a_duckdb_query_reproduces() {
     }
     // The runs differ where they should: run b's heading bias (orientations
     // only, positions untouched) shows in KITTI drift and RPE, not in the ATE.
+    // `WHERE sequence = ...` (DuckDB, Hive partitioning) and a pyarrow
+    // dataset filter find every row of the sequence: the trajectory metrics
+    // compared, once per run that has the sequence (`long`: runs a and b;
+    // `short`, `all`, `mean`: all three).
+    let per_run = mmtrack_analysis::campaign::TRAJECTORY_COMPARED.len() as u64;
+    for (sequence, runs) in [("long", 2), ("short", 3), ("all", 3), ("mean", 3)] {
+        let counts = &json["filtered"][sequence];
+        assert_eq!(counts[0].as_u64(), Some(runs * per_run), "DuckDB WHERE sequence = '{sequence}': {json}");
+        assert_eq!(counts[1].as_u64(), Some(runs * per_run), "pyarrow sequence == '{sequence}': {json}");
+    }
     let value = |run: usize, k: usize| duckdb[run][k].as_f64().unwrap();
     assert!(value(1, 1) > value(0, 1) && value(1, 3) > value(0, 3), "{json}");
     assert_eq!(value(1, 2), value(0, 2), "{json}");

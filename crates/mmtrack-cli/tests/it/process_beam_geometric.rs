@@ -146,8 +146,13 @@ fn analyze_geometric(dir: &Path, rows: &[GeometricEpochRow]) {
     // Both runs side by side: the campaign comparison carries the summary.
     let out = mmtrack(dir, &["analyze", "t", "h", "-o", "both"]);
     assert!(out.status.success(), "{}", text(&out).1);
-    let compared: Vec<RunComparisonRow> =
-        read_table(&dir.join("both/tables/run_comparison/sequence=all/part-0.parquet")).unwrap();
+    // Partitioned by sequence: run h's rows under sequence=handover, run t's under its own.
+    let partitions = mmtrack_io::table::read_table_dir::<RunComparisonRow>(&dir.join("both/tables")).unwrap();
+    let mut expected = vec![sequence.as_str(), "handover"];
+    expected.sort_unstable();
+    assert_eq!(partitions.keys().map(String::as_str).collect::<Vec<_>>(), expected);
+    assert!(partitions["handover"].iter().all(|r| r.run == "h"), "{partitions:?}");
+    let compared: Vec<RunComparisonRow> = partitions.into_values().flatten().collect();
     let value = |run: &str, metric: &str| {
         let found =
             compared.iter().find(|r| r.source_table == "geometric_summary" && r.run == run && r.metric == metric);
