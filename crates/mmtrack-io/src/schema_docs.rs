@@ -42,7 +42,7 @@ fn index() -> String {
          `frame` and `frame.meaning` (the coordinate frame of the table's positions and angles; `not_applicable` for a table without any) and `frame.origin` (JSON, where the recording names the frame's origin, e.g. a GNSS origin's `latitude_deg`/`longitude_deg`/`altitude_m`), \
          `mmtrack.table`, `mmtrack.version`, `mmtrack.run_config` (JSON). \
          Every Arrow field carries `unit` (`1` for a dimensionless number, `none` for a string, flag or bytes) and `description` (the meaning below). \
-         Times are `t_ns` (int64 nanoseconds on the time base), angles radians, durations seconds.\n\n");
+         Times are `t_ns` (int64 nanoseconds on the time base), angles radians (WGS-84 latitude and longitude excepted: degrees), durations and delays seconds, rotational drift degrees per 100 m, powers dB with the reference in the column's meaning.\n\n");
     for spec in ALL_TABLES {
         out.push_str(&format!("- [{0}](tables/{0}.md): {1}\n", spec.name, spec.description));
     }

@@ -13,7 +13,7 @@ pointed from its prediction; block 0 is the channel estimate the trackers start 
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamRmsRow {
         tracker: String, "", "tracker name (pv-ekf, pv-ekf-paper-table, angle-ekf)";
-        snr_db: f64, "dB", "received SNR of the scenario point";
+        snr_db: f64, "dB", "received SNR of the scenario point: signal power over noise power, dB re the noise power";
         speed_kmh: f64, "km/h", "initial speed of the scenario point";
         block: u64, "", "block index (1 ms each)";
         rms_aod_rad: f64, "rad", "RMS AoD pointing error over the runs";
@@ -31,7 +31,7 @@ where it gives one.",
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamValidTrackingRow {
         tracker: String, "", "tracker name";
-        snr_db: f64, "dB", "received SNR";
+        snr_db: f64, "dB", "received SNR: signal power over noise power, dB re the noise power";
         speed_kmh: f64, "km/h", "initial speed";
         runs: u64, "", "Monte Carlo runs";
         blocks_simulated: u64, "", "blocks per run";
@@ -56,9 +56,9 @@ its neighbour, beams measured per sweep (a full sweep counts all beams) and re-i
         passes: u64, "", "sequences summarised (1 per sequence; the site's passes when pooled)";
         sweeps: u64, "", "sweeps summarised";
         beam_count: u32, "", "beams of the codebook (what a full sweep measures)";
-        mean_loss_db: f64, "dB", "mean received-power loss against the best beam, 10 log10(P_best / P_chosen)";
-        median_loss_db: f64, "dB", "median loss (mean of the two middle values for an even count)";
-        p90_loss_db: f64, "dB", "90th percentile of the loss (nearest rank)";
+        mean_loss_db: f64, "dB", "mean received-power loss against the best beam, 10 log10(P_best / P_chosen): dB re the best beam's received power";
+        median_loss_db: f64, "dB", "median loss (mean of the two middle values for an even count); dB re the best beam's received power";
+        p90_loss_db: f64, "dB", "90th percentile of the loss (nearest rank); dB re the best beam's received power";
         top1: f64, "", "share of sweeps whose chosen beam is the best beam";
         within_one: f64, "", "share of sweeps whose chosen beam is the best beam or its neighbour";
         mean_beams_per_sweep: f64, "", "mean beams measured per sweep, re-acquisitions included";

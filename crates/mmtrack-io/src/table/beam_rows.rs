@@ -25,7 +25,7 @@ consecutive and in time order. Trackers see only the beams they measure; the ful
         beams_measured: u32, "",
             "distinct beams the tracker measured in this sweep, re-acquisition included (beam_count for a full sweep)";
         reinitialised: bool, "", "true when the tracker (re-)acquired the beam in this sweep (pass start or loss)";
-        loss_db: f64, "dB", "received-power loss of the chosen beam against the best: 10 log10(P_best / P_chosen) >= 0";
+        loss_db: f64, "dB", "received-power loss of the chosen beam against the best: 10 log10(P_best / P_chosen) >= 0, dB re the best beam's received power in the full sweep";
         gnss_beam: Option<f64>, "",
             "beam the vehicle's GNSS position predicts through the beam map (continuous index); null without a map";
     }

@@ -28,7 +28,7 @@ proposed-doppler-mps (the same for the proposed tracker with its own beam window
         t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         runs: u64, "", "Monte Carlo runs with an estimate at this epoch";
         nmse: f64, "", "sum (r_est - r)^2 / sum r^2";
-        nmse_db: f64, "dB", "10 log10(nmse)";
+        nmse_db: f64, "dB", "10 log10(nmse): dB re 1 (nmse is a dimensionless power ratio)";
         rmse_m: f64, "m", "root mean squared range error";
     }
 }

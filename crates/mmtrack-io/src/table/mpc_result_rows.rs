@@ -26,14 +26,14 @@ Transition columns are null for the first set.",
         death_rate_per_m: Option<f64>, "1/m", "deaths / distance_m";
         birth_rate_per_s: Option<f64>, "1/s", "births / time since the previous set";
         death_rate_per_s: Option<f64>, "1/s", "deaths / time since the previous set";
-        channel_gain_db: f64, "dB", "channel gain after thresholding and windowing (mpc_sets)";
-        detected_gain_db: f64, "dB", "gain captured by the detections";
-        tracked_gain_db: f64, "dB", "gain captured by the short-term tracks";
-        full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks";
-        gmphd_tracked_gain_db: Option<f64>, "dB", "gain captured by the GM-PHD tracks; null without them";
-        detection_loss_db: f64, "dB", "channel_gain_db - detected_gain_db";
-        tracking_loss_db: f64, "dB", "channel_gain_db - tracked_gain_db";
-        gmphd_tracking_loss_db: Option<f64>, "dB", "channel_gain_db - gmphd_tracked_gain_db";
+        channel_gain_db: f64, "dB", "channel gain after thresholding and windowing (mpc_sets); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detected_gain_db: f64, "dB", "gain captured by the detections; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        tracked_gain_db: f64, "dB", "gain captured by the short-term tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        gmphd_tracked_gain_db: Option<f64>, "dB", "gain captured by the GM-PHD tracks; null without them; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detection_loss_db: f64, "dB", "channel_gain_db - detected_gain_db: dB re the channel gain";
+        tracking_loss_db: f64, "dB", "channel_gain_db - tracked_gain_db: dB re the channel gain";
+        gmphd_tracking_loss_db: Option<f64>, "dB", "channel_gain_db - gmphd_tracked_gain_db: dB re the channel gain";
         true_births: Option<u64>, "", "true paths above the floor appearing since the previous set; null without truth";
         true_deaths: Option<u64>, "", "true paths above the floor gone since the previous set; null without truth";
     }
@@ -52,7 +52,7 @@ the order of mpc_tracks: sample standard deviation (n - 1) of its detections' po
         set_index: u64, "", "set of the track";
         detections: u64, "", "detections of the track";
         full_lifetime: bool, "", "true when the track spans every processed snapshot of its set";
-        power_std_db: f64, "dB", "standard deviation of power_db over the track";
+        power_std_db: f64, "dB", "standard deviation of power_db over the track (a spread of dB values, independent of their reference)";
     }
 }
 
@@ -113,10 +113,10 @@ they are null without one, and the per-second rates always apply. Truth columns 
         death_rate_per_m: Option<f64>, "1/m", "deaths / distance_m";
         birth_rate_per_s: Option<f64>, "1/s", "births / duration_s";
         death_rate_per_s: Option<f64>, "1/s", "deaths / duration_s";
-        mean_detection_loss_db: Option<f64>, "dB", "mean over sets of channel minus detected gain";
-        mean_tracking_loss_db: Option<f64>, "dB", "mean over sets of channel minus short-term tracked gain";
-        mean_full_lifetime_loss_db: Option<f64>, "dB", "mean over sets of channel minus full-lifetime gain";
-        mean_gmphd_tracking_loss_db: Option<f64>, "dB", "mean over sets of channel minus GM-PHD tracked gain";
+        mean_detection_loss_db: Option<f64>, "dB", "mean over sets of channel minus detected gain: dB re the channel gain";
+        mean_tracking_loss_db: Option<f64>, "dB", "mean over sets of channel minus short-term tracked gain: dB re the channel gain";
+        mean_full_lifetime_loss_db: Option<f64>, "dB", "mean over sets of channel minus full-lifetime gain: dB re the channel gain";
+        mean_gmphd_tracking_loss_db: Option<f64>, "dB", "mean over sets of channel minus GM-PHD tracked gain: dB re the channel gain";
         full_lifetime_std_below_1db: Option<f64>, "", "share of full-lifetime tracks with power std < 1 dB";
         all_tracks_std_below_1_5db: Option<f64>, "", "share of all short-term tracks with power std < 1.5 dB";
         chi_0_1ns_power_share: Option<f64>, "", "share of linked power in classes chi <= 0.1 ns";
@@ -137,7 +137,7 @@ they are null without one, and the per-second rates always apply. Truth columns 
         true_birth_rate_per_m: Option<f64>, "1/m", "true_births / distance_m";
         true_death_rate_per_m: Option<f64>, "1/m", "true_deaths / distance_m";
         first_path_dynamic_range_db: f64, "dB",
-            "a snapshot's first path is its earliest detection at most this far below its strongest (mpc_first_path)";
+            "a snapshot's first path is its earliest detection at most this far below its strongest (mpc_first_path): dB re the strongest detection's power";
         first_path_snapshots: u64, "", "snapshots with a first path (at least one detection)";
         first_path_hint_snapshots: u64, "", "of those, snapshots carrying the receiver's own first-path estimate";
         first_path_minus_hint_median_s: Option<f64>, "s",
@@ -165,9 +165,9 @@ strongest detection, and its distance from the receiver's own first-path estimat
         snapshot_index: u32, "", "snapshot within the set";
         detections: u64, "", "detections of the snapshot";
         strongest_delay_s: Option<f64>, "s", "delay of the strongest detection";
-        strongest_power_db: Option<f64>, "dB", "power of the strongest detection";
+        strongest_power_db: Option<f64>, "dB", "power of the strongest detection (mpc_detections.power_db); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         first_path_delay_s: Option<f64>, "s", "delay of the first path";
-        first_path_power_db: Option<f64>, "dB", "power of the first path";
+        first_path_power_db: Option<f64>, "dB", "power of the first path (mpc_detections.power_db); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         first_path_hint_s: Option<f64>, "s", "the receiver's own first-path estimate (mpc_snapshots); null when not given";
         first_path_minus_hint_s: Option<f64>, "s", "first_path_delay_s - first_path_hint_s";
     }

@@ -33,7 +33,7 @@ Sec. V), ordered by set then long-term track; a long-term track is the rows shar
         t_ns: i64, "ns", "mean time of the short-term track's detections";
         short_track_id: u64, "", "the full-lifetime short-term track (track_id in mpc_tracks)";
         mean_delay_s: f64, "s", "mean delay over the set (tau-bar, eq. 33)";
-        mean_power_db: f64, "dB", "10 log10 of the mean linear power over the set (a-bar, eq. 33)";
+        mean_power_db: f64, "dB", "10 log10 of the mean linear power |a|^2 over the set (a-bar, eq. 33); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         doppler_hz: f64, "Hz", "Doppler of the short-term track (nu, eq. 31)";
         link_error_s: Option<f64>, "s",
             "larger two-way delay prediction error of the link from the previous set (eqs. 41-42); null for the first entry";
@@ -57,13 +57,13 @@ was captured.",
         detections: u32, "", "detections over the set";
         short_term_tracks: u32, "", "short-term tracks of the set";
         full_lifetime_tracks: u32, "", "short-term tracks spanning the whole set";
-        noise_floor_db: f64, "dB", "mean noise floor of the set's snapshots";
-        channel_gain_db: f64, "dB", "channel gain after thresholding and windowing";
-        detected_gain_db: f64, "dB", "gain captured by the detections";
-        tracked_gain_db: f64, "dB", "gain captured by the short-term tracks";
-        full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks";
+        noise_floor_db: f64, "dB", "mean noise floor (mean tap power) of the set's snapshots; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        channel_gain_db: f64, "dB", "channel gain (sum of |h|^2 over the taps) after thresholding and windowing; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detected_gain_db: f64, "dB", "gain captured by the detections (sum of |a|^2 times the pulse energy); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        tracked_gain_db: f64, "dB", "gain captured by the short-term tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         gmphd_tracked_gain_db: Option<f64>, "dB",
-            "gain captured by the GM-PHD baseline's tracks (same definition); null when it did not run";
+            "gain captured by the GM-PHD baseline's tracks (same definition); null when it did not run; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
     }
 }
 
@@ -81,9 +81,9 @@ Sec. III-A) and the receiver's own first-path estimate carried in the recording,
         snapshot_index: u32, "", "snapshot within the set";
         detections: u32, "", "detected MPCs (rows of mpc_detections of this snapshot)";
         skipped: bool, "", "true when detection skipped the snapshot (all taps zero)";
-        noise_floor_db: f64, "dB", "estimated noise floor (mean tap power); -inf when skipped";
-        channel_gain_db: f64, "dB", "channel gain after thresholding and windowing; -inf when skipped";
-        detected_gain_db: f64, "dB", "gain captured by the detections; -inf when none";
+        noise_floor_db: f64, "dB", "estimated noise floor (mean tap power); -inf when skipped; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        channel_gain_db: f64, "dB", "channel gain (sum of |h|^2 over the taps) after thresholding and windowing; -inf when skipped; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detected_gain_db: f64, "dB", "gain captured by the detections; -inf when none; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         first_path_hint_s: Option<f64>, "s",
             "the receiver's own first-path estimate on the delay axis (e.g. DW1000 HLP); null when not given";
     }
@@ -103,7 +103,7 @@ order; path_id is stable while the propagation path exists.",
         delay_s: f64, "s", "true delay on the recording's delay axis";
         amplitude_re: f64, "", "real part of the true complex amplitude", |r| r.amplitude.re;
         amplitude_im: f64, "", "imaginary part of the true complex amplitude", |r| r.amplitude.im;
-        power_db: f64, "dB", "20 log10 |amplitude| (derived, for convenience)", MpcTruth::power_db;
+        power_db: f64, "dB", "20 log10 |amplitude| (derived, for convenience); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm) (the simulated CIR's)", MpcTruth::power_db;
         doppler_hz: f64, "Hz", "true Doppler shift, -f_c d(tau)/dt";
     } => {
         let amplitude = Complex64::new(amplitude_re, amplitude_im);

@@ -123,7 +123,7 @@ crate::define_table! {
         delay_s: f64, "s", "estimated delay";
         amplitude_re: f64, "", "real part of the complex amplitude", |r| r.amplitude.re;
         amplitude_im: f64, "", "imaginary part of the complex amplitude", |r| r.amplitude.im;
-        power_db: f64, "dB", "20 log10 |amplitude| (derived, for convenience)", MpcDetection::power_db;
+        power_db: f64, "dB", "20 log10 |amplitude| (derived, for convenience); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)", MpcDetection::power_db;
     } => {
         let amplitude = Complex64::new(amplitude_re, amplitude_im);
         MpcDetection { t_ns, set_index, snapshot_index, delay_s, amplitude }
@@ -151,7 +151,7 @@ crate::define_table! {
         delay_s: f64, "s", "estimated delay", |r| r.detection.delay_s;
         amplitude_re: f64, "", "real part of the complex amplitude", |r| r.detection.amplitude.re;
         amplitude_im: f64, "", "imaginary part of the complex amplitude", |r| r.detection.amplitude.im;
-        power_db: f64, "dB", "20 log10 |amplitude|", |r| r.detection.power_db();
+        power_db: f64, "dB", "20 log10 |amplitude|; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)", |r| r.detection.power_db();
     } => {
         let amplitude = Complex64::new(amplitude_re, amplitude_im);
         let detection = MpcDetection { t_ns, set_index, snapshot_index, delay_s, amplitude };
