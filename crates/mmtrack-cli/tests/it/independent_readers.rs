@@ -223,6 +223,6 @@ fn pyarrow_rewritten_tables_with_every_codec_are_read() {
         let out = mmtrack(d, &["inspect", &file]);
         let (stdout, stderr) = text(&out);
         assert!(out.status.success(), "inspect {codec}: {stderr}");
-        assert!(stdout.contains("odometry / sequence=oxford-demo: 8 rows"), "{codec}: {stdout}");
+        assert!(stdout.contains("odometry / sequence=oxford-demo: 160 rows"), "{codec}: {stdout}");
     }
 }

@@ -27,7 +27,7 @@ fn data(relative: &str) -> PathBuf {
 fn radar_recording(dir: &Path, scans: usize) -> PathBuf {
     let output = dir.join("radar.mcap");
     let simulation = RadarSimulation {
-        scenario: data("demo/radar-scenario.toml"),
+        scenario: data("demo/fixture-scenario.toml"),
         trajectory: None,
         max_scans: Some(scans),
         max_distance_m: None,
