@@ -166,3 +166,60 @@ impl TableTimeBase {
         }))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::table::{GROUND_TRUTH, ODOMETRY_TIMING, RADAR_SCANS, RunInfo};
+
+    fn map(pairs: &[(&str, &str)]) -> BTreeMap<String, String> {
+        pairs.iter().map(|(k, v)| (k.to_string(), v.to_string())).collect()
+    }
+
+    #[test]
+    fn a_recording_frame_carries_the_origin_the_recording_names() {
+        let utm = map(&[
+            ("ground_truth.frame", "ins (local east-north frame about the origin)"),
+            ("ground_truth.origin_north_m", "5736001"),
+            ("ground_truth.origin_east_m", "620000"),
+        ]);
+        let frame = Frame::of_recording("ground_truth", "gt", &utm);
+        assert_eq!(frame.origin, Some(map(&[("north_m", "5736001"), ("east_m", "620000")])));
+        assert!(frame.meaning.contains("ins (local east-north frame about the origin)"), "{}", frame.meaning);
+        let gnss = map(&[("gnss.enu_origin_latitude_deg", "51.76"), ("gnss.enu_origin_longitude_deg", "-1.26")]);
+        let frame = Frame::of_recording("ground_truth", "gt", &gnss);
+        assert_eq!(frame.origin, Some(map(&[("latitude_deg", "51.76"), ("longitude_deg", "-1.26")])));
+        assert!(frame.meaning.contains("GNSS origin"), "{}", frame.meaning);
+        assert_eq!(Frame::of_recording("ground_truth", "gt", &map(&[("radar.model", "x")])).origin, None);
+    }
+
+    #[test]
+    fn every_table_states_time_base_and_frame_and_a_positions_table_needs_the_run_frame() {
+        let run = RunInfo::new("{}", TimeBase::ScenarioStart);
+        let kv = |spec| run.context_metadata(spec).unwrap().into_iter().collect::<BTreeMap<_, _>>();
+        let timing = kv(&ODOMETRY_TIMING);
+        assert_eq!(timing[TIME_BASE_KEY], "scenario_start");
+        assert_eq!(timing[FRAME_KEY], FRAME_NOT_APPLICABLE);
+        assert_eq!(kv(&RADAR_SCANS)[FRAME_KEY], "radar_sensor");
+        let err = run.context_metadata(&GROUND_TRUTH).unwrap_err();
+        assert!(err.contains("table ground_truth holds positions but the run states no frame"), "{err}");
+        let origin = map(&[("latitude_deg", "51.76")]);
+        let framed = run.with_frame(Frame { id: "enu".into(), meaning: "m".into(), origin: Some(origin) });
+        let truth: BTreeMap<_, _> = framed.context_metadata(&GROUND_TRUTH).unwrap().into_iter().collect();
+        assert_eq!(
+            (truth[FRAME_KEY].as_str(), truth[FRAME_ORIGIN_KEY].as_str()),
+            ("enu", r#"{"latitude_deg":"51.76"}"#)
+        );
+    }
+
+    #[test]
+    fn pooled_time_bases_agree_or_say_mixed() {
+        let unix = TableTimeBase::from(TimeBase::UnixEpoch);
+        let scenario = TableTimeBase::from(TimeBase::ScenarioStart);
+        assert_eq!(TableTimeBase::pooled([&unix, &unix]), Some(unix.clone()));
+        let mixed = TableTimeBase::pooled([&unix, &scenario]).unwrap();
+        assert_eq!(mixed.name, "mixed");
+        assert!(mixed.meaning.contains("unix_epoch, scenario_start"), "{}", mixed.meaning);
+        assert_eq!(TableTimeBase::pooled([]), None);
+    }
+}

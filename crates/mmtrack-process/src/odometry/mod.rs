@@ -171,13 +171,14 @@ pub fn write_outputs(
     recording: &Path,
 ) -> anyhow::Result<Vec<TableWriteSummary>> {
     let (estimates, frame) = in_ground_truth_frame(&run.estimates, &run.ground_truth);
+    let truth_frame = Frame::of_recording(
+        "ground_truth",
+        "the world frame of the recording's ground truth (/ground_truth/pose); odometry is moved into it at the run \
+         config's frame.anchor_t_ns",
+        &run.recording_extra,
+    );
     let table_frame = match frame["world"].as_str() {
-        Some("ground_truth") => Frame::of_recording(
-            "ground_truth",
-            "the world frame of the recording's ground truth (/ground_truth/pose); odometry is moved into it at the \
-             run config's frame.anchor_t_ns",
-            &run.recording_extra,
-        ),
+        Some("ground_truth") => truth_frame.clone(),
         _ => Frame::new(
             "first_scan",
             "the vehicle's pose at the first radar scan (the recording has no ground truth at the scan times)",
@@ -202,7 +203,8 @@ pub fn write_outputs(
     tables.write(sequence, &run.timings, &info)?;
     if !run.ground_truth.is_empty() {
         let truth: Vec<GroundTruthPose> = run.ground_truth.iter().cloned().map(GroundTruthPose).collect();
-        tables.write(sequence, &truth, &info)?;
+        // The ground truth is in its own frame, also when the odometry is not.
+        tables.write(sequence, &truth, &RunInfo { frame: Some(truth_frame), ..info.clone() })?;
     }
     tables.publish()
 }
