@@ -69,4 +69,4 @@ reproduce *args:
 # Regenerate schemas/ and data/ fixtures from the code.
 regenerate:
     cargo run -q -p mmtrack-cli -- schemas --write schemas
-    cargo run -q -p mmtrack-cli -- simulate radar --scenario data/demo/radar-scenario.toml --format oxford -o data/demo/oxford-demo --force
+    cargo run -q -p mmtrack-cli -- simulate radar --scenario data/demo/fixture-scenario.toml --format oxford -o data/demo/oxford-demo --force

@@ -11,6 +11,7 @@ summary table.
 """
 
 import argparse
+import math
 import pathlib
 
 import matplotlib
@@ -83,8 +84,8 @@ def main():
     if spebt is not None:
         fig, ax = plt.subplots()
         for (sequence,), s in spebt.collect().sort("slot").group_by("sequence", maintain_order=True):
-            ax.plot(s["slot"], s["rmse_aod_deg"], label=f"{sequence} AoD")
-            ax.plot(s["slot"], s["rmse_aoa_deg"], label=f"{sequence} AoA")
+            ax.plot(s["slot"], s["rmse_aod_rad"] * 180.0 / math.pi, label=f"{sequence} AoD")
+            ax.plot(s["slot"], s["rmse_aoa_rad"] * 180.0 / math.pi, label=f"{sequence} AoA")
         ax.set_xlabel("slot")
         ax.set_ylabel("RMSE over runs (deg)")
         ax.legend(fontsize=7)

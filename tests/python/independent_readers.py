@@ -78,7 +78,7 @@ def check_demo_recording(root):
     check(metadata["mmtrack.recording"]["sequence_id"] == "oxford-demo", "demo sequence id")
     images = [(m, d) for t, s, m, d in messages if t == "/radar/image"]
     metas = {m.sequence: d for t, s, m, d in messages if t == "/radar/scan_meta"}
-    check(len(images) == 8 and len(metas) == 8, "8 scans")
+    check(len(images) == 160 and len(metas) == 160, "160 scans (the demo drive)")
     for m, image in images:
         check(image.format == "png", "png format")
         meta = metas[m.sequence]
@@ -119,7 +119,7 @@ def check_tables(root):
     taps = con.execute("SELECT len(taps_re), taps_im[2] FROM read_parquet(?)", [str(tables / "cir_snapshots" / "*" / "*.parquet")]).fetchall()
     check(taps == [(16, -1.0)], f"duckdb list columns {taps}")
     poses = con.execute("SELECT count(*) FROM read_parquet(?)", [str(root / "demo" / "tables" / "ground_truth" / "*" / "*.parquet")]).fetchone()
-    check(poses == (8,), f"demo ground truth {poses}")
+    check(poses == (160,), f"demo ground truth {poses}")
     print("parquet (pyarrow, duckdb): ok")
 
 

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::RunInfo;
+use mmtrack_io::table::{RunInfo, TableTimeBase};
 
 use crate::campaign::{RunTables, discover_runs};
 use crate::mpc::MpcOptions;
@@ -111,16 +111,35 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
         bail!("--first-path-range-db {range_db}: expected a finite, non-negative number of dB");
     }
     let runs = discover_runs(tables)?;
-    let config = |tables: serde_json::Value| RunInfo {
-        config_json: serde_json::json!({
-            "command": "analyze",
-            "tables": tables,
-            "segment_lengths_m": options.drift.segment_lengths_m,
-            "step": format!("{:?}", options.drift.step),
-            "first_path_range_db": range_db,
-            "mmtrack_version": env!("CARGO_PKG_VERSION"),
+    // The run's time base: its inputs' (each sequence's tables then carry their own, `RunResults::time_bases`).
+    let mut stated = Vec::new();
+    for run in &runs {
+        stated.extend(crate::pipeline::time_bases(&run.tables)?.into_values());
+    }
+    // Asked after the analysis, so an input without tables gets its own message first.
+    let time_base = || {
+        TableTimeBase::pooled(&stated).with_context(|| {
+            format!(
+                "{}: no input table states its time base (key time_base; tables written by an mmtrack before it); \
+                 process the recordings again",
+                tables.iter().map(|t| t.display().to_string()).collect::<Vec<_>>().join(", ")
+            )
         })
-        .to_string(),
+    };
+    let config = |tables: serde_json::Value| -> anyhow::Result<RunInfo> {
+        Ok(RunInfo {
+            config_json: serde_json::json!({
+                "command": "analyze",
+                "tables": tables,
+                "segment_lengths_m": options.drift.segment_lengths_m,
+                "step": format!("{:?}", options.drift.step),
+                "first_path_range_db": range_db,
+                "mmtrack_version": env!("CARGO_PKG_VERSION"),
+            })
+            .to_string(),
+            time_base: time_base()?,
+            frame: None,
+        })
     };
     // One run: its results straight into the output, as always.
     if let [only] = runs.as_slice()
@@ -128,7 +147,7 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
         && only.tables == tables[0]
     {
         let results = analyze_run(&only.tables, &options.drift, &options.mpc)?;
-        let run = config(serde_json::json!(only.tables.display().to_string()));
+        let run = config(serde_json::json!(only.tables.display().to_string()))?;
         let written = write_all_results(output, &results, &options.drift, &run, options.overwrite)?;
         return Ok(Analyzed::Run { results: Box::new(results), written });
     }
@@ -140,7 +159,7 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
     }
     let inputs: serde_json::Map<String, serde_json::Value> =
         runs.iter().map(|r| (r.id.clone(), serde_json::json!(r.tables.display().to_string()))).collect();
-    let run = config(serde_json::Value::Object(inputs));
+    let run = config(serde_json::Value::Object(inputs))?;
     let written = write_campaign(output, &analyzed, &options.drift, &run, options.overwrite)?;
     Ok(Analyzed::Campaign { runs: analyzed, written })
 }

@@ -298,11 +298,7 @@ pub fn pooled_trajectory_exprs() -> Vec<Expr> {
             .map(|c| col(c).sum())
             .collect();
     exprs.extend(["path_length_m", "estimate_path_length_m"].into_iter().map(|c| col(c).sum()));
-    exprs.extend(
-        ["kitti_translational_pct", "kitti_rotational_deg_per_m", "kitti_rotational_deg_per_100m"]
-            .into_iter()
-            .map(by_segments),
-    );
+    exprs.extend(["kitti_translational_pct", "kitti_rotational_deg_per_100m"].into_iter().map(by_segments));
     exprs.extend(
         ["ate_rmse_m", "x_rmse_m", "y_rmse_m", "position_rmse_m", "yaw_rmse_rad"]
             .into_iter()
@@ -342,7 +338,6 @@ pub fn pooled_trajectory_metrics(ms: &[&TrajectoryMetrics]) -> anyhow::Result<Op
         "path_length_m" => v(|m| m.path_length_m),
         "estimate_path_length_m" => v(|m| m.estimate_path_length_m),
         "kitti_translational_pct" => o(|m| m.kitti_translational_pct),
-        "kitti_rotational_deg_per_m" => o(|m| m.kitti_rotational_deg_per_m),
         "kitti_rotational_deg_per_100m" => o(|m| m.kitti_rotational_deg_per_100m),
         "ate_rmse_m" => v(|m| m.ate_rmse_m),
         "x_rmse_m" => v(|m| m.x_rmse_m),
@@ -365,7 +360,6 @@ pub fn pooled_trajectory_metrics(ms: &[&TrajectoryMetrics]) -> anyhow::Result<Op
         estimate_path_length_m: f("estimate_path_length_m")?.unwrap_or(0.0),
         kitti_segments: n("kitti_segments")?,
         kitti_translational_pct: f("kitti_translational_pct")?,
-        kitti_rotational_deg_per_m: f("kitti_rotational_deg_per_m")?,
         kitti_rotational_deg_per_100m: f("kitti_rotational_deg_per_100m")?,
         ate_rmse_m: f("ate_rmse_m")?.unwrap_or(0.0),
         ate_max_m: f("ate_max_m")?.unwrap_or(0.0),
@@ -389,12 +383,22 @@ fn string_at(df: &DataFrame, name: &str, row: usize) -> anyhow::Result<String> {
     Ok(column.str().with_context(|| format!("column {name}"))?.get(row).unwrap_or("").to_string())
 }
 
+/// One `run_comparison` row and its sequence: the partition
+/// (`sequence=<id>`, `all` or `mean`) it is written to.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComparedRow {
+    /// Sequence id; `all` and `mean` for the pooled trajectory rows.
+    pub sequence: String,
+    /// The row.
+    pub row: RunComparisonRow,
+}
+
 /// Wide rows (run, sequence, keys, metrics) into long rows.
 fn long_rows(
     df: &DataFrame,
     compared: &ComparedTable,
     sequence: Option<&str>,
-    rows: &mut Vec<RunComparisonRow>,
+    rows: &mut Vec<ComparedRow>,
 ) -> anyhow::Result<()> {
     for row in 0..df.height() {
         let run = string_at(df, "run", row)?;
@@ -404,14 +408,16 @@ fn long_rows(
         };
         let key = compared.keys.iter().map(|k| string_at(df, k, row)).collect::<anyhow::Result<Vec<_>>>()?.join(" / ");
         for metric in compared.metrics {
-            rows.push(RunComparisonRow {
-                run: run.clone(),
-                source_table: compared.spec.name.to_string(),
-                sequence_id: sequence_id.clone(),
-                key: key.clone(),
-                metric: (*metric).to_string(),
-                unit: unit_of(compared.spec, metric),
-                value: f64_at(df, metric, row)?,
+            rows.push(ComparedRow {
+                sequence: sequence_id.clone(),
+                row: RunComparisonRow {
+                    run: run.clone(),
+                    source_table: compared.spec.name.to_string(),
+                    key: key.clone(),
+                    metric: (*metric).to_string(),
+                    unit: unit_of(compared.spec, metric),
+                    value: f64_at(df, metric, row)?,
+                },
             });
         }
     }
@@ -422,7 +428,7 @@ fn long_rows(
 /// (`<out>/run=<id>/tables/...`): every compared table's metrics per run and
 /// sequence, and for `trajectory_metrics` the pooled rows `all` and `mean`
 /// per run (module docs). Sorted by table, sequence, key, metric order, run.
-pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<RunComparisonRow>> {
+pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
     let mut rows = Vec::new();
     for compared in &COMPARED {
         let Some(frame) = read_runs(out, compared.spec.name)? else { continue };
@@ -454,7 +460,8 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<RunComparisonRow>> {
             long_rows(&means, compared, Some("mean"), &mut rows)?;
         }
     }
-    let metric_rank = |row: &RunComparisonRow| {
+    let metric_rank = |row: &ComparedRow| {
+        let row = &row.row;
         COMPARED
             .iter()
             .find(|c| c.spec.name == row.source_table)
@@ -467,14 +474,14 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<RunComparisonRow>> {
         _ => 0,
     };
     rows.sort_by(|a, b| {
-        let table = |r: &RunComparisonRow| COMPARED.iter().position(|c| c.spec.name == r.source_table);
-        (table(a), sequence_rank(&a.sequence_id), &a.sequence_id, &a.key, metric_rank(a), &a.run).cmp(&(
+        let table = |r: &ComparedRow| COMPARED.iter().position(|c| c.spec.name == r.row.source_table);
+        (table(a), sequence_rank(&a.sequence), &a.sequence, &a.row.key, metric_rank(a), &a.row.run).cmp(&(
             table(b),
-            sequence_rank(&b.sequence_id),
-            &b.sequence_id,
-            &b.key,
+            sequence_rank(&b.sequence),
+            &b.sequence,
+            &b.row.key,
             metric_rank(b),
-            &b.run,
+            &b.row.run,
         ))
     });
     Ok(rows)
@@ -523,7 +530,7 @@ fn relative(a: Option<f64>, b: Option<f64>, unit: &str) -> String {
 /// left out of a table where no run has more than one sequence (they would
 /// repeat the sequence's row).
 #[must_use]
-pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
+pub fn section(rows: &[ComparedRow], runs: &[String]) -> String {
     use std::fmt::Write;
     let mut text = String::from("## Runs side by side\n\n");
     let baseline = runs.first().cloned().unwrap_or_default();
@@ -538,14 +545,14 @@ pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
          per-sequence values.\n",
         runs.iter().map(|r| format!("`{r}`")).collect::<Vec<_>>().join(", ")
     );
-    let tables: BTreeSet<&str> = rows.iter().map(|r| r.source_table.as_str()).collect();
+    let tables: BTreeSet<&str> = rows.iter().map(|r| r.row.source_table.as_str()).collect();
     let pooled = |s: &str| s == "all" || s == "mean";
     for compared in COMPARED.iter().filter(|c| tables.contains(c.spec.name)) {
         let _ = writeln!(text, "### {}\n", compared.spec.name);
-        let of_table: Vec<&RunComparisonRow> = rows.iter().filter(|r| r.source_table == compared.spec.name).collect();
+        let of_table: Vec<&ComparedRow> = rows.iter().filter(|r| r.row.source_table == compared.spec.name).collect();
         let mut sequences_per_run: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
-        for row in of_table.iter().filter(|r| !pooled(&r.sequence_id)) {
-            sequences_per_run.entry(row.run.as_str()).or_default().insert(row.sequence_id.as_str());
+        for compared_row in of_table.iter().filter(|r| !pooled(&r.sequence)) {
+            sequences_per_run.entry(compared_row.row.run.as_str()).or_default().insert(compared_row.sequence.as_str());
         }
         let show_pooled = sequences_per_run.values().any(|s| s.len() > 1);
         let mut header = String::from("| sequence |");
@@ -567,8 +574,8 @@ pub fn section(rows: &[RunComparisonRow], runs: &[String]) -> String {
         let _ = writeln!(text, "{header}\n{rule}");
         // (sequence, key, metric) in row order -> run -> value.
         let mut lines: Vec<(LineId, BTreeMap<String, Option<f64>>)> = Vec::new();
-        for row in of_table.iter().filter(|r| show_pooled || !pooled(&r.sequence_id)) {
-            let id = (row.sequence_id.clone(), row.key.clone(), row.metric.clone(), row.unit.clone());
+        for ComparedRow { sequence, row } in of_table.into_iter().filter(|r| show_pooled || !pooled(&r.sequence)) {
+            let id = (sequence.clone(), row.key.clone(), row.metric.clone(), row.unit.clone());
             match lines.last_mut() {
                 Some((last, values)) if *last == id => {
                     values.insert(row.run.clone(), row.value);
@@ -653,7 +660,6 @@ mod tests {
             step_m: None,
             kitti_segments: segments,
             kitti_translational_pct: kitti_pct,
-            kitti_rotational_deg_per_m: kitti_pct.map(|p| p / 100.0),
             kitti_rotational_deg_per_100m: kitti_pct,
             ate_rmse_m: ate_m,
             ate_max_m: 2.0 * ate_m,
@@ -670,11 +676,19 @@ mod tests {
     #[test]
     fn compare_runs_reads_every_runs_partitions_and_pools_per_run() {
         use mmtrack_io::Overwrite;
-        use mmtrack_io::table::{RunInfo, write_table};
+        use mmtrack_io::table::write_table;
         let dir = tempfile::tempdir().unwrap();
         let write = |run: &str, sequence: &str, m: &TrajectoryMetrics| {
             let tables = dir.path().join(format!("run={run}")).join("tables");
-            write_table(&tables, sequence, std::slice::from_ref(m), &RunInfo::default(), Overwrite::Refuse).unwrap();
+            write_table(
+                &tables,
+                sequence,
+                std::slice::from_ref(m),
+                &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+                    .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+                Overwrite::Refuse,
+            )
+            .unwrap();
         };
         let (a1, a2) = (trajectory(11, 3, Some(1.0), 1.0), trajectory(31, 1, Some(5.0), 2.0));
         let b1 = trajectory(5, 0, None, 1.5);
@@ -686,14 +700,17 @@ mod tests {
 
         let rows = compare_runs(dir.path()).unwrap();
         let value = |run: &str, sequence: &str, metric: &str| {
-            let found: Vec<&RunComparisonRow> =
-                rows.iter().filter(|r| r.run == run && r.sequence_id == sequence && r.metric == metric).collect();
+            let found: Vec<&RunComparisonRow> = rows
+                .iter()
+                .filter(|r| r.row.run == run && r.sequence == sequence && r.row.metric == metric)
+                .map(|r| &r.row)
+                .collect();
             assert_eq!(found.len(), 1, "{run} {sequence} {metric}: {found:?}");
             assert_eq!((found[0].source_table.as_str(), found[0].key.as_str()), ("trajectory_metrics", ""));
             found[0].value
         };
         assert_eq!(rows.len(), (3 + 2 + 2) * TRAJECTORY_COMPARED.len());
-        assert!(rows.iter().all(|r| r.run != "c"));
+        assert!(rows.iter().all(|r| r.row.run != "c"));
         assert_eq!(value("a", "s1", "ate_rmse_m"), Some(1.0));
         assert_eq!(value("a", "s2", "kitti_translational_pct"), Some(5.0));
         assert_eq!(value("b", "s1", "ate_rmse_m"), Some(1.5));
@@ -706,11 +723,11 @@ mod tests {
         assert_eq!(value("a", "mean", "ate_rmse_m"), Some(1.5));
         assert_eq!(value("a", "mean", "kitti_translational_pct"), Some(3.0));
         assert_eq!(value("b", "mean", "kitti_translational_pct"), None);
-        let unit = rows.iter().find(|r| r.metric == "ate_rmse_m").map(|r| r.unit.as_str());
+        let unit = rows.iter().find(|r| r.row.metric == "ate_rmse_m").map(|r| r.row.unit.as_str());
         assert_eq!(unit, Some("m"));
         // Sequences first, then `all`, then `mean`; metrics in report order; runs last.
         let order: Vec<(&str, &str, &str)> =
-            rows.iter().map(|r| (r.sequence_id.as_str(), r.metric.as_str(), r.run.as_str())).collect();
+            rows.iter().map(|r| (r.sequence.as_str(), r.row.metric.as_str(), r.row.run.as_str())).collect();
         assert_eq!(
             &order[..3],
             [
@@ -734,14 +751,16 @@ mod tests {
 
     #[test]
     fn section_puts_runs_side_by_side_and_marks_missing_rows() {
-        let row = |run: &str, sequence: &str, value: Option<f64>| RunComparisonRow {
-            run: run.into(),
-            source_table: "trajectory_metrics".into(),
-            sequence_id: sequence.into(),
-            key: String::new(),
-            metric: "ate_rmse_m".into(),
-            unit: "m".into(),
-            value,
+        let row = |run: &str, sequence: &str, value: Option<f64>| ComparedRow {
+            sequence: sequence.into(),
+            row: RunComparisonRow {
+                run: run.into(),
+                source_table: "trajectory_metrics".into(),
+                key: String::new(),
+                metric: "ate_rmse_m".into(),
+                unit: "m".into(),
+                value,
+            },
         };
         let rows = [row("a", "s1", Some(1.5)), row("b", "s1", None), row("a", "s2", Some(2.0))];
         let text = section(&rows, &["a".into(), "b".into()]);

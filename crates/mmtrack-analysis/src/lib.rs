@@ -59,5 +59,6 @@ mod plot_common;
 pub mod plots;
 pub mod report;
 pub mod report_html;
+mod sequence_run;
 pub mod slam;
 pub mod trajectory;

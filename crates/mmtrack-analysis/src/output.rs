@@ -7,7 +7,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{RunInfo, write_table};
+use std::collections::BTreeMap;
+
+use mmtrack_io::table::{RunComparisonRow, RunInfo, write_table};
+
+use crate::sequence_run::SequenceRun;
 
 use crate::beam::geometric_analysis::{self, GeometricResults};
 use crate::beam::spebt_analysis::{self, SpebtResults};
@@ -91,7 +95,8 @@ pub fn write_all_results(
 /// Writes several runs into `out`: each run's results as [`write_all_results`]
 /// would, into `<out>/run=<id>/`, then the runs side by side (polars over
 /// the runs' result tables, [`crate::campaign`]): table
-/// `<out>/tables/run_comparison/sequence=all/part-0.parquet` and
+/// `<out>/tables/run_comparison/sequence=<id>/part-0.parquet` (one partition
+/// per sequence, `all` and `mean` for the pooled rows) and
 /// `<out>/report.md` / `report.html` linking each run's own report.
 pub fn write_campaign(
     out: &Path,
@@ -109,7 +114,14 @@ pub fn write_campaign(
     }
     let rows = crate::campaign::compare_runs(staging.path())?;
     let tables = staging.path().join("tables");
-    write_table(&tables, "all", &rows, run, Overwrite::Refuse)?;
+    // One partition per sequence, so the Hive column `sequence` filters the table.
+    let mut by_sequence: BTreeMap<&str, Vec<RunComparisonRow>> = BTreeMap::new();
+    for compared in &rows {
+        by_sequence.entry(compared.sequence.as_str()).or_default().push(compared.row.clone());
+    }
+    for (sequence, partition) in &by_sequence {
+        write_table(&tables, sequence, partition, run, Overwrite::Refuse)?;
+    }
     let ids: Vec<String> = runs.iter().map(|(r, _)| r.id.clone()).collect();
     let mut text = String::from("# mmtrack campaign report\n\n");
     text.push_str("| run | tables | report |\n|---|---|---|\n");
@@ -154,14 +166,15 @@ impl WrittenResults {
 
 /// One run's tables, plots, `report.md` and `report.html` into `dir`.
 fn write_run_into(dir: &Path, results: &RunResults, options: &DriftOptions, run: &RunInfo) -> anyhow::Result<usize> {
-    let RunResults { trajectory, mpc, beam, slam, skipped } = results;
+    let RunResults { trajectory, mpc, beam, slam, skipped, time_bases } = results;
     mmtrack_io::create_output_dirs(dir).with_context(|| dir.display().to_string())?;
-    let mut files = write_into(dir, trajectory, skipped, options, run)?;
-    files += write_mpc_into(dir, mpc, run)?;
-    files += write_beam_into(dir, &beam.sweeps, run)?;
-    files += write_spebt_into(dir, &beam.spebt, run)?;
-    files += write_geometric_into(dir, &beam.geometric, run)?;
-    files += crate::slam::analysis::write_slam_into(dir, slam, run)?;
+    let tables_run = SequenceRun::new(run, time_bases);
+    let mut files = write_into(dir, trajectory, skipped, options, &tables_run)?;
+    files += write_mpc_into(dir, mpc, &tables_run)?;
+    files += write_beam_into(dir, &beam.sweeps, &tables_run)?;
+    files += write_spebt_into(dir, &beam.spebt, &tables_run)?;
+    files += write_geometric_into(dir, &beam.geometric, &tables_run)?;
+    files += crate::slam::analysis::write_slam_into(dir, slam, &tables_run)?;
     if !mpc.is_empty() || !beam.is_empty() || !slam.is_empty() {
         let report_path = dir.join("report.md");
         let mut text = report::markdown(trajectory, &[], options)?;
@@ -230,15 +243,15 @@ fn write_into(
     results: &[TrajectoryResult],
     skipped: &[(String, String)],
     options: &DriftOptions,
-    run: &RunInfo,
+    run: &SequenceRun<'_>,
 ) -> anyhow::Result<usize> {
     let tables = dir.join("tables");
     let mut files = 0;
     for r in results {
         let seq = &r.sequence;
-        write_table(&tables, seq, std::slice::from_ref(&r.metrics), run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.drift_rows(), run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.rpe_rows(), run, Overwrite::Refuse)?;
+        write_table(&tables, seq, std::slice::from_ref(&r.metrics), &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.drift_rows(), &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.rpe_rows(), &run.at(seq), Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
         mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let plots = [
@@ -260,17 +273,17 @@ fn write_into(
     Ok(files + 1)
 }
 
-fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &RunInfo) -> anyhow::Result<usize> {
+fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &SequenceRun<'_>) -> anyhow::Result<usize> {
     let tables = dir.join("tables");
     let mut files = 0;
     for r in results {
         let seq = &r.sequence;
-        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.per_set, run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.counts, run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.power_std, run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.chi, run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.first_path, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.per_set, &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.counts, &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.power_std, &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.chi, &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.first_path, &run.at(seq), Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
         mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let svgs = [
@@ -298,7 +311,7 @@ fn write_svg(path: &Path, svg: anyhow::Result<String>, what: &str) -> anyhow::Re
     std::fs::write(path, svg).with_context(|| path.display().to_string())
 }
 
-fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &RunInfo) -> anyhow::Result<usize> {
+fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &SequenceRun<'_>) -> anyhow::Result<usize> {
     if results.is_empty() {
         return Ok(0);
     }
@@ -307,7 +320,7 @@ fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &RunInfo) -> any
     let mut files = 0;
     for r in &results.sequences {
         let seq = &r.sequence;
-        write_table(&tables, seq, &r.summary, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.summary, &run.at(seq), Overwrite::Refuse)?;
         let (best, chosen) = sweeps::beam_index_series(r);
         let beam_count = r.rows.iter().map(|row| row.beam_count).max().unwrap_or(1);
         let [(index_file, _), (cdf_file, _)] = sweeps::SEQUENCE_PLOTS;
@@ -323,7 +336,13 @@ fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &RunInfo) -> any
         )?;
         files += 1 + sweeps::SEQUENCE_PLOTS.len();
     }
-    write_table(&tables, "all", &results.pooled, run, Overwrite::Refuse)?;
+    write_table(
+        &tables,
+        "all",
+        &results.pooled,
+        &run.pooled(results.sequences.iter().map(|r| r.sequence.as_str())),
+        Overwrite::Refuse,
+    )?;
     let mut sites: Vec<&str> = results.pooled.iter().map(|BeamSweepPooledRow(p)| p.site.as_str()).collect();
     sites.dedup();
     for site in sites {
@@ -339,7 +358,7 @@ fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &RunInfo) -> any
     Ok(files + 1)
 }
 
-fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &RunInfo) -> anyhow::Result<usize> {
+fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &SequenceRun<'_>) -> anyhow::Result<usize> {
     if results.is_empty() {
         return Ok(0);
     }
@@ -347,7 +366,7 @@ fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &RunInfo) -> anyhow
     let mut files = 0;
     for r in &results.sequences {
         let seq = &r.sequence;
-        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), &run.at(seq), Overwrite::Refuse)?;
         let (file, _) = spebt_analysis::SEQUENCE_PLOT;
         let title = format!("{seq}: SPEBT {} run 0 against the truth", r.summary.experiment);
         write_svg(
@@ -357,15 +376,21 @@ fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &RunInfo) -> anyhow
         )?;
         files += 2;
     }
-    write_table(&tables, "all", &results.pooled, run, Overwrite::Refuse)?;
+    write_table(
+        &tables,
+        "all",
+        &results.pooled,
+        &run.pooled(results.sequences.iter().map(|r| r.sequence.as_str())),
+        Overwrite::Refuse,
+    )?;
     Ok(files + 1)
 }
 
-fn write_geometric_into(dir: &Path, results: &GeometricResults, run: &RunInfo) -> anyhow::Result<usize> {
+fn write_geometric_into(dir: &Path, results: &GeometricResults, run: &SequenceRun<'_>) -> anyhow::Result<usize> {
     let tables = dir.join("tables");
     for r in &results.sequences {
         let seq = &r.sequence;
-        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), &run.at(seq), Overwrite::Refuse)?;
         let (file, _) = geometric_analysis::SEQUENCE_PLOT;
         let title = format!("{seq}: geometric Doppler-bearing tracker against the truth");
         write_svg(

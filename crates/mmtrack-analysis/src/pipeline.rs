@@ -14,7 +14,7 @@ use mmtrack_io::table::{
     BEAM_SWEEPS_TRACKED, BeamSweepTracked, DriftPerLength, GEOMETRIC_PER_EPOCH, GROUND_TRUTH, GeometricEpochRow,
     GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS,
     MpcSnapshotStats, ODOMETRY, RelativePoseErrorRow, SLAM_UE, SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow,
-    SpebtSummaryRow, TableRow, TrajectoryMetrics, read_table, read_table_dir, table_path,
+    SpebtSummaryRow, TableRow, TableTimeBase, TrajectoryMetrics, read_table, read_table_dir, table_path,
 };
 
 use crate::beam::BeamResults;
@@ -207,7 +207,7 @@ impl TrajectoryResult {
                 length_m: l.length_m,
                 segments: l.segments as u64,
                 translational_pct: l.translational_pct,
-                rotational_deg_per_m: l.rotational_deg_per_m,
+                rotational_deg_per_100m: 100.0 * l.rotational_deg_per_m,
             })
             .collect()
     }
@@ -264,7 +264,6 @@ pub fn analyze_trajectory(
         step_m,
         kitti_segments: drift.segments.len() as u64,
         kitti_translational_pct: summary.map(|s| s.translational_pct),
-        kitti_rotational_deg_per_m: summary.map(|s| s.rotational_deg_per_m),
         kitti_rotational_deg_per_100m: summary.map(|s| s.rotational_deg_per_100m()),
         ate_rmse_m: ate.position_rmse_m,
         ate_max_m: ate.position_max_m,
@@ -460,6 +459,29 @@ pub struct RunResults {
     pub slam: Vec<crate::slam::analysis::SlamSequenceResult>,
     /// Sequences with tables but no metric, and why.
     pub skipped: Vec<(String, String)>,
+    /// The time base of each sequence as its input tables state it
+    /// ([`time_bases`]); the result tables of a sequence carry it.
+    pub time_bases: BTreeMap<String, TableTimeBase>,
+}
+
+/// The time base of each sequence under `root`, as its tables state it (key
+/// `time_base`): one sequence's tables agree unless they came from different
+/// recordings of one sequence id (then `mixed`). A sequence whose tables
+/// state none (written by an mmtrack before the key existed) is left out.
+///
+/// # Errors
+/// An unreadable table file.
+pub fn time_bases(root: &Path) -> anyhow::Result<BTreeMap<String, TableTimeBase>> {
+    let mut stated: BTreeMap<String, Vec<TableTimeBase>> = BTreeMap::new();
+    for (table, sequences) in &inventory(root)?.tables {
+        for sequence in sequences {
+            let path = table_path(root, table, sequence)?;
+            if let Some(time_base) = TableTimeBase::of_table_file(&path)? {
+                stated.entry(sequence.clone()).or_default().push(time_base);
+            }
+        }
+    }
+    Ok(stated.into_iter().filter_map(|(s, bases)| TableTimeBase::pooled(&bases).map(|t| (s, t))).collect())
 }
 
 /// Analyzes every sequence of the table directory `root`: the metrics that
@@ -499,5 +521,5 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
     let beam = analyze_beam_all(root, &plan)?;
     let (slam, slam_skipped) = crate::slam::analysis::analyze_slam_all(root, &plan.slam)?;
     plan.skipped.extend(slam_skipped);
-    Ok(RunResults { trajectory, mpc, beam, slam, skipped: plan.skipped })
+    Ok(RunResults { trajectory, mpc, beam, slam, skipped: plan.skipped, time_bases: time_bases(root)? })
 }

@@ -98,9 +98,9 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
         step(options)
     );
     out.push_str(
-        "| sequence | poses | dropped | path (m) | KITTI t (%) | KITTI r (deg/m) | KITTI r (deg/100 m) | ATE (m) | \
+        "| sequence | poses | dropped | path (m) | KITTI t (%) | KITTI r (deg/100 m) | ATE (m) | \
          ATE max (m) | RMSE (x, y) (m) | yaw RMSE (deg) | RPE t (m) | RPE yaw (deg) | end-point error (m) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let pooled = if results.len() > 1 {
         crate::campaign::pooled_trajectory_metrics(&results.iter().map(|r| &r.metrics).collect::<Vec<_>>())?
@@ -115,12 +115,11 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
     for (name, m, end_point_m) in rows {
         let _ = writeln!(
             out,
-            "| {name} | {} | {} | {:.1} | {} | {} | {} | {:.3} | {:.3} | ({:.3}, {:.3}) | {:.3} | {:.4} | {:.4} | {} |",
+            "| {name} | {} | {} | {:.1} | {} | {} | {:.3} | {:.3} | ({:.3}, {:.3}) | {:.3} | {:.4} | {:.4} | {} |",
             m.associated_poses,
             m.dropped_poses,
             m.path_length_m,
             opt(m.kitti_translational_pct, 3),
-            opt(m.kitti_rotational_deg_per_m, 5),
             opt(m.kitti_rotational_deg_per_100m, 3),
             m.ate_rmse_m,
             m.ate_max_m,
@@ -198,7 +197,6 @@ mod tests {
             step_m: None,
             kitti_segments: segments,
             kitti_translational_pct: kitti_pct,
-            kitti_rotational_deg_per_m: kitti_pct.map(|p| p / 100.0),
             kitti_rotational_deg_per_100m: kitti_pct,
             ate_rmse_m: ate_m,
             ate_max_m: 2.0 * ate_m,

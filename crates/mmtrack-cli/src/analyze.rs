@@ -52,8 +52,8 @@ only with --force and only if it holds nothing but earlier results.\n\n\
 Several runs (several TABLES directories, or run=<ID> folders written by `mmtrack process ... --run-id <ID>`; a \
 directory holding tables directly is a run named after the directory): each run is analyzed as above into \
 <OUT>/run=<ID>/, then the runs are compared side by side with polars (lazy scans of the runs' result tables, \
-group-bys per run): <OUT>/tables/run_comparison/sequence=all/part-0.parquet (long format: run, source_table, \
-sequence_id, key, metric, unit, value) and <OUT>/report.md / report.html with one table per result table, a \
+group-bys per run): <OUT>/tables/run_comparison/sequence=<id>/part-0.parquet (long format: run, source_table, \
+key, metric, unit, value; one partition per sequence, `all` and `mean` for the pooled rows) and <OUT>/report.md / report.html with one table per result table, a \
 column per run and the difference of each run to the first (B - A, and relative where meaningful), and the runs' \
 curves overlaid per sequence (trajectories, errors against distance, beam-sweep loss CDFs). Pooled trajectory rows per run: `all` pools KITTI drift over the segments of every sequence (as the \
 KITTI devkit pools a dataset), RMSEs and ATE over poses, RPE over frame pairs; `mean` is the mean of the \

@@ -205,7 +205,12 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if !quiet {
         for r in &done.recordings {
             let s = &r.summary;
-            println!("{}: SPEBT RMSE AoD {:.3} deg, AoA {:.3} deg", r.sequence_id, s.rmse_aod_deg, s.rmse_aoa_deg);
+            println!(
+                "{}: SPEBT RMSE AoD {:.3} deg, AoA {:.3} deg",
+                r.sequence_id,
+                s.rmse_aod_rad.to_degrees(),
+                s.rmse_aoa_rad.to_degrees()
+            );
         }
     }
 
@@ -228,15 +233,18 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!("slam: {} epochs, {va} VAs and {sp} SPs confirmed at the end", done.tables.ue.len());
     }
 
-    // 5. Every table analyzed together. The demo drive is 14 m: KITTI
-    // segments scaled down from the devkit's 100..800 m, a first frame at
-    // every scan.
+    // 5. Every table analyzed together. The demo drive is 318 m: KITTI
+    // segments of 50..300 m (the devkit's 100..800 m need a longer drive), a
+    // first frame at every scan.
     let analyze_options = AnalyzeOptions {
-        drift: DriftOptions { segment_lengths_m: vec![4.0, 8.0, 12.0], step: FirstFrameStep::Frames(1) },
+        drift: DriftOptions {
+            segment_lengths_m: vec![50.0, 100.0, 150.0, 200.0, 250.0, 300.0],
+            step: FirstFrameStep::Frames(1),
+        },
         mpc: MpcOptions::default(),
         overwrite: Overwrite::Replace,
     };
-    let kitti = ["--segment-lengths-m", "4,8,12", "--step-frames", "1", "--force"];
+    let kitti = ["--segment-lengths-m", "50,100,150,200,250,300", "--step-frames", "1", "--force"];
     announce(&[&["analyze", &w_tables, "-o", &w_analysis][..], &kitti].concat(), quiet);
     let analyzed = analyze(std::slice::from_ref(&tables), &analysis, &analyze_options)?;
     if !quiet {

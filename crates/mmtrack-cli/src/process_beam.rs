@@ -218,8 +218,8 @@ fn print_spebt(done: &spebt::SpebtOutput) {
             summary.runs,
             if summary.runs == 1 { "" } else { "s" },
             summary.rmse_gain_pct,
-            summary.rmse_aod_deg,
-            summary.rmse_aoa_deg,
+            summary.rmse_aod_rad.to_degrees(),
+            summary.rmse_aoa_rad.to_degrees(),
             summary.reinitialisations_mean,
             summary.reinitialisation_share_pct
         );

@@ -36,7 +36,13 @@ fn index() -> String {
     for spec in ALL_SPECS {
         out.push_str(&format!("- [{0}](mcap/{0}.md): {1}\n", spec.full_name, spec.description));
     }
-    out.push_str("\n## Parquet tables\n\nLayout: `<root>/<table>/sequence=<id>/part-0.parquet`, zstd; key-value metadata `units` (JSON column -> unit), `mmtrack.table`, `mmtrack.version`, `mmtrack.run_config` (JSON: the full configuration of the run, and for `process` runs its `inputs`: canonical absolute path, bytes, CRC-32).\n\n");
+    out.push_str("\n## Parquet tables\n\nLayout: `<root>/<table>/sequence=<id>/part-0.parquet`, zstd. Key-value metadata of every file (also on the Arrow schema): \
+         `units` (JSON column -> unit), \
+         `time_base` and `time_base.meaning` (what `t_ns` counts from: the input recording's `unix_epoch`, `scenario_start`, `sim_time` or `relative`; `mixed` for a table pooling inputs of different time bases), \
+         `frame` and `frame.meaning` (the coordinate frame of the table's positions and angles; `not_applicable` for a table without any) and `frame.origin` (JSON, where the recording names the frame's origin, e.g. a GNSS origin's `latitude_deg`/`longitude_deg`/`altitude_m`), \
+         `mmtrack.table`, `mmtrack.version`, `mmtrack.run_config` (JSON: the full configuration of the run, and for `process` runs its `inputs`: canonical absolute path, bytes, CRC-32). \
+         Every Arrow field carries `unit` (`1` for a dimensionless number, `none` for a string, flag or bytes) and `description` (the meaning below). \
+         Times are `t_ns` (int64 nanoseconds on the time base), angles radians (WGS-84 latitude and longitude excepted: degrees), durations and delays seconds, rotational drift degrees per 100 m, powers dB with the reference in the column's meaning.\n\n");
     for spec in ALL_TABLES {
         out.push_str(&format!("- [{0}](tables/{0}.md): {1}\n", spec.name, spec.description));
     }
@@ -90,8 +96,11 @@ fn message(spec: &MessageSpec) -> String {
 
 fn table(spec: &TableSpec) -> String {
     let mut out = format!(
-        "{GENERATED}# Table `{}`\n\n{}\n\n| column | type | nullable | unit | meaning |\n|---|---|---|---|---|\n",
-        spec.name, spec.description
+        "{GENERATED}# Table `{}`\n\n{}\n\nKey-value metadata (see [the index](../README.md#parquet-tables)): `time_base` of the input recording; \
+         `frame` {}.\n\n| column | type | nullable | unit | meaning |\n|---|---|---|---|---|\n",
+        spec.name,
+        spec.description,
+        spec.frame.doc()
     );
     for c in spec.columns {
         out.push_str(&format!(
@@ -99,7 +108,7 @@ fn table(spec: &TableSpec) -> String {
             c.name,
             c.ty.doc_name(),
             if c.nullable { "yes" } else { "no" },
-            c.unit,
+            c.unit_label(),
             c.meaning
         ));
     }

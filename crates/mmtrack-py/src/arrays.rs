@@ -17,7 +17,7 @@ use mmtrack_analysis::analyze::AnalyzeOptions;
 use mmtrack_analysis::pipeline::analyze_trajectory;
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{BeamSweep, CirSnapshot, Complex64, MpcDetection, Se2, StampedPose};
-use mmtrack_io::table::{BeamSweepTracked, RunInfo, table_bytes};
+use mmtrack_io::table::{BeamSweepTracked, RunInfo, TableTimeBase, table_bytes};
 use mmtrack_mpc::{Detector, SounderPulse};
 use mmtrack_process::beam::sweep::{Reacquire, SweepTrackerKind, track_pass};
 
@@ -57,6 +57,12 @@ fn run_info(call: &str, config: serde_json::Value) -> RunInfo {
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        // No recording: t_ns is whatever the caller's array holds.
+        time_base: TableTimeBase {
+            name: "caller".to_string(),
+            meaning: "t_ns as the caller's array gives it (an array call on no recording)".to_string(),
+        },
+        frame: None,
     }
 }
 

@@ -114,7 +114,11 @@ def test_tables_are_lazy_frames_with_units_time_base_and_frame(demo: dict[str, P
     assert spec.units["x_m"] == "m" and spec.units["yaw_rad"] == "rad" and spec.units["t_ns"] == "ns"
     info = mmtrack.table_info(demo["tables"], "odometry")
     assert info.units == {c.name: c.unit for c in spec.columns}
-    assert info.frame is not None
+    assert info.descriptions == {c.name: c.meaning for c in spec.columns}
+    assert all(info.units.values()) and all(info.descriptions.values())
+    # The demo recording has ground truth, so the odometry is in its frame.
+    assert info.frame == "ground_truth" and info.frame_meaning
+    assert mmtrack.table_info(demo["tables"], "odometry_timing").frame == "not_applicable"
     assert info.run_config["command"] == "process odometry"
     # The recording's time base (the demo's simulated drive starts at a UNIX time).
     assert info.time_base == "unix_epoch"

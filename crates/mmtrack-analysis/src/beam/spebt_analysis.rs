@@ -42,11 +42,11 @@ impl SpebtSequenceResult {
         let mut s = SpebtTrackingSeries::default();
         for r in &self.per_slot {
             s.true_gain.push(r.true_gain);
-            s.true_aod_deg.push(r.true_aod_deg);
-            s.true_aoa_deg.push(r.true_aoa_deg);
+            s.true_aod_deg.push(r.true_aod_rad.to_degrees());
+            s.true_aoa_deg.push(r.true_aoa_rad.to_degrees());
             s.estimate_gain.push(r.run0_gain);
-            s.estimate_aod_deg.push(r.run0_aod_deg);
-            s.estimate_aoa_deg.push(r.run0_aoa_deg);
+            s.estimate_aod_deg.push(r.run0_aod_rad.to_degrees());
+            s.estimate_aoa_deg.push(r.run0_aoa_rad.to_degrees());
             s.reinitialised.push(r.run0_reinitialised);
         }
         s
@@ -102,16 +102,15 @@ pub fn sequence_result(
             return Err(format!("sequence {sequence}: spebt_per_slot row {k} is slot {}; expected slot {k}", r.slot));
         }
         let columns = [
-            ("t_s", r.t_s),
             ("true_gain", r.true_gain),
-            ("true_aod_deg", r.true_aod_deg),
-            ("true_aoa_deg", r.true_aoa_deg),
+            ("true_aod_rad", r.true_aod_rad),
+            ("true_aoa_rad", r.true_aoa_rad),
             ("run0_gain", r.run0_gain),
-            ("run0_aod_deg", r.run0_aod_deg),
-            ("run0_aoa_deg", r.run0_aoa_deg),
+            ("run0_aod_rad", r.run0_aod_rad),
+            ("run0_aoa_rad", r.run0_aoa_rad),
             ("rmse_gain_pct", r.rmse_gain_pct),
-            ("rmse_aod_deg", r.rmse_aod_deg),
-            ("rmse_aoa_deg", r.rmse_aoa_deg),
+            ("rmse_aod_rad", r.rmse_aod_rad),
+            ("rmse_aoa_rad", r.rmse_aoa_rad),
             ("reinitialisation_rate", r.reinitialisation_rate),
         ];
         if let Some((name, value)) = columns.iter().find(|(_, v)| !v.is_finite()) {
@@ -125,8 +124,8 @@ pub fn sequence_result(
         |f: fn(&SpebtSlotRow) -> f64| (tracked.iter().map(|r| f(r) * f(r)).sum::<f64>() / tracked.len() as f64).sqrt();
     let checks = [
         ("rmse_gain_pct", summary.rmse_gain_pct, rms(|r| r.rmse_gain_pct)),
-        ("rmse_aod_deg", summary.rmse_aod_deg, rms(|r| r.rmse_aod_deg)),
-        ("rmse_aoa_deg", summary.rmse_aoa_deg, rms(|r| r.rmse_aoa_deg)),
+        ("rmse_aod_rad", summary.rmse_aod_rad, rms(|r| r.rmse_aod_rad)),
+        ("rmse_aoa_rad", summary.rmse_aoa_rad, rms(|r| r.rmse_aoa_rad)),
     ];
     for (name, stated, from_slots) in checks {
         let scale = stated.abs().max(from_slots.abs()).max(1e-12);
@@ -166,19 +165,25 @@ pub fn pool(sequences: &[SpebtSequenceResult]) -> Vec<SpebtPooledRow> {
                 sequences: members.len() as u64,
                 tracked_estimates: estimates,
                 rmse_gain_pct: pooled(|s| s.rmse_gain_pct),
-                rmse_aod_deg: pooled(|s| s.rmse_aod_deg),
-                rmse_aoa_deg: pooled(|s| s.rmse_aoa_deg),
+                rmse_aod_rad: pooled(|s| s.rmse_aod_rad),
+                rmse_aoa_rad: pooled(|s| s.rmse_aoa_rad),
                 reinitialisation_share_pct: 100.0 * reinitialisations / estimates as f64,
                 paper_rmse_gain_pct: first.paper_rmse_gain_pct,
-                paper_rmse_aod_deg: first.paper_rmse_aod_deg,
-                paper_rmse_aoa_deg: first.paper_rmse_aoa_deg,
+                paper_rmse_aod_rad: first.paper_rmse_aod_rad,
+                paper_rmse_aoa_rad: first.paper_rmse_aoa_rad,
                 paper_reinitialisation_share_pct: first.paper_reinitialisation_share_pct,
             }
         })
         .collect()
 }
 
-/// The report section.
+/// A paper's number, stored in radians, back in the degrees the paper
+/// prints (rounded to 9 decimals, so 0.22 deg reads 0.22 again).
+fn paper_deg(rad: f64) -> f64 {
+    (rad.to_degrees() * 1e9).round() / 1e9
+}
+
+/// The report section (angles in degrees, as the paper reports them).
 pub fn section(out: &mut String, results: &SpebtResults) {
     out.push_str(
         "## SPEBT beam tracking (tables `spebt_summary`, `spebt_per_slot`)\n\n\
@@ -198,10 +203,10 @@ pub fn section(out: &mut String, results: &SpebtResults) {
             p.tracked_estimates,
             p.rmse_gain_pct,
             p.paper_rmse_gain_pct,
-            p.rmse_aod_deg,
-            p.paper_rmse_aod_deg,
-            p.rmse_aoa_deg,
-            p.paper_rmse_aoa_deg,
+            p.rmse_aod_rad.to_degrees(),
+            paper_deg(p.paper_rmse_aod_rad),
+            p.rmse_aoa_rad.to_degrees(),
+            paper_deg(p.paper_rmse_aoa_rad),
             p.reinitialisation_share_pct,
             p.paper_reinitialisation_share_pct
         );
@@ -220,8 +225,8 @@ pub fn section(out: &mut String, results: &SpebtResults) {
             s.slots,
             s.runs,
             s.rmse_gain_pct,
-            s.rmse_aod_deg,
-            s.rmse_aoa_deg,
+            s.rmse_aod_rad.to_degrees(),
+            s.rmse_aoa_rad.to_degrees(),
             s.reinitialisation_share_pct,
         );
     }
@@ -249,12 +254,12 @@ pub fn one_lines(results: &SpebtResults) -> Vec<String> {
                 p.sequences,
                 p.tracked_estimates,
                 p.rmse_gain_pct,
-                p.rmse_aod_deg,
-                p.rmse_aoa_deg,
+                p.rmse_aod_rad.to_degrees(),
+                p.rmse_aoa_rad.to_degrees(),
                 p.reinitialisation_share_pct,
                 p.paper_rmse_gain_pct,
-                p.paper_rmse_aod_deg,
-                p.paper_rmse_aoa_deg,
+                paper_deg(p.paper_rmse_aod_rad),
+                paper_deg(p.paper_rmse_aoa_rad),
                 p.paper_reinitialisation_share_pct
             )
         })
@@ -273,11 +278,11 @@ mod tests {
             runs,
             seed: 1,
             rmse_gain_pct: rmse[0],
-            rmse_aod_deg: rmse[1],
-            rmse_aoa_deg: rmse[2],
+            rmse_aod_rad: rmse[1].to_radians(),
+            rmse_aoa_rad: rmse[2].to_radians(),
             rmse_gain_before_reset_pct: rmse[0],
-            rmse_aod_before_reset_deg: rmse[1],
-            rmse_aoa_before_reset_deg: rmse[2],
+            rmse_aod_before_reset_rad: rmse[1].to_radians(),
+            rmse_aoa_before_reset_rad: rmse[2].to_radians(),
             reinitialisations_mean: reinit_mean,
             reinitialisations_min: 0,
             reinitialisations_max: 1,
@@ -286,8 +291,8 @@ mod tests {
             reinit_aod_pct: 100.0,
             reinit_aoa_pct: 0.0,
             paper_rmse_gain_pct: 0.3,
-            paper_rmse_aod_deg: 0.22,
-            paper_rmse_aoa_deg: 4.6,
+            paper_rmse_aod_rad: 0.22f64.to_radians(),
+            paper_rmse_aoa_rad: 4.6f64.to_radians(),
             paper_reinitialisation_share_pct: 4.7,
         }
     }
@@ -295,21 +300,21 @@ mod tests {
     fn slot(k: u64, rmse: [f64; 3]) -> SpebtSlotRow {
         SpebtSlotRow {
             slot: k,
-            t_s: 0.25 * k as f64,
+            t_ns: 250_000_000 * k as i64,
             x_m: 0.0,
             y_m: 0.0,
-            yaw_deg: 0.0,
+            yaw_rad: 0.0,
             range_m: 100.0,
             true_gain: 1e-6,
-            true_aod_deg: 10.0,
-            true_aoa_deg: -20.0,
+            true_aod_rad: 10f64.to_radians(),
+            true_aoa_rad: -20f64.to_radians(),
             run0_gain: 1.1e-6,
-            run0_aod_deg: 10.1,
-            run0_aoa_deg: -21.0,
+            run0_aod_rad: 10.1f64.to_radians(),
+            run0_aoa_rad: -21f64.to_radians(),
             run0_reinitialised: false,
             rmse_gain_pct: rmse[0],
-            rmse_aod_deg: rmse[1],
-            rmse_aoa_deg: rmse[2],
+            rmse_aod_rad: rmse[1].to_radians(),
+            rmse_aoa_rad: rmse[2].to_radians(),
             reinitialisation_rate: 0.0,
         }
     }
@@ -341,10 +346,10 @@ mod tests {
         let p = &pooled[0];
         assert_eq!((p.experiment.as_str(), p.sequences, p.tracked_estimates), ("radar-odometry", 2, 8));
         // (4 x 5 + 4 x 4) / 8 = 4.5.
-        assert!((p.rmse_aod_deg - 4.5f64.sqrt()).abs() < 1e-12, "{}", p.rmse_aod_deg);
+        assert!((p.rmse_aod_rad.to_degrees() - 4.5f64.sqrt()).abs() < 1e-12, "{}", p.rmse_aod_rad);
         // Re-initialisations: 1 x 2 runs + 0.5 x 4 runs = 4 over 8 tracked slots.
         assert!((p.reinitialisation_share_pct - 50.0).abs() < 1e-12);
-        assert_eq!(pooled[1].rmse_aod_deg, 7.0);
+        assert_eq!(pooled[1].rmse_aod_rad, 7f64.to_radians());
         let mut text = String::new();
         section(&mut text, &SpebtResults { sequences: Vec::new(), pooled });
         assert!(text.contains("| radar-odometry | 2 | 8 | 1.00 [0.3] | 2.121 [0.22] |"), "{text}");
@@ -354,13 +359,15 @@ mod tests {
     fn inconsistent_or_bad_tables_are_named() {
         let good = || vec![slot(0, [0.0; 3]), slot(1, [1.0, 2.0, 3.0])];
         let err = sequence_result("p", vec![summary("x", 2, 1, [1.0, 2.5, 3.0], 0.0)], good()).unwrap_err();
-        assert!(err.contains("sequence p: spebt_summary.rmse_aod_deg is 2.5 but spebt_per_slot gives 2"), "{err}");
+        let (stated, slots) = (2.5f64.to_radians(), 2f64.to_radians());
+        let expected = format!("sequence p: spebt_summary.rmse_aod_rad is {stated} but spebt_per_slot gives {slots}");
+        assert!(err.contains(&expected), "{err}");
         let err = sequence_result("p", Vec::new(), good()).unwrap_err();
         assert!(err.contains("has 0 rows, expected one"), "{err}");
         let mut slots = good();
-        slots[1].run0_aoa_deg = f64::NAN;
+        slots[1].run0_aoa_rad = f64::NAN;
         let err = sequence_result("p", vec![summary("x", 2, 1, [1.0, 2.0, 3.0], 0.0)], slots).unwrap_err();
-        assert!(err.contains("slot 1: run0_aoa_deg is NaN"), "{err}");
+        assert!(err.contains("slot 1: run0_aoa_rad is NaN"), "{err}");
         let mut slots = good();
         slots[1].slot = 5;
         let err = sequence_result("p", vec![summary("x", 2, 1, [1.0, 2.0, 3.0], 0.0)], slots).unwrap_err();

@@ -294,7 +294,7 @@ fn draw_nlos_errors(
         .filter(shown)
         .fold((f64::INFINITY, 0.0f64), |(a, b), e| (a.min(e.position_rmse_m), b.max(e.position_rmse_m)));
     let (lo, hi) = if lo.is_finite() { (lo / 1.5, hi * 1.5) } else { (1e-2, 1e2) };
-    let t_end = errors.iter().map(|e| e.t_s).filter(|t| t.is_finite()).fold(0.0f64, f64::max).max(1e-3);
+    let t_end = errors.iter().map(|e| e.t_ns as f64 * 1e-9).fold(0.0f64, f64::max).max(1e-3);
     let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
@@ -312,7 +312,8 @@ fn draw_nlos_errors(
         .map_err(err)?;
     for (i, path) in paths.iter().enumerate() {
         let style = PATH_COLORS[i % PATH_COLORS.len()].stroke_width(2);
-        let points = errors.iter().filter(|e| e.path == *path).filter(shown).map(|e| (e.t_s, e.position_rmse_m));
+        let points =
+            errors.iter().filter(|e| e.path == *path).filter(shown).map(|e| (e.t_ns as f64 * 1e-9, e.position_rmse_m));
         chart
             .draw_series(LineSeries::new(points, style))
             .map_err(err)?
@@ -346,7 +347,7 @@ mod tests {
     fn nlos_figure_has_the_map_and_one_error_curve_per_path() {
         let label = |path: &str, k: usize, image_y: f64, reflection: Option<[f64; 2]>| ZoechmannPathLabelRow {
             path: path.into(),
-            t_s: 0.02 * k as f64,
+            t_ns: 20_000_000 * k as i64,
             x_m: if k == 0 { 1e5 } else { -10.0 + 0.4 * k as f64 },
             y_m: image_y + 0.1,
             vx_mps: 20.0,
@@ -367,7 +368,7 @@ mod tests {
                 errors.push(ZoechmannNlosErrorRow {
                     path: path.into(),
                     epoch: k as u64,
-                    t_s: 0.02 * k as f64,
+                    t_ns: 20_000_000 * k as i64,
                     runs: 10,
                     position_rmse_m: if k == 0 { f64::NAN } else { 10.0 / k as f64 },
                     velocity_rmse_mps: 1.0,

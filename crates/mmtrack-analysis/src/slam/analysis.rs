@@ -16,7 +16,7 @@ use std::path::Path;
 use anyhow::Context;
 use mmtrack_core::slam::UeState;
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{RunInfo, read_table, table_path, write_table};
+use mmtrack_io::table::{read_table, table_path, write_table};
 use mmtrack_io::table_kv::read_key_value_metadata;
 
 use super::metrics::{EpochView, MapTruth, RunOutcome, evaluate};
@@ -253,13 +253,17 @@ pub fn analyze_slam_all(root: &Path, sequences: &[String]) -> anyhow::Result<(Ve
 ///
 /// # Errors
 /// A table or plot that cannot be written.
-pub fn write_slam_into(dir: &Path, results: &[SlamSequenceResult], run: &RunInfo) -> anyhow::Result<usize> {
+pub(crate) fn write_slam_into(
+    dir: &Path,
+    results: &[SlamSequenceResult],
+    run: &crate::sequence_run::SequenceRun<'_>,
+) -> anyhow::Result<usize> {
     let tables = dir.join("tables");
     let mut files = 0;
     for r in results {
         let seq = &r.sequence;
-        write_table(&tables, seq, std::slice::from_ref(&r.summary), run, Overwrite::Refuse)?;
-        write_table(&tables, seq, &r.per_epoch, run, Overwrite::Refuse)?;
+        write_table(&tables, seq, std::slice::from_ref(&r.summary), &run.at(seq), Overwrite::Refuse)?;
+        write_table(&tables, seq, &r.per_epoch, &run.at(seq), Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
         mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
         let curve = |label: &str, f: &dyn Fn(&SlamPerEpochRow) -> f64| EpochCurve {

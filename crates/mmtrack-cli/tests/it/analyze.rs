@@ -69,7 +69,8 @@ fn drive(gt_frames: usize) -> (Vec<OdometryEstimate>, Vec<GroundTruthPose>) {
 }
 
 fn write_pair(root: &Path, sequence: &str, estimate: &[OdometryEstimate], truth: Option<&[GroundTruthPose]>) {
-    let run = RunInfo { config_json: "{}".into() };
+    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(root, sequence, estimate, &run, Overwrite::Refuse).unwrap();
     if let Some(truth) = truth {
         write_table(root, sequence, truth, &run, Overwrite::Refuse).unwrap();
@@ -143,7 +144,8 @@ fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
     let t = devkit["t_err"].as_f64().unwrap() * 100.0;
     let r = devkit["r_err"].as_f64().unwrap().to_degrees();
     assert!(relative_diff(t, t_pct) < 1e-9, "translational {t} % (devkit) vs {t_pct} %");
-    let ours_r = m.kitti_rotational_deg_per_m.unwrap();
+    // The devkit's deg/m, ours per 100 m.
+    let ours_r = m.kitti_rotational_deg_per_100m.unwrap() / 100.0;
     assert!(relative_diff(r, ours_r) < 1e-9, "rotational {r} deg/m (devkit) vs {ours_r} deg/m");
     let theirs = devkit["per_length"].as_array().unwrap();
     assert_eq!(theirs.len(), per_length.len());
@@ -152,7 +154,7 @@ fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
         let t = d["t_err"].as_f64().unwrap() * 100.0;
         assert!(relative_diff(t, ours.translational_pct) < 1e-9, "{d} vs {ours:?}");
         let r = d["r_err"].as_f64().unwrap().to_degrees();
-        assert!(relative_diff(r, ours.rotational_deg_per_m) < 1e-9, "{d} vs {ours:?}");
+        assert!(relative_diff(r, ours.rotational_deg_per_100m / 100.0) < 1e-9, "{d} vs {ours:?}");
     }
 }
 
@@ -301,14 +303,22 @@ mine = con.execute(f"""
 """).fetchall()
 theirs = con.execute(f"""
     SELECT run,
-        max(CASE WHEN sequence_id = 'all' AND metric = 'kitti_translational_pct' THEN value END),
-        max(CASE WHEN sequence_id = 'all' AND metric = 'ate_rmse_m' THEN value END),
-        max(CASE WHEN sequence_id = 'all' AND metric = 'rpe_translation_rmse_m' THEN value END),
-        max(CASE WHEN sequence_id = 'mean' AND metric = 'position_rmse_m' THEN value END),
-        count(DISTINCT sequence_id) - 2
+        max(CASE WHEN sequence = 'all' AND metric = 'kitti_translational_pct' THEN value END),
+        max(CASE WHEN sequence = 'all' AND metric = 'ate_rmse_m' THEN value END),
+        max(CASE WHEN sequence = 'all' AND metric = 'rpe_translation_rmse_m' THEN value END),
+        max(CASE WHEN sequence = 'mean' AND metric = 'position_rmse_m' THEN value END),
+        count(DISTINCT sequence) - 2
     FROM {comparison} WHERE source_table = 'trajectory_metrics' GROUP BY run ORDER BY run
 """).fetchall()
-print(json.dumps({"duckdb": [list(r) for r in mine], "run_comparison": [list(r) for r in theirs]}))
+# Issue 28: filtering on the sequence (the Hive column) finds the rows, in DuckDB and in pyarrow.
+import pyarrow.dataset as ds
+dataset = ds.dataset(f"{root}/tables/run_comparison", format="parquet", partitioning="hive")
+filtered = {}
+for sequence in ["long", "short", "all", "mean"]:
+    duck = con.execute(f"SELECT count(*) FROM {comparison} WHERE sequence = '{sequence}'").fetchone()[0]
+    arrow = dataset.to_table(filter=ds.field("sequence") == sequence).num_rows
+    filtered[sequence] = [duck, arrow]
+print(json.dumps({"duckdb": [list(r) for r in mine], "run_comparison": [list(r) for r in theirs], "filtered": filtered}))
 "#;
 
 #[test]
@@ -374,6 +384,16 @@ fn analyze_puts_runs_side_by_side_with_pooled_rows_a_duckdb_query_reproduces() {
     }
     // The runs differ where they should: run b's heading bias (orientations
     // only, positions untouched) shows in KITTI drift and RPE, not in the ATE.
+    // `WHERE sequence = ...` (DuckDB, Hive partitioning) and a pyarrow
+    // dataset filter find every row of the sequence: the trajectory metrics
+    // compared, once per run that has the sequence (`long`: runs a and b;
+    // `short`, `all`, `mean`: all three).
+    let per_run = mmtrack_analysis::campaign::TRAJECTORY_COMPARED.len() as u64;
+    for (sequence, runs) in [("long", 2), ("short", 3), ("all", 3), ("mean", 3)] {
+        let counts = &json["filtered"][sequence];
+        assert_eq!(counts[0].as_u64(), Some(runs * per_run), "DuckDB WHERE sequence = '{sequence}': {json}");
+        assert_eq!(counts[1].as_u64(), Some(runs * per_run), "pyarrow sequence == '{sequence}': {json}");
+    }
     let value = |run: usize, k: usize| duckdb[run][k].as_f64().unwrap();
     assert!(value(1, 1) > value(0, 1) && value(1, 3) > value(0, 3), "{json}");
     assert_eq!(value(1, 2), value(0, 2), "{json}");

@@ -48,7 +48,16 @@ fn demo_writes_a_recording_and_a_table_and_says_where() {
     let inspect = mmtrack(dir.path(), &["inspect", "--json", "demo-out/recording.mcap"]);
     let summary: serde_json::Value = serde_json::from_slice(&inspect.stdout).unwrap();
     let scans = summary["channels"].as_array().unwrap().iter().find(|c| c["topic"] == "/radar/image").unwrap();
-    assert_eq!(scans["messages"], 8);
+    // The demo drive (issue 28): 160 scans over 320 m, long enough for KITTI
+    // segments of 100 to 300 m, so the plots and drift numbers say something.
+    assert_eq!(scans["messages"], 160);
+    let metrics: Vec<mmtrack_io::table::TrajectoryMetrics> = mmtrack_io::table::read_table(
+        &dir.path().join("demo-out/analysis/tables/trajectory_metrics/sequence=oxford-demo/part-0.parquet"),
+    )
+    .unwrap();
+    let m = &metrics[0];
+    assert!(m.path_length_m > 300.0 && m.associated_poses >= 150, "{m:?}");
+    assert!(m.kitti_segments > 0 && m.kitti_rotational_deg_per_100m.is_some(), "{m:?}");
 }
 
 /// The demo from a clean directory: every pipeline's tables, the analysis
@@ -271,8 +280,8 @@ fn poses_are_added_to_an_existing_recording_in_place() {
         summary["channels"].as_array().unwrap().iter().find(|c| c["topic"] == topic).map(|c| c["messages"].clone())
     };
     assert_eq!(count("/estimate/pose"), Some(serde_json::json!(2)));
-    assert_eq!(count("/radar/image"), Some(serde_json::json!(8)), "the scans were copied");
-    assert_eq!(count("/ground_truth/pose"), Some(serde_json::json!(8)));
+    assert_eq!(count("/radar/image"), Some(serde_json::json!(160)), "the scans were copied");
+    assert_eq!(count("/ground_truth/pose"), Some(serde_json::json!(160)));
     assert_eq!(summary["metadata"]["mmtrack.recording"]["sequence_id"], "oxford-demo");
 
     // A second ground truth is refused and the recording is left as it was.

@@ -5,7 +5,7 @@ use super::common::{files, mmtrack, root};
 #[test]
 fn demo_fixture_folder_regenerates_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
-    let scenario = root().join("data/demo/radar-scenario.toml");
+    let scenario = root().join("data/demo/fixture-scenario.toml");
     let out = mmtrack(
         dir.path(),
         &[
@@ -27,7 +27,7 @@ fn demo_fixture_folder_regenerates_byte_for_byte() {
     for relative in files(&committed) {
         assert!(
             std::fs::read(committed.join(&relative)).unwrap() == std::fs::read(fresh.join(&relative)).unwrap(),
-            "{} differs from a fresh generation; regenerate with the command in data/demo/radar-scenario.toml",
+            "{} differs from a fresh generation; regenerate with the command in data/demo/fixture-scenario.toml",
             relative.display()
         );
     }

@@ -69,7 +69,8 @@ fn write_samples(dir: &Path) {
         .unwrap();
     writer.finish().unwrap();
 
-    let run = RunInfo { config_json: r#"{"who":"independent reader test"}"#.into() };
+    let run = RunInfo::new(r#"{"who":"independent reader test"}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     let tables = dir.join("tables");
     let tracks = vec![MpcTrack {
         track_id: 4,
@@ -222,6 +223,6 @@ fn pyarrow_rewritten_tables_with_every_codec_are_read() {
         let out = mmtrack(d, &["inspect", &file]);
         let (stdout, stderr) = text(&out);
         assert!(out.status.success(), "inspect {codec}: {stderr}");
-        assert!(stdout.contains("odometry / sequence=oxford-demo: 8 rows"), "{codec}: {stdout}");
+        assert!(stdout.contains("odometry / sequence=oxford-demo: 160 rows"), "{codec}: {stdout}");
     }
 }

@@ -40,4 +40,5 @@ mod run_ids;
 mod simulate_radar;
 mod simulate_sounder;
 mod slam_pipeline;
+mod table_metadata;
 mod threads;

@@ -134,7 +134,8 @@ fn analyze_geometric(dir: &Path, rows: &[GeometricEpochRow]) {
         .iter()
         .map(|r| GeometricEpochRow { filter: if r.epoch >= 40 { "rls" } else { "h-infinity" }.into(), ..r.clone() })
         .collect();
-    let run = RunInfo { config_json: "{}".into() };
+    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&dir.join("h"), "handover", &handed_over, &run, Overwrite::Refuse).unwrap();
     let out = mmtrack(dir, &["analyze", "h", "-o", "b"]);
     assert!(out.status.success(), "{}", text(&out).1);
@@ -145,8 +146,13 @@ fn analyze_geometric(dir: &Path, rows: &[GeometricEpochRow]) {
     // Both runs side by side: the campaign comparison carries the summary.
     let out = mmtrack(dir, &["analyze", "t", "h", "-o", "both"]);
     assert!(out.status.success(), "{}", text(&out).1);
-    let compared: Vec<RunComparisonRow> =
-        read_table(&dir.join("both/tables/run_comparison/sequence=all/part-0.parquet")).unwrap();
+    // Partitioned by sequence: run h's rows under sequence=handover, run t's under its own.
+    let partitions = mmtrack_io::table::read_table_dir::<RunComparisonRow>(&dir.join("both/tables")).unwrap();
+    let mut expected = vec![sequence.as_str(), "handover"];
+    expected.sort_unstable();
+    assert_eq!(partitions.keys().map(String::as_str).collect::<Vec<_>>(), expected);
+    assert!(partitions["handover"].iter().all(|r| r.run == "h"), "{partitions:?}");
+    let compared: Vec<RunComparisonRow> = partitions.into_values().flatten().collect();
     let value = |run: &str, metric: &str| {
         let found =
             compared.iter().find(|r| r.source_table == "geometric_summary" && r.run == run && r.metric == metric);

@@ -46,7 +46,8 @@ const ODOMETRY: &str = "tables/odometry/sequence=drive/part-0.parquet";
 fn corrupt(dir: &Path, edit: impl FnOnce(&mut Vec<OdometryEstimate>)) {
     let mut rows = read_table::<OdometryEstimate>(&dir.join(ODOMETRY)).unwrap();
     edit(&mut rows);
-    let info = RunInfo { config_json: "{}".into() };
+    let info = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&dir.join("bad"), "drive", &rows, &info, Overwrite::Replace).unwrap();
 }
 
@@ -67,15 +68,15 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert!(stdout.contains("drive (radar-odometry, 24 slots, 1 run)"), "{stdout}");
     let (summary, slots) = tables(d, "out");
     assert_eq!((summary.experiment.as_str(), summary.slots, summary.runs), ("radar-odometry", 24, 1));
-    for value in [summary.rmse_gain_pct, summary.rmse_aod_deg, summary.rmse_aoa_deg] {
+    for value in [summary.rmse_gain_pct, summary.rmse_aod_rad, summary.rmse_aoa_rad] {
         assert!(value.is_finite() && value >= 0.0, "{summary:?}");
     }
     // A short straight-ish drive 130 m from the BS: the AoD moves little;
     // the AoA error is the odometry's heading error plus the filter's.
-    assert!(summary.rmse_aod_deg < 2.0 && summary.rmse_aoa_deg < 15.0, "{summary:?}");
+    assert!(summary.rmse_aod_rad.to_degrees() < 2.0 && summary.rmse_aoa_rad.to_degrees() < 15.0, "{summary:?}");
     assert_eq!(slots.len(), 24);
-    assert!(slots.iter().enumerate().all(|(k, s)| s.slot == k as u64 && s.run0_aoa_deg.is_finite()));
-    assert!(slots.windows(2).all(|w| w[1].t_s > w[0].t_s) && slots[0].t_s == 0.0);
+    assert!(slots.iter().enumerate().all(|(k, s)| s.slot == k as u64 && s.run0_aoa_rad.is_finite()));
+    assert!(slots.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
     // Again without --force: refused.
     let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "tables", "-o", "out"]].concat());
     assert!(!ok && stderr.contains("--force"), "{stderr}");
@@ -87,7 +88,9 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert!(ok, "{stderr}");
     let (_, turned) = tables(d, "turned");
     assert!(turned[..12].iter().zip(&slots[..12]).all(|(a, b)| a == b));
-    assert!((turned[12].run0_aoa_deg - slots[12].run0_aoa_deg).abs() > 1.0 || turned[12].run0_reinitialised);
+    assert!(
+        (turned[12].run0_aoa_rad - slots[12].run0_aoa_rad).abs().to_degrees() > 1.0 || turned[12].run0_reinitialised
+    );
 
     // Bad odometry tables: NaN, a gap, estimates outside the ground truth's span.
     corrupt(d, |rows| rows[7].world_from_vehicle.y_m = f64::NAN);
@@ -111,7 +114,11 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert!(stdout.contains("drive (pose-error-model, 24 slots, 4 runs)"), "{stdout}");
     let (summary, slots) = tables(d, "model");
     assert_eq!((summary.experiment.as_str(), summary.runs, summary.seed, slots.len()), ("pose-error-model", 4, 7, 24));
-    assert!(summary.rmse_aod_deg.is_finite() && summary.rmse_aoa_deg.is_finite() && summary.rmse_aoa_deg < 15.0);
+    assert!(
+        summary.rmse_aod_rad.is_finite()
+            && summary.rmse_aoa_rad.is_finite()
+            && summary.rmse_aoa_rad.to_degrees() < 15.0
+    );
     let (ok, _, stderr) = run(d, &[&model[..], &["-o", "model2"]].concat());
     assert!(ok, "{stderr}");
     assert_eq!(tables(d, "model2"), (summary.clone(), slots));
@@ -124,7 +131,7 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     let pooled =
         read_table::<SpebtPooledRow>(&analysis.join("tables/spebt_pooled/sequence=all/part-0.parquet")).unwrap();
     assert_eq!((pooled.len(), pooled[0].tracked_estimates), (1, 23 * 4));
-    assert!((pooled[0].rmse_aod_deg - summary.rmse_aod_deg).abs() <= 1e-12 * summary.rmse_aod_deg, "{pooled:?}");
+    assert!((pooled[0].rmse_aod_rad - summary.rmse_aod_rad).abs() <= 1e-12 * summary.rmse_aod_rad, "{pooled:?}");
     let copied = read_table::<SpebtSummaryRow>(&analysis.join("tables/spebt_summary/sequence=drive/part-0.parquet"));
     assert_eq!(copied.unwrap(), vec![summary]);
     let svg = std::fs::read_to_string(analysis.join("plots/drive/spebt_tracking.svg")).unwrap();
@@ -134,11 +141,12 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     // A summary that does not belong to its per-slot table is named.
     let mut other =
         read_table::<SpebtSummaryRow>(&d.join("model/spebt_summary/sequence=drive/part-0.parquet")).unwrap();
-    other[0].rmse_aod_deg += 1.0;
-    let info = RunInfo { config_json: "{}".into() };
+    other[0].rmse_aod_rad += 1f64.to_radians();
+    let info = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&d.join("model"), "drive", &other, &info, Overwrite::Replace).unwrap();
     let (ok, _, stderr) = run(d, &["analyze", "model", "-o", "mixed"]);
-    assert!(!ok && stderr.contains("sequence drive: spebt_summary.rmse_aod_deg is"), "{stderr}");
+    assert!(!ok && stderr.contains("sequence drive: spebt_summary.rmse_aod_rad is"), "{stderr}");
     assert!(stderr.contains("not from the same run") && !d.join("mixed").exists(), "{stderr}");
 
     // The link from --link: a base station elsewhere; one on the path is refused.
@@ -147,8 +155,8 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert!(ok, "{stderr}");
     let (_, far) = tables(d, "far");
     // The vehicle starts at (0, 0): AoD atan2(0 + 125, 0 + 300).
-    let expected = 125f64.atan2(300.0).to_degrees();
-    assert!((far[0].true_aod_deg - expected).abs() < 1e-9, "{}", far[0].true_aod_deg);
+    let expected = 125f64.atan2(300.0);
+    assert!((far[0].true_aod_rad - expected).abs() < 1e-9, "{}", far[0].true_aod_rad);
     std::fs::write(d.join("on.toml"), "[scenario]\nbs_x_m = 0.0\nbs_y_m = 0.5\n").unwrap();
     let (ok, _, stderr) = run(d, &[&spebt[..], &["--link", "on.toml", "-o", "on"]].concat());
     assert!(!ok && stderr.contains("on.toml") && stderr.contains("passes 0.500 m from the base station"), "{stderr}");
@@ -211,7 +219,8 @@ fn the_odometry_table_is_found_in_its_run_folder_and_several_runs_are_named() {
     let mut rows =
         read_table::<OdometryEstimate>(&d.join("tables/run=a/odometry/sequence=drive/part-0.parquet")).unwrap();
     rows[12..].iter_mut().for_each(|r| r.world_from_vehicle.yaw_rad += 30f64.to_radians());
-    let info = RunInfo { config_json: "{}".into() };
+    let info = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     write_table(&d.join("tables/run=b"), "drive", &rows, &info, Overwrite::Refuse).unwrap();
     // A run of another sequence only does not count.
     write_table(&d.join("tables/run=other"), "elsewhere", &rows, &info, Overwrite::Refuse).unwrap();
@@ -229,7 +238,9 @@ fn the_odometry_table_is_found_in_its_run_folder_and_several_runs_are_named() {
     assert!(odometry_used(d, "picked-b").ends_with("tables/run=b/odometry/sequence=drive/part-0.parquet"));
     let (_, run_b) = tables(d, "picked-b");
     assert_eq!(run_b[..12], run_a.1[..12]);
-    assert!((run_b[12].run0_aoa_deg - run_a.1[12].run0_aoa_deg).abs() > 1.0 || run_b[12].run0_reinitialised);
+    assert!(
+        (run_b[12].run0_aoa_rad - run_a.1[12].run0_aoa_rad).abs().to_degrees() > 1.0 || run_b[12].run0_reinitialised
+    );
     let (ok, _, stderr) = go(&["--odometry", "tables", "--odometry-run", "a", "-o", "picked-a"]);
     assert!(ok, "{stderr}");
     assert_eq!(tables(d, "picked-a"), run_a);

@@ -26,7 +26,7 @@ fn nmea_drive_gives_1653_fixes_and_reports_bad_checksums() {
             _ => {}
         }
     }
-    assert_eq!((fixes, scans), (1653, 8));
+    assert_eq!((fixes, scans), (1653, 160));
     let meta = mmtrack(dir.path(), &["inspect", "--json", rec]);
     let summary: serde_json::Value = serde_json::from_slice(&meta.stdout).unwrap();
     let m = &summary["metadata"]["mmtrack.recording"];

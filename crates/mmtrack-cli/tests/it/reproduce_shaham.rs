@@ -36,7 +36,7 @@ fn quick_shaham_writes_tables_figures_verdicts_and_its_readme_block() {
     for row in valid.iter().filter(|r| r.tracker == "pv-ekf") {
         let angle = blocks("angle-ekf", row.snr_db, row.speed_kmh);
         assert!(blocks("pv-ekf", row.snr_db, row.speed_kmh) > angle, "{row:?} vs angle-ekf {angle}");
-        assert!((row.threshold_deg - 4.51).abs() < 0.01, "{row:?}");
+        assert!((row.threshold_rad.to_degrees() - 4.51).abs() < 0.01, "{row:?}");
     }
     assert!(blocks("pv-ekf", 0.0, 60.0) as f64 >= 1.49 * blocks("angle-ekf", 0.0, 60.0) as f64);
     let rms: Vec<BeamRmsRow> =

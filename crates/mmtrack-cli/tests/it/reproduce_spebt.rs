@@ -59,13 +59,13 @@ fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
     }
     let slots: Vec<SpebtSlotRow> = read_table(&dir.path().join("out").join(per_slot(EXPERIMENTS[0]))).unwrap();
     // Slot 0 is the initial access: the estimate is the truth.
-    assert_eq!((slots[0].run0_gain, slots[0].run0_aod_deg), (slots[0].true_gain, slots[0].true_aod_deg));
-    assert_eq!(slots[0].rmse_aod_deg, 0.0);
+    assert_eq!((slots[0].run0_gain, slots[0].run0_aod_rad), (slots[0].true_gain, slots[0].true_aod_rad));
+    assert_eq!(slots[0].rmse_aod_rad, 0.0);
     // The vehicle starts at (0, 0), 128.5 m from the base station at (-30, -125) m.
     assert!((slots[0].range_m - 30f64.hypot(125.0)).abs() < 1e-9 && slots[0].x_m == 0.0);
     // A slot re-initialised in run 0 ends on the true channel.
     let reset = slots.iter().find(|s| s.run0_reinitialised).expect("run 0 re-initialises somewhere");
-    assert_eq!((reset.run0_gain, reset.run0_aoa_deg), (reset.true_gain, reset.true_aoa_deg));
+    assert_eq!((reset.run0_gain, reset.run0_aoa_rad), (reset.true_gain, reset.true_aoa_rad));
 
     for figure in ["fig5_tracking.svg", "fig5_tracking_odometry.svg"] {
         let svg = std::fs::read_to_string(dir.path().join("out").join(figure)).unwrap();

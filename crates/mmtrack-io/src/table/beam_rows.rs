@@ -1,12 +1,15 @@
 //! Tables of the beam-sweep pipeline: what each tracker chose for each
 //! measured sweep, and what that cost against the sweep's best beam.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `beam_sweeps_tracked`: one tracked sweep per row.
     pub const BEAM_SWEEPS_TRACKED = "beam_sweeps_tracked",
         "One beam sweep of one sequence (a vehicle pass) as one beam-sweep tracker handled it: the beam it chose, \
 the best beam of the full sweep, how many beams it measured and the received-power loss; rows of one tracker are \
-consecutive and in time order. Trackers see only the beams they measure; the full sweep scores them.";
+consecutive and in time order. Trackers see only the beams they measure; the full sweep scores them.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`BEAM_SWEEPS_TRACKED`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamSweepTracked {
@@ -22,7 +25,7 @@ consecutive and in time order. Trackers see only the beams they measure; the ful
         beams_measured: u32, "",
             "distinct beams the tracker measured in this sweep, re-acquisition included (beam_count for a full sweep)";
         reinitialised: bool, "", "true when the tracker (re-)acquired the beam in this sweep (pass start or loss)";
-        loss_db: f64, "dB", "received-power loss of the chosen beam against the best: 10 log10(P_best / P_chosen) >= 0";
+        loss_db: f64, "dB", "received-power loss of the chosen beam against the best: 10 log10(P_best / P_chosen) >= 0, dB re the best beam's received power in the full sweep";
         gnss_beam: Option<f64>, "",
             "beam the vehicle's GNSS position predicts through the beam map (continuous index); null without a map";
     }

@@ -3,7 +3,8 @@
 /// Declares a table once: its [`TableSpec`](crate::table::TableSpec) const and
 /// the [`TableRow`](crate::table::TableRow) impl of its row type, see `table/rows.rs`.
 ///
-/// - Header: the const's docs, `pub const NAME = "name", "description";`.
+/// - Header: the const's docs, `pub const NAME = "name", "description", frame: TableFrame;`
+///   (the [`TableFrame`](crate::table::TableFrame) of its positions and angles).
 /// - Then `Row { column: Type, "unit", "meaning"[, value of a row r];* }`: the
 ///   Arrow type follows from [`ColumnValue`](crate::table::ColumnValue) for
 ///   `Type` (`Option<T>`: nullable); the value is `|r| &r.column` unless given.
@@ -21,7 +22,7 @@ macro_rules! define_table {
     (@new $row:ident [$($col:ident)*] =>? $new:expr) => { ($new).map_err(|e| ::std::format!("row {}: {e}", $row)) };
     (@new $row:ident [$($col:ident)*] => $new:expr) => { ::std::result::Result::Ok($new) };
     (
-        $(#[$doc:meta])* $vis:vis const $spec:ident = $name:literal, $description:expr;
+        $(#[$doc:meta])* $vis:vis const $spec:ident = $name:literal, $description:expr, frame: $frame:expr;
         $(#[$row_attr:meta])* $row_vis:vis struct $row:ident {
             $($col:ident: $ty:ty, $unit:literal, $meaning:literal $(, $get:expr)?;)*
         }
@@ -32,13 +33,13 @@ macro_rules! define_table {
             $(#[doc = $meaning] pub $col: $ty,)*
         }
         $crate::define_table! {
-            $(#[$doc])* $vis const $spec = $name, $description;
+            $(#[$doc])* $vis const $spec = $name, $description, frame: $frame;
             $row { $($col: $ty, $unit, $meaning $(, $get)?;)* }
             $($new)*
         }
     };
     (
-        $(#[$doc:meta])* $vis:vis const $spec:ident = $name:literal, $description:expr;
+        $(#[$doc:meta])* $vis:vis const $spec:ident = $name:literal, $description:expr, frame: $frame:expr;
         $row:ident($inner:ty);
     ) => {
         $(#[$doc])*
@@ -46,6 +47,7 @@ macro_rules! define_table {
             name: $name,
             description: $description,
             columns: <$inner as $crate::table::TableRow>::SPEC.columns,
+            frame: $frame,
         };
 
         impl $crate::table::TableRow for $row {
@@ -65,7 +67,7 @@ macro_rules! define_table {
         }
     };
     (
-        $(#[$doc:meta])* $vis:vis const $spec:ident = $name:literal, $description:expr;
+        $(#[$doc:meta])* $vis:vis const $spec:ident = $name:literal, $description:expr, frame: $frame:expr;
         $row:ty {
             $($col:ident: $ty:ty, $unit:literal, $meaning:literal $(, $get:expr)?;)*
         }
@@ -82,6 +84,7 @@ macro_rules! define_table {
                 unit: $unit,
                 meaning: $meaning,
             }),*],
+            frame: $frame,
         };
 
         impl $crate::table::TableRow for $row {

@@ -4,13 +4,16 @@
 //! partition `zoechmann`) and by `mmtrack process beam --tracker geometric`
 //! (`geometric_per_epoch`, one partition per recording).
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `zoechmann_nmse`: NMSE of the range per epoch, manoeuvre and estimator.
     pub const ZOECHMANN_NMSE = "zoechmann_nmse",
         "NMSE of the range over the Monte Carlo runs of one manoeuvre (Zoechmann et al. 2019, Figs. 4-5), per epoch and \
 estimator: sum over runs of (r_est - r)^2 over the sum of r^2, r the true range at the epoch and r_est the estimator's \
 range at the same time (the proposed tracker and the genies project their initial state (10); the batch baseline \
-estimates it directly).";
+estimates it directly).",
+        frame: TableFrame::NotApplicable;
     /// One row of [`ZOECHMANN_NMSE`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct ZoechmannNmseRow {
@@ -22,10 +25,10 @@ ho-chan-true-azimuth (the baseline on the true azimuths), ho-chan-doppler-mps, e
 proposed-full-scan-doppler-mps (the Doppler equation (5) multiplied by the wavelength, i.e. in m/s), \
 proposed-doppler-mps (the same for the proposed tracker with its own beam window)";
         epoch: u64, "", "epoch index (20 ms each)";
-        t_s: f64, "s", "time since the start of the manoeuvre";
+        t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         runs: u64, "", "Monte Carlo runs with an estimate at this epoch";
         nmse: f64, "", "sum (r_est - r)^2 / sum r^2";
-        nmse_db: f64, "dB", "10 log10(nmse)";
+        nmse_db: f64, "dB", "10 log10(nmse): dB re 1 (nmse is a dimensionless power ratio)";
         rmse_m: f64, "m", "root mean squared range error";
     }
 }
@@ -35,7 +38,8 @@ crate::define_table! {
     pub const ZOECHMANN_SUMMARY = "zoechmann_summary",
         "Per manoeuvre of reproduce zoechmann: the proposed tracker's hand-over from H-infinity to RLS (the epoch of the \
 third distinct azimuth) over the runs, and the beams it measured (full scans for the first 10 epochs, then the 3 beams \
-nearest the projected azimuth) against a full scan at every epoch.";
+nearest the projected azimuth) against a full scan at every epoch.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`ZOECHMANN_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct ZoechmannSummaryRow {
@@ -67,13 +71,14 @@ crate::define_table! {
     pub const ZOECHMANN_NLOS_ERROR = "zoechmann_nlos_error",
         "The proposed geometric tracker on each path of an overtaking between two walls (line of sight and the two \
 single wall bounces, image method), per epoch: RMS error over the Monte Carlo runs of the apparent source's position \
-(the transmitter or its mirror image) and velocity, against the simulator's truth.";
+(the transmitter or its mirror image) and velocity, against the simulator's truth.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`ZOECHMANN_NLOS_ERROR`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct ZoechmannNlosErrorRow {
         path: String, "", "los, left-wall or right-wall";
         epoch: u64, "", "epoch index (20 ms each)";
-        t_s: f64, "s", "time since the start of the manoeuvre";
+        t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         runs: u64, "", "runs with an estimate at this epoch";
         position_rmse_m: f64, "m", "RMS distance between estimated and true apparent source";
         velocity_rmse_mps: f64, "m/s", "RMS norm of the relative-velocity error";
@@ -85,12 +90,16 @@ crate::define_table! {
     pub const ZOECHMANN_PATH_LABELS = "zoechmann_path_labels",
         "Labels for other sensors (Zoechmann et al. 2019, Sec. II and VII): for each path of the first Monte Carlo run, \
 the tracker's estimate of the apparent source (transmitter or wall image) in the receiver's frame (x along its heading, \
-y to the left) and its relative velocity, per epoch, beside the simulator's truth and the reflection point.";
+y to the left) and its relative velocity, per epoch, beside the simulator's truth and the reflection point.",
+        frame: TableFrame::Fixed {
+            id: "receiver",
+            meaning: "the receiver's frame: x along its heading, y to the left, origin at the receiver; velocities relative to it",
+        };
     /// One row of [`ZOECHMANN_PATH_LABELS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct ZoechmannPathLabelRow {
         path: String, "", "los, left-wall or right-wall";
-        t_s: f64, "s", "time since the start of the manoeuvre";
+        t_ns: i64, "ns", "time since the start of the manoeuvre (time_base scenario_start)";
         x_m: f64, "m", "estimated x of the apparent source";
         y_m: f64, "m", "estimated y of the apparent source";
         vx_mps: f64, "m/s", "estimated relative velocity, x";
@@ -110,7 +119,11 @@ crate::define_table! {
         "The geometric Doppler-bearing tracker (Zoechmann et al. 2019) on a recording's two vehicles (channel-sounder \
 ground truth of transmitter and receiver): the receiver's 60 GHz UCA codebook and Doppler are simulated along the true \
 poses every epoch; per epoch the tracker's estimate and the truth in the receiver's frame (x forward, y left), the \
-filter in use and the beams measured.";
+filter in use and the beams measured.",
+        frame: TableFrame::Fixed {
+            id: "receiver",
+            meaning: "the receiver's frame: x forward, y left, origin at the receiver; azimuths counter-clockwise from x; velocities relative to it",
+        };
     /// One row of [`GEOMETRIC_PER_EPOCH`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct GeometricEpochRow {
@@ -138,7 +151,8 @@ crate::define_table! {
 geometric_per_epoch (process beam --tracker geometric), one row per sequence: the hand-over from H-infinity to RLS \
 (the epoch of the third distinct azimuth, Sec. IV), the range and azimuth errors from the hand-over on (before it \
 the range is unobservable and the estimate is reported as not converged, never scored), and the beams measured \
-against a full scan at every epoch. Written by `mmtrack analyze`.";
+against a full scan at every epoch. Written by `mmtrack analyze`.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`GEOMETRIC_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct GeometricSummaryRow {

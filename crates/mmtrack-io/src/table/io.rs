@@ -12,15 +12,77 @@ use parquet::file::metadata::KeyValue;
 use parquet::file::properties::WriterProperties;
 
 use super::columns::{Columns, check_no_nulls};
-use super::{TableRow, TableSpec};
+use super::{
+    FRAME_KEY, FRAME_MEANING_KEY, FRAME_NOT_APPLICABLE, FRAME_ORIGIN_KEY, Frame, NOT_APPLICABLE_MEANING, TIME_BASE_KEY,
+    TableFrame, TableRow, TableSpec, TableTimeBase,
+};
 use crate::atomic::{AtomicFile, Durability, Overwrite, commit_all};
 use crate::error::{IoError, Result, os_err};
+use crate::recording::TIME_BASE_MEANING_KEY;
 
-/// Provenance of a run, stored in every table it writes.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// Provenance of a run and what its numbers are measured against, stored in
+/// every table it writes.
+#[derive(Debug, Clone, PartialEq)]
 pub struct RunInfo {
     /// The run's full configuration as JSON.
     pub config_json: String,
+    /// What `t_ns` counts from: the input recording's time base (key `time_base`).
+    pub time_base: TableTimeBase,
+    /// The world frame of the run's positions (keys `frame`, `frame.meaning`,
+    /// `frame.origin`), for its tables of [`TableFrame::Run`]; a run that
+    /// writes such a table without it fails.
+    pub frame: Option<Frame>,
+}
+
+impl RunInfo {
+    /// A run on inputs of `time_base`, without a world frame (enough for
+    /// tables without positions).
+    #[must_use]
+    pub fn new(config_json: impl Into<String>, time_base: impl Into<TableTimeBase>) -> Self {
+        Self { config_json: config_json.into(), time_base: time_base.into(), frame: None }
+    }
+
+    /// The same run with its positions in `frame`.
+    #[must_use]
+    pub fn with_frame(mut self, frame: Frame) -> Self {
+        self.frame = Some(frame);
+        self
+    }
+
+    /// The key-value pairs stating the time base and the frame of a table of
+    /// `spec` written by this run.
+    ///
+    /// # Errors
+    /// A table of [`TableFrame::Run`] when the run states no frame.
+    pub fn context_metadata(&self, spec: &TableSpec) -> std::result::Result<Vec<(String, String)>, String> {
+        let mut pairs = vec![
+            (TIME_BASE_KEY.to_string(), self.time_base.name.clone()),
+            (TIME_BASE_MEANING_KEY.to_string(), self.time_base.meaning.clone()),
+        ];
+        match spec.frame {
+            TableFrame::NotApplicable => {
+                pairs.push((FRAME_KEY.to_string(), FRAME_NOT_APPLICABLE.to_string()));
+                pairs.push((FRAME_MEANING_KEY.to_string(), NOT_APPLICABLE_MEANING.to_string()));
+            }
+            TableFrame::Fixed { id, meaning } => {
+                pairs.push((FRAME_KEY.to_string(), id.to_string()));
+                pairs.push((FRAME_MEANING_KEY.to_string(), meaning.to_string()));
+            }
+            TableFrame::Run => {
+                let frame = self.frame.as_ref().ok_or_else(|| {
+                    format!("table {} holds positions but the run states no frame for them", spec.name)
+                })?;
+                pairs.push((FRAME_KEY.to_string(), frame.id.clone()));
+                pairs.push((FRAME_MEANING_KEY.to_string(), frame.meaning.clone()));
+                if let Some(origin) = &frame.origin {
+                    let json: serde_json::Map<String, serde_json::Value> =
+                        origin.iter().map(|(k, v)| (k.clone(), serde_json::Value::from(v.as_str()))).collect();
+                    pairs.push((FRAME_ORIGIN_KEY.to_string(), serde_json::Value::Object(json).to_string()));
+                }
+            }
+        }
+        Ok(pairs)
+    }
 }
 
 /// Path of one partition: `<root>/<table>/sequence=<id>/part-0.parquet`.
@@ -51,23 +113,25 @@ pub struct TableWriteSummary {
 
 /// The Arrow schema (units on each field, the key-value pairs on the
 /// schema) and the writer properties (zstd, the key-value pairs in the file
-/// footer) of every file of `spec`: `units`, `mmtrack.table`,
+/// footer) of every file of `spec`: `units`, `time_base`, `time_base.meaning`,
+/// `frame`, `frame.meaning` (`frame.origin`), `mmtrack.table`,
 /// `mmtrack.version`, `mmtrack.run_config`.
 fn schema_and_properties(
     spec: &TableSpec,
     run: &RunInfo,
-) -> std::result::Result<(Arc<arrow_schema::Schema>, WriterProperties), parquet::errors::ParquetError> {
-    let metadata = vec![
-        KeyValue::new("units".to_string(), spec.units_json()),
+) -> std::result::Result<(Arc<arrow_schema::Schema>, WriterProperties), String> {
+    let mut metadata = vec![KeyValue::new("units".to_string(), spec.units_json())];
+    metadata.extend(run.context_metadata(spec)?.into_iter().map(|(k, v)| KeyValue::new(k, v)));
+    metadata.extend([
         KeyValue::new("mmtrack.table".to_string(), spec.name.to_string()),
         KeyValue::new("mmtrack.version".to_string(), env!("CARGO_PKG_VERSION").to_string()),
         KeyValue::new("mmtrack.run_config".to_string(), run.config_json.clone()),
-    ];
+    ]);
     // The same pairs on the Arrow schema, where pyarrow and pandas users
     // look (`pq.read_table(f).schema.metadata`), and in the file footer.
     let schema_metadata: std::collections::HashMap<String, String> =
         metadata.iter().map(|kv| (kv.key.clone(), kv.value.clone().unwrap_or_default())).collect();
-    let level = ZstdLevel::try_new(3)?;
+    let level = ZstdLevel::try_new(3).map_err(|e| e.to_string())?;
     let props = WriterProperties::builder()
         .set_compression(Compression::ZSTD(level))
         .set_key_value_metadata(Some(metadata))

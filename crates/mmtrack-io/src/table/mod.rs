@@ -7,7 +7,14 @@
 //! Spark and DataFusion read a whole campaign as one dataset. Each file carries
 //! in its key-value metadata:
 //!
-//! - `units`: JSON object column -> unit (also on each Arrow field as `unit`);
+//! - `units`: JSON object column -> unit (also on each Arrow field as `unit`,
+//!   beside its `description`); `1` for a dimensionless number, `none` for a
+//!   string, flag or bytes;
+//! - `time_base`, `time_base.meaning`: what `t_ns` counts from, the input
+//!   recording's ([`TableTimeBase`]);
+//! - `frame`, `frame.meaning` (and `frame.origin` where the recording names an
+//!   origin): the coordinate frame of the table's positions and angles,
+//!   `not_applicable` for a table without any ([`TableFrame`]);
 //! - `mmtrack.table`, `mmtrack.version`;
 //! - `mmtrack.run_config`: the run's full configuration as JSON.
 //!
@@ -19,6 +26,7 @@ mod beam_result_rows;
 mod beam_rows;
 mod campaign_rows;
 mod columns;
+mod context;
 mod define;
 mod geometric_rows;
 mod io;
@@ -38,6 +46,10 @@ pub use beam_result_rows::{
 pub use beam_rows::{BEAM_SWEEPS_TRACKED, BeamSweepTracked};
 pub use campaign_rows::{RUN_COMPARISON, RunComparisonRow};
 pub use columns::{ColumnValue, Columns, ListColumn};
+pub use context::{
+    FRAME_KEY, FRAME_MEANING_KEY, FRAME_NOT_APPLICABLE, FRAME_ORIGIN_KEY, Frame, NOT_APPLICABLE_MEANING, TIME_BASE_KEY,
+    TableFrame, TableTimeBase,
+};
 pub use geometric_rows::{
     GEOMETRIC_FILTER_H_INFINITY, GEOMETRIC_FILTER_RLS, GEOMETRIC_PER_EPOCH, GEOMETRIC_SUMMARY, GeometricEpochRow,
     GeometricSummaryRow, ZOECHMANN_NLOS_ERROR, ZOECHMANN_NMSE, ZOECHMANN_PATH_LABELS, ZOECHMANN_SUMMARY,
@@ -159,6 +171,20 @@ pub struct ColumnSpec {
     pub meaning: &'static str,
 }
 
+impl ColumnSpec {
+    /// The unit as the files state it: [`ColumnSpec::unit`], or `1` for a
+    /// dimensionless number (a count, ratio or index) and `none` for a
+    /// string, flag or bytes, so every field names one.
+    #[must_use]
+    pub fn unit_label(&self) -> &'static str {
+        match (self.unit, self.ty) {
+            ("", ColumnType::Utf8 | ColumnType::Boolean | ColumnType::Binary | ColumnType::ListBoolean) => "none",
+            ("", _) => "1",
+            (unit, _) => unit,
+        }
+    }
+}
+
 /// A table: its name, what one row is, and its columns.
 #[derive(Debug, Clone, Copy)]
 pub struct TableSpec {
@@ -168,32 +194,34 @@ pub struct TableSpec {
     pub description: &'static str,
     /// Columns in file order.
     pub columns: &'static [ColumnSpec],
+    /// The coordinate frame of its positions and angles.
+    pub frame: TableFrame,
 }
 
 impl TableSpec {
-    /// The Arrow schema, with each field's unit in its metadata.
+    /// The Arrow schema, with each field's `unit` ([`ColumnSpec::unit_label`])
+    /// and `description` in its metadata.
     #[must_use]
     pub fn arrow_schema(&self) -> Schema {
         let fields: Vec<Field> = self
             .columns
             .iter()
             .map(|c| {
-                let field = Field::new(c.name, c.ty.data_type(), c.nullable);
-                if c.unit.is_empty() {
-                    field
-                } else {
-                    field.with_metadata(std::collections::HashMap::from([("unit".to_string(), c.unit.to_string())]))
-                }
+                Field::new(c.name, c.ty.data_type(), c.nullable).with_metadata(std::collections::HashMap::from([
+                    ("unit".to_string(), c.unit_label().to_string()),
+                    ("description".to_string(), c.meaning.to_string()),
+                ]))
             })
             .collect();
         Schema::new(fields)
     }
 
-    /// JSON object column -> unit, for the `units` key-value metadata.
+    /// JSON object column -> unit ([`ColumnSpec::unit_label`]), for the
+    /// `units` key-value metadata.
     #[must_use]
     pub fn units_json(&self) -> String {
         let map: serde_json::Map<String, serde_json::Value> =
-            self.columns.iter().map(|c| (c.name.to_string(), serde_json::Value::from(c.unit))).collect();
+            self.columns.iter().map(|c| (c.name.to_string(), serde_json::Value::from(c.unit_label()))).collect();
         serde_json::Value::Object(map).to_string()
     }
 

@@ -1,6 +1,8 @@
 //! Tables of the odometry pipeline: estimates, their stage timings, and the
 //! ground truth they are compared with.
 
+use super::TableFrame;
+
 use mmtrack_core::{OdometryEstimate, OdometryTiming, Se2, StampedPose};
 
 /// A ground-truth pose: the same columns as `poses`, in its own table so an
@@ -11,7 +13,8 @@ pub struct GroundTruthPose(pub StampedPose);
 crate::define_table! {
     /// `ground_truth`: the reference trajectory of a recording.
     pub const GROUND_TRUTH = "ground_truth",
-        "One ground-truth pose world_from_vehicle per row, in time order, as the recording gives it.";
+        "One ground-truth pose world_from_vehicle per row, in time order, as the recording gives it.",
+        frame: TableFrame::Run;
     GroundTruthPose(StampedPose);
 }
 
@@ -21,7 +24,8 @@ crate::define_table! {
         "One odometry estimate world_from_vehicle per radar scan, in time order, with registration diagnostics; \
 the world frame is the ground truth's when the recording has ground truth (the first estimate inside its time span \
 sits at the ground-truth pose of that time), else the vehicle's pose at the first scan: the run config's `frame` \
-says which.";
+says which.",
+        frame: TableFrame::Run;
     OdometryEstimate {
         t_ns: i64, "ns", "scan time";
         x_m: f64, "m", "estimated x of the vehicle in the world frame", |r| r.world_from_vehicle.x_m;
@@ -46,7 +50,8 @@ crate::define_table! {
     /// `odometry_timing`: per-stage time of each scan (varies run to run).
     pub const ODOMETRY_TIMING = "odometry_timing",
         "Wall-clock time of each odometry stage per scan. Unlike every other table this one is not \
-deterministic; it is kept apart so the result tables are.";
+deterministic; it is kept apart so the result tables are.",
+        frame: TableFrame::NotApplicable;
     OdometryTiming {
         t_ns: i64, "ns", "scan time";
         filter_s: f64, "s", "k-strongest filter and motion compensation";

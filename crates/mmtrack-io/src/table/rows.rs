@@ -1,5 +1,7 @@
 //! Tables of the core types: what each looks like on disk.
 
+use super::TableFrame;
+
 use mmtrack_core::{
     AzimuthSample, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcDetection, MpcTrack, PolarScan, PolarScanHeader,
     Se2, StampedPose,
@@ -10,7 +12,8 @@ use super::{ArrayRef, Columns, TableRow, TableSpec};
 crate::define_table! {
     /// `poses`: a trajectory.
     pub const POSES = "poses",
-        "One pose world_from_vehicle per row, in time order (ground truth or an estimate; the run config says which).";
+        "One pose world_from_vehicle per row, in time order (ground truth or an estimate; the run config says which).",
+        frame: TableFrame::Run;
     StampedPose {
         t_ns: i64, "ns", "time of validity";
         x_m: f64, "m", "x of the vehicle in the world frame", |r| r.parent_from_child.x_m;
@@ -21,7 +24,11 @@ crate::define_table! {
 
 crate::define_table! {
     /// `gnss_fixes`: GNSS positions.
-    pub const GNSS_FIXES = "gnss_fixes", "One WGS-84 GNSS fix per row.";
+    pub const GNSS_FIXES = "gnss_fixes", "One WGS-84 GNSS fix per row.",
+        frame: TableFrame::Fixed {
+            id: "wgs84",
+            meaning: "WGS-84 geodetic latitude and longitude in degrees (the GNSS convention), altitude as the receiver gives it (the recording names its datum)",
+        };
     GnssFix {
         t_ns: i64, "ns", "fix time";
         latitude_deg: f64, "deg", "geodetic latitude, north positive";
@@ -42,7 +49,11 @@ crate::define_table! {
 crate::define_table! {
     /// `radar_scans`: polar radar scans, one per row.
     pub const RADAR_SCANS = "radar_scans",
-        "One polar radar scan per row; power is row-major azimuth x bin, one byte per bin.";
+        "One polar radar scan per row; power is row-major azimuth x bin, one byte per bin.",
+        frame: TableFrame::Fixed {
+            id: "radar_sensor",
+            meaning: "azimuth_rad in the radar sensor's own frame, clockwise from its forward axis seen from above, as the sensor reports it",
+        };
     PolarScan {
         t_ns: i64, "ns", "scan timestamp", |r| r.header.t_ns;
         range_resolution_m: f64, "m", "range bin size", |r| r.header.range_resolution_m;
@@ -75,7 +86,8 @@ crate::define_table! {
 crate::define_table! {
     /// `cir_snapshots`: channel impulse responses, one per row.
     pub const CIR_SNAPSHOTS = "cir_snapshots",
-        "One channel impulse response per row; tap k is at delay delay_offset_s + k * tap_spacing_s.";
+        "One channel impulse response per row; tap k is at delay delay_offset_s + k * tap_spacing_s.",
+        frame: TableFrame::NotApplicable;
     CirSnapshot {
         t_ns: i64, "ns", "measurement time";
         set_index: u64, "", "sounder set";
@@ -102,7 +114,8 @@ crate::define_table! {
 
 crate::define_table! {
     /// `mpc_detections`: detected multipath components.
-    pub const MPC_DETECTIONS = "mpc_detections", "One detected multipath component per row.";
+    pub const MPC_DETECTIONS = "mpc_detections", "One detected multipath component per row.",
+        frame: TableFrame::NotApplicable;
     MpcDetection {
         t_ns: i64, "ns", "time of the snapshot";
         set_index: u64, "", "sounder set";
@@ -110,7 +123,7 @@ crate::define_table! {
         delay_s: f64, "s", "estimated delay";
         amplitude_re: f64, "", "real part of the complex amplitude", |r| r.amplitude.re;
         amplitude_im: f64, "", "imaginary part of the complex amplitude", |r| r.amplitude.im;
-        power_db: f64, "dB", "20 log10 |amplitude| (derived, for convenience)", MpcDetection::power_db;
+        power_db: f64, "dB", "20 log10 |amplitude| (derived, for convenience); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)", MpcDetection::power_db;
     } => {
         let amplitude = Complex64::new(amplitude_re, amplitude_im);
         MpcDetection { t_ns, set_index, snapshot_index, delay_s, amplitude }
@@ -127,7 +140,8 @@ struct TrackPoint {
 crate::define_table! {
     /// `mpc_tracks`: tracked multipath components, one row per track point.
     pub const MPC_TRACKS = "mpc_tracks",
-        "One associated detection of a multipath-component track per row; rows of a track are consecutive and in time order.";
+        "One associated detection of a multipath-component track per row; rows of a track are consecutive and in time order.",
+        frame: TableFrame::NotApplicable;
     TrackPoint {
         track_id: u64, "", "track identifier, unique within the run";
         doppler_hz: Option<f64>, "Hz", "Doppler of the track from its delay slope; null when not estimated";
@@ -137,7 +151,7 @@ crate::define_table! {
         delay_s: f64, "s", "estimated delay", |r| r.detection.delay_s;
         amplitude_re: f64, "", "real part of the complex amplitude", |r| r.detection.amplitude.re;
         amplitude_im: f64, "", "imaginary part of the complex amplitude", |r| r.detection.amplitude.im;
-        power_db: f64, "dB", "20 log10 |amplitude|", |r| r.detection.power_db();
+        power_db: f64, "dB", "20 log10 |amplitude|; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)", |r| r.detection.power_db();
     } => {
         let amplitude = Complex64::new(amplitude_re, amplitude_im);
         let detection = MpcDetection { t_ns, set_index, snapshot_index, delay_s, amplitude };

@@ -1,5 +1,7 @@
 //! Result tables of the 5G mmWave SLAM experiment, with units.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `slam_summary`: one row per experiment row (scenario variant).
     pub const SLAM_SUMMARY = "slam_summary",
@@ -7,7 +9,8 @@ crate::define_table! {
 runs of the time-averaged UE errors, of the time-averaged localisation errors of the confirmed VAs and SPs (each \
 against the nearest true source of its type), and the epochs (1-based, as the paper's k) at which every VA and every \
 SP seen along the drive was confirmed. Written by `reproduce kim` (one row per scenario variant) and by `mmtrack \
-analyze` on the tables of `process slam` (one partition per sequence, row = the sequence, runs = 1).";
+analyze` on the tables of `process slam` (one partition per sequence, row = the sequence, runs = 1).",
+        frame: TableFrame::NotApplicable;
     /// One row of [`SLAM_SUMMARY`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamSummaryRow {
@@ -41,7 +44,8 @@ crate::define_table! {
     pub const SLAM_PER_EPOCH = "slam_per_epoch",
         "5G mmWave SLAM per epoch, averaged over the Monte Carlo runs of one scenario variant (Kim et al. 2018, \
 Figs. 4-6): UE errors, localisation errors of the confirmed sources and the number of confirmed VAs and SPs. \
-`mmtrack analyze` writes it per sequence of `process slam` (one run: the values of that run).";
+`mmtrack analyze` writes it per sequence of `process slam` (one run: the values of that run).",
+        frame: TableFrame::NotApplicable;
     /// One row of [`SLAM_PER_EPOCH`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamPerEpochRow {
@@ -62,7 +66,8 @@ crate::define_table! {
     pub const SLAM_UE = "slam_ue",
         "The 5G mmWave SLAM filter's UE estimate per epoch of one recording (`mmtrack process slam`, Kim et al. \
 2018): the posterior mean and spreads after the epoch's update, what the epoch held and used, and the true state when \
-the recording carries it (/slam/ue_truth; null otherwise).";
+the recording carries it (/slam/ue_truth; null otherwise).",
+        frame: TableFrame::Run;
     /// One row of [`SLAM_UE`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamUeRow {
@@ -98,7 +103,8 @@ crate::define_table! {
     pub const SLAM_MAP = "slam_map",
         "The 5G mmWave SLAM map over time (`mmtrack process slam`): after each epoch, one row per source of the \
 filter's map (the known base station, confirmed virtual anchors and scattering points, unconfirmed sources), with its \
-type, spatial belief and history.";
+type, spatial belief and history.",
+        frame: TableFrame::Run;
     /// One row of [`SLAM_MAP`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamMapRow {
@@ -122,7 +128,8 @@ crate::define_table! {
     pub const SLAM_ASSOCIATIONS = "slam_associations",
         "The 5G mmWave SLAM data association (`mmtrack process slam`, Kim et al. 2018, eq. (3)-(7), solved by \
 Kuhn-Munkres): one row per usable path of each epoch, the decision and its score, beside the path's true source when \
-the recording carries it.";
+the recording carries it.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`SLAM_ASSOCIATIONS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamAssociationRow {
@@ -144,7 +151,8 @@ crate::define_table! {
     pub const SLAM_TRUE_SOURCES = "slam_true_sources",
         "The sources of the 5G mmWave paths as the recording gives them (/slam/sources): the base station and, \
 from a simulation, the true virtual anchors and scattering points; with the number of epochs each was seen in \
-(from the ground-truth path origins).";
+(from the ground-truth path origins).",
+        frame: TableFrame::Run;
     /// One row of [`SLAM_TRUE_SOURCES`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct SlamTrueSourceRow {

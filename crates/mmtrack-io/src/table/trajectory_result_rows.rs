@@ -1,12 +1,15 @@
 //! Result tables of the trajectory evaluation (`mmtrack analyze` on the
 //! tables of `process odometry`), with units: one partition per sequence.
 
+use super::TableFrame;
+
 crate::define_table! {
     /// `trajectory_metrics`: one row per sequence.
     pub const TRAJECTORY_METRICS = "trajectory_metrics",
         "Summary metrics of one estimated trajectory (table odometry) against its ground truth (table \
 ground_truth), one row per sequence. Both are associated by time and start at the identity; KITTI drift follows the \
-KITTI devkit (evaluate_odometry.cpp).";
+KITTI devkit (evaluate_odometry.cpp).",
+        frame: TableFrame::NotApplicable;
     /// One row of [`TRAJECTORY_METRICS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct TrajectoryMetrics {
@@ -25,9 +28,9 @@ KITTI devkit (evaluate_odometry.cpp).";
         kitti_segments: u64, "", "segments evaluated; 0 when the path is shorter than every length";
         kitti_translational_pct: Option<f64>, "%",
             "KITTI translational drift, mean over all segments; null without segments";
-        kitti_rotational_deg_per_m: Option<f64>, "deg/m",
-            "KITTI rotational drift, mean over all segments; null without segments";
-        kitti_rotational_deg_per_100m: Option<f64>, "deg/100m", "the same in degrees per 100 m";
+        kitti_rotational_deg_per_100m: Option<f64>, "deg/100m",
+            "KITTI rotational drift, mean over all segments, in degrees per 100 m (the unit the radar-odometry \
+papers report, CFEAR's 0.60 deg/100 m; the devkit's deg/m times 100); null without segments";
         ate_rmse_m: f64, "m", "absolute trajectory error: position RMSE after least-squares SE(2) alignment";
         ate_max_m: f64, "m", "largest position error after alignment";
         x_rmse_m: f64, "m", "RMSE of x without alignment";
@@ -44,14 +47,15 @@ crate::define_table! {
     /// `drift_per_length`: KITTI drift per segment length.
     pub const DRIFT_PER_LENGTH = "drift_per_length",
         "KITTI drift of one sequence per segment length (the devkit's per-length plots), in segment-length \
-order; lengths longer than the path are absent.";
+order; lengths longer than the path are absent.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`DRIFT_PER_LENGTH`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct DriftPerLength {
         length_m: f64, "m", "nominal segment length";
         segments: u64, "", "segments of this length";
         translational_pct: f64, "%", "mean translational error / length";
-        rotational_deg_per_m: f64, "deg/m", "mean rotational error / length";
+        rotational_deg_per_100m: f64, "deg/100m", "mean rotational error / length, in degrees per 100 m";
     }
 }
 
@@ -59,7 +63,8 @@ crate::define_table! {
     /// `relative_pose_errors`: one row per frame.
     pub const RELATIVE_POSE_ERRORS = "relative_pose_errors",
         "Frame-to-frame relative pose error E_k = (gt_{k-1}^-1 gt_k)^-1 (est_{k-1}^-1 est_k) of one sequence, \
-one row per associated frame k >= 1, in time order.";
+one row per associated frame k >= 1, in time order.",
+        frame: TableFrame::NotApplicable;
     /// One row of [`RELATIVE_POSE_ERRORS`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct RelativePoseErrorRow {

@@ -7,7 +7,7 @@ use arrow_array::{ArrayRef, Float64Array, Int64Array, RecordBatch};
 use arrow_schema::{DataType, Field, Schema};
 use mmtrack_core::StampedPose;
 use mmtrack_io::recording::{PoseStream, inspect_recording};
-use mmtrack_io::table::{RunInfo, read_table, write_table};
+use mmtrack_io::table::{read_table, write_table};
 use mmtrack_io::{IoError, Overwrite, RecordingOptions, RecordingReader, RecordingWriter};
 
 use crate::samples;
@@ -156,7 +156,15 @@ fn parquet_with_wrong_type_or_unknown_column_names_it() {
 #[test]
 fn truncated_parquet_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    let summary = write_table(dir.path(), "s", &samples::poses(), &RunInfo::default(), Overwrite::Refuse).unwrap();
+    let summary = write_table(
+        dir.path(),
+        "s",
+        &samples::poses(),
+        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+        Overwrite::Refuse,
+    )
+    .unwrap();
     let bytes = std::fs::read(&summary.path).unwrap();
     std::fs::write(&summary.path, &bytes[..bytes.len() / 2]).unwrap();
     let err = read_table::<StampedPose>(&summary.path).unwrap_err();
@@ -167,12 +175,36 @@ fn truncated_parquet_is_a_clear_error() {
 #[test]
 fn existing_table_is_refused_unless_replace() {
     let dir = tempfile::tempdir().unwrap();
-    let first = write_table(dir.path(), "s", &samples::poses(), &RunInfo::default(), Overwrite::Refuse).unwrap();
+    let first = write_table(
+        dir.path(),
+        "s",
+        &samples::poses(),
+        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+        Overwrite::Refuse,
+    )
+    .unwrap();
     let before = std::fs::read(&first.path).unwrap();
-    let err = write_table(dir.path(), "s", &samples::poses()[..2], &RunInfo::default(), Overwrite::Refuse).unwrap_err();
+    let err = write_table(
+        dir.path(),
+        "s",
+        &samples::poses()[..2],
+        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+        Overwrite::Refuse,
+    )
+    .unwrap_err();
     assert!(matches!(err, IoError::OutputExists { .. }));
     assert_eq!(std::fs::read(&first.path).unwrap(), before);
-    let second = write_table(dir.path(), "s", &samples::poses()[..2], &RunInfo::default(), Overwrite::Replace).unwrap();
+    let second = write_table(
+        dir.path(),
+        "s",
+        &samples::poses()[..2],
+        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+        Overwrite::Replace,
+    )
+    .unwrap();
     assert_eq!(read_table::<StampedPose>(&second.path).unwrap().len(), 2);
     let leftovers: Vec<_> =
         std::fs::read_dir(first.path.parent().unwrap()).unwrap().map(|e| e.unwrap().file_name()).collect();
@@ -183,7 +215,15 @@ fn existing_table_is_refused_unless_replace() {
 fn unsafe_sequence_names_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     for bad in ["", "..", "a/b", "x y"] {
-        let err = write_table(dir.path(), bad, &samples::poses(), &RunInfo::default(), Overwrite::Refuse).unwrap_err();
+        let err = write_table(
+            dir.path(),
+            bad,
+            &samples::poses(),
+            &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+                .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
+            Overwrite::Refuse,
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("sequence_id"), "{bad}: {err}");
     }
 }

@@ -189,7 +189,8 @@ fn carried_png_is_stored_unchanged_and_decodes_to_the_scan() {
 
 fn table_round_trip<T: TableRow + PartialEq + std::fmt::Debug + Clone>(rows: &[T]) -> Vec<T> {
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo { config_json: r#"{"test":true}"#.into() };
+    let run = RunInfo::new(r#"{"test":true}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     let summary = write_table(dir.path(), "seq-1", rows, &run, Overwrite::Refuse).unwrap();
     assert_eq!(summary.path, table_path(dir.path(), T::SPEC.name, "seq-1").unwrap());
     assert_eq!(summary.rows, rows.len() as u64);
@@ -238,7 +239,6 @@ fn trajectory_metrics_round_trip_with_and_without_nulls() {
         step_m: None,
         kitti_segments: 12,
         kitti_translational_pct: Some(1.25),
-        kitti_rotational_deg_per_m: Some(0.002),
         kitti_rotational_deg_per_100m: Some(0.2),
         ate_rmse_m: 1.0,
         ate_max_m: 2.0,
@@ -255,7 +255,6 @@ fn trajectory_metrics_round_trip_with_and_without_nulls() {
         step_frames: None,
         step_m: Some(5.0),
         kitti_translational_pct: None,
-        kitti_rotational_deg_per_m: None,
         kitti_rotational_deg_per_100m: None,
         ..full.clone()
     };
@@ -285,7 +284,8 @@ fn records_spanning_reader_batches_come_back_whole() {
 #[test]
 fn parquet_metadata_carries_units_and_run_config() {
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo { config_json: r#"{"k":3}"#.into() };
+    let run = RunInfo::new(r#"{"k":3}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     let summary = write_table(dir.path(), "s", &samples::poses(), &run, Overwrite::Refuse).unwrap();
     let file = std::fs::File::open(&summary.path).unwrap();
     let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();
@@ -323,7 +323,7 @@ proptest! {
         }).collect();
         prop_assert_eq!(back.iter().map(pose_bits).collect::<Vec<_>>(), poses.iter().map(pose_bits).collect::<Vec<_>>());
 
-        let summary = write_table(dir.path(), "p", &poses, &RunInfo::default(), Overwrite::Refuse).unwrap();
+        let summary = write_table(dir.path(), "p", &poses, &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch).with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")), Overwrite::Refuse).unwrap();
         let back = read_table::<StampedPose>(&summary.path).unwrap();
         prop_assert_eq!(back.iter().map(pose_bits).collect::<Vec<_>>(), poses.iter().map(pose_bits).collect::<Vec<_>>());
     }

@@ -165,7 +165,8 @@ fn beam_sweeps_tracked_table_round_trips_with_and_without_gnss_beam() {
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo { config_json: r#"{"test":"beam"}"#.into() };
+    let run = RunInfo::new(r#"{"test":"beam"}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     let summary = write_table(dir.path(), "scenario1-pass01", &rows, &run, Overwrite::Refuse).unwrap();
     assert!(summary.path.ends_with("beam_sweeps_tracked/sequence=scenario1-pass01/part-0.parquet"));
     let back = read_table::<BeamSweepTracked>(&summary.path).unwrap();

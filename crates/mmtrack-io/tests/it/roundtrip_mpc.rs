@@ -14,7 +14,8 @@ const AWKWARD: [f64; 6] = [0.1, -1.0 / 3.0, 5e-324, -0.0, 1.7976931348623157e308
 
 fn round_trip<T: TableRow + PartialEq + std::fmt::Debug>(rows: &[T]) -> Vec<T> {
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo { config_json: r#"{"test":"mpc"}"#.into() };
+    let run = RunInfo::new(r#"{"test":"mpc"}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     let summary = write_table(dir.path(), "conv-tx0-rx0", rows, &run, Overwrite::Refuse).unwrap();
     assert_eq!(summary.rows, rows.len() as u64);
     let back = read_table::<T>(&summary.path).unwrap();
@@ -127,7 +128,8 @@ fn mpc_tables_carry_units_and_keep_nulls() {
     assert_eq!(unit(&MPC_SETS, "channel_gain_db"), ("dB", false));
     assert_eq!(unit(&MPC_TRUTH, "doppler_hz"), ("Hz", false));
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo { config_json: "{}".into() };
+    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
     let summary = write_table(dir.path(), "s", &long_term(), &run, Overwrite::Refuse).unwrap();
     let file = std::fs::File::open(&summary.path).unwrap();
     let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();

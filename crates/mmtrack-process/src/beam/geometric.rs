@@ -26,7 +26,7 @@ use mmtrack_beam::geometric::{
 };
 use mmtrack_core::random::standard_normal;
 use mmtrack_core::{Se2, StampedPose, wrap_angle_rad};
-use mmtrack_io::recording::{PoseStream, RecordingMetadata};
+use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
 use mmtrack_io::table::RunInfo;
 use mmtrack_io::table::{
     GEOMETRIC_FILTER_H_INFINITY, GEOMETRIC_FILTER_RLS, GEOMETRIC_PER_EPOCH, GeometricEpochRow, TableWriteSummary,
@@ -98,6 +98,7 @@ pub struct GeometricOutput {
 
 struct TwoVehicles {
     sequence_id: String,
+    time_base: TimeBase,
     tx: Vec<StampedPose>,
     rx: Vec<StampedPose>,
 }
@@ -113,8 +114,8 @@ fn read(path: &Path) -> anyhow::Result<TwoVehicles> {
         }
     }
     let metadata = reader.metadata().cloned().unwrap_or_default();
-    let sequence_id = RecordingMetadata::from_map(&metadata)
-        .map(|m| m.sequence_id)
+    let (sequence_id, time_base) = RecordingMetadata::from_map(&metadata)
+        .map(|m| (m.sequence_id, m.time_base))
         .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
     for (name, poses) in [("transmitter (/ground_truth_tx/pose)", &tx), ("receiver (/ground_truth_rx/pose)", &rx)] {
         if poses.len() < 2 {
@@ -132,7 +133,7 @@ fn read(path: &Path) -> anyhow::Result<TwoVehicles> {
             bail!("{}: {name} pose {i} is not finite", path.display());
         }
     }
-    Ok(TwoVehicles { sequence_id, tx, rx })
+    Ok(TwoVehicles { sequence_id, time_base, tx, rx })
 }
 
 /// The pose at `t_ns` (inside the span), linear in x, y and shortest-arc yaw.
@@ -251,6 +252,8 @@ pub fn process_geometric(
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),
+            time_base: vehicles.time_base.into(),
+            frame: None,
         };
         tables.write(&vehicles.sequence_id, &rows, &info)?;
         results.push(GeometricRecordingResult {

@@ -36,7 +36,7 @@ use mmtrack_beam::sweep::{
 };
 use mmtrack_core::{BeamSweep, GnssFix};
 use mmtrack_ingest::nmea::{EnuOrigin, geodetic_to_enu_m};
-use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata};
+use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata, TimeBase};
 use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingReader};
 
@@ -88,6 +88,8 @@ pub struct BeamRecording {
     pub path: PathBuf,
     /// Sequence id (recording metadata).
     pub sequence_id: String,
+    /// What its `t_ns` counts from (recording metadata).
+    pub time_base: TimeBase,
     /// Site (metadata `beam.site`, else the sequence id).
     pub site: String,
     /// Full sweeps in time order.
@@ -137,14 +139,14 @@ pub fn read_beam_recording(path: &Path) -> anyhow::Result<BeamRecording> {
         }
     }
     let metadata = reader.metadata().cloned().unwrap_or_default();
-    let sequence_id = RecordingMetadata::from_map(&metadata)
-        .map(|m| m.sequence_id)
+    let (sequence_id, time_base) = RecordingMetadata::from_map(&metadata)
+        .map(|m| (m.sequence_id, m.time_base))
         .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
     if sweeps.is_empty() {
         bail!("{}: no beam sweeps (topic /beam/sweeps); nothing to track", path.display());
     }
     let site = metadata.get(BEAM_SITE_KEY).cloned().unwrap_or_else(|| sequence_id.clone());
-    Ok(BeamRecording { path: path.to_path_buf(), sequence_id, site, sweeps, vehicle, array })
+    Ok(BeamRecording { path: path.to_path_buf(), sequence_id, time_base, site, sweeps, vehicle, array })
 }
 
 /// Latitude and longitude of `fixes` (time order) at `t_ns`: the fix at
@@ -407,6 +409,8 @@ pub fn process_sweeps(
     kinds.dedup();
     let recordings = files.iter().map(|f| read_beam_recording(f)).collect::<anyhow::Result<Vec<_>>>()?;
     let mut by_sequence: BTreeMap<&str, &Path> = BTreeMap::new();
+    let time_bases: BTreeMap<&str, TimeBase> =
+        recordings.iter().map(|r| (r.sequence_id.as_str(), r.time_base)).collect();
     for r in &recordings {
         if let Some(other) = by_sequence.insert(&r.sequence_id, &r.path) {
             bail!(
@@ -452,8 +456,7 @@ pub fn process_sweeps(
             summaries.push((site.name.clone(), kind, summary));
         }
     }
-    let info = RunInfo {
-        config_json: serde_json::json!({
+    let config_json = serde_json::json!({
             "command": "process beam",
             "recordings": files.iter().map(|f| crate::provenance::canonical(f)).collect::<Vec<_>>(),
             "inputs": crate::provenance::input_files(files)?,
@@ -466,11 +469,12 @@ pub fn process_sweeps(
             "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
-        .to_string(),
-    };
+        .to_string();
     let mut staged = out.tables();
     for (sequence, rows) in &tables {
-        staged.write(sequence, rows, &info)?;
+        // Each pass is one recording's sequence, on that recording's time base.
+        let time_base = *time_bases.get(sequence.as_str()).context("a pass without its recording")?;
+        staged.write(sequence, rows, &RunInfo::new(config_json.clone(), time_base))?;
     }
     let written = staged.publish()?;
     let sites = sites

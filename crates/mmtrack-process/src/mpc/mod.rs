@@ -21,7 +21,8 @@ use anyhow::{Context, bail};
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{CirSnapshot, MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
 use mmtrack_io::recording::pulse::{PULSE_SPECTRUM_KEY, decode_pulse_spectrum};
-use mmtrack_io::recording::{PoseStream, RecordingItem};
+use mmtrack_io::recording::{PoseStream, RecordingItem, TimeBase};
+use mmtrack_io::table::Frame;
 use mmtrack_io::table::{
     GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MpcSnapshotStats, RunInfo, TableWriteSummary,
 };
@@ -174,6 +175,9 @@ fn snapshot_stats(cir: &CirSnapshot, found: &SnapshotDetections) -> MpcSnapshotS
 /// Everything read and computed.
 struct MpcRun {
     sequence_id: String,
+    /// The recording's time base and metadata (for the tables' `time_base` and `frame`).
+    time_base: TimeBase,
+    metadata: BTreeMap<String, String>,
     links: BTreeMap<(u32, u32), LinkRun>,
     truth: Vec<MpcTruth>,
     tx: Vec<StampedPose>,
@@ -238,6 +242,8 @@ fn read_and_process(
     let mut pulse: Option<SounderPulse> = None;
     let mut run = MpcRun {
         sequence_id: String::new(),
+        time_base: TimeBase::Relative,
+        metadata: BTreeMap::new(),
         links: BTreeMap::new(),
         truth: Vec::new(),
         tx: Vec::new(),
@@ -317,11 +323,13 @@ fn read_and_process(
         link.end_set(true).with_context(|| format!("{}: link tx{}:rx{}", path.display(), key.0, key.1))?;
     }
     progress.finish();
-    run.sequence_id = reader
+    let metadata = reader
         .metadata()
         .and_then(RecordingMetadata::from_map)
-        .map(|m| m.sequence_id)
         .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
+    run.metadata = reader.metadata().cloned().unwrap_or_default();
+    run.sequence_id = metadata.sequence_id;
+    run.time_base = metadata.time_base;
     if run.links.is_empty() {
         match link_filter {
             Some((tx, rx)) if run.snapshots == 0 => {
@@ -429,6 +437,13 @@ pub fn process_mpc(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        time_base: run.time_base.into(),
+        frame: Some(Frame::of_recording(
+            "recording_world",
+            "the recording's world frame of both vehicles' ground truth (/ground_truth/tx, /ground_truth/rx): x, y \
+             in metres, yaw counter-clockwise from world x",
+            &run.metadata,
+        )),
     };
     let mut tables = out.tables();
     let mut links = Vec::new();

@@ -2,6 +2,7 @@
 //! radar scans, written as the `odometry`, `odometry_timing` and
 //! `ground_truth` tables (`mmtrack process odometry`).
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
@@ -9,7 +10,8 @@ use anyhow::{Context, bail};
 use mmtrack_core::progress::Progress;
 use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose};
 use mmtrack_io::recording::PoseStream;
-use mmtrack_io::table::{GroundTruthPose, RunInfo, TableWriteSummary};
+use mmtrack_io::recording::TimeBase;
+use mmtrack_io::table::{Frame, GroundTruthPose, RunInfo, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingMetadata};
 use mmtrack_odometry::{OdometryConfig, RadarOdometry};
 
@@ -50,6 +52,11 @@ pub struct OdometryRun {
     pub ground_truth: Vec<StampedPose>,
     /// The recording's sequence id.
     pub sequence_id: String,
+    /// What the recording's `t_ns` counts from.
+    pub time_base: TimeBase,
+    /// The recording's other metadata keys (its word on the ground truth's
+    /// frame and origin, [`Frame::of_recording`]).
+    pub recording_extra: BTreeMap<String, String>,
     /// Wall-clock seconds for reading, decoding and processing.
     pub elapsed_s: f64,
 }
@@ -83,15 +90,22 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, progress: &dyn Pro
         Ok(())
     })?;
     progress.finish();
-    let sequence_id = metadata
+    let RecordingMetadata { sequence_id, time_base, extra: recording_extra, .. } = metadata
         .as_ref()
         .and_then(RecordingMetadata::from_map)
-        .map(|m| m.sequence_id)
         .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", recording.display()))?;
     if estimates.is_empty() {
         bail!("{}: the recording has no radar scans (topic /radar/image); nothing written", recording.display());
     }
-    Ok(OdometryRun { estimates, timings, ground_truth, sequence_id, elapsed_s: started.elapsed().as_secs_f64() })
+    Ok(OdometryRun {
+        estimates,
+        timings,
+        ground_truth,
+        sequence_id,
+        time_base,
+        recording_extra,
+        elapsed_s: started.elapsed().as_secs_f64(),
+    })
 }
 
 fn process_scan(
@@ -157,6 +171,19 @@ pub fn write_outputs(
     recording: &Path,
 ) -> anyhow::Result<Vec<TableWriteSummary>> {
     let (estimates, frame) = in_ground_truth_frame(&run.estimates, &run.ground_truth);
+    let truth_frame = Frame::of_recording(
+        "ground_truth",
+        "the world frame of the recording's ground truth (/ground_truth/pose); odometry is moved into it at the run \
+         config's frame.anchor_t_ns",
+        &run.recording_extra,
+    );
+    let table_frame = match frame["world"].as_str() {
+        Some("ground_truth") => truth_frame.clone(),
+        _ => Frame::new(
+            "first_scan",
+            "the vehicle's pose at the first radar scan (the recording has no ground truth at the scan times)",
+        ),
+    };
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process odometry",
@@ -169,13 +196,16 @@ pub fn write_outputs(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        time_base: run.time_base.into(),
+        frame: Some(table_frame),
     };
     let mut tables = out.tables();
     tables.write(sequence, &estimates, &info)?;
     tables.write(sequence, &run.timings, &info)?;
     if !run.ground_truth.is_empty() {
         let truth: Vec<GroundTruthPose> = run.ground_truth.iter().cloned().map(GroundTruthPose).collect();
-        tables.write(sequence, &truth, &info)?;
+        // The ground truth is in its own frame, also when the odometry is not.
+        tables.write(sequence, &truth, &RunInfo { frame: Some(truth_frame), ..info.clone() })?;
     }
     tables.publish()
 }

@@ -25,6 +25,7 @@ use anyhow::{Context, bail};
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 use mmtrack_io::RecordingEvent;
 use mmtrack_io::recording::RecordingMetadata;
+use mmtrack_io::table::Frame;
 use mmtrack_io::table::{RunInfo, TableWriteSummary};
 use mmtrack_io::table::{
     SLAM_ASSOCIATIONS, SLAM_MAP, SLAM_TRUE_SOURCES, SLAM_UE, SlamAssociationRow, SlamMapRow, SlamTrueSourceRow,
@@ -78,6 +79,8 @@ pub struct SlamRecording {
     pub sources: Vec<(SourceType, usize, [f64; 3])>,
     /// The scenario the recording was simulated from, when it says.
     pub scenario: Option<SlamScenario>,
+    /// The recording's metadata (time base, frame keys); `None` only before it is read.
+    pub metadata: Option<RecordingMetadata>,
 }
 
 /// Reads the SLAM channels of a recording.
@@ -98,6 +101,7 @@ pub fn read_recording(path: &Path) -> anyhow::Result<SlamRecording> {
         Ok(())
     })?;
     let metadata = metadata.as_ref().and_then(RecordingMetadata::from_map);
+    out.metadata = metadata.clone();
     out.sequence_id = metadata
         .as_ref()
         .map(|m| m.sequence_id.clone())
@@ -358,6 +362,9 @@ pub fn process_slam(recording_path: &Path, output: &Path, args: &SlamOptions) ->
     let prior = prior_of(recording_path, args, &recording)?;
     let tables =
         run_filter(&recording, &config, prior, args.seed).with_context(|| recording_path.display().to_string())?;
+    // read_recording fails without metadata, so it is there.
+    let metadata =
+        recording.metadata.as_ref().with_context(|| format!("{}: no recording metadata", recording_path.display()))?;
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process slam",
@@ -372,6 +379,13 @@ pub fn process_slam(recording_path: &Path, output: &Path, args: &SlamOptions) ->
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        time_base: metadata.time_base.into(),
+        frame: Some(Frame::of_recording(
+            "recording_world",
+            "the world frame of the recording's SLAM channels (/slam/sources, /slam/ue_truth): the base station's \
+             position as /slam/sources gives it, x, y, z in metres, headings counter-clockwise from world x",
+            &metadata.extra,
+        )),
     };
     let mut staged = out.tables();
     staged.write(&sequence, &tables.ue, &info)?;

@@ -27,7 +27,7 @@ fn data(relative: &str) -> PathBuf {
 fn radar_recording(dir: &Path, scans: usize) -> PathBuf {
     let output = dir.join("radar.mcap");
     let simulation = RadarSimulation {
-        scenario: data("demo/radar-scenario.toml"),
+        scenario: data("demo/fixture-scenario.toml"),
         trajectory: None,
         max_scans: Some(scans),
         max_distance_m: None,
@@ -69,7 +69,7 @@ fn odometry_writes_one_pose_per_scan_refuses_existing_tables_and_keeps_runs_apar
     assert_eq!(spebt.recordings[0].pose_source, RADAR_ODOMETRY);
     let rows: Vec<SpebtSummaryRow> = read_table(&spebt.written[0].path).unwrap();
     assert_eq!((rows[0].slots, rows[0].runs), (6, 2));
-    assert!(rows[0].rmse_aod_deg.is_finite());
+    assert!(rows[0].rmse_aod_rad.is_finite());
 }
 
 #[test]

@@ -29,7 +29,7 @@ class Column:
     #: Arrow type as the schema documents name it (int64, float64, list<float64>, ...).
     type: str
     nullable: bool
-    #: Unit ("" for unitless).
+    #: Unit as the files state it ("1" for a dimensionless number, "none" for a string, flag or bytes).
     unit: str
     meaning: str
 
@@ -40,11 +40,13 @@ class TableSpec:
 
     name: str
     description: str
+    #: The frame of its positions and angles as declared (``not_applicable``, fixed, or the run's).
+    frame: str
     columns: list[Column]
 
     @property
     def units(self) -> dict[str, str]:
-        """Column name -> unit ("" for unitless)."""
+        """Column name -> unit ("1" for dimensionless, "none" for strings and flags)."""
         return {c.name: c.unit for c in self.columns}
 
 
@@ -55,15 +57,22 @@ class TableInfo:
     spec: Optional[TableSpec]
     #: Column -> unit, from the files' ``units`` metadata.
     units: dict[str, str]
+    #: Column -> description, from the files' Arrow field metadata.
+    descriptions: dict[str, str]
     #: The run configuration (``mmtrack.run_config``) of the first file.
     run_config: dict[str, Any]
-    #: The frame of the poses (``world_from_vehicle``), where the run says which.
-    frame: Optional[Any]
-    #: The time base of ``t_ns`` (``unix_epoch``, ``scenario_start``, ``sim_time``
-    #: or ``relative``): the recording's, when the run configuration names a
-    #: recording that can be read.
+    #: The coordinate frame of the positions and angles (key ``frame``, e.g.
+    #: ``ground_truth``; ``not_applicable`` for a table without any).
+    frame: Optional[str]
+    #: What the frame is (``frame.meaning``).
+    frame_meaning: Optional[str]
+    #: The frame's origin where the recording names one (``frame.origin``), e.g.
+    #: a GNSS origin's ``latitude_deg``, ``longitude_deg``, ``altitude_m``.
+    frame_origin: Optional[dict[str, str]]
+    #: The time base of ``t_ns`` (key ``time_base``: ``unix_epoch``,
+    #: ``scenario_start``, ``sim_time``, ``relative``; ``mixed`` when pooled).
     time_base: Optional[str]
-    #: What the time base means, where the recording says.
+    #: What the time base means (``time_base.meaning``).
     time_base_meaning: Optional[str]
     #: The partition files, sorted.
     files: list[str]
@@ -76,7 +85,7 @@ def _specs() -> dict[str, TableSpec]:
     global _SPECS
     if _SPECS is None:
         _SPECS = {
-            s["name"]: TableSpec(s["name"], s["description"], [Column(**c) for c in s["columns"]])
+            s["name"]: TableSpec(s["name"], s["description"], s["frame"], [Column(**c) for c in s["columns"]])
             for s in _native.table_specs()
         }
     return _SPECS
@@ -141,18 +150,25 @@ def table_info(root: PathLike, name: str) -> TableInfo:
         raise _native.MmtrackError(f"{base}: no table {name} (expected {name}/sequence=<id>/part-0.parquet)")
     meta = _native.table_file_metadata(str(files[0]))
     units = json.loads(meta.get("units", "{}"))
+    descriptions = {name: m.get("description", "") for name, m in _native.table_field_metadata(str(files[0]))}
     run_config = json.loads(meta.get("mmtrack.run_config", "{}") or "{}")
-    time_base = meaning = None
+    time_base = meta.get("time_base")
+    meaning = meta.get("time_base.meaning")
     recording = run_config.get("recording") if isinstance(run_config, dict) else None
-    if isinstance(recording, str) and Path(recording).is_file():
+    if time_base is None and isinstance(recording, str) and Path(recording).is_file():
+        # Tables written before the key existed: the recording's word.
         rec = _native.recording_metadata(recording)
         time_base = rec.get("time_base")
         meaning = rec.get("time_base.meaning")
+    origin = meta.get("frame.origin")
     return TableInfo(
         spec=_specs().get(name),
         units=units,
+        descriptions=descriptions,
         run_config=run_config if isinstance(run_config, dict) else {},
-        frame=run_config.get("frame") if isinstance(run_config, dict) else None,
+        frame=meta.get("frame"),
+        frame_meaning=meta.get("frame.meaning"),
+        frame_origin=json.loads(origin) if origin else None,
         time_base=time_base,
         time_base_meaning=meaning,
         files=[str(f) for f in files],

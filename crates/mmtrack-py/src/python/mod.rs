@@ -126,6 +126,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(results::reproduce_all, m)?)?;
     m.add_function(wrap_pyfunction!(results::table_specs, m)?)?;
     m.add_function(wrap_pyfunction!(results::table_file_metadata, m)?)?;
+    m.add_function(wrap_pyfunction!(results::table_field_metadata, m)?)?;
     m.add_function(wrap_pyfunction!(results::recording_metadata, m)?)?;
     m.add_function(wrap_pyfunction!(results::detect_mpc, m)?)?;
     m.add_function(wrap_pyfunction!(results::track_beams, m)?)?;

@@ -116,14 +116,19 @@ fn spec_dict<'py>(py: Python<'py>, spec: &TableSpec) -> PyResult<Bound<'py, PyDi
                 ("name", any(py, c.name)?),
                 ("type", any(py, c.ty.doc_name())?),
                 ("nullable", any(py, c.nullable)?),
-                ("unit", any(py, c.unit)?),
+                ("unit", any(py, c.unit_label())?),
                 ("meaning", any(py, c.meaning)?),
             ],
         )?)?;
     }
     dict(
         py,
-        &[("name", any(py, spec.name)?), ("description", any(py, spec.description)?), ("columns", columns.into_any())],
+        &[
+            ("name", any(py, spec.name)?),
+            ("description", any(py, spec.description)?),
+            ("frame", any(py, spec.frame.doc())?),
+            ("columns", columns.into_any()),
+        ],
     )
 }
 
@@ -142,6 +147,12 @@ pub(super) fn table_specs(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
 #[pyfunction]
 pub(super) fn table_file_metadata(py: Python<'_>, path: PathBuf) -> PyResult<BTreeMap<String, String>> {
     run(py, 0, || Ok(mmtrack_io::table_kv::read_key_value_metadata(&path)?))
+}
+
+/// Each field's metadata (`unit`, `description`) of a table file, in file order.
+#[pyfunction]
+pub(super) fn table_field_metadata(py: Python<'_>, path: PathBuf) -> PyResult<Vec<(String, BTreeMap<String, String>)>> {
+    run(py, 0, || Ok(mmtrack_io::table_kv::read_field_metadata(&path)?))
 }
 
 /// The metadata of a recording (sequence id, time base, sensors).

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use mmtrack_analysis::slam::plots::{EpochCurve, MapFigure, epoch_curves_svg, map_svg};
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::table::{SlamPerEpochRow, SlamSummaryRow};
 use mmtrack_sim::slam::SlamScenario;
@@ -193,6 +194,9 @@ pub fn write_outputs(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        // A simulated experiment: times count from the start of its scenario.
+        time_base: TimeBase::ScenarioStart.into(),
+        frame: None,
     };
     let summaries: Vec<SlamSummaryRow> = results.iter().map(|r| r.summary.clone()).collect();
     let per_epoch: Vec<SlamPerEpochRow> = results.iter().flat_map(|r| r.per_epoch.iter().cloned()).collect();

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use mmtrack_analysis::output::write_results;
 use mmtrack_analysis::pipeline::TrajectoryResult;
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::RunInfo;
 use mmtrack_process::odometry::{self, OdometryRun};
 use mmtrack_process::output::RunDir;
@@ -123,6 +124,10 @@ pub fn write_outputs(
     let tables = staging.path().join("tables");
     let Measured { scenario, drift, ground_truth, presets, elapsed_s } = measured;
     let mut analysis: Vec<TrajectoryResult> = Vec::new();
+    // The simulator's rule for its recordings (`simulate radar`): UNIX time
+    // when the trajectory puts the drive at a date, scenario time otherwise.
+    let first_t_ns = ground_truth.first().map_or(0, |p| p.t_ns);
+    let time_base = TimeBase::unix_or(first_t_ns, TimeBase::ScenarioStart);
     for r in presets {
         let sequence = sequence_of(r.preset);
         let run = OdometryRun {
@@ -130,6 +135,8 @@ pub fn write_outputs(
             timings: r.timings,
             ground_truth: ground_truth.clone(),
             sequence_id: sequence.clone(),
+            time_base,
+            recording_extra: std::collections::BTreeMap::new(),
             elapsed_s,
         };
         let out = RunDir { path: tables.clone(), overwrite: Overwrite::Refuse };
@@ -147,6 +154,8 @@ pub fn write_outputs(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        time_base: time_base.into(),
+        frame: None,
     };
     write_results(&staging.path().join("analysis"), &analysis, &[], &drift, &info, Overwrite::Refuse)?;
     std::fs::write(staging.path().join("reproduce.md"), report)?;

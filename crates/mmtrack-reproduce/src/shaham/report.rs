@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use mmtrack_analysis::beam::plots::{RmsCurve, rms_curves_svg};
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{BeamRmsRow, BeamValidTrackingRow};
 use mmtrack_io::table::{RunInfo, write_table};
 
@@ -211,6 +212,9 @@ pub fn write_outputs(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        // A simulated experiment: times count from the start of its scenario.
+        time_base: TimeBase::ScenarioStart.into(),
+        frame: None,
     };
     let mut rms_rows = Vec::new();
     let mut valid_rows = Vec::new();
@@ -222,7 +226,7 @@ pub fn write_outputs(
                     snr_db: point.snr_db,
                     speed_kmh: point.speed_kmh,
                     block: block as u64,
-                    rms_aod_deg: rms.to_degrees(),
+                    rms_aod_rad: *rms,
                 });
             }
             let paper = experiment
@@ -237,7 +241,7 @@ pub fn write_outputs(
                 speed_kmh: point.speed_kmh,
                 runs,
                 blocks_simulated: experiment.blocks as u64,
-                threshold_deg: threshold_rad.to_degrees(),
+                threshold_rad,
                 valid_blocks: point.valid_blocks[t].map(|b| b as u64),
                 paper_blocks: paper,
             });

@@ -9,6 +9,7 @@ use anyhow::Context as _;
 use mmtrack_analysis::beam::spebt_plots::{SpebtTrackingSeries, spebt_tracking_svg};
 use mmtrack_core::{StampedPose, path_length_m, wrap_angle_rad};
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, SpebtSummaryRow, write_table};
 use mmtrack_process::beam::spebt::monte_carlo::{ExperimentResult, SpebtExperiment};
 use mmtrack_process::beam::spebt::tables::{slot_rows, summary_row};
@@ -81,6 +82,12 @@ fn target_text(claim: &Claim) -> String {
     }
 }
 
+/// A paper's number, stored in radians, back in the degrees the paper prints
+/// (rounded to 9 decimals, so 0.22 deg reads 0.22 again).
+fn paper_deg(rad: f64) -> f64 {
+    (rad.to_degrees() * 1e9).round() / 1e9
+}
+
 /// The numbers `reproduce --all` checks for one experiment: RMSE of
 /// |alpha|, AoD and AoA and the re-initialisation share, with the paper's.
 #[must_use]
@@ -88,8 +95,19 @@ pub fn metrics(row: &SpebtSummaryRow) -> Vec<Metric> {
     let e = &row.experiment;
     vec![
         Metric::new(format!("{e} RMSE abs(alpha)"), row.rmse_gain_pct, "%", Some(row.paper_rmse_gain_pct)),
-        Metric::new(format!("{e} RMSE AoD"), row.rmse_aod_deg, "deg", Some(row.paper_rmse_aod_deg)),
-        Metric::new(format!("{e} RMSE AoA"), row.rmse_aoa_deg, "deg", Some(row.paper_rmse_aoa_deg)),
+        // In degrees, as the paper reports them (the table holds radians).
+        Metric::new(
+            format!("{e} RMSE AoD"),
+            row.rmse_aod_rad.to_degrees(),
+            "deg",
+            Some(paper_deg(row.paper_rmse_aod_rad)),
+        ),
+        Metric::new(
+            format!("{e} RMSE AoA"),
+            row.rmse_aoa_rad.to_degrees(),
+            "deg",
+            Some(paper_deg(row.paper_rmse_aoa_rad)),
+        ),
         Metric::new(
             format!("{e} re-initialisation share"),
             row.reinitialisation_share_pct,
@@ -373,6 +391,11 @@ pub fn write_outputs(
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),
+            // The trajectory's clock, by the simulator's rule (`simulate radar`): UNIX time
+            // when the trajectory puts the drive at a date, scenario time otherwise.
+            time_base: TimeBase::unix_or(run.link.slots().first().map_or(0, |s| s.t_ns), TimeBase::ScenarioStart)
+                .into(),
+            frame: None,
         };
         write_table(&tables, run.name, &[summary_row_of(config, run)], &info, Overwrite::Refuse)?;
         write_table(&tables, run.name, &slot_rows(&run.link, &run.result), &info, Overwrite::Refuse)?;

@@ -97,7 +97,7 @@ pub(super) fn run(
                         if run_index == 0 {
                             labels.push(ZoechmannPathLabelRow {
                                 path: path.kind.name().to_string(),
-                                t_s: t.t_s,
+                                t_ns: (t.t_s * 1e9).round() as i64,
                                 x_m: position[0],
                                 y_m: position[1],
                                 vx_mps: velocity[0],
@@ -157,7 +157,7 @@ pub(super) fn error_rows(result: &NlosResult, epoch_s: f64) -> Vec<ZoechmannNlos
             rows.push(ZoechmannNlosErrorRow {
                 path: p.name.to_string(),
                 epoch: k as u64,
-                t_s: k as f64 * epoch_s,
+                t_ns: (k as f64 * epoch_s * 1e9).round() as i64,
                 runs: p.counted[k],
                 position_rmse_m: rms(p.position_sq[k], p.counted[k]),
                 velocity_rmse_mps: rms(p.velocity_sq[k], p.counted[k]),

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use mmtrack_analysis::beam::zoechmann_plots::{NmseCurve, zoechmann_figure_svg, zoechmann_nlos_svg};
 use mmtrack_io::Overwrite;
+use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::table::{ZoechmannNmseRow, ZoechmannSummaryRow};
 
@@ -339,6 +340,9 @@ pub fn write_outputs(
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
         })
         .to_string(),
+        // A simulated experiment: times count from the start of its scenario.
+        time_base: TimeBase::ScenarioStart.into(),
+        frame: None,
     };
     let epoch_s = experiment.scenario.epoch_s;
     let mut nmse_rows = Vec::new();
@@ -350,7 +354,7 @@ pub fn write_outputs(
                     manoeuvre: r.manoeuvre.name.clone(),
                     estimator: (*name).to_string(),
                     epoch: k as u64,
-                    t_s: k as f64 * epoch_s,
+                    t_ns: (k as f64 * epoch_s * 1e9).round() as i64,
                     runs: r.counted[e][k],
                     nmse,
                     nmse_db: 10.0 * nmse.log10(),

@@ -33,7 +33,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail, ensure};
 use mmtrack_core::progress::Progress;
 use mmtrack_core::{OdometryEstimate, Se2, StampedPose, interpolate_pose};
-use mmtrack_io::recording::{PoseStream, RecordingMetadata};
+use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
 use mmtrack_io::table::{ODOMETRY, RunInfo, read_table, table_path};
 use mmtrack_io::table::{SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSummaryRow, TableWriteSummary};
 use mmtrack_io::{RecordingEvent, RecordingReader};
@@ -100,6 +100,7 @@ struct LinkFile {
 struct TruthRecording {
     path: PathBuf,
     sequence_id: String,
+    time_base: TimeBase,
     ground_truth: Vec<StampedPose>,
 }
 
@@ -112,8 +113,8 @@ fn read_truth(path: &Path) -> anyhow::Result<TruthRecording> {
         }
     }
     let metadata = reader.metadata().cloned().unwrap_or_default();
-    let sequence_id = RecordingMetadata::from_map(&metadata)
-        .map(|m| m.sequence_id)
+    let (sequence_id, time_base) = RecordingMetadata::from_map(&metadata)
+        .map(|m| (m.sequence_id, m.time_base))
         .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
     if ground_truth.len() < 2 {
         bail!(
@@ -132,7 +133,7 @@ fn read_truth(path: &Path) -> anyhow::Result<TruthRecording> {
             ground_truth[i].t_ns
         );
     }
-    Ok(TruthRecording { path: path.to_path_buf(), sequence_id, ground_truth })
+    Ok(TruthRecording { path: path.to_path_buf(), sequence_id, time_base, ground_truth })
 }
 
 /// The file of the recording's sequence of the `odometry` table under `dir`
@@ -399,6 +400,8 @@ pub fn process_spebt(
                 "mmtrack_version": env!("CARGO_PKG_VERSION"),
             })
             .to_string(),
+            time_base: recording.time_base.into(),
+            frame: None,
         };
         let summary = tables::summary_row(&experiment, &recording.path, name, &link, &result);
         staged.write(&recording.sequence_id, std::slice::from_ref(&summary), &info)?;

@@ -31,11 +31,11 @@ pub fn summary_row(
         runs: r.runs,
         seed: experiment.seed,
         rmse_gain_pct: 100.0 * gain,
-        rmse_aod_deg: aod.to_degrees(),
-        rmse_aoa_deg: aoa.to_degrees(),
+        rmse_aod_rad: aod,
+        rmse_aoa_rad: aoa,
         rmse_gain_before_reset_pct: 100.0 * gain_before,
-        rmse_aod_before_reset_deg: aod_before.to_degrees(),
-        rmse_aoa_before_reset_deg: aoa_before.to_degrees(),
+        rmse_aod_before_reset_rad: aod_before,
+        rmse_aoa_before_reset_rad: aoa_before,
         reinitialisations_mean: r.mean_reinitialisations(),
         reinitialisations_min: r.reinitialisations.iter().copied().min().unwrap_or(0),
         reinitialisations_max: r.reinitialisations.iter().copied().max().unwrap_or(0),
@@ -44,8 +44,8 @@ pub fn summary_row(
         reinit_aod_pct: cause(1),
         reinit_aoa_pct: cause(2),
         paper_rmse_gain_pct: paper.rmse_gain_pct,
-        paper_rmse_aod_deg: paper.rmse_aod_deg,
-        paper_rmse_aoa_deg: paper.rmse_aoa_deg,
+        paper_rmse_aod_rad: paper.rmse_aod_deg.to_radians(),
+        paper_rmse_aoa_rad: paper.rmse_aoa_deg.to_radians(),
         paper_reinitialisation_share_pct: 100.0 * paper.reinitialisations as f64 / paper.slots as f64,
     }
 }
@@ -53,7 +53,6 @@ pub fn summary_row(
 /// The `spebt_per_slot` rows of one experiment.
 #[must_use]
 pub fn slot_rows(link: &SpebtLink, r: &ExperimentResult) -> Vec<SpebtSlotRow> {
-    let t0 = link.slots()[0].t_ns;
     let runs = r.runs.max(1) as f64;
     link.slots()
         .iter()
@@ -63,21 +62,21 @@ pub fn slot_rows(link: &SpebtLink, r: &ExperimentResult) -> Vec<SpebtSlotRow> {
             let rms = |i: usize| (r.sum_squared[i][k] / runs).sqrt();
             SpebtSlotRow {
                 slot: k as u64,
-                t_s: (s.t_ns - t0) as f64 * 1e-9,
+                t_ns: s.t_ns,
                 x_m: s.pose.x_m,
                 y_m: s.pose.y_m,
-                yaw_deg: wrap_angle_rad(s.pose.yaw_rad).to_degrees(),
+                yaw_rad: wrap_angle_rad(s.pose.yaw_rad),
                 range_m: s.range_m,
                 true_gain: s.gain.norm(),
-                true_aod_deg: s.aod_rad.to_degrees(),
-                true_aoa_deg: s.aoa_rad.to_degrees(),
+                true_aod_rad: s.aod_rad,
+                true_aoa_rad: s.aoa_rad,
                 run0_gain: estimate.gain_magnitude,
-                run0_aod_deg: estimate.aod_rad.to_degrees(),
-                run0_aoa_deg: estimate.aoa_rad.to_degrees(),
+                run0_aod_rad: estimate.aod_rad,
+                run0_aoa_rad: estimate.aoa_rad,
                 run0_reinitialised: reinitialised,
                 rmse_gain_pct: 100.0 * rms(0),
-                rmse_aod_deg: rms(1).to_degrees(),
-                rmse_aoa_deg: rms(2).to_degrees(),
+                rmse_aod_rad: rms(1),
+                rmse_aoa_rad: rms(2),
                 reinitialisation_rate: r.reinitialised_runs[k] as f64 / runs,
             }
         })
