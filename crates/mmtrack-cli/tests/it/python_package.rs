@@ -2,7 +2,8 @@
 //! venv, `pip install crates/mmtrack-py` (maturin from PyPI builds the
 //! extension), `import mmtrack; print(mmtrack.__version__)`, then the
 //! package's pytest suite (`crates/mmtrack-py/tests`), which compares the
-//! package's calls with this build's `mmtrack` binary.
+//! package's calls with this build's `mmtrack` binary, and the quickstart
+//! notebook (`examples/quickstart.ipynb`) executed top to bottom (nbclient).
 //!
 //! The build reuses what `cargo test --workspace` compiled: it runs in the
 //! same `CARGO_TARGET_DIR` with the workspace's dev profile
@@ -98,4 +99,73 @@ fn pip_install_then_pytest_against_the_cli() {
     eprintln!("{report}");
     assert!(report.contains(" passed"), "{report}");
     assert!(!report.contains(" failed"), "{report}");
+    quickstart_notebook_runs_top_to_bottom(&python);
+}
+
+/// The notebook runner and the notebook's plotting, pinned.
+const NOTEBOOK_REQUIREMENTS: &[&str] =
+    &["nbclient==0.11.0", "nbformat==5.11.1", "ipykernel==7.4.0", "matplotlib==3.11.2"];
+
+/// Runs every cell of `examples/quickstart.ipynb` in a kernel of this venv
+/// (nbclient; a cell's error fails the run), from `examples/` as Jupyter
+/// would, on the real samples; keeps the executed notebook beside the venv
+/// and checks its plots and numbers came out.
+const RUN_NOTEBOOK: &str = r#"
+import json, sys
+import nbformat
+from nbclient import NotebookClient
+
+notebook, executed = sys.argv[1], sys.argv[2]
+nb = nbformat.read(notebook, as_version=4)
+NotebookClient(nb, timeout=600, kernel_name="python3", resources={"metadata": {"path": sys.argv[3]}}).execute()
+nbformat.write(nb, executed)
+outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
+errors = [o for o in outputs if o.output_type == "error"]
+images = sum("image/png" in o.get("data", {}) for o in outputs)
+text = "\n".join(str(o.get("text", "")) + str(o.get("data", {}).get("text/plain", "")) for o in outputs)
+print(json.dumps({"cells": len(nb.cells), "errors": len(errors), "images": images, "text": text}))
+"#;
+
+fn quickstart_notebook_runs_top_to_bottom(python: &Path) {
+    run(
+        "pip install notebook requirements",
+        Command::new(python)
+            .args(["-m", "pip", "install", "--quiet", "--disable-pip-version-check"])
+            .args(NOTEBOOK_REQUIREMENTS),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let venv = python.parent().and_then(Path::parent).unwrap();
+    let script = venv.join("run_notebook.py");
+    std::fs::write(&script, RUN_NOTEBOOK).unwrap();
+    let examples = root().join("examples");
+    let executed = venv.join("quickstart.executed.ipynb");
+    let realdata =
+        std::env::var_os("MMTRACK_REALDATA").map(PathBuf::from).unwrap_or_else(|| root().join("../shared/realdata"));
+    let out = run(
+        "execute examples/quickstart.ipynb",
+        Command::new(python)
+            .arg(&script)
+            .arg(examples.join("quickstart.ipynb"))
+            .arg(&executed)
+            .arg(&examples)
+            .env("MMTRACK_REALDATA", &realdata)
+            .current_dir(&examples),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let json: serde_json::Value =
+        serde_json::from_str(out.lines().find(|l| l.starts_with("{\"cells\"")).unwrap_or_default())
+            .unwrap_or_else(|e| panic!("{e}: {out}"));
+    eprintln!(
+        "quickstart notebook: {} cells, {} plots; executed copy {}",
+        json["cells"],
+        json["images"],
+        executed.display()
+    );
+    assert_eq!(json["errors"], 0, "{json}");
+    // Two figures: the Oxford path and error, the DeepSense loss CDF.
+    assert_eq!(json["images"], 2, "{json}");
+    let text = json["text"].as_str().unwrap();
+    // The Oxford tables' time base, and both trackers' rows of the DeepSense passes.
+    assert!(text.contains("time base: unix_epoch"), "{text}");
+    assert!(text.contains("window") && text.contains("last-full-sweep"), "{text}");
 }
