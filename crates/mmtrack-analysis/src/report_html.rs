@@ -55,18 +55,10 @@ pub fn report_time(source_date_epoch: Option<&str>, now_s: i64) -> String {
 }
 
 /// Seconds since 1970-01-01 UTC as `YYYY-MM-DD HH:MM:SS UTC` (proleptic
-/// Gregorian; Hinnant's civil-from-days).
+/// Gregorian, [`mmtrack_core::calendar`]).
 fn utc(seconds: i64) -> String {
     let (days, s) = (seconds.div_euclid(86_400), seconds.rem_euclid(86_400));
-    let z = days + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z - era * 146_097;
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let day = doy - (153 * mp + 2) / 5 + 1;
-    let month = if mp < 10 { mp + 3 } else { mp - 9 };
-    let year = yoe + era * 400 + i64::from(month <= 2);
+    let (year, month, day) = mmtrack_core::calendar::civil_from_days(days);
     format!("{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02} UTC", s / 3600, s % 3600 / 60, s % 60)
 }
 

@@ -35,6 +35,7 @@
 pub mod array;
 pub mod array_uca;
 mod beam_sweep;
+pub mod calendar;
 mod cir;
 pub mod error;
 mod gnss;

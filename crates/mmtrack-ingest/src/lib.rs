@@ -18,7 +18,6 @@
 
 pub mod beams;
 pub mod boreas;
-mod calendar;
 pub mod cdr;
 pub mod cir;
 mod csv;

@@ -41,11 +41,11 @@ use mmtrack_core::NS_PER_S;
 use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase, WriteSummary};
 use mmtrack_io::{RecordingOptions, RecordingWriter};
 
-use crate::calendar::{civil_from_days, days_from_civil};
 use crate::error::os_err;
 use crate::oxford::{NavtechLayout, OXFORD, write_navtech_scans};
 use crate::scan_folder::{ScanFile, StampUnit, folder_name, list_scan_pngs, within_scan_span};
 use crate::{IngestError, Progress};
+use mmtrack_core::calendar::{civil_from_days, days_from_civil};
 
 /// Range bin before the radar upgrade of 2021-09-21, metres.
 pub const RESOLUTION_BEFORE_UPGRADE_M: f64 = 0.0596;

@@ -150,13 +150,7 @@ fn parse_datetime_ns(text: &str) -> Option<i64> {
         return None;
     }
     let frac_ns: i64 = if frac.is_empty() { 0 } else { format!("{frac:0<9}").parse().ok()? };
-    // Days from civil (H. Hinnant's algorithm).
-    let y = if m <= 2 { y - 1 } else { y };
-    let era = y.div_euclid(400);
-    let yoe = y - era * 400;
-    let doy = (153 * (m + if m > 2 { -3 } else { 9 }) + 2) / 5 + day - 1;
-    let doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
-    let days = era * 146_097 + doe - 719_468;
+    let days = mmtrack_core::calendar::days_from_civil(y, m, day);
     (days * 86_400 + hh * 3600 + mm * 60 + ss).checked_mul(1_000_000_000)?.checked_add(frac_ns)
 }
 

@@ -5,7 +5,7 @@
 
 use mmtrack_core::GnssFixQuality;
 
-pub(super) use crate::calendar::days_from_civil;
+pub(super) use mmtrack_core::calendar::days_from_civil;
 use mmtrack_core::plausible::{ALTITUDE_M, LATITUDE_DEG, LONGITUDE_DEG};
 
 /// Nanoseconds in a day.

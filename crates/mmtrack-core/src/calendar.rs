@@ -1,9 +1,11 @@
 //! Proleptic Gregorian dates to and from days since 1970-01-01 (Howard
 //! Hinnant's `days_from_civil` / `civil_from_days`), for readers whose files
-//! give dates (NMEA RMC/ZDA, Boreas folder names).
+//! give dates (NMEA RMC/ZDA, Boreas folder names, SigMF datetimes) and for
+//! the UTC time in report provenance.
 
 /// Days since 1970-01-01 of a date.
-pub(crate) fn days_from_civil(year: i64, month: i64, day: i64) -> i64 {
+#[must_use]
+pub fn days_from_civil(year: i64, month: i64, day: i64) -> i64 {
     let y = if month <= 2 { year - 1 } else { year };
     let era = y.div_euclid(400);
     let yoe = y - era * 400;
@@ -14,7 +16,8 @@ pub(crate) fn days_from_civil(year: i64, month: i64, day: i64) -> i64 {
 }
 
 /// The date `(year, month, day)` of a day number since 1970-01-01.
-pub(crate) fn civil_from_days(days: i64) -> (i64, i64, i64) {
+#[must_use]
+pub fn civil_from_days(days: i64) -> (i64, i64, i64) {
     let z = days + 719_468;
     let era = z.div_euclid(146_097);
     let doe = z - era * 146_097;
