@@ -19,12 +19,10 @@
 //! Boreas files hold the same association with integer microseconds (floor
 //! of `t_ns / 1000`), as the pyboreas benchmark asks (file name = sequence).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use mmtrack_core::{Se2, StampedPose};
-use mmtrack_io::{AtomicFile, Durability, Overwrite};
+use mmtrack_io::Overwrite;
 
 use crate::pipeline::TrajectoryInput;
 use crate::trajectory::{Association, associate, validate_trajectory};
@@ -93,14 +91,8 @@ pub struct ExportedFile {
 }
 
 fn write_text(path: &Path, lines: &[String], overwrite: Overwrite) -> anyhow::Result<()> {
-    let file = AtomicFile::create(path, overwrite)?;
-    let mut writer = file.writer()?;
-    for line in lines {
-        writeln!(writer, "{line}").with_context(|| path.display().to_string())?;
-    }
-    writer.flush().with_context(|| path.display().to_string())?;
-    drop(writer);
-    file.commit(overwrite, Durability::Fsync)?;
+    let text: String = lines.iter().flat_map(|line| [line.as_str(), "\n"]).collect();
+    mmtrack_io::atomic::write_file(path, text.as_bytes(), overwrite)?;
     Ok(())
 }
 

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use mmtrack_io::atomic::{AtomicFile, Durability, Overwrite};
+use mmtrack_io::atomic::Overwrite;
 use mmtrack_reproduce::suite::{self, Suite, SuiteCheck};
 
 #[derive(Args)]
@@ -105,7 +105,8 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if args.bless {
         let text = std::fs::read_to_string(&args.suite).with_context(|| suite_name.clone())?;
         let blessed = suite::bless(&text, &checks).with_context(|| format!("{suite_name}: --bless"))?;
-        write_in_place(&args.suite, &blessed)?;
+        // Atomic: the old suite stays whole on any failure.
+        mmtrack_io::atomic::write_file(&args.suite, blessed.as_bytes(), Overwrite::Replace)?;
         if !quiet {
             let moved = checks.iter().filter(|c| !c.ok()).count();
             println!("blessed {suite_name}: {} expectations written ({moved} of them had moved)", checks.len());
@@ -127,16 +128,4 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         })
         .collect();
     bail!("{suite_name}: {} of {} metrics regressed: {}", failed.len(), checks.len(), named.join("; "))
-}
-
-/// Replaces the suite atomically (the old one stays whole on any failure).
-fn write_in_place(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write as _;
-    let file = AtomicFile::create(path, Overwrite::Replace)?;
-    let mut writer = file.writer()?;
-    writer.write_all(text.as_bytes()).with_context(|| path.display().to_string())?;
-    writer.flush().with_context(|| path.display().to_string())?;
-    drop(writer);
-    file.commit(Overwrite::Replace, Durability::Fsync)?;
-    Ok(())
 }

@@ -3,14 +3,12 @@
 //! task alone (`--task N`, a cluster job), printed for a scheduler, or
 //! written from a dataset folder (`--from`).
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use mmtrack_io::Overwrite;
-use mmtrack_io::atomic::{AtomicFile, Durability};
 use mmtrack_process::manifest::from_dataset::{self, Layout};
 use mmtrack_process::manifest::marker::{self, Record, Resume, State};
 use mmtrack_process::manifest::{self, Manifest, Outcome, Task};
@@ -248,12 +246,7 @@ fn write_from_dataset(args: &ManifestArgs, root: &Path, layout: LayoutArg, quiet
     let target = &args.manifest;
     let overwrite = if args.force { Overwrite::Replace } else { Overwrite::Refuse };
     let context = || format!("{}: cannot write the manifest", target.display());
-    let file = AtomicFile::create(target, overwrite).with_context(context)?;
-    let mut writer = file.writer().with_context(context)?;
-    writer.write_all(text.as_bytes()).with_context(context)?;
-    writer.flush().with_context(context)?;
-    drop(writer);
-    file.commit(overwrite, Durability::Fsync).with_context(context)?;
+    mmtrack_io::atomic::write_file(target, text.as_bytes(), overwrite).with_context(context)?;
     if !quiet {
         println!(
             "wrote {}: {} {} sequence(s), {} tasks (ingest, then odometry)",

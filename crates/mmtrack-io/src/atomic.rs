@@ -125,6 +125,22 @@ impl AtomicFile {
     }
 }
 
+/// Writes `contents` to `target` atomically ([`AtomicFile`], synced before
+/// the rename): a small output written whole (a text report, a manifest, a
+/// task record).
+///
+/// # Errors
+/// As [`AtomicFile::create`] and [`AtomicFile::commit`], or the OS error
+/// of writing, naming `target`.
+pub fn write_file(target: &Path, contents: &[u8], overwrite: Overwrite) -> Result<PathBuf> {
+    use std::io::Write as _;
+    let file = AtomicFile::create(target, overwrite)?;
+    let mut writer = file.writer()?;
+    writer.write_all(contents).and_then(|()| writer.flush()).map_err(os_err(target))?;
+    drop(writer);
+    file.commit(overwrite, Durability::Fsync)
+}
+
 /// Makes `files` visible at their targets together: either all of them are
 /// published or, on an error, none (a target published before the error is
 /// removed again, or the file it replaced is put back). Each is synced first

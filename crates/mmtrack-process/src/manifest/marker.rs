@@ -17,12 +17,10 @@
 //! killed during the task ([`resume`]). The directory is hidden, so Hive
 //! readers (`<table>/*/*.parquet`) and `mmtrack analyze` do not see it.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use mmtrack_io::Overwrite;
-use mmtrack_io::atomic::{AtomicFile, Durability};
 use serde::{Deserialize, Serialize};
 
 /// The directory of the records, under the manifest's `-o`.
@@ -108,13 +106,9 @@ pub fn read(tables: &Path, command: &[String]) -> anyhow::Result<Option<Record>>
 pub fn write(tables: &Path, record: &Record) -> anyhow::Result<()> {
     let target = path(tables, &record.command);
     let context = || format!("{}: cannot write the task record", target.display());
-    let file = AtomicFile::create(&target, Overwrite::Replace).with_context(context)?;
-    let mut writer = file.writer().with_context(context)?;
-    serde_json::to_writer(&mut writer, record).with_context(context)?;
-    writer.write_all(b"\n").with_context(context)?;
-    writer.flush().with_context(context)?;
-    drop(writer);
-    file.commit(Overwrite::Replace, Durability::Fsync).with_context(context)?;
+    let mut text = serde_json::to_vec(record).with_context(context)?;
+    text.push(b'\n');
+    mmtrack_io::atomic::write_file(&target, &text, Overwrite::Replace).with_context(context)?;
     Ok(())
 }
 

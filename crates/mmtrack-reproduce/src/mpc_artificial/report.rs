@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use mmtrack_analysis::mpc_artificial::{self as plots, ArtificialTracker, SeparationBin, SweepPoint};
-use mmtrack_io::{AtomicFile, Durability, Overwrite};
+use mmtrack_io::Overwrite;
 
 use super::config::SEPARATION_PLOT_POWERS_DB;
 use super::run::Sweep;
@@ -400,13 +400,7 @@ pub fn write_outputs(output: &Path, sweep: &Sweep, markdown: &str, metrics: &[Me
 }
 
 fn write_atomically(path: &Path, text: &str) -> anyhow::Result<()> {
-    use std::io::Write as _;
-    let file = AtomicFile::create(path, Overwrite::Replace)?;
-    let mut writer = file.writer()?;
-    writer.write_all(text.as_bytes()).with_context(|| path.display().to_string())?;
-    writer.flush().with_context(|| path.display().to_string())?;
-    drop(writer);
-    file.commit(Overwrite::Replace, Durability::Fsync)?;
+    mmtrack_io::atomic::write_file(path, text.as_bytes(), Overwrite::Replace)?;
     Ok(())
 }
 
