@@ -156,15 +156,7 @@ fn parquet_with_wrong_type_or_unknown_column_names_it() {
 #[test]
 fn truncated_parquet_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    let summary = write_table(
-        dir.path(),
-        "s",
-        &samples::poses(),
-        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
-            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
-        Overwrite::Refuse,
-    )
-    .unwrap();
+    let summary = write_table(dir.path(), "s", &samples::poses(), &samples::run_info("{}"), Overwrite::Refuse).unwrap();
     let bytes = std::fs::read(&summary.path).unwrap();
     std::fs::write(&summary.path, &bytes[..bytes.len() / 2]).unwrap();
     let err = read_table::<StampedPose>(&summary.path).unwrap_err();
@@ -175,36 +167,14 @@ fn truncated_parquet_is_a_clear_error() {
 #[test]
 fn existing_table_is_refused_unless_replace() {
     let dir = tempfile::tempdir().unwrap();
-    let first = write_table(
-        dir.path(),
-        "s",
-        &samples::poses(),
-        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
-            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
-        Overwrite::Refuse,
-    )
-    .unwrap();
+    let first = write_table(dir.path(), "s", &samples::poses(), &samples::run_info("{}"), Overwrite::Refuse).unwrap();
     let before = std::fs::read(&first.path).unwrap();
-    let err = write_table(
-        dir.path(),
-        "s",
-        &samples::poses()[..2],
-        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
-            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
-        Overwrite::Refuse,
-    )
-    .unwrap_err();
+    let err =
+        write_table(dir.path(), "s", &samples::poses()[..2], &samples::run_info("{}"), Overwrite::Refuse).unwrap_err();
     assert!(matches!(err, IoError::OutputExists { .. }));
     assert_eq!(std::fs::read(&first.path).unwrap(), before);
-    let second = write_table(
-        dir.path(),
-        "s",
-        &samples::poses()[..2],
-        &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
-            .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
-        Overwrite::Replace,
-    )
-    .unwrap();
+    let second =
+        write_table(dir.path(), "s", &samples::poses()[..2], &samples::run_info("{}"), Overwrite::Replace).unwrap();
     assert_eq!(read_table::<StampedPose>(&second.path).unwrap().len(), 2);
     let leftovers: Vec<_> =
         std::fs::read_dir(first.path.parent().unwrap()).unwrap().map(|e| e.unwrap().file_name()).collect();
@@ -215,15 +185,8 @@ fn existing_table_is_refused_unless_replace() {
 fn unsafe_sequence_names_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     for bad in ["", "..", "a/b", "x y"] {
-        let err = write_table(
-            dir.path(),
-            bad,
-            &samples::poses(),
-            &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
-                .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")),
-            Overwrite::Refuse,
-        )
-        .unwrap_err();
+        let err =
+            write_table(dir.path(), bad, &samples::poses(), &samples::run_info("{}"), Overwrite::Refuse).unwrap_err();
         assert!(err.to_string().contains("sequence_id"), "{bad}: {err}");
     }
 }

@@ -2,7 +2,7 @@
 
 use mmtrack_core::{CirSnapshot, GnssFix, MpcDetection, MpcTrack, PolarScan, Se2, StampedPose};
 use mmtrack_io::recording::{Compression, PoseStream, inspect_recording};
-use mmtrack_io::table::{RunInfo, TableRow, TrajectoryMetrics, read_table, read_table_dir, table_path, write_table};
+use mmtrack_io::table::{TableRow, TrajectoryMetrics, read_table, read_table_dir, table_path, write_table};
 use mmtrack_io::{Overwrite, RecordingEvent, RecordingOptions, RecordingReader, RecordingWriter};
 use proptest::prelude::*;
 
@@ -189,8 +189,7 @@ fn carried_png_is_stored_unchanged_and_decodes_to_the_scan() {
 
 fn table_round_trip<T: TableRow + PartialEq + std::fmt::Debug + Clone>(rows: &[T]) -> Vec<T> {
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo::new(r#"{"test":true}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
-        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
+    let run = samples::run_info(r#"{"test":true}"#);
     let summary = write_table(dir.path(), "seq-1", rows, &run, Overwrite::Refuse).unwrap();
     assert_eq!(summary.path, table_path(dir.path(), T::SPEC.name, "seq-1").unwrap());
     assert_eq!(summary.rows, rows.len() as u64);
@@ -284,8 +283,7 @@ fn records_spanning_reader_batches_come_back_whole() {
 #[test]
 fn parquet_metadata_carries_units_and_run_config() {
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo::new(r#"{"k":3}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
-        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
+    let run = samples::run_info(r#"{"k":3}"#);
     let summary = write_table(dir.path(), "s", &samples::poses(), &run, Overwrite::Refuse).unwrap();
     let file = std::fs::File::open(&summary.path).unwrap();
     let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();
@@ -323,7 +321,7 @@ proptest! {
         }).collect();
         prop_assert_eq!(back.iter().map(pose_bits).collect::<Vec<_>>(), poses.iter().map(pose_bits).collect::<Vec<_>>());
 
-        let summary = write_table(dir.path(), "p", &poses, &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch).with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame")), Overwrite::Refuse).unwrap();
+        let summary = write_table(dir.path(), "p", &poses, &samples::run_info("{}"), Overwrite::Refuse).unwrap();
         let back = read_table::<StampedPose>(&summary.path).unwrap();
         prop_assert_eq!(back.iter().map(pose_bits).collect::<Vec<_>>(), poses.iter().map(pose_bits).collect::<Vec<_>>());
     }

@@ -148,7 +148,7 @@ fn malformed_beam_sweeps_are_errors_naming_topic_message_and_problem() {
 #[test]
 fn beam_sweeps_tracked_table_round_trips_with_and_without_gnss_beam() {
     use mmtrack_io::Overwrite;
-    use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, RunInfo, read_table, write_table};
+    use mmtrack_io::table::{BEAM_SWEEPS_TRACKED, BeamSweepTracked, read_table, write_table};
     let rows: Vec<BeamSweepTracked> = (0..6u32)
         .map(|k| BeamSweepTracked {
             tracker: if k < 3 { "window".into() } else { "gnss-map".into() },
@@ -165,8 +165,7 @@ fn beam_sweeps_tracked_table_round_trips_with_and_without_gnss_beam() {
         })
         .collect();
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo::new(r#"{"test":"beam"}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
-        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
+    let run = samples::run_info(r#"{"test":"beam"}"#);
     let summary = write_table(dir.path(), "scenario1-pass01", &rows, &run, Overwrite::Refuse).unwrap();
     assert!(summary.path.ends_with("beam_sweeps_tracked/sequence=scenario1-pass01/part-0.parquet"));
     let back = read_table::<BeamSweepTracked>(&summary.path).unwrap();

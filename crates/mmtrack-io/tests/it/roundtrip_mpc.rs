@@ -2,11 +2,12 @@
 //! statistics, true MPCs, both sounder vehicles' poses) through Parquet and
 //! back, bit-exact, with their units in the metadata.
 
+use crate::samples;
 use mmtrack_core::{Complex64, MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, Se2, StampedPose};
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::{
-    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_LONG_TERM, MPC_SETS, MPC_TRUTH, RunInfo, TableRow,
-    read_table, read_table_dir, write_table,
+    GmPhdTrack, GroundTruthRxPose, GroundTruthTxPose, MPC_LONG_TERM, MPC_SETS, MPC_TRUTH, TableRow, read_table,
+    read_table_dir, write_table,
 };
 
 /// Values whose decimal forms do not round-trip through a naive printer.
@@ -14,8 +15,7 @@ const AWKWARD: [f64; 6] = [0.1, -1.0 / 3.0, 5e-324, -0.0, 1.7976931348623157e308
 
 fn round_trip<T: TableRow + PartialEq + std::fmt::Debug>(rows: &[T]) -> Vec<T> {
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo::new(r#"{"test":"mpc"}"#, mmtrack_io::recording::TimeBase::UnixEpoch)
-        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
+    let run = samples::run_info(r#"{"test":"mpc"}"#);
     let summary = write_table(dir.path(), "conv-tx0-rx0", rows, &run, Overwrite::Refuse).unwrap();
     assert_eq!(summary.rows, rows.len() as u64);
     let back = read_table::<T>(&summary.path).unwrap();
@@ -128,8 +128,7 @@ fn mpc_tables_carry_units_and_keep_nulls() {
     assert_eq!(unit(&MPC_SETS, "channel_gain_db"), ("dB", false));
     assert_eq!(unit(&MPC_TRUTH, "doppler_hz"), ("Hz", false));
     let dir = tempfile::tempdir().unwrap();
-    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch)
-        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test world frame"));
+    let run = samples::run_info("{}");
     let summary = write_table(dir.path(), "s", &long_term(), &run, Overwrite::Refuse).unwrap();
     let file = std::fs::File::open(&summary.path).unwrap();
     let reader = parquet::file::reader::SerializedFileReader::new(file).unwrap();

@@ -9,6 +9,13 @@ use mmtrack_core::{
 };
 use mmtrack_io::recording::{RecordingMetadata, TimeBase};
 
+/// The run of a table written by a test: `config` as its run configuration,
+/// UNIX time, a test frame.
+pub fn run_info(config: &str) -> mmtrack_io::table::RunInfo {
+    mmtrack_io::table::RunInfo::new(config, TimeBase::UnixEpoch)
+        .with_frame(mmtrack_io::table::Frame::new("test_world", "a test's world frame"))
+}
+
 pub const AWKWARD: [f64; 6] = [-0.0, 5e-324, 1.7976931348623157e308, -1.0e-300, std::f64::consts::PI, 0.1];
 
 pub fn poses() -> Vec<StampedPose> {
