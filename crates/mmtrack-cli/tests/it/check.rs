@@ -35,6 +35,11 @@ fn the_example_suite_passes_fails_when_nudged_and_bless_round_trips() {
     assert!(stdout.contains("all 7 metrics within their tolerances"), "{stdout}");
     let words = |l: &str| l.split_whitespace().map(str::to_string).collect::<Vec<_>>();
     assert!(stdout.lines().any(|l| words(l) == ["oxford", "scans", "11", "11", "+-0", "ok"]), "{stdout}");
+    // docs/check.md shows this run's table as printed.
+    let table = &stdout[stdout.find("metric ").unwrap()..];
+    let docs = std::fs::read_to_string(root().join("docs/check.md")).unwrap();
+    let shown = docs.split("```text\n").nth(1).and_then(|b| b.split("```").next()).unwrap();
+    assert_eq!(shown, table, "docs/check.md's example output is not what the example suite prints");
 
     let original = suite_copy(&realdata);
     let originals = expected_values(&original);
