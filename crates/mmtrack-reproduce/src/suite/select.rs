@@ -107,23 +107,19 @@ pub fn select(table_dir: &Path, selection: &Selection) -> anyhow::Result<Selecte
         values.extend(values_of_file(file, partitions, selection)?);
     }
     let rows = values.len();
+    let filters = if selection.filters.is_empty() {
+        "no filter".to_string()
+    } else {
+        selection.filters.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(" and ")
+    };
     let value = match (rows, selection.aggregate) {
-        (0, _) => bail!(
-            "{}: no row has {} (partitions there: {})",
-            table_dir.display(),
-            selection.filters.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(" and "),
-            list(&partitions_seen)
-        ),
+        (0, _) => bail!("{}: no row has {filters} (partitions there: {})", table_dir.display(), list(&partitions_seen)),
         (_, Some(Aggregate::Count)) => rows as f64,
         (1, None) => values[0],
         (_, None) => bail!(
-            "{}: {rows} rows have {}; narrow them with `sequence`/`where` or give an `aggregate` (mean, min, max, sum, count)",
-            table_dir.display(),
-            if selection.filters.is_empty() {
-                "no filter".to_string()
-            } else {
-                selection.filters.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(" and ")
-            }
+            "{}: {rows} rows have {filters}; narrow them with `sequence`/`where` or give an `aggregate` (mean, min, \
+             max, sum, count)",
+            table_dir.display()
         ),
         (_, Some(Aggregate::Mean)) => values.iter().sum::<f64>() / rows as f64,
         (_, Some(Aggregate::Sum)) => values.iter().sum(),
