@@ -57,9 +57,7 @@ pub fn report_time(source_date_epoch: Option<&str>, now_s: i64) -> String {
 /// Seconds since 1970-01-01 UTC as `YYYY-MM-DD HH:MM:SS UTC` (proleptic
 /// Gregorian, [`mmtrack_core::calendar`]).
 fn utc(seconds: i64) -> String {
-    let (days, s) = (seconds.div_euclid(86_400), seconds.rem_euclid(86_400));
-    let (year, month, day) = mmtrack_core::calendar::civil_from_days(days);
-    format!("{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02} UTC", s / 3600, s % 3600 / 60, s % 60)
+    mmtrack_core::calendar::utc_text(seconds)
 }
 
 /// Page style: body text 16 px, tables 15 px, nothing below 14 px; tables

@@ -11,9 +11,9 @@ use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
 use mmtrack_analysis::export::{ExportFormat, export_sequence};
 use mmtrack_analysis::pipeline::{inventory, read_trajectories};
-use mmtrack_core::{OdometryEstimate, StampedPose};
+use mmtrack_core::{OdometryEstimate, Se2, StampedPose};
 use mmtrack_io::recording::{EstimateToAdd, METADATA_NAME, RawReader, RecordingMetadata, copy_with_estimate};
-use mmtrack_io::table::{read_table, table_path};
+use mmtrack_io::table::{SLAM_MAP, SLAM_UE, SlamMapRow, SlamUeRow, read_table, table_path};
 use mmtrack_io::table_kv::read_key_value_metadata;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
@@ -27,7 +27,8 @@ enum Format {
     /// pyboreas odometry benchmark: `t_us` + 3x4 vehicle_from_world, `boreas/estimate/<seq>.txt`.
     Boreas,
     /// A copy of `--recording` with the estimate added as poses (`/estimate/pose`, `/viz/estimate`, and
-    /// `world -> estimate` on `/tf`) for Foxglove; `-o` is the new recording's path.
+    /// `world -> estimate` on `/tf`) for Foxglove, from the odometry table or a SLAM run's UE estimate; a SLAM
+    /// run's map after each epoch as markers on `/viz/slam_estimate`. `-o` is the new recording's path.
     Mcap,
 }
 
@@ -37,8 +38,8 @@ enum Format {
 each sequence as text files that evo, the KITTI odometry devkit and pyboreas read. Numbers are written at full \
 precision (shortest round-trip) and times as exact decimals. Files: <seq>.estimate.<fmt>.txt and \
 <seq>.ground_truth.<fmt>.txt (KITTI also <seq>.times.txt; Boreas boreas/{estimate,ground_truth}/<seq>.txt). \
-With --format mcap: a copy of --recording (never modified) plus the estimate of its sequence as poses, written \
-to -o atomically.",
+With --format mcap: a copy of --recording (never modified) plus the estimate of its sequence as poses (table \
+odometry, or slam_ue of `process slam` with the map of slam_map as 3D markers), written to -o atomically.",
     after_help = "Examples: mmtrack export --format kitti out/tables -o out/kitti && evo_ape kitti \
 out/kitti/seq.ground_truth.kitti.txt out/kitti/seq.estimate.kitti.txt\n\
 mmtrack export --format mcap out/tables --recording rec.mcap -o rec.estimate.mcap   (then open it in Foxglove)"
@@ -121,33 +122,52 @@ fn recording_metadata(path: &Path) -> anyhow::Result<RecordingMetadata> {
         .with_context(|| format!("{}: not an mmtrack recording (no mmtrack.recording metadata)", path.display()))
 }
 
-/// `--format mcap`: the recording plus the `odometry` table of its sequence.
+/// `--format mcap`: the recording plus the estimate of its sequence: the
+/// `odometry` table, or a SLAM run's `slam_ue` and `slam_map` tables.
 fn export_mcap(args: &ExportArgs, overwrite: Overwrite, quiet: bool) -> anyhow::Result<ExitCode> {
     let Some(recording) = &args.recording else { bail!("--format mcap needs --recording <RECORDING.mcap>") };
     let metadata = recording_metadata(recording)?;
     let sequence = args.sequence.clone().unwrap_or_else(|| metadata.sequence_id.clone());
-    let table = table_path(&args.tables, "odometry", &sequence)?;
-    if !table.is_file() {
+    let odometry = table_path(&args.tables, "odometry", &sequence)?;
+    let slam_ue = table_path(&args.tables, SLAM_UE.name, &sequence)?;
+    let (table, poses, slam_map, parent_frame) = if odometry.is_file() {
+        let rows: Vec<OdometryEstimate> = read_table(&odometry)?;
+        let poses: Vec<StampedPose> =
+            rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
+        // Tables in the ground truth's frame share the recording's `world`; older
+        // tables, and runs without ground truth, start at the first scan's pose.
+        let run_config = read_key_value_metadata(&odometry)?.remove("mmtrack.run_config").unwrap_or_default();
+        let world = serde_json::from_str::<serde_json::Value>(&run_config)
+            .ok()
+            .and_then(|c| c["frame"]["world"].as_str().map(str::to_string))
+            .unwrap_or_else(|| "first_scan".to_string());
+        let parent_frame = if world == "ground_truth" { "world" } else { "odometry_first_scan" };
+        (odometry, poses, Vec::new(), parent_frame)
+    } else if slam_ue.is_file() {
+        // A SLAM run is in the recording's world frame. The UE poses from
+        // its initialisation on (before it the estimate is the prior), and
+        // the map after every epoch.
+        let rows: Vec<SlamUeRow> = read_table(&slam_ue)?;
+        let poses: Vec<StampedPose> = rows
+            .iter()
+            .filter(|r| r.initialised)
+            .map(|r| StampedPose { t_ns: r.t_ns, parent_from_child: Se2::new(r.x_m, r.y_m, r.heading_rad) })
+            .collect();
+        let map = table_path(&args.tables, SLAM_MAP.name, &sequence)?;
+        let slam_map: Vec<SlamMapRow> = if map.is_file() { read_table(&map)? } else { Vec::new() };
+        (slam_ue, poses, slam_map, "world")
+    } else {
         bail!(
-            "{}: no odometry table of sequence {sequence} (the recording's; pick another with --sequence; found {})",
-            table.display(),
+            "{}: no odometry or slam_ue table of sequence {sequence} (the recording's; pick another with --sequence; \
+             found {})",
+            odometry.display(),
             inventory(&args.tables)?.describe()
         );
-    }
-    let rows: Vec<OdometryEstimate> = read_table(&table)?;
-    let poses: Vec<StampedPose> =
-        rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
-    // Tables in the ground truth's frame share the recording's `world`; older
-    // tables, and runs without ground truth, start at the first scan's pose.
-    let run_config = read_key_value_metadata(&table)?.remove("mmtrack.run_config").unwrap_or_default();
-    let world = serde_json::from_str::<serde_json::Value>(&run_config)
-        .ok()
-        .and_then(|c| c["frame"]["world"].as_str().map(str::to_string))
-        .unwrap_or_else(|| "first_scan".to_string());
-    let parent_frame = if world == "ground_truth" { "world" } else { "odometry_first_scan" };
+    };
     let estimate = EstimateToAdd {
         poses: &poses,
         parent_frame,
+        slam_map: &slam_map,
         metadata: BTreeMap::from([
             ("estimate.source".to_string(), table.display().to_string()),
             ("estimate.frame".to_string(), parent_frame.to_string()),
@@ -156,8 +176,14 @@ fn export_mcap(args: &ExportArgs, overwrite: Overwrite, quiet: bool) -> anyhow::
     let options = RecordingOptions { overwrite, durability: Durability::Fsync, ..RecordingOptions::default() };
     let summary = copy_with_estimate(recording, &args.output, &estimate, &options)?;
     if !quiet {
+        let maps = if slam_map.is_empty() {
+            String::new()
+        } else {
+            let epochs: std::collections::BTreeSet<u64> = slam_map.iter().map(|r| r.epoch).collect();
+            format!(" and {} SLAM maps", epochs.len())
+        };
         println!(
-            "{sequence}: {} estimate poses added to a copy of {}: {} ({:.1} MB)",
+            "{sequence}: {} estimate poses{maps} added to a copy of {}: {} ({:.1} MB)",
             poses.len(),
             recording.display(),
             summary.path.display(),

@@ -45,6 +45,12 @@ fn shown_value(value: &str) -> Cow<'_, str> {
     Cow::Owned(format!("{head}… ({} bytes; `--json` prints it whole)", value.len()))
 }
 
+/// Nanoseconds since 1970-01-01 UTC as `YYYY-MM-DD HH:MM:SS UTC` (what a
+/// viewer that shows dates shows for this log time).
+fn utc(ns: i64) -> String {
+    mmtrack_core::calendar::utc_text(ns.div_euclid(1_000_000_000))
+}
+
 fn seconds(ns: u64) -> f64 {
     ns as f64 * 1e-9
 }
@@ -75,7 +81,11 @@ fn print_recording(summary: &RecordingSummary) {
     let start = summary.channels.iter().map(|c| c.start_ns).min();
     let end = summary.channels.iter().map(|c| c.end_ns).max();
     if let (Some(start), Some(end)) = (start, end) {
-        println!("  time span: {:.3} s ({start} .. {end} ns)", seconds(end - start));
+        println!(
+            "  time span: {:.3} s ({start} .. {end} ns; from {})",
+            seconds(end - start),
+            utc(i64::try_from(start).unwrap_or(i64::MAX))
+        );
     }
     let topic_width = summary.channels.iter().map(|c| c.topic.len()).max().unwrap_or(0).max(5);
     let schema_width = summary.channels.iter().map(|c| c.schema_name.len()).max().unwrap_or(0).max(6);
@@ -97,7 +107,7 @@ fn tables_json(tables: &[TableFileSummary]) -> serde_json::Value {
             .iter()
             .map(|t| json!({
                 "table": t.table, "sequence": t.sequence, "path": t.path, "rows": t.rows,
-                "columns": t.columns, "t_ns_span": t.t_ns_span,
+                "columns": t.columns, "t_ns_span": t.t_ns_span, "time_base": t.time_base, "frame": t.frame,
             }))
             .collect::<Vec<_>>()
     )
@@ -108,6 +118,11 @@ fn print_tables(root: &std::path::Path, tables: &[TableFileSummary]) {
     for t in tables {
         let span = t.t_ns_span.map(|(a, b)| format!(", {:.3} s", (b - a) as f64 * 1e-9)).unwrap_or_default();
         println!("  {} / sequence={}: {} rows{span}", t.table, t.sequence, t.rows);
+        if t.time_base.is_some() || t.frame.is_some() {
+            let shown =
+                |v: &Option<String>| v.as_deref().map_or_else(|| "-".to_string(), |v| printable(v).into_owned());
+            println!("    time base: {}, frame: {}", shown(&t.time_base), shown(&t.frame));
+        }
         for c in &t.columns {
             println!("      {c}");
         }

@@ -29,6 +29,15 @@ pub fn civil_from_days(days: i64) -> (i64, i64, i64) {
     (yoe + era * 400 + i64::from(month <= 2), month, day)
 }
 
+/// Seconds since 1970-01-01 UTC as `YYYY-MM-DD HH:MM:SS UTC` (proleptic
+/// Gregorian, no leap seconds).
+#[must_use]
+pub fn utc_text(seconds: i64) -> String {
+    let (days, s) = (seconds.div_euclid(86_400), seconds.rem_euclid(86_400));
+    let (year, month, day) = civil_from_days(days);
+    format!("{year:04}-{month:02}-{day:02} {:02}:{:02}:{:02} UTC", s / 3600, s % 3600 / 60, s % 60)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

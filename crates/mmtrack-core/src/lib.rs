@@ -56,7 +56,7 @@ pub use beam_sweep::BeamSweep;
 pub use cir::CirSnapshot;
 pub use error::CoreError;
 pub use gnss::{GnssFix, GnssFixQuality};
-pub use mpc::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth};
+pub use mpc::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, PathGeometry};
 pub use num_complex::Complex64;
 pub use odometry::{OdometryEstimate, OdometryTiming};
 pub use pose::{Se2, StampedPose, interpolate_pose, path_length_m, wrap_angle_rad};

@@ -59,6 +59,18 @@ pub struct MpcTruth {
     pub doppler_hz: f64,
 }
 
+/// Where a true propagation path runs at one instant, as a simulator that
+/// knows the geometry gives it: from the transmitter through each
+/// interaction point (wall bounce, scattering car) to the receiver, in the
+/// world frame, metres (horizontal plane).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathGeometry {
+    /// Identifier of the propagation path, as in [`MpcTruth::path_id`].
+    pub path_id: u64,
+    /// Transmitter, interaction points in order, receiver; metres.
+    pub points_m: Vec<[f64; 2]>,
+}
+
 impl MpcTruth {
     /// Power of the component, dB: `20 log10 |amplitude|`.
     #[must_use]

@@ -76,3 +76,11 @@ pub mod slam;
 pub mod sounder;
 
 pub use error::SimError;
+
+/// Where a simulated clock starts unless the scenario's `start_t_ns` says
+/// otherwise: 2023-11-14 22:13:20 UTC (UNIX time 1 700 000 000 s), in
+/// nanoseconds since the UNIX epoch. A stated date, not when anything was
+/// measured: viewers that show dates (Foxglove) place a simulated recording
+/// there rather than at 1970-01-01, and `t_ns` keeps nanosecond steps
+/// (scenario times are differences from this start).
+pub const DEFAULT_START_T_NS: i64 = 1_700_000_000_000_000_000;

@@ -45,6 +45,14 @@ fn demo_writes_a_recording_and_a_table_and_says_where() {
     assert!(again.status.success(), "{}", text(&again).1);
     assert!(text(&again).0.is_empty(), "--quiet prints nothing");
 
+    // Issue 28: inspect names each table's time base and frame, and a
+    // recording's start as the date a viewer shows.
+    let tables = text(&mmtrack(dir.path(), &["inspect", "demo-out/tables"])).0;
+    assert!(tables.contains("ground_truth / sequence=oxford-demo: 160 rows"), "{tables}");
+    assert!(tables.contains("time base: unix_epoch, frame: ground_truth"), "{tables}");
+    assert!(tables.contains("time base: scenario_start, frame: recording_world"), "{tables}");
+    let recording = text(&mmtrack(dir.path(), &["inspect", "demo-out/recording.mcap"])).0;
+    assert!(recording.contains("; from 2023-11-14 22:13:20 UTC)"), "{recording}");
     let inspect = mmtrack(dir.path(), &["inspect", "--json", "demo-out/recording.mcap"]);
     let summary: serde_json::Value = serde_json::from_slice(&inspect.stdout).unwrap();
     let scans = summary["channels"].as_array().unwrap().iter().find(|c| c["topic"] == "/radar/image").unwrap();

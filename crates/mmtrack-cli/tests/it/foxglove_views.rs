@@ -29,29 +29,43 @@ duration_s = 3.0
 /// schema is a Foxglove one, checks the frame tree and the Cartesian images,
 /// and prints one JSON line of counts and metadata.
 const CHECK: &str = r#"
-import json, sys
+import json, math, sys
 from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 
 path = sys.argv[1]
 counts, parents, cartesian, static, pose_children, tf_children = {}, {}, 0, [], {}, set()
-scene_ids, sources, truths, path_lines = {}, {}, [], []
+scene_ids, sources, truths, path_lines, log_times, estimate_scenes = {}, {}, [], [], [], []
+first_snapshot_truth_m, mpc_path_lengths_m = {}, []
 with open(path, "rb") as f:
     reader = make_reader(f, decoder_factories=[DecoderFactory()])
     metadata = {m.name: dict(m.metadata) for m in reader.iter_metadata()}
     for schema, channel, message, decoded in reader.iter_decoded_messages():
+        log_times.append(message.log_time)
         if schema.name == "mmtrack.Pose2D":
             pose_children.setdefault(channel.topic, set()).add(decoded.child_frame)
         if channel.topic == "/slam/sources":
             sources[(decoded.kind, decoded.index)] = (decoded.x_m, decoded.y_m, decoded.z_m)
         if channel.topic == "/slam/ue_truth":
             truths.append(decoded)
+        if channel.topic == "/channel/mpc_truth" and decoded.snapshot_index == 0:
+            first_snapshot_truth_m.setdefault(decoded.set_index, []).append(decoded.delay_s * 299792458.0)
+        if channel.topic == "/viz/mpc_paths":
+            (entity,) = decoded.entities
+            mpc_path_lengths_m.append(sorted(
+                sum(math.dist((a.x, a.y, a.z), (b.x, b.y, b.z)) for a, b in zip(l.points, l.points[1:]))
+                for l in entity.lines))
         if schema.name == "foxglove.SceneUpdate":
             for e in decoded.entities:
                 assert e.frame_id == "world", e.frame_id
                 scene_ids.setdefault(channel.topic, []).append(e.id)
                 if channel.topic == "/viz/slam_paths":
                     path_lines.append([(l.color.r, [(p.x, p.y, p.z) for p in l.points]) for l in e.lines])
+            if channel.topic == "/viz/slam_estimate":
+                assert [d.type for d in decoded.deletions] == [1], decoded.deletions  # ALL earlier entities
+                spheres = {e.id: e.spheres[0] for e in decoded.entities}
+                estimate_scenes.append({"t_ns": message.log_time, "entities": {
+                    i: [s.pose.position.x, s.pose.position.y, s.pose.position.z, s.size.x] for i, s in spheres.items()}})
         if not schema.name.startswith("foxglove."):
             continue
         # Decoded against the FileDescriptorSet embedded in the file.
@@ -99,6 +113,12 @@ for truth, lines in zip(truths, path_lines):
     assert sorted(drawn) == wanted, (drawn, wanted)
     segments += sum(len(p) // 2 for p in drawn)
 
+# MPC path lines against the truth: each set's lines are as long as the
+# delays of its first snapshot's true paths say (c * delay).
+assert len(mpc_path_lengths_m) == len(first_snapshot_truth_m) or not mpc_path_lengths_m
+for drawn, (_, truth_m) in zip(mpc_path_lengths_m, sorted(first_snapshot_truth_m.items())):
+    assert len(drawn) == len(truth_m) and all(abs(a - b) < 1e-6 for a, b in zip(drawn, sorted(truth_m))), (drawn, truth_m)
+
 # One frame naming: a pose's child frame is the frame /tf moves.
 for topic, children in pose_children.items():
     assert children <= tf_children, (topic, children, tf_children)
@@ -109,6 +129,10 @@ print(json.dumps({
     "path_segments": segments,
     "pose_children": {topic: sorted(children) for topic, children in pose_children.items()},
     "counts": counts,
+    "first_log_time_ns": min(log_times),
+    "estimate_scenes": estimate_scenes,
+    "mpc_path_sets": len(mpc_path_lengths_m),
+    "mpc_paths_drawn": sum(len(d) for d in mpc_path_lengths_m),
     "cartesian": cartesian,
     "chains": {f: root(f) for f in sorted(set(parents) | set(parents.values()))},
     "metadata": metadata.get("mmtrack.recording", {}),
@@ -167,7 +191,8 @@ fn foxglove_messages_decode_frames_chain_and_estimates_are_added_to_a_copy() {
         "{est}"
     );
     assert_eq!(chain(&est, "estimate"), ["estimate", "world"], "{est}");
-    assert_eq!(est["metadata"]["time_base"], "unix_epoch");
+    // Issue 28: a simulated drive runs on the scenario's clock, at its stated date.
+    assert_eq!(est["metadata"]["time_base"], "scenario_start");
     assert!(est["metadata"]["estimate.source"].as_str().unwrap().contains("odometry"), "{est}");
 
     // Refused: writing over the input, and an input that has estimates already.
@@ -236,7 +261,12 @@ fn sounder_recordings_name_their_scenario_time_base() {
     assert!(out.status.success(), "{}", text(&out).1);
     let json = check(&python, d, &d.join("s.mcap"));
     assert_eq!(json["metadata"]["time_base"], "scenario_start", "{json}");
-    assert!(json["metadata"]["time_base.meaning"].as_str().unwrap().contains("not UNIX time"), "{json}");
+    assert!(json["metadata"]["time_base.meaning"].as_str().unwrap().contains("a stated date"), "{json}");
+    // Issue 28: stamped at the stated epoch (2023-11-14 22:13:20 UTC), not 1970.
+    assert_eq!(json["first_log_time_ns"], 1_700_000_000_000_000_000_i64, "{json}");
+    // Issue 28: each set's true paths drawn (their lengths checked against the truth's delays by the script).
+    assert_eq!(json["mpc_path_sets"], 3, "{json}");
+    assert!(json["mpc_paths_drawn"].as_u64().unwrap() >= 3 * 3, "LOS and both walls at least: {json}");
     // Both cars move in /tf.
     assert_eq!(chain(&json, "tx"), ["tx", "world"], "{json}");
     assert_eq!(chain(&json, "rx"), ["rx", "world"], "{json}");
@@ -281,6 +311,46 @@ fn slam_recordings_mark_their_sources_and_true_paths() {
     // 29 paths (the script matched each to /slam/ue_truth): 5 line of
     // sight, 20 VA and 4 SP paths (two segments each).
     assert_eq!(json["path_segments"], 5 + 20 + 2 * 4, "{json}");
+    // Issue 28: stamped at the stated epoch (2023-11-14 22:13:20 UTC), not 1970.
+    assert_eq!(json["metadata"]["time_base"], "scenario_start", "{json}");
+    assert_eq!(json["first_log_time_ns"], 1_700_000_000_000_000_000_i64, "{json}");
+
+    // Issue 28: the SLAM estimate in a copy: the UE poses from the
+    // initialisation on, and the map after each epoch as markers equal to
+    // the `slam_map` rows of that epoch.
+    let out = mmtrack(d, &["process", "slam", "s.mcap", "-o", "tables", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(d, &["export", "--format", "mcap", "tables", "--recording", "s.mcap", "-o", "est.mcap"]);
+    let stdout = text(&out).0;
+    assert!(out.status.success(), "{}", text(&out).1);
+    let ue: Vec<mmtrack_io::table::SlamUeRow> =
+        mmtrack_io::table::read_table(&d.join("tables/slam_ue/sequence=s/part-0.parquet")).unwrap();
+    let map: Vec<mmtrack_io::table::SlamMapRow> =
+        mmtrack_io::table::read_table(&d.join("tables/slam_map/sequence=s/part-0.parquet")).unwrap();
+    let initialised = ue.iter().filter(|r| r.initialised).count();
+    assert!(initialised >= 4, "the UE is initialised from the first epochs' line of sight: {initialised}");
+    assert!(stdout.contains(&format!("{initialised} estimate poses and 5 SLAM maps")), "{stdout}");
+    let est = check(&python, d, &d.join("est.mcap"));
+    assert_eq!(chain(&est, "estimate"), ["estimate", "world"], "{est}");
+    assert_eq!(est["counts"]["foxglove.PoseInFrame"], 5 + initialised, "ground truth and estimate: {est}");
+    let scenes = est["estimate_scenes"].as_array().unwrap();
+    assert_eq!(scenes.len(), 5, "{est}");
+    for (k, scene) in scenes.iter().enumerate() {
+        let rows: Vec<_> = map.iter().filter(|r| r.epoch == k as u64 + 1).collect();
+        let entities = scene["entities"].as_object().unwrap();
+        assert_eq!(entities.len(), rows.len(), "epoch {}: {scene}", k + 1);
+        assert!(rows.iter().any(|r| r.status == "bs"), "epoch {}: the base station is not drawn", k + 1);
+        assert!(rows.len() >= 2, "epoch {}: no source besides the base station to draw", k + 1);
+        assert_eq!(scene["t_ns"], rows[0].t_ns, "{scene}");
+        for r in rows {
+            let e = &entities[&format!("est-{}", r.source_id)];
+            let drawn: Vec<f64> = serde_json::from_value(e.clone()).unwrap();
+            // To 1e-9 m: serde_json's float parsing may differ from Python's repr in the last bit.
+            let want = [r.x_m, r.y_m, r.z_m, (2.0 * r.spread_m).clamp(1.5, 10.0)];
+            let off = drawn.iter().zip(want).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+            assert!(off < 1e-9, "source {} at epoch {}: drawn {drawn:?}, table {want:?}", r.source_id, k + 1);
+        }
+    }
 }
 
 #[test]

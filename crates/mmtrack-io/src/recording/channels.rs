@@ -35,6 +35,8 @@ pub const CIR_TOPIC: &str = "/channel/cir";
 pub const CIR_VIZ_TOPIC: &str = "/viz/cir";
 /// Topic of the true multipath components of simulated CIRs.
 pub const MPC_TRUTH_TOPIC: &str = "/channel/mpc_truth";
+/// Display lines of a simulated sounder run's true paths (`foxglove.SceneUpdate`).
+pub const MPC_PATHS_VIZ_TOPIC: &str = "/viz/mpc_paths";
 /// Topic of beam sweeps of a measured codebook.
 pub const BEAM_SWEEP_TOPIC: &str = "/beam/sweeps";
 /// Topic of GNSS fixes of the beam-sweeping array (e.g. a roadside unit);
@@ -52,6 +54,9 @@ pub const SLAM_SOURCES_TOPIC: &str = "/slam/sources";
 pub const SLAM_SOURCES_VIZ_TOPIC: &str = "/viz/slam_sources";
 /// Display markers of each epoch's true paths (`foxglove.SceneUpdate`).
 pub const SLAM_PATHS_VIZ_TOPIC: &str = "/viz/slam_paths";
+/// Display markers of the SLAM filter's map after each epoch, added by
+/// `mmtrack export --format mcap` (`foxglove.SceneUpdate`).
+pub const SLAM_ESTIMATE_VIZ_TOPIC: &str = "/viz/slam_estimate";
 /// Recording metadata key naming the site of a beam-sweep recording: one
 /// array at one place (e.g. `deepsense-scenario1`). Recordings of one site
 /// share the array's boresight and codebook, so a beam map fitted on some of
@@ -233,6 +238,24 @@ pub const CHANNELS: &[ChannelSpec] = &[
                   paths, replaced every epoch): line of sight base station -> UE, a virtual anchor's path VA -> UE \
                   (the unfolded reflection, as long as the path), a scattering point's base station -> SP -> UE; \
                   clutter has no line",
+    },
+    ChannelSpec {
+        topic: MPC_PATHS_VIZ_TOPIC,
+        schema_names: &["foxglove.SceneUpdate"],
+        canonical: false,
+        meaning: "where the true paths of a simulated sounder run go, at each set's first snapshot, as lines in the \
+                  3D panel (frame world; entity paths, replaced every set): one line strip per path of \
+                  /channel/mpc_truth from the transmitter through its wall bounces or scattering car to the \
+                  receiver; direct blue, one interaction orange, two green; diffuse scatterers are not drawn",
+    },
+    ChannelSpec {
+        topic: SLAM_ESTIMATE_VIZ_TOPIC,
+        schema_names: &["foxglove.SceneUpdate"],
+        canonical: false,
+        meaning: "the SLAM filter's map after each epoch (table slam_map), added by export --format mcap, in the 3D \
+                  panel (frame world; replaced every epoch): one entity per source, id est-<source_id>, a sphere as \
+                  wide as twice the belief's spread (1.5 m to 10 m), the base station and confirmed VAs and SPs in \
+                  their kind's colour half transparent, unconfirmed sources grey, labelled with kind, id and spread",
     },
     ChannelSpec {
         topic: RADAR_CARTESIAN_TOPIC,

@@ -8,11 +8,12 @@ use std::path::{Path, PathBuf};
 
 use mmtrack_core::StampedPose;
 
-use super::channels::PoseStream;
+use super::channels::{PoseStream, SLAM_ESTIMATE_VIZ_TOPIC};
 use super::metadata::RecordingMetadata;
 use super::writer::{RecordingOptions, RecordingWriter, WriteSummary};
 use super::{METADATA_NAME, RawReader};
 use crate::error::{IoError, Result};
+use crate::table::SlamMapRow;
 
 /// An estimated trajectory to add to a copy of a recording.
 #[derive(Debug, Clone)]
@@ -22,6 +23,9 @@ pub struct EstimateToAdd<'a> {
     /// Frame the poses are given in (`world` when they are in the ground
     /// truth's frame).
     pub parent_frame: &'a str,
+    /// A SLAM run's map (rows of table `slam_map`, any order), drawn epoch
+    /// by epoch on `/viz/slam_estimate`; empty for odometry.
+    pub slam_map: &'a [SlamMapRow],
     /// Metadata keys added to the copy's `mmtrack.recording` record (e.g.
     /// `estimate.source`, `estimate.frame`).
     pub metadata: BTreeMap<String, String>,
@@ -29,7 +33,8 @@ pub struct EstimateToAdd<'a> {
 
 /// Writes `output`: every message of `input` (channels, schemas, sequence
 /// numbers and log times kept), then `estimate` on `/estimate/pose` (with its
-/// `/viz/estimate` display copy and `world -> estimate` on `/tf`). The
+/// `/viz/estimate` display copy and `world -> estimate` on `/tf`) and a SLAM
+/// run's map on `/viz/slam_estimate`, one scene per epoch. The
 /// recording metadata gains `estimate.metadata`. Refuses an input that already
 /// has estimates, and an output that is the input.
 pub fn copy_with_estimate(
@@ -73,7 +78,10 @@ pub fn copy_with_estimate(
             },
         };
         let topic = message.channel.topic.as_str();
-        if topic == PoseStream::Estimate.topic() || topic == PoseStream::Estimate.viz_topic() {
+        if topic == PoseStream::Estimate.topic()
+            || topic == PoseStream::Estimate.viz_topic()
+            || topic == SLAM_ESTIMATE_VIZ_TOPIC
+        {
             return Err(IoError::BadMessage {
                 path: input.to_path_buf(),
                 topic: topic.to_string(),
@@ -85,6 +93,14 @@ pub fn copy_with_estimate(
     }
     for pose in estimate.poses {
         writer.write_pose(PoseStream::Estimate, pose, estimate.parent_frame)?;
+    }
+    let mut by_epoch: BTreeMap<(i64, u64), Vec<SlamMapRow>> = BTreeMap::new();
+    for row in estimate.slam_map {
+        by_epoch.entry((row.t_ns, row.epoch)).or_default().push(row.clone());
+    }
+    for ((t_ns, _), mut sources) in by_epoch {
+        sources.sort_by_key(|s| s.source_id);
+        writer.write_slam_estimate(t_ns, &sources)?;
     }
     writer.finish()
 }

@@ -9,7 +9,9 @@ use std::collections::BTreeMap;
 pub enum TimeBase {
     /// Nanoseconds since the UNIX epoch (real recordings).
     UnixEpoch,
-    /// Nanoseconds since the start of a simulated scenario.
+    /// A simulated scenario's clock: nanoseconds since the UNIX epoch, the
+    /// scenario starting at its stated `start_t_ns` (simulators default to
+    /// 2023-11-14 22:13:20 UTC), not a time anything was measured.
     ScenarioStart,
     /// A simulator's clock (ROS 2 `/clock`, `use_sim_time`), as the source
     /// stamps it: counts from the simulation's start, not a date.
@@ -41,8 +43,9 @@ impl TimeBase {
         match self {
             Self::UnixEpoch => "t_ns and log times are nanoseconds since 1970-01-01 00:00 UTC (UNIX time)",
             Self::ScenarioStart => {
-                "t_ns and log times are nanoseconds since the start of the simulated scenario, not UNIX time \
-                 (viewers showing dates show 1970-01-01)"
+                "t_ns and log times are a simulated scenario's clock in nanoseconds since 1970-01-01 00:00 UTC: \
+                 the scenario starts at its start_t_ns (by default 2023-11-14 22:13:20 UTC), a stated date, not when \
+                 anything was measured"
             }
             Self::SimTime => {
                 "t_ns and log times are a simulator's clock (ROS sim time) as the source stamps them, not UNIX time \

@@ -22,6 +22,7 @@ use crate::atomic::{AtomicFile, Durability, Overwrite};
 use crate::error::{IoError, Result};
 use crate::proto::{self, SpecMessage};
 
+mod mpc_paths;
 mod slam;
 
 /// Chunk compression of a recording.

@@ -368,6 +368,10 @@ pub struct TableFileSummary {
     pub columns: Vec<String>,
     /// Smallest and largest `t_ns`, when the table has that column.
     pub t_ns_span: Option<(i64, i64)>,
+    /// The file's `time_base` key (what `t_ns` counts from), when present.
+    pub time_base: Option<String>,
+    /// The file's `frame` key (the frame of its coordinates), when present.
+    pub frame: Option<String>,
 }
 
 /// Summarises every table partition under `root` (a results directory) or,
@@ -422,6 +426,14 @@ fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileS
         check_schema(path, spec, builder.schema())?;
     }
     let rows = builder.metadata().file_metadata().num_rows();
+    let key = |name: &str| {
+        builder
+            .metadata()
+            .file_metadata()
+            .key_value_metadata()
+            .and_then(|kv| kv.iter().find(|e| e.key == name).and_then(|e| e.value.clone()))
+    };
+    let (time_base, frame) = (key("time_base"), key("frame"));
     let columns = builder
         .schema()
         .fields()
@@ -452,5 +464,7 @@ fn summarise_file(table: &str, sequence: &str, path: &Path) -> Result<TableFileS
         rows,
         columns,
         t_ns_span: span,
+        time_base,
+        frame,
     })
 }

@@ -212,11 +212,16 @@ fn write_recording(
     if let Some(t) = &sim.trajectory {
         extra.insert("simulator.trajectory".to_string(), t.path.display().to_string());
     }
-    // Scan times are the trajectory's: UNIX time when a real trajectory or the
-    // scenario's `start_t_ns` puts the drive at a date, scenario time from 0 otherwise.
+    // Scan times are the trajectory's: a real drive's UNIX times when
+    // `--trajectory` brings one, else the scenario's clock from its stated
+    // `start_t_ns`.
     let mut simulator = simulator.peekable();
     let first_t_ns = simulator.peek().map_or(0, |(scan, _)| scan.header.t_ns);
-    let time_base = TimeBase::unix_or(first_t_ns, TimeBase::ScenarioStart);
+    let time_base = if sim.trajectory.is_some() {
+        TimeBase::unix_or(first_t_ns, TimeBase::ScenarioStart)
+    } else {
+        TimeBase::ScenarioStart
+    };
     let metadata = RecordingMetadata {
         sequence_id: sim
             .output

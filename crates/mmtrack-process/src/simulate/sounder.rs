@@ -119,6 +119,7 @@ fn write_convoy(
     for set in simulator.take(sets) {
         writer.write_pose(PoseStream::GroundTruthTx, &set.tx_pose, "world")?;
         writer.write_pose(PoseStream::GroundTruthRx, &set.rx_pose, "world")?;
+        writer.write_mpc_paths(set.rx_pose.t_ns, &set.paths)?;
         for cir in &set.snapshots {
             write_snapshot(&mut writer, cir, &set.truth)?;
         }

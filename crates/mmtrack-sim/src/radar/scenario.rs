@@ -2,7 +2,7 @@
 //!
 //! ```toml
 //! seed = 7
-//! start_t_ns = 1_700_000_000_000_000_000   # time of the start (default 0)
+//! start_t_ns = 1_700_000_000_000_000_000   # time of the start, UNIX ns (default: mmtrack_sim::DEFAULT_START_T_NS)
 //! max_scans = 12                           # optional cut
 //! max_distance_m = 500.0                   # optional cut
 //!
@@ -44,15 +44,19 @@ pub struct Motion {
     pub duration_s: f64,
 }
 
+fn default_start_t_ns() -> i64 {
+    crate::DEFAULT_START_T_NS
+}
+
 /// A radar scenario: sensor, scene, motion, cuts and seed.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
     /// Seed of every random draw (scene generation, noise, speckle).
     pub seed: u64,
-    /// Time of the start of the constant-turn motion, nanoseconds (a UNIX
-    /// time makes fixtures look like real files).
-    #[serde(default)]
+    /// Time of the start of the constant-turn motion, nanoseconds since the
+    /// UNIX epoch (default [`crate::DEFAULT_START_T_NS`]).
+    #[serde(default = "default_start_t_ns")]
     pub start_t_ns: i64,
     /// Render at most this many sweeps.
     #[serde(default)]

@@ -120,6 +120,9 @@ pub struct SlamScenario {
     pub clutter_per_epoch: usize,
     /// Largest clutter TOA beyond the LOS TOA, metres (300).
     pub clutter_max_excess_m: f64,
+    /// Time of the first epoch, nanoseconds since the UNIX epoch (not in
+    /// the paper; default [`crate::DEFAULT_START_T_NS`]).
+    pub start_t_ns: i64,
 }
 
 impl Default for SlamScenario {
@@ -156,6 +159,7 @@ impl Default for SlamScenario {
             detection_probability: 1.0,
             clutter_per_epoch: 0,
             clutter_max_excess_m: 300.0,
+            start_t_ns: crate::DEFAULT_START_T_NS,
         }
     }
 }
@@ -232,6 +236,10 @@ impl SlamScenario {
         if self.epochs == 0 || !limits::SLAM_EPOCHS.allows_count(self.epochs as u64) {
             return Err(invalid("epochs", self.epochs, limits::SLAM_EPOCHS.expected));
         }
+        let run_ns = self.epochs as f64 * self.epoch_s * 1e9;
+        if !run_ns.is_finite() || run_ns >= (i64::MAX - self.start_t_ns.max(0)) as f64 {
+            return Err(invalid("start_t_ns", self.start_t_ns, "a start whose last epoch ends before the year 2262"));
+        }
         if !limits::CLUTTER_PER_EPOCH.allows_count(self.clutter_per_epoch as u64) {
             return Err(invalid("clutter_per_epoch", self.clutter_per_epoch, limits::CLUTTER_PER_EPOCH.expected));
         }
@@ -276,7 +284,7 @@ impl SlamScenario {
         let mut epochs = Vec::with_capacity(self.epochs);
         let mut truth = Vec::with_capacity(self.epochs);
         for k in 0..self.epochs {
-            let t_ns = (k as f64 * self.epoch_s * 1e9).round() as i64;
+            let t_ns = self.start_t_ns + (k as f64 * self.epoch_s * 1e9).round() as i64;
             let (paths, origins) = self.measure(&world, &ue, &mut rng);
             epochs.push(SlamEpoch { t_ns, paths });
             truth.push(SlamTruth { ue, origins });

@@ -50,7 +50,8 @@ pub struct ArtificialChannelConfig {
     /// Snapshots per set (the set/snapshot indices only: timing stays
     /// continuous); absent = all snapshots form set 0.
     pub snapshots_per_set: Option<u32>,
-    /// Time of the first snapshot, nanoseconds.
+    /// Time of the first snapshot, nanoseconds since the UNIX epoch
+    /// (default [`crate::DEFAULT_START_T_NS`]).
     pub start_t_ns: i64,
 }
 
@@ -65,7 +66,7 @@ impl Default for ArtificialChannelConfig {
             snapshots: 100,
             snapshot_interval_s: 0.717e-3,
             snapshots_per_set: None,
-            start_t_ns: 0,
+            start_t_ns: crate::DEFAULT_START_T_NS,
         }
     }
 }

@@ -166,7 +166,8 @@ pub struct ConvoyConfig {
     pub snapshot_interval_s: f64,
     /// Time between the starts of two sets, seconds.
     pub set_interval_s: f64,
-    /// Time of the first snapshot, nanoseconds.
+    /// Time of the first snapshot, nanoseconds since the UNIX epoch
+    /// (default [`crate::DEFAULT_START_T_NS`]).
     pub start_t_ns: i64,
     /// Delay of tap 0, seconds, fixed for the run (the sounder's clocks are
     /// synchronised, so delays are absolute and their slope is the Doppler).
@@ -200,7 +201,7 @@ impl Default for ConvoyConfig {
             snapshots_per_set: 6,
             snapshot_interval_s: 0.717e-3,
             set_interval_s: 10e-3,
-            start_t_ns: 0,
+            start_t_ns: crate::DEFAULT_START_T_NS,
             delay_offset_s: 200e-9,
             guard_taps: 4,
             noise_tail_taps: 64,

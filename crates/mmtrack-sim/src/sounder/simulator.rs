@@ -5,7 +5,7 @@ use std::f64::consts::{PI, TAU};
 
 use mmtrack_core::random::{self, standard_exponential, standard_normal_pair};
 use mmtrack_core::sounder::SounderBand;
-use mmtrack_core::{CirSnapshot, Complex64, MpcTruth, Se2, StampedPose};
+use mmtrack_core::{CirSnapshot, Complex64, MpcTruth, PathGeometry, Se2, StampedPose};
 use rand::RngExt;
 use rayon::prelude::*;
 
@@ -31,6 +31,9 @@ pub struct SounderSet {
     pub rx_pose: StampedPose,
     /// `world_from_vehicle` of the transmitter at the set's first snapshot.
     pub tx_pose: StampedPose,
+    /// Where each path of the set's first snapshot that is in the truth
+    /// runs (transmitter, interaction points, receiver), in `path_id` order.
+    pub paths: Vec<PathGeometry>,
 }
 
 /// Smooth speed profile along a lane: `v(t) = v_mid + v_half sin(2 pi t / T + phi)`.
@@ -88,10 +91,19 @@ struct Scatterer {
     phase_rad: f64,
 }
 
+/// The interaction points of a specular path, in order from the transmitter.
+#[derive(Debug, Clone, Copy)]
+enum Via {
+    Direct,
+    One(P2),
+    Two(P2, P2),
+}
+
 /// A specular path at one instant.
 #[derive(Debug, Clone, Copy)]
 struct Path {
     id: u64,
+    via: Via,
     length_m: f64,
     /// `dL/dt`, metres per second.
     rate_mps: f64,
@@ -246,6 +258,7 @@ impl ConvoySimulator {
         let visible: Vec<&Scatterer> = self.diffuse_candidates(tx0.position, rx0.position, &ranges);
         let mut snapshots = Vec::with_capacity(self.config.snapshots_per_set as usize);
         let mut truth = Vec::new();
+        let mut geometry = Vec::new();
         for snapshot_index in 0..self.config.snapshots_per_set {
             let t_ns = self.t_ns(set_index, snapshot_index);
             let t_s = (t_ns - self.config.start_t_ns) as f64 * 1e-9;
@@ -258,6 +271,14 @@ impl ConvoySimulator {
                 let amplitude = self.amplitude(p.magnitude, p.phase_rad, p.length_m);
                 render.push(RenderPath { relative_delay_s, amplitude });
                 if 20.0 * p.magnitude.log10() >= self.config.truth_min_power_db {
+                    if snapshot_index == 0 {
+                        let points_m = match p.via {
+                            Via::Direct => vec![tx.position, rx.position],
+                            Via::One(q) => vec![tx.position, q, rx.position],
+                            Via::Two(q1, q2) => vec![tx.position, q1, q2, rx.position],
+                        };
+                        geometry.push(PathGeometry { path_id: p.id, points_m });
+                    }
                     truth.push(MpcTruth {
                         t_ns,
                         set_index,
@@ -289,7 +310,8 @@ impl ConvoySimulator {
             let sigma = self.config.sounder.noise_sigma();
             snapshots.push(render_snapshot(&self.band, &self.pulse, &render, sigma, [self.seed, NOISE_STREAM], stamp));
         }
-        Some(SounderSet { set_index, snapshots, truth, rx_pose: pose(&rx0), tx_pose: pose(&tx0) })
+        geometry.sort_by_key(|g| g.path_id);
+        Some(SounderSet { set_index, snapshots, truth, rx_pose: pose(&rx0), tx_pose: pose(&tx0), paths: geometry })
     }
 
     /// Delay after tap 0 when the path lies inside the usable window.
@@ -348,6 +370,7 @@ impl ConvoySimulator {
             let length_m = dist(a, b);
             paths.push(Path {
                 id: PathKind::Los.base(),
+                via: Via::Direct,
                 length_m,
                 rate_mps: dot(sub(tx.velocity, rx.velocity), unit(b, a)),
                 magnitude: self.free_space(length_m),
@@ -364,6 +387,7 @@ impl ConvoySimulator {
                 let length_m = dist(a, p) + dist(p, b);
                 paths.push(Path {
                     id,
+                    via: Via::One(p),
                     length_m,
                     rate_mps: end_rate(p, p),
                     magnitude: self.free_space(length_m) * self.reflection(),
@@ -383,6 +407,7 @@ impl ConvoySimulator {
                     let rho = self.reflection();
                     paths.push(Path {
                         id,
+                        via: Via::Two(p1, p2),
                         length_m,
                         rate_mps: end_rate(p1, p2),
                         magnitude: self.free_space(length_m) * rho * rho,
@@ -405,7 +430,14 @@ impl ConvoySimulator {
                 + dot(c.velocity, unit(b, c.position));
             // Bistatic radar equation: |a| = g lambda sqrt(sigma) / ((4 pi)^(3/2) d1 d2).
             let magnitude = gain * self.wavelength_m() * sigma_m2.sqrt() / ((2.0 * TAU).powf(1.5) * d1 * d2);
-            paths.push(Path { id, length_m: d1 + d2, rate_mps, magnitude, phase_rad: self.static_phase(id) });
+            paths.push(Path {
+                id,
+                via: Via::One(c.position),
+                length_m: d1 + d2,
+                rate_mps,
+                magnitude,
+                phase_rad: self.static_phase(id),
+            });
         }
         paths
     }

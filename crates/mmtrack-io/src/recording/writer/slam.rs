@@ -2,7 +2,8 @@
 //! and the sources of the paths.
 
 use foxglove::schemas::{
-    Color, LinePrimitive, Point3, Pose, SceneEntity, SceneUpdate, SpherePrimitive, TextPrimitive, Vector3,
+    Color, LinePrimitive, Point3, Pose, SceneEntity, SceneEntityDeletion, SceneUpdate, SpherePrimitive, TextPrimitive,
+    Vector3, scene_entity_deletion,
 };
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 
@@ -10,12 +11,18 @@ use super::RecordingWriter;
 use crate::error::{IoError, Result};
 use crate::proto;
 use crate::recording::channels::{
-    SLAM_PATHS_TOPIC, SLAM_PATHS_VIZ_TOPIC, SLAM_SOURCES_TOPIC, SLAM_SOURCES_VIZ_TOPIC, SLAM_UE_TRUTH_TOPIC,
+    SLAM_ESTIMATE_VIZ_TOPIC, SLAM_PATHS_TOPIC, SLAM_PATHS_VIZ_TOPIC, SLAM_SOURCES_TOPIC, SLAM_SOURCES_VIZ_TOPIC,
+    SLAM_UE_TRUTH_TOPIC,
 };
 use crate::recording::tf::{WORLD_FRAME, timestamp};
+use crate::table::SlamMapRow;
 
 /// Diameter of a source's sphere in the 3D panel, metres.
 const SOURCE_MARKER_M: f64 = 1.5;
+
+/// Largest diameter of an estimated source's sphere, metres: a wider belief
+/// is drawn at this size (its label states the spread).
+const ESTIMATE_MARKER_MAX_M: f64 = 10.0;
 
 /// The display colour of a kind of source (`bs`, `va`, `sp`).
 fn kind_color(kind: &str) -> Color {
@@ -25,6 +32,26 @@ fn kind_color(kind: &str) -> Color {
         _ => (0.17, 0.63, 0.17),
     };
     Color { r, g, b, a: 1.0 }
+}
+
+/// Pose of a marker at `position_m`, lifted by `lift_m`.
+fn marker_pose(position_m: [f64; 3], lift_m: f64) -> Pose {
+    Pose {
+        position: Some(Vector3 { x: position_m[0], y: position_m[1], z: position_m[2] + lift_m }),
+        orientation: Some(crate::recording::tf::yaw_quaternion(0.0)),
+    }
+}
+
+/// A source's label in the 3D panel.
+fn source_label(text: String) -> TextPrimitive {
+    TextPrimitive {
+        billboard: true,
+        font_size: 14.0,
+        scale_invariant: true,
+        color: Some(Color { r: 1.0, g: 1.0, b: 1.0, a: 1.0 }),
+        text,
+        ..Default::default()
+    }
 }
 
 fn point(p: [f64; 3]) -> Point3 {
@@ -155,26 +182,18 @@ impl RecordingWriter {
                 SourceType::VirtualAnchor => format!("VA {index}"),
                 SourceType::ScatteringPoint => format!("SP {index}"),
             };
-            let pose = |lift_m: f64| Pose {
-                position: Some(Vector3 { x: position_m[0], y: position_m[1], z: position_m[2] + lift_m }),
-                orientation: Some(crate::recording::tf::yaw_quaternion(0.0)),
-            };
             let entity = SceneEntity {
                 timestamp: timestamp(t_ns),
                 frame_id: WORLD_FRAME.into(),
                 id: format!("{}-{index}", kind.name()),
                 spheres: vec![SpherePrimitive {
-                    pose: Some(pose(0.0)),
+                    pose: Some(marker_pose(position_m, 0.0)),
                     size: Some(Vector3 { x: SOURCE_MARKER_M, y: SOURCE_MARKER_M, z: SOURCE_MARKER_M }),
                     color: Some(kind_color(kind.name())),
                 }],
                 texts: vec![TextPrimitive {
-                    pose: Some(pose(SOURCE_MARKER_M)),
-                    billboard: true,
-                    font_size: 14.0,
-                    scale_invariant: true,
-                    color: Some(Color { r: 1.0, g: 1.0, b: 1.0, a: 1.0 }),
-                    text: label,
+                    pose: Some(marker_pose(position_m, SOURCE_MARKER_M)),
+                    ..source_label(label)
                 }],
                 ..Default::default()
             };
@@ -185,6 +204,59 @@ impl RecordingWriter {
                 None,
             )?;
         }
+        Ok(())
+    }
+
+    /// Writes the filter's map after the epoch at `t_ns` (rows of table
+    /// `slam_map` of that epoch) as display markers on `/viz/slam_estimate`:
+    /// one `foxglove.SceneUpdate` that first deletes the entities of earlier
+    /// epochs, then one sphere per source, `est-<source_id>`, as wide as
+    /// twice the belief's spread (between the truth markers' 1.5 m and
+    /// 10 m), the base station and confirmed VAs / SPs in their kind's
+    /// colour half transparent, unconfirmed sources grey, with a label
+    /// (`VA 3 est, 0.42 m`). Nothing without Foxglove views.
+    pub fn write_slam_estimate(&mut self, t_ns: i64, sources: &[SlamMapRow]) -> Result<()> {
+        if !self.foxglove_views {
+            return Ok(());
+        }
+        let entities = sources
+            .iter()
+            .map(|source| {
+                let position_m = [source.x_m, source.y_m, source.z_m];
+                let diameter_m = (2.0 * source.spread_m).clamp(SOURCE_MARKER_M, ESTIMATE_MARKER_MAX_M);
+                let color = if source.confirmed {
+                    Color { a: 0.5, ..kind_color(&source.status) }
+                } else {
+                    Color { r: 0.6, g: 0.6, b: 0.6, a: 0.35 }
+                };
+                let label =
+                    format!("{} {} est, {:.2} m", source.status.to_uppercase(), source.source_id, source.spread_m);
+                SceneEntity {
+                    timestamp: timestamp(t_ns),
+                    frame_id: WORLD_FRAME.into(),
+                    id: format!("est-{}", source.source_id),
+                    spheres: vec![SpherePrimitive {
+                        pose: Some(marker_pose(position_m, 0.0)),
+                        size: Some(Vector3 { x: diameter_m, y: diameter_m, z: diameter_m }),
+                        color: Some(color),
+                    }],
+                    texts: vec![TextPrimitive {
+                        pose: Some(marker_pose(position_m, 0.5 * diameter_m + 0.5)),
+                        ..source_label(label)
+                    }],
+                    ..Default::default()
+                }
+            })
+            .collect();
+        let update = SceneUpdate {
+            deletions: vec![SceneEntityDeletion {
+                timestamp: timestamp(t_ns),
+                r#type: scene_entity_deletion::Type::All as i32,
+                id: String::new(),
+            }],
+            entities,
+        };
+        self.write_foxglove(SLAM_ESTIMATE_VIZ_TOPIC, t_ns, &update, None)?;
         Ok(())
     }
 }
