@@ -11,7 +11,7 @@ use mmtrack_ingest::cir::{CirFormat, ingest_cir};
 use mmtrack_ingest::mulran::{self, MulranOptions};
 use mmtrack_ingest::oxford::{self, OxfordOptions};
 use mmtrack_ingest::poses::{self, Plane};
-use mmtrack_ingest::ros2::{RadarTopic, Ros2Topics};
+use mmtrack_ingest::ros2::Ros2Topics;
 use mmtrack_io::RecordingOptions;
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::recording::RecordingFlags;
@@ -499,19 +499,15 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             radar_range_resolution_m,
             sweep,
         } => {
-            let radar = match (radar_topic, radar_range_resolution_m) {
-                (Some(topic), Some(range_resolution_m)) => {
-                    positive_metres("--radar-range-resolution-m", range_resolution_m)?;
-                    Some(RadarTopic { topic, range_resolution_m, timing: sweep.timing()? })
-                }
-                _ => None,
-            };
-            let topics = Ros2Topics {
-                pose_topic: (pose_topic != "none").then_some(pose_topic),
-                pose_stream: if poses_are_ground_truth { PoseStream::GroundTruth } else { PoseStream::Estimate },
+            let topics = Ros2Topics::from_flags(
+                &pose_topic,
+                poses_are_ground_truth,
                 gnss_topic,
-                radar,
-            };
+                radar_topic,
+                radar_range_resolution_m,
+                sweep.timing()?,
+            )
+            .map_err(anyhow::Error::msg)?;
             folders::ros2_bag(&input, &output, &topics, quiet)
         }
     }

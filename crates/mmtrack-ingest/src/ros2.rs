@@ -143,6 +143,44 @@ pub struct Ros2Topics {
 }
 
 impl Ros2Topics {
+    /// The topics `mmtrack ingest ros2`'s flags choose (the Python keywords
+    /// are the same words): `--pose-topic` (`none` for no poses),
+    /// `--poses-are-ground-truth`, `--gnss-topic`, `--radar-topic` with
+    /// `--radar-range-resolution-m` and the sweep timing.
+    ///
+    /// # Errors
+    /// A radar topic without its range resolution, or a resolution that is
+    /// not a positive number of metres.
+    pub fn from_flags(
+        pose_topic: &str,
+        poses_are_ground_truth: bool,
+        gnss_topic: Option<String>,
+        radar_topic: Option<String>,
+        radar_range_resolution_m: Option<f64>,
+        timing: SweepTiming,
+    ) -> Result<Self, String> {
+        let radar = match (radar_topic, radar_range_resolution_m) {
+            (Some(topic), Some(r)) => Some(RadarTopic {
+                topic,
+                range_resolution_m: crate::flags::positive_metres("--radar-range-resolution-m", r)?,
+                timing,
+            }),
+            (Some(topic), None) => {
+                return Err(format!(
+                    "--radar-topic {topic}: give --radar-range-resolution-m (the images do not carry it; CTS350-X: \
+                     0.0438, CIR204-H: 0.0596)"
+                ));
+            }
+            (None, _) => None,
+        };
+        Ok(Self {
+            pose_topic: (pose_topic != "none").then(|| pose_topic.to_string()),
+            pose_stream: if poses_are_ground_truth { PoseStream::GroundTruth } else { PoseStream::Estimate },
+            gnss_topic,
+            radar,
+        })
+    }
+
     /// Each chosen topic with its role and the message types that role takes.
     fn roles(&self) -> impl Iterator<Item = (&'static str, &str, &'static [&'static str])> {
         [

@@ -101,6 +101,17 @@ def test_ingest_and_process_write_what_the_cli_writes(demo: dict[str, Path]) -> 
         assert ours.equals(theirs), table
 
 
+def test_ingest_ros2_writes_what_the_cli_writes(tmp_path: Path) -> None:
+    bag = realdata("ros2-mcap") / "nav2_turtlebot.mcap"
+    cli("ingest", "ros2", bag, "-o", tmp_path / "cli.mcap", "--pose-topic", "/amcl_pose", "-q")
+    done = mmtrack.ingest("ros2", bag, tmp_path / "py.mcap", pose_topic="/amcl_pose")
+    assert done["poses"] > 0 and done["radar_scans"] == 0
+    assert (tmp_path / "py.mcap").read_bytes() == (tmp_path / "cli.mcap").read_bytes()
+    # A radar topic needs its range resolution (the images do not carry it).
+    with pytest.raises(mmtrack.MmtrackError, match="give --radar-range-resolution-m"):
+        mmtrack.ingest("ros2", bag, tmp_path / "radar.mcap", radar_topic="/radar")
+
+
 def test_tables_are_lazy_frames_with_units_time_base_and_frame(demo: dict[str, Path]) -> None:
     all_tables = mmtrack.tables(demo["tables"])
     assert sorted(all_tables) == ["ground_truth", "odometry", "odometry_timing"]

@@ -25,6 +25,15 @@ INGEST_OPTIONS: dict[str, dict[str, Any]] = {
     "cir": {"format": None, "sidecar": None},
     "nmea": {"add_to": None},
     "beams": {"format": "deepsense", "scenario": None, "positions": "auto", "sweep_period_s": 0.1},
+    "ros2": {
+        "pose_topic": "/odom",
+        "poses_are_ground_truth": False,
+        "gnss_topic": None,
+        "radar_topic": None,
+        "radar_range_resolution_m": None,
+        "stamp_at": "end",
+        "scan_period_s": 0.25,
+    },
 }
 
 #: Options of each ``process`` pipeline and their defaults.
@@ -107,7 +116,7 @@ def ingest(
 ) -> Any:
     """``mmtrack ingest <kind> <input> -o <output>``: a raw dataset into a canonical recording.
 
-    ``kind``: oxford, boreas, mulran, cir, nmea or beams; ``options`` are the
+    ``kind``: oxford, boreas, mulran, cir, nmea, ros2 or beams; ``options`` are the
     kind's own flags (:data:`INGEST_OPTIONS`), e.g. ``bins="auto"`` for
     oxford, ``format="npy", sidecar="cir.toml"`` for cir. Returns the
     recording written (path, bytes, message counts and the kind's counts);
@@ -144,6 +153,19 @@ def ingest(
         return _native.ingest_cir(i, out, flags, o["format"], _path(o["sidecar"]))
     if kind == "nmea":
         return _native.ingest_nmea(i, out, flags, _path(o["add_to"]))
+    if kind == "ros2":
+        return _native.ingest_ros2(
+            i,
+            out,
+            flags,
+            o["pose_topic"],
+            o["poses_are_ground_truth"],
+            o["gnss_topic"],
+            o["radar_topic"],
+            o["radar_range_resolution_m"],
+            o["stamp_at"],
+            o["scan_period_s"],
+        )
     if o["format"] != "deepsense":
         raise _native.MmtrackError(f"--format '{o['format']}': expected deepsense")
     return _native.ingest_beams(i, out, flags, o["scenario"], o["positions"], o["sweep_period_s"])

@@ -40,6 +40,18 @@ def ingest_cir(
     input: str, output: str, flags: dict[str, Any], format: str, sidecar: Optional[str]
 ) -> dict[str, Any]: ...
 def ingest_nmea(input: str, output: str, flags: dict[str, Any], add_to: Optional[str]) -> dict[str, Any]: ...
+def ingest_ros2(
+    input: str,
+    output: str,
+    flags: dict[str, Any],
+    pose_topic: str,
+    poses_are_ground_truth: bool,
+    gnss_topic: Optional[str],
+    radar_topic: Optional[str],
+    radar_range_resolution_m: Optional[float],
+    stamp_at: str,
+    scan_period_s: float,
+) -> dict[str, Any]: ...
 def ingest_beams(
     input: str,
     output: str,

@@ -185,6 +185,53 @@ pub(super) fn ingest_nmea<'py>(
     )
 }
 
+/// `mmtrack ingest ros2`.
+#[pyfunction]
+#[pyo3(signature = (
+    input, output, flags, pose_topic, poses_are_ground_truth, gnss_topic, radar_topic, radar_range_resolution_m,
+    stamp_at, scan_period_s
+))]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn ingest_ros2<'py>(
+    py: Python<'py>,
+    input: PathBuf,
+    output: PathBuf,
+    flags: &Bound<'py, PyDict>,
+    pose_topic: String,
+    poses_are_ground_truth: bool,
+    gnss_topic: Option<String>,
+    radar_topic: Option<String>,
+    radar_range_resolution_m: Option<f64>,
+    stamp_at: String,
+    scan_period_s: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mmtrack_ingest::ros2::{Ros2Topics, ingest_ros2};
+    let flags = recording_flags(flags)?;
+    let report = run(py, 0, || {
+        let timing = mmtrack_ingest::flags::sweep_timing(&stamp_at, scan_period_s).map_err(msg)?;
+        let topics = Ros2Topics::from_flags(
+            &pose_topic,
+            poses_are_ground_truth,
+            gnss_topic,
+            radar_topic,
+            radar_range_resolution_m,
+            timing,
+        )
+        .map_err(msg)?;
+        Ok(ingest_ros2(&input, &output, &topics, &options_of(&flags)?, &mut |_, _| {})?)
+    })?;
+    recording_written(
+        py,
+        &report.output,
+        &[
+            ("poses", report.poses),
+            ("gnss_fixes", report.gnss_fixes),
+            ("no_fix", report.no_fix),
+            ("radar_scans", report.radar_scans),
+        ],
+    )
+}
+
 /// `mmtrack ingest beams --format deepsense`.
 #[pyfunction]
 #[pyo3(signature = (input, output, flags, scenario, positions, sweep_period_s))]
