@@ -413,7 +413,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             };
             allow_in_place(add_to.as_deref(), &mut output);
             let stream = if estimate { PoseStream::Estimate } else { PoseStream::GroundTruth };
-            let source = format!("{}:{}", format.name(), input.display());
+            let source = format!("{}:{}", format.name(), mmtrack_io::paths::canonical(&input));
             let summary = poses::write_poses(
                 &trajectory,
                 stream,

@@ -334,7 +334,7 @@ fn metadata(bag: &Path, topics: &Ros2Topics, first_stamp_ns: Option<i64>) -> Rec
     }
     RecordingMetadata {
         sequence_id: bag.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bag".into()),
-        source: format!("ros2:{}", bag.display()),
+        source: format!("ros2:{}", mmtrack_io::paths::canonical(bag)),
         time_base,
         extra,
     }

@@ -16,6 +16,7 @@
 
 pub mod atomic;
 mod error;
+pub mod paths;
 mod png_gray;
 pub mod proto;
 pub mod recording;

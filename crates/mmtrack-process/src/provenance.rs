@@ -32,12 +32,7 @@ pub struct InputFile {
     pub crc32: String,
 }
 
-/// The canonical absolute form of `path` as text; `path` as given when it
-/// cannot be resolved (a missing file: the reader reports that itself).
-#[must_use]
-pub fn canonical(path: &Path) -> String {
-    std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()).display().to_string()
-}
+pub use mmtrack_io::paths::canonical;
 
 /// The path, size and CRC-32 of the file at `path`, read once in 1 MiB
 /// blocks.

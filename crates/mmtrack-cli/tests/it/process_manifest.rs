@@ -136,6 +136,48 @@ fn the_same_command_from_two_working_directories_gives_identical_tables() {
     assert_eq!(input["crc32"], format!("{:08x}", crc32_ieee(&bytes)), "{config}");
 }
 
+/// Issue 27: recordings name their sources by canonical absolute path, so
+/// ingesting (and simulating) the same input from two working directories,
+/// one through `..`, writes byte-identical recordings.
+#[test]
+fn ingest_and_simulate_from_two_working_directories_give_identical_recordings() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let fixture = super::common::root().join("data/demo/oxford-demo");
+    std::fs::create_dir(d.join("in")).unwrap();
+    copy_dir(&fixture, &d.join("in/oxford"));
+    std::fs::copy(super::common::root().join("data/demo/fixture-scenario.toml"), d.join("in/s.toml")).unwrap();
+    std::fs::create_dir(d.join("elsewhere")).unwrap();
+    let here = d.join("elsewhere");
+    for (cwd, prefix, out) in [(d, "in", "a"), (here.as_path(), "../elsewhere/../in", "../b")] {
+        std::fs::create_dir_all(cwd.join(out)).unwrap();
+        let input = format!("{prefix}/oxford");
+        ok(cwd, &["ingest", "oxford", &input, "-o", &format!("{out}/o.mcap"), "--bins", "auto", "-q"]);
+        let scenario = format!("{prefix}/s.toml");
+        ok(cwd, &["simulate", "radar", "--scenario", &scenario, "-o", &format!("{out}/r.mcap"), "-q"]);
+    }
+    for name in ["o.mcap", "r.mcap"] {
+        let (a, b) = (std::fs::read(d.join("a").join(name)).unwrap(), std::fs::read(d.join("b").join(name)).unwrap());
+        assert!(a == b, "{name} differs between the two working directories");
+    }
+    let text = String::from_utf8_lossy(&std::fs::read(d.join("a/o.mcap")).unwrap()).into_owned();
+    let canonical = d.join("in/oxford").canonicalize().unwrap();
+    assert!(text.contains(&format!("oxford:{}", canonical.display())), "the source is not the canonical path");
+}
+
+fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
+
 /// CRC-32 (IEEE 802.3, reflected, polynomial 0xEDB88320) bit by bit: the
 /// zlib checksum, computed independently of `crc32fast`.
 fn crc32_ieee(bytes: &[u8]) -> u32 {

@@ -519,7 +519,7 @@ fn write_pass(
     ]);
     let metadata = RecordingMetadata {
         sequence_id: sequence_id.to_string(),
-        source: format!("deepsense:{}", folder.display()),
+        source: format!("deepsense:{}", mmtrack_io::paths::canonical(folder)),
         time_base: TimeBase::Relative,
         extra,
     };

@@ -230,7 +230,7 @@ pub fn ingest_boreas(
         Some((path, sensor)) => {
             let text = crate::error::read_text(path)?;
             let parsed = applanix::parse_applanix_poses(path, &text)?;
-            extra.insert("ground_truth.source".into(), path.display().to_string());
+            extra.insert("ground_truth.source".into(), mmtrack_io::paths::canonical(path));
             extra.insert("ground_truth.frame".into(), sensor.clone());
             extra.insert("ground_truth.origin_frame".into(), parsed.position_frame.into());
             for (axis, value) in ["east", "north", "up"].iter().zip(parsed.origin) {
@@ -242,7 +242,7 @@ pub fn ingest_boreas(
     };
     let fixes = match &folder.gps {
         Some(path) => {
-            extra.insert("gnss.source".into(), path.display().to_string());
+            extra.insert("gnss.source".into(), mmtrack_io::paths::canonical(path));
             extra.insert("gnss.kind".into(), "Applanix post-processed GNSS/INS solution (200 Hz)".into());
             gps::read_boreas_gps(path)?
         }
@@ -260,7 +260,7 @@ pub fn ingest_boreas(
     let fixes = within_scan_span(&folder.scans, "fixes", &gps_source, &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
-        source: format!("boreas:{}", folder.root.display()),
+        source: format!("boreas:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,
     };

@@ -8,7 +8,7 @@
 //! time origin.
 
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use mmtrack_core::CirSnapshot;
 use mmtrack_io::RecordingOptions;
@@ -102,7 +102,7 @@ pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSideca
     let mut metadata = BTreeMap::new();
     metadata.insert("cir.format".to_string(), format.name().to_string());
     let sidecar_name =
-        if sidecar.path.as_os_str().is_empty() { "none".into() } else { sidecar.path.display().to_string() };
+        if sidecar.path.as_os_str().is_empty() { "none".into() } else { mmtrack_io::paths::canonical(&sidecar.path) };
     metadata.insert("cir.sidecar".into(), sidecar_name);
     let domain = match sidecar.domain {
         Domain::Cir => "cir: the file holds impulse responses".to_string(),
@@ -256,7 +256,7 @@ pub fn ingest_cir(
         return Err(IngestError::BadLayout { path: input.to_path_buf(), detail: "holds no CIR snapshots".into() });
     };
     let tap_spacing_s = first.tap_spacing_s;
-    let source = format!("cir-{}:{}", format.name(), absolute(input).display());
+    let source = format!("cir-{}:{}", format.name(), mmtrack_io::paths::canonical(input));
     let mut writer = crate::target::open_writer(
         out,
         None,
@@ -282,8 +282,4 @@ pub fn ingest_cir(
         skipped: file.skipped,
         metadata: file.metadata,
     })
-}
-
-fn absolute(path: &Path) -> PathBuf {
-    std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
 }

@@ -202,7 +202,7 @@ fn metadata(
     let Some(path) = &folder.global_pose else { return Ok((extra, Vec::new())) };
     let text = crate::error::read_text(path)?;
     let parsed = global_pose::parse_global_pose(path, &text)?;
-    extra.insert("ground_truth.source".into(), path.display().to_string());
+    extra.insert("ground_truth.source".into(), mmtrack_io::paths::canonical(path));
     extra.insert("ground_truth.frame".into(), "vehicle".into());
     for (axis, value) in ["x", "y", "z"].iter().zip(parsed.origin) {
         extra.insert(format!("ground_truth.origin_{axis}_m"), value.to_string());
@@ -221,7 +221,7 @@ pub fn ingest_mulran(
     let (mut extra, truth) = metadata(folder, options)?;
     let fixes = match &folder.gps {
         Some(path) => {
-            extra.insert("gnss.source".into(), path.display().to_string());
+            extra.insert("gnss.source".into(), mmtrack_io::paths::canonical(path));
             gps::read_mulran_gps(path)?
         }
         None => Vec::new(),
@@ -232,7 +232,7 @@ pub fn ingest_mulran(
     let fixes = within_scan_span(&folder.scans, "fixes", &source(&folder.gps), &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
-        source: format!("mulran:{}", folder.root.display()),
+        source: format!("mulran:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,
     };

@@ -332,7 +332,7 @@ pub fn ingest_nmea(
         datum => datum,
     };
     let mut extra = std::collections::BTreeMap::from([
-        ("gnss.source".to_string(), format!("nmea:{}", input.display())),
+        ("gnss.source".to_string(), format!("nmea:{}", mmtrack_io::paths::canonical(input))),
         ("gnss.altitude_datum".to_string(), altitude_datum.to_string()),
         ("gnss.enu_origin_latitude_deg".to_string(), first.latitude_deg.to_string()),
         ("gnss.enu_origin_longitude_deg".to_string(), first.longitude_deg.to_string()),
@@ -340,7 +340,7 @@ pub fn ingest_nmea(
     if let Some(altitude_m) = log.fixes.iter().find_map(|fix| fix.altitude_m) {
         extra.insert("gnss.enu_origin_altitude_m".to_string(), altitude_m.to_string());
     }
-    let source = format!("nmea:{}", input.display());
+    let source = format!("nmea:{}", mmtrack_io::paths::canonical(input));
     let mut writer = crate::target::open_writer(
         out,
         extend,

@@ -192,12 +192,12 @@ struct Auxiliary {
 fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -> Result<Auxiliary, IngestError> {
     let mut aux = Auxiliary { ground_truth: Vec::new(), fixes: Vec::new(), ins_used_as: None, ins_rows_not_good: 0 };
     if let Some(path) = &folder.ground_truth {
-        extra.insert("ground_truth.source".into(), path.display().to_string());
+        extra.insert("ground_truth.source".into(), mmtrack_io::paths::canonical(path));
         extra.insert("ground_truth.frame".into(), "radar".into());
         aux.ground_truth = odometry::read_radar_odometry(path)?;
     }
     if let Some(path) = &folder.gps {
-        extra.insert("gnss.source".into(), path.display().to_string());
+        extra.insert("gnss.source".into(), mmtrack_io::paths::canonical(path));
         extra.insert("gnss.altitude_datum".into(), "as in the Oxford gps.csv (NovAtel)".into());
         aux.fixes = gps::read_gps_csv(path)?.into_iter().map(|row| row.fix).collect();
     }
@@ -205,7 +205,7 @@ fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -
     let solution = ins::read_ins_csv(path)?;
     let mut used = Vec::new();
     if folder.ground_truth.is_none() {
-        extra.insert("ground_truth.source".into(), path.display().to_string());
+        extra.insert("ground_truth.source".into(), mmtrack_io::paths::canonical(path));
         extra.insert("ground_truth.frame".into(), "ins (local east-north frame about the origin)".into());
         for (axis, value) in ["east", "north", "up"].iter().zip(solution.origin) {
             extra.insert(format!("ground_truth.origin_{axis}_m"), value.to_string());
@@ -215,7 +215,7 @@ fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -
         used.push("ground truth");
     }
     if folder.gps.is_none() {
-        extra.insert("gnss.source".into(), path.display().to_string());
+        extra.insert("gnss.source".into(), mmtrack_io::paths::canonical(path));
         extra.insert("gnss.altitude_datum".into(), "as in the Oxford ins.csv (NovAtel)".into());
         aux.fixes = solution.fixes;
         used.push("GNSS fixes");
@@ -225,7 +225,7 @@ fn read_auxiliary(folder: &OxfordFolder, extra: &mut BTreeMap<String, String>) -
     } else {
         used.join(" and ")
     };
-    extra.insert("ins.source".into(), path.display().to_string());
+    extra.insert("ins.source".into(), mmtrack_io::paths::canonical(path));
     extra.insert("ins.used_as".into(), used_as.clone());
     aux.ins_used_as = Some(used_as);
     aux.ins_rows_not_good = solution.skipped_not_good;
@@ -255,7 +255,7 @@ pub fn ingest_oxford(
     let fixes_in_span = within_scan_span(&folder.scans, "fixes", &source("gnss.source"), &aux.fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
         sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
-        source: format!("oxford:{}", folder.root.display()),
+        source: format!("oxford:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,
     };

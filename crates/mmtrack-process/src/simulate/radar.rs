@@ -206,11 +206,11 @@ fn write_recording(
 ) -> anyhow::Result<()> {
     let mut extra = std::collections::BTreeMap::from([
         ("simulator.seed".to_string(), scenario.seed.to_string()),
-        ("simulator.scenario".to_string(), sim.scenario.display().to_string()),
+        ("simulator.scenario".to_string(), mmtrack_io::paths::canonical(&sim.scenario)),
         ("radar.model".to_string(), "simulated Navtech CTS350-X-like".to_string()),
     ]);
     if let Some(t) = &sim.trajectory {
-        extra.insert("simulator.trajectory".to_string(), t.path.display().to_string());
+        extra.insert("simulator.trajectory".to_string(), mmtrack_io::paths::canonical(&t.path));
     }
     // Scan times are the trajectory's: a real drive's UNIX times when
     // `--trajectory` brings one, else the scenario's clock from its stated
@@ -228,7 +228,7 @@ fn write_recording(
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "simulated".into()),
-        source: format!("simulate:{}", sim.scenario.display()),
+        source: format!("simulate:{}", mmtrack_io::paths::canonical(&sim.scenario)),
         time_base,
         extra,
     };

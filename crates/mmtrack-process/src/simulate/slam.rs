@@ -59,7 +59,7 @@ pub fn load_slam_scenario(path: &Path) -> anyhow::Result<SlamScenario> {
 }
 
 fn metadata(args: &SlamSimulation, scenario: &SlamScenario) -> anyhow::Result<RecordingMetadata> {
-    let source = args.scenario.as_ref().map_or_else(|| "paper".to_string(), |p| p.display().to_string());
+    let source = args.scenario.as_ref().map_or_else(|| "paper".to_string(), |p| mmtrack_io::paths::canonical(p));
     let extra = BTreeMap::from([
         (SEED_KEY.to_string(), args.seed.to_string()),
         ("simulator.scenario".to_string(), source.clone()),

@@ -50,14 +50,14 @@ fn sounder_metadata(extra: &mut BTreeMap<String, String>, sounder: &SounderConfi
 fn metadata(args: &SounderSimulation, seed: u64, extra: BTreeMap<String, String>) -> RecordingMetadata {
     let mut extra = extra;
     extra.insert("simulator.seed".into(), seed.to_string());
-    extra.insert("simulator.scenario".into(), args.scenario.display().to_string());
+    extra.insert("simulator.scenario".into(), mmtrack_io::paths::canonical(&args.scenario));
     RecordingMetadata {
         sequence_id: args
             .output
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "simulated".into()),
-        source: format!("simulate:{}", args.scenario.display()),
+        source: format!("simulate:{}", mmtrack_io::paths::canonical(&args.scenario)),
         time_base: TimeBase::ScenarioStart,
         extra,
     }
