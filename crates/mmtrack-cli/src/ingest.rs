@@ -3,7 +3,6 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::Context;
 use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_ingest::beams::{DeepsenseOptions, VehiclePositions};
 use mmtrack_ingest::boreas::BoreasOptions;
@@ -107,20 +106,12 @@ pub enum PoseFormat {
 impl PoseFormat {
     /// The library's trajectory format.
     #[must_use]
-    pub fn trajectory_format(self) -> mmtrack_process::simulate::radar::TrajectoryFormat {
-        use mmtrack_process::simulate::radar::TrajectoryFormat;
+    pub fn trajectory_format(self) -> mmtrack_ingest::poses::TrajectoryFormat {
+        use mmtrack_ingest::poses::TrajectoryFormat;
         match self {
             Self::Tum => TrajectoryFormat::Tum,
             Self::Kitti => TrajectoryFormat::Kitti,
             Self::Oxford => TrajectoryFormat::Oxford,
-        }
-    }
-
-    pub(crate) fn name(self) -> &'static str {
-        match self {
-            Self::Tum => "tum",
-            Self::Kitti => "kitti",
-            Self::Oxford => "oxford",
         }
     }
 }
@@ -401,29 +392,19 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 PlaneArg::Xy => Plane::Xy,
                 PlaneArg::XzCamera => Plane::XzCamera,
             };
-            let text = poses::read_text(&input)?;
-            let trajectory = match format {
-                PoseFormat::Tum => poses::parse_tum(&input, &text, plane)?,
-                PoseFormat::Kitti => {
-                    let times_path = times.context("KITTI pose files carry no time: give --times <times.txt>")?;
-                    let times = poses::parse_times(&times_path, &poses::read_text(&times_path)?, t0_ns)?;
-                    poses::parse_kitti(&input, &text, &times, plane)?
-                }
-                PoseFormat::Oxford => oxford::odometry::read_radar_odometry(&input)?,
+            let file = poses::PoseFile {
+                path: &input,
+                format: format.trajectory_format(),
+                times: times.as_deref(),
+                t0_ns,
+                plane,
             };
             allow_in_place(add_to.as_deref(), &mut output);
             let stream = if estimate { PoseStream::Estimate } else { PoseStream::GroundTruth };
-            let source = format!("{}:{}", format.name(), mmtrack_io::paths::canonical(&input));
-            let summary = poses::write_poses(
-                &trajectory,
-                stream,
-                &source,
-                add_to.as_deref(),
-                &output.output,
-                &output.recording_options()?,
-            )?;
+            let (summary, count) =
+                poses::ingest_poses(&file, stream, add_to.as_deref(), &output.output, &output.recording_options()?)?;
             if !quiet {
-                println!("{}: {} poses on {}", summary.path.display(), trajectory.len(), stream.topic());
+                println!("{}: {count} poses on {}", summary.path.display(), stream.topic());
             }
             Ok(ExitCode::SUCCESS)
         }

@@ -64,6 +64,17 @@ impl Plane {
             Self::XzCamera => "xz-camera",
         }
     }
+
+    /// The plane a `--plane` value names.
+    ///
+    /// # Errors
+    /// Another value (the message lists the values).
+    pub fn parse(flag: &str) -> Result<Self, String> {
+        [Self::Xy, Self::XzCamera]
+            .into_iter()
+            .find(|p| p.flag() == flag)
+            .ok_or_else(|| format!("--plane '{flag}': expected xy or xz-camera"))
+    }
 }
 
 /// How far from 1 the norm of an orientation quaternion may be: printing a
@@ -331,6 +342,69 @@ pub fn parse_kitti(path: &Path, text: &str, times_ns: &[i64], plane: Plane) -> R
     Ok(poses)
 }
 
+/// A trajectory file's format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrajectoryFormat {
+    /// Oxford `gt/radar_odometry.csv` (relative poses, chained).
+    Oxford,
+    /// TUM: `t x y z qx qy qz qw` per line.
+    Tum,
+    /// KITTI: 3x4 matrices per line, times from a separate file.
+    Kitti,
+}
+
+impl TrajectoryFormat {
+    /// The name on the command line (`--format`, `--trajectory-format`).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Oxford => "oxford",
+            Self::Tum => "tum",
+            Self::Kitti => "kitti",
+        }
+    }
+
+    /// The format of a name, as [`TrajectoryFormat::name`] writes it.
+    ///
+    /// # Errors
+    /// Another name (the message lists the names).
+    pub fn parse(name: &str) -> Result<Self, String> {
+        [Self::Oxford, Self::Tum, Self::Kitti]
+            .into_iter()
+            .find(|f| f.name() == name)
+            .ok_or_else(|| format!("'{name}': expected oxford, tum or kitti"))
+    }
+}
+
+/// Reads a trajectory file as `world_from_vehicle` poses: TUM and KITTI in
+/// the ground `plane`, Oxford's chained relative poses; KITTI's times from
+/// `times` (decimal seconds per line) plus `t0_ns`.
+///
+/// # Errors
+/// The file (or KITTI's times file, or its absence) cannot be read or parsed.
+pub fn read_trajectory(
+    path: &Path,
+    format: TrajectoryFormat,
+    times: Option<&Path>,
+    t0_ns: i64,
+    plane: Plane,
+) -> Result<Vec<StampedPose>, IngestError> {
+    match format {
+        TrajectoryFormat::Oxford => crate::oxford::odometry::read_radar_odometry(path),
+        TrajectoryFormat::Tum => parse_tum(path, &read_text(path)?, plane),
+        TrajectoryFormat::Kitti => {
+            let Some(times_path) = times else {
+                return Err(IngestError::BadLayout {
+                    path: path.to_path_buf(),
+                    detail: "KITTI pose files carry no time: give --times <times.txt>".into(),
+                });
+            };
+            let times = parse_times(times_path, &read_text(times_path)?, t0_ns)?;
+            parse_kitti(path, &read_text(path)?, &times, plane)
+        }
+    }
+}
+
 /// Reads a file as text.
 pub fn read_text(path: &Path) -> Result<String, IngestError> {
     crate::error::read_text(path)
@@ -360,6 +434,41 @@ pub fn write_poses(
         writer.write_pose(stream, pose, "world")?;
     }
     Ok(writer.finish()?)
+}
+
+/// A trajectory file to ingest (`mmtrack ingest poses`).
+#[derive(Debug, Clone)]
+pub struct PoseFile<'a> {
+    /// The file.
+    pub path: &'a Path,
+    /// Its format.
+    pub format: TrajectoryFormat,
+    /// KITTI: the times file and the nanoseconds added to each time.
+    pub times: Option<&'a Path>,
+    /// KITTI: nanoseconds added to every time of `times`.
+    pub t0_ns: i64,
+    /// The ground plane.
+    pub plane: Plane,
+}
+
+/// `mmtrack ingest poses`: reads `file` and writes its poses as `stream`
+/// into `out` (a new recording, or a copy of `extend` plus the poses), the
+/// source named by its canonical path. Returns the recording and the
+/// number of poses.
+///
+/// # Errors
+/// The file cannot be read or parsed, or the recording cannot be written.
+pub fn ingest_poses(
+    file: &PoseFile<'_>,
+    stream: PoseStream,
+    extend: Option<&Path>,
+    out: &Path,
+    recording: &RecordingOptions,
+) -> Result<(WriteSummary, usize), IngestError> {
+    let trajectory = read_trajectory(file.path, file.format, file.times, file.t0_ns, file.plane)?;
+    let source = format!("{}:{}", file.format.name(), mmtrack_io::paths::canonical(file.path));
+    let summary = write_poses(&trajectory, stream, &source, extend, out, recording)?;
+    Ok((summary, trajectory.len()))
 }
 
 #[cfg(test)]

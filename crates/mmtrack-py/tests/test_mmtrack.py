@@ -112,6 +112,27 @@ def test_ingest_ros2_writes_what_the_cli_writes(tmp_path: Path) -> None:
         mmtrack.ingest("ros2", bag, tmp_path / "radar.mcap", radar_topic="/radar")
 
 
+def test_ingest_poses_writes_what_the_cli_writes(tmp_path: Path) -> None:
+    tum = tmp_path / "gt.tum"
+    tum.write_text("".join(f"{1.7e9 + 0.25 * k:.2f} {2.0 * k} {0.1 * k} 0 0 0 0 1\n" for k in range(12)))
+    # The sequence id is the output's file name: the same name in two folders.
+    (tmp_path / "cli").mkdir()
+    (tmp_path / "py").mkdir()
+    cli("ingest", "poses", tum, "--format", "tum", "-o", tmp_path / "cli/gt.mcap", "-q")
+    done = mmtrack.ingest("poses", tum, tmp_path / "py/gt.mcap", format="tum")
+    assert done["poses"] == 12
+    assert (tmp_path / "py/gt.mcap").read_bytes() == (tmp_path / "cli/gt.mcap").read_bytes()
+    # Added to a copy of a recording as an estimate, as the CLI does.
+    cli("ingest", "poses", tum, "--format", "tum", "--estimate", "--add-to", tmp_path / "cli/gt.mcap",
+        "-o", tmp_path / "cli/est.mcap", "-q")
+    mmtrack.ingest("poses", tum, tmp_path / "py/est.mcap", format="tum", estimate=True, add_to=tmp_path / "py/gt.mcap")
+    assert (tmp_path / "py/est.mcap").read_bytes() == (tmp_path / "cli/est.mcap").read_bytes()
+    with pytest.raises(mmtrack.MmtrackError, match="expected oxford, tum or kitti"):
+        mmtrack.ingest("poses", tum, tmp_path / "x.mcap", format="evo")
+    with pytest.raises(mmtrack.MmtrackError, match="give --times"):
+        mmtrack.ingest("poses", tum, tmp_path / "x.mcap", format="kitti")
+
+
 def test_tables_are_lazy_frames_with_units_time_base_and_frame(demo: dict[str, Path]) -> None:
     all_tables = mmtrack.tables(demo["tables"])
     assert sorted(all_tables) == ["ground_truth", "odometry", "odometry_timing"]

@@ -75,12 +75,8 @@ impl ExperimentRequest {
     }
 
     fn trajectory(&self) -> anyhow::Result<(PathBuf, TrajectoryFormat)> {
-        let format = match self.trajectory_format.as_deref().unwrap_or("oxford") {
-            "oxford" => TrajectoryFormat::Oxford,
-            "tum" => TrajectoryFormat::Tum,
-            "kitti" => TrajectoryFormat::Kitti,
-            other => bail!("--trajectory-format '{other}': expected oxford, tum or kitti"),
-        };
+        let format = TrajectoryFormat::parse(self.trajectory_format.as_deref().unwrap_or("oxford"))
+            .map_err(|e| anyhow::anyhow!("--trajectory-format {e}"))?;
         Ok((self.trajectory.clone().unwrap_or_else(|| PathBuf::from(DEFAULT_TRAJECTORY)), format))
     }
 }

@@ -47,7 +47,7 @@ pub fn run(args: &OdometryArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let request = ExperimentRequest {
         scenario: args.scenario.clone(),
         trajectory: Some(args.trajectory.clone()),
-        trajectory_format: Some(args.trajectory_format.name().to_string()),
+        trajectory_format: Some(args.trajectory_format.trajectory_format().name().to_string()),
         max_distance_m: args.max_distance_m,
         ..args.common.request()
     };

@@ -61,7 +61,7 @@ pub fn run(args: &SpebtArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         readme: args.monte_carlo.readme.clone(),
         experiment_file: args.experiment.clone(),
         trajectory: Some(args.trajectory.clone()),
-        trajectory_format: Some(args.trajectory_format.name().to_string()),
+        trajectory_format: Some(args.trajectory_format.trajectory_format().name().to_string()),
         skip_odometry: args.skip_odometry,
         ..args.common.request()
     };

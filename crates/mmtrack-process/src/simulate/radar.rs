@@ -12,16 +12,7 @@ use mmtrack_io::recording::{PoseStream, RecordingMetadata, TimeBase};
 use mmtrack_io::{Overwrite, RecordingOptions, RecordingWriter, check_replaceable_dir};
 use mmtrack_sim::radar::{RadarSimulator, Scenario, Trajectory};
 
-/// Trajectory file formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum TrajectoryFormat {
-    /// Oxford `gt/radar_odometry.csv` (relative poses, chained).
-    Oxford,
-    /// TUM: `t x y z qx qy qz qw` per line.
-    Tum,
-    /// KITTI: 3x4 matrices per line, times from a separate file.
-    Kitti,
-}
+pub use mmtrack_ingest::poses::TrajectoryFormat;
 
 /// A trajectory file to drive along.
 #[derive(Debug, Clone)]
@@ -95,7 +86,7 @@ pub fn parse_scenario(text: &str) -> anyhow::Result<Scenario> {
     Ok(scenario)
 }
 
-/// Reads a trajectory file as `world_from_vehicle` poses.
+/// Reads a trajectory file as `world_from_vehicle` poses (ground plane x-y).
 ///
 /// # Errors
 /// The file (or KITTI's times file) cannot be read or parsed.
@@ -105,16 +96,7 @@ pub fn read_trajectory(
     times: Option<&Path>,
     t0_ns: i64,
 ) -> anyhow::Result<Vec<StampedPose>> {
-    let poses = match format {
-        TrajectoryFormat::Oxford => oxford::odometry::read_radar_odometry(path)?,
-        TrajectoryFormat::Tum => poses::parse_tum(path, &poses::read_text(path)?, Plane::Xy)?,
-        TrajectoryFormat::Kitti => {
-            let times_path = times.context("KITTI pose files carry no time: give --times <times.txt>")?;
-            let times = poses::parse_times(times_path, &poses::read_text(times_path)?, t0_ns)?;
-            poses::parse_kitti(path, &poses::read_text(path)?, &times, Plane::Xy)?
-        }
-    };
-    Ok(poses)
+    Ok(poses::read_trajectory(path, format, times, t0_ns, Plane::Xy)?)
 }
 
 /// Streams `simulator`'s scans into an Oxford folder at `dir` (replaced

@@ -25,6 +25,7 @@ INGEST_OPTIONS: dict[str, dict[str, Any]] = {
     "cir": {"format": None, "sidecar": None},
     "nmea": {"add_to": None},
     "beams": {"format": "deepsense", "scenario": None, "positions": "auto", "sweep_period_s": 0.1},
+    "poses": {"format": None, "add_to": None, "estimate": False, "times": None, "t0_ns": 0, "plane": "xy"},
     "ros2": {
         "pose_topic": "/odom",
         "poses_are_ground_truth": False,
@@ -116,7 +117,7 @@ def ingest(
 ) -> Any:
     """``mmtrack ingest <kind> <input> -o <output>``: a raw dataset into a canonical recording.
 
-    ``kind``: oxford, boreas, mulran, cir, nmea, ros2 or beams; ``options`` are the
+    ``kind``: oxford, boreas, mulran, poses, cir, nmea, ros2 or beams; ``options`` are the
     kind's own flags (:data:`INGEST_OPTIONS`), e.g. ``bins="auto"`` for
     oxford, ``format="npy", sidecar="cir.toml"`` for cir. Returns the
     recording written (path, bytes, message counts and the kind's counts);
@@ -153,6 +154,12 @@ def ingest(
         return _native.ingest_cir(i, out, flags, o["format"], _path(o["sidecar"]))
     if kind == "nmea":
         return _native.ingest_nmea(i, out, flags, _path(o["add_to"]))
+    if kind == "poses":
+        if o["format"] is None:
+            raise _native.MmtrackError("ingest poses: give format= (tum, kitti or oxford)")
+        return _native.ingest_poses(
+            i, out, flags, o["format"], _path(o["add_to"]), o["estimate"], _path(o["times"]), o["t0_ns"], o["plane"]
+        )
     if kind == "ros2":
         return _native.ingest_ros2(
             i,

@@ -40,6 +40,17 @@ def ingest_cir(
     input: str, output: str, flags: dict[str, Any], format: str, sidecar: Optional[str]
 ) -> dict[str, Any]: ...
 def ingest_nmea(input: str, output: str, flags: dict[str, Any], add_to: Optional[str]) -> dict[str, Any]: ...
+def ingest_poses(
+    input: str,
+    output: str,
+    flags: dict[str, Any],
+    format: str,
+    add_to: Optional[str],
+    estimate: bool,
+    times: Optional[str],
+    t0_ns: int,
+    plane: str,
+) -> dict[str, Any]: ...
 def ingest_ros2(
     input: str,
     output: str,

@@ -185,6 +185,36 @@ pub(super) fn ingest_nmea<'py>(
     )
 }
 
+/// `mmtrack ingest poses`.
+#[pyfunction]
+#[pyo3(signature = (input, output, flags, format, add_to, estimate, times, t0_ns, plane))]
+#[allow(clippy::too_many_arguments)]
+pub(super) fn ingest_poses<'py>(
+    py: Python<'py>,
+    input: PathBuf,
+    output: PathBuf,
+    flags: &Bound<'py, PyDict>,
+    format: String,
+    add_to: Option<PathBuf>,
+    estimate: bool,
+    times: Option<PathBuf>,
+    t0_ns: i64,
+    plane: String,
+) -> PyResult<Bound<'py, PyDict>> {
+    use mmtrack_ingest::poses::{self, Plane, TrajectoryFormat};
+    use mmtrack_io::recording::PoseStream;
+    let mut flags = recording_flags(flags)?;
+    let (summary, poses) = run(py, 0, || {
+        let format = TrajectoryFormat::parse(&format).map_err(|e| msg(format!("--format {e}")))?;
+        let plane = Plane::parse(&plane).map_err(msg)?;
+        let file = poses::PoseFile { path: &input, format, times: times.as_deref(), t0_ns, plane };
+        flags.force = mmtrack_ingest::flags::replaces_output(add_to.as_deref(), &output, flags.force);
+        let stream = if estimate { PoseStream::Estimate } else { PoseStream::GroundTruth };
+        Ok(poses::ingest_poses(&file, stream, add_to.as_deref(), &output, &options_of(&flags)?)?)
+    })?;
+    recording_written(py, &summary, &[("poses", poses as u64)])
+}
+
 /// `mmtrack ingest ros2`.
 #[pyfunction]
 #[pyo3(signature = (

@@ -116,6 +116,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ingest::ingest_cir, m)?)?;
     m.add_function(wrap_pyfunction!(ingest::ingest_nmea, m)?)?;
     m.add_function(wrap_pyfunction!(ingest::ingest_ros2, m)?)?;
+    m.add_function(wrap_pyfunction!(ingest::ingest_poses, m)?)?;
     m.add_function(wrap_pyfunction!(ingest::ingest_beams, m)?)?;
     m.add_function(wrap_pyfunction!(process::process_odometry, m)?)?;
     m.add_function(wrap_pyfunction!(process::effective_config, m)?)?;
