@@ -51,6 +51,11 @@ pub struct Config {
     pub paper_saving: f64,
     /// Relative tolerance on the saving.
     pub saving_tolerance: f64,
+    /// The saving counts only where the window holds the strongest beam in
+    /// at least this share of its epochs (ours: the paper states no figure;
+    /// a window that misses the strongest beam saves measurements of a
+    /// link it has lost).
+    pub saving_min_window_hit_share: f64,
     /// Wall-time target of the full run, seconds ...
     pub time_target_s: f64,
     /// ... and the runs it applies to.

@@ -54,10 +54,21 @@ pub fn metrics(experiment: &Config, results: &[ManoeuvreResult]) -> Vec<Metric> 
                 Some(experiment.paper_saving),
             ));
         }
+        out.push(Metric::new(format!("{name} window holds the strongest beam"), r.window_hit_rate(0), "1", None));
+        if *name == experiment.convergence_manoeuvre
+            && let Some(m) = quantile_nearest_rank(&r.handovers_full_scan_s, 0.5)
+        {
+            out.push(Metric::new(
+                format!("{name} median hand-over on full scans"),
+                m,
+                "s",
+                Some(experiment.paper_convergence_s),
+            ));
+        }
         if *name == experiment.convergence_manoeuvre
             && let Some(m) = r.handover_quantile(0.5)
         {
-            out.push(Metric::new(format!("{name} median hand-over"), m, "s", Some(experiment.paper_convergence_s)));
+            out.push(Metric::new(format!("{name} median hand-over"), m, "s", None));
         }
     }
     out
@@ -120,37 +131,53 @@ pub fn verdicts(experiment: &Config, results: &[ManoeuvreResult], runs: u64, ela
         );
         out.push(Verdict::decided(claim.informational(), met, measured));
     }
+    // The hand-over is judged on full-scan azimuths: the paper's "three
+    // different azimuth angles" are the car's; the literal schedule's wrong
+    // early beams give distinct azimuths before the car has moved through
+    // them (docs/results/zoechmann.md), so its earlier median is a variant.
     let convergence = results.iter().find(|r| r.manoeuvre.name == experiment.convergence_manoeuvre);
-    let median = convergence.and_then(|r| r.handover_quantile(0.5));
-    let claim = Claim::new(
-        format!(
-            "{}: hand-over to RLS (third distinct azimuth), median within {} s",
-            experiment.convergence_manoeuvre, experiment.convergence_tolerance_s
-        ),
-        "s",
-        Some(experiment.paper_convergence_s),
-        format!("about {} s", experiment.paper_convergence_s),
-        Rule::Within { target: experiment.paper_convergence_s, tolerance: experiment.convergence_tolerance_s },
-    );
-    let measured = match (median, convergence) {
-        (Some(m), Some(r)) => format!(
-            "{m:.2} s (mean {:.2}, p90 {:.2}; {} of {} runs never; full-scan variant: median {})",
+    let handover_claim = |schedule: &str| {
+        Claim::new(
+            format!(
+                "{}: hand-over to RLS (third distinct azimuth) {schedule}, median within {} s",
+                experiment.convergence_manoeuvre, experiment.convergence_tolerance_s
+            ),
+            "s",
+            Some(experiment.paper_convergence_s),
+            format!("about {} s", experiment.paper_convergence_s),
+            Rule::Within { target: experiment.paper_convergence_s, tolerance: experiment.convergence_tolerance_s },
+        )
+    };
+    if let Some(r) = convergence {
+        let full_scan = quantile_nearest_rank(&r.handovers_full_scan_s, 0.5);
+        let note = format!(
+            "{} ({} of {} runs never)",
+            full_scan.map_or("-".into(), |v| format!("{v:.2} s")),
+            r.runs - r.handovers_full_scan_s.len() as u64,
+            r.runs
+        );
+        out.push(Verdict::judged(handover_claim("on full-scan azimuths"), full_scan, note));
+        let literal = r.handover_quantile(0.5);
+        let note = format!(
+            "{} (mean {:.2}, p90 {:.2}; {} of {} runs never): early, from wrong beams' distinct azimuths",
+            literal.map_or("-".into(), |v| format!("{v:.2} s")),
             r.handover_mean().unwrap_or(f64::NAN),
             r.handover_quantile(0.9).unwrap_or(f64::NAN),
             r.runs - r.handovers_s.len() as u64,
             r.runs,
-            quantile_nearest_rank(&r.handovers_full_scan_s, 0.5).map_or("-".into(), |v| format!("{v:.2} s"))
-        ),
-        _ => "-".into(),
-    };
-    out.push(Verdict::judged(claim, median, measured));
+        );
+        out.push(Verdict::judged(handover_claim("on the literal window schedule").informational(), literal, note));
+    }
     for r in results {
         let windowed = r.beams[0].windowed_saving(experiment.scenario.beams);
+        let hit_share = r.window_hit_rate(0);
         let claim = Claim::new(
             format!(
-                "{}: beam-measurement saving per tracked epoch, within {:.0} %",
+                "{}: beam-measurement saving per tracked epoch, within {:.0} %, with the window holding the strongest \
+                 beam in at least {:.0} % of its epochs",
                 r.manoeuvre.name,
-                100.0 * experiment.saving_tolerance
+                100.0 * experiment.saving_tolerance,
+                100.0 * experiment.saving_min_window_hit_share
             ),
             "x",
             Some(experiment.paper_saving),
@@ -169,7 +196,11 @@ pub fn verdicts(experiment: &Config, results: &[ManoeuvreResult], runs: u64, ela
             r.beams[1].saving().map_or("-".into(), |v| format!("{v:.1}")),
             100.0 * r.window_hit_rate(1),
         );
-        out.push(Verdict::judged(claim, windowed, measured));
+        // 128 / 3 holds by construction; the saving is worth it only with the link kept.
+        let holds_beam = hit_share >= experiment.saving_min_window_hit_share;
+        let mut verdict = Verdict::judged(claim, windowed, measured);
+        verdict.met &= holds_beam;
+        out.push(verdict);
     }
     if runs >= experiment.time_target_runs {
         let claim = Claim::new(
