@@ -99,16 +99,13 @@ pub(crate) fn check_plausible(
     })
 }
 
-/// Reads a whole input file, refusing one over `limit` before reading it, and
-/// stopping one byte past the limit where the OS reports no size (a pipe,
-/// `/dev/zero`), so no input makes the reader allocate beyond its limit.
-pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::Limit) -> Result<Vec<u8>, IngestError> {
-    use std::io::Read as _;
-    let max_bytes = limit.max as u64;
-    let too_large = |size: String| IngestError::BadLayout {
-        path: path.to_path_buf(),
-        detail: format!("{size} bytes is too large: expected {}", limit.expected),
-    };
+/// Opens an input file that will be read up to `limit` bytes, refusing a
+/// device (`/dev/zero`) and a file the OS reports over `limit` before reading
+/// anything; the file size with it (`None` for a pipe).
+pub(crate) fn open_capped(
+    path: &std::path::Path,
+    limit: &mmtrack_core::limits::Limit,
+) -> Result<(std::fs::File, u64), IngestError> {
     let file = std::fs::File::open(path).map_err(os_err(path))?;
     let metadata = file.metadata().map_err(os_err(path))?;
     if is_device(&metadata) {
@@ -118,13 +115,30 @@ pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::
         });
     }
     let size = metadata.len();
-    if size > max_bytes {
-        return Err(too_large(size.to_string()));
+    if size > limit.max as u64 {
+        return Err(too_large(path, limit, size.to_string()));
     }
+    Ok((file, size))
+}
+
+fn too_large(path: &std::path::Path, limit: &mmtrack_core::limits::Limit, size: String) -> IngestError {
+    IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: format!("{size} bytes is too large: expected {}", limit.expected),
+    }
+}
+
+/// Reads a whole input file, refusing one over `limit` before reading it, and
+/// stopping one byte past the limit where the OS reports no size (a pipe,
+/// `/dev/zero`), so no input makes the reader allocate beyond its limit.
+pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::Limit) -> Result<Vec<u8>, IngestError> {
+    use std::io::Read as _;
+    let max_bytes = limit.max as u64;
+    let (file, size) = open_capped(path, limit)?;
     let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
     file.take(max_bytes + 1).read_to_end(&mut bytes).map_err(os_err(path))?;
     if bytes.len() as u64 > max_bytes {
-        return Err(too_large(format!("more than {max_bytes}")));
+        return Err(too_large(path, limit, format!("more than {max_bytes}")));
     }
     Ok(bytes)
 }
