@@ -290,4 +290,6 @@ fn analyze_force_interrupted_while_removing_the_old_results_leaves_nothing() {
         }
     }
     println!("{signalled_while_removing} of 16 runs interrupted while the old results were being removed");
+    // 16 of 16 here; the bound only makes sure the window was hit at all.
+    assert!(signalled_while_removing >= 2, "only {signalled_while_removing} runs hit the removal");
 }
