@@ -173,6 +173,35 @@ mod tests {
     use super::*;
     use mmtrack_core::limits::Limit;
 
+    /// Every text reader goes through the capped read (or streams, NMEA):
+    /// `/dev/zero` given as any of them is a one-line error naming it, at once.
+    #[test]
+    fn every_text_reader_refuses_an_endless_device_naming_it() {
+        let zero = std::path::Path::new("/dev/zero");
+        if !zero.exists() {
+            return;
+        }
+        let readers: [(&str, Box<dyn Fn() -> Option<IngestError>>); 10] = [
+            ("oxford gps.csv", Box::new(|| crate::oxford::gps::read_gps_csv(zero).err())),
+            ("oxford ins.csv", Box::new(|| crate::oxford::ins::read_ins_csv(zero).err())),
+            ("oxford radar_odometry.csv", Box::new(|| crate::oxford::odometry::read_radar_odometry(zero).err())),
+            ("boreas gps", Box::new(|| crate::boreas::gps::read_boreas_gps(zero).err())),
+            ("mulran gps.csv", Box::new(|| crate::mulran::gps::read_mulran_gps(zero).err())),
+            ("TUM/KITTI poses", Box::new(|| crate::poses::read_text(zero).err())),
+            ("DecaWave log", Box::new(|| crate::cir::read_decawave_log(zero, &Default::default()).err())),
+            ("CIR CSV", Box::new(|| crate::cir::read_cir_file(crate::cir::CirFormat::Csv, zero, None).err())),
+            ("CIR sidecar", Box::new(|| crate::cir::CirSidecar::read(zero).err())),
+            ("NMEA", Box::new(|| crate::nmea::read_nmea(zero).err())),
+        ];
+        for (reader, read) in readers {
+            let start = std::time::Instant::now();
+            let err = read().map(|e| e.to_string()).unwrap_or_default();
+            assert!(err.starts_with("/dev/zero") && !err.contains('\n'), "{reader}: {err:?}");
+            assert!(err.contains("is a device") || err.contains("longer than 4096 bytes"), "{reader}: {err}");
+            println!("{reader}: {err} ({:.1} ms)", start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+
     /// Before: text inputs were read whole whatever their size; `/dev/zero`
     /// as an input grew without bound.
     #[test]
