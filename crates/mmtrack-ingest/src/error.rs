@@ -181,7 +181,8 @@ mod tests {
         if !zero.exists() {
             return;
         }
-        let readers: [(&str, Box<dyn Fn() -> Option<IngestError>>); 10] = [
+        type Reader = Box<dyn Fn() -> Option<IngestError>>;
+        let readers: [(&str, Reader); 10] = [
             ("oxford gps.csv", Box::new(|| crate::oxford::gps::read_gps_csv(zero).err())),
             ("oxford ins.csv", Box::new(|| crate::oxford::ins::read_ins_csv(zero).err())),
             ("oxford radar_odometry.csv", Box::new(|| crate::oxford::odometry::read_radar_odometry(zero).err())),

@@ -225,7 +225,7 @@ impl<'a> ImageData<'a> {
             self.piece = vec![0; READ_PIECE_BYTES];
         }
         while !self.ended && self.left_in_chunk == 0 {
-            self.ended = !self.to_next_chunk()?;
+            self.ended = !self.next_chunk()?;
         }
         if self.ended {
             return Ok(None);
@@ -236,7 +236,7 @@ impl<'a> ImageData<'a> {
         self.read += n as u64;
         let mut last = false;
         while !self.ended && self.left_in_chunk == 0 {
-            self.ended = !self.to_next_chunk()?;
+            self.ended = !self.next_chunk()?;
             last = self.ended;
         }
         Ok(Some((&self.piece[..n], last)))
@@ -245,7 +245,7 @@ impl<'a> ImageData<'a> {
     /// Moves to the data of the next IDAT chunk of the run (skipping the
     /// chunks before the run and the current chunk's CRC); false at the end
     /// of the run.
-    fn to_next_chunk(&mut self) -> std::io::Result<bool> {
+    fn next_chunk(&mut self) -> std::io::Result<bool> {
         if self.started {
             self.input.seek_relative(4)?; // the CRC
         } else if !self.after_signature {
@@ -277,7 +277,7 @@ impl<'a> ImageData<'a> {
             rest += self.left_in_chunk;
             self.input.seek_relative(i64::try_from(self.left_in_chunk).unwrap_or(i64::MAX))?;
             self.left_in_chunk = 0;
-            self.ended = !self.to_next_chunk()?;
+            self.ended = !self.next_chunk()?;
         }
         Ok(rest)
     }
