@@ -418,7 +418,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             )?;
             let log = &report.log;
             if !quiet {
-                let without_altitude = log.fixes.iter().filter(|fix| fix.altitude_m.is_none()).count();
+                let without_altitude = log.fixes_without_altitude;
                 let partial = if without_altitude > 0 {
                     format!(" ({} from RMC alone, {without_altitude} without altitude)", log.rmc_only_fixes)
                 } else {
@@ -445,7 +445,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 println!(
                     "{}: {} GNSS fixes{partial}; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix{out_of_order}{leap_seconds}; {} other sentences ignored",
                     report.output.path.display(),
-                    log.fixes.len(),
+                    log.fix_count,
                     log.bad_checksum_lines,
                     log.first_bad_checksum_line.map(|l| format!(" (first at line {l})")).unwrap_or_default(),
                     log.unparsable_lines,

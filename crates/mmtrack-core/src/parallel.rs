@@ -33,6 +33,34 @@ pub fn map_in_order<I, U, E>(
     items: I,
     per_thread: usize,
     map: impl Fn(I::Item) -> U + Sync,
+    consume: impl FnMut(U) -> Result<(), E> + Send,
+) -> Result<(), E>
+where
+    I: Iterator + Send,
+    I::Item: Send,
+    U: Send,
+    E: Send,
+{
+    map_in_order_within(items, per_thread, usize::MAX, |_| 0, map, consume)
+}
+
+/// [`map_in_order`] within a memory budget: `cost(item)` (called on the
+/// consumer's thread, in input order) is what the item may hold from the
+/// start of its map until `consume` has taken its result, and the items
+/// mapped or waiting at once cost at most `budget_bytes` together; an item
+/// over the budget is mapped alone. Admission is decided by the consumer, so
+/// no map task ever waits for memory (a task waiting for the consumer while
+/// the consumer runs it would never end), and the outcome does not depend
+/// on the thread count.
+///
+/// # Errors
+/// The first error returned by `consume`.
+pub fn map_in_order_within<I, U, E>(
+    items: I,
+    per_thread: usize,
+    budget_bytes: usize,
+    mut cost: impl FnMut(&I::Item) -> usize + Send,
+    map: impl Fn(I::Item) -> U + Sync,
     mut consume: impl FnMut(U) -> Result<(), E> + Send,
 ) -> Result<(), E>
 where
@@ -53,21 +81,37 @@ where
                 slot.fill(outcome);
             });
         };
-        let mut spawned = 0;
-        for item in items.by_ref().take(window) {
-            spawn(spawned, item);
-            spawned += 1;
-        }
-        let mut next = 0;
-        while next < spawned {
-            consume(slots[next % window].take())?;
-            next += 1;
-            if let Some(item) = items.next() {
+        // Costs of the items spawned and not yet consumed, oldest first.
+        let mut costs = std::collections::VecDeque::with_capacity(window);
+        let (mut in_flight, mut spawned, mut next) = (0usize, 0usize, 0usize);
+        // The next item with its cost, waiting for room in the budget.
+        let mut waiting: Option<(I::Item, usize)> = None;
+        loop {
+            while spawned - next < window {
+                let Some((item, bytes)) = waiting.take().or_else(|| {
+                    items.next().map(|item| {
+                        let bytes = cost(&item);
+                        (item, bytes)
+                    })
+                }) else {
+                    break;
+                };
+                if spawned > next && in_flight.saturating_add(bytes) > budget_bytes {
+                    waiting = Some((item, bytes));
+                    break;
+                }
+                in_flight = in_flight.saturating_add(bytes);
+                costs.push_back(bytes);
                 spawn(spawned, item);
                 spawned += 1;
             }
+            if next == spawned {
+                return Ok(());
+            }
+            consume(slots[next % window].take())?;
+            in_flight -= costs.pop_front().unwrap_or(0);
+            next += 1;
         }
-        Ok(())
     })
 }
 
@@ -141,6 +185,42 @@ mod tests {
                     .unwrap();
                 assert_eq!(seen, expected, "threads {threads}, batch {batch}");
             }
+        }
+    }
+
+    /// Without the budget, 4 threads map 8 items ahead (80 bytes of
+    /// 10-byte items); within 30 bytes, at most 3 are held at once, and an
+    /// item over the budget is held alone.
+    #[test]
+    fn items_held_at_once_stay_within_the_budget() {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let cost = |i: &usize| if i % 7 == 3 { 100 } else { 10 };
+        for threads in [1, 2, 4] {
+            let (held, peak) = (AtomicUsize::new(0), AtomicUsize::new(0));
+            let mut seen = Vec::new();
+            pool(threads)
+                .install(|| {
+                    map_in_order_within(
+                        0..40usize,
+                        2,
+                        30,
+                        cost,
+                        |i| {
+                            let now = held.fetch_add(cost(&i), Ordering::SeqCst) + cost(&i);
+                            peak.fetch_max(if cost(&i) > 30 { now - cost(&i) + 30 } else { now }, Ordering::SeqCst);
+                            std::thread::sleep(std::time::Duration::from_millis(2));
+                            i
+                        },
+                        |i| {
+                            held.fetch_sub(cost(&i), Ordering::SeqCst);
+                            seen.push(i);
+                            Ok::<(), ()>(())
+                        },
+                    )
+                })
+                .unwrap();
+            assert_eq!(seen, (0..40).collect::<Vec<_>>());
+            assert!(peak.load(Ordering::SeqCst) <= 30, "{threads} threads: {} held", peak.load(Ordering::SeqCst));
         }
     }
 

@@ -99,16 +99,13 @@ pub(crate) fn check_plausible(
     })
 }
 
-/// Reads a whole input file, refusing one over `limit` before reading it, and
-/// stopping one byte past the limit where the OS reports no size (a pipe,
-/// `/dev/zero`), so no input makes the reader allocate beyond its limit.
-pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::Limit) -> Result<Vec<u8>, IngestError> {
-    use std::io::Read as _;
-    let max_bytes = limit.max as u64;
-    let too_large = |size: String| IngestError::BadLayout {
-        path: path.to_path_buf(),
-        detail: format!("{size} bytes is too large: expected {}", limit.expected),
-    };
+/// Opens an input file that will be read up to `limit` bytes, refusing a
+/// device (`/dev/zero`) and a file the OS reports over `limit` before reading
+/// anything; the file size with it (`None` for a pipe).
+pub(crate) fn open_capped(
+    path: &std::path::Path,
+    limit: &mmtrack_core::limits::Limit,
+) -> Result<(std::fs::File, u64), IngestError> {
     let file = std::fs::File::open(path).map_err(os_err(path))?;
     let metadata = file.metadata().map_err(os_err(path))?;
     if is_device(&metadata) {
@@ -118,13 +115,30 @@ pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::
         });
     }
     let size = metadata.len();
-    if size > max_bytes {
-        return Err(too_large(size.to_string()));
+    if size > limit.max as u64 {
+        return Err(too_large(path, limit, size.to_string()));
     }
+    Ok((file, size))
+}
+
+fn too_large(path: &std::path::Path, limit: &mmtrack_core::limits::Limit, size: String) -> IngestError {
+    IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: format!("{size} bytes is too large: expected {}", limit.expected),
+    }
+}
+
+/// Reads a whole input file, refusing one over `limit` before reading it, and
+/// stopping one byte past the limit where the OS reports no size (a pipe,
+/// `/dev/zero`), so no input makes the reader allocate beyond its limit.
+pub(crate) fn read_capped(path: &std::path::Path, limit: &mmtrack_core::limits::Limit) -> Result<Vec<u8>, IngestError> {
+    use std::io::Read as _;
+    let max_bytes = limit.max as u64;
+    let (file, size) = open_capped(path, limit)?;
     let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
     file.take(max_bytes + 1).read_to_end(&mut bytes).map_err(os_err(path))?;
     if bytes.len() as u64 > max_bytes {
-        return Err(too_large(format!("more than {max_bytes}")));
+        return Err(too_large(path, limit, format!("more than {max_bytes}")));
     }
     Ok(bytes)
 }
@@ -158,6 +172,36 @@ fn is_device(metadata: &std::fs::Metadata) -> bool {
 mod tests {
     use super::*;
     use mmtrack_core::limits::Limit;
+
+    /// Every text reader goes through the capped read (or streams, NMEA):
+    /// `/dev/zero` given as any of them is a one-line error naming it, at once.
+    #[test]
+    fn every_text_reader_refuses_an_endless_device_naming_it() {
+        let zero = std::path::Path::new("/dev/zero");
+        if !zero.exists() {
+            return;
+        }
+        type Reader = Box<dyn Fn() -> Option<IngestError>>;
+        let readers: [(&str, Reader); 10] = [
+            ("oxford gps.csv", Box::new(|| crate::oxford::gps::read_gps_csv(zero).err())),
+            ("oxford ins.csv", Box::new(|| crate::oxford::ins::read_ins_csv(zero).err())),
+            ("oxford radar_odometry.csv", Box::new(|| crate::oxford::odometry::read_radar_odometry(zero).err())),
+            ("boreas gps", Box::new(|| crate::boreas::gps::read_boreas_gps(zero).err())),
+            ("mulran gps.csv", Box::new(|| crate::mulran::gps::read_mulran_gps(zero).err())),
+            ("TUM/KITTI poses", Box::new(|| crate::poses::read_text(zero).err())),
+            ("DecaWave log", Box::new(|| crate::cir::read_decawave_log(zero, &Default::default()).err())),
+            ("CIR CSV", Box::new(|| crate::cir::read_cir_file(crate::cir::CirFormat::Csv, zero, None).err())),
+            ("CIR sidecar", Box::new(|| crate::cir::CirSidecar::read(zero).err())),
+            ("NMEA", Box::new(|| crate::nmea::read_nmea(zero).err())),
+        ];
+        for (reader, read) in readers {
+            let start = std::time::Instant::now();
+            let err = read().map(|e| e.to_string()).unwrap_or_default();
+            assert!(err.starts_with("/dev/zero") && !err.contains('\n'), "{reader}: {err:?}");
+            assert!(err.contains("is a device") || err.contains("longer than 4096 bytes"), "{reader}: {err}");
+            println!("{reader}: {err} ({:.1} ms)", start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
 
     /// Before: text inputs were read whole whatever their size; `/dev/zero`
     /// as an input grew without bound.

@@ -133,26 +133,61 @@ pub fn folder_name(root: &Path) -> String {
 /// Scans decoded ahead of the writer, per thread of the pool.
 const DECODED_PER_THREAD: usize = 2;
 
+/// Memory the scans being decoded and those waiting for the writer may hold
+/// together, bytes: one image at the decoder's cap
+/// ([`mmtrack_io::MAX_GRAY8_BYTES`]). Real scans (1.5 MB for Oxford, 2.7 MB
+/// for Boreas) still decode [`DECODED_PER_THREAD`] per thread side by side;
+/// scans near the cap go one at a time, from the first read of their file
+/// until the writer has taken them, whatever the thread count.
+pub(crate) const SCAN_MEMORY_BUDGET_BYTES: usize = mmtrack_io::MAX_GRAY8_BYTES;
+
 /// Reads and decodes the scans on the current rayon pool and hands them to
 /// `write` in file order.
 ///
 /// Up to [`DECODED_PER_THREAD`] scans per thread are decoded ahead while
-/// `write` takes them in order ([`mmtrack_core::parallel::map_in_order`]), so
-/// at most `DECODED_PER_THREAD * threads` decoded scans are in memory whatever
-/// the folder size, and the output is the same for any thread count. PNG
-/// decoding (inflate and unfilter, needed to reach the row headers) is most of
-/// an ingest's time.
+/// `write` takes them in order
+/// ([`mmtrack_core::parallel::map_in_order_within`]), and those decoding or
+/// waiting hold at most [`SCAN_MEMORY_BUDGET_BYTES`] together by `cost` (what
+/// one scan holds from its first read until `write` has taken it; a scan over
+/// the budget goes alone), so memory grows neither with the folder size nor
+/// with the thread count, and the output is the same for any thread count.
+/// PNG decoding (inflate and unfilter, needed to reach the row headers) is
+/// most of an ingest's time.
 pub fn decode_in_order<T: Send>(
     scans: &[ScanFile],
+    cost: &(dyn Fn(&ScanFile) -> usize + Sync),
     decode: &(dyn Fn(&ScanFile) -> Result<T, IngestError> + Sync),
     write: &mut (dyn FnMut(usize, T) -> Result<(), IngestError> + Send),
 ) -> Result<(), IngestError> {
-    mmtrack_core::parallel::map_in_order(
+    mmtrack_core::parallel::map_in_order_within(
         scans.iter().enumerate(),
         DECODED_PER_THREAD,
+        SCAN_MEMORY_BUDGET_BYTES,
+        |(_, scan)| cost(scan),
         |(index, scan)| (index, decode(scan)),
         |(index, decoded)| write(index, decoded?),
     )
+}
+
+/// The bytes of the image a scan PNG's header announces (pixels plus a
+/// filter byte per row: the decoder's buffer), read from its first 24 bytes;
+/// 0 for a file that is no PNG or an image over the decoder's cap (refused
+/// before a pixel is allocated).
+pub(crate) fn png_image_bytes(path: &Path) -> usize {
+    use std::io::Read as _;
+    let mut head = [0u8; 24];
+    let read = std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head));
+    if read.is_err() || &head[..8] != b"\x89PNG\r\n\x1a\n" || &head[12..16] != b"IHDR" {
+        return 0;
+    }
+    let width = u32::from_be_bytes([head[16], head[17], head[18], head[19]]) as usize;
+    let height = u32::from_be_bytes([head[20], head[21], head[22], head[23]]) as usize;
+    width.checked_mul(height).filter(|&n| n <= mmtrack_io::MAX_GRAY8_BYTES).map_or(0, |n| n + height)
+}
+
+/// The size of a file, bytes (0 if it cannot be read: its reader says why).
+pub(crate) fn file_bytes(path: &Path) -> usize {
+    std::fs::metadata(path).map_or(0, |m| usize::try_from(m.len()).unwrap_or(usize::MAX))
 }
 
 /// The items of a ground-truth or GNSS file that fall within the scans'
@@ -255,7 +290,7 @@ mod tests {
         let scans: Vec<ScanFile> =
             (1..=9).map(|i| ScanFile { t_ns: i, path: PathBuf::from(format!("{i}.png")) }).collect();
         let mut seen = Vec::new();
-        decode_in_order(&scans, &|s: &ScanFile| Ok(s.t_ns * 10), &mut |index, value| {
+        decode_in_order(&scans, &|_| 0, &|s: &ScanFile| Ok(s.t_ns * 10), &mut |index, value| {
             seen.push((index, value));
             Ok(())
         })
@@ -270,7 +305,7 @@ mod tests {
             }
         };
         let mut written = 0;
-        let err = decode_in_order(&scans, &failing, &mut |_, _| {
+        let err = decode_in_order(&scans, &|_| 0, &failing, &mut |_, _| {
             written += 1;
             Ok(())
         })

@@ -284,9 +284,36 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
 /// The OS error of a rename (nothing changed then), or of deleting the old
 /// copy after the new one is in place (the error names the copy left).
 pub fn publish_dir(staged: &Path, out: &Path) -> Result<()> {
-    let live = live_partials();
+    match swap_dir_into_place(staged, out)? {
+        Some(aside) => aside.remove(),
+        None => Ok(()),
+    }
+}
+
+/// The old output moved aside by [`publish_dir`], registered as a partial
+/// output until it is removed: an interruption while it is being deleted
+/// removes the rest of it ([`remove_partial_outputs`]).
+#[derive(Debug)]
+struct ReplacedDir(PathBuf);
+
+impl ReplacedDir {
+    fn remove(self) -> Result<()> {
+        std::fs::remove_dir_all(&self.0).map_err(os_err(&self.0))
+    }
+}
+
+impl Drop for ReplacedDir {
+    fn drop(&mut self) {
+        live_partials().remove(&self.0);
+    }
+}
+
+/// The renames of [`publish_dir`], under the registry lock; the old output,
+/// if any, is returned registered.
+fn swap_dir_into_place(staged: &Path, out: &Path) -> Result<Option<ReplacedDir>> {
+    let mut live = live_partials();
     if std::fs::symlink_metadata(out).is_err() {
-        return std::fs::rename(staged, out).map_err(os_err(out));
+        return std::fs::rename(staged, out).map(|()| None).map_err(os_err(out));
     }
     let name = staged.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let stem = name.strip_suffix(PARTIAL_SUFFIX).unwrap_or(&name);
@@ -296,8 +323,8 @@ pub fn publish_dir(staged: &Path, out: &Path) -> Result<()> {
         let _ = std::fs::rename(&aside, out);
         return Err(IoError::Os { path: out.to_path_buf(), source: e });
     }
-    drop(live);
-    std::fs::remove_dir_all(&aside).map_err(os_err(&aside))
+    live.insert(aside.clone(), PartialKind::Directory);
+    Ok(Some(ReplacedDir(aside)))
 }
 
 /// Creates `dir` and its missing parents (as `create_dir_all`) for an
@@ -380,7 +407,7 @@ pub fn check_replaceable_dir(
 const PARTIAL_SUFFIX: &str = ".partial";
 
 /// The end of the name of an output moved aside by [`commit_all`] until its
-/// replacement's set is in place.
+/// replacement's set is in place, or by [`publish_dir`] until it is deleted.
 const REPLACED_SUFFIX: &str = ".replaced";
 
 /// What a registered partial output is.
@@ -449,15 +476,21 @@ pub fn remove_partial_outputs() -> PartialOutputsRemoved {
 /// open lands in it.
 fn remove_directory_being_written(path: &Path) -> std::io::Result<()> {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let moved = name
-        .strip_suffix(PARTIAL_SUFFIX)
-        .map(|stem| path.with_file_name(format!("{stem}x{PARTIAL_SUFFIX}")))
+    let moved = [PARTIAL_SUFFIX, REPLACED_SUFFIX]
+        .iter()
+        .find_map(|suffix| name.strip_suffix(suffix).map(|stem| path.with_file_name(format!("{stem}x{suffix}"))))
         .filter(|moved| std::fs::rename(path, moved).is_ok());
     let target = moved.as_deref().unwrap_or(path);
     let mut attempts = 0;
     loop {
         match std::fs::remove_dir_all(target) {
-            Err(e) if e.kind() == std::io::ErrorKind::DirectoryNotEmpty && attempts < 100 => {
+            // Another thread adding files, or deleting them (an old output
+            // being removed by `publish_dir`) as this walks the tree.
+            Err(e)
+                if (e.kind() == std::io::ErrorKind::DirectoryNotEmpty
+                    || (e.kind() == std::io::ErrorKind::NotFound && target.exists()))
+                    && attempts < 100 =>
+            {
                 attempts += 1;
                 std::thread::sleep(std::time::Duration::from_millis(10));
             }
@@ -627,6 +660,30 @@ mod tests {
         drop(second);
         first.commit(Overwrite::Refuse, Durability::PageCache).unwrap();
         assert!(!first_partial.exists() && target.exists());
+    }
+
+    /// Before: the old output `publish_dir` moved aside was not in the
+    /// registry, so an interruption while it was being deleted left it. Now
+    /// it is registered from the rename until it is gone.
+    #[test]
+    fn an_old_output_moved_aside_is_a_registered_partial_until_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("results");
+        std::fs::create_dir(&out).unwrap();
+        std::fs::write(out.join("old.txt"), b"old").unwrap();
+        let staged = staging_dir(dir.path(), ".results.").unwrap().keep();
+        std::fs::write(staged.join("new.txt"), b"new").unwrap();
+        let aside = swap_dir_into_place(&staged, &out).unwrap().unwrap();
+        assert_eq!(std::fs::read(out.join("new.txt")).unwrap(), b"new");
+        assert_eq!(std::fs::read(aside.0.join("old.txt")).unwrap(), b"old");
+        assert!(aside.0.file_name().unwrap().to_string_lossy().ends_with(REPLACED_SUFFIX));
+        assert_eq!(live_partials().get(&aside.0), Some(&PartialKind::Directory));
+        let path = aside.0.clone();
+        aside.remove().unwrap();
+        assert!(!path.exists() && !live_partials().contains_key(&path));
+        // Into a place that is free: nothing moved aside.
+        let staged = staging_dir(dir.path(), ".other.").unwrap().keep();
+        assert!(swap_dir_into_place(&staged, &dir.path().join("other")).unwrap().is_none());
     }
 
     /// Issue 26: a set of files is published whole or not at all; a rename

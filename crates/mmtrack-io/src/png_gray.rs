@@ -2,7 +2,8 @@
 //! errors that say what was wrong with the image rather than panicking.
 //!
 //! Memory: a decode holds one buffer of the image's size (pixels plus one
-//! filter byte per row; the filters are undone in place), and decodes
+//! filter byte per row; the filters are undone in place) and, for a file
+//! ([`Gray8Png::open_file`]), buffers of 64 KiB, never the whole file; decodes
 //! running at once share a budget of one [`MAX_GRAY8_BYTES`] image, so
 //! images near the cap (PNG bombs included) decode one at a time.
 //!
@@ -20,7 +21,8 @@
 //! decode as a good one. Here the stream must end exactly after the last
 //! pixel row with a matching Adler-32.
 
-use std::io::Cursor;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Cursor, Read, Seek, SeekFrom};
 use std::sync::{Condvar, Mutex, PoisonError};
 
 /// Largest image [`Gray8Png::decode`] decodes, bytes (= pixels): 64 MiB, 24
@@ -31,10 +33,82 @@ pub const MAX_GRAY8_BYTES: usize = 64 << 20;
 /// (text, ICC profiles), bytes.
 const MAX_METADATA_BYTES: usize = 8 << 20;
 
+/// Bytes of image data read from a file at a time while inflating.
+const READ_PIECE_BYTES: usize = 64 << 10;
+
+/// Where a PNG's bytes are: in memory, or in a file read piece by piece, so
+/// decoding a file never holds the whole file beside the image.
+#[derive(Clone, Copy)]
+enum Source<'a> {
+    Bytes(&'a [u8]),
+    File(&'a File),
+}
+
+impl<'a> Source<'a> {
+    /// A reader from the first byte (a file handle is shared: rewound here).
+    fn reader(self) -> std::io::Result<Input<'a>> {
+        Ok(match self {
+            Self::Bytes(bytes) => Input::Bytes(Cursor::new(bytes)),
+            Self::File(mut file) => {
+                file.seek(SeekFrom::Start(0))?;
+                Input::File(BufReader::with_capacity(READ_PIECE_BYTES, file))
+            }
+        })
+    }
+}
+
+/// A reader of a [`Source`].
+enum Input<'a> {
+    Bytes(Cursor<&'a [u8]>),
+    File(BufReader<&'a File>),
+}
+
+impl Read for Input<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        match self {
+            Self::Bytes(r) => r.read(buf),
+            Self::File(r) => r.read(buf),
+        }
+    }
+}
+
+impl BufRead for Input<'_> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        match self {
+            Self::Bytes(r) => r.fill_buf(),
+            Self::File(r) => r.fill_buf(),
+        }
+    }
+
+    fn consume(&mut self, amount: usize) {
+        match self {
+            Self::Bytes(r) => r.consume(amount),
+            Self::File(r) => r.consume(amount),
+        }
+    }
+}
+
+impl Seek for Input<'_> {
+    fn seek(&mut self, position: SeekFrom) -> std::io::Result<u64> {
+        match self {
+            Self::Bytes(r) => r.seek(position),
+            Self::File(r) => r.seek(position),
+        }
+    }
+
+    /// Within the buffer, a file's position moves without a read.
+    fn seek_relative(&mut self, offset: i64) -> std::io::Result<()> {
+        match self {
+            Self::Bytes(r) => r.seek_relative(offset),
+            Self::File(r) => r.seek_relative(offset),
+        }
+    }
+}
+
 /// An 8-bit greyscale PNG whose header has been read, not yet decoded.
 pub struct Gray8Png<'a> {
-    bytes: &'a [u8],
-    reader: png::Reader<Cursor<&'a [u8]>>,
+    source: Source<'a>,
+    reader: png::Reader<Input<'a>>,
     width: usize,
     height: usize,
 }
@@ -45,7 +119,19 @@ impl<'a> Gray8Png<'a> {
     /// a PNG, a bad chunk, or a colour type, bit depth or interlacing other
     /// than plain 8-bit grey.
     pub fn open(bytes: &'a [u8]) -> Result<Self, String> {
-        let decoder = png::Decoder::new_with_limits(Cursor::new(bytes), png::Limits { bytes: MAX_METADATA_BYTES });
+        Self::open_source(Source::Bytes(bytes))
+    }
+
+    /// [`Gray8Png::open`] on a file, which is read piece by piece (here and
+    /// by [`Gray8Png::decode`]), never whole: decoding it holds the image and
+    /// buffers of [`READ_PIECE_BYTES`], not the file.
+    pub fn open_file(file: &'a File) -> Result<Self, String> {
+        Self::open_source(Source::File(file))
+    }
+
+    fn open_source(source: Source<'a>) -> Result<Self, String> {
+        let input = source.reader().map_err(|e| format!("cannot read the PNG: {e}"))?;
+        let decoder = png::Decoder::new_with_limits(input, png::Limits { bytes: MAX_METADATA_BYTES });
         let reader = decoder.read_info().map_err(|e| format!("not a readable PNG: {e}"))?;
         let info = reader.info();
         if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Eight {
@@ -58,7 +144,7 @@ impl<'a> Gray8Png<'a> {
             return Err("PNG is interlaced (Adam7); expected a plain, non-interlaced image".into());
         }
         let (width, height) = (info.width as usize, info.height as usize);
-        Ok(Self { bytes, reader, width, height })
+        Ok(Self { source, reader, width, height })
     }
 
     /// Image width from the header, pixels.
@@ -82,11 +168,13 @@ impl<'a> Gray8Png<'a> {
         let pixels = width.checked_mul(height).filter(|&n| n <= MAX_GRAY8_BYTES).ok_or_else(|| {
             format!("{width} x {height} pixels is over the {} MiB this reader decodes", MAX_GRAY8_BYTES >> 20)
         })?;
-        // Every chunk, image data included, up to IEND: structure and CRCs.
+        // Every chunk, image data included, up to IEND: structure and CRCs
+        // (the image data is skipped, not inflated).
         self.reader.finish().map_err(|e| format!("PNG data is truncated or corrupt: {e}"))?;
         let _share = DecodeShare::acquire(pixels + height);
         let mut filtered = vec![0u8; pixels + height];
-        inflate_exact(&image_data(self.bytes), &mut filtered)
+        let mut image_data = ImageData::new(self.source.reader().map_err(|e| format!("cannot read the PNG: {e}"))?);
+        inflate_exact(&mut image_data, &mut filtered)
             .map_err(|e| format!("PNG image data ({width} x {height}) is corrupt: {e}"))?;
         unfilter(filtered, width)
     }
@@ -100,49 +188,131 @@ pub fn decode_gray8(bytes: &[u8]) -> Result<(usize, usize, Vec<u8>), String> {
     Ok((width, height, image.decode()?))
 }
 
-/// The data of the first run of consecutive IDAT chunks, in order. The chunk
-/// structure has been checked by the `png` crate; a chunk whose length runs
-/// past the end ends the walk.
-fn image_data(png: &[u8]) -> Vec<&[u8]> {
-    let mut chunks = Vec::new();
-    let mut at = 8; // after the signature
-    while let Some(header) = png.get(at..at + 8) {
-        let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;
-        let Some(data) = png.get(at + 8..).and_then(|rest| rest.get(..length)) else { break };
-        if &header[4..8] == b"IDAT" {
-            chunks.push(data);
-        } else if !chunks.is_empty() {
-            break;
-        }
-        at += 12 + length;
-    }
-    chunks
+/// The data of the first run of consecutive IDAT chunks, in order, read
+/// piece by piece (at most [`READ_PIECE_BYTES`] at a time). The chunk
+/// structure and CRCs have been checked by the `png` crate; a chunk header
+/// that cannot be read ends the run.
+struct ImageData<'a> {
+    input: Input<'a>,
+    /// Bytes of the current IDAT chunk not yet read.
+    left_in_chunk: u64,
+    /// Whether the run of IDAT chunks has begun, and whether it has ended.
+    started: bool,
+    ended: bool,
+    /// Whether the input is past the PNG signature (it starts at byte 0).
+    after_signature: bool,
+    /// Image-data bytes read so far.
+    read: u64,
+    piece: Vec<u8>,
 }
 
-/// Inflates the zlib stream split over `chunks` into `out`, which it must
-/// fill exactly; the stream's Adler-32 is verified, and no byte may follow
-/// it in the image data.
+impl<'a> ImageData<'a> {
+    fn new(input: Input<'a>) -> Self {
+        Self {
+            input,
+            left_in_chunk: 0,
+            started: false,
+            ended: false,
+            after_signature: false,
+            read: 0,
+            piece: Vec::new(),
+        }
+    }
+
+    /// The next piece of image data, and whether it is the last.
+    fn next_piece(&mut self) -> std::io::Result<Option<(&[u8], bool)>> {
+        if self.piece.is_empty() {
+            self.piece = vec![0; READ_PIECE_BYTES];
+        }
+        while !self.ended && self.left_in_chunk == 0 {
+            self.ended = !self.next_chunk()?;
+        }
+        if self.ended {
+            return Ok(None);
+        }
+        let n = usize::try_from(self.left_in_chunk).map_or(READ_PIECE_BYTES, |left| left.min(READ_PIECE_BYTES));
+        self.input.read_exact(&mut self.piece[..n])?;
+        self.left_in_chunk -= n as u64;
+        self.read += n as u64;
+        let mut last = false;
+        while !self.ended && self.left_in_chunk == 0 {
+            self.ended = !self.next_chunk()?;
+            last = self.ended;
+        }
+        Ok(Some((&self.piece[..n], last)))
+    }
+
+    /// Moves to the data of the next IDAT chunk of the run (skipping the
+    /// chunks before the run and the current chunk's CRC); false at the end
+    /// of the run.
+    fn next_chunk(&mut self) -> std::io::Result<bool> {
+        if self.started {
+            self.input.seek_relative(4)?; // the CRC
+        } else if !self.after_signature {
+            self.input.seek_relative(8)?;
+            self.after_signature = true;
+        }
+        loop {
+            let mut header = [0u8; 8];
+            if self.input.read_exact(&mut header).is_err() {
+                return Ok(false);
+            }
+            let length = u64::from(u32::from_be_bytes([header[0], header[1], header[2], header[3]]));
+            if &header[4..8] == b"IDAT" {
+                self.started = true;
+                self.left_in_chunk = length;
+                return Ok(true);
+            }
+            if self.started {
+                return Ok(false);
+            }
+            self.input.seek_relative(i64::try_from(length + 4).unwrap_or(i64::MAX))?;
+        }
+    }
+
+    /// Bytes of image data in the run not yet read (skipped, not read).
+    fn skip_rest(&mut self) -> std::io::Result<u64> {
+        let mut rest = 0;
+        while !self.ended {
+            rest += self.left_in_chunk;
+            self.input.seek_relative(i64::try_from(self.left_in_chunk).unwrap_or(i64::MAX))?;
+            self.left_in_chunk = 0;
+            self.ended = !self.next_chunk()?;
+        }
+        Ok(rest)
+    }
+}
+
+/// Inflates the zlib stream of `image_data` into `out`, which it must fill
+/// exactly; the stream's Adler-32 is verified, and no byte may follow it in
+/// the image data.
 ///
 /// `fdeflate` reads up to 7 bytes ahead of what it decodes, so whether the
 /// stream ends at the last byte cannot be told from what it consumed: the
 /// checksum is verified here instead, and its position among the last
 /// bytes consumed is where the stream ends.
-fn inflate_exact(chunks: &[&[u8]], out: &mut [u8]) -> Result<(), String> {
+fn inflate_exact(image_data: &mut ImageData<'_>, out: &mut [u8]) -> Result<(), String> {
+    let io_error = |e: std::io::Error| format!("cannot read the image data: {e}");
     let mut inflater = fdeflate::Decompressor::new();
     inflater.ignore_adler32();
-    let (mut filled, mut consumed_total) = (0, 0);
-    for (index, chunk) in chunks.iter().enumerate() {
-        let last = index + 1 == chunks.len();
-        let mut input = *chunk;
+    let (mut filled, mut consumed_total) = (0, 0u64);
+    // The last bytes consumed, newest last: where the checksum is.
+    let mut tail = [0u8; 16];
+    while let Some((piece, last)) = image_data.next_piece().map_err(io_error)? {
+        let mut input = piece;
         while !input.is_empty() && !inflater.is_done() {
             let (consumed, produced) =
                 inflater.read(input, out, filled, last).map_err(|e| inflate_error(&e, filled, out.len()))?;
             if consumed == 0 && produced == 0 {
                 return Err(format!("the zlib stream holds more than the {} bytes of the pixel rows", out.len()));
             }
+            let kept = consumed.min(tail.len());
+            tail.copy_within(kept.., 0);
+            let start = tail.len() - kept;
+            tail[start..].copy_from_slice(&input[consumed - kept..consumed]);
             input = &input[consumed..];
             filled += produced;
-            consumed_total += consumed;
+            consumed_total += consumed as u64;
         }
         if inflater.is_done() {
             break;
@@ -160,21 +330,16 @@ fn inflate_exact(chunks: &[&[u8]], out: &mut [u8]) -> Result<(), String> {
     let mut adler = simd_adler32::Adler32::new();
     adler.write(out);
     let trailer = adler.finish().to_be_bytes();
-    let byte = |mut at: usize| {
-        chunks.iter().find_map(|c| {
-            if at < c.len() {
-                Some(c[at])
-            } else {
-                at -= c.len();
-                None
-            }
-        })
+    // The byte at offset `at` of the image data, if among the tail.
+    let byte = |at: u64| {
+        let back = consumed_total.checked_sub(at)?;
+        (1..=tail.len() as u64).contains(&back).then(|| tail[tail.len() - back as usize])
     };
     let stream_end = (0..8)
         .filter_map(|ahead| consumed_total.checked_sub(ahead).filter(|&end| end >= 4))
-        .find(|&end| (0..4).all(|j| byte(end - 4 + j) == Some(trailer[j])))
+        .find(|&end| (0..4).all(|j| byte(end - 4 + j) == Some(trailer[j as usize])))
         .ok_or("the zlib stream's Adler-32 checksum does not match its data")?;
-    let after = chunks.iter().map(|c| c.len()).sum::<usize>() - stream_end;
+    let after = image_data.read + image_data.skip_rest().map_err(io_error)? - stream_end;
     if after > 0 {
         return Err(format!(
             "{after} bytes follow the end of the zlib stream (its Adler-32 checksum) in the image data"
@@ -302,6 +467,23 @@ fn paeth(a: u8, b: u8, c: u8) -> u8 {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// The data of the first run of consecutive IDAT chunks, in order.
+    fn image_data(png: &[u8]) -> Vec<&[u8]> {
+        let mut chunks = Vec::new();
+        let mut at = 8; // after the signature
+        while let Some(header) = png.get(at..at + 8) {
+            let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;
+            let Some(data) = png.get(at + 8..).and_then(|rest| rest.get(..length)) else { break };
+            if &header[4..8] == b"IDAT" {
+                chunks.push(data);
+            } else if !chunks.is_empty() {
+                break;
+            }
+            at += 12 + length;
+        }
+        chunks
+    }
 
     fn encode(width: u32, height: u32, pixels: &[u8], filter: png::Filter, compression: png::Compression) -> Vec<u8> {
         let mut out = Vec::new();
@@ -463,6 +645,51 @@ mod tests {
         drop(writer);
         let err = decode_gray8(&two).unwrap_err();
         assert!(err.contains("64 bytes follow the end of the zlib stream"), "{err}");
+    }
+
+    fn decode_file(bytes: &[u8]) -> Result<Vec<u8>, String> {
+        let mut file = tempfile::tempfile().unwrap();
+        std::io::Write::write_all(&mut file, bytes).unwrap();
+        Gray8Png::open_file(&file)?.decode()
+    }
+
+    /// A file is read in pieces of 64 KiB: images whose data spans many
+    /// pieces and chunks (stored, so every byte is data), and the errors of
+    /// a bad stream, are the same as from memory.
+    #[test]
+    fn a_file_read_in_pieces_decodes_as_from_memory() {
+        let (width, height) = (1001u32, 300u32);
+        let pixels = noise((width * height) as usize, 11);
+        for (stored, compression) in [(true, png::Compression::NoCompression), (false, png::Compression::Fast)] {
+            let bytes = encode(width, height, &pixels, png::Filter::Paeth, compression);
+            assert!(!stored || bytes.len() > 4 * READ_PIECE_BYTES, "{} bytes", bytes.len());
+            assert_eq!(decode_file(&bytes).unwrap(), pixels);
+            // The same data as many small chunks, one of them empty.
+            let idat = image_data(&bytes).concat();
+            let mut split = Vec::new();
+            let mut encoder = png::Encoder::new(&mut split, width, height);
+            encoder.set_color(png::ColorType::Grayscale);
+            encoder.set_depth(png::BitDepth::Eight);
+            let mut writer = encoder.write_header().unwrap();
+            for (i, part) in idat.chunks(7777).enumerate() {
+                writer.write_chunk(png::chunk::IDAT, part).unwrap();
+                if i == 3 {
+                    writer.write_chunk(png::chunk::IDAT, &[]).unwrap();
+                }
+            }
+            drop(writer);
+            assert_eq!(decode_file(&split).unwrap(), pixels);
+            for n in [1, 7, 8, 100_000] {
+                let mut junk = idat.clone();
+                junk.extend(std::iter::repeat_n(0xAB, n));
+                let bad = repack(width, height, &junk);
+                let err = decode_file(&bad).unwrap_err();
+                assert_eq!(err, decode_gray8(&bad).unwrap_err());
+                assert!(err.contains(&format!(": {n} bytes follow the end of the zlib stream")), "{n}: {err}");
+            }
+            let short = repack(width, height, &idat[..idat.len() - 10]);
+            assert_eq!(decode_file(&short).unwrap_err(), decode_gray8(&short).unwrap_err());
+        }
     }
 
     #[test]

@@ -253,3 +253,53 @@ fn a_folder_of_png_bombs_under_the_decode_cap_stays_under_100_mb() {
     assert!(run.peak_rss_kb < MAX_PEAK_RSS_KB, "peak RSS {} kB", run.peak_rss_kb);
     assert!(!dir.path().join("out.mcap").exists());
 }
+
+/// Issue 26: a Boreas folder of uncompressed (stored-deflate) PNGs just under
+/// the 64 MiB decode cap, whose rows hold no valid time, is refused within
+/// 100 MB at 1, 2, 4 and 8 threads. Before, each scan's file (67 MB) was read
+/// whole beside its image (67 MB), on every thread and for the scans
+/// waiting for the writer: 162 MB with 1 thread, 365 MB with 8
+/// (`/usr/bin/time -v`, debug build). Now the file is streamed into the
+/// decoder and the scans in flight share one cap-sized budget.
+#[test]
+fn a_folder_of_uncompressed_png_under_the_decode_cap_stays_under_100_mb() {
+    let (width, height) = (8190, 8192);
+    let mut stored = Vec::new();
+    {
+        let mut encoder = png::Encoder::new(&mut stored, width, height);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::NoCompression);
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&vec![0u8; width as usize * height as usize]).unwrap();
+        writer.finish().unwrap();
+    }
+    assert!(stored.len() > (width * height) as usize, "{} bytes: stored, not compressed", stored.len());
+    let dir = tempfile::tempdir().unwrap();
+    let radar = dir.path().join("boreas-2021-11-02-11-16/radar");
+    std::fs::create_dir_all(&radar).unwrap();
+    for i in 0..3 {
+        std::fs::write(radar.join(format!("{}.png", 1_635_866_700_000_000_u64 + 250_000 * i)), &stored).unwrap();
+    }
+    for threads in ["1", "2", "4", "8"] {
+        let args = ["ingest", "boreas", "boreas-2021-11-02-11-16", "-o", "out.mcap", "--threads", threads];
+        let run = run_measured(dir.path(), &args);
+        println!(
+            "3 stored PNGs ({} bytes each), {threads} threads: exit {:?}, peak RSS {:.1} MB ({})",
+            stored.len(),
+            run.output.status.code(),
+            run.peak_rss_kb as f64 / 1000.0,
+            run.method
+        );
+        assert_eq!(run.output.status.code(), Some(1), "{}", run.stderr);
+        assert_eq!(run.stderr.lines().count(), 1, "one error line: {}", run.stderr);
+        assert!(
+            run.stderr.contains("radar/1635866700000000.png") && run.stderr.contains("not a valid UNIX time"),
+            "{}",
+            run.stderr
+        );
+        assert!(run.peak_rss_kb > 0, "the measurement saw the process");
+        assert!(run.peak_rss_kb < MAX_PEAK_RSS_KB, "{threads} threads: peak RSS {} kB", run.peak_rss_kb);
+        assert!(!dir.path().join("out.mcap").exists());
+    }
+}

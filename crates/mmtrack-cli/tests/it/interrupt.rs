@@ -229,3 +229,67 @@ fn analyze_interrupted_while_writing_leaves_no_partial() {
     }
     assert!(interrupted >= 6, "only {interrupted} of 24 runs were interrupted while writing");
 }
+
+/// Issue 26: `analyze --force` moves the old results aside
+/// (`<staging name>.replaced`) and deletes them once the new ones are in
+/// place; that copy was not registered for the signal clean-up, so a SIGINT
+/// while it was being deleted left it. Each run here is signalled as soon
+/// as the copy appears (polled tightly; a run whose copy came and went
+/// between two polls is not counted) and must leave neither it nor a
+/// partial, with whole results in place.
+#[test]
+fn analyze_force_interrupted_while_removing_the_old_results_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = root().join("data/sounder/convoy-tunnel.toml");
+    let args = ["simulate", "sounder", "--scenario", scenario.to_str().unwrap(), "-o", "rec.mcap", "--sets", "8", "-q"];
+    let out = mmtrack(dir.path(), &args);
+    assert!(out.status.success(), "{}", text(&out).1);
+    // Many sequences, so the old results take a while to delete.
+    for i in 0..20 {
+        let sequence = format!("s{i}");
+        let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "tables", "-q", "--sequence", &sequence]);
+        assert!(out.status.success(), "{}", text(&out).1);
+    }
+    let out = mmtrack(dir.path(), &["analyze", "tables", "-o", "results", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let leftovers = |dir: &Path| -> Vec<String> {
+        std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".partial") || n.ends_with(".replaced"))
+            .collect()
+    };
+    let mut signalled_while_removing = 0;
+    for run_index in 0..16 {
+        let child = Command::new(env!("CARGO_BIN_EXE_mmtrack"))
+            .args(["analyze", "tables", "-o", "results", "--force", "-q"])
+            .current_dir(dir.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut run = Running(child);
+        let mut seen = false;
+        while run.0.try_wait().unwrap().is_none() {
+            if leftovers(dir.path()).iter().any(|n| n.ends_with(".replaced")) {
+                send("INT", &run);
+                seen = true;
+                break;
+            }
+            std::thread::sleep(Duration::from_micros(100));
+        }
+        let (status, stderr) = finish(run);
+        assert_eq!(leftovers(dir.path()), Vec::<String>::new(), "run {run_index} left these: {stderr}");
+        assert!(dir.path().join("results/report.html").exists(), "run {run_index}: {stderr}");
+        if seen {
+            // 0: the removal ended before the signal came.
+            assert!(matches!(status.code(), Some(130 | 0)), "run {run_index}: {status:?} {stderr}");
+            signalled_while_removing += u32::from(status.code() == Some(130));
+        } else {
+            assert!(status.success(), "run {run_index}: {stderr}");
+        }
+    }
+    println!("{signalled_while_removing} of 16 runs interrupted while the old results were being removed");
+    // 16 of 16 here; the bound only makes sure the window was hit at all.
+    assert!(signalled_while_removing >= 2, "only {signalled_while_removing} runs hit the removal");
+}

@@ -114,6 +114,27 @@ pub fn decode_mulran_png(
     options: &MulranOptions,
 ) -> Result<PolarScan, IngestError> {
     let image = mmtrack_io::Gray8Png::open(png).map_err(|detail| bad(path, "PNG data", detail))?;
+    decode_mulran_image(path, image, scan_t_ns, options)
+}
+
+/// [`decode_mulran_png`] on the open PNG file of `path`, read piece by
+/// piece: the file is never held whole beside its image.
+pub fn decode_mulran_png_file(
+    path: &Path,
+    file: &std::fs::File,
+    scan_t_ns: i64,
+    options: &MulranOptions,
+) -> Result<PolarScan, IngestError> {
+    let image = mmtrack_io::Gray8Png::open_file(file).map_err(|detail| bad(path, "PNG data", detail))?;
+    decode_mulran_image(path, image, scan_t_ns, options)
+}
+
+fn decode_mulran_image(
+    path: &Path,
+    image: mmtrack_io::Gray8Png<'_>,
+    scan_t_ns: i64,
+    options: &MulranOptions,
+) -> Result<PolarScan, IngestError> {
     let (azimuths, bins) = (image.width(), image.height());
     if azimuths == 0 || bins == 0 {
         return Err(bad(path, "width/height", format!("{azimuths} x {bins} image has no pixels")));
@@ -240,9 +261,12 @@ pub fn ingest_mulran(
     let total = folder.scans.len() as u64;
     // The Cartesian view is resampled on the decoding threads too.
     let resampler = writer.cartesian_resampler().cloned();
+    // The image and its transpose (the scan) are held at once.
+    let view_bytes = resampler.as_ref().map_or(0, |r| (r.grid().size_px as usize).pow(2));
+    let cost = |scan: &ScanFile| (2 * crate::scan_folder::png_image_bytes(&scan.path)).saturating_add(view_bytes);
     let decode = |scan: &ScanFile| -> Result<(PolarScan, Option<Vec<u8>>), IngestError> {
-        let bytes = crate::error::read_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?;
-        let polar = decode_mulran_png(&scan.path, &bytes, scan.t_ns, options)?;
+        let (file, _) = crate::error::open_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?;
+        let polar = decode_mulran_png_file(&scan.path, &file, scan.t_ns, options)?;
         let view =
             match &resampler {
                 Some(r) => Some(r.resample(&polar.header, &polar.power, polar.header.bins_per_azimuth, 0).map_err(
@@ -258,7 +282,7 @@ pub fn ingest_mulran(
         Ok((polar, view))
     };
     let mut same_size = SameSize::default();
-    decode_in_order(&folder.scans, &decode, &mut |index, (scan, view): (PolarScan, Option<Vec<u8>>)| {
+    decode_in_order(&folder.scans, &cost, &decode, &mut |index, (scan, view): (PolarScan, Option<Vec<u8>>)| {
         same_size.check(&folder.scans[index].path, scan.header.azimuths.len(), scan.header.bins_per_azimuth)?;
         writer.write_radar_scan_and_view(&scan, view.as_deref())?;
         progress(index as u64 + 1, total);

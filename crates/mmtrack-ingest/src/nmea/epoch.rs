@@ -134,28 +134,61 @@ fn clock(t_ns: i64) -> String {
     format!("{:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, ns % 1_000_000_000)
 }
 
+/// How altitudes are put on their datum, which is known only once every
+/// fix has been seen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(super) enum Datum {
+    /// Keep the fixes and each one's geoid separation; [`Assembler::finish`]
+    /// moves them to the ellipsoid if every one gives it (one pass).
+    #[default]
+    Collect,
+    /// Decide the datum only (first of two passes; fixes are taken away as
+    /// they come and their separations not kept).
+    Decide,
+    /// Decided by a first pass: each fix goes on it as it is made.
+    Known { ellipsoid: bool },
+}
+
 #[derive(Default)]
 pub(super) struct Assembler {
     pub(super) log: NmeaLog,
-    /// Line of the latest fix, for messages.
-    last_fix_line: Option<usize>,
+    pub(super) datum: Datum,
+    /// Time and line of the latest fix, for ordering and messages.
+    last_fix: Option<(i64, usize)>,
     /// Geoid separation of each fix that has an altitude, while every one
-    /// of them gives it (to move altitudes to the ellipsoid).
+    /// of them gives it (to move altitudes to the ellipsoid); only with
+    /// [`Datum::Collect`].
     separations_m: Vec<f64>,
+    /// Whether some fix has an altitude with a geoid separation.
+    separation_seen: bool,
     /// Whether some fix has an altitude without a geoid separation (the
     /// datum is then mean sea level, and `separations_m` is emptied).
     separation_missing: bool,
     /// Latest known UNIX time (an RMC's date and time, or a fix), for dating.
     reference_ns: Option<i64>,
+    /// The UNIX time of the first dated epoch, which dates the fixes before
+    /// it: found by a first pass, given to the second
+    /// ([`Assembler::first_dated_ns`]), so those fixes need not wait.
+    pub(super) first_dated_ns: Option<i64>,
     pub(super) undated: Vec<Undated>,
+    /// The first fix's altitude above mean sea level with its geoid
+    /// separation, for the ENU origin ([`Assembler::first_altitude_m`]).
+    first_altitude: Option<(f64, Option<f64>)>,
 }
 
 impl Assembler {
+    /// An assembler putting altitudes on their datum as `datum` says, dating
+    /// fixes before the first dated epoch by `first_dated_ns` when known.
+    pub(super) fn new(datum: Datum, first_dated_ns: Option<i64>) -> Self {
+        Self { datum, first_dated_ns, ..Self::default() }
+    }
+
     pub(super) fn close(&mut self, epoch: Epoch) {
         let rmc_date = epoch.days();
         if let Some(days) = rmc_date {
             let reference_ns = days * NS_PER_DAY + epoch.time_of_day_ns;
             self.reference_ns = Some(reference_ns);
+            self.first_dated_ns.get_or_insert(reference_ns);
             for undated in std::mem::take(&mut self.undated) {
                 let t_ns = nearest_ns(reference_ns, undated.time_of_day_ns);
                 self.emit(t_ns, undated.candidate, undated.horizontal_sigma_m, undated.line);
@@ -177,6 +210,14 @@ impl Assembler {
         let t_ns = match (rmc_date, self.reference_ns) {
             (Some(days), _) => days * NS_PER_DAY + epoch.time_of_day_ns,
             (None, Some(reference_ns)) => nearest_ns(reference_ns, epoch.time_of_day_ns),
+            // Dated as the first pass found (the first dated epoch will date
+            // them so): the same fixes, in the same order, none kept waiting.
+            (None, None) if self.first_dated_ns.is_some() && matches!(self.datum, Datum::Known { .. }) => {
+                let first_dated_ns = self.first_dated_ns.unwrap_or_default();
+                let t_ns = nearest_ns(first_dated_ns, epoch.time_of_day_ns);
+                self.emit(t_ns, candidate, epoch.horizontal_sigma_m, epoch.line);
+                return;
+            }
             (None, None) => {
                 let (time_of_day_ns, horizontal_sigma_m, line) =
                     (epoch.time_of_day_ns, epoch.horizontal_sigma_m, epoch.line);
@@ -192,31 +233,40 @@ impl Assembler {
     /// Appends a fix; returns whether it was kept (not a repeated or
     /// out-of-order epoch, which are counted instead).
     fn emit(&mut self, t_ns: i64, candidate: Candidate, horizontal_sigma_m: Option<f64>, line: usize) -> bool {
-        if let (Some(last), Some(last_line)) = (self.log.fixes.last(), self.last_fix_line) {
-            if t_ns == last.t_ns {
+        if let Some((last_t_ns, last_line)) = self.last_fix {
+            if t_ns == last_t_ns {
                 self.log.duplicate_epochs += 1;
                 return false;
             }
-            if t_ns < last.t_ns {
+            if t_ns < last_t_ns {
                 self.log.out_of_order_epochs += 1;
                 if self.log.first_out_of_order.is_none() {
-                    let back_ns = last.t_ns - t_ns;
+                    let back_ns = last_t_ns - t_ns;
                     let reason = format!(
                         "fix at {} UTC is {}.{:09} s before the previous fix ({} UTC, line {last_line})",
                         clock(t_ns),
                         back_ns / 1_000_000_000,
                         back_ns % 1_000_000_000,
-                        clock(last.t_ns),
+                        clock(last_t_ns),
                     );
                     self.log.first_out_of_order = Some(SkippedLine { line, reason });
                 }
                 return false;
             }
         }
-        self.last_fix_line = Some(line);
-        if candidate.altitude_msl_m.is_some() && !self.separation_missing {
+        self.last_fix = Some((t_ns, line));
+        let mut altitude_m = candidate.altitude_msl_m;
+        if let Some(altitude_msl_m) = candidate.altitude_msl_m {
+            self.first_altitude.get_or_insert((altitude_msl_m, candidate.geoid_separation_m));
             match candidate.geoid_separation_m {
-                Some(separation_m) => self.separations_m.push(separation_m),
+                Some(separation_m) => {
+                    self.separation_seen = true;
+                    match self.datum {
+                        Datum::Collect if !self.separation_missing => self.separations_m.push(separation_m),
+                        Datum::Known { ellipsoid: true } => altitude_m = Some(altitude_msl_m + separation_m),
+                        _ => {}
+                    }
+                }
                 None => {
                     self.separation_missing = true;
                     self.separations_m = Vec::new();
@@ -224,11 +274,13 @@ impl Assembler {
             }
         }
         self.log.rmc_only_fixes += u64::from(candidate.rmc_only);
+        self.log.fix_count += 1;
+        self.log.fixes_without_altitude += u64::from(altitude_m.is_none());
         self.log.fixes.push(GnssFix {
             t_ns,
             latitude_deg: candidate.latitude_deg,
             longitude_deg: candidate.longitude_deg,
-            altitude_m: candidate.altitude_msl_m,
+            altitude_m,
             horizontal_sigma_m,
             num_satellites: candidate.num_satellites,
             quality: candidate.quality,
@@ -243,14 +295,26 @@ impl Assembler {
         }
     }
 
+    /// The first fix's altitude on the datum [`Assembler::finish`] decides:
+    /// the same number as that fix's `altitude_m` in the log.
+    pub(super) fn first_altitude_m(&self) -> Option<f64> {
+        let (altitude_msl_m, separation_m) = self.first_altitude?;
+        match separation_m {
+            Some(separation_m) if !self.separation_missing => Some(altitude_msl_m + separation_m),
+            _ => Some(altitude_msl_m),
+        }
+    }
+
     /// The log, altitudes moved to the ellipsoid when every fix with an
     /// altitude gives the geoid separation.
     pub(super) fn finish(self) -> NmeaLog {
         let mut log = self.log;
         if self.separation_missing {
             log.altitude_datum = "mean sea level";
-        } else if self.separations_m.is_empty() {
+        } else if !self.separation_seen {
             log.altitude_datum = "";
+        } else if self.datum != Datum::Collect {
+            log.altitude_datum = "ellipsoid";
         } else {
             let mut separations = self.separations_m.iter();
             for altitude_m in log.fixes.iter_mut().filter_map(|fix| fix.altitude_m.as_mut()) {

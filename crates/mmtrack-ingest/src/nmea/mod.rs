@@ -1,8 +1,12 @@
 //! NMEA 0183 GNSS logs: GGA and RMC or ZDA (and GST when present) from any
 //! talker (GP, GN, GL, GA, GB, GQ, ...), one fix per epoch.
 //!
-//! The log is read as a stream, one line at a time, so memory does not grow
-//! with the file (only with the number of fixes). A line longer than
+//! The log is read as a stream, one line at a time. [`ingest_nmea`] reads a
+//! file twice (the first pass decides the altitude datum, which needs every
+//! fix, and finds the first fix; the second writes each fix as it is made),
+//! so its memory grows neither with the file nor with the number of fixes;
+//! from a pipe, which cannot be read again, and in [`parse_nmea`], the fixes
+//! are kept (about 90 bytes each). A line longer than
 //! [`MAX_LINE_BYTES`] (NMEA 0183 sentences are at most 82 characters), or a
 //! file with no sentence in its first [`MAX_LINES_BEFORE_FIRST_SENTENCE`]
 //! lines, is not an NMEA log (binary data, `/dev/zero`, a wrong file): it is
@@ -98,7 +102,7 @@ use std::path::Path;
 
 use mmtrack_core::GnssFix;
 
-use self::epoch::{Assembler, Epoch, Part};
+use self::epoch::{Assembler, Datum, Epoch, Part};
 use self::sentence::Line;
 use crate::IngestError;
 use crate::error::os_err;
@@ -127,8 +131,13 @@ pub struct SkippedLine {
 /// What a log gave.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct NmeaLog {
-    /// Fixes in strictly increasing time order.
+    /// Fixes in strictly increasing time order ([`parse_nmea`], [`read_nmea`];
+    /// empty from [`ingest_nmea`], which streams them into the recording).
     pub fixes: Vec<GnssFix>,
+    /// How many fixes the log gave.
+    pub fix_count: u64,
+    /// Fixes without an altitude.
+    pub fixes_without_altitude: u64,
     /// Fixes from an RMC alone (no GGA, or one that did not parse): no
     /// altitude and no satellite count.
     pub rmc_only_fixes: u64,
@@ -164,9 +173,40 @@ pub struct NmeaLog {
 /// comes early enough (not an NMEA log), on a read error, and when there are
 /// fixes but no date; everything else is skipped and counted (see the module
 /// documentation). Bytes that are not UTF-8 make their lines unparsable, not
-/// the log.
-pub fn parse_nmea(path: &Path, mut input: impl BufRead) -> Result<NmeaLog, IngestError> {
-    let mut parser = Parser::default();
+/// the log. The fixes are kept in memory (about 90 bytes each), since their
+/// altitude datum is decided by the last; [`ingest_nmea`] streams a file
+/// twice instead.
+pub fn parse_nmea(path: &Path, input: impl BufRead) -> Result<NmeaLog, IngestError> {
+    Ok(run(path, input, Parser::default(), &mut |_| Ok(()))?.log)
+}
+
+/// What a pass over a log found beside its [`NmeaLog`].
+struct Pass {
+    log: NmeaLog,
+    /// The first fix with an altitude: its altitude on the log's datum.
+    first_altitude_m: Option<f64>,
+    /// The UNIX time of the first dated epoch (dates the fixes before it).
+    first_dated_ns: Option<i64>,
+}
+
+/// Reads a log line by line with `parser`, handing each fix to `sink` as
+/// it is made when the parser does not keep them ([`Datum::Decide`],
+/// [`Datum::Known`]).
+fn run(
+    path: &Path,
+    mut input: impl BufRead,
+    mut parser: Parser,
+    sink: &mut dyn FnMut(&GnssFix) -> Result<(), IngestError>,
+) -> Result<Pass, IngestError> {
+    let streamed = parser.assembler.datum != Datum::Collect;
+    let mut drain = |parser: &mut Parser| -> Result<(), IngestError> {
+        if streamed {
+            for fix in parser.assembler.log.fixes.drain(..) {
+                sink(&fix)?;
+            }
+        }
+        Ok(())
+    };
     let mut bytes = Vec::with_capacity(MAX_LINE_BYTES + 1);
     let mut line_number = 0;
     let mut seen_sentence = false;
@@ -196,8 +236,9 @@ pub fn parse_nmea(path: &Path, mut input: impl BufRead) -> Result<NmeaLog, Inges
                  not an NMEA text log (binary data?)"
             )));
         }
+        drain(&mut parser)?;
     }
-    parser.finish(path)
+    parser.finish(path, &mut drain)
 }
 
 /// The epoch being read and what the closed ones gave.
@@ -265,11 +306,17 @@ impl Parser {
         true
     }
 
-    /// Closes the last epoch; fails when fixes could not be dated.
-    fn finish(mut self, path: &Path) -> Result<NmeaLog, IngestError> {
+    /// Closes the last epoch (its fix to `drain`); fails when fixes could
+    /// not be dated.
+    fn finish(
+        mut self,
+        path: &Path,
+        drain: &mut dyn FnMut(&mut Self) -> Result<(), IngestError>,
+    ) -> Result<Pass, IngestError> {
         if let Some(epoch) = self.current.take() {
             self.assembler.close(epoch);
         }
+        drain(&mut self)?;
         if let Some(first) = self.assembler.undated.first() {
             return Err(IngestError::BadLayout {
                 path: path.to_path_buf(),
@@ -281,7 +328,8 @@ impl Parser {
                 ),
             });
         }
-        Ok(self.assembler.finish())
+        let (first_altitude_m, first_dated_ns) = (self.assembler.first_altitude_m(), self.assembler.first_dated_ns);
+        Ok(Pass { log: self.assembler.finish(), first_altitude_m, first_dated_ns })
     }
 }
 
@@ -313,8 +361,26 @@ pub fn ingest_nmea(
     recording: &mmtrack_io::RecordingOptions,
 ) -> Result<NmeaReport, IngestError> {
     use mmtrack_io::recording::channels::{GNSS_TOPIC, GNSS_VIZ_TOPIC};
-    let log = read_nmea(input)?;
-    let first = log.fixes.first().ok_or_else(|| IngestError::BadLayout {
+    let file = std::fs::File::open(input).map_err(os_err(input))?;
+    let regular = file.metadata().map_err(os_err(input))?.is_file();
+    // A file is read twice: the first pass decides the altitude datum (and
+    // finds the first fix), the second writes; a pipe cannot be read again,
+    // so its fixes are kept in memory until the datum is known.
+    let (first_pass, kept) = if regular {
+        let mut first_fix = None;
+        let decide = Parser { assembler: Assembler::new(Datum::Decide, None), current: None };
+        let pass = run(input, std::io::BufReader::new(file), decide, &mut |fix| {
+            first_fix.get_or_insert_with(|| fix.clone());
+            Ok(())
+        })?;
+        (pass, first_fix)
+    } else {
+        let pass = run(input, std::io::BufReader::new(file), Parser::default(), &mut |_| Ok(()))?;
+        let first = pass.log.fixes.first().cloned();
+        (pass, first)
+    };
+    let log = &first_pass.log;
+    let first = kept.ok_or_else(|| IngestError::BadLayout {
         path: input.to_path_buf(),
         detail: format!(
             "no fixes (bad checksums {}, unparsable lines {}{}, epochs without fix {})",
@@ -337,7 +403,7 @@ pub fn ingest_nmea(
         ("gnss.enu_origin_latitude_deg".to_string(), first.latitude_deg.to_string()),
         ("gnss.enu_origin_longitude_deg".to_string(), first.longitude_deg.to_string()),
     ]);
-    if let Some(altitude_m) = log.fixes.iter().find_map(|fix| fix.altitude_m) {
+    if let Some(altitude_m) = first_pass.first_altitude_m {
         extra.insert("gnss.enu_origin_altitude_m".to_string(), altitude_m.to_string());
     }
     let source = format!("nmea:{}", mmtrack_io::paths::canonical(input));
@@ -346,13 +412,35 @@ pub fn ingest_nmea(
         extend,
         &source,
         extra,
-        log.fixes.first().map(|f| f.t_ns),
+        Some(first.t_ns),
         &[GNSS_TOPIC, GNSS_VIZ_TOPIC],
         recording,
     )?;
-    for fix in &log.fixes {
-        writer.write_gnss_fix(fix)?;
+    if !regular {
+        for fix in &first_pass.log.fixes {
+            writer.write_gnss_fix(fix)?;
+        }
+        let output = writer.finish()?;
+        return Ok(NmeaReport { log: first_pass.log, output });
+    }
+    let file = std::fs::File::open(input).map_err(os_err(input))?;
+    let write = Parser {
+        assembler: Assembler::new(
+            Datum::Known { ellipsoid: log.altitude_datum == "ellipsoid" },
+            first_pass.first_dated_ns,
+        ),
+        current: None,
+    };
+    let second_pass = run(input, std::io::BufReader::new(file), write, &mut |fix| Ok(writer.write_gnss_fix(fix)?))?;
+    if second_pass.log != first_pass.log {
+        return Err(IngestError::BadLayout {
+            path: input.to_path_buf(),
+            detail: format!(
+                "changed while it was read: {} fixes on the first reading, {} on the second",
+                first_pass.log.fix_count, second_pass.log.fix_count
+            ),
+        });
     }
     let output = writer.finish()?;
-    Ok(NmeaReport { log, output })
+    Ok(NmeaReport { log: second_pass.log, output })
 }

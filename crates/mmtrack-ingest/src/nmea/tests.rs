@@ -617,3 +617,64 @@ fn an_implausible_altitude_is_skipped_and_reported() {
     let reason = log.first_unparsable.unwrap().reason;
     assert!(reason.contains("altitude") && reason.contains("1e300 is not an altitude within"), "{reason}");
 }
+
+/// The fixes of the recording at `path`.
+fn recorded_fixes(path: &Path) -> Vec<mmtrack_core::GnssFix> {
+    use mmtrack_io::recording::{RecordingEvent, RecordingReader};
+    let mut reader = RecordingReader::open(path).unwrap();
+    reader
+        .by_ref()
+        .filter_map(|event| match event.unwrap() {
+            RecordingEvent::Gnss(fix) => Some(fix),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Before: `ingest_nmea` kept every fix in memory (about 90 bytes each)
+/// until the last had decided the altitude datum. A file is now read twice
+/// (the datum, then the writing) and no fix is kept; the recording is the
+/// same, with GGAs before the first RMC dated by it, altitudes on either
+/// datum, and the ENU origin's height on the datum. A pipe is read once.
+#[test]
+fn a_file_is_ingested_in_two_passes_keeping_no_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let without_geoid = sentence("GNGGA,021419.00,3725.58362,N,12205.61915,W,1,12,0.76,9.9,M,,M,,");
+    let undated = [gga("GN", "021415.00", "1"), gga("GN", "021416.00", "1")].join("\n") + "\n";
+    let ellipsoid = undated.clone() + &epoch("GN", "021417.00") + &epoch("GN", "021418.00");
+    let msl = ellipsoid.clone() + &rmc("GN", "021419.00", "A", "070220") + "\n" + &without_geoid + "\n";
+    for (name, text, datum, origin_m) in
+        [("e.nmea", &ellipsoid, "ellipsoid", 4.4 - 30.0), ("m.nmea", &msl, "mean sea level", 4.4)]
+    {
+        let input = dir.path().join(name);
+        std::fs::write(&input, text).unwrap();
+        let expected = parse(text).unwrap();
+        assert_eq!(expected.altitude_datum, datum);
+        let out = dir.path().join(format!("{name}.mcap"));
+        let report = ingest_nmea(&input, &out, None, &mmtrack_io::RecordingOptions::default()).unwrap();
+        assert!(report.log.fixes.is_empty(), "{} fixes kept", report.log.fixes.len());
+        assert_eq!(report.log, NmeaLog { fixes: Vec::new(), ..expected.clone() });
+        assert_eq!(recorded_fixes(&out), expected.fixes);
+        assert_eq!(expected.fixes.len(), 4 + usize::from(datum == "mean sea level"));
+        let mut reader = mmtrack_io::recording::RecordingReader::open(&out).unwrap();
+        let _ = reader.next();
+        let metadata = reader.metadata().unwrap().clone();
+        let origin: f64 = metadata["gnss.enu_origin_altitude_m"].parse().unwrap();
+        assert!((origin - origin_m).abs() < 1e-9, "{origin}");
+        assert_eq!(metadata["gnss.altitude_datum"], datum);
+    }
+    #[cfg(unix)]
+    {
+        let fifo = dir.path().join("pipe");
+        assert!(std::process::Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+        let feeder = {
+            let (fifo, text) = (fifo.clone(), msl.clone());
+            std::thread::spawn(move || std::fs::write(fifo, text).unwrap())
+        };
+        let out = dir.path().join("pipe.mcap");
+        let report = ingest_nmea(&fifo, &out, None, &mmtrack_io::RecordingOptions::default()).unwrap();
+        feeder.join().unwrap();
+        assert_eq!(report.log.fix_count, 5);
+        assert_eq!(recorded_fixes(&out), parse(&msl).unwrap().fixes);
+    }
+}

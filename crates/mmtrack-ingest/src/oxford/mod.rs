@@ -31,7 +31,9 @@ use crate::scan_folder::{
     SameSize, StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check, within_scan_span,
 };
 use crate::{IngestError, Progress};
-pub use png_scan::{DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, encode_scan_png};
+pub use png_scan::{
+    DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, decode_scan_png_file, encode_scan_png,
+};
 
 pub use crate::scan_folder::ScanFile;
 
@@ -281,16 +283,27 @@ pub fn ingest_oxford(
     })
 }
 
-/// A scan PNG as read and decoded on a worker thread.
+/// A scan PNG as read and decoded on a worker thread: the PNG bytes to
+/// carry, or the decoded scan (never both).
 struct DecodedScan {
-    decoded: DecodedScanPng,
-    png: Vec<u8>,
+    payload: ScanPayload,
     cartesian: Option<Vec<u8>>,
+}
+
+enum ScanPayload {
+    Png { header: mmtrack_core::PolarScanHeader, png: Vec<u8> },
+    Scan(PolarScan),
 }
 
 /// Decodes Oxford/Boreas-style scan PNGs (one worker per core) and writes them
 /// in order: the PNG bytes carried unchanged, or decoded mono8 images. Every
 /// scan must have the size of the first.
+///
+/// Memory: a PNG is decoded from its file piece by piece (never held whole
+/// beside its image); a carried PNG is read whole after its image is
+/// dropped. What one scan holds, the larger of the two plus its Cartesian
+/// view, counts against [`crate::scan_folder::SCAN_MEMORY_BUDGET_BYTES`]
+/// until the writer has taken it.
 pub(crate) fn write_navtech_scans(
     writer: &mut RecordingWriter,
     scans: &[ScanFile],
@@ -302,9 +315,16 @@ pub(crate) fn write_navtech_scans(
     // The Cartesian view is resampled on the decoding threads, from the
     // decoded image with its header columns skipped.
     let resampler = writer.cartesian_resampler().cloned();
+    let view_bytes = resampler.as_ref().map_or(0, |r| (r.grid().size_px as usize).pow(2));
+    let cost = |scan: &ScanFile| {
+        let image = crate::scan_folder::png_image_bytes(&scan.path);
+        let carried = if carry_png { crate::scan_folder::file_bytes(&scan.path) } else { 0 };
+        image.max(carried).saturating_add(view_bytes)
+    };
     let decode = |scan: &ScanFile| -> Result<DecodedScan, IngestError> {
-        let bytes = crate::error::read_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?;
-        let decoded = decode_scan_png(&scan.path, &bytes, scan.t_ns, layout)?;
+        let (file, _) = crate::error::open_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?;
+        let decoded = decode_scan_png_file(&scan.path, &file, scan.t_ns, layout)?;
+        drop(file);
         let cartesian =
             match &resampler {
                 Some(r) => Some(r.resample(&decoded.header, &decoded.pixels, decoded.width, HEADER_COLUMNS).map_err(
@@ -317,22 +337,36 @@ pub(crate) fn write_navtech_scans(
                 )?),
                 None => None,
             };
-        Ok(DecodedScan { decoded, png: bytes, cartesian })
+        let payload = if carry_png {
+            let DecodedScanPng { header, pixels, .. } = decoded;
+            drop(pixels); // before the file is read
+            ScanPayload::Png {
+                header,
+                png: crate::error::read_capped(&scan.path, &mmtrack_core::limits::SCAN_PNG_BYTES)?,
+            }
+        } else {
+            ScanPayload::Scan(decoded.into_scan())
+        };
+        Ok(DecodedScan { payload, cartesian })
     };
     let mut same_size = SameSize::default();
     let mut write = |index: usize, scan: DecodedScan| -> Result<(), IngestError> {
-        let DecodedScan { decoded, png, cartesian } = scan;
-        let path = &scans[index].path;
-        same_size.check(path, decoded.header.azimuths.len(), decoded.header.bins_per_azimuth)?;
-        if carry_png {
-            writer.write_radar_png_and_view(&decoded.header, &png, HEADER_COLUMNS as u32, cartesian.as_deref())?;
-        } else {
-            writer.write_radar_scan_and_view(&decoded.into_scan(), cartesian.as_deref())?;
+        let DecodedScan { payload, cartesian } = scan;
+        let header = match &payload {
+            ScanPayload::Png { header, .. } => header,
+            ScanPayload::Scan(scan) => &scan.header,
+        };
+        same_size.check(&scans[index].path, header.azimuths.len(), header.bins_per_azimuth)?;
+        match &payload {
+            ScanPayload::Png { header, png } => {
+                writer.write_radar_png_and_view(header, png, HEADER_COLUMNS as u32, cartesian.as_deref())?;
+            }
+            ScanPayload::Scan(scan) => writer.write_radar_scan_and_view(scan, cartesian.as_deref())?,
         }
         progress(index as u64 + 1, total);
         Ok(())
     };
-    decode_in_order(scans, &decode, &mut write)
+    decode_in_order(scans, &cost, &decode, &mut write)
 }
 
 /// Writes scans (and optional relative-pose ground truth) as an Oxford-layout

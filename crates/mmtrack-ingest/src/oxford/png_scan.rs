@@ -62,8 +62,15 @@ impl DecodedScanPng {
     /// The scan with header columns removed from the power.
     #[must_use]
     pub fn into_scan(self) -> PolarScan {
-        let power = self.pixels.chunks_exact(self.width).flat_map(|row| &row[HEADER_COLUMNS..]).copied().collect();
-        PolarScan { header: self.header, power }
+        // In place: row r's bins move left by the header columns of rows 0..=r.
+        let Self { header, width, mut pixels } = self;
+        let bins = width - HEADER_COLUMNS;
+        let rows = pixels.len() / width;
+        for row in 0..rows {
+            pixels.copy_within(row * width + HEADER_COLUMNS..(row + 1) * width, row * bins);
+        }
+        pixels.truncate(rows * bins);
+        PolarScan { header, power: pixels }
     }
 }
 
@@ -117,8 +124,30 @@ pub fn decode_scan_png(
     scan_t_ns: i64,
     layout: &NavtechLayout,
 ) -> Result<DecodedScanPng, IngestError> {
+    let image = mmtrack_io::Gray8Png::open(png).map_err(|detail| bad(path, "image".into(), "PNG data", detail))?;
+    decode_scan_image(path, image, scan_t_ns, layout)
+}
+
+/// [`decode_scan_png`] on the open PNG file of `path`, read piece by piece:
+/// the file is never held whole beside its image.
+pub fn decode_scan_png_file(
+    path: &Path,
+    file: &std::fs::File,
+    scan_t_ns: i64,
+    layout: &NavtechLayout,
+) -> Result<DecodedScanPng, IngestError> {
+    let image =
+        mmtrack_io::Gray8Png::open_file(file).map_err(|detail| bad(path, "image".into(), "PNG data", detail))?;
+    decode_scan_image(path, image, scan_t_ns, layout)
+}
+
+fn decode_scan_image(
+    path: &Path,
+    image: mmtrack_io::Gray8Png<'_>,
+    scan_t_ns: i64,
+    layout: &NavtechLayout,
+) -> Result<DecodedScanPng, IngestError> {
     let png_error = |detail| bad(path, "image".into(), "PNG data", detail);
-    let image = mmtrack_io::Gray8Png::open(png).map_err(png_error)?;
     let (width, height) = (image.width(), image.height());
     check_size(path, width, height, layout)?;
     let bins = width - HEADER_COLUMNS;

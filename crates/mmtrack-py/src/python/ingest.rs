@@ -178,7 +178,7 @@ pub(super) fn ingest_nmea<'py>(
         py,
         &report.output,
         &[
-            ("fixes", log.fixes.len() as u64),
+            ("fixes", log.fix_count),
             ("bad_checksum_lines", log.bad_checksum_lines as u64),
             ("unparsable_lines", log.unparsable_lines as u64),
         ],
