@@ -359,7 +359,7 @@ const FIGURE_FILES: [&str; 4] =
 #[must_use]
 pub fn report_markdown(summary: &str) -> String {
     let mut out = summary.to_string();
-    out.push_str("\n");
+    out.push('\n');
     for file in FIGURE_FILES {
         out.push_str(&format!("![{file}]({file})\n\n"));
     }

@@ -79,9 +79,10 @@ pub fn measure(config: &Config, tier: Tier, runs: Option<u64>, progress: &dyn Pr
     let result = monte_carlo(&link, &tracker, experiment.seed, runs_a, PoseSource::ErrorModel, progress)?;
     let mut pilot_variants = Vec::new();
     let sensitivity = &experiment.sensitivity;
-    let runs_variant = match sensitivity.pilot_power_dbm.is_empty() {
-        true => 0,
-        false => run_count(runs, tier, sensitivity.quick_runs, sensitivity.runs)?,
+    let runs_variant = if sensitivity.pilot_power_dbm.is_empty() {
+        0
+    } else {
+        run_count(runs, tier, sensitivity.quick_runs, sensitivity.runs)?
     };
     for &pilot_power_dbm in &sensitivity.pilot_power_dbm {
         let mut variant = experiment.clone();
