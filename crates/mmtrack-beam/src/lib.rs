@@ -15,7 +15,8 @@
 //!   2019 (recursive H-infinity/RLS on the initial state, the Ho-Chan batch
 //!   baseline, two genie bounds, beam selection with measurement counting);
 //! - [`PilotTracker`]: the predict / update roles every such tracker plays,
-//!   so experiments drive them alike;
+//!   so experiments drive them alike; [`OpenLoop`] runs one's predictor
+//!   without its updates (the open-loop baseline);
 //! - [`valid_tracking`]: the paper's metric, blocks until the RMS angle error
 //!   over Monte Carlo runs exceeds half the beamwidth;
 //! - [`sweep`]: beam-sweep trackers for measured codebooks (a window around
@@ -38,6 +39,6 @@ pub mod valid_tracking;
 
 pub use angle_ekf::{AngleEkf, AngleEkfConfig};
 pub use error::BeamError;
-pub use link::{BeamPair, PilotTracker};
+pub use link::{BeamPair, OpenLoop, PilotTracker};
 pub use position_velocity_ekf::{PositionVelocityEkf, PositionVelocityEkfConfig, ProcessModel};
 pub use spebt::{Deviation, SpebtConfig, SpebtEkf, SpebtState};

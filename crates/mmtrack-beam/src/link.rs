@@ -50,6 +50,25 @@ pub trait PilotTracker {
     fn update(&mut self, pilot: Complex64) -> Result<(), BeamError>;
 }
 
+/// A tracker's predictor run open loop: [`PilotTracker::predict`] as the
+/// tracker's, every pilot discarded. From the channel estimate of block 0,
+/// the position-velocity EKF's prediction (eq. (24), `x[k+1|k] = A x[k|k]`)
+/// then extrapolates the start at constant speed, `d[k] = d[0] + v[0] k dt`:
+/// the baseline that tells what the measurement updates add.
+#[derive(Debug, Clone)]
+pub struct OpenLoop<T>(pub T);
+
+impl<T: PilotTracker> PilotTracker for OpenLoop<T> {
+    fn predict(&mut self) -> Result<BeamPair, BeamError> {
+        self.0.predict()
+    }
+
+    /// Discards the pilot (no measurement update).
+    fn update(&mut self, _pilot: Complex64) -> Result<(), BeamError> {
+        Ok(())
+    }
+}
+
 /// A complex pilot as the real measurement `[Re z, Im z]` (Shaham et al.
 /// Sec. III-C).
 pub(crate) fn stacked(z: Complex64) -> Col<f64> {

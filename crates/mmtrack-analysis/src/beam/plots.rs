@@ -71,6 +71,93 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
     Ok(svg)
 }
 
+/// One line of the distance figure: RMS AoD error against the vehicle's
+/// horizontal distance from the overpass.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DistanceCurve {
+    /// Legend text.
+    pub label: String,
+    /// Mean true distance `d` of block `k` at index `k`, metres (negative
+    /// before the overpass).
+    pub distance_m: Vec<f64>,
+    /// RMS AoD error of block `k` at index `k`, degrees.
+    pub rms_deg: Vec<f64>,
+    /// Index into the palette (curves of one scenario point share it).
+    pub color: usize,
+    /// Drawn dashed (a baseline) rather than solid.
+    pub dashed: bool,
+}
+
+/// An SVG of `curves` against the distance from the overpass, with the
+/// threshold line at `threshold_deg` and a vertical line where the vehicle
+/// passes under the overpass (`d = 0`); the y axis is logarithmic.
+///
+/// # Errors
+/// When plotters fails to draw (not expected for finite input).
+pub fn rms_against_distance_svg(title: &str, curves: &[DistanceCurve], threshold_deg: f64) -> anyhow::Result<String> {
+    let x = padded_range(curves.iter().flat_map(|c| c.distance_m.iter().copied()).chain([0.0]));
+    let positive = || curves.iter().flat_map(|c| c.rms_deg.iter().copied()).filter(|v| *v > 0.0 && v.is_finite());
+    let y_lo = positive().fold(threshold_deg, f64::min).max(1e-3) * 0.8;
+    let y_hi = positive().fold(threshold_deg, f64::max) * 1.2;
+    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0)];
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(65)
+            .build_cartesian_2d(x.clone(), (y_lo..y_hi).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .label_style(crate::plot_common::TICK_FONT)
+            .axis_desc_style(crate::plot_common::AXIS_FONT)
+            .x_desc("horizontal distance from the overpass d (m), negative before it")
+            .y_desc("RMS AoD error (deg)")
+            .draw()
+            .map_err(err)?;
+        for curve in curves {
+            let color = palette[curve.color % palette.len()];
+            let points: Vec<(f64, f64)> = curve
+                .distance_m
+                .iter()
+                .zip(&curve.rms_deg)
+                .filter(|(d, v)| **v > 0.0 && v.is_finite() && d.is_finite())
+                .map(|(d, v)| (*d, v.clamp(y_lo, y_hi)))
+                .collect();
+            let style = color.stroke_width(2);
+            let series = if curve.dashed {
+                chart.draw_series(DashedLineSeries::new(points, 6, 4, style))
+            } else {
+                chart.draw_series(LineSeries::new(points, style))
+            };
+            let dashed = curve.dashed;
+            series.map_err(err)?.label(curve.label.clone()).legend(move |(x, y)| {
+                let end = if dashed { x + 8 } else { x + 20 };
+                PathElement::new(vec![(x, y), (end, y)], style)
+            });
+        }
+        let thin = BLACK.stroke_width(1);
+        chart
+            .draw_series(LineSeries::new([(x.start, threshold_deg), (x.end, threshold_deg)], thin))
+            .map_err(err)?
+            .label(format!("half beamwidth ({threshold_deg:.2} deg)"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], thin));
+        let grey = RGBColor(120, 120, 120).stroke_width(1);
+        chart
+            .draw_series(DashedLineSeries::new([(0.0, y_lo), (0.0, y_hi)], 8, 5, grey))
+            .map_err(err)?
+            .label("under the overpass (d = 0)")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
+        root.present().map_err(err)?;
+    }
+    Ok(svg)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -85,6 +172,21 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.contains("half beamwidth (4.50 deg)"), "{svg}");
         // Two curves, the threshold and their three legend samples.
         assert!(svg.matches("<polyline").count() >= 6, "{svg}");
+    }
+
+    #[test]
+    fn draws_curves_against_distance_with_the_overpass_line() {
+        let curve = |label: &str, dashed| DistanceCurve {
+            label: label.into(),
+            distance_m: (0..100).map(|k| -3.0 + 0.05 * f64::from(k)).collect(),
+            rms_deg: (0..100).map(|k| 0.05 * f64::from(k)).collect(),
+            color: 0,
+            dashed,
+        };
+        let svg = rms_against_distance_svg("test", &[curve("pv", false), curve("open", true)], 4.5).unwrap();
+        assert!(svg.contains("half beamwidth (4.50 deg)") && svg.contains("under the overpass (d = 0)"), "{svg}");
+        assert!(svg.contains("horizontal distance from the overpass d (m)") && svg.contains("RMS AoD error (deg)"));
+        assert!(svg.contains("\npv\n") && svg.contains("\nopen\n"), "both legend entries: {svg}");
     }
 }
 

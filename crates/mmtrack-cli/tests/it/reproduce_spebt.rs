@@ -39,6 +39,17 @@ fn quick_spebt_writes_tables_figure_verdicts_and_its_readme_block() {
     // share; |alpha| is reported only.
     assert_eq!(report.matches("| met |").count() + missed, 2 * 5, "{report}");
     assert_eq!(report.matches("| RMSE abs(alpha) (%) | 1.580 |").count(), 2, "{report}");
+    // The pilot power is ours, not the paper's: (a) again at 20 and 40 dBm (4 runs at --quick)
+    // beside the claims' 30 dBm run (8 runs), the others marked as variants.
+    let row = |power: &str| report.lines().find(|l| l.starts_with(&format!("| {power} | "))).unwrap_or("");
+    assert!(row("30").starts_with("| 30 | 8 |") && row("30").ends_with("| the claims' run |"), "{report}");
+    for power in ["20", "40"] {
+        let line = row(power);
+        assert!(
+            line.starts_with(&format!("| {power} | 4 |")) && line.ends_with("| variant, not a target |"),
+            "{report}"
+        );
+    }
 
     // (a) on the 6388 Oxford slots, 8 runs; (b) on the simulator's scans along the first 480 poses, 4 runs.
     for (experiment, runs, slots) in [("pose-error-model", 8, 6388..=6388), ("radar-odometry", 4, 470..=480)] {

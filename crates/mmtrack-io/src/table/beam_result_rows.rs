@@ -12,7 +12,7 @@ pointed from its prediction; block 0 is the channel estimate the trackers start 
     /// One row of [`BEAM_RMS_PER_BLOCK`].
     #[derive(Debug, Clone, PartialEq)]
     pub struct BeamRmsRow {
-        tracker: String, "", "tracker name (pv-ekf, pv-ekf-paper-table, angle-ekf)";
+        tracker: String, "", "tracker name (pv-ekf, pv-ekf-paper-table, angle-ekf, open-loop)";
         snr_db: f64, "dB", "received SNR of the scenario point: signal power over noise power, dB re the noise power";
         speed_kmh: f64, "km/h", "initial speed of the scenario point";
         block: u64, "", "block index (1 ms each)";

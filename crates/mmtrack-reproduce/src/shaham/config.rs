@@ -59,8 +59,18 @@ pub struct Target {
     pub paper_blocks: u64,
 }
 
-/// The trackers, in table order; the targets apply to the first.
-pub const TRACKERS: [&str; 3] = ["pv-ekf", "pv-ekf-paper-table", "angle-ekf"];
+/// How many trackers run on each realisation.
+pub const TRACKER_COUNT: usize = 4;
+
+/// The trackers, in table order; the targets apply to the first. The last,
+/// `open-loop`, is the proposed EKF's predictor without measurement updates
+/// (`mmtrack_beam::OpenLoop`): from the channel estimate it extrapolates at
+/// constant speed, a baseline of ours that tells what the pilots add.
+pub const TRACKERS: [&str; TRACKER_COUNT] = ["pv-ekf", "pv-ekf-paper-table", "angle-ekf", "open-loop"];
+/// Index of the angle-state EKF in [`TRACKERS`].
+pub const ANGLE_EKF: usize = 2;
+/// Index of the open-loop predictor in [`TRACKERS`].
+pub const OPEN_LOOP: usize = 3;
 
 impl Config {
     /// The experiment file at `path`, else the embedded default.

@@ -50,8 +50,10 @@ pub fn check_start(output: &Path, force: bool, readme: Option<&Path>) -> anyhow:
 /// `options.runs`; (b) on the first `quick_slots` slots at the smoke
 /// tier), then writes the Parquet tables (summary, per slot), the Fig.
 /// 5-style figures, `reproduce.md` and `metrics.json` into
-/// `options.output_dir`, replacing it whole. The verdicts are (a)'s three
-/// (AoD, AoA, re-initialisation share), then (b)'s.
+/// `options.output_dir`, replacing it whole. The verdicts are (a)'s
+/// (RMSE AoD and AoA after and before re-initialisation, re-initialisation
+/// share), then (b)'s, then (a)'s at the `[sensitivity]` pilot powers as
+/// variants (not targets).
 ///
 /// # Errors
 /// Zero runs, a missing or bad trajectory, a tracker or odometry failure,
@@ -80,6 +82,7 @@ pub fn run(config: &Config, options: &RunOptions, progress: &dyn Progress) -> an
                     v
                 })
             })
+            .chain(report::variant_verdicts(&config.experiment, &measured))
             .collect(),
         files,
         readme: ReadmeBlock { name: README_BLOCK, body: summary.clone() },

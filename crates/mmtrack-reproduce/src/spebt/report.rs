@@ -11,13 +11,13 @@ use mmtrack_core::{StampedPose, path_length_m, wrap_angle_rad};
 use mmtrack_io::Overwrite;
 use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, SpebtSummaryRow, write_table};
-use mmtrack_process::beam::spebt::monte_carlo::{ExperimentResult, SpebtExperiment};
+use mmtrack_process::beam::spebt::monte_carlo::{ExperimentResult, POSE_ERROR_MODEL, SpebtExperiment};
 use mmtrack_process::beam::spebt::tables::{slot_rows, summary_row};
 use mmtrack_sim::beam::spebt_link::{SpebtLink, SpebtSlot};
 
 use super::config::Config;
 use super::drive::OdometryDrive;
-use super::run::{ExperimentRun, Measured};
+use super::run::{ExperimentRun, Measured, PilotVariant};
 use crate::common::Staged;
 use crate::model::{Claim, Metric, Rule, Verdict, write_metrics};
 
@@ -122,10 +122,73 @@ fn summary_row_of(config: &Config, run: &ExperimentRun) -> SpebtSummaryRow {
     summary_row(&config.experiment, &config.trajectory, run.name, &run.link, &run.result)
 }
 
-/// Every experiment's metrics, (a) then (b).
+/// Every experiment's metrics, (a) then (b), then (a) at each pilot power
+/// of `[sensitivity]`.
 #[must_use]
 pub fn all_metrics(config: &Config, measured: &Measured) -> Vec<Metric> {
-    measured.experiments.iter().flat_map(|run| metrics(&summary_row_of(config, run))).collect()
+    let mut out: Vec<Metric> =
+        measured.experiments.iter().flat_map(|run| metrics(&summary_row_of(config, run))).collect();
+    for v in &measured.pilot_variants {
+        let name = variant_name(v);
+        out.extend(metrics(&summary_row(&config.experiment, &config.trajectory, &name, &v.link, &v.result)));
+    }
+    out
+}
+
+/// How a pilot-power variant is named in metrics and claims.
+fn variant_name(v: &PilotVariant) -> String {
+    format!("{POSE_ERROR_MODEL}, pilot {} dBm", v.pilot_power_dbm)
+}
+
+/// The claims of experiment (a) at each pilot power of `[sensitivity]`, as
+/// variants (not targets): the RMSEs before any re-initialisation and the
+/// re-initialisation share.
+#[must_use]
+pub fn variant_verdicts(experiment: &SpebtExperiment, measured: &Measured) -> Vec<Verdict> {
+    let mut out = Vec::new();
+    for v in &measured.pilot_variants {
+        for mut verdict in verdicts(experiment, &v.result) {
+            let what = &verdict.claim.what;
+            if what.contains("before re-initialisation") || what.starts_with("re-initialisations") {
+                verdict.claim.what = format!("{what} ({}, variant)", variant_name(v));
+                verdict.claim = verdict.claim.informational();
+                out.push(verdict);
+            }
+        }
+    }
+    out
+}
+
+/// Experiment (a) at the claims' pilot power and at the `[sensitivity]`
+/// ones, by power: the pilot power is not in the paper.
+fn pilot_sensitivity(e: &SpebtExperiment, claims_run: &ExperimentRun, variants: &[PilotVariant]) -> String {
+    let mut rows: Vec<(f64, &ExperimentResult, bool)> = vec![(e.scenario.pilot_power_dbm, &claims_run.result, true)];
+    rows.extend(variants.iter().map(|v| (v.pilot_power_dbm, &v.result, false)));
+    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out = format!(
+        "\n**Pilot power** (not in the paper; the claims above are at {} dBm): experiment (a) at other pilot powers, \
+         same seed, pose errors and noise draws.\n\n| pilot dBm | runs | RMSE abs(alpha) (%) | RMSE AoD (deg) | RMSE \
+         AoA (deg) | AoD / AoA before re-initialisation (deg) | re-initialisations (share of tracked slots) | role \
+         |\n|---|---|---|---|---|---|---|---|\n",
+        e.scenario.pilot_power_dbm
+    );
+    for (power, r, claims) in rows {
+        let [gain, aod, aoa] = r.rmse();
+        let [_, aod_before, aoa_before] = r.rmse_before_reset();
+        let share_pct = 100.0 * r.mean_reinitialisations() / r.tracked_slots().max(1) as f64;
+        let _ = writeln!(
+            out,
+            "| {power} | {} | {:.3} | {:.3} | {:.3} | {:.3} / {:.3} | {share_pct:.2} % | {} |",
+            r.runs,
+            100.0 * gain,
+            aod.to_degrees(),
+            aoa.to_degrees(),
+            aod_before.to_degrees(),
+            aoa_before.to_degrees(),
+            if claims { "the claims' run" } else { "variant, not a target" }
+        );
+    }
+    out
 }
 
 /// Run 0 against the truth, for the Fig. 5 figure.
@@ -175,16 +238,22 @@ pub fn summary(config: &Config, measured: &Measured, verdicts: &[Vec<Verdict>]) 
     );
     for (index, (run, verdicts)) in measured.experiments.iter().zip(verdicts).enumerate() {
         out.push_str(&experiment_section(e, index, run, verdicts));
+        if index == 0 && !measured.pilot_variants.is_empty() {
+            out.push_str(&pilot_sensitivity(e, run, &measured.pilot_variants));
+        }
     }
+    let variant_runs = measured.pilot_variants.iter().map(|v| (&v.result, &v.link));
     let runs: Vec<String> = measured
         .experiments
         .iter()
-        .map(|o| {
+        .map(|o| (&o.result, &o.link))
+        .chain(variant_runs)
+        .map(|(result, link)| {
             format!(
                 "{} runs x {} slots ({:.0} runs per CPU-second)",
-                o.result.runs,
-                o.link.len(),
-                o.result.runs as f64 / o.result.tracker_cpu_s.max(1e-9)
+                result.runs,
+                link.len(),
+                result.runs as f64 / result.tracker_cpu_s.max(1e-9)
             )
         })
         .collect();

@@ -34,10 +34,22 @@ pub struct ExperimentRun {
     pub result: ExperimentResult,
 }
 
+/// Experiment (a) at another pilot power (`[sensitivity]`).
+pub struct PilotVariant {
+    /// The variant's pilot power, dBm.
+    pub pilot_power_dbm: f64,
+    /// Its link (the same trajectory, another pilot power).
+    pub link: SpebtLink,
+    /// What its runs measured.
+    pub result: ExperimentResult,
+}
+
 /// What the whole Monte Carlo measured, and how long it took.
 pub struct Measured {
     /// (a), then (b) unless skipped.
     pub experiments: Vec<ExperimentRun>,
+    /// (a) at the `[sensitivity]` pilot powers, in the file's order.
+    pub pilot_variants: Vec<PilotVariant>,
     /// Wall time, seconds.
     pub elapsed_s: f64,
     /// Threads of the rayon pool.
@@ -65,11 +77,32 @@ pub fn measure(config: &Config, tier: Tier, runs: Option<u64>, progress: &dyn Pr
 
     let started = Instant::now();
     let result = monte_carlo(&link, &tracker, experiment.seed, runs_a, PoseSource::ErrorModel, progress)?;
+    let mut pilot_variants = Vec::new();
+    let sensitivity = &experiment.sensitivity;
+    let runs_variant = if sensitivity.pilot_power_dbm.is_empty() {
+        0
+    } else {
+        run_count(runs, tier, sensitivity.quick_runs, sensitivity.runs)?
+    };
+    for &pilot_power_dbm in &sensitivity.pilot_power_dbm {
+        let mut variant = experiment.clone();
+        variant.scenario.pilot_power_dbm = pilot_power_dbm;
+        let link = SpebtLink::new(&variant.scenario, &poses)
+            .with_context(|| format!("{source}: [sensitivity] pilot_power_dbm = {pilot_power_dbm}"))?;
+        let tracker = tracker_config(&variant);
+        let result = monte_carlo(&link, &tracker, experiment.seed, runs_variant, PoseSource::ErrorModel, progress)?;
+        pilot_variants.push(PilotVariant { pilot_power_dbm, link, result });
+    }
     let mut experiments = vec![ExperimentRun { name: POSE_ERROR_MODEL, link, drive: None, result }];
     if !config.skip_odometry {
         experiments.push(radar_odometry(config, tier, &tracker, poses, runs_b, progress)?);
     }
-    Ok(Measured { experiments, elapsed_s: started.elapsed().as_secs_f64(), threads: rayon::current_num_threads() })
+    Ok(Measured {
+        experiments,
+        pilot_variants,
+        elapsed_s: started.elapsed().as_secs_f64(),
+        threads: rayon::current_num_threads(),
+    })
 }
 
 /// Experiment (b): radar odometry along the first slots of the trajectory

@@ -82,13 +82,20 @@ fn spebt_smoke_judges_table_iii_for_both_experiments() {
     let paper = &config.experiment.paper;
     let share_pct = 100.0 * paper.reinitialisations as f64 / paper.slots as f64;
     let expected_paper = [paper.rmse_aod_deg, paper.rmse_aoa_deg, paper.rmse_aod_deg, paper.rmse_aoa_deg, share_pct];
-    assert_eq!(outcome.verdicts.len(), 10);
-    for (i, v) in outcome.verdicts.iter().enumerate() {
+    // Then (a) at the two [sensitivity] pilot powers, 20 and 40 dBm: AoD and AoA before
+    // re-initialisation and the share, variants rather than targets.
+    assert_eq!(outcome.verdicts.len(), 10 + 2 * 3);
+    let (targets, variants) = outcome.verdicts.split_at(10);
+    assert!(targets.iter().all(|v| !v.claim.informational), "{targets:?}");
+    for (v, power) in variants.iter().zip(["20", "20", "20", "40", "40", "40"]) {
+        assert!(v.claim.informational && v.claim.what.contains(&format!("pilot {power} dBm, variant")), "{v:?}");
+    }
+    for (i, v) in targets.iter().enumerate() {
         let paper_value = v.claim.paper_value.unwrap();
         assert_eq!(paper_value, expected_paper[i % 5], "{v:?}");
         let measured = v.measured.unwrap_or_else(|| panic!("{}: nothing measured", v.claim.what));
         assert_eq!(v.met, v.claim.rule.holds(measured) == Some(true), "{v:?}");
     }
-    assert_eq!(outcome.metrics.len(), 2 * 4, "|alpha|, AoD, AoA, share per experiment");
+    assert_eq!(outcome.metrics.len(), 4 * 4, "|alpha|, AoD, AoA, share per experiment and pilot-power variant");
     assert!(outcome.metrics.iter().all(|m| m.paper.is_some()), "{:?}", outcome.metrics);
 }

@@ -60,7 +60,8 @@ fn shaham_smoke_meets_its_expectations() {
     let options = smoke(&dir);
     let outcome = shaham::run(&shaham::Config::embedded().unwrap(), &options, &NoProgress).unwrap();
     check(&outcome, &options);
-    assert_eq!(outcome.verdicts.len(), 10, "7 published numbers, 2 orderings, 1 gain");
+    assert_eq!(outcome.verdicts.len(), 11, "7 published numbers, 2 orderings, 1 gain, the open-loop row");
+    assert_eq!(outcome.verdicts.iter().filter(|v| v.claim.informational).count(), 1, "the open-loop row is ours");
 }
 
 #[test]

@@ -46,6 +46,23 @@ pub struct SpebtExperiment {
     pub paper: Paper,
     /// The bounds the verdicts check.
     pub targets: Targets,
+    /// Experiment (a) re-run at other pilot powers (none by default).
+    #[serde(default)]
+    pub sensitivity: Sensitivity,
+}
+
+/// Experiment (a) re-run at other pilot powers: the paper does not give the
+/// pilot power, so the choice of `[scenario] pilot_power_dbm` is reported
+/// beside its alternatives (variants, not targets).
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sensitivity {
+    /// Pilot powers of the variants, dBm (the scenario's own is the claims' run).
+    pub pilot_power_dbm: Vec<f64>,
+    /// Monte Carlo runs per variant, full tier.
+    pub runs: u64,
+    /// Monte Carlo runs per variant, smoke tier.
+    pub quick_runs: u64,
 }
 
 /// The filter's model and thresholds.
