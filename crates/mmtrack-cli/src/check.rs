@@ -103,7 +103,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         }
     }
     if args.bless {
-        let text = std::fs::read_to_string(&args.suite).with_context(|| suite_name.clone())?;
+        let text = mmtrack_io::paths::read_config_text(&args.suite)?;
         let blessed = suite::bless(&text, &checks).with_context(|| format!("{suite_name}: --bless"))?;
         // Atomic: the old suite stays whole on any failure.
         mmtrack_io::atomic::write_file(&args.suite, blessed.as_bytes(), Overwrite::Replace)?;

@@ -104,6 +104,12 @@ pub const ITERATIONS: Limit = Limit { max: 10_000.0, expected: "between 1 and 10
 pub const TEXT_FILE_BYTES: Limit =
     Limit { max: 1_073_741_824.0, expected: "a text file of at most 1073741824 bytes (1 GiB)" };
 
+/// Size of a configuration file read whole (a scenario, a pipeline or
+/// experiment configuration, a manifest, a regression suite, a SLAM prior),
+/// bytes: 16 MiB, thousands of times the largest we ship (a few kB).
+pub const CONFIG_FILE_BYTES: Limit =
+    Limit { max: 16_777_216.0, expected: "a configuration file of at most 16777216 bytes (16 MiB)" };
+
 /// Size of a binary array input read whole (`.npy`, `.npz`, `.mat`, SigMF
 /// data), bytes: 4 GiB.
 pub const ARRAY_FILE_BYTES: Limit =
@@ -135,6 +141,7 @@ mod tests {
             REFLECTORS,
             ITERATIONS,
             TEXT_FILE_BYTES,
+            CONFIG_FILE_BYTES,
             ARRAY_FILE_BYTES,
             SCAN_PNG_BYTES,
         ];

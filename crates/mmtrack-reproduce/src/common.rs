@@ -56,9 +56,7 @@ pub fn load_experiment<T: DeserializeOwned>(
     embedded_name: &str,
 ) -> anyhow::Result<(String, T)> {
     let (source, text) = match path {
-        Some(path) => {
-            (path.display().to_string(), std::fs::read_to_string(path).with_context(|| path.display().to_string())?)
-        }
+        Some(path) => (path.display().to_string(), mmtrack_io::paths::read_config_text(path)?),
         None => (format!("embedded {embedded_name}"), embedded.to_string()),
     };
     let experiment = toml::from_str(&text).with_context(|| source.clone())?;

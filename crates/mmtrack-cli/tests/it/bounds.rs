@@ -117,3 +117,25 @@ fn pipeline_flags_and_keys_beyond_the_limits_are_refused() {
         &["--runs", "1000000"],
     );
 }
+
+/// Configuration files are read within a cap: `/dev/zero` or a 17 MiB file
+/// as a scenario, a pipeline configuration, a manifest or a suite is refused
+/// by name before it is read (these read without a bound before).
+#[test]
+fn configuration_files_beyond_their_cap_are_refused_before_reading() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::File::create(d.join("big.toml")).unwrap().set_len(17 * 1024 * 1024).unwrap();
+    for config in ["/dev/zero", "big.toml"] {
+        let what: &[&str] = if config == "big.toml" {
+            &["big.toml", "too large", "at most 16777216 bytes"]
+        } else {
+            &["/dev/zero", "is a device"]
+        };
+        refused(d, &["simulate", "radar", "--scenario", config, "-o", "r.mcap"], what);
+        refused(d, &["simulate", "sounder", "--scenario", config, "-o", "s.mcap"], what);
+        refused(d, &["process", "manifest", config, "-o", "t"], what);
+        refused(d, &["process", "odometry", "r.mcap", "--config", config, "-o", "t"], what);
+        refused(d, &["check", config], what);
+    }
+}

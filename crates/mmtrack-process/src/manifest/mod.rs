@@ -255,7 +255,7 @@ fn threads_of(words: &[String]) -> Option<Result<usize, String>> {
 /// a cycle. Each error names the file, the task and the key.
 pub fn read_manifest(path: &Path) -> anyhow::Result<Manifest> {
     let file = path.display();
-    let text = std::fs::read_to_string(path).with_context(|| format!("{file}: cannot read the manifest"))?;
+    let text = mmtrack_io::paths::read_config_text(path).context("cannot read the manifest")?;
     let table: toml::Table = toml::from_str(&text).with_context(|| file.to_string())?;
     if let Some(key) = table.keys().find(|k| *k != "task") {
         bail!("{file}: unknown key `{key}` (a manifest holds [[task]] tables only)");

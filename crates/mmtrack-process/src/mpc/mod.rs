@@ -85,7 +85,7 @@ pub fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
 /// The file cannot be read, is not TOML or not a valid configuration.
 pub fn effective_config(path: Option<&Path>) -> anyhow::Result<MpcConfig> {
     let Some(path) = path else { return Ok(MpcConfig::default()) };
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = mmtrack_io::paths::read_config_text(path)?;
     let changes: toml::Table = toml::from_str(&text).with_context(|| format!("{}: not valid TOML", path.display()))?;
     let mut merged = toml::Table::try_from(MpcConfig::default())?;
     merge_tables(&mut merged, changes);

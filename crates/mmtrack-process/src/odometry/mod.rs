@@ -26,7 +26,7 @@ use crate::output::{OutputOptions, RunDir, run_id_of};
 pub fn effective_config(preset: &str, overrides: Option<&Path>) -> anyhow::Result<OdometryConfig> {
     let base = OdometryConfig::preset(preset).with_context(|| format!("unknown preset '{preset}'"))?;
     let Some(path) = overrides else { return Ok(base) };
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let text = mmtrack_io::paths::read_config_text(path)?;
     let changes: toml::Table = toml::from_str(&text).with_context(|| format!("{}: not valid TOML", path.display()))?;
     let mut merged = toml::Table::try_from(&base)?;
     for (key, value) in changes {

@@ -72,7 +72,7 @@ pub struct RadarSimulated {
 /// # Errors
 /// The file cannot be read, parsed or checked, naming it.
 pub fn load_scenario(path: &Path) -> anyhow::Result<Scenario> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let text = mmtrack_io::paths::read_config_text(path)?;
     parse_scenario(&text).with_context(|| format!("{}", path.display()))
 }
 

@@ -52,7 +52,7 @@ pub struct SlamSimulated {
 /// # Errors
 /// The file cannot be read, parsed or checked, naming it.
 pub fn load_slam_scenario(path: &Path) -> anyhow::Result<SlamScenario> {
-    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    let text = mmtrack_io::paths::read_config_text(path)?;
     let scenario: SlamScenario = toml::from_str(&text).with_context(|| path.display().to_string())?;
     scenario.validate().with_context(|| path.display().to_string())?;
     Ok(scenario)

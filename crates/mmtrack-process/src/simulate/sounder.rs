@@ -32,7 +32,7 @@ pub struct SounderSimulation {
 /// # Errors
 /// The file cannot be read, parsed or checked, naming it.
 pub fn load_sounder_scenario(path: &Path) -> anyhow::Result<SounderScenario> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("{}", path.display()))?;
+    let text = mmtrack_io::paths::read_config_text(path)?;
     let scenario: SounderScenario = toml::from_str(&text).with_context(|| format!("{}", path.display()))?;
     scenario.validate().with_context(|| format!("{}", path.display()))?;
     Ok(scenario)

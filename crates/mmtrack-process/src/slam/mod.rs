@@ -122,7 +122,7 @@ pub fn read_recording(path: &Path) -> anyhow::Result<SlamRecording> {
 fn filter_config(path: &Path, args: &SlamOptions, recording: &SlamRecording) -> anyhow::Result<SlamConfig> {
     let mut config = match &args.config {
         Some(path) => {
-            let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+            let text = mmtrack_io::paths::read_config_text(path)?;
             toml::from_str::<SlamConfig>(&text).with_context(|| path.display().to_string())?
         }
         None => SlamConfig::default(),

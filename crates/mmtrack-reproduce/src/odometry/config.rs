@@ -110,9 +110,7 @@ impl Config {
         trajectory_format: TrajectoryFormat,
     ) -> anyhow::Result<Self> {
         let (source, text) = match scenario {
-            Some(path) => {
-                (path.display().to_string(), std::fs::read_to_string(path).with_context(|| path.display().to_string())?)
-            }
+            Some(path) => (path.display().to_string(), mmtrack_io::paths::read_config_text(path)?),
             None => (format!("embedded {DRIVE_SCENARIO_NAME}"), DRIVE_SCENARIO.to_string()),
         };
         let scenario = parse_scenario(&text).with_context(|| source.clone())?;

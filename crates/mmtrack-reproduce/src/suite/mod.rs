@@ -50,8 +50,6 @@ pub use select::{Aggregate, Selected, Selection, Wanted};
 pub const MAX_STEPS: usize = 1000;
 /// Most metrics one suite may list.
 pub const MAX_METRICS: usize = 10_000;
-/// Largest suite file read.
-pub const MAX_SUITE_BYTES: u64 = 16 << 20;
 /// The commands a step may run: those that read fixtures and write files.
 pub const STEP_COMMANDS: [&str; 5] = ["ingest", "simulate", "process", "analyze", "export"];
 
@@ -147,15 +145,11 @@ pub struct Suite {
 /// Reads and checks the suite at `path`.
 ///
 /// # Errors
-/// The file cannot be read, is larger than [`MAX_SUITE_BYTES`], or
+/// The file cannot be read, is larger than
+/// [`mmtrack_core::limits::CONFIG_FILE_BYTES`] (a configuration file), or
 /// [`parse_suite`] refuses it.
 pub fn read_suite(path: &Path) -> anyhow::Result<Suite> {
-    let name = path.display().to_string();
-    let size = std::fs::metadata(path).with_context(|| format!("{name}: cannot read the suite"))?.len();
-    if size > MAX_SUITE_BYTES {
-        bail!("{name}: {size} bytes; a suite is at most {MAX_SUITE_BYTES} bytes");
-    }
-    let text = std::fs::read_to_string(path).with_context(|| format!("{name}: cannot read the suite"))?;
+    let text = mmtrack_io::paths::read_config_text(path).context("cannot read the suite")?;
     parse_suite(path, &text)
 }
 

@@ -265,7 +265,7 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(SpebtExperiment, String
         toml::from_str(SPEBT_EXPERIMENT).context("embedded data/reproduce/spebt.toml")?;
     let mut source = "embedded data/reproduce/spebt.toml".to_string();
     if let Some(path) = &options.link {
-        let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+        let text = mmtrack_io::paths::read_config_text(path)?;
         let link: LinkFile = toml::from_str(&text).with_context(|| path.display().to_string())?;
         if let Some(scenario) = link.scenario {
             experiment.scenario = scenario;
