@@ -1,6 +1,7 @@
 use std::path::PathBuf;
 
 use mmtrack_core::error::printable;
+use mmtrack_io::paths::is_device;
 use thiserror::Error;
 
 /// Errors of the ingest adapters. Each names the file, the record (row, line,
@@ -151,21 +152,6 @@ pub(crate) fn read_text(path: &std::path::Path) -> Result<String, IngestError> {
         path: path.to_path_buf(),
         detail: format!("not UTF-8 text: invalid byte at offset {}", e.utf8_error().valid_up_to()),
     })
-}
-
-/// Whether `metadata` is of a character or block device (`/dev/zero`,
-/// `/dev/urandom`): endless input no reader should take.
-fn is_device(metadata: &std::fs::Metadata) -> bool {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::FileTypeExt as _;
-        metadata.file_type().is_char_device() || metadata.file_type().is_block_device()
-    }
-    #[cfg(not(unix))]
-    {
-        let _ = metadata;
-        false
-    }
 }
 
 #[cfg(test)]

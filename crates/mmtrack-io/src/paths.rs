@@ -51,8 +51,10 @@ pub fn read_config_text(path: &Path) -> Result<String, IoError> {
         .map_err(|e| bad("text", format!("not UTF-8 text: invalid byte at offset {}", e.utf8_error().valid_up_to())))
 }
 
-/// Whether `metadata` is of a character or block device (`/dev/zero`).
-fn is_device(metadata: &std::fs::Metadata) -> bool {
+/// Whether `metadata` is of a character or block device (`/dev/zero`,
+/// `/dev/urandom`): endless input no reader should take.
+#[must_use]
+pub fn is_device(metadata: &std::fs::Metadata) -> bool {
     #[cfg(unix)]
     {
         use std::os::unix::fs::FileTypeExt as _;
