@@ -91,7 +91,14 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
             check("mean UE clock-bias error", targets.ue_clock_bias_m, Some(s.ue_clock_bias_error_m), "m", 3);
             check("mean VA localisation error, every confirmed VA", targets.va_m, s.va_error_m, "m", 3);
             check("mean SP localisation error, every confirmed SP", targets.sp_m, s.sp_error_m, "m", 3);
-            let epochs = |claim: &str, paper: u64, mean: f64, median: f64, max: u64| {
+            let epochs = |claim: &str, paper: u64, mean: f64, median: f64, max: u64, per_run: &[usize]| {
+                let late: Vec<String> = per_run
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, e)| **e as f64 > bound(paper as f64))
+                    .map(|(r, e)| format!("run {r}: {e}"))
+                    .collect();
+                let late = if late.is_empty() { String::new() } else { format!("; later: {}", late.join(", ")) };
                 let claim = Claim::new(
                     format!("{claim} ({}), worst run", row.name),
                     "epoch",
@@ -102,7 +109,7 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
                 Verdict::judged(
                     role(claim),
                     Some(max as f64),
-                    format!("epoch {max} (mean {mean:.1}, median {median:.1})"),
+                    format!("epoch {max} (mean {mean:.1}, median {median:.1}{late})"),
                 )
             };
             out.push(epochs(
@@ -111,6 +118,7 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
                 s.all_va_epoch_mean,
                 x.all_va_epoch_median,
                 s.all_va_epoch_max,
+                &x.all_va_epochs,
             ));
             out.push(epochs(
                 "all SPs confirmed by",
@@ -118,6 +126,7 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
                 s.all_sp_epoch_mean,
                 x.all_sp_epoch_median,
                 s.all_sp_epoch_max,
+                &x.all_sp_epochs,
             ));
             let claim = Claim::new(
                 format!("no false source at any epoch ({}), worst epoch of any run", row.name),

@@ -3,8 +3,9 @@
 //! On the paper's circular-road world (`mmtrack_sim::slam`), the filter of
 //! `mmtrack_slam` runs over Monte Carlo realisations (each its own 10 random
 //! SPs, trajectory and noise) of every row of the experiment: the paper's
-//! setting, then the robustness rows (detection probability 0.9, one
-//! clutter path per epoch). Reported per row: the mean over runs of the
+//! setting with and without `ue_error_floor`, the LOS-only baseline, the
+//! same three with the LOS blocked in a stretch of epochs, then the
+//! robustness rows (detection probability 0.9, one clutter path per epoch). Reported per row: the mean over runs of the
 //! time-averaged UE position, heading, clock-bias (and smoothed speed and
 //! turn-rate) errors, the VA and SP localisation errors, and the epochs at
 //! which all VAs and all SPs are confirmed.
@@ -69,6 +70,11 @@ pub struct RowExtra {
     pub all_va_epoch_median: f64,
     /// The same for the SPs.
     pub all_sp_epoch_median: f64,
+    /// Per run, the epoch at which all VAs / all SPs are confirmed
+    /// (epochs + 1 when never), in run order.
+    pub all_va_epochs: Vec<usize>,
+    /// The same for the SPs.
+    pub all_sp_epochs: Vec<usize>,
 }
 
 /// Quantile `p` of the chi-square distribution with `dof` degrees of
@@ -223,6 +229,8 @@ fn aggregate(
         }),
         all_va_epoch_median: median_of(&|o| o.all_va_epoch),
         all_sp_epoch_median: median_of(&|o| o.all_sp_epoch),
+        all_va_epochs: outcomes.iter().map(|o| o.all_va_epoch.unwrap_or(never)).collect(),
+        all_sp_epochs: outcomes.iter().map(|o| o.all_sp_epoch.unwrap_or(never)).collect(),
     };
     let summary = SlamSummaryRow {
         row: row.name.clone(),
