@@ -24,6 +24,9 @@ pub struct UeEstimate {
     pub state: UeState,
     /// Root of the trace of the horizontal position covariance, metres.
     pub position_std_m: f64,
+    /// Horizontal position covariance `[xx, xy, yy]`, m^2 (for the
+    /// normalised estimation error squared of a consistency check).
+    pub position_cov_m2: [f64; 3],
     /// Heading standard deviation, radians.
     pub heading_std_rad: f64,
     /// Clock-bias standard deviation, metres.
@@ -323,6 +326,7 @@ impl SlamFilter {
         let estimate = UeEstimate {
             state: ue_of(&m.mean, self.particles.z_m),
             position_std_m: (m.cov[(0, 0)] + m.cov[(1, 1)]).max(0.0).sqrt(),
+            position_cov_m2: [m.cov[(0, 0)], m.cov[(0, 1)], m.cov[(1, 1)]],
             heading_std_rad: m.cov[(2, 2)].max(0.0).sqrt(),
             clock_bias_std_m: m.cov[(5, 5)].max(0.0).sqrt(),
         };

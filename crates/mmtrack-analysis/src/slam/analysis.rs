@@ -134,7 +134,14 @@ pub fn sequence_result(
             format!("{}: epoch {} has no true UE state (a recording without ground truth)", SLAM_UE.name, row.epoch)
         })?;
         let (va_m, sp_m) = confirmed.get(&row.epoch).cloned().unwrap_or_default();
-        views.push(EpochView { estimate: estimate_of(row), position_std_m: row.position_std_m, truth, va_m, sp_m });
+        views.push(EpochView {
+            estimate: estimate_of(row),
+            position_std_m: row.position_std_m,
+            position_cov_m2: None,
+            truth,
+            va_m,
+            sp_m,
+        });
     }
     let of_kind = |kind: &str| -> (Vec<[f64; 3]>, Vec<usize>) {
         let mut rows: Vec<&SlamTrueSourceRow> = sources.iter().filter(|s| s.kind == kind).collect();

@@ -28,13 +28,13 @@ trace), all epochs of all runs: 1 for a consistent filter, above 1 for an overco
         ue_clock_bias_error_m: f64, "m", "mean absolute clock-bias error";
         ue_speed_error_mps: f64, "m/s", "mean absolute speed error (1-step smoothed)";
         ue_turn_rate_error_radps: f64, "rad/s", "mean absolute turn-rate error (1-step smoothed)";
-        va_error_m: Option<f64>, "m", "mean localisation error of confirmed VAs; null when none was confirmed";
-        sp_error_m: Option<f64>, "m", "mean localisation error of confirmed SPs; null when none was confirmed";
+        va_error_m: Option<f64>, "m", "mean localisation error of every confirmed VA (its distance to the nearest true VA, no cut-off); null when none was confirmed";
+        sp_error_m: Option<f64>, "m", "mean localisation error of every confirmed SP (its distance to the nearest true SP, no cut-off); null when none was confirmed";
         all_va_epoch_mean: f64, "", "mean over runs of the epoch when all VAs were confirmed (epochs + 1 if never)";
         all_va_epoch_max: u64, "", "latest such epoch over the runs (epochs + 1 if never)";
         all_sp_epoch_mean: f64, "", "mean over runs of the epoch when all seen SPs were confirmed (epochs + 1 if never)";
         all_sp_epoch_max: u64, "", "latest such epoch over the runs (epochs + 1 if never)";
-        false_sources: f64, "", "mean confirmed sources per run with no true source of their type within the match radius";
+        false_sources: f64, "", "mean confirmed sources per run, at the last epoch, that match no true source of their type (one confirmed source per true one, within the match radius)";
         skipped_paths: u64, "", "paths skipped as unusable over all runs";
     }
 }
@@ -54,8 +54,8 @@ Figs. 4-6): UE errors, localisation errors of the confirmed sources and the numb
         ue_position_error_m: f64, "m", "mean UE position error";
         ue_heading_error_rad: f64, "rad", "mean absolute heading error";
         ue_clock_bias_error_m: f64, "m", "mean absolute clock-bias error";
-        va_error_m: Option<f64>, "m", "mean error of the confirmed VAs; null when no run had one";
-        sp_error_m: Option<f64>, "m", "mean error of the confirmed SPs; null when no run had one";
+        va_error_m: Option<f64>, "m", "mean error of every confirmed VA (no cut-off); null when no run had one";
+        sp_error_m: Option<f64>, "m", "mean error of every confirmed SP (no cut-off); null when no run had one";
         confirmed_va: f64, "", "mean number of confirmed VAs";
         confirmed_sp: f64, "", "mean number of confirmed SPs";
     }

@@ -60,8 +60,58 @@ pub struct Row {
     pub detection_probability: f64,
     /// Clutter paths per epoch.
     pub clutter_per_epoch: usize,
-    /// Whether the row is checked against the targets.
-    pub checked: bool,
+    /// Whether the paper's numbers ([`Targets`]) are judged on this row.
+    #[serde(default)]
+    pub paper_targets: bool,
+    /// Whether the row is a variant of ours: its claims are reported, not
+    /// targets.
+    #[serde(default)]
+    pub variant: bool,
+    /// `ue_error_floor` of the filter (ours, not in the paper); `None`
+    /// keeps the `[filter]` table's.
+    #[serde(default)]
+    pub ue_error_floor: Option<bool>,
+    /// The LOS-only baseline: no source is ever confirmed (a source needs
+    /// more sightings than the run has epochs), so only the LOS path
+    /// updates the UE, and an epoch without it only predicts.
+    #[serde(default)]
+    pub los_only: bool,
+    /// First and last epoch (1-based, inclusive) in which the LOS path is
+    /// blocked (ours: the paper's LOS is always present).
+    #[serde(default)]
+    pub los_blocked_epochs: Option<[usize; 2]>,
+    /// Name of the LOS-only row on the same world that this row must beat
+    /// (UE position error over the blocked epochs, or over the whole run).
+    #[serde(default)]
+    pub baseline: Option<String>,
+}
+
+impl Row {
+    /// The scenario of this row: `base` with its detection, clutter and
+    /// blocked LOS.
+    #[must_use]
+    pub fn scenario(&self, base: &SlamScenario) -> SlamScenario {
+        SlamScenario {
+            detection_probability: self.detection_probability,
+            clutter_per_epoch: self.clutter_per_epoch,
+            los_blocked_epochs: self.los_blocked_epochs,
+            ..base.clone()
+        }
+    }
+
+    /// The filter of this row: `base` assuming the row's detection
+    /// probability (0.99 for P_D = 1, eq. (3)), with its `ue_error_floor`,
+    /// and for the LOS-only baseline a confirmation that never happens in
+    /// `epochs`.
+    #[must_use]
+    pub fn filter(&self, base: &SlamConfig, epochs: usize) -> SlamConfig {
+        SlamConfig {
+            detection_probability: self.detection_probability.min(base.detection_probability),
+            ue_error_floor: self.ue_error_floor.unwrap_or(base.ue_error_floor),
+            confirm_min_sightings: if self.los_only { epochs + 1 } else { base.confirm_min_sightings },
+            ..base.clone()
+        }
+    }
 }
 
 /// The paper's numbers.
@@ -82,6 +132,9 @@ pub struct Targets {
     pub all_va_epoch: u64,
     /// Epoch by which all SPs are confirmed.
     pub all_sp_epoch: u64,
+    /// False sources at any epoch ("All unconfirmed sources are detected
+    /// correctly").
+    pub false_sources: f64,
     /// A target is met at most at `paper * (1 + tolerance)`, full tier ...
     pub tolerance: f64,
     /// ... and smoke tier.
@@ -122,6 +175,18 @@ impl Config {
         filter.bs_m = self.scenario.bs_m;
         filter.validate().with_context(|| format!("{}: [filter]", self.source))?;
         self.scenario.validate().with_context(|| format!("{}: [scenario]", self.source))?;
+        for row in &self.rows {
+            if let Some(name) = &row.baseline {
+                let baseline = self.rows.iter().find(|r| &r.name == name);
+                anyhow::ensure!(
+                    baseline.is_some_and(|b| b.los_only && b.los_blocked_epochs == row.los_blocked_epochs),
+                    "{}: row {}: baseline `{name}`; expected the name of a los_only row with the same \
+                     los_blocked_epochs",
+                    self.source,
+                    row.name
+                );
+            }
+        }
         Ok(filter)
     }
 
@@ -140,7 +205,14 @@ mod tests {
     fn the_embedded_experiment_parses_with_the_papers_targets() {
         let experiment = Config::embedded().unwrap();
         assert!(experiment.runs >= 20);
-        assert_eq!(experiment.rows.len(), 3);
+        // The paper row is judged without our ue_error_floor, with its LOS-only baseline.
+        let paper = experiment.rows.iter().find(|r| r.paper_targets && !r.variant).unwrap();
+        assert_eq!(paper.ue_error_floor, Some(false));
+        let baseline = experiment.rows.iter().find(|r| Some(&r.name) == paper.baseline.as_ref()).unwrap();
+        assert!(baseline.los_only && baseline.los_blocked_epochs.is_none());
+        let blocked = experiment.rows.iter().find(|r| r.los_blocked_epochs.is_some() && !r.los_only).unwrap();
+        assert!(blocked.baseline.is_some() && !blocked.variant);
+        experiment.filter_for(None, Tier::Full).unwrap();
         assert_eq!(experiment.targets.all_va_epoch, 26);
         assert_eq!(experiment.targets.all_sp_epoch, 91);
         assert_eq!(experiment.filter, SlamConfig::default());

@@ -53,6 +53,7 @@ pub fn run_filter(
         views.push(EpochView {
             estimate: report.estimate.state,
             position_std_m: report.estimate.position_std_m,
+            position_cov_m2: Some(report.estimate.position_cov_m2),
             truth: truth.ue,
             va_m: of(SourceStatus::VirtualAnchor),
             sp_m: of(SourceStatus::ScatteringPoint),

@@ -3,8 +3,9 @@
 //! On the paper's circular-road world (`mmtrack_sim::slam`), the filter of
 //! `mmtrack_slam` runs over Monte Carlo realisations (each its own 10 random
 //! SPs, trajectory and noise) of every row of the experiment: the paper's
-//! setting, then the robustness rows (detection probability 0.9, one
-//! clutter path per epoch). Reported per row: the mean over runs of the
+//! setting with and without `ue_error_floor`, the LOS-only baseline, the
+//! same three with the LOS blocked in a stretch of epochs, then the
+//! robustness rows (detection probability 0.9, one clutter path per epoch). Reported per row: the mean over runs of the
 //! time-averaged UE position, heading, clock-bias (and smoothed speed and
 //! turn-rate) errors, the VA and SP localisation errors, and the epochs at
 //! which all VAs and all SPs are confirmed.
@@ -37,6 +38,67 @@ pub struct RowResult {
     pub per_epoch: Vec<SlamPerEpochRow>,
     /// Run 0, for the map figure.
     pub first: RunOutcome,
+    /// What the summary table does not carry.
+    pub extra: RowExtra,
+}
+
+/// A row's numbers beyond [`SlamSummaryRow`]: the blocked stretch, false
+/// sources over all epochs, the consistency of the UE estimate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowExtra {
+    /// Mean over runs of the mean UE position error over the epochs with
+    /// the LOS blocked, metres; `None` without a blocked stretch.
+    pub blocked_ue_position_error_m: Option<f64>,
+    /// False sources per epoch, mean over the epochs of all runs.
+    pub false_sources_per_epoch: f64,
+    /// Most false sources at any epoch of any run.
+    pub false_sources_max: usize,
+    /// Mean distance of the false sources (every epoch of every run) to
+    /// the nearest true source of their type, metres; `None` without one.
+    pub false_source_error_m: Option<f64>,
+    /// Mean horizontal-position NEES over the epochs of all runs (2 for a
+    /// consistent filter); `None` when no epoch had one.
+    pub nees_mean: Option<f64>,
+    /// The two-sided 95 % interval of the average NEES of `runs`
+    /// independent runs at one epoch of a consistent filter.
+    pub nees_interval: [f64; 2],
+    /// Share of the epochs whose average NEES over the runs lies in
+    /// `nees_interval` (0.95 for a consistent filter).
+    pub nees_share_inside: Option<f64>,
+    /// Median over runs of the epoch at which all VAs / all SPs are
+    /// confirmed (a run that never confirms counts as epochs + 1).
+    pub all_va_epoch_median: f64,
+    /// The same for the SPs.
+    pub all_sp_epoch_median: f64,
+    /// Per run, the epoch at which all VAs / all SPs are confirmed
+    /// (epochs + 1 when never), in run order.
+    pub all_va_epochs: Vec<usize>,
+    /// The same for the SPs.
+    pub all_sp_epochs: Vec<usize>,
+}
+
+/// Quantile `p` of the chi-square distribution with `dof` degrees of
+/// freedom by the Wilson-Hilferty cube-root approximation,
+/// `dof (1 - 2/(9 dof) + z_p sqrt(2/(9 dof)))^3` (Wilson and Hilferty 1931;
+/// relative error below 1e-3 from 4 degrees of freedom on, at these
+/// tails), for `z_p` the standard normal quantile.
+#[must_use]
+pub fn chi_square_quantile(dof: f64, z_p: f64) -> f64 {
+    let a = 2.0 / (9.0 * dof);
+    dof * (1.0 - a + z_p * a.sqrt()).powi(3).max(0.0)
+}
+
+/// Standard normal quantile at 0.975.
+const Z_975: f64 = 1.959_963_984_540_054;
+
+/// The 95 % interval of the average over `runs` runs of a 2-dof NEES of a
+/// consistent filter: `runs * average ~ chi-square(2 runs)` (Bar-Shalom,
+/// Li and Kirubarajan 2001, Sec. 5.4.2, eq. (5.4.2-5)).
+#[must_use]
+pub fn nees_interval(runs: usize) -> [f64; 2] {
+    let dof = 2.0 * runs.max(1) as f64;
+    let n = runs.max(1) as f64;
+    [chi_square_quantile(dof, -Z_975) / n, chi_square_quantile(dof, Z_975) / n]
 }
 
 /// What the whole Monte Carlo measured, and how long it took.
@@ -72,17 +134,9 @@ pub fn measure(
     progress.start("reproduce kim", runs * experiment.rows.len() as u64, "runs");
     let mut results = Vec::new();
     for row in &experiment.rows {
-        let scenario = SlamScenario {
-            detection_probability: row.detection_probability,
-            clutter_per_epoch: row.clutter_per_epoch,
-            ..experiment.scenario.clone()
-        };
+        let scenario = row.scenario(&experiment.scenario);
         scenario.validate().with_context(|| format!("{source}: row {}", row.name))?;
-        // The filter assumes the row's detection probability (0.99 for P_D = 1, eq. (3)).
-        let config = SlamConfig {
-            detection_probability: row.detection_probability.min(filter.detection_probability),
-            ..filter.clone()
-        };
+        let config = row.filter(filter, scenario.epochs);
         let outcomes: Vec<RunOutcome> = (0..runs)
             .into_par_iter()
             .map(|r| {
@@ -134,6 +188,50 @@ fn aggregate(
     };
     let (va_mean, va_max) = epochs_of(&|o| o.all_va_epoch);
     let (sp_mean, sp_max) = epochs_of(&|o| o.all_sp_epoch);
+    let median_of = |f: &dyn Fn(&RunOutcome) -> Option<usize>| -> f64 {
+        let mut v: Vec<f64> = outcomes.iter().map(|o| f(o).unwrap_or(never) as f64).collect();
+        v.sort_by(f64::total_cmp);
+        mmtrack_core::stats::quantile(&v, 0.5).unwrap_or(never as f64)
+    };
+    let all_epochs = || outcomes.iter().flat_map(|o| o.epochs.iter());
+    let blocked_ue_position_error_m = scenario.los_blocked_epochs.map(|[first, last]| {
+        let per_run: Vec<f64> = outcomes
+            .iter()
+            .map(|o| {
+                let stretch = &o.epochs[first - 1..last.min(o.epochs.len())];
+                stretch.iter().map(|e| e.position_m).sum::<f64>() / stretch.len().max(1) as f64
+            })
+            .collect();
+        per_run.iter().sum::<f64>() / n
+    });
+    let epoch_count = all_epochs().count().max(1) as f64;
+    let false_errors: Vec<f64> =
+        all_epochs().filter_map(|e| e.false_source_error_m.map(|m| m * e.false_sources as f64)).collect();
+    let false_total: usize = all_epochs().map(|e| e.false_sources).sum();
+    let nees: Vec<f64> = all_epochs().filter_map(|e| e.position_nees).collect();
+    let interval = nees_interval(outcomes.len());
+    let per_epoch_nees: Vec<f64> = (0..scenario.epochs)
+        .filter_map(|k| {
+            let v: Vec<f64> = outcomes.iter().filter_map(|o| o.epochs.get(k).and_then(|e| e.position_nees)).collect();
+            (v.len() == outcomes.len()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        })
+        .collect();
+    let extra = RowExtra {
+        blocked_ue_position_error_m,
+        false_sources_per_epoch: false_total as f64 / epoch_count,
+        false_sources_max: all_epochs().map(|e| e.false_sources).max().unwrap_or(0),
+        false_source_error_m: (false_total > 0).then(|| false_errors.iter().sum::<f64>() / false_total as f64),
+        nees_mean: (!nees.is_empty()).then(|| nees.iter().sum::<f64>() / nees.len() as f64),
+        nees_interval: interval,
+        nees_share_inside: (!per_epoch_nees.is_empty()).then(|| {
+            per_epoch_nees.iter().filter(|v| (interval[0]..=interval[1]).contains(*v)).count() as f64
+                / per_epoch_nees.len() as f64
+        }),
+        all_va_epoch_median: median_of(&|o| o.all_va_epoch),
+        all_sp_epoch_median: median_of(&|o| o.all_sp_epoch),
+        all_va_epochs: outcomes.iter().map(|o| o.all_va_epoch.unwrap_or(never)).collect(),
+        all_sp_epochs: outcomes.iter().map(|o| o.all_sp_epoch.unwrap_or(never)).collect(),
+    };
     let summary = SlamSummaryRow {
         row: row.name.clone(),
         runs: outcomes.len() as u64,
@@ -182,5 +280,5 @@ fn aggregate(
             }
         })
         .collect();
-    Ok(RowResult { row: row.clone(), summary, per_epoch, first })
+    Ok(RowResult { row: row.clone(), summary, per_epoch, first, extra })
 }

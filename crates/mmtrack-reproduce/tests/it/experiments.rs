@@ -79,5 +79,11 @@ fn kim_smoke_meets_its_expectations() {
     let options = smoke(&dir);
     let outcome = kim::run(&kim::Config::embedded().unwrap(), None, &options, &NoProgress).unwrap();
     check(&outcome, &options);
-    assert_eq!(outcome.verdicts.len(), 7, "five errors and two confirmation epochs of the paper row");
+    // The targets: the paper's five errors, two confirmation epochs and no
+    // false source on the paper row, and SLAM below LOS-only with the LOS blocked.
+    let targets: Vec<&str> =
+        outcome.verdicts.iter().filter(|v| !v.claim.informational).map(|v| v.claim.what.as_str()).collect();
+    assert_eq!(targets.iter().filter(|w| w.contains("(paper)")).count(), 8, "{targets:#?}");
+    assert_eq!(targets.iter().filter(|w| w.contains("LOS blocked")).count(), 1, "{targets:#?}");
+    assert_eq!(targets.len(), 9, "{targets:#?}");
 }

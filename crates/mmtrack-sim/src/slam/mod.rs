@@ -120,6 +120,10 @@ pub struct SlamScenario {
     pub clutter_per_epoch: usize,
     /// Largest clutter TOA beyond the LOS TOA, metres (300).
     pub clutter_max_excess_m: f64,
+    /// First and last epoch (1-based, inclusive) in which the line of
+    /// sight is blocked: its path is absent, the others are unchanged
+    /// (none; not in Kim et al., whose LOS is always present).
+    pub los_blocked_epochs: Option<[usize; 2]>,
     /// Time of the first epoch, nanoseconds since the UNIX epoch (not in
     /// the paper; default [`crate::DEFAULT_START_T_NS`]).
     pub start_t_ns: i64,
@@ -159,6 +163,7 @@ impl Default for SlamScenario {
             detection_probability: 1.0,
             clutter_per_epoch: 0,
             clutter_max_excess_m: 300.0,
+            los_blocked_epochs: None,
             start_t_ns: crate::DEFAULT_START_T_NS,
         }
     }
@@ -257,6 +262,15 @@ impl SlamScenario {
         ensure_non_negative("angle_std_rad", self.angle_std_rad)?;
         ensure_within("detection_probability", self.detection_probability, 0.0, 1.0, "a probability in [0, 1]")?;
         ensure_positive("clutter_max_excess_m", self.clutter_max_excess_m)?;
+        if let Some([first, last]) = self.los_blocked_epochs
+            && !(1 <= first && first <= last && last <= self.epochs)
+        {
+            return Err(invalid(
+                "los_blocked_epochs",
+                format!("[{first}, {last}]"),
+                "[first, last] with 1 <= first <= last <= epochs",
+            ));
+        }
         Ok(())
     }
 
@@ -285,7 +299,8 @@ impl SlamScenario {
         let mut truth = Vec::with_capacity(self.epochs);
         for k in 0..self.epochs {
             let t_ns = self.start_t_ns + (k as f64 * self.epoch_s * 1e9).round() as i64;
-            let (paths, origins) = self.measure(&world, &ue, &mut rng);
+            let los_blocked = self.los_blocked_epochs.is_some_and(|[first, last]| (first..=last).contains(&(k + 1)));
+            let (paths, origins) = self.measure(&world, &ue, los_blocked, &mut rng);
             epochs.push(SlamEpoch { t_ns, paths });
             truth.push(SlamTruth { ue, origins });
             ue = ue.ctrv_step(self.epoch_s);
@@ -332,8 +347,15 @@ impl SlamScenario {
         Ok(SlamWorld { bs_m: self.bs_m, walls: self.walls.clone(), virtual_anchors_m, scattering_points_m })
     }
 
-    /// The paths of one epoch (detected ones, plus clutter), shuffled.
-    fn measure(&self, world: &SlamWorld, ue: &UeState, rng: &mut Pcg64) -> (Vec<PathMeasurement>, Vec<PathOrigin>) {
+    /// The paths of one epoch (detected ones, plus clutter), shuffled;
+    /// without the line of sight when `los_blocked`.
+    fn measure(
+        &self,
+        world: &SlamWorld,
+        ue: &UeState,
+        los_blocked: bool,
+        rng: &mut Pcg64,
+    ) -> (Vec<PathMeasurement>, Vec<PathOrigin>) {
         let mut sources: Vec<(PathOrigin, SourceType, [f64; 3])> =
             vec![(PathOrigin::LineOfSight, SourceType::BaseStation, world.bs_m)];
         for (v, (va, wall)) in world.virtual_anchors_m.iter().zip(&world.walls).enumerate() {
@@ -386,6 +408,12 @@ impl SlamScenario {
             let j = rng.random_range(0..=i);
             paths.swap(i, j);
             origins.swap(i, j);
+        }
+        // A blocked LOS is removed only now, after every draw, so the other
+        // paths, their noise and the trajectory are those of the open run.
+        if los_blocked && let Some(i) = origins.iter().position(|o| *o == PathOrigin::LineOfSight) {
+            paths.remove(i);
+            origins.remove(i);
         }
         (paths, origins)
     }
@@ -443,6 +471,40 @@ mod tests {
         let rms = (toa_residuals.iter().map(|r| r * r).sum::<f64>() / toa_residuals.len() as f64).sqrt();
         // ~1000 residuals of sigma 0.1 m: the RMS is within 10 % of 0.1 (4 sigma of its spread).
         assert!((rms - 0.1).abs() < 0.01, "{rms}");
+    }
+
+    #[test]
+    fn a_blocked_line_of_sight_removes_only_its_path_in_the_stretch() {
+        let open = SlamScenario::default().realise(7, 0).unwrap();
+        let blocked =
+            SlamScenario { los_blocked_epochs: Some([41, 60]), ..SlamScenario::default() }.realise(7, 0).unwrap();
+        assert_eq!(open.truth.len(), blocked.truth.len());
+        for (k, ((a, ta), (b, tb))) in
+            open.epochs.iter().zip(&open.truth).zip(blocked.epochs.iter().zip(&blocked.truth)).enumerate()
+        {
+            assert_eq!(ta.ue, tb.ue, "epoch {}: the same trajectory", k + 1);
+            let los = |origins: &[PathOrigin]| origins.iter().filter(|o| **o == PathOrigin::LineOfSight).count();
+            let in_stretch = (41..=60).contains(&(k + 1));
+            assert_eq!(los(&ta.origins), 1);
+            assert_eq!(los(&tb.origins), usize::from(!in_stretch), "epoch {}", k + 1);
+            // The other paths and their noise are those of the open run.
+            let others = |e: &SlamEpoch, t: &SlamTruth| {
+                let mut v: Vec<(String, u64)> = e
+                    .paths
+                    .iter()
+                    .zip(&t.origins)
+                    .filter(|(_, o)| **o != PathOrigin::LineOfSight)
+                    .map(|(z, o)| (format!("{o:?}"), z.toa_m.to_bits()))
+                    .collect();
+                v.sort();
+                v
+            };
+            assert_eq!(others(a, ta), others(b, tb), "epoch {}", k + 1);
+        }
+        for bad in [[0, 5], [6, 5], [90, 101]] {
+            let s = SlamScenario { los_blocked_epochs: Some(bad), ..SlamScenario::default() };
+            assert!(s.validate().unwrap_err().to_string().contains("los_blocked_epochs"), "{bad:?}");
+        }
     }
 
     #[test]
