@@ -336,13 +336,7 @@ fn write_beam_into(dir: &Path, results: &BeamSweepResults, run: &SequenceRun<'_>
         )?;
         files += 1 + sweeps::SEQUENCE_PLOTS.len();
     }
-    write_table(
-        &tables,
-        "all",
-        &results.pooled,
-        &run.pooled(results.sequences.iter().map(|r| r.sequence.as_str())),
-        Overwrite::Refuse,
-    )?;
+    write_pooled(&tables, &results.pooled, run, results.sequences.iter().map(|r| r.sequence.as_str()))?;
     let mut sites: Vec<&str> = results.pooled.iter().map(|BeamSweepPooledRow(p)| p.site.as_str()).collect();
     sites.dedup();
     for site in sites {
@@ -376,14 +370,20 @@ fn write_spebt_into(dir: &Path, results: &SpebtResults, run: &SequenceRun<'_>) -
         )?;
         files += 2;
     }
-    write_table(
-        &tables,
-        "all",
-        &results.pooled,
-        &run.pooled(results.sequences.iter().map(|r| r.sequence.as_str())),
-        Overwrite::Refuse,
-    )?;
+    write_pooled(&tables, &results.pooled, run, results.sequences.iter().map(|r| r.sequence.as_str()))?;
     Ok(files + 1)
+}
+
+/// The rows pooled over `sequences`, as the `sequence=all` partition of
+/// their table.
+fn write_pooled<'a, T: mmtrack_io::table::TableRow>(
+    tables: &Path,
+    rows: &[T],
+    run: &SequenceRun<'_>,
+    sequences: impl Iterator<Item = &'a str>,
+) -> anyhow::Result<()> {
+    write_table(tables, "all", rows, &run.pooled(sequences), Overwrite::Refuse)?;
+    Ok(())
 }
 
 fn write_geometric_into(dir: &Path, results: &GeometricResults, run: &SequenceRun<'_>) -> anyhow::Result<usize> {

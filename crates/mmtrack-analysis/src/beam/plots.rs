@@ -15,6 +15,15 @@ pub struct RmsCurve {
     pub rms_deg: Vec<f64>,
 }
 
+/// Colours of the trackers' curves, in tracker order.
+const PALETTE: [RGBColor; 7] = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0)];
+
+/// Bottom of a log-scale RMS axis: below the smallest positive value and the
+/// threshold, never under 1e-3 deg.
+fn log_floor_deg(positive: impl Iterator<Item = f64>, threshold_deg: f64) -> f64 {
+    positive.fold(threshold_deg, f64::min).max(1e-3) * 0.8
+}
+
 /// An SVG of `curves` with the threshold line at `threshold_deg`; the y axis
 /// is logarithmic like the paper's MSE plots.
 ///
@@ -24,8 +33,7 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
     let blocks = curves.iter().map(|c| c.rms_deg.len()).max().unwrap_or(1).max(2);
     let positive = || curves.iter().flat_map(|c| c.rms_deg.iter().copied()).filter(|v| *v > 0.0 && v.is_finite());
     let range = padded_range(positive().chain([threshold_deg]));
-    let (y_lo, y_hi) = (positive().fold(threshold_deg, f64::min).max(1e-3) * 0.8, range.end.max(threshold_deg) * 1.2);
-    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0)];
+    let (y_lo, y_hi) = (log_floor_deg(positive(), threshold_deg), range.end.max(threshold_deg) * 1.2);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
@@ -45,7 +53,7 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
             .y_desc("RMS AoD error (deg)")
             .draw()
             .map_err(err)?;
-        for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
+        for (curve, color) in curves.iter().zip(PALETTE.iter().cycle()) {
             let points = curve
                 .rms_deg
                 .iter()
@@ -97,9 +105,8 @@ pub struct DistanceCurve {
 pub fn rms_against_distance_svg(title: &str, curves: &[DistanceCurve], threshold_deg: f64) -> anyhow::Result<String> {
     let x = padded_range(curves.iter().flat_map(|c| c.distance_m.iter().copied()).chain([0.0]));
     let positive = || curves.iter().flat_map(|c| c.rms_deg.iter().copied()).filter(|v| *v > 0.0 && v.is_finite());
-    let y_lo = positive().fold(threshold_deg, f64::min).max(1e-3) * 0.8;
+    let y_lo = log_floor_deg(positive(), threshold_deg);
     let y_hi = positive().fold(threshold_deg, f64::max) * 1.2;
-    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0)];
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 560)).into_drawing_area();
@@ -120,7 +127,7 @@ pub fn rms_against_distance_svg(title: &str, curves: &[DistanceCurve], threshold
             .draw()
             .map_err(err)?;
         for curve in curves {
-            let color = palette[curve.color % palette.len()];
+            let color = PALETTE[curve.color % PALETTE.len()];
             let points: Vec<(f64, f64)> = curve
                 .distance_m
                 .iter()
