@@ -348,6 +348,26 @@ mod tests {
         );
     }
 
+    /// The front page's headline (claims met, metrics checked) is the one
+    /// the last full run wrote into docs/results/README.md, not typed apart.
+    #[test]
+    fn the_front_page_headline_is_the_generated_one() {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+        let results = std::fs::read_to_string(root.join("docs/results/README.md")).unwrap();
+        let front = std::fs::read_to_string(root.join("README.md")).unwrap().replace('\n', " ");
+        let between = |text: &str, start: &str, end: &str| -> String {
+            let from = text.find(start).unwrap_or_else(|| panic!("`{start}` not found")) + start.len();
+            text[from..].split(end).next().unwrap().trim().to_string()
+        };
+        let claims = between(&results, "**", " paper claims met**");
+        let metrics = between(&results, "Written by `mmtrack reproduce --all`: ", " metrics of");
+        assert!(
+            front.contains(&format!("**{claims} paper claims met**")),
+            "README.md lacks `{claims} paper claims met`"
+        );
+        assert!(front.contains(&format!("regression check of {metrics} metrics")), "README.md lacks {metrics} metrics");
+    }
+
     /// The summary leads with the paper verdicts: a miss is counted and
     /// shown with its rule, variants are listed but not counted.
     #[test]
