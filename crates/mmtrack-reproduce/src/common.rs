@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use mmtrack_core::StampedPose;
-use mmtrack_process::simulate::radar::{TrajectoryFormat, read_trajectory};
+use mmtrack_ingest::poses::{Plane, TrajectoryFormat, read_trajectory};
 use serde::de::DeserializeOwned;
 
 use crate::model::Tier;
@@ -84,7 +84,7 @@ pub fn read_drive(path: &Path, format: TrajectoryFormat) -> anyhow::Result<Vec<S
         }
         bail!("{}: not found (--trajectory)", path.display());
     }
-    read_trajectory(path, format, None, 0)
+    Ok(read_trajectory(path, format, None, 0, Plane::Xy)?)
 }
 
 /// Monte Carlo runs: `explicit` (the CLI's `--runs`), else the

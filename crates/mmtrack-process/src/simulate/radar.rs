@@ -4,7 +4,6 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use mmtrack_core::StampedPose;
 use mmtrack_core::progress::Progress;
 use mmtrack_ingest::oxford::{self, NavtechLayout};
 use mmtrack_ingest::poses::{self, Plane};
@@ -84,19 +83,6 @@ pub fn parse_scenario(text: &str) -> anyhow::Result<Scenario> {
     let scenario: Scenario = toml::from_str(text)?;
     scenario.validate()?;
     Ok(scenario)
-}
-
-/// Reads a trajectory file as `world_from_vehicle` poses (ground plane x-y).
-///
-/// # Errors
-/// The file (or KITTI's times file) cannot be read or parsed.
-pub fn read_trajectory(
-    path: &Path,
-    format: TrajectoryFormat,
-    times: Option<&Path>,
-    t0_ns: i64,
-) -> anyhow::Result<Vec<StampedPose>> {
-    Ok(poses::read_trajectory(path, format, times, t0_ns, Plane::Xy)?)
 }
 
 /// Streams `simulator`'s scans into an Oxford folder at `dir` (replaced
@@ -240,7 +226,7 @@ pub fn simulate_radar(args: &RadarSimulation, progress: &dyn Progress) -> anyhow
     }
     let trajectory = match &args.trajectory {
         Some(file) => {
-            let poses = read_trajectory(&file.path, file.format, file.times.as_deref(), file.t0_ns)?;
+            let poses = poses::read_trajectory(&file.path, file.format, file.times.as_deref(), file.t0_ns, Plane::Xy)?;
             Trajectory::from_poses(poses).with_context(|| file.path.display().to_string())?
         }
         None => scenario.motion_trajectory().with_context(|| args.scenario.display().to_string())?,
