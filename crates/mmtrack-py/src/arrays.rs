@@ -17,9 +17,9 @@ use mmtrack_analysis::analyze::AnalyzeOptions;
 use mmtrack_analysis::pipeline::analyze_trajectory;
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{BeamSweep, CirSnapshot, Complex64, MpcDetection, Se2, StampedPose};
-use mmtrack_io::table::{BeamSweepTracked, RunInfo, TableTimeBase, table_bytes};
+use mmtrack_io::table::{RunInfo, TableTimeBase, table_bytes};
 use mmtrack_mpc::{Detector, SounderPulse};
-use mmtrack_process::beam::sweep::{Reacquire, SweepTrackerKind, track_pass};
+use mmtrack_process::beam::sweep::{PassInput, Reacquire, SweepTrackerKind, car_east_north_m, track_site};
 
 /// `f64` values of little-endian bytes.
 ///
@@ -137,36 +137,92 @@ pub fn detect_mpc(cir: &CirArray<'_>, config: Option<&Path>, pulse: Option<&[Com
     Ok(table_bytes(&rows, &info)?)
 }
 
-/// The sweep policies `trackers` (window, last-full-sweep) on full sweeps
-/// of `beams` beams: row `i` of `power` (linear power per beam) at
-/// `t_ns[i]`. The `beam_sweeps_tracked` rows `process beam` writes for a
-/// recording of the same sweeps (site `site`), policy after policy.
+/// Full sweeps as arrays: row `i` of `power` (linear power per beam, `beams`
+/// per row) at `t_ns[i]`, in pass `pass_index[i]` (one pass when absent;
+/// a pass's sweeps are consecutive rows), the car at `car[i]`.
+#[derive(Debug, Clone, Copy)]
+pub struct SweepArrays<'a> {
+    /// Linear power, sweeps x beams, row-major.
+    pub power: &'a [f64],
+    /// Beams per sweep.
+    pub beams: usize,
+    /// Sweep times, ns.
+    pub t_ns: &'a [i64],
+    /// Pass of each sweep.
+    pub pass_index: Option<&'a [i64]>,
+    /// The car's position at each sweep (two values per sweep).
+    pub car: Option<&'a [f64]>,
+    /// What `car` holds.
+    pub car_frame: CarFrame<'a>,
+}
+
+/// How the car's positions are given.
+#[derive(Debug, Clone, Copy)]
+pub enum CarFrame<'a> {
+    /// East and north metres from the array.
+    EastNorthM,
+    /// Latitude and longitude, degrees; the array's latitude and longitude
+    /// per sweep (two values per sweep) or once (two values).
+    LatLonDeg {
+        /// The array's position.
+        array_lat_lon_deg: &'a [f64],
+    },
+}
+
+/// The sweep policies `trackers` (window, gnss-window, last-full-sweep,
+/// gnss-map) on the passes of `sweeps` at one site: per pass (in order of
+/// first appearance), its `pass_index` value and the `beam_sweeps_tracked`
+/// rows `process beam` writes for a recording of that pass, policy after
+/// policy. The GNSS policies fit the beam map leave-one-pass-out over the
+/// passes given, as `process beam` does over the recordings of a site
+/// ([`track_site`]).
 ///
 /// # Errors
-/// A power array that is not `t_ns.len() x beams`, an unknown or GNSS
-/// policy, bad sweeps, and the trackers' errors.
+/// A power array that is not `t_ns.len() x beams`; pass indices, car or
+/// array positions of the wrong length or not finite; a pass split into
+/// pieces; an unknown policy; bad sweeps, and the trackers' errors.
 pub fn track_beams(
-    power: &[f64],
-    beams: usize,
-    t_ns: &[i64],
+    sweeps: &SweepArrays<'_>,
     trackers: &[String],
     reacquire: &str,
     site: &str,
-) -> anyhow::Result<Vec<u8>> {
+) -> anyhow::Result<Vec<(i64, Vec<u8>)>> {
+    let SweepArrays { power, beams, t_ns, pass_index, car, car_frame } = *sweeps;
+    let n = t_ns.len();
     ensure!(beams > 0, "power: no beams");
-    ensure!(
-        power.len() == t_ns.len() * beams,
-        "power: {} values for {} sweeps of {beams} beams",
-        power.len(),
-        t_ns.len()
-    );
+    ensure!(power.len() == n * beams, "power: {} values for {n} sweeps of {beams} beams", power.len());
     let reacquire = Reacquire::parse(reacquire)?;
-    let mut kinds = trackers.iter().map(|t| SweepTrackerKind::parse(t)).collect::<anyhow::Result<Vec<_>>>()?;
-    kinds.sort();
-    kinds.dedup();
-    if kinds.is_empty() {
-        bail!("--tracker: name at least one of window, last-full-sweep");
+    let kinds = trackers.iter().map(|t| SweepTrackerKind::parse(t)).collect::<anyhow::Result<Vec<_>>>()?;
+    let pass_of = |i: usize| pass_index.map_or(0, |p| p[i]);
+    if let Some(p) = pass_index {
+        ensure!(p.len() == n, "pass_index: {} values for {n} sweeps", p.len());
     }
+    let positions: Option<Vec<[f64; 2]>> = match car {
+        None => None,
+        Some(car) => {
+            ensure!(car.len() == 2 * n, "car positions: {} values for {n} sweeps (expected 2 per sweep)", car.len());
+            if let Some(i) = car.iter().position(|v| !v.is_finite()) {
+                bail!("car positions: sweep {}: {} is not finite", i / 2, car[i]);
+            }
+            Some(match car_frame {
+                CarFrame::EastNorthM => car.chunks_exact(2).map(|c| [c[0], c[1]]).collect(),
+                CarFrame::LatLonDeg { array_lat_lon_deg: array } => {
+                    ensure!(
+                        array.len() == 2 || array.len() == 2 * n,
+                        "array_lat_lon_deg: {} values (expected 2, or 2 per sweep for {n} sweeps)",
+                        array.len()
+                    );
+                    if let Some(i) = array.iter().position(|v| !v.is_finite()) {
+                        bail!("array_lat_lon_deg: value {i} ({}) is not finite", array[i]);
+                    }
+                    let array_at = |i: usize| {
+                        if array.len() == 2 { [array[0], array[1]] } else { [array[2 * i], array[2 * i + 1]] }
+                    };
+                    car.chunks_exact(2).enumerate().map(|(i, c)| car_east_north_m([c[0], c[1]], array_at(i))).collect()
+                }
+            })
+        }
+    };
     let sweeps = power
         .chunks_exact(beams)
         .zip(t_ns)
@@ -175,15 +231,46 @@ pub fn track_beams(
             BeamSweep::new(t, row.to_vec(), vec![true; beams]).with_context(|| format!("power: sweep {i} (t_ns {t})"))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut rows: Vec<BeamSweepTracked> = Vec::new();
-    for kind in &kinds {
-        rows.extend(track_pass(*kind, reacquire, site, &sweeps)?);
+    // Passes: runs of equal pass_index, each appearing once.
+    let mut spans: Vec<(i64, std::ops::Range<usize>)> = Vec::new();
+    for i in 0..n {
+        match spans.last_mut() {
+            Some((pass, range)) if *pass == pass_of(i) => range.end = i + 1,
+            _ => {
+                if let Some((_, earlier)) = spans.iter().find(|(pass, _)| *pass == pass_of(i)) {
+                    bail!(
+                        "pass_index: pass {} holds sweeps {}..{} and again sweep {i}; a pass's sweeps must be \
+                         consecutive rows",
+                        pass_of(i),
+                        earlier.start,
+                        earlier.end - 1
+                    );
+                }
+                spans.push((pass_of(i), i..i + 1));
+            }
+        }
     }
+    ensure!(!spans.is_empty(), "power: no sweeps");
+    let labels: Vec<String> =
+        spans.iter().map(|(pass, range)| format!("pass {pass} (sweeps {}..{})", range.start, range.end - 1)).collect();
+    let inputs: Vec<PassInput<'_>> = spans
+        .iter()
+        .zip(&labels)
+        .map(|((_, range), label)| PassInput {
+            label,
+            sweeps: &sweeps[range.clone()],
+            east_north_m: positions.as_deref().map(|p| &p[range.clone()]),
+        })
+        .collect();
+    let run = track_site(&kinds, reacquire, site, &inputs)?;
+    let mut names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+    names.sort_unstable();
+    names.dedup();
     let info = run_info(
         "mmtrack.track_beams",
-        serde_json::json!({ "trackers": kinds.iter().map(|k| k.name()).collect::<Vec<_>>(), "reacquire": format!("{reacquire:?}") }),
+        serde_json::json!({ "trackers": names, "reacquire": format!("{reacquire:?}"), "beam_map": "fitted leave-one-pass-out over the passes given" }),
     );
-    Ok(table_bytes(&rows, &info)?)
+    spans.iter().zip(run.rows).map(|((pass, _), rows)| Ok((*pass, table_bytes(&rows, &info)?))).collect()
 }
 
 /// Poses of `t_ns` and `x_y_yaw` (`x_m, y_m, yaw_rad` per row).

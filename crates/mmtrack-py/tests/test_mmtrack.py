@@ -247,6 +247,45 @@ def test_track_beams_on_a_power_array_matches_process_beam(tmp_path: Path) -> No
         assert_frames_close(got.sort("tracker", maintain_order=True), expected.sort("tracker", maintain_order=True))
 
 
+def test_track_beams_with_the_gnss_policies_matches_process_beam(tmp_path: Path) -> None:
+    # Every policy, GNSS ones included, on all 52 passes of scenario 3: the
+    # beam maps are fitted leave-one-pass-out over the passes given, as
+    # `process beam` fits them over the recordings of the site.
+    folder = realdata("deepsense-60ghz-beams")
+    passes = mmtrack.ingest("beams", folder, tmp_path / "rec", scenario=3)
+    trackers = ["window", "gnss-window", "last-full-sweep", "gnss-map"]
+    cli("process", "beam", tmp_path / "rec", "-o", tmp_path / "tables", "--tracker", ",".join(trackers))
+    tracked = mmtrack.read_table(tmp_path / "tables", "beam_sweeps_tracked").collect()
+    seq_index = np.load(folder / "scenario3_seq_index_1-1487.npy").ravel()
+    power = np.load(folder / "scenario3_unit1_pwr_60ghz_1-1487.npy")
+    car = np.load(folder / "scenario3_unit2_loc_cal_1-1487.npy")
+    array = np.load(folder / "scenario3_unit1_loc_1-1487.npy")
+    times = tracked.filter(pl.col("tracker") == "window").sort("t_ns")["t_ns"].to_numpy()
+    assert len(times) == len(power) == 1487
+    got = mmtrack.track_beams(
+        power,
+        tracker=trackers,
+        t_ns=times,
+        site=tracked["site"][0],
+        pass_index=seq_index,
+        car_lat_lon_deg=car,
+        array_lat_lon_deg=array,
+    )
+    assert got["pass"].n_unique() == len(passes) == 52
+    assert got.filter(pl.col("tracker") == "gnss-window")["gnss_beam"].null_count() == 0
+    by_pass = {p["pass"]: p["sequence_id"] for p in passes}
+    for index, sequence in by_pass.items():
+        expected = tracked.filter(pl.col("sequence") == sequence).drop("sequence")
+        mine = got.filter(pl.col("pass") == index).drop("pass")
+        key = ["tracker", "t_ns"]
+        assert_frames_close(mine.sort(key), expected.sort(key))
+    # One pass is not enough for a leave-one-pass-out map.
+    with pytest.raises(mmtrack.MmtrackError, match="at least two passes"):
+        mmtrack.track_beams(power[:5], tracker="gnss-window", car_east_north_m=np.zeros((5, 2)))
+    with pytest.raises(mmtrack.MmtrackError, match="need the car's position at each sweep"):
+        mmtrack.track_beams(power[:20], tracker="gnss-window", pass_index=seq_index[:20] * 0 + np.arange(20) // 10)
+
+
 def test_reproduce_returns_the_claims_the_cli_reports(tmp_path: Path) -> None:
     done = mmtrack.reproduce("zoechmann", quick=True, output=tmp_path / "py")
     cli("reproduce", "zoechmann", "--quick", "-o", tmp_path / "cli", ok=False)
@@ -283,7 +322,7 @@ def test_errors_carry_the_cli_line(tmp_path: Path) -> None:
         mmtrack.analyze(tmp_path / "no-tables", tmp_path / "analysis")
     assert str(caught.value) == cli_error("analyze", tmp_path / "no-tables", "-o", tmp_path / "analysis")
 
-    with pytest.raises(mmtrack.MmtrackError, match="--tracker gnss-map: the GNSS policies need the beam map"):
+    with pytest.raises(mmtrack.MmtrackError, match="the GNSS policies need a beam map fitted leave-one-pass-out"):
         mmtrack.track_beams(np.ones((3, 4)), tracker="gnss-map")
     with pytest.raises(mmtrack.MmtrackError, match="estimate: row 1: t_ns 0 does not increase"):
         t = np.array([0, 0, 1], dtype=np.int64)

@@ -352,7 +352,7 @@ fn process_beam_refuses_gnss_policies_without_two_passes_and_recordings_without_
     let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", "window,gnss-window"]);
     let (_, stderr) = text(&out);
     assert!(!out.status.success());
-    assert!(stderr.contains("site deepsense-scenario2") && stderr.contains("at least two recordings"), "{stderr}");
+    assert!(stderr.contains("site deepsense-scenario2") && stderr.contains("at least two passes"), "{stderr}");
     assert!(!dir.path().join("tables").exists(), "nothing written");
     // The window tracker alone needs no map: the best beam (2) every sweep.
     let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", "window"]);

@@ -199,21 +199,87 @@ fn east_north_m(recording: &BeamRecording) -> anyhow::Result<Vec<[f64; 2]>> {
                     )
                 })
             };
-            let [car_lat, car_lon] = position(&recording.vehicle, "/gnss/fix")?;
-            let [lat, lon] = position(&recording.array, "/gnss/array")?;
-            let origin = EnuOrigin { latitude_deg: lat, longitude_deg: lon, altitude_m: 0.0 };
-            let enu = geodetic_to_enu_m(&origin, car_lat, car_lon, 0.0);
-            Ok([enu[0], enu[1]])
+            Ok(car_east_north_m(position(&recording.vehicle, "/gnss/fix")?, position(&recording.array, "/gnss/array")?))
         })
         .collect()
 }
 
-/// The recordings of one site with, when a GNSS policy runs, their GNSS
-/// beam predictions from leave-one-pass-out maps.
-struct Site<'a> {
-    name: String,
-    passes: Vec<&'a BeamRecording>,
-    maps: Option<SiteMaps>,
+/// The car's east and north metres from the array, both given as latitude
+/// and longitude (degrees, WGS-84), on the array's local tangent plane.
+#[must_use]
+pub fn car_east_north_m(car_lat_lon_deg: [f64; 2], array_lat_lon_deg: [f64; 2]) -> [f64; 2] {
+    let origin = EnuOrigin { latitude_deg: array_lat_lon_deg[0], longitude_deg: array_lat_lon_deg[1], altitude_m: 0.0 };
+    let enu = geodetic_to_enu_m(&origin, car_lat_lon_deg[0], car_lat_lon_deg[1], 0.0);
+    [enu[0], enu[1]]
+}
+
+/// One pass of full sweeps as [`track_site`] takes it, from a recording or
+/// from arrays.
+#[derive(Debug, Clone, Copy)]
+pub struct PassInput<'a> {
+    /// Names the pass in errors (a recording's path, or `pass 3`).
+    pub label: &'a str,
+    /// Full sweeps in time order.
+    pub sweeps: &'a [BeamSweep],
+    /// The car's east/north metres from the array at each sweep; needed by
+    /// the GNSS policies only.
+    pub east_north_m: Option<&'a [[f64; 2]]>,
+}
+
+/// What [`track_site`] did for one site.
+#[derive(Debug, Clone)]
+pub struct SiteRun {
+    /// The `beam_sweeps_tracked` rows of each pass (policy after policy).
+    pub rows: Vec<Vec<BeamSweepTracked>>,
+    /// Per policy, its summary over every pass.
+    pub summaries: Vec<(SweepTrackerKind, SweepSummary)>,
+    /// The beam map fitted on every pass, when a GNSS policy ran (for
+    /// display; each pass was predicted by the map of the other passes).
+    pub map: Option<BeamMap>,
+}
+
+/// Every policy of `kinds` on every pass of one site. The GNSS policies
+/// predict each pass with a beam map fitted on the site's other passes
+/// (leave-one-pass-out), so they need at least two passes, each with the
+/// car's positions.
+///
+/// # Errors
+/// No policy or no pass; a GNSS policy with fewer than two passes or a pass
+/// without positions (or with one per sweep missing); a degenerate map; the
+/// trackers' errors; each naming the pass.
+pub fn track_site(
+    kinds: &[SweepTrackerKind],
+    reacquire: Reacquire,
+    site: &str,
+    passes: &[PassInput<'_>],
+) -> anyhow::Result<SiteRun> {
+    let mut kinds = kinds.to_vec();
+    kinds.sort();
+    kinds.dedup();
+    if kinds.is_empty() {
+        bail!("--tracker: name at least one of window, gnss-window, last-full-sweep, gnss-map");
+    }
+    if passes.is_empty() {
+        bail!("site {site}: no passes to track");
+    }
+    let maps = if kinds.iter().any(|k| k.needs_map()) { Some(fit_maps(site, passes)?) } else { None };
+    let mut rows: Vec<Vec<BeamSweepTracked>> = vec![Vec::new(); passes.len()];
+    let mut summaries = Vec::new();
+    for &kind in &kinds {
+        let mut records_of_kind = Vec::new();
+        for (i, pass) in passes.iter().enumerate() {
+            let map = maps.as_ref().map(|m| &m.per_pass[i]);
+            let gnss_beam = maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
+            let mut policy = tracker(kind, reacquire, map)?;
+            let records = evaluate(policy.as_mut(), &[SweepPass { sweeps: pass.sweeps, gnss_beam }])
+                .with_context(|| format!("{}: {}", pass.label, kind.name()))?;
+            rows[i].extend(pass_rows(kind, site, pass.sweeps, &records, gnss_beam));
+            records_of_kind.push(records);
+        }
+        let summary = SweepSummary::from_records(records_of_kind.iter().flatten()).context("no sweeps")?;
+        summaries.push((kind, summary));
+    }
+    Ok(SiteRun { rows, summaries, map: maps.map(|m| m.all) })
 }
 
 struct SiteMaps {
@@ -225,13 +291,13 @@ struct SiteMaps {
     all: BeamMap,
 }
 
-fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
+fn fit_maps(site: &str, passes: &[PassInput<'_>]) -> anyhow::Result<SiteMaps> {
     if passes.len() < 2 {
         bail!(
-            "site {site}: the GNSS policies need a beam map fitted leave-one-pass-out, so at least two recordings of \
+            "site {site}: the GNSS policies need a beam map fitted leave-one-pass-out, so at least two passes of \
              the site ({} given: {}); give more passes, or choose --tracker window,last-full-sweep",
             passes.len(),
-            passes.iter().map(|p| p.path.display().to_string()).collect::<Vec<_>>().join(", ")
+            passes.iter().map(|p| p.label).collect::<Vec<_>>().join(", ")
         );
     }
     let beam_count = passes[0].sweeps[0].beam_count();
@@ -239,14 +305,25 @@ fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
         bail!(
             "{}: sweeps of {beam_count} beam: the GNSS policies fit a beam map (beam index against the car's \
              bearing), which needs a codebook of at least 2 beams",
-            passes[0].path.display()
+            passes[0].label
         );
     }
+    let positions: Vec<&[[f64; 2]]> = passes
+        .iter()
+        .map(|p| {
+            let positions = p.east_north_m.with_context(|| {
+                format!("{}: the GNSS policies need the car's position at each sweep; none given", p.label)
+            })?;
+            if positions.len() != p.sweeps.len() {
+                bail!("{}: {} car positions for {} sweeps", p.label, positions.len(), p.sweeps.len());
+            }
+            Ok(positions)
+        })
+        .collect::<anyhow::Result<_>>()?;
     let t_ns: Vec<Vec<i64>> = passes.iter().map(|p| p.sweeps.iter().map(BeamSweep::t_ns).collect()).collect();
-    let positions: Vec<Vec<[f64; 2]>> = passes.iter().map(|p| east_north_m(p)).collect::<Result<_, _>>()?;
     let best: Vec<Vec<usize>> =
         passes.iter().map(|p| p.sweeps.iter().map(BeamSweep::best_measured_beam).collect()).collect();
-    let gnss = |i: usize| GnssPass { t_ns: &t_ns[i], east_north_m: &positions[i] };
+    let gnss = |i: usize| GnssPass { t_ns: &t_ns[i], east_north_m: positions[i] };
     let map_passes: Vec<MapPass<'_>> =
         (0..passes.len()).map(|i| MapPass { gnss: gnss(i), best_beam: &best[i] }).collect();
     let config = BeamMapConfig::default();
@@ -271,17 +348,15 @@ fn fit_maps(site: &str, passes: &[&BeamRecording]) -> anyhow::Result<SiteMaps> {
             _ => "the best beams lie exactly on the map, which leaves the GNSS window no first width".to_string(),
         };
         bail!(
-            "site {site}: the beam map for {} (fitted on the other recordings) has an RMS residual of 0 beams: {cause}",
-            passes[i].path.display()
+            "site {site}: the beam map for {} (fitted on the other passes) has an RMS residual of 0 beams: {cause}",
+            passes[i].label
         );
     }
     let all = BeamMap::fit(&map_passes, beam_count, &config).with_context(|| format!("site {site}: beam map"))?;
     let gnss_beam = per_pass
         .iter()
         .enumerate()
-        .map(|(i, map)| {
-            map.predict_pass(&gnss(i)).with_context(|| format!("{}: beam map prediction", passes[i].path.display()))
-        })
+        .map(|(i, map)| map.predict_pass(&gnss(i)).with_context(|| format!("{}: beam map prediction", passes[i].label)))
         .collect::<anyhow::Result<_>>()?;
     Ok(SiteMaps { per_pass, gnss_beam, all })
 }
@@ -319,22 +394,7 @@ fn tracker(
     })
 }
 
-/// Every pass of `site` through `kind`: the records of each pass.
-fn run_tracker(site: &Site<'_>, kind: SweepTrackerKind, reacquire: Reacquire) -> anyhow::Result<Vec<Vec<SweepRecord>>> {
-    site.passes
-        .iter()
-        .enumerate()
-        .map(|(i, pass)| {
-            let map = site.maps.as_ref().map(|m| &m.per_pass[i]);
-            let gnss_beam = site.maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
-            let mut policy = tracker(kind, reacquire, map)?;
-            evaluate(policy.as_mut(), &[SweepPass { sweeps: &pass.sweeps, gnss_beam }])
-                .with_context(|| format!("{}: {}", pass.path.display(), kind.name()))
-        })
-        .collect()
-}
-
-fn rows(
+fn pass_rows(
     kind: SweepTrackerKind,
     site: &str,
     sweeps: &[BeamSweep],
@@ -427,34 +487,36 @@ pub fn process_sweeps(
         sites.entry(&r.site).or_default().push(r);
     }
     let needs_map = kinds.iter().any(|k| k.needs_map());
-    let sites: Vec<Site<'_>> = sites
-        .into_iter()
-        .map(|(name, mut passes)| {
-            // Sequence order, so the maps do not depend on the order of the arguments.
-            passes.sort_by(|a, b| a.sequence_id.cmp(&b.sequence_id));
-            let maps = if needs_map { Some(fit_maps(name, &passes)?) } else { None };
-            Ok(Site { name: name.to_string(), passes, maps })
-        })
-        .collect::<anyhow::Result<_>>()?;
-
     let mut tables: BTreeMap<String, Vec<BeamSweepTracked>> = BTreeMap::new();
     let mut summaries = Vec::new();
-    for site in &sites {
-        for &kind in &kinds {
-            let per_pass = run_tracker(site, kind, reacquire)?;
-            for (i, (pass, records)) in site.passes.iter().zip(&per_pass).enumerate() {
-                let gnss = site.maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
-                tables.entry(pass.sequence_id.clone()).or_default().extend(rows(
-                    kind,
-                    &site.name,
-                    &pass.sweeps,
-                    records,
-                    gnss,
-                ));
-            }
-            let summary = SweepSummary::from_records(per_pass.iter().flatten()).context("no sweeps")?;
-            summaries.push((site.name.clone(), kind, summary));
+    let mut site_reports = Vec::new();
+    for (name, mut passes) in sites {
+        // Sequence order, so the maps do not depend on the order of the arguments.
+        passes.sort_by(|a, b| a.sequence_id.cmp(&b.sequence_id));
+        let positions: Vec<Option<Vec<[f64; 2]>>> =
+            passes.iter().map(|p| needs_map.then(|| east_north_m(p)).transpose()).collect::<anyhow::Result<_>>()?;
+        let labels: Vec<String> = passes.iter().map(|p| p.path.display().to_string()).collect();
+        let inputs: Vec<PassInput<'_>> = passes
+            .iter()
+            .zip(&positions)
+            .zip(&labels)
+            .map(|((pass, positions), label)| PassInput {
+                label,
+                sweeps: &pass.sweeps,
+                east_north_m: positions.as_deref(),
+            })
+            .collect();
+        let run = track_site(&kinds, reacquire, name, &inputs)?;
+        for (pass, rows) in passes.iter().zip(run.rows) {
+            tables.entry(pass.sequence_id.clone()).or_default().extend(rows);
         }
+        summaries.extend(run.summaries.into_iter().map(|(kind, summary)| (name.to_string(), kind, summary)));
+        site_reports.push(SiteReport {
+            name: name.to_string(),
+            passes: passes.len(),
+            sweeps: passes.iter().map(|p| p.sweeps.len()).sum(),
+            map: run.map,
+        });
     }
     let config_json = serde_json::json!({
             "command": "process beam",
@@ -477,44 +539,7 @@ pub fn process_sweeps(
         staged.write(sequence, rows, &RunInfo::new(config_json.clone(), time_base))?;
     }
     let written = staged.publish()?;
-    let sites = sites
-        .iter()
-        .map(|site| SiteReport {
-            name: site.name.clone(),
-            passes: site.passes.len(),
-            sweeps: site.passes.iter().map(|p| p.sweeps.len()).sum(),
-            map: site.maps.as_ref().map(|m| m.all),
-        })
-        .collect();
-    Ok(SweepOutput { sites, summaries, written, dir: out.path })
-}
-
-/// One pass of full sweeps through one measurement-only policy (`window` or
-/// `last-full-sweep`), without files: the `beam_sweeps_tracked` rows that
-/// `process beam` writes for the same sweeps (site `site`). The sweeps are
-/// the rows of a power array: sweep `i` at `t_ns[i]`, every beam measured.
-/// The GNSS policies need the beam map fitted from both units' positions over
-/// several passes, so they run on recordings only ([`process_sweeps`]).
-///
-/// # Errors
-/// A GNSS policy; sweeps that are not full, of different beam counts or not
-/// increasing in time; the tracker's errors.
-pub fn track_pass(
-    kind: SweepTrackerKind,
-    reacquire: Reacquire,
-    site: &str,
-    sweeps: &[BeamSweep],
-) -> anyhow::Result<Vec<BeamSweepTracked>> {
-    if kind.needs_map() {
-        bail!(
-            "--tracker {}: the GNSS policies need the beam map fitted from the car's and the array's GNSS positions \
-             over several passes; run `process beam` on recordings for them (here: window or last-full-sweep)",
-            kind.name()
-        );
-    }
-    let mut policy = tracker(kind, reacquire, None)?;
-    let records = evaluate(policy.as_mut(), &[SweepPass { sweeps, gnss_beam: None }])?;
-    Ok(rows(kind, site, sweeps, &records, None))
+    Ok(SweepOutput { sites: site_reports, summaries, written, dir: out.path })
 }
 
 impl SweepTrackerKind {

@@ -102,15 +102,28 @@ def track_beams(
     sweep_period_s: float = 0.1,
     reacquire: str = "coarse",
     site: str = "array",
+    pass_index: Optional[Any] = None,
+    car_east_north_m: Optional[Any] = None,
+    car_lat_lon_deg: Optional[Any] = None,
+    array_lat_lon_deg: Optional[Any] = None,
 ) -> pl.DataFrame:
     """The beam-sweep trackers on full sweeps: ``power`` of shape (sweeps, beams), linear power per beam.
 
-    ``tracker``: window (constant-velocity Kalman filter on the beam index)
-    and/or last-full-sweep (baseline); the GNSS policies need recordings with
-    both units' positions (``process("beam", ...)``). Sweep ``i`` is at
-    ``t_ns[i]`` (default ``i * sweep_period_s``). Returns the
-    ``beam_sweeps_tracked`` rows: per tracker and sweep the chosen and best
-    beam, beams measured, re-initialisation and received-power loss (dB).
+    ``tracker``: window (constant-velocity Kalman filter on the beam index),
+    gnss-window (the car's GNSS bearing through a beam map moves the window),
+    last-full-sweep and gnss-map (baselines). Sweep ``i`` is at ``t_ns[i]``
+    (default ``i * sweep_period_s``) and belongs to pass ``pass_index[i]``
+    (default: one pass; a pass's sweeps are consecutive rows).
+
+    The GNSS policies need the car's position at each sweep, either
+    ``car_east_north_m`` (N, 2) metres from the array, or ``car_lat_lon_deg``
+    (N, 2) with ``array_lat_lon_deg`` ((2,) or (N, 2)), and at least two
+    passes: the beam map is fitted leave-one-pass-out over the passes given,
+    as ``process("beam", ...)`` fits it over the recordings of a site.
+
+    Returns the ``beam_sweeps_tracked`` rows: per tracker and sweep the chosen
+    and best beam, beams measured, re-initialisation and received-power loss
+    (dB); with ``pass_index``, a first column ``pass`` names each row's pass.
     """
     p = np.asarray(power, dtype=np.float64)
     if p.ndim != 2:
@@ -121,7 +134,23 @@ def track_beams(
     else:
         t = np.asarray(t_ns, dtype=np.int64)
     names = [tracker] if isinstance(tracker, str) else list(tracker)
-    return _frame(_native.track_beams(_le(p, "f8"), beams, _le(t, "i8"), names, reacquire, site))
+    passes = None if pass_index is None else _le(np.asarray(pass_index).ravel(), "i8")
+    if car_east_north_m is not None and car_lat_lon_deg is not None:
+        raise _native.MmtrackError("give car_east_north_m or car_lat_lon_deg, not both")
+    if car_lat_lon_deg is not None:
+        car, frame = _le(np.asarray(car_lat_lon_deg, dtype=np.float64), "f8"), "lat_lon_deg"
+    elif car_east_north_m is not None:
+        car, frame = _le(np.asarray(car_east_north_m, dtype=np.float64), "f8"), "east_north_m"
+    else:
+        car, frame = None, "east_north_m"
+    array = None if array_lat_lon_deg is None else _le(np.asarray(array_lat_lon_deg, dtype=np.float64), "f8")
+    tables = _native.track_beams(_le(p, "f8"), beams, _le(t, "i8"), names, reacquire, site, passes, car, frame, array)
+    frames = [_frame(data) for _, data in tables]
+    if pass_index is None:
+        return frames[0]
+    return pl.concat(
+        [f.select(pl.lit(index, dtype=pl.Int64).alias("pass"), pl.all()) for (index, _), f in zip(tables, frames)]
+    )
 
 
 @dataclass(frozen=True)

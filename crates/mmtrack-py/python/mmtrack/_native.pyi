@@ -143,8 +143,17 @@ def detect_mpc(
     pulse: Optional[bytes],
 ) -> bytes: ...
 def track_beams(
-    power: bytes, beams: int, t_ns: bytes, tracker: list[str], reacquire: str, site: str
-) -> bytes: ...
+    power: bytes,
+    beams: int,
+    t_ns: bytes,
+    tracker: list[str],
+    reacquire: str,
+    site: str,
+    pass_index: Optional[bytes] = None,
+    car: Optional[bytes] = None,
+    car_frame: str = "east_north_m",
+    array_lat_lon_deg: Optional[bytes] = None,
+) -> list[tuple[int, bytes]]: ...
 def trajectory_metrics(
     sequence: str,
     estimate_t_ns: bytes,

@@ -200,9 +200,11 @@ pub(super) fn detect_mpc<'py>(
     Ok(PyBytes::new(py, &bytes))
 }
 
-/// The beam-sweep trackers on an (N, beams) power array.
+/// The beam-sweep trackers on an (N, beams) power array: per pass, its
+/// index and table bytes.
 #[pyfunction]
-#[pyo3(signature = (power, beams, t_ns, tracker, reacquire, site))]
+#[pyo3(signature = (power, beams, t_ns, tracker, reacquire, site, pass_index=None, car=None, car_frame="east_north_m", array_lat_lon_deg=None))]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn track_beams<'py>(
     py: Python<'py>,
     power: &Bound<'py, PyBytes>,
@@ -211,11 +213,41 @@ pub(super) fn track_beams<'py>(
     tracker: Vec<String>,
     reacquire: String,
     site: String,
-) -> PyResult<Bound<'py, PyBytes>> {
-    let power = arrays::f64s(power.as_bytes(), "power").map_err(py_err)?;
-    let t_ns = arrays::i64s(t_ns.as_bytes(), "t_ns").map_err(py_err)?;
-    let bytes = run(py, 0, || arrays::track_beams(&power, beams, &t_ns, &tracker, &reacquire, &site))?;
-    Ok(PyBytes::new(py, &bytes))
+    pass_index: Option<&Bound<'py, PyBytes>>,
+    car: Option<&Bound<'py, PyBytes>>,
+    car_frame: &str,
+    array_lat_lon_deg: Option<&Bound<'py, PyBytes>>,
+) -> PyResult<Vec<(i64, Bound<'py, PyBytes>)>> {
+    let read = || -> anyhow::Result<_> {
+        let power = arrays::f64s(power.as_bytes(), "power")?;
+        let t_ns = arrays::i64s(t_ns.as_bytes(), "t_ns")?;
+        let pass_index = pass_index.map(|b| arrays::i64s(b.as_bytes(), "pass_index")).transpose()?;
+        let car = car.map(|b| arrays::f64s(b.as_bytes(), "car positions")).transpose()?;
+        let array = array_lat_lon_deg.map(|b| arrays::f64s(b.as_bytes(), "array_lat_lon_deg")).transpose()?;
+        Ok((power, t_ns, pass_index, car, array))
+    };
+    let (power, t_ns, pass_index, car, array) = read().map_err(py_err)?;
+    let tables = run(py, 0, || {
+        let car_frame = match (car_frame, array.as_deref()) {
+            ("east_north_m", None) => arrays::CarFrame::EastNorthM,
+            ("lat_lon_deg", Some(array_lat_lon_deg)) => arrays::CarFrame::LatLonDeg { array_lat_lon_deg },
+            ("east_north_m", Some(_)) => anyhow::bail!("array_lat_lon_deg: only with car positions in lat_lon_deg"),
+            ("lat_lon_deg", None) => {
+                anyhow::bail!("car_lat_lon_deg: give array_lat_lon_deg too (the array's position)")
+            }
+            (other, _) => anyhow::bail!("car_frame '{other}': expected east_north_m or lat_lon_deg"),
+        };
+        let sweeps = arrays::SweepArrays {
+            power: &power,
+            beams,
+            t_ns: &t_ns,
+            pass_index: pass_index.as_deref(),
+            car: car.as_deref(),
+            car_frame,
+        };
+        arrays::track_beams(&sweeps, &tracker, &reacquire, &site)
+    })?;
+    Ok(tables.into_iter().map(|(pass, bytes)| (pass, PyBytes::new(py, &bytes))).collect())
 }
 
 /// Trajectory metrics of two pose arrays.
