@@ -13,9 +13,10 @@
 //!   extension, the loss rule and how the beam is found again;
 //! - [`WindowTracker`]: a constant-velocity Kalman filter on the beam index,
 //!   from the measurements alone;
-//! - [`GnssWindowTracker`]: the car's GNSS position through the fitted
-//!   [`BeamMap`] moves the window (the SPEBT idea of Liu et al. 2024 with
-//!   GNSS in place of radar odometry);
+//! - [`GnssWindowTracker`]: the same filter with the beam the car's GNSS
+//!   position predicts through the fitted [`BeamMap`] as a second, coarser
+//!   measurement (the SPEBT idea of Liu et al. 2024 with GNSS in place of
+//!   radar odometry);
 //! - [`BeamMap`]: beam index against the car's bearing from the array, with
 //!   the boresight, beam spacing and GNSS time offset fitted from data
 //!   (leave-one-pass-out for evaluation);

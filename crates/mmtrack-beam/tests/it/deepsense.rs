@@ -166,11 +166,11 @@ fn window(reacquisition: Reacquisition) -> WindowTrackerConfig {
 }
 
 fn gnss(map: &BeamMap, reacquisition: Reacquisition) -> GnssTrackerConfig {
+    // The pass's map residual (fitted on the other passes) is the GNSS
+    // beam's noise.
     GnssTrackerConfig {
-        search: SearchConfig { reacquisition, ..SearchConfig::default() },
-        // The pass's map residual (fitted on the other passes) sets the
-        // first window.
-        initial_offset_sigma_beams: map.rms_residual_beams(),
+        window: window(reacquisition),
+        gnss_sigma_beams: map.rms_residual_beams(),
         ..Default::default()
     }
 }
@@ -254,8 +254,8 @@ struct Setting {
     half_window_beams: usize,
     max_extension_beams: usize,
     drop_db: f64,
-    /// Window tracker: acceleration noise, beams/s^2; GNSS tracker: offset
-    /// random walk, beams/sqrt(s).
+    /// Acceleration noise of both trackers' constant-velocity filter,
+    /// beams/s^2.
     motion_noise: f64,
 }
 
@@ -300,9 +300,8 @@ fn defaults_chosen_on_one_scenario_hold_on_the_other() {
         ..WindowTrackerConfig::default()
     };
     let gnss_of = |s: &Setting, map: &BeamMap| GnssTrackerConfig {
-        search: search(s),
-        offset_walk_beams_per_sqrt_s: s.motion_noise,
-        initial_offset_sigma_beams: map.rms_residual_beams(),
+        window: window_of(s),
+        gnss_sigma_beams: map.rms_residual_beams(),
         ..GnssTrackerConfig::default()
     };
     let evaluate_setting = |tracker: &str, k: usize, s: &Setting| -> SweepSummary {
@@ -316,7 +315,7 @@ fn defaults_chosen_on_one_scenario_hold_on_the_other() {
         (0..2).map(|k| summary(&run(&scenarios[k].1, &maps[k], &|_| Box::new(LastFullSweep::new())))).collect();
     println!("\nHeld-out settings (chosen on one scenario, evaluated on the other):");
     let mut over_budget = Vec::new();
-    for (tracker, noise) in [("window", [10.0, 30.0, 60.0]), ("gnss-window", [1.0, 2.0, 4.0])] {
+    for (tracker, noise) in [("window", [10.0, 30.0, 60.0]), ("gnss-window", [10.0, 30.0, 60.0])] {
         for (tune, test) in [(0, 1), (1, 0)] {
             let settings = grid(noise);
             let chosen = settings

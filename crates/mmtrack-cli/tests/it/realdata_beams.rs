@@ -179,7 +179,7 @@ fn ingest_written_passes(dir: &Path, beams: usize, power: impl Fn(usize, usize) 
 }
 
 /// All-zero power or a one-beam codebook: the GNSS policies say so, not
-/// that `initial_offset_sigma_beams` (a parameter nobody set) is 0.
+/// that `gnss_sigma_beams` (a parameter nobody set) is 0.
 #[test]
 fn flat_power_or_one_beam_names_the_cause_not_a_parameter() {
     for (beams, expected) in [
@@ -195,7 +195,7 @@ fn flat_power_or_one_beam_names_the_cause_not_a_parameter() {
             let out = mmtrack(dir.path(), &["process", "beam", "rec", "-o", "tables", "--tracker", tracker]);
             let (_, stderr) = text(&out);
             assert!(!out.status.success(), "{beams} beams, {tracker}");
-            assert!(stderr.contains(expected) && !stderr.contains("initial_offset_sigma_beams"), "{stderr}");
+            assert!(stderr.contains(expected) && !stderr.contains("gnss_sigma_beams"), "{stderr}");
         }
     }
 }

@@ -361,6 +361,21 @@ fn fit_maps(site: &str, passes: &[PassInput<'_>]) -> anyhow::Result<SiteMaps> {
     Ok(SiteMaps { per_pass, gnss_beam, all })
 }
 
+/// The `gnss-window` settings for a pass whose map (fitted on the other
+/// passes) is `map`: the window tracker's, and the map's residual as the
+/// GNSS beam's noise.
+fn gnss_window_config(reacquire: Reacquire, map: &BeamMap) -> GnssTrackerConfig {
+    GnssTrackerConfig {
+        window: window_config(reacquire),
+        gnss_sigma_beams: map.rms_residual_beams(),
+        ..Default::default()
+    }
+}
+
+fn window_config(reacquire: Reacquire) -> WindowTrackerConfig {
+    WindowTrackerConfig { search: search(reacquire), ..Default::default() }
+}
+
 fn search(reacquire: Reacquire) -> SearchConfig {
     let reacquisition = match reacquire {
         Reacquire::Coarse => Reacquisition::Coarse { stride: 4 },
@@ -376,18 +391,10 @@ fn tracker(
     map: Option<&BeamMap>,
 ) -> anyhow::Result<Box<dyn SweepTracker>> {
     Ok(match kind {
-        SweepTrackerKind::Window => {
-            Box::new(WindowTracker::new(WindowTrackerConfig { search: search(reacquire), ..Default::default() })?)
-        }
+        SweepTrackerKind::Window => Box::new(WindowTracker::new(window_config(reacquire))?),
         SweepTrackerKind::GnssWindow => {
             let map = map.context("gnss-window without a beam map")?;
-            Box::new(GnssWindowTracker::new(GnssTrackerConfig {
-                search: search(reacquire),
-                // The pass's map residual (fitted on the other passes) sets
-                // the first window.
-                initial_offset_sigma_beams: map.rms_residual_beams(),
-                ..Default::default()
-            })?)
+            Box::new(GnssWindowTracker::new(gnss_window_config(reacquire, map))?)
         }
         SweepTrackerKind::LastFullSweep => Box::new(LastFullSweep::new()),
         SweepTrackerKind::GnssMap => Box::new(GnssMapOnly),
@@ -525,8 +532,8 @@ pub fn process_sweeps(
             "trackers": kinds.iter().map(|k| k.name()).collect::<Vec<_>>(),
             "reacquire": format!("{:?}", search(reacquire).reacquisition),
             "search": format!("{:?}", search(reacquire)),
-            "window": format!("{:?}", WindowTrackerConfig { search: search(reacquire), ..Default::default() }),
-            "gnss_window": format!("{:?} (initial_offset_sigma_beams: each pass's map residual)", GnssTrackerConfig { search: search(reacquire), ..Default::default() }),
+            "window": format!("{:?}", window_config(reacquire)),
+            "gnss_window": format!("{:?} (gnss_sigma_beams: each pass's map residual)", GnssTrackerConfig { window: window_config(reacquire), ..Default::default() }),
             "beam_map": "fitted leave-one-pass-out over the recordings of each site given together",
             "run_id": out.run_id(),
             "mmtrack_version": env!("CARGO_PKG_VERSION"),
