@@ -77,10 +77,8 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let parent = args.suite.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let suite_dir = std::path::absolute(parent).with_context(|| suite_name.clone())?;
     let work = work_dir(args.work_dir.as_deref())?;
-    if !quiet {
-        if let Some(description) = &suite.description {
-            println!("{suite_name}: {description}");
-        }
+    if !quiet && let Some(description) = &suite.description {
+        println!("{suite_name}: {description}");
     }
     let steps = suite.steps.len();
     for (i, step) in suite.steps.iter().enumerate() {
@@ -97,10 +95,10 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if !quiet || checks.iter().any(|c| !c.ok()) {
         print!("{}", suite::table(&checks));
     }
-    if let WorkDir::Kept(dir) = &work {
-        if !quiet {
-            println!("outputs kept in {}", dir.display());
-        }
+    if let WorkDir::Kept(dir) = &work
+        && !quiet
+    {
+        println!("outputs kept in {}", dir.display());
     }
     if args.bless {
         let text = mmtrack_io::paths::read_config_text(&args.suite)?;

@@ -26,7 +26,7 @@ use mmtrack_process::beam::sweep::{PassInput, Reacquire, SweepTrackerKind, car_e
 /// # Errors
 /// A length that is not a multiple of 8, naming `what`.
 pub fn f64s(bytes: &[u8], what: &str) -> anyhow::Result<Vec<f64>> {
-    ensure!(bytes.len() % 8 == 0, "{what}: {} bytes is not a whole number of float64 values", bytes.len());
+    ensure!(bytes.len().is_multiple_of(8), "{what}: {} bytes is not a whole number of float64 values", bytes.len());
     Ok(bytes.chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect())
 }
 
@@ -35,7 +35,7 @@ pub fn f64s(bytes: &[u8], what: &str) -> anyhow::Result<Vec<f64>> {
 /// # Errors
 /// A length that is not a multiple of 8, naming `what`.
 pub fn i64s(bytes: &[u8], what: &str) -> anyhow::Result<Vec<i64>> {
-    ensure!(bytes.len() % 8 == 0, "{what}: {} bytes is not a whole number of int64 values", bytes.len());
+    ensure!(bytes.len().is_multiple_of(8), "{what}: {} bytes is not a whole number of int64 values", bytes.len());
     Ok(bytes.chunks_exact(8).map(|c| i64::from_le_bytes(c.try_into().unwrap_or([0; 8]))).collect())
 }
 
@@ -44,7 +44,7 @@ pub fn i64s(bytes: &[u8], what: &str) -> anyhow::Result<Vec<i64>> {
 /// # Errors
 /// A length that is not a multiple of 16, naming `what`.
 pub fn complexes(bytes: &[u8], what: &str) -> anyhow::Result<Vec<Complex64>> {
-    ensure!(bytes.len() % 16 == 0, "{what}: {} bytes is not a whole number of complex128 values", bytes.len());
+    ensure!(bytes.len().is_multiple_of(16), "{what}: {} bytes is not a whole number of complex128 values", bytes.len());
     let values = f64s(bytes, what)?;
     Ok(values.chunks_exact(2).map(|c| Complex64::new(c[0], c[1])).collect())
 }

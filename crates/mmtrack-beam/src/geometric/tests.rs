@@ -290,7 +290,7 @@ fn bad_observations_are_refused_and_leave_the_estimator_unchanged() {
 #[test]
 fn proposed_beats_ho_chan_and_the_genies_bound_it_over_half_overtakings() {
     let (p0, v) = HALF;
-    let mut spread = Noise(0x5eed_0f_f1e1d);
+    let mut spread = Noise(0x5ee_d0ff_1e1d);
     // Sum of normalised squared errors and their count, per estimator:
     // proposed, Ho-Chan, error-free genie, nullspace genie.
     let mut nmse = [0.0_f64; 4];

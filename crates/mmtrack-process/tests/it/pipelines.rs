@@ -35,7 +35,7 @@ fn radar_recording(dir: &Path, scans: usize) -> PathBuf {
         output: output.clone(),
         recording: RecordingOptions::default(),
     };
-    let done = simulate_radar(&simulation, &NoProgress).unwrap();
+    let done = simulate_radar(&simulation, &NoProgress).expect("simulate the fixture drive");
     assert_eq!(done.scans, scans);
     output
 }
