@@ -33,6 +33,7 @@ use crate::scan_folder::{
 use crate::{IngestError, Progress};
 pub use png_scan::{
     DecodedScanPng, HEADER_COLUMNS, NavtechLayout, OXFORD, decode_scan_png, decode_scan_png_file, encode_scan_png,
+    shift_scan_png_times,
 };
 
 pub use crate::scan_folder::ScanFile;

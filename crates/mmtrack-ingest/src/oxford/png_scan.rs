@@ -211,6 +211,48 @@ fn decode_scan_image(
     Ok(DecodedScanPng { header, width, pixels })
 }
 
+/// The scan PNG of `path` (its own stamp `scan_t_ns`) with every row time
+/// moved by `shift_us` microseconds, re-encoded (balanced compression): the
+/// same scan as if recorded `shift_us` later. Used to repeat real scans under
+/// later stamps, whose row times must lie near the new stamp.
+///
+/// # Errors
+/// As [`decode_scan_png`]; a shift that takes a row time out of range; an
+/// encoder error.
+pub fn shift_scan_png_times(
+    path: &Path,
+    png: &[u8],
+    scan_t_ns: i64,
+    shift_us: i64,
+    layout: &NavtechLayout,
+) -> Result<Vec<u8>, IngestError> {
+    let DecodedScanPng { width, mut pixels, header } = decode_scan_png(path, png, scan_t_ns, layout)?;
+    for (row_index, row) in pixels.chunks_exact_mut(width).enumerate() {
+        let t_us = i64::from_le_bytes(row[0..8].try_into().unwrap_or([0; 8]));
+        let shifted = t_us.checked_add(shift_us).ok_or_else(|| {
+            bad(
+                path,
+                format!("azimuth row {row_index}"),
+                "timestamp (bytes 0-7)",
+                format!("{t_us} us + {shift_us} us overflows"),
+            )
+        })?;
+        row[0..8].copy_from_slice(&shifted.to_le_bytes());
+    }
+    let encode = || -> Result<Vec<u8>, png::EncodingError> {
+        let mut out = Vec::new();
+        let mut encoder = png::Encoder::new(&mut out, width as u32, header.azimuths.len() as u32);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_compression(png::Compression::Balanced);
+        let mut writer = encoder.write_header()?;
+        writer.write_image_data(&pixels)?;
+        writer.finish()?;
+        Ok(out)
+    };
+    encode().map_err(|e| bad(path, "image".into(), "PNG data", format!("re-encoding: {e}")))
+}
+
 /// Encodes a scan as an Oxford-style PNG (the inverse of [`decode_scan_png`],
 /// up to the microsecond and encoder-count quantisation of the format). Used
 /// to make fixtures and benchmark folders.

@@ -99,7 +99,7 @@ pub fn run(options: &IngestBenchOptions, simulate_oxford: SimulateOxfordCommand<
         Some(real) => {
             replicate_real_folder(real, &large, scans)?;
             replicate_real_folder(real, &small, small_scans)?;
-            format!("real PNG bytes of {} repeated", real.display())
+            format!("real PNG bytes of {}, repeated; the repeats moved in time and re-encoded", real.display())
         }
         None => {
             simulated_oxford_folder(&large, scans, temp.path(), simulate_oxford)?;
@@ -210,17 +210,36 @@ fn simulated_oxford_folder(
 }
 
 /// Writes an Oxford folder of `count` scans whose PNGs are the real ones of
-/// `real`, cycled, under new increasing stamps (the ingest reads the scan stamp
-/// from the file name and the azimuth times from the rows).
+/// `real`, cycled, under increasing stamps: the first cycle keeps each
+/// scan's own stamp and bytes; each later cycle moves the stamp and every
+/// row time (the ingest checks the rows against the file name's stamp) by
+/// the first cycle's span, so its PNGs are re-encoded
+/// ([`oxford::shift_scan_png_times`]).
 fn replicate_real_folder(real: &Path, to: &Path, count: usize) -> anyhow::Result<()> {
     let folder = OxfordFolder::open(real)?;
-    let first = folder.scans.first().ok_or_else(|| anyhow::anyhow!("{}: no radar scans", real.display()))?;
+    let (Some(first), Some(last)) = (folder.scans.first(), folder.scans.last()) else {
+        anyhow::bail!("{}: no radar scans", real.display());
+    };
     std::fs::create_dir_all(to.join("radar"))?;
     let mut timestamps = String::new();
-    let first_us = first.t_ns / 1000;
+    // One scan period past the last scan: cycles follow each other like scans.
+    let period_us = if folder.scans.len() > 1 {
+        (last.t_ns - first.t_ns) / 1000 / (folder.scans.len() as i64 - 1)
+    } else {
+        250_000
+    };
+    let cycle_us = (last.t_ns - first.t_ns) / 1000 + period_us;
     for (i, scan) in (0..count).zip(folder.scans.iter().cycle()) {
-        let t_us = first_us + i as i64 * 250_000;
-        std::fs::copy(&scan.path, to.join("radar").join(format!("{t_us}.png")))?;
+        let shift_us = (i / folder.scans.len()) as i64 * cycle_us;
+        let t_us = scan.t_ns / 1000 + shift_us;
+        let target = to.join("radar").join(format!("{t_us}.png"));
+        if shift_us == 0 {
+            std::fs::copy(&scan.path, &target)?;
+        } else {
+            let png = std::fs::read(&scan.path)?;
+            let shifted = oxford::shift_scan_png_times(&scan.path, &png, scan.t_ns, shift_us, &oxford::OXFORD)?;
+            std::fs::write(&target, shifted)?;
+        }
         timestamps.push_str(&format!("{t_us} 1\n"));
     }
     std::fs::write(to.join("radar.timestamps"), timestamps)?;

@@ -129,6 +129,23 @@ fn bench_io_gives_a_row_per_compression_with_the_target_on_none_and_zstd() {
     assert_eq!(text.lines().filter(|l| l.starts_with("| none |") || l.starts_with("| lz4 |")).count(), 2, "{text}");
 }
 
+/// `bench ingest --from` the real Oxford sample with more scans than it
+/// holds: the repeats are moved in time, rows included (the ingest refused
+/// them before: "row 0: timestamp ... is -2.750 s from the scan's own
+/// stamp").
+#[test]
+fn bench_ingest_repeats_the_real_oxford_scans_under_later_times() {
+    let real = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/oxford-radar-tiny");
+    assert!(real.is_dir(), "{}: the real samples belong beside the clone", real.display());
+    let dir = tempfile::tempdir().unwrap();
+    let options =
+        ingest::IngestBenchOptions { scans: 24, repeats: 1, dir: Some(dir.path().to_path_buf()), from: Some(real) };
+    let no_simulation = |_: &Path, _: &Path| -> Command { unreachable!("real PNGs given: nothing to simulate") };
+    let bench = ingest::run(&options, &no_simulation).unwrap();
+    assert_eq!((bench.scans, bench.small_scans, bench.real), (24, 6, true));
+    assert!(bench.source.contains("re-encoded"), "{}", bench.source);
+}
+
 #[test]
 fn bench_ingest_and_odometry_run_on_a_small_simulated_oxford_folder() {
     let dir = tempfile::tempdir().unwrap();
