@@ -10,6 +10,58 @@ use mmtrack_core::slam::PathOrigin;
 use mmtrack_sim::slam::SlamRun;
 use mmtrack_slam::{SlamConfig, SlamFilter, SourceStatus};
 
+/// The true source found last in a run (the one that completes "all VAs" or
+/// "all SPs"): when its paths were first measured and when a confirmed
+/// source of its type first came within the match radius, so a late run can
+/// be told apart as late seen (geometry) or late mapped (the filter).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LastFound {
+    /// Its index in the world's list of VAs or SPs.
+    pub source: usize,
+    /// First epoch (1-based) with a path from it; `None` if never measured.
+    pub first_measured_epoch: Option<usize>,
+    /// First epoch (1-based) with a confirmed source of its type within the
+    /// match radius; `None` if never.
+    pub found_epoch: Option<usize>,
+}
+
+/// A run's outcome and its last-found VA and SP.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KimRunOutcome {
+    /// The paper's metrics.
+    pub outcome: RunOutcome,
+    /// The VA found last.
+    pub last_va: Option<LastFound>,
+    /// The SP found last, among those that count (seen in at least the
+    /// minimum number of epochs).
+    pub last_sp: Option<LastFound>,
+}
+
+/// Of `sources` (index, position), the one whose first epoch with a
+/// confirmed estimate (`confirmed[k]`, epoch `k + 1`) within `radius_m` comes
+/// last (never counts as last of all).
+fn last_found(
+    sources: &[(usize, [f64; 3])],
+    confirmed: &[Vec<[f64; 3]>],
+    first_measured: &[Option<usize>],
+    radius_m: f64,
+) -> Option<LastFound> {
+    let found_epoch = |p: [f64; 3]| {
+        confirmed.iter().position(|est| {
+            est.iter()
+                .any(|q| ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt() <= radius_m)
+        })
+    };
+    sources
+        .iter()
+        .map(|&(source, p)| LastFound {
+            source,
+            first_measured_epoch: first_measured.get(source).copied().flatten(),
+            found_epoch: found_epoch(p).map(|k| k + 1),
+        })
+        .max_by_key(|l| (l.found_epoch.is_none(), l.found_epoch))
+}
+
 /// Runs the filter (prior centred on the true first state, Sec. V-A) over
 /// `run` and measures it.
 ///
@@ -21,17 +73,24 @@ pub fn run_filter(
     seed: u64,
     match_radius_m: f64,
     sp_min_detections: usize,
-) -> anyhow::Result<RunOutcome> {
+) -> anyhow::Result<KimRunOutcome> {
     let first = run.truth.first().context("a run without epochs")?;
     let mut filter = SlamFilter::new(config.clone(), first.ue, seed)?;
     let true_sp = &run.world.scattering_points_m;
     let mut detections = vec![0usize; true_sp.len()];
-    for truth in &run.truth {
+    let mut sp_first = vec![None; true_sp.len()];
+    let mut va_first = vec![None; run.world.virtual_anchors_m.len()];
+    for (k, truth) in run.truth.iter().enumerate() {
         for origin in &truth.origins {
-            if let PathOrigin::ScatteringPoint(i) = origin
-                && let Some(d) = detections.get_mut(*i)
-            {
-                *d += 1;
+            match *origin {
+                PathOrigin::ScatteringPoint(i) if i < true_sp.len() => {
+                    detections[i] += 1;
+                    sp_first[i].get_or_insert(k + 1);
+                }
+                PathOrigin::VirtualAnchor(j) if j < va_first.len() => {
+                    va_first[j].get_or_insert(k + 1);
+                }
+                _ => {}
             }
         }
     }
@@ -61,5 +120,14 @@ pub fn run_filter(
     }
     let mut outcome = evaluate(&map_truth, &views);
     outcome.skipped_paths = skipped_paths;
-    Ok(outcome)
+    let vas: Vec<(usize, [f64; 3])> = run.world.virtual_anchors_m.iter().copied().enumerate().collect();
+    let sps: Vec<(usize, [f64; 3])> =
+        true_sp.iter().copied().enumerate().filter(|(i, _)| detections[*i] >= sp_min_detections).collect();
+    let confirmed_va: Vec<Vec<[f64; 3]>> = views.iter().map(|v| v.va_m.clone()).collect();
+    let confirmed_sp: Vec<Vec<[f64; 3]>> = views.iter().map(|v| v.sp_m.clone()).collect();
+    Ok(KimRunOutcome {
+        last_va: last_found(&vas, &confirmed_va, &va_first, match_radius_m),
+        last_sp: last_found(&sps, &confirmed_sp, &sp_first, match_radius_m),
+        outcome,
+    })
 }

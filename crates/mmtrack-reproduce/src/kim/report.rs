@@ -12,6 +12,7 @@ use mmtrack_io::table::{RunInfo, write_table};
 use mmtrack_io::table::{SlamPerEpochRow, SlamSummaryRow};
 
 use super::config::{Config, Targets};
+use super::evaluate::LastFound;
 use super::run::{Measured, RowResult};
 use crate::common::Staged;
 use crate::model::{Claim, Metric, Rule, Verdict, write_metrics};
@@ -91,12 +92,25 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
             check("mean UE clock-bias error", targets.ue_clock_bias_m, Some(s.ue_clock_bias_error_m), "m", 3);
             check("mean VA localisation error, every confirmed VA", targets.va_m, s.va_error_m, "m", 3);
             check("mean SP localisation error, every confirmed SP", targets.sp_m, s.sp_error_m, "m", 3);
-            let epochs = |claim: &str, paper: u64, mean: f64, median: f64, max: u64, per_run: &[usize]| {
+            let epochs = |claim: &str,
+                          paper: u64,
+                          mean: f64,
+                          median: f64,
+                          max: u64,
+                          per_run: &[usize],
+                          last: &[Option<LastFound>],
+                          kind: &str| {
                 let late: Vec<String> = per_run
                     .iter()
                     .enumerate()
                     .filter(|(_, e)| **e as f64 > bound(paper as f64))
-                    .map(|(r, e)| format!("run {r}: {e}"))
+                    .map(|(r, e)| match last.get(r).copied().flatten() {
+                        Some(LastFound { source, first_measured_epoch, .. }) => format!(
+                            "run {r}: {e}, its last {kind} ({kind} {source}) first measured at epoch {}",
+                            first_measured_epoch.map_or("-".into(), |k| k.to_string())
+                        ),
+                        None => format!("run {r}: {e}"),
+                    })
                     .collect();
                 let late = if late.is_empty() { String::new() } else { format!("; later: {}", late.join(", ")) };
                 let claim = Claim::new(
@@ -119,6 +133,8 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
                 x.all_va_epoch_median,
                 s.all_va_epoch_max,
                 &x.all_va_epochs,
+                &x.last_va,
+                "VA",
             ));
             out.push(epochs(
                 "all SPs confirmed by",
@@ -127,6 +143,8 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
                 x.all_sp_epoch_median,
                 s.all_sp_epoch_max,
                 &x.all_sp_epochs,
+                &x.last_sp,
+                "SP",
             ));
             let claim = Claim::new(
                 format!("no false source at any epoch ({}), worst epoch of any run", row.name),

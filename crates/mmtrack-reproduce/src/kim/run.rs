@@ -24,7 +24,7 @@ use mmtrack_slam::SlamConfig;
 use rayon::prelude::*;
 
 use super::config::{Config, Row};
-use super::evaluate::{EpochErrors, RunOutcome, run_filter};
+use super::evaluate::{EpochErrors, KimRunOutcome, LastFound, RunOutcome, run_filter};
 use crate::common::load_average;
 
 /// What one row measured.
@@ -75,6 +75,10 @@ pub struct RowExtra {
     pub all_va_epochs: Vec<usize>,
     /// The same for the SPs.
     pub all_sp_epochs: Vec<usize>,
+    /// Per run, the VA found last: first measured and first found.
+    pub last_va: Vec<Option<LastFound>>,
+    /// The same for the SPs that count.
+    pub last_sp: Vec<Option<LastFound>>,
 }
 
 /// Quantile `p` of the chi-square distribution with `dof` degrees of
@@ -132,12 +136,12 @@ pub fn measure(
     let load_before = load_average();
     let started = Instant::now();
     progress.start("reproduce kim", runs * experiment.rows.len() as u64, "runs");
-    let mut results = Vec::new();
+    let mut rows = Vec::new();
     for row in &experiment.rows {
         let scenario = row.scenario(&experiment.scenario);
         scenario.validate().with_context(|| format!("{source}: row {}", row.name))?;
         let config = row.filter(filter, scenario.epochs);
-        let outcomes: Vec<RunOutcome> = (0..runs)
+        let results: Vec<KimRunOutcome> = (0..runs)
             .into_par_iter()
             .map(|r| {
                 let realised = scenario.realise(experiment.seed, r)?;
@@ -154,13 +158,15 @@ pub fn measure(
                 outcome
             })
             .collect::<anyhow::Result<_>>()?;
-        results.push(aggregate(row, &scenario, &config, &outcomes)?);
+        let last: Vec<[Option<LastFound>; 2]> = results.iter().map(|k| [k.last_va, k.last_sp]).collect();
+        let outcomes: Vec<RunOutcome> = results.into_iter().map(|k| k.outcome).collect();
+        rows.push(aggregate(row, &scenario, &config, &outcomes, &last)?);
     }
     progress.finish();
     Ok(Measured {
         runs,
         filter: filter.clone(),
-        rows: results,
+        rows,
         elapsed_s: started.elapsed().as_secs_f64(),
         threads: rayon::current_num_threads(),
         load: (load_before, load_average()),
@@ -173,6 +179,7 @@ fn aggregate(
     scenario: &SlamScenario,
     config: &SlamConfig,
     outcomes: &[RunOutcome],
+    last: &[[Option<LastFound>; 2]],
 ) -> anyhow::Result<RowResult> {
     let first = outcomes.first().context("no runs")?.clone();
     let n = outcomes.len() as f64;
@@ -231,6 +238,8 @@ fn aggregate(
         all_sp_epoch_median: median_of(&|o| o.all_sp_epoch),
         all_va_epochs: outcomes.iter().map(|o| o.all_va_epoch.unwrap_or(never)).collect(),
         all_sp_epochs: outcomes.iter().map(|o| o.all_sp_epoch.unwrap_or(never)).collect(),
+        last_va: last.iter().map(|l| l[0]).collect(),
+        last_sp: last.iter().map(|l| l[1]).collect(),
     };
     let summary = SlamSummaryRow {
         row: row.name.clone(),
