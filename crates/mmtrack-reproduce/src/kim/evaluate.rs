@@ -14,12 +14,13 @@ use mmtrack_slam::{SlamConfig, SlamFilter, SourceStatus};
 /// "all SPs"): when its paths were first measured and when a confirmed
 /// source of its type first came within the match radius, so a late run can
 /// be told apart as late seen (geometry) or late mapped (the filter).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LastFound {
     /// Its index in the world's list of VAs or SPs.
     pub source: usize,
-    /// First epoch (1-based) with a path from it; `None` if never measured.
-    pub first_measured_epoch: Option<usize>,
+    /// The epochs (1-based) with a path from it, up to `found_epoch` (or all),
+    /// as inclusive ranges.
+    pub measured_epochs: Vec<[usize; 2]>,
     /// First epoch (1-based) with a confirmed source of its type within the
     /// match radius; `None` if never.
     pub found_epoch: Option<usize>,
@@ -43,7 +44,7 @@ pub struct KimRunOutcome {
 fn last_found(
     sources: &[(usize, [f64; 3])],
     confirmed: &[Vec<[f64; 3]>],
-    first_measured: &[Option<usize>],
+    measured: &[Vec<usize>],
     radius_m: f64,
 ) -> Option<LastFound> {
     let found_epoch = |p: [f64; 3]| {
@@ -54,12 +55,32 @@ fn last_found(
     };
     sources
         .iter()
-        .map(|&(source, p)| LastFound {
-            source,
-            first_measured_epoch: first_measured.get(source).copied().flatten(),
-            found_epoch: found_epoch(p).map(|k| k + 1),
+        .map(|&(source, p)| {
+            let found = found_epoch(p).map(|k| k + 1);
+            let epochs = measured.get(source).map_or(&[][..], Vec::as_slice);
+            let mut ranges: Vec<[usize; 2]> = Vec::new();
+            for &k in epochs.iter().take_while(|&&k| found.is_none_or(|f| k <= f)) {
+                match ranges.last_mut() {
+                    Some(range) if range[1] + 1 == k => range[1] = k,
+                    _ => ranges.push([k, k]),
+                }
+            }
+            LastFound { source, measured_epochs: ranges, found_epoch: found }
         })
         .max_by_key(|l| (l.found_epoch.is_none(), l.found_epoch))
+}
+
+impl LastFound {
+    /// "epochs 1-2, 88-92" (or "never").
+    #[must_use]
+    pub fn measured_text(&self) -> String {
+        if self.measured_epochs.is_empty() {
+            return "never".into();
+        }
+        let ranges: Vec<String> =
+            self.measured_epochs.iter().map(|[a, b]| if a == b { a.to_string() } else { format!("{a}-{b}") }).collect();
+        format!("epochs {}", ranges.join(", "))
+    }
 }
 
 /// Runs the filter (prior centred on the true first state, Sec. V-A) over
@@ -78,17 +99,21 @@ pub fn run_filter(
     let mut filter = SlamFilter::new(config.clone(), first.ue, seed)?;
     let true_sp = &run.world.scattering_points_m;
     let mut detections = vec![0usize; true_sp.len()];
-    let mut sp_first = vec![None; true_sp.len()];
-    let mut va_first = vec![None; run.world.virtual_anchors_m.len()];
+    let mut sp_measured = vec![Vec::new(); true_sp.len()];
+    let mut va_measured = vec![Vec::new(); run.world.virtual_anchors_m.len()];
     for (k, truth) in run.truth.iter().enumerate() {
         for origin in &truth.origins {
             match *origin {
                 PathOrigin::ScatteringPoint(i) if i < true_sp.len() => {
                     detections[i] += 1;
-                    sp_first[i].get_or_insert(k + 1);
+                    if sp_measured[i].last() != Some(&(k + 1)) {
+                        sp_measured[i].push(k + 1);
+                    }
                 }
-                PathOrigin::VirtualAnchor(j) if j < va_first.len() => {
-                    va_first[j].get_or_insert(k + 1);
+                PathOrigin::VirtualAnchor(j) if j < va_measured.len() => {
+                    if va_measured[j].last() != Some(&(k + 1)) {
+                        va_measured[j].push(k + 1);
+                    }
                 }
                 _ => {}
             }
@@ -126,8 +151,37 @@ pub fn run_filter(
     let confirmed_va: Vec<Vec<[f64; 3]>> = views.iter().map(|v| v.va_m.clone()).collect();
     let confirmed_sp: Vec<Vec<[f64; 3]>> = views.iter().map(|v| v.sp_m.clone()).collect();
     Ok(KimRunOutcome {
-        last_va: last_found(&vas, &confirmed_va, &va_first, match_radius_m),
-        last_sp: last_found(&sps, &confirmed_sp, &sp_first, match_radius_m),
+        last_va: last_found(&vas, &confirmed_va, &va_measured, match_radius_m),
+        last_sp: last_found(&sps, &confirmed_sp, &sp_measured, match_radius_m),
         outcome,
     })
+}
+
+#[cfg(test)]
+mod last_found_tests {
+    use super::*;
+
+    #[test]
+    fn the_last_found_source_names_when_it_was_measured_until_found() {
+        // Source 0 found at epoch 2; source 1 (measured in epochs 1, 2 and
+        // 5-6) found at epoch 6, within 1 m; the far estimate never counts.
+        let sources = [(0, [0.0, 0.0, 0.0]), (1, [10.0, 0.0, 0.0])];
+        let confirmed = vec![
+            vec![[50.0, 0.0, 0.0]],
+            vec![[0.5, 0.0, 0.0]],
+            vec![[0.5, 0.0, 0.0]],
+            vec![[0.5, 0.0, 0.0], [13.0, 0.0, 0.0]],
+            vec![[0.5, 0.0, 0.0], [12.0, 0.0, 0.0]],
+            vec![[0.5, 0.0, 0.0], [10.5, 0.0, 0.0]],
+        ];
+        let measured = vec![vec![1, 2, 3], vec![1, 2, 5, 6, 7]];
+        let last = last_found(&sources, &confirmed, &measured, 1.0).unwrap();
+        assert_eq!(last.source, 1);
+        assert_eq!(last.found_epoch, Some(6));
+        assert_eq!(last.measured_epochs, vec![[1, 2], [5, 6]]);
+        assert_eq!(last.measured_text(), "epochs 1-2, 5-6");
+        // A source never found is the last of all.
+        let never = last_found(&[(0, [99.0, 0.0, 0.0])], &confirmed, &[vec![]], 1.0).unwrap();
+        assert_eq!((never.found_epoch, never.measured_text()), (None, "never".to_string()));
+    }
 }

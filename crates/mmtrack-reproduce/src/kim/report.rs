@@ -104,10 +104,11 @@ pub fn verdicts(targets: &Targets, tolerance: f64, results: &[RowResult]) -> Vec
                     .iter()
                     .enumerate()
                     .filter(|(_, e)| **e as f64 > bound(paper as f64))
-                    .map(|(r, e)| match last.get(r).copied().flatten() {
-                        Some(LastFound { source, first_measured_epoch, .. }) => format!(
-                            "run {r}: {e}, its last {kind} ({kind} {source}) first measured at epoch {}",
-                            first_measured_epoch.map_or("-".into(), |k| k.to_string())
+                    .map(|(r, e)| match last.get(r).and_then(Option::as_ref) {
+                        Some(l) => format!(
+                            "run {r}: {e}; its last {kind} ({kind} {}) was measured in {} until then",
+                            l.source,
+                            l.measured_text()
                         ),
                         None => format!("run {r}: {e}"),
                     })

@@ -158,7 +158,8 @@ pub fn measure(
                 outcome
             })
             .collect::<anyhow::Result<_>>()?;
-        let last: Vec<[Option<LastFound>; 2]> = results.iter().map(|k| [k.last_va, k.last_sp]).collect();
+        let last: Vec<[Option<LastFound>; 2]> =
+            results.iter().map(|k| [k.last_va.clone(), k.last_sp.clone()]).collect();
         let outcomes: Vec<RunOutcome> = results.into_iter().map(|k| k.outcome).collect();
         rows.push(aggregate(row, &scenario, &config, &outcomes, &last)?);
     }
@@ -238,8 +239,8 @@ fn aggregate(
         all_sp_epoch_median: median_of(&|o| o.all_sp_epoch),
         all_va_epochs: outcomes.iter().map(|o| o.all_va_epoch.unwrap_or(never)).collect(),
         all_sp_epochs: outcomes.iter().map(|o| o.all_sp_epoch.unwrap_or(never)).collect(),
-        last_va: last.iter().map(|l| l[0]).collect(),
-        last_sp: last.iter().map(|l| l[1]).collect(),
+        last_va: last.iter().map(|l| l[0].clone()).collect(),
+        last_sp: last.iter().map(|l| l[1].clone()).collect(),
     };
     let summary = SlamSummaryRow {
         row: row.name.clone(),
