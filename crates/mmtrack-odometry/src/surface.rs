@@ -242,29 +242,6 @@ mod tests {
             .collect()
     }
 
-    /// The 11 real Oxford Radar RobotCar scans of the shared sample (Barnes
-    /// et al., ICRA 2020, CC BY-NC-SA 4.0), read where the integration
-    /// tests read them.
-    fn oxford_scans() -> Option<Vec<mmtrack_core::PolarScan>> {
-        use mmtrack_ingest::oxford::{self, OxfordFolder};
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/oxford-radar-tiny");
-        if !dir.is_dir() {
-            eprintln!("skipped: real data not found at {}", dir.display());
-            return None;
-        }
-        let folder = OxfordFolder::open(&dir).unwrap();
-        let scans: Vec<_> = folder
-            .scans
-            .iter()
-            .map(|file| {
-                let png = std::fs::read(&file.path).unwrap();
-                oxford::decode_scan_png(&file.path, &png, file.t_ns, &oxford::OXFORD).unwrap().into_scan()
-            })
-            .collect();
-        assert_eq!(scans.len(), 11);
-        Some(scans)
-    }
-
     fn preset_params(config: &crate::OdometryConfig) -> SurfaceParams {
         SurfaceParams {
             radius_m: config.grid_m,
@@ -277,7 +254,7 @@ mod tests {
     #[test]
     fn on_real_scans_the_pruned_search_gives_the_full_searchs_surface_points_bit_for_bit() {
         use crate::filter::{BodyVelocity, k_strongest, place};
-        let Some(scans) = oxford_scans() else { return };
+        let Some(scans) = crate::real_scans::oxford() else { return };
         let bits = |points: &[SurfacePoint]| -> Vec<(u32, [u64; 4])> {
             points
                 .iter()
@@ -309,7 +286,7 @@ mod tests {
     #[test]
     fn on_real_scans_every_neighbour_within_the_radius_is_found() {
         use crate::filter::{k_strongest, place};
-        let Some(scans) = oxford_scans() else { return };
+        let Some(scans) = crate::real_scans::oxford() else { return };
         // Three scans with cfear's k = 40 (the densest neighbourhoods): the
         // pruned grid search from every downsampled centre against a count
         // over every filtered point; a missed or extra neighbour changes it.
