@@ -83,39 +83,17 @@ pub fn k_strongest(scan: &PolarScan, k: usize, min_power: u8, min_range_m: f64, 
     let kept_per_azimuth = k.min(end_bin.saturating_sub(first_bin));
     let mut points = Vec::with_capacity(header.azimuths.len() * kept_per_azimuth);
     let mut strongest: Vec<(u8, usize)> = Vec::with_capacity(kept_per_azimuth + 1);
+    let mut candidates: Vec<(u8, usize)> = Vec::new();
     for (row_index, azimuth) in header.azimuths.iter().enumerate() {
         let Some(row) = scan.row(row_index) else { break };
         if !azimuth.valid || first_bin >= end_bin {
             continue;
         }
-        strongest.clear();
         let bins = &row[first_bin..end_bin];
-        let mut block_start = 0;
-        while block_start < bins.len() {
-            // The weakest power that can still enter: the threshold, or one
-            // above the k-th strongest once k are kept. It only rises along
-            // the row, so a block of bins all below it changes nothing and is
-            // skipped whole (the test below compiles to a few vector
-            // compares); the result is the bin-by-bin sweep's.
-            let entry = if strongest.len() == k { u16::from(strongest[k - 1].0) + 1 } else { u16::from(min_power) };
-            if entry > u16::from(u8::MAX) {
-                break;
-            }
-            let block = &bins[block_start..bins.len().min(block_start + SKIP_BLOCK_BINS)];
-            if u16::from(block.iter().fold(0u8, |m, &p| m.max(p))) < entry {
-                block_start += block.len();
-                continue;
-            }
-            for (offset, &power) in block.iter().enumerate() {
-                if power < min_power || (strongest.len() == k && power <= strongest[k - 1].0) {
-                    continue;
-                }
-                // Insert keeping (power desc, bin asc); a later bin never displaces an equal earlier one.
-                let at = strongest.iter().position(|&(p, _)| p < power).unwrap_or(strongest.len());
-                strongest.insert(at, (power, first_bin + block_start + offset));
-                strongest.truncate(k);
-            }
-            block_start += block.len();
+        if k <= MAX_K_BY_INSERTION {
+            strongest_by_insertion(bins, first_bin, k, min_power, &mut strongest);
+        } else {
+            strongest_by_counting(bins, first_bin, k, min_power, &mut candidates, &mut strongest);
         }
         let (sin_a, cos_a) = azimuth.azimuth_rad.sin_cos();
         let dt_s = (azimuth.t_ns - header.t_ns) as f64 * 1e-9;
@@ -124,6 +102,100 @@ pub fn k_strongest(scan: &PolarScan, k: usize, min_power: u8, min_range_m: f64, 
         }
     }
     points
+}
+
+/// Largest `k` for which [`k_strongest`] keeps a row's strongest bins by
+/// insertion into a sorted list (O(k) per entering bin, but a kept list
+/// that fills early raises the bar and skips most blocks); above it, by
+/// counting the candidates' powers (O(levels) per row, whatever `k`).
+const MAX_K_BY_INSERTION: usize = 8;
+
+/// The `k` strongest of `bins` with power at least `min_power`, as
+/// `(power, bin)` in (power desc, bin asc) order: one sweep inserting into a
+/// sorted list, skipping the blocks of [`SKIP_BLOCK_BINS`] none of whose
+/// bins can enter.
+fn strongest_by_insertion(bins: &[u8], first_bin: usize, k: usize, min_power: u8, strongest: &mut Vec<(u8, usize)>) {
+    strongest.clear();
+    let mut block_start = 0;
+    while block_start < bins.len() {
+        // The weakest power that can still enter: the threshold, or one
+        // above the k-th strongest once k are kept. It only rises along
+        // the row, so a block of bins all below it changes nothing and is
+        // skipped whole (the test below compiles to a few vector
+        // compares); the result is the bin-by-bin sweep's.
+        let entry = if strongest.len() == k { u16::from(strongest[k - 1].0) + 1 } else { u16::from(min_power) };
+        if entry > u16::from(u8::MAX) {
+            break;
+        }
+        let block = &bins[block_start..bins.len().min(block_start + SKIP_BLOCK_BINS)];
+        if u16::from(block.iter().fold(0u8, |m, &p| m.max(p))) < entry {
+            block_start += block.len();
+            continue;
+        }
+        for (offset, &power) in block.iter().enumerate() {
+            if power < min_power || (strongest.len() == k && power <= strongest[k - 1].0) {
+                continue;
+            }
+            // Insert keeping (power desc, bin asc); a later bin never displaces an equal earlier one.
+            let at = strongest.iter().position(|&(p, _)| p < power).unwrap_or(strongest.len());
+            strongest.insert(at, (power, first_bin + block_start + offset));
+            strongest.truncate(k);
+        }
+        block_start += block.len();
+    }
+}
+
+/// What [`strongest_by_insertion`] returns, by a counting sort: the bins of
+/// at least `min_power` are collected in bin order (blocks without one are
+/// skipped whole), their powers counted, and each is written to its place
+/// in (power desc, bin asc) order when that place is among the first `k`.
+/// The same list: within a power, bins keep their order, so the nearer bin
+/// wins a tie at the k-th place as in the insertion.
+fn strongest_by_counting(
+    bins: &[u8],
+    first_bin: usize,
+    k: usize,
+    min_power: u8,
+    candidates: &mut Vec<(u8, usize)>,
+    strongest: &mut Vec<(u8, usize)>,
+) {
+    candidates.clear();
+    for (block_index, block) in bins.chunks(SKIP_BLOCK_BINS).enumerate() {
+        if block.iter().fold(0u8, |m, &p| m.max(p)) < min_power {
+            continue;
+        }
+        let block_start = first_bin + block_index * SKIP_BLOCK_BINS;
+        for (offset, &power) in block.iter().enumerate() {
+            if power >= min_power {
+                candidates.push((power, block_start + offset));
+            }
+        }
+    }
+    strongest.clear();
+    let kept = k.min(candidates.len());
+    if kept == 0 {
+        return;
+    }
+    // next[p]: the place of the next candidate of power p, counted from
+    // the strongest (the candidates stronger than p come first).
+    let mut next = [0usize; 256];
+    for &(power, _) in candidates.iter() {
+        next[usize::from(power)] += 1;
+    }
+    let mut stronger = 0;
+    for level in (usize::from(min_power)..256).rev() {
+        let count = next[level];
+        next[level] = stronger;
+        stronger += count;
+    }
+    strongest.resize(kept, (0, 0));
+    for &(power, bin) in candidates.iter() {
+        let place = &mut next[usize::from(power)];
+        if *place < kept {
+            strongest[*place] = (power, bin);
+        }
+        *place += 1;
+    }
 }
 
 /// Places the kept bins in the vehicle frame at the scan stamp. With
@@ -198,6 +270,61 @@ mod tests {
         let ranges: Vec<f64> = points.iter().map(|p| p.xy_m[0]).collect();
         assert_eq!(ranges, vec![1.0, 4.0]);
         assert!(points.iter().all(|p| p.power == 90));
+    }
+
+    #[test]
+    fn counting_keeps_what_insertion_keeps_in_the_same_order() {
+        // Rows of few distinct powers (many ties at the k-th place), of
+        // bright and of empty stretches, for k below, at and above the
+        // candidates in a row, and thresholds from 0 to 255.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let (mut strongest, mut candidates, mut by_insertion) = (Vec::new(), Vec::new(), Vec::new());
+        let mut compared = 0;
+        for row_index in 0..600 {
+            let len = 1 + (next() % 400) as usize;
+            let levels = [2, 5, 256][row_index % 3];
+            let row: Vec<u8> = (0..len)
+                .map(|i| {
+                    let dark = (i / 64 + row_index) % 4 == 0;
+                    if dark { 0 } else { (next() % levels) as u8 * (255 / (levels - 1).max(1)) as u8 }
+                })
+                .collect();
+            for k in [1, 3, 9, 40, 500] {
+                for min_power in [0u8, 1, 60, 128, 255] {
+                    strongest_by_insertion(&row, 7, k, min_power, &mut by_insertion);
+                    strongest_by_counting(&row, 7, k, min_power, &mut candidates, &mut strongest);
+                    assert_eq!(strongest, by_insertion, "row {row_index}, k {k}, min power {min_power}");
+                    compared += strongest.len();
+                }
+            }
+        }
+        assert!(compared > 100_000, "{compared}");
+    }
+
+    #[test]
+    fn on_real_scans_counting_keeps_what_insertion_keeps() {
+        let Some(scans) = crate::real_scans::oxford() else { return };
+        let (mut by_insertion, mut candidates, mut by_counting) = (Vec::new(), Vec::new(), Vec::new());
+        let mut kept = 0;
+        for scan in &scans {
+            for row_index in 0..scan.header.azimuths.len() {
+                let row = scan.row(row_index).unwrap();
+                // cfear's and CFEAR-1's k, Fast-CFEAR's K, over whole rows.
+                for (k, min_power) in [(40, 60), (12, 60), (3, 55)] {
+                    strongest_by_insertion(row, 0, k, min_power, &mut by_insertion);
+                    strongest_by_counting(row, 0, k, min_power, &mut candidates, &mut by_counting);
+                    assert_eq!(by_counting, by_insertion, "t {} row {row_index} k {k}", scan.header.t_ns);
+                    kept += by_counting.len();
+                }
+            }
+        }
+        assert!(kept > 100_000, "{kept}");
     }
 
     #[test]

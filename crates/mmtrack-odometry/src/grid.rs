@@ -127,6 +127,43 @@ impl GridIndex {
         }
     }
 
+    /// Calls `visit(positions)` with the points of each of the 3 x 3 cells
+    /// around `p`, in the order of [`GridIndex::for_each_candidate`], but
+    /// leaves out the cells all of whose area lies farther than `radius_m`
+    /// from `p` (`radius_m` at most the cell side; in practice the corner
+    /// cells when `p` is not near that corner of its own cell): none of
+    /// their points can be within `radius_m`. The cell's nearest distance is
+    /// shortened by a margin far above the rounding of `p / cell_m`, so a
+    /// point that a caller's own `d^2 <= radius^2` test would keep is never
+    /// in a skipped cell.
+    #[inline]
+    pub fn for_each_cell_near(&self, p: [f64; 2], radius_m: f64, mut visit: impl FnMut(&[[f64; 2]])) {
+        let (cx, cy) = cell_of(p, self.cell_m);
+        // Distances from `p` to the lower and upper sides of its own cell.
+        let lower = [p[0] - cx as f64 * self.cell_m, p[1] - cy as f64 * self.cell_m];
+        let upper = [(cx + 1) as f64 * self.cell_m - p[0], (cy + 1) as f64 * self.cell_m - p[1]];
+        let margin_m = 1e-9 * (self.cell_m + p[0].abs() + p[1].abs());
+        let gap = |d: i64, axis: usize| match d {
+            -1 => (lower[axis] - margin_m).max(0.0),
+            1 => (upper[axis] - margin_m).max(0.0),
+            _ => 0.0,
+        };
+        let radius_sq = radius_m * radius_m;
+        for dy in -1..=1 {
+            let gap_y = gap(dy, 1);
+            for dx in -1..=1 {
+                let gap_x = gap(dx, 0);
+                if gap_x * gap_x + gap_y * gap_y > radius_sq {
+                    continue;
+                }
+                let range = self.cell_range((cx + dx, cy + dy));
+                if !range.is_empty() {
+                    visit(&self.xy_m[range]);
+                }
+            }
+        }
+    }
+
     /// Non-empty cells in (x, y) order, each as its points' indices in
     /// insertion order.
     #[cfg(test)]
@@ -197,6 +234,40 @@ mod tests {
         let mut visited = 0;
         index.for_each_candidate([0.0, 0.0], |_, _| visited += 1);
         assert!(visited > 0, "the query at the centre finds points");
+    }
+
+    #[test]
+    fn cells_near_keep_every_point_within_the_radius_in_candidate_order_and_skip_far_corners() {
+        let points: Vec<[f64; 2]> =
+            (0..2000).map(|i| [((i * 37) % 211) as f64 * 0.05 - 3.0, ((i * 53) % 199) as f64 * 0.05 - 4.0]).collect();
+        let cell_m = 1.5;
+        let index = GridIndex::new(points.iter().copied(), cell_m);
+        // Queries all over, and at distances of 1e-12 m and less from cell
+        // corners and sides, where the skip test is tightest.
+        let mut queries: Vec<[f64; 2]> =
+            (0..300).map(|i| [((i * 17) % 101) as f64 * 0.11 - 3.3, ((i * 29) % 97) as f64 * 0.09 - 4.1]).collect();
+        for (kx, ky) in [(0.0, 0.0), (1.0, 1.0), (-1.0, 2.0), (2.0, -2.0)] {
+            for (ex, ey) in [(1e-12, 1e-12), (-1e-12, 1e-12), (0.0, 0.0), (-1e-15, -1e-15), (0.7, 1e-13)] {
+                queries.push([kx * cell_m + ex, ky * cell_m + ey]);
+            }
+        }
+        let mut skipped = 0;
+        for radius_m in [cell_m, 0.8] {
+            for &q in &queries {
+                let within =
+                    |p: &[f64; 2]| (p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) <= radius_m * radius_m;
+                let mut expected = Vec::new();
+                index.for_each_candidate(q, |_, p| expected.push(p));
+                let all_candidates = expected.len();
+                expected.retain(within);
+                let mut near = Vec::new();
+                index.for_each_cell_near(q, radius_m, |cell| near.extend_from_slice(cell));
+                skipped += all_candidates - near.len();
+                near.retain(within);
+                assert_eq!(near, expected, "query {q:?}, radius {radius_m}");
+            }
+        }
+        assert!(skipped > 10_000, "{skipped} candidates skipped");
     }
 
     #[test]

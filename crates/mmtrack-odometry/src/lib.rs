@@ -40,6 +40,34 @@ mod pipeline;
 pub mod register;
 pub mod surface;
 
+#[cfg(test)]
+pub(crate) mod real_scans {
+    //! The real scans the unit tests check against.
+
+    /// The 11 real Oxford Radar RobotCar scans of the shared sample (Barnes
+    /// et al., ICRA 2020, CC BY-NC-SA 4.0), read where the integration
+    /// tests read them.
+    pub fn oxford() -> Option<Vec<mmtrack_core::PolarScan>> {
+        use mmtrack_ingest::oxford::{self, OxfordFolder};
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realdata/oxford-radar-tiny");
+        if !dir.is_dir() {
+            eprintln!("skipped: real data not found at {}", dir.display());
+            return None;
+        }
+        let folder = OxfordFolder::open(&dir).unwrap();
+        let scans: Vec<_> = folder
+            .scans
+            .iter()
+            .map(|file| {
+                let png = std::fs::read(&file.path).unwrap();
+                oxford::decode_scan_png(&file.path, &png, file.t_ns, &oxford::OXFORD).unwrap().into_scan()
+            })
+            .collect();
+        assert_eq!(scans.len(), 11);
+        Some(scans)
+    }
+}
+
 pub use config::OdometryConfig;
 pub use error::OdometryError;
 pub use pipeline::{MIN_TRANSLATION_OBSERVABILITY, RadarOdometry, ScanOdometry};

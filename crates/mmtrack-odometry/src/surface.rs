@@ -38,6 +38,14 @@ pub struct SurfaceParams {
 /// `max_condition_number` are dropped. Cells are visited in (x, y) order so the
 /// output is deterministic.
 ///
+/// The neighbourhood search: a grid of cells of side d_D, so `N_i` lies in
+/// the 3 x 3 cells around `p_i`; cells wholly farther than d_D are not
+/// read, and each cell's points are tested before the inside ones are
+/// summed ([`GridIndex::for_each_cell_near`], `Moments::add_within`). The
+/// sums run over the same points in the same order as summing every
+/// candidate with `+0.0` for the outside ones, so the surface points are
+/// the same to the last bit (tested on the real Oxford scans).
+///
 /// # References
 /// Liu et al., SPEBT, Sec. III-A.2 and III-A.3 (the covariance of eq. (6)).
 #[must_use]
@@ -58,10 +66,7 @@ pub fn surface_points(filtered: &[FilteredPoint], params: &SurfaceParams) -> Vec
         let count = cell.len() as f64;
         let centre = [sum[0] / count, sum[1] / count];
         let mut moments = Moments::default();
-        index.for_each_candidate(centre, |_, q| {
-            let (dx, dy) = (q[0] - centre[0], q[1] - centre[1]);
-            moments.add_if(dx * dx + dy * dy <= radius_sq, dx, dy);
-        });
+        index.for_each_cell_near(centre, params.radius_m, |cell| moments.add_within(cell, centre, radius_sq));
         if moments.n < params.min_neighbours.max(2) {
             continue;
         }
@@ -85,7 +90,38 @@ struct Moments {
     sxy: f64,
 }
 
+/// Points [`Moments::add_within`] tests before summing the ones inside.
+const MOMENT_CHUNK: usize = 64;
+
 impl Moments {
+    /// [`Moments::add`] for each point of `points` within `radius_sq` of
+    /// `centre` (squared distance `<= radius_sq`), in their order. Two passes
+    /// per chunk of [`MOMENT_CHUNK`] points: the distance tests write every
+    /// offset into a buffer but advance its end only past the inside ones
+    /// (no branch, no misprediction), then the inside offsets are summed.
+    /// The sums are the same as [`Moments::add_if`] over all the points
+    /// (which adds `+0.0` for the outside ones), term for term, but the
+    /// dependent chain of additions, the cost of a neighbourhood, runs over
+    /// the inside points only (about a third of the candidates).
+    #[inline]
+    fn add_within(&mut self, points: &[[f64; 2]], centre: [f64; 2], radius_sq: f64) {
+        let mut dx_m = [0.0; MOMENT_CHUNK];
+        let mut dy_m = [0.0; MOMENT_CHUNK];
+        for chunk in points.chunks(MOMENT_CHUNK) {
+            let mut inside = 0;
+            for q in chunk {
+                let (dx, dy) = (q[0] - centre[0], q[1] - centre[1]);
+                // `inside` <= the index of `q` < MOMENT_CHUNK: the mask only drops the bounds check.
+                dx_m[inside & (MOMENT_CHUNK - 1)] = dx;
+                dy_m[inside & (MOMENT_CHUNK - 1)] = dy;
+                inside += usize::from(dx * dx + dy * dy <= radius_sq);
+            }
+            for (&dx, &dy) in dx_m[..inside].iter().zip(&dy_m[..inside]) {
+                self.add(dx, dy);
+            }
+        }
+    }
+
     /// [`Moments::add`] when `inside`, else nothing, without a branch: about
     /// a third of a query's candidates are inside, in no predictable order,
     /// so a branch would be mispredicted often. Adding `+0.0` for the others
@@ -93,7 +129,7 @@ impl Moments {
     /// round-to-nearest sum that cancels to zero is `+0.0`, so none is ever
     /// `-0.0`, the one value `+0.0` would change), and the selected terms
     /// are the same products in the same order as `add`'s.
-    #[inline]
+    #[cfg(test)]
     fn add_if(&mut self, inside: bool, dx: f64, dy: f64) {
         let pick = |v: f64| if inside { v } else { 0.0 };
         self.n += usize::from(inside);
@@ -104,7 +140,7 @@ impl Moments {
         self.sxy += pick(dx * dy);
     }
 
-    #[cfg(test)]
+    #[inline]
     fn add(&mut self, dx: f64, dy: f64) {
         self.n += 1;
         self.sx += dx;
@@ -156,6 +192,122 @@ mod tests {
 
     fn points(xy: impl Iterator<Item = [f64; 2]>) -> Vec<FilteredPoint> {
         xy.map(|xy_m| FilteredPoint { xy_m, power: 100 }).collect()
+    }
+
+    /// The search before the pruned one: every point of the 3 x 3 cells,
+    /// added with `+0.0` when outside the radius.
+    fn surface_points_full_3x3(filtered: &[FilteredPoint], params: &SurfaceParams) -> Vec<SurfacePoint> {
+        assert_eq!(params.cell_m, params.radius_m, "the real-scan presets use f_D = 1");
+        let index = GridIndex::new(filtered.iter().map(|p| p.xy_m), params.radius_m);
+        let radius_sq = params.radius_m * params.radius_m;
+        let mut out = Vec::new();
+        for cell in index.occupied_cell_positions() {
+            let sum = cell.iter().fold([0.0, 0.0], |acc, p| [acc[0] + p[0], acc[1] + p[1]]);
+            let count = cell.len() as f64;
+            let centre = [sum[0] / count, sum[1] / count];
+            let mut moments = Moments::default();
+            index.for_each_candidate(centre, |_, q| {
+                let (dx, dy) = (q[0] - centre[0], q[1] - centre[1]);
+                moments.add_if(dx * dx + dy * dy <= radius_sq, dx, dy);
+            });
+            if moments.n < params.min_neighbours.max(2) {
+                continue;
+            }
+            if let Some(point) = moments.oriented_point(centre, params.max_condition_number) {
+                out.push(point);
+            }
+        }
+        out
+    }
+
+    /// Every downsampled centre with its neighbour count over all filtered
+    /// points (no grid): what the neighbourhood search must find.
+    fn brute_force_counts(filtered: &[FilteredPoint], params: &SurfaceParams) -> Vec<([f64; 2], usize)> {
+        let index = GridIndex::new(filtered.iter().map(|p| p.xy_m), params.cell_m);
+        let radius_sq = params.radius_m * params.radius_m;
+        index
+            .occupied_cell_positions()
+            .map(|cell| {
+                let sum = cell.iter().fold([0.0, 0.0], |acc, p| [acc[0] + p[0], acc[1] + p[1]]);
+                let centre = [sum[0] / cell.len() as f64, sum[1] / cell.len() as f64];
+                let inside = filtered
+                    .iter()
+                    .filter(|p| {
+                        let (dx, dy) = (p.xy_m[0] - centre[0], p.xy_m[1] - centre[1]);
+                        dx * dx + dy * dy <= radius_sq
+                    })
+                    .count();
+                (centre, inside)
+            })
+            .collect()
+    }
+
+    fn preset_params(config: &crate::OdometryConfig) -> SurfaceParams {
+        SurfaceParams {
+            radius_m: config.grid_m,
+            cell_m: config.grid_m / config.resample_factor,
+            min_neighbours: config.min_surface_neighbours,
+            max_condition_number: config.max_condition_number,
+        }
+    }
+
+    #[test]
+    fn on_real_scans_the_pruned_search_gives_the_full_searchs_surface_points_bit_for_bit() {
+        use crate::filter::{BodyVelocity, k_strongest, place};
+        let Some(scans) = crate::real_scans::oxford() else { return };
+        let bits = |points: &[SurfacePoint]| -> Vec<(u32, [u64; 4])> {
+            points
+                .iter()
+                .map(|p| (p.neighbours, [p.mean_m[0], p.mean_m[1], p.normal[0], p.normal[1]].map(f64::to_bits)))
+                .collect()
+        };
+        // Both presets; the sweep as instantaneous and motion-compensated
+        // (a turning drive, as cfear places it in its association rounds).
+        let turning = BodyVelocity { vx_mps: 8.3, vy_mps: -0.2, yaw_rate_radps: 0.21 };
+        let mut compared = 0;
+        for config in [crate::OdometryConfig::fast_cfear(), crate::OdometryConfig::cfear()] {
+            let params = preset_params(&config);
+            for scan in &scans {
+                let kept =
+                    k_strongest(scan, config.k_strongest, config.min_power, config.min_range_m, config.max_range_m);
+                for velocity in [None, Some(turning)] {
+                    let filtered = place(&kept, velocity);
+                    let pruned = surface_points(&filtered, &params);
+                    let full = surface_points_full_3x3(&filtered, &params);
+                    assert!(pruned.len() > 50, "{} surface points: too few to test anything", pruned.len());
+                    assert_eq!(bits(&pruned), bits(&full), "k = {}, {velocity:?}", config.k_strongest);
+                    compared += pruned.len();
+                }
+            }
+        }
+        assert!(compared > 5_000, "{compared}");
+    }
+
+    #[test]
+    fn on_real_scans_every_neighbour_within_the_radius_is_found() {
+        use crate::filter::{k_strongest, place};
+        let Some(scans) = crate::real_scans::oxford() else { return };
+        // Three scans with cfear's k = 40 (the densest neighbourhoods): the
+        // pruned grid search from every downsampled centre against a count
+        // over every filtered point; a missed or extra neighbour changes it.
+        let config = crate::OdometryConfig::cfear();
+        let params = preset_params(&config);
+        let radius_sq = params.radius_m * params.radius_m;
+        for scan in scans.iter().step_by(5) {
+            let kept = k_strongest(scan, config.k_strongest, config.min_power, config.min_range_m, config.max_range_m);
+            let filtered = place(&kept, None);
+            let index = GridIndex::new(filtered.iter().map(|p| p.xy_m), params.radius_m);
+            let truth = brute_force_counts(&filtered, &params);
+            assert!(truth.len() > 200 && filtered.len() > 10_000, "{} centres, {} points", truth.len(), filtered.len());
+            let mut pairs = 0;
+            for &(centre, expected) in &truth {
+                let mut moments = Moments::default();
+                index.for_each_cell_near(centre, params.radius_m, |cell| moments.add_within(cell, centre, radius_sq));
+                assert_eq!(moments.n, expected, "neighbours of the centre at {centre:?}");
+                pairs += expected;
+            }
+            assert!(pairs > 10 * truth.len(), "{pairs} neighbours for {} centres", truth.len());
+        }
     }
 
     #[test]
