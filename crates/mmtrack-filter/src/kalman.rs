@@ -24,12 +24,11 @@
 //! *Filtering for Stochastic Processes with Applications to Guidance*, 1968 (the
 //! Joseph form).
 
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Col, Mat, Par};
+use faer::{Col, ColRef, Mat};
 
 use crate::error::{FilterError, ensure_finite_vector, ensure_len, ensure_shape};
 use crate::gaussian::{Gaussian, checked_spd, log_normal_pdf_with};
-use crate::linalg::{Cholesky, symmetrise};
+use crate::linalg::{Cholesky, mul, mul_add, mul_col, symmetrise};
 use crate::models::{LinearMeasurement, TransitionModel};
 
 /// How the posterior covariance is computed.
@@ -117,11 +116,11 @@ impl<T: TransitionModel> KalmanPredictor<T> {
 
 /// `N(F m, F P F^T + Q)`, shapes already checked.
 fn predict_with(prior: &Gaussian, f: &Mat<f64>, q: &Mat<f64>) -> Result<Gaussian, FilterError> {
-    let mean = f * prior.mean();
-    let fp = f * prior.cov();
+    let mean = mul_col(f.as_ref(), prior.mean().as_ref());
+    let fp = mul(f.as_ref(), prior.cov().as_ref());
     // F P F^T + Q, written into a copy of Q.
     let mut cov = q.clone();
-    matmul(cov.as_mut(), Accum::Add, &fp, f.transpose(), 1.0, Par::Seq);
+    mul_add(cov.as_mut(), 1.0, fp.as_ref(), f.transpose());
     Gaussian::new(mean, symmetrise(cov))
 }
 
@@ -149,7 +148,7 @@ impl KalmanUpdater {
     pub fn prepare(&self, prior: &Gaussian) -> Result<PreparedUpdate, FilterError> {
         ensure_len("prior mean", prior.mean(), self.model.state_dim())?;
         let h = self.model.h();
-        prepare_linearised(prior, h * prior.mean(), h, self.model.r(), self.covariance_update)
+        prepare_linearised(prior, mul_col(h.as_ref(), prior.mean().as_ref()), h, self.model.r(), self.covariance_update)
     }
 
     /// One full update of `prior` with measurement `z`.
@@ -180,10 +179,10 @@ pub(crate) fn prepare_linearised(
     ensure_shape("measurement covariance R", r, m, m)?;
     ensure_finite_vector("predicted measurement", &predicted_measurement)?;
     let p = prior.cov();
-    let hp = h * p;
+    let hp = mul(h.as_ref(), p.as_ref());
     // S = H P H^T + R, written into a copy of R.
     let mut s = r.clone();
-    matmul(s.as_mut(), Accum::Add, &hp, h.transpose(), 1.0, Par::Seq);
+    mul_add(s.as_mut(), 1.0, hp.as_ref(), h.transpose());
     let s = symmetrise(s);
     let s_chol = Cholesky::new("innovation covariance S", &s)?;
     // K^T = S^-1 H P (S and P symmetric), so K = (S^-1 (H P))^T.
@@ -192,12 +191,12 @@ pub(crate) fn prepare_linearised(
     let gain = gain_t.transpose().to_owned();
     // I - K H, written into I.
     let mut i_kh = Mat::<f64>::identity(n, n);
-    matmul(i_kh.as_mut(), Accum::Add, &gain, h, -1.0, Par::Seq);
-    let i_kh_p = &i_kh * p;
+    mul_add(i_kh.as_mut(), -1.0, gain.as_ref(), h.as_ref());
+    let i_kh_p = mul(i_kh.as_ref(), p.as_ref());
     let post = match covariance_update {
         CovarianceUpdate::Joseph => {
-            let mut post = &i_kh_p * i_kh.transpose();
-            matmul(post.as_mut(), Accum::Add, &gain * r, gain.transpose(), 1.0, Par::Seq);
+            let mut post = mul(i_kh_p.as_ref(), i_kh.transpose());
+            mul_add(post.as_mut(), 1.0, mul(gain.as_ref(), r.as_ref()).as_ref(), gain.transpose());
             post
         }
         CovarianceUpdate::Standard => i_kh_p,
@@ -301,14 +300,14 @@ impl PreparedUpdate {
     /// As [`PreparedUpdate::innovation`].
     pub fn posterior(&self, z: &Col<f64>) -> Result<Gaussian, FilterError> {
         let nu = self.innovation(z)?;
-        self.posterior_of_innovation(&nu)
+        self.posterior_of_innovation(nu.as_ref())
     }
 
     /// Posterior for an innovation already computed.
-    pub(crate) fn posterior_of_innovation(&self, nu: &Col<f64>) -> Result<Gaussian, FilterError> {
+    pub(crate) fn posterior_of_innovation(&self, nu: ColRef<'_, f64>) -> Result<Gaussian, FilterError> {
         // m + K nu, written into a copy of m.
         let mut mean = self.prior_mean.clone();
-        matmul(mean.as_mat_mut(), Accum::Add, &self.gain, nu.as_mat(), 1.0, Par::Seq);
+        mul_add(mean.as_mat_mut(), 1.0, self.gain.as_ref(), nu.as_mat());
         Gaussian::with_checked_cov(mean, self.posterior_cov.clone())
     }
 }

@@ -14,7 +14,8 @@ use std::mem::MaybeUninit;
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt;
-use faer::{Col, ColRef, Mat, MatMut, Par};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Col, ColRef, Mat, MatMut, MatRef, Par};
 
 use crate::error::{FilterError, ensure_shape};
 
@@ -130,6 +131,47 @@ impl Cholesky {
         }
         d2
     }
+}
+
+/// Largest dimension multiplied by [`mul_add`]'s plain loops rather than
+/// faer's matmul.
+const SMALL_DIM: usize = 4;
+
+/// `dst + alpha A B`, written into `dst`. Up to [`SMALL_DIM`] rows, columns
+/// and inner dimension it is plain loops (`s = sum_k a_ik b_kj` in order of
+/// `k`, then `dst_ij + alpha s`): faer's matmul, built for large matrices,
+/// spends more on dispatch than on the arithmetic of a 2 x 2 product, and
+/// the GM-PHD multiplies several per component and step. Larger products
+/// go to faer.
+pub(crate) fn mul_add(mut dst: MatMut<'_, f64>, alpha: f64, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    let small = a.nrows() <= SMALL_DIM && a.ncols() <= SMALL_DIM && b.ncols() <= SMALL_DIM;
+    if !small {
+        matmul(dst, Accum::Add, a, b, alpha, Par::Seq);
+        return;
+    }
+    for j in 0..b.ncols() {
+        for i in 0..a.nrows() {
+            let mut s = 0.0;
+            for k in 0..a.ncols() {
+                s += a[(i, k)] * b[(k, j)];
+            }
+            dst[(i, j)] += alpha * s;
+        }
+    }
+}
+
+/// `A B` (see [`mul_add`]).
+pub(crate) fn mul(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
+    let mut out = Mat::zeros(a.nrows(), b.ncols());
+    mul_add(out.as_mut(), 1.0, a, b);
+    out
+}
+
+/// `A x` (see [`mul_add`]).
+pub(crate) fn mul_col(a: MatRef<'_, f64>, x: ColRef<'_, f64>) -> Col<f64> {
+    let mut out = Col::zeros(a.nrows());
+    mul_add(out.as_mat_mut(), 1.0, a, x.as_mat());
+    out
 }
 
 /// `max |P - P^T|` of a square matrix (0 for an empty one).

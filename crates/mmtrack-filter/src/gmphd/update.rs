@@ -19,7 +19,7 @@
 
 use std::collections::BTreeMap;
 
-use faer::Col;
+use faer::{Col, ColRef};
 
 use super::{Component, GmPhdParams};
 use crate::error::{FilterError, ensure_finite_vector, ensure_len};
@@ -109,9 +109,14 @@ pub(crate) fn update<G: Gate>(
     let dim = updater.model.measurement_dim();
     let mut nu = Col::zeros(dim);
     let mut solve_scratch = Col::zeros(dim);
+    // (component index, ln(p_D w q)) of the pairs that pass the gate, and
+    // their innovations, `dim` values each, reused from one measurement to
+    // the next.
+    let mut terms: Vec<(usize, f64)> = Vec::new();
+    let mut innovations: Vec<f64> = Vec::new();
     for (j, z) in measurements.iter().enumerate() {
-        // (component index, ln(p_D w q), innovation)
-        let mut terms = Vec::new();
+        terms.clear();
+        innovations.clear();
         for (i, (c, prep)) in predicted.iter().zip(&prepared).enumerate() {
             let eta = prep.predicted_measurement();
             for r in 0..dim {
@@ -131,7 +136,8 @@ pub(crate) fn update<G: Gate>(
             }
             let log_numerator = (p_d * c.weight).ln() + prep.log_likelihood_from_mahalanobis(mahalanobis_squared);
             if log_numerator > f64::NEG_INFINITY {
-                terms.push((i, log_numerator, nu.clone()));
+                terms.push((i, log_numerator));
+                innovations.extend(nu.iter());
             }
         }
         // ln(kappa + sum exp(ln numerator)) by log-sum-exp: no overflow for
@@ -140,7 +146,8 @@ pub(crate) fn update<G: Gate>(
         let log_denominator = log_sum_exp(std::iter::once(log_kappa).chain(terms.iter().map(|t| t.1)));
         let mut total = 0.0;
         if log_denominator > f64::NEG_INFINITY {
-            for (i, log_numerator, nu) in terms {
+            for (t, &(i, log_numerator)) in terms.iter().enumerate() {
+                let nu = ColRef::from_slice(&innovations[t * dim..(t + 1) * dim]);
                 let weight = (log_numerator - log_denominator).exp();
                 if weight <= 0.0 {
                     continue;
@@ -149,7 +156,7 @@ pub(crate) fn update<G: Gate>(
                 out.push(Component {
                     label,
                     weight,
-                    density: prepared[i].posterior_of_innovation(&nu)?,
+                    density: prepared[i].posterior_of_innovation(nu)?,
                     measurement: Some(j),
                 });
                 *assoc.entry((label, j)).or_insert(0.0) += weight;
