@@ -11,6 +11,12 @@
 //! Generation is not timed; only [`CHUNK_SETS`] sets are held at a time (about
 //! 13 MB of taps), so memory does not grow with the snapshot count. Every
 //! timed stage sees the same chunk.
+//!
+//! The GM-PHD baseline is also timed alone on drawn sparse and dense
+//! detections ([`gmphd`]), so its cost per snapshot can be followed apart
+//! from the detector.
+
+pub mod gmphd;
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -318,6 +324,8 @@ pub struct MpcBench {
     pub gmphd_s: f64,
     /// `gmphd_s` over the first row's tracking time; `None` when that is zero.
     pub gmphd_ratio_to_tracking: Option<f64>,
+    /// GM-PHD alone on drawn sparse and dense detections.
+    pub gmphd_rows: Vec<gmphd::GmPhdRow>,
     /// The target: [`MPC_TARGET_SNAPSHOTS`] ...
     pub target_snapshots: usize,
     /// ... in at most [`MPC_TARGET_S`].
@@ -406,6 +414,7 @@ pub fn run(options: &MpcBenchOptions) -> anyhow::Result<MpcBench> {
         })
         .collect();
     let gmphd_ratio_to_tracking = rows.first().filter(|r| r.tracking_s > 0.0).map(|r| gmphd_s / r.tracking_s);
+    let gmphd_rows = gmphd::rows(&gmphd_config, n)?;
     Ok(MpcBench {
         snapshots: n,
         mpcs: options.mpcs,
@@ -416,6 +425,7 @@ pub fn run(options: &MpcBenchOptions) -> anyhow::Result<MpcBench> {
         fft_us_per_snapshot: fft.total_s / n as f64 * 1e6,
         gmphd_s,
         gmphd_ratio_to_tracking,
+        gmphd_rows,
         target_snapshots: MPC_TARGET_SNAPSHOTS,
         target_s: MPC_TARGET_S,
         rows,
@@ -467,6 +477,7 @@ pub fn markdown(bench: &MpcBench) -> String {
             bench.gmphd_s, first.tracking_s, first.threads,
         ));
     }
+    out.push_str(&gmphd::markdown(&bench.gmphd_rows));
     let load = |l: Option<f64>| l.map_or_else(|| "-".to_string(), |l| format!("{l:.1}"));
     out.push_str(&format!(
         "\n1-minute load average before / after the run: {} / {} (on {} cores; above that, other work shared them).\n",

@@ -57,6 +57,17 @@ fn bench_mpc_gives_a_row_per_thread_count_with_consistent_verdicts() {
     let text = mpc::markdown(&bench);
     assert!(text.starts_with("`mmtrack bench mpc`: 12 simulated snapshots"), "{text}");
     assert_eq!(text.lines().filter(|l| l.starts_with("| 1 |") || l.starts_with("| 2 |")).count(), 2, "{text}");
+    // GM-PHD alone on drawn detections: 13 paths x 0.95 + 0.5 false ones
+    // (12.85 per snapshot) and 147 x 0.95 + 0.5 (140.15); the bounds are
+    // about 5 standard deviations of the mean over the 12 snapshots.
+    let gmphd: Vec<_> = bench.gmphd_rows.iter().map(|r| (r.label, r.paths, r.snapshots)).collect();
+    assert_eq!(gmphd, [("sparse", 13, 12), ("dense", 147, 12)]);
+    for (row, (lo, hi)) in bench.gmphd_rows.iter().zip([(11.0, 14.5), (136.0, 144.5)]) {
+        assert!((lo..=hi).contains(&row.detections_per_snapshot), "{row:?}");
+        assert_positive("us_per_snapshot", row.us_per_snapshot);
+        assert!(row.tracks > 0, "{row:?}");
+    }
+    assert!(text.contains("| sparse | 13 | 12 |") && text.contains("| dense | 147 | 12 |"), "{text}");
 
     let error = mpc::run(&mpc::MpcBenchOptions { snapshots: 0, ..options }).unwrap_err();
     assert!(error.to_string().contains("snapshots"), "{error}");
