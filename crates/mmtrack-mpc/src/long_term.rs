@@ -232,7 +232,8 @@ impl LongTermTracker {
             let next: Vec<TrackSummary> = free.iter().map(|&c| summaries[c].clone()).collect();
             for link in relate_sets(&current, &next, self.carrier_hz, &self.config) {
                 continued[open[link.current]] = true;
-                link_of[free[link.next]] = Some(LongTermLink { current: open[link.current], next: free[link.next], ..link });
+                link_of[free[link.next]] =
+                    Some(LongTermLink { current: open[link.current], next: free[link.next], ..link });
             }
         }
         let mut entries = Vec::with_capacity(summaries.len());

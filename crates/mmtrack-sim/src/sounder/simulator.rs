@@ -305,7 +305,8 @@ impl ConvoySimulator {
                         geometry.push(PathGeometry { path_id, points_m: vec![tx.position, s.point, rx.position] });
                     }
                     // dL/dt of TX -> s -> RX with s at rest.
-                    let rate_mps = dot(tx.velocity, unit(s.point, tx.position)) + dot(rx.velocity, unit(s.point, rx.position));
+                    let rate_mps =
+                        dot(tx.velocity, unit(s.point, tx.position)) + dot(rx.velocity, unit(s.point, rx.position));
                     truth.push(MpcTruth {
                         t_ns,
                         set_index,
