@@ -109,6 +109,22 @@ impl Default for ShortTermConfig {
     }
 }
 
+/// Where the delay gate of eq. (35) is centred.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CandidateGate {
+    /// The paper's eq. (35) as printed: `|tau_c - tau_k| <= xi_tau`, the raw
+    /// change of mean delay between the two sets.
+    #[default]
+    RawDelay,
+    /// Ours: `|tau_c - tau~_r| <= xi_tau`, around the Doppler-predicted
+    /// delay `tau~_r` of eq. (37) (the prediction the paper uses next, in
+    /// eqs. (38) and (41)). A path whose delay moves more than `xi_tau`
+    /// between sets (an oncoming car: about 1.75 ns per 10 ms) stays a
+    /// candidate; the two-way check of eqs. (40)-(42) is unchanged.
+    PredictedDelay,
+}
+
 /// Long-term tracking across sets (Sec. V, eqs. (33)-(43)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -116,6 +132,16 @@ pub struct LongTermConfig {
     /// Largest change of mean delay between sets for a candidate, seconds
     /// (xi_tau of eq. (35); paper: 1 ns).
     pub delay_gate_s: f64,
+    /// Where the delay gate is centred (default: the paper's raw delay).
+    pub candidate_gate: CandidateGate,
+    /// Sets a long-term track may miss and still be continued (default 0,
+    /// the paper: only adjacent sets are related). With 1, a track of set
+    /// `i` without a successor in set `i + 1` is tried against the tracks
+    /// of set `i + 2` that no track of set `i + 1` took, with `T_r` the
+    /// 20 ms between them. The paper names this bridging as a possible fix
+    /// and its risk: "bridging a track across multiple snapshots might
+    /// result in less reliable tracking results" (Sec. IV-B).
+    pub max_missed_sets: u32,
     /// Largest change of mean power between sets for a candidate, dB
     /// (xi_a; paper: 5 dB).
     pub magnitude_gate_db: f64,
@@ -127,7 +153,13 @@ pub struct LongTermConfig {
 
 impl Default for LongTermConfig {
     fn default() -> Self {
-        Self { delay_gate_s: 1e-9, magnitude_gate_db: 5.0, chi_classes_s: vec![0.1e-9, 0.2e-9, 0.5e-9, 1e-9] }
+        Self {
+            delay_gate_s: 1e-9,
+            candidate_gate: CandidateGate::RawDelay,
+            max_missed_sets: 0,
+            magnitude_gate_db: 5.0,
+            chi_classes_s: vec![0.1e-9, 0.2e-9, 0.5e-9, 1e-9],
+        }
     }
 }
 
@@ -209,11 +241,17 @@ impl ShortTermConfig {
     }
 }
 
+/// Most sets a long-term track may miss ([`LongTermConfig::max_missed_sets`]).
+const MAX_MISSED_SETS: u32 = 10;
+
 impl LongTermConfig {
     /// Checks every field; the error names the first bad one.
     pub fn validate(&self) -> Result<(), MpcError> {
         positive("long_term.delay_gate_s", self.delay_gate_s)?;
         positive("long_term.magnitude_gate_db", self.magnitude_gate_db)?;
+        if self.max_missed_sets > MAX_MISSED_SETS {
+            return Err(bad("long_term.max_missed_sets", self.max_missed_sets, "at most 10 sets"));
+        }
         if self.chi_classes_s.is_empty() {
             return Err(bad("long_term.chi_classes_s", "[]", "at least one class"));
         }

@@ -11,7 +11,13 @@
 //!    related with `|a_c - a_k| <= xi_a` and `|tau_c - tau_k| <= xi_tau`
 //!    (componentwise, as in eq. (15); `xi_a` =
 //!    [`LongTermConfig::magnitude_gate_db`], 5 dB; `xi_tau` =
-//!    [`LongTermConfig::delay_gate_s`], 1 ns).
+//!    [`LongTermConfig::delay_gate_s`], 1 ns). That is the paper's gate
+//!    ([`CandidateGate::RawDelay`], the default). Our variant
+//!    [`CandidateGate::PredictedDelay`] centres the delay gate on the
+//!    forward prediction of step 2 instead, `|tau_c - tau~_r| <= xi_tau`:
+//!    the raw gate drops a path whose delay moves more than `xi_tau`
+//!    between sets (an oncoming car moves about 1.75 ns per 10 ms) before
+//!    its Doppler is ever consulted, although eqs. (37)-(42) would relate it.
 //! 2. **Forward prediction** (eq. (37)):
 //!    `tau~_r = tau_k + m_k T_r` with the delay rate `m_k = -nu_k / f_c` and
 //!    `T_r = t_c - t_k` (the difference of the two tracks' mean times).
@@ -37,13 +43,20 @@
 //! id of the track it is related to, otherwise it starts a new one
 //! (eq. (43)).
 //!
+//! **Missed sets** ([`LongTermConfig::max_missed_sets`], ours; the paper's
+//! is 0): a track of set `i` that relates to no track of set `i + 1` stays
+//! open, and is tried (steps 1-5, `T_r` now the time from set `i`) against
+//! the tracks of set `i + 2` that no track of set `i + 1` took, and so on
+//! for up to `max_missed_sets` sets. Tracks that missed fewer sets choose
+//! first (then strongest first, as above).
+//!
 //! # References
 //! T. Mahler et al., "Tracking of wideband multipath components in a vehicular
 //! communication scenario", IEEE TVT 66(1), 2017, Sec. V, eqs. (33)-(43).
 
 use mmtrack_core::{MpcLongTermEntry, MpcTrack};
 
-use crate::{LongTermConfig, MpcError};
+use crate::{CandidateGate, LongTermConfig, MpcError};
 
 /// A full-lifetime track as long-term tracking sees it: `q_k` of eq. (34)
 /// plus its identity and mean time.
@@ -140,18 +153,19 @@ pub fn relate_sets(
         let closest = next
             .iter()
             .enumerate()
-            .filter(|&(c, q_c)| {
-                !taken[c]
-                    && (q_c.mean_power_db - q_k.mean_power_db).abs() <= config.magnitude_gate_db
-                    && (q_c.mean_delay_s - q_k.mean_delay_s).abs() <= config.delay_gate_s
-            })
+            .filter(|&(c, q_c)| !taken[c] && (q_c.mean_power_db - q_k.mean_power_db).abs() <= config.magnitude_gate_db)
             .map(|(c, q_c)| {
                 let t_r_s = (i128::from(q_c.t_ns) - i128::from(q_k.t_ns)) as f64 * 1e-9;
                 let predicted_s = q_k.mean_delay_s - q_k.doppler_hz / carrier_hz * t_r_s;
-                (c, t_r_s, (predicted_s - q_c.mean_delay_s).abs())
+                let gated_from_s = match config.candidate_gate {
+                    CandidateGate::RawDelay => q_k.mean_delay_s,
+                    CandidateGate::PredictedDelay => predicted_s,
+                };
+                (c, t_r_s, (predicted_s - q_c.mean_delay_s).abs(), (q_c.mean_delay_s - gated_from_s).abs())
             })
+            .filter(|&(_, _, _, gate_distance_s)| gate_distance_s <= config.delay_gate_s)
             .min_by(|x, y| x.2.total_cmp(&y.2).then(x.0.cmp(&y.0)));
-        let Some((eta, t_r_s, forward_error_s)) = closest else { continue };
+        let Some((eta, t_r_s, forward_error_s, _)) = closest else { continue };
         let q_eta = &next[eta];
         let back_predicted_s = q_eta.mean_delay_s + q_eta.doppler_hz / carrier_hz * t_r_s;
         let backward_error_s = (back_predicted_s - q_k.mean_delay_s).abs();
@@ -165,14 +179,17 @@ pub fn relate_sets(
 
 /// Chains [`relate_sets`] over a stream of sets into long-term tracks.
 ///
-/// Holds only the previous set's summaries and long-term ids.
+/// Holds only the open tracks: the previous set's summaries and long-term
+/// ids, and with [`LongTermConfig::max_missed_sets`] those of earlier sets
+/// still waiting for a successor.
 #[derive(Debug, Clone)]
 pub struct LongTermTracker {
     config: LongTermConfig,
     carrier_hz: f64,
     next_long_id: u64,
-    /// The previous set's summaries with their long-term ids.
-    previous: Vec<(TrackSummary, u64)>,
+    /// Open tracks: summary, long-term id, sets missed since (0: the
+    /// previous set's tracks).
+    previous: Vec<(TrackSummary, u64, u32)>,
 }
 
 impl LongTermTracker {
@@ -197,18 +214,31 @@ impl LongTermTracker {
     /// them, e.g. with [`crate::short_term::is_full_lifetime`]) and returns
     /// one entry per track, in input order. Tracks without a Doppler estimate
     /// are left out (they cannot be predicted). Fresh long-term ids are given
-    /// in input order. A set without tracks breaks every chain.
+    /// in input order. A set without tracks breaks every chain (with
+    /// [`LongTermConfig::max_missed_sets`] 0, the paper's).
     pub fn push_set(&mut self, full_lifetime_tracks: &[MpcTrack]) -> Vec<MpcLongTermEntry> {
         let summaries: Vec<TrackSummary> = full_lifetime_tracks.iter().filter_map(TrackSummary::of).collect();
-        let current: Vec<TrackSummary> = self.previous.iter().map(|(s, _)| s.clone()).collect();
-        let links = relate_sets(&current, &summaries, self.carrier_hz, &self.config);
-        let mut link_of: Vec<Option<&LongTermLink>> = vec![None; summaries.len()];
-        for link in &links {
-            link_of[link.next] = Some(link);
+        // Links with `current` an index into `self.previous`, `next` into
+        // `summaries`: open tracks that missed fewer sets choose first.
+        let mut link_of: Vec<Option<LongTermLink>> = vec![None; summaries.len()];
+        let mut continued = vec![false; self.previous.len()];
+        for missed in 0..=self.config.max_missed_sets {
+            let open: Vec<usize> = (0..self.previous.len()).filter(|&k| self.previous[k].2 == missed).collect();
+            let free: Vec<usize> = (0..summaries.len()).filter(|&c| link_of[c].is_none()).collect();
+            if open.is_empty() || free.is_empty() {
+                continue;
+            }
+            let current: Vec<TrackSummary> = open.iter().map(|&k| self.previous[k].0.clone()).collect();
+            let next: Vec<TrackSummary> = free.iter().map(|&c| summaries[c].clone()).collect();
+            for link in relate_sets(&current, &next, self.carrier_hz, &self.config) {
+                continued[open[link.current]] = true;
+                link_of[free[link.next]] =
+                    Some(LongTermLink { current: open[link.current], next: free[link.next], ..link });
+            }
         }
         let mut entries = Vec::with_capacity(summaries.len());
         let mut previous = Vec::with_capacity(summaries.len());
-        for (summary, link) in summaries.into_iter().zip(link_of) {
+        for (summary, link) in summaries.into_iter().zip(&link_of) {
             let long_track_id = match link {
                 Some(link) => self.previous[link.current].1,
                 None => {
@@ -224,10 +254,16 @@ impl LongTermTracker {
                 mean_delay_s: summary.mean_delay_s,
                 mean_power_db: summary.mean_power_db,
                 doppler_hz: summary.doppler_hz,
-                link_error_s: link.map(LongTermLink::error_s),
-                chi_class_s: link.map(|l| l.chi_class_s),
+                link_error_s: link.as_ref().map(LongTermLink::error_s),
+                chi_class_s: link.as_ref().map(|l| l.chi_class_s),
             });
-            previous.push((summary, long_track_id));
+            previous.push((summary, long_track_id, 0));
+        }
+        // Open tracks without a successor wait while they may miss more sets.
+        for (open, continued) in self.previous.drain(..).zip(continued) {
+            if !continued && open.2 < self.config.max_missed_sets {
+                previous.push((open.0, open.1, open.2 + 1));
+            }
         }
         self.previous = previous;
         entries

@@ -31,7 +31,7 @@ use mmtrack_core::progress::Progress;
 
 use crate::expectation::{Check, ExpectedMetric, compare, parse_expected, table};
 use crate::model::{Outcome, RunOptions, Tier, Verdict};
-use crate::{kim, mpc_artificial, odometry, readme_block, shaham, spebt, zoechmann};
+use crate::{kim, mpc_artificial, mpc_convoy, odometry, readme_block, shaham, spebt, zoechmann};
 
 /// The block (in docs/results/README.md) that receives the table of every
 /// metric.
@@ -66,7 +66,7 @@ impl Experiment {
 }
 
 /// Every experiment, in the order [`run_all`] runs them.
-pub const EXPERIMENTS: [Experiment; 6] = [
+pub const EXPERIMENTS: [Experiment; 7] = [
     Experiment {
         name: odometry::NAME,
         block: None,
@@ -82,6 +82,14 @@ pub const EXPERIMENTS: [Experiment; 6] = [
         expected_path: "data/reproduce/mpc-artificial.expected.toml",
         check_start: mpc_artificial::check_start,
         run: run_mpc_artificial,
+    },
+    Experiment {
+        name: mpc_convoy::NAME,
+        block: Some(mpc_convoy::README_BLOCK),
+        expected: include_str!("../../../data/reproduce/mpc-convoy.expected.toml"),
+        expected_path: "data/reproduce/mpc-convoy.expected.toml",
+        check_start: mpc_convoy::check_start,
+        run: run_mpc_convoy,
     },
     Experiment {
         name: shaham::NAME,
@@ -123,6 +131,10 @@ fn run_odometry(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result
 
 fn run_mpc_artificial(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
     mpc_artificial::run(&mpc_artificial::Config::default(), options, progress)
+}
+
+fn run_mpc_convoy(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {
+    mpc_convoy::run(&mpc_convoy::Config::embedded()?, options, progress)
 }
 
 fn run_shaham(options: &RunOptions, progress: &dyn Progress) -> anyhow::Result<Outcome> {

@@ -22,7 +22,7 @@
 //! - [`expectation`]: the regression check against
 //!   `data/reproduce/<experiment>.expected.toml` (separate from the
 //!   verdicts: "did our numbers move?", not "does it reproduce the paper?");
-//! - [`odometry`], [`mpc_artificial`], [`shaham`], [`spebt`],
+//! - [`odometry`], [`mpc_artificial`], [`mpc_convoy`], [`shaham`], [`spebt`],
 //!   [`zoechmann`], [`kim`]: the experiments, one folder each
 //!   (`config <- run <- report`, and `mod.rs` with `run()`);
 //! - [`all`]: every experiment in one call, checked against its expectations;
@@ -39,6 +39,7 @@ pub mod expectation;
 pub mod kim;
 pub mod model;
 pub mod mpc_artificial;
+pub mod mpc_convoy;
 pub mod odometry;
 pub mod readme_block;
 pub mod request;

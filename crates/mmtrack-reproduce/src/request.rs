@@ -12,11 +12,11 @@ use mmtrack_process::simulate::radar::TrajectoryFormat;
 
 use crate::common::DEFAULT_TRAJECTORY;
 use crate::model::{Outcome, RunOptions, Tier};
-use crate::{kim, mpc_artificial, odometry, readme_block, shaham, spebt, zoechmann};
+use crate::{kim, mpc_artificial, mpc_convoy, odometry, readme_block, shaham, spebt, zoechmann};
 
 /// The experiment names, as `mmtrack reproduce <name>` takes them.
-pub const EXPERIMENT_NAMES: [&str; 6] =
-    [odometry::NAME, mpc_artificial::NAME, shaham::NAME, spebt::NAME, zoechmann::NAME, kim::NAME];
+pub const EXPERIMENT_NAMES: [&str; 7] =
+    [odometry::NAME, mpc_artificial::NAME, mpc_convoy::NAME, shaham::NAME, spebt::NAME, zoechmann::NAME, kim::NAME];
 
 /// The options of one experiment; each applies to the experiments named in
 /// its doc, and one given to another experiment is refused by name.
@@ -28,7 +28,7 @@ pub struct ExperimentRequest {
     pub force: bool,
     /// The CI version (smoke tier).
     pub quick: bool,
-    /// Monte Carlo runs (all but odometry; mpc-artificial: runs per point,
+    /// Monte Carlo runs (all but odometry and mpc-convoy; mpc-artificial: runs per point,
     /// default 20).
     pub runs: Option<u64>,
     /// README whose block the run rewrites (all but odometry).
@@ -56,10 +56,12 @@ pub struct ExperimentRequest {
 impl ExperimentRequest {
     /// The flags given, with the experiments each belongs to.
     fn given(&self) -> Vec<(&'static str, &'static [&'static str])> {
-        let all_but_odometry: &'static [&'static str] =
+        let monte_carlo: &'static [&'static str] =
             &[mpc_artificial::NAME, shaham::NAME, spebt::NAME, zoechmann::NAME, kim::NAME];
+        let all_but_odometry: &'static [&'static str] =
+            &[mpc_artificial::NAME, mpc_convoy::NAME, shaham::NAME, spebt::NAME, zoechmann::NAME, kim::NAME];
         let flags: [(&'static str, bool, &'static [&'static str]); 11] = [
-            ("--runs", self.runs.is_some(), all_but_odometry),
+            ("--runs", self.runs.is_some(), monte_carlo),
             ("--readme", self.readme.is_some(), all_but_odometry),
             ("--experiment", self.experiment_file.is_some(), &[shaham::NAME, spebt::NAME, zoechmann::NAME, kim::NAME]),
             ("--scenario", self.scenario.is_some(), &[odometry::NAME]),
@@ -126,6 +128,10 @@ pub fn run_experiment(name: &str, request: &ExperimentRequest, progress: &dyn Pr
                 mpc_artificial::Config { runs, pulse, zero_below_threshold: !request.keep_taps_below_threshold };
             // The runs are the config's; the tier picks smoke or full.
             mpc_artificial::run(&config, &RunOptions { runs: None, ..options.clone() }, progress)?
+        }
+        mpc_convoy::NAME => {
+            mpc_convoy::check_start(output, force, readme)?;
+            mpc_convoy::run(&mpc_convoy::Config::embedded()?, &options, progress)?
         }
         shaham::NAME => {
             shaham::check_start(output, force, readme)?;

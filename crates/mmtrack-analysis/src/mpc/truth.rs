@@ -73,6 +73,9 @@ pub struct TruthScores {
     pub deaths_on_true_paths: u64,
     /// Long-term tracks that follow a true path / true paths followed.
     pub long_term_tracks_per_path: Option<f64>,
+    /// `path_id` -> births of the long-term tracks that follow it (not in
+    /// the first set): which paths the births on true paths are on.
+    pub births_by_path: BTreeMap<u64, u64>,
     /// Later set -> (true births, true deaths) across the pair of sets.
     pub transitions: BTreeMap<u64, (u64, u64)>,
 }
@@ -235,6 +238,7 @@ pub fn score(
         births_on_true_paths: long.births,
         deaths_on_true_paths: long.deaths,
         long_term_tracks_per_path: long.per_path,
+        births_by_path: long.births_by_path,
         transitions: true_transitions(&truth, sets, &threshold_db),
     }
 }
@@ -243,6 +247,7 @@ pub fn score(
 struct LongTermScores {
     false_share: Option<f64>,
     births: u64,
+    births_by_path: BTreeMap<u64, u64>,
     deaths: u64,
     per_path: Option<f64>,
 }
@@ -266,19 +271,24 @@ fn long_term_scores(
     }
     let (mut births, mut deaths, mut false_tracks) = (0u64, 0u64, 0u64);
     let mut followed: BTreeMap<u64, u64> = BTreeMap::new();
+    let mut births_by_path: BTreeMap<u64, u64> = BTreeMap::new();
     for (first, last, votes) in tracks.values() {
         let Some((path, _)) = majority(votes) else {
             false_tracks += 1;
             continue;
         };
         *followed.entry(path).or_default() += 1;
-        births += u64::from(Some(*first) != first_set);
+        if Some(*first) != first_set {
+            births += 1;
+            *births_by_path.entry(path).or_default() += 1;
+        }
         deaths += u64::from(Some(*last) != last_set);
     }
     let on_paths: u64 = followed.values().sum();
     LongTermScores {
         false_share: share(false_tracks, tracks.len() as u64),
         births,
+        births_by_path,
         deaths,
         per_path: share(on_paths, followed.len() as u64),
     }

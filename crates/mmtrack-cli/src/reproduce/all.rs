@@ -15,7 +15,7 @@ use crate::progress::IndicatifProgress;
 /// Options of `reproduce --all`.
 #[derive(Args, Debug, Clone)]
 pub struct AllArgs {
-    /// Run every experiment (odometry, mpc-artificial, shaham, spebt, zoechmann, kim): print "N of M paper claims
+    /// Run every experiment (odometry, mpc-artificial, mpc-convoy, shaham, spebt, zoechmann, kim): print "N of M paper claims
     /// met" with every claim's rule and verdict, then check each metric against
     /// data/reproduce/<experiment>.expected.toml (our earlier runs); exit 1 when a metric moved (a regression), not
     /// on a missed paper claim (which the table shows).

@@ -150,20 +150,20 @@ fn all_smoke_runs_every_experiment_within_its_expectations() {
     assert!(out.status.success(), "a metric left its expected range:\n{stdout}\n{stderr}");
     // Every expectation of every experiment was measured (the command also
     // fails on a metric without an expectation).
-    let expected: usize = ["odometry", "mpc-artificial", "shaham", "spebt", "zoechmann", "kim"]
+    let expected: usize = ["odometry", "mpc-artificial", "mpc-convoy", "shaham", "spebt", "zoechmann", "kim"]
         .iter()
         .map(|e| {
             let path = root().join(format!("data/reproduce/{e}.expected.toml"));
             std::fs::read_to_string(&path).unwrap().matches("[[metric]]").count()
         })
         .sum();
-    let line = format!("{expected} metrics of 6 experiments, 0 outside their expected range");
+    let line = format!("{expected} metrics of 7 experiments, 0 outside their expected range");
     assert!(stdout.contains(&line), "{line}:\n{stdout}");
     // The paper verdicts come first, counted, misses included.
     let headline = stdout.lines().find(|l| l.contains(" paper claims met**")).unwrap_or_else(|| panic!("{stdout}"));
     assert!(stdout.find(headline) < stdout.find(&line), "{stdout}");
     assert!(stdout.contains("| experiment | claim | paper | rule | measured | verdict |"), "{stdout}");
-    for experiment in ["odometry", "mpc-artificial", "shaham", "spebt", "zoechmann", "kim"] {
+    for experiment in ["odometry", "mpc-artificial", "mpc-convoy", "shaham", "spebt", "zoechmann", "kim"] {
         assert!(out_dir.join(experiment).join("metrics.json").is_file(), "{experiment}");
     }
     assert!(out_dir.join("summary.md").is_file());

@@ -36,7 +36,7 @@ Sec. V), ordered by set then long-term track; a long-term track is the rows shar
         mean_power_db: f64, "dB", "10 log10 of the mean linear power |a|^2 over the set (a-bar, eq. 33); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         doppler_hz: f64, "Hz", "Doppler of the short-term track (nu, eq. 31)";
         link_error_s: Option<f64>, "s",
-            "larger two-way delay prediction error of the link from the previous set (eqs. 41-42); null for the first entry";
+            "larger two-way delay prediction error of the link from the previous entry of its track (eqs. 41-42): the previous set, or an earlier one with long_term.max_missed_sets; null for the first entry";
         chi_class_s: Option<f64>, "s",
             "smallest confidence class chi holding the link (eq. 40); null for the first entry";
     }

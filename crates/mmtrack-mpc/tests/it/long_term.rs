@@ -4,7 +4,7 @@
 use mmtrack_core::{Complex64, MpcDetection, MpcTrack};
 use mmtrack_mpc::long_term::{TrackSummary, relate_sets};
 use mmtrack_mpc::short_term::doppler_hz;
-use mmtrack_mpc::{LongTermConfig, LongTermTracker, MpcError};
+use mmtrack_mpc::{CandidateGate, LongTermConfig, LongTermTracker, MpcError};
 
 use crate::common::CARRIER_HZ;
 
@@ -186,4 +186,72 @@ fn bad_configs_are_refused_by_name() {
     let config = LongTermConfig { chi_classes_s: vec![0.5e-9, 0.2e-9], ..LongTermConfig::default() };
     let err = LongTermTracker::new(config, CARRIER_HZ, 0).unwrap_err();
     assert!(matches!(err, MpcError::BadConfig { field: "long_term.chi_classes_s", .. }), "{err}");
+}
+
+/// Long-term ids of a fast oncoming car's path (delay falling 1.75 ns per
+/// 10 ms set, the convoy's oncoming cars) over sets 0..10 with set 5
+/// missing, and of a slow wall bounce beside it, for one tracker config.
+fn ids_of_a_fast_path_with_a_missing_set(config: LongTermConfig) -> (Vec<u64>, Vec<u64>) {
+    let mut lt = LongTermTracker::new(config, CARRIER_HZ, 0).unwrap();
+    let (mut fast, mut slow) = (Vec::new(), Vec::new());
+    for set in 0..10u64 {
+        let mut tracks = vec![track(2 * set, set, 150e-9, 0.0, -100.0, 0.0)];
+        if set != 5 {
+            tracks.push(track(2 * set + 1, set, 400e-9, -1.75e-7, -118.0, 0.0));
+        }
+        let entries = lt.push_set(&tracks);
+        slow.push(entries[0].long_track_id);
+        fast.extend(entries.get(1).map(|e| e.long_track_id));
+    }
+    (fast, slow)
+}
+
+fn distinct(ids: &[u64]) -> usize {
+    ids.iter().collect::<std::collections::BTreeSet<_>>().len()
+}
+
+#[test]
+fn the_doppler_gated_variant_with_a_one_set_gap_keeps_a_fast_path_whole_where_the_paper_gate_splits_it() {
+    let variant = |candidate_gate, max_missed_sets| LongTermConfig {
+        candidate_gate,
+        max_missed_sets,
+        ..LongTermConfig::default()
+    };
+    // The paper's eq. (35): 1.75 ns of raw delay change is outside the 1 ns
+    // gate, so each of the 9 sets holding the path starts a new track.
+    let (fast, slow) = ids_of_a_fast_path_with_a_missing_set(LongTermConfig::default());
+    assert_eq!((fast.len(), distinct(&fast)), (9, 9), "{fast:?}");
+    assert_eq!(distinct(&slow), 1, "the slow path links in every set: {slow:?}");
+    // Gated around the Doppler-predicted delay: linked, but the missing
+    // set ends the chain (the paper's adjacency).
+    let (fast, _) = ids_of_a_fast_path_with_a_missing_set(variant(CandidateGate::PredictedDelay, 0));
+    assert_eq!(distinct(&fast), 2, "{fast:?}");
+    // A gap alone does not help the raw gate (3.5 ns over 20 ms).
+    let (fast, _) = ids_of_a_fast_path_with_a_missing_set(variant(CandidateGate::RawDelay, 1));
+    assert_eq!(distinct(&fast), 9, "{fast:?}");
+    // Both: one long-term track across the gap; the slow path unchanged.
+    let (fast, slow) = ids_of_a_fast_path_with_a_missing_set(variant(CandidateGate::PredictedDelay, 1));
+    assert_eq!((fast.len(), distinct(&fast)), (9, 1), "{fast:?}");
+    assert_eq!(distinct(&slow), 1, "{slow:?}");
+}
+
+#[test]
+fn a_track_waits_at_most_max_missed_sets_and_the_bridge_carries_its_prediction_error() {
+    let config = LongTermConfig { max_missed_sets: 1, ..LongTermConfig::default() };
+    let mut lt = LongTermTracker::new(config, CARRIER_HZ, 0).unwrap();
+    lt.push_set(&[track(0, 0, 30e-9, 4e-8, -100.0, 0.0)]);
+    assert!(lt.push_set(&[]).is_empty());
+    // Set 2: 20 ms later, 0.8 ns further (within the raw gate), linked to
+    // set 0 with an exact prediction.
+    let bridged = lt.push_set(&[track(1, 2, 30e-9, 4e-8, -100.0, 0.0)]);
+    assert_eq!(bridged[0].long_track_id, 0);
+    assert!(bridged[0].link_error_s.unwrap() < 1e-12, "{:?}", bridged[0].link_error_s);
+    // Two sets missed: a new track.
+    assert!(lt.push_set(&[]).is_empty());
+    assert!(lt.push_set(&[]).is_empty());
+    let fresh = lt.push_set(&[track(2, 5, 30e-9, 4e-8, -100.0, 0.0)]);
+    assert_eq!((fresh[0].long_track_id, fresh[0].chi_class_s), (1, None));
+    let err = LongTermTracker::new(LongTermConfig { max_missed_sets: 11, ..LongTermConfig::default() }, CARRIER_HZ, 0)
+        .unwrap_err();
+    assert!(matches!(err, MpcError::BadConfig { field: "long_term.max_missed_sets", .. }), "{err}");
 }

@@ -324,7 +324,7 @@ def reproduce(
 ) -> Reproduced:
     """``mmtrack reproduce <experiment>``: a paper's experiment against its published numbers.
 
-    ``experiment``: odometry, mpc-artificial, shaham, spebt, zoechmann, kim,
+    ``experiment``: odometry, mpc-artificial, mpc-convoy, shaham, spebt, zoechmann, kim,
     or ``all`` (``reproduce --all``; ``quick`` is ``--smoke``). ``quick`` is
     the CI version; ``experiment_file`` is ``--experiment``. Returns the
     claims with the paper's value, the measured value and the verdict. A

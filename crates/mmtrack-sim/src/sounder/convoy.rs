@@ -144,11 +144,18 @@ pub struct DiffuseConfig {
     /// same path length, dB, uniform in `[min, max]` (times a Rayleigh draw
     /// and the Lambertian factor `cos(incidence) cos(departure)`).
     pub relative_power_db: [f64; 2],
+    /// List the scatterers in the truth like the specular paths (path id
+    /// `1_000_000 +` the scatterer's index, with their geometry, when at
+    /// least `truth_min_power_db` strong). Off by default: they are the
+    /// diffuse part of the channel, which the paper's tracker is not meant
+    /// to follow; but rendered as discrete points they are trackable, so a
+    /// score that leaves them out counts their tracks as false.
+    pub in_truth: bool,
 }
 
 impl Default for DiffuseConfig {
     fn default() -> Self {
-        Self { scatterers_per_m: 0.25, relative_power_db: [-20.0, -10.0] }
+        Self { scatterers_per_m: 0.25, relative_power_db: [-20.0, -10.0], in_truth: false }
     }
 }
 

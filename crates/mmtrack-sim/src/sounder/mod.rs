@@ -63,7 +63,7 @@
 //!     highway), each `relative_power_db` below a specular bounce of the
 //!     same length times a Rayleigh draw and `cos(incidence) cos(departure)`,
 //!     random static phase; visibility per set, delay per snapshot. They are
-//!     rendered but not listed in the truth.
+//!     rendered but listed in the truth only with `diffuse.in_truth`.
 //!
 //!   Because reflection points are stationary points of the path length
 //!   (Fermat), `dL/dt` is exact from the end legs:
@@ -84,7 +84,7 @@
 //! specular path at least `truth_min_power_db` strong; `path_id` is stable
 //! for a path while it exists ([`PathKind`]: LOS 0, single bounce off wall
 //! `w` 100 + w, double bounce starting on wall `w` 200 + w, traffic car `i`
-//! 1000 + i).
+//! 1000 + i; diffuse scatterer `j`, with `diffuse.in_truth`, 1 000 000 + j).
 //!
 //! **Sets.** Snapshot `n` of set `m` is at
 //! `start_t_ns + m * set_interval_s + n * snapshot_interval_s` (paper: 6
@@ -133,11 +133,17 @@ pub enum PathKind {
     DoubleBounce,
     /// A traffic car, id `1000 + car index`.
     Traffic,
+    /// A diffuse scatterer, id `1_000_000 + scatterer index` (listed only
+    /// with `diffuse.in_truth`).
+    Diffuse,
 }
 
 impl PathKind {
     /// Also the traffic base, for readers of path ids.
     pub const TRAFFIC_BASE: u64 = 1000;
+
+    /// The first diffuse scatterer id.
+    pub const DIFFUSE_BASE: u64 = 1_000_000;
 
     /// The first id of this kind.
     #[must_use]
@@ -147,6 +153,7 @@ impl PathKind {
             Self::SingleBounce => 100,
             Self::DoubleBounce => 200,
             Self::Traffic => Self::TRAFFIC_BASE,
+            Self::Diffuse => Self::DIFFUSE_BASE,
         }
     }
 
@@ -157,7 +164,8 @@ impl PathKind {
             0 => Some(Self::Los),
             100..=199 => Some(Self::SingleBounce),
             200..=299 => Some(Self::DoubleBounce),
-            1000.. => Some(Self::Traffic),
+            1000..Self::DIFFUSE_BASE => Some(Self::Traffic),
+            Self::DIFFUSE_BASE.. => Some(Self::Diffuse),
             _ => None,
         }
     }

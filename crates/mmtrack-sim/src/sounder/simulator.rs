@@ -23,9 +23,9 @@ pub struct SounderSet {
     pub set_index: u64,
     /// The set's CIR snapshots, in time order.
     pub snapshots: Vec<CirSnapshot>,
-    /// True specular MPCs of every snapshot (LOS, wall bounces, traffic),
-    /// in snapshot order then `path_id` order. Diffuse scatterers are not
-    /// listed.
+    /// True MPCs of every snapshot (LOS, wall bounces, traffic; the diffuse
+    /// scatterers too with [`super::DiffuseConfig::in_truth`]), in snapshot
+    /// order then `path_id` order.
     pub truth: Vec<MpcTruth>,
     /// `world_from_vehicle` of the receiver at the set's first snapshot.
     pub rx_pose: StampedPose,
@@ -255,7 +255,7 @@ impl ConvoySimulator {
         // Diffuse scatterers: visibility once per set (the cars move about
         // 5 cm during a set's 3.6 ms); delays and phases per snapshot.
         let ranges = self.ranges(tx0.position, rx0.position);
-        let visible: Vec<&Scatterer> = self.diffuse_candidates(tx0.position, rx0.position, &ranges);
+        let visible: Vec<(usize, &Scatterer)> = self.diffuse_candidates(tx0.position, rx0.position, &ranges);
         let mut snapshots = Vec::with_capacity(self.config.snapshots_per_set as usize);
         let mut truth = Vec::new();
         let mut geometry = Vec::new();
@@ -290,15 +290,33 @@ impl ConvoySimulator {
                     });
                 }
             }
-            for s in &visible {
+            for &(index, s) in &visible {
                 let length_m = dist(tx.position, s.point) + dist(s.point, rx.position);
                 let Some(relative_delay_s) = self.in_window(length_m) else { continue };
                 let lambert = (cross(s.tangent, unit(s.point, tx.position)).abs()
                     * cross(s.tangent, unit(s.point, rx.position)).abs())
                 .sqrt();
                 let magnitude = self.free_space(length_m) * self.reflection() * s.gain * lambert;
-                render
-                    .push(RenderPath { relative_delay_s, amplitude: self.amplitude(magnitude, s.phase_rad, length_m) });
+                let amplitude = self.amplitude(magnitude, s.phase_rad, length_m);
+                render.push(RenderPath { relative_delay_s, amplitude });
+                if self.config.diffuse.in_truth && 20.0 * magnitude.log10() >= self.config.truth_min_power_db {
+                    let path_id = PathKind::Diffuse.base() + index as u64;
+                    if snapshot_index == 0 {
+                        geometry.push(PathGeometry { path_id, points_m: vec![tx.position, s.point, rx.position] });
+                    }
+                    // dL/dt of TX -> s -> RX with s at rest.
+                    let rate_mps =
+                        dot(tx.velocity, unit(s.point, tx.position)) + dot(rx.velocity, unit(s.point, rx.position));
+                    truth.push(MpcTruth {
+                        t_ns,
+                        set_index,
+                        snapshot_index,
+                        path_id,
+                        delay_s: length_m / SPEED_OF_LIGHT_MPS,
+                        amplitude,
+                        doppler_hz: -fc * rate_mps / SPEED_OF_LIGHT_MPS,
+                    });
+                }
             }
             let stamp = SnapshotStamp {
                 t_ns,
@@ -348,14 +366,16 @@ impl ConvoySimulator {
         rng.random::<f64>() * TAU
     }
 
-    fn diffuse_candidates(&self, tx: P2, rx: P2, ranges: &[(usize, usize)]) -> Vec<&Scatterer> {
+    /// The scatterers visible from both cars, with their index in
+    /// `self.scatterers` (their stable identity), in index order.
+    fn diffuse_candidates(&self, tx: P2, rx: P2, ranges: &[(usize, usize)]) -> Vec<(usize, &Scatterer)> {
         let s_mid = 0.5 * (self.road.centre_s(tx) + self.road.centre_s(rx));
         let reach = 0.5 * max_path_m(&self.config);
         let lo = self.scatterers.partition_point(|s| s.s_centre_m < s_mid - reach);
         let hi = self.scatterers.partition_point(|s| s.s_centre_m <= s_mid + reach);
-        self.scatterers[lo..hi]
-            .iter()
-            .filter(|s| !blocked(&self.walls, ranges, tx, s.point) && !blocked(&self.walls, ranges, s.point, rx))
+        (lo..hi)
+            .map(|i| (i, &self.scatterers[i]))
+            .filter(|(_, s)| !blocked(&self.walls, ranges, tx, s.point) && !blocked(&self.walls, ranges, s.point, rx))
             .collect()
     }
 
