@@ -15,6 +15,7 @@ fn bench_mpc_prints_the_table_and_rewrites_its_readme_block() {
     assert!(stdout.contains("`mmtrack bench mpc`: 60 simulated snapshots of 2048 taps"), "{stdout}");
     assert!(stdout.contains("| threads | snapshots/s |"), "{stdout}");
     assert!(stdout.contains("GM-PHD baseline"), "{stdout}");
+    assert!(stdout.contains("Target (one thread): "), "{stdout}");
     let rows: Vec<Vec<&str>> = stdout
         .lines()
         .filter(|l| l.starts_with("| 1 |") || l.starts_with("| 2 |"))
@@ -22,13 +23,14 @@ fn bench_mpc_prints_the_table_and_rewrites_its_readme_block() {
         .collect();
     assert_eq!(rows.len(), 2, "one row per thread count (1, 2):\n{stdout}");
     for row in &rows {
-        // Cells: "", threads, snapshots/s, s, s per 10 000, detection s, tracking s, / FFT, detections, verdict, "".
-        assert_eq!(row.len(), 11, "{row:?}");
+        // Cells: "", threads, snapshots/s, s, s per 10 000, detection s, tracking s, / FFT, detections,
+        // per true path, verdict, "".
+        assert_eq!(row.len(), 12, "{row:?}");
         let detections: f64 = row[8].parse().unwrap();
         // 40 paths, 15..50 dB over a -140 dB floor and several pulse widths
         // apart: each is found; noise peaks above floor + 6 dB add a few.
         assert!((38.0..=60.0).contains(&detections), "detections per snapshot {detections}");
-        assert!(row[9] == "met" || row[9] == "**missed**", "{row:?}");
+        assert!(row[10] == "met" || row[10] == "**missed**", "{row:?}");
     }
     // Both thread counts see the same snapshots and must find the same detections.
     assert_eq!(rows[0][8], rows[1][8]);
