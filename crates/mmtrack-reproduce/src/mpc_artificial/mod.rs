@@ -37,13 +37,7 @@ pub const NAME: &str = "mpc-artificial";
 /// # Errors
 /// `output` exists without `force`; the README lacks the block.
 pub fn check_start(output: &Path, force: bool, readme: Option<&Path>) -> anyhow::Result<()> {
-    if output.exists() && !force {
-        anyhow::bail!("{}: exists; use --force to replace it (nothing was done)", output.display());
-    }
-    if let Some(readme) = readme {
-        crate::readme_block::check_block(readme, README_BLOCK)?;
-    }
-    Ok(())
+    crate::common::check_start(output, force, readme, README_BLOCK)
 }
 
 /// Runs the experiment: the power sweep at `options.tier` (full: -100 to
