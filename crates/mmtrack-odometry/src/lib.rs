@@ -40,6 +40,10 @@ mod pipeline;
 pub mod register;
 pub mod surface;
 
+pub use config::OdometryConfig;
+pub use error::OdometryError;
+pub use pipeline::{MIN_TRANSLATION_OBSERVABILITY, RadarOdometry, ScanOdometry};
+
 #[cfg(test)]
 pub(crate) mod real_scans {
     //! The real scans the unit tests check against.
@@ -67,7 +71,3 @@ pub(crate) mod real_scans {
         Some(scans)
     }
 }
-
-pub use config::OdometryConfig;
-pub use error::OdometryError;
-pub use pipeline::{MIN_TRANSLATION_OBSERVABILITY, RadarOdometry, ScanOdometry};

@@ -2,12 +2,11 @@
 //! filter on the beam index, with the beam the car's GNSS position predicts
 //! (through the fitted beam map) as a second, coarser measurement.
 
-use mmtrack_filter::faer::{Col, Mat};
-use mmtrack_filter::{ConstantVelocity, Gaussian, KalmanPredictor, KalmanUpdater, LinearMeasurement};
+use mmtrack_filter::{KalmanUpdater, LinearMeasurement};
 
 use super::error::{SweepError, check};
-use super::search::{BeamProbe, PowerHold, Window, acquire, search_sweep, subbeam_peak};
-use super::{Reacquisition, SweepDecision, SweepTracker, WindowTrackerConfig, dt_s};
+use super::search::BeamProbe;
+use super::{Reacquisition, SweepDecision, SweepTracker, WindowTracker, WindowTrackerConfig};
 
 /// Settings of [`GnssWindowTracker`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,128 +70,65 @@ impl Default for GnssTrackerConfig {
 /// Sec. III-B; `../shared/seeds/liu2024-spebt-fast-cfear.md`.
 #[derive(Debug, Clone)]
 pub struct GnssWindowTracker {
-    config: GnssTrackerConfig,
-    predictor: KalmanPredictor<ConstantVelocity>,
-    peak: KalmanUpdater,
+    /// The beam-only filter, search and power hold.
+    window: WindowTracker,
+    /// The GNSS beam's measurement update.
     gnss: KalmanUpdater,
-    track: Option<(Gaussian, i64)>,
-    hold: PowerHold,
+    gnss_sigma_beams: f64,
+    initial_window_sigmas: f64,
 }
 
 impl GnssWindowTracker {
     /// Checks `config` and builds a tracker with no track.
     ///
     /// # Errors
-    /// [`SweepError::BadConfig`] for a bad search config, or a noise level,
-    /// GNSS sigma or window factor that is not positive and finite.
+    /// [`WindowTracker::new`]'s, or a GNSS sigma or window factor that is not
+    /// positive and finite.
     pub fn new(config: GnssTrackerConfig) -> Result<Self, SweepError> {
         let GnssTrackerConfig { window, gnss_sigma_beams: sigma_g, initial_window_sigmas: k } = config;
-        window.search.validate()?;
-        check(
-            "sigma_accel_beams_per_s2",
-            window.sigma_accel_beams_per_s2,
-            window.sigma_accel_beams_per_s2 > 0.0,
-            "> 0",
-        )?;
-        check("measurement_sigma_beams", window.measurement_sigma_beams, window.measurement_sigma_beams > 0.0, "> 0")?;
-        check(
-            "initial_rate_sigma_beams_per_s",
-            window.initial_rate_sigma_beams_per_s,
-            window.initial_rate_sigma_beams_per_s > 0.0,
-            "> 0",
-        )?;
+        let window = WindowTracker::new(window)?;
         check("gnss_sigma_beams", sigma_g, sigma_g > 0.0 && sigma_g.is_finite(), "> 0")?;
         check("initial_window_sigmas", k, k > 0.0 && k.is_finite(), "> 0")?;
-        let bad = |field: &'static str| SweepError::BadConfig {
-            field,
+        let gnss = LinearMeasurement::position(1, sigma_g).map_err(|_| SweepError::BadConfig {
+            field: "gnss_sigma_beams",
             value: "rejected by the filter".into(),
             expected: "> 0",
-        };
-        let model =
-            ConstantVelocity::new(1, window.sigma_accel_beams_per_s2).map_err(|_| bad("sigma_accel_beams_per_s2"))?;
-        let peak = LinearMeasurement::position(1, window.measurement_sigma_beams)
-            .map_err(|_| bad("measurement_sigma_beams"))?;
-        let gnss = LinearMeasurement::position(1, sigma_g).map_err(|_| bad("gnss_sigma_beams"))?;
-        Ok(Self {
-            config,
-            predictor: KalmanPredictor::new(model),
-            peak: KalmanUpdater::new(peak),
-            gnss: KalmanUpdater::new(gnss),
-            track: None,
-            hold: PowerHold::new(window.search.hold_s),
-        })
-    }
-
-    /// A track at `beam` (variance `beam_var`) with rate `rate_beams_per_s`.
-    fn start(&self, beam: f64, beam_var: f64, rate_beams_per_s: f64, t_ns: i64) -> Result<Gaussian, SweepError> {
-        let mean = Col::from_fn(2, |i| if i == 0 { beam } else { rate_beams_per_s });
-        let rate_var = self.config.window.initial_rate_sigma_beams_per_s.powi(2);
-        let cov = Mat::from_fn(2, 2, |i, j| match (i, j) {
-            (0, 0) => beam_var,
-            (1, 1) => rate_var,
-            _ => 0.0,
-        });
-        Gaussian::new(mean, cov).map_err(|source| SweepError::Filter { t_ns, source })
+        })?;
+        Ok(Self { window, gnss: KalmanUpdater::new(gnss), gnss_sigma_beams: sigma_g, initial_window_sigmas: k })
     }
 }
 
 impl SweepTracker for GnssWindowTracker {
     fn start_pass(&mut self) {
-        self.track = None;
-        self.hold.clear();
+        self.window.start_pass();
     }
 
     fn step(&mut self, probe: &mut BeamProbe<'_>, gnss_beam: Option<f64>) -> Result<SweepDecision, SweepError> {
-        let t_ns = probe.t_ns();
         let gnss_beam = match gnss_beam {
             Some(beam) if beam.is_finite() => beam,
             other => {
                 return Err(SweepError::BadInput {
-                    what: format!("sweep at {t_ns} ns: the GNSS tracker needs a finite GNSS beam, got {other:?}"),
+                    what: format!(
+                        "sweep at {} ns: the GNSS tracker needs a finite GNSS beam, got {other:?}",
+                        probe.t_ns()
+                    ),
                 });
             }
         };
-        let filter_error = |source| SweepError::Filter { t_ns, source };
-        let search = self.config.window.search;
-        let peak_var = self.config.window.measurement_sigma_beams.powi(2);
-        let (prior, half) = match self.track.take() {
-            None => {
-                let sigma_g = self.config.gnss_sigma_beams;
-                let half = (self.config.initial_window_sigmas * sigma_g).ceil().min(probe.beam_count() as f64) as usize;
-                let half = half.max(search.half_window_beams);
-                let acquisition_beams = match search.reacquisition {
-                    Reacquisition::Coarse { stride } => probe.beam_count().div_ceil(stride),
-                    Reacquisition::FullSweep => probe.beam_count(),
-                };
-                if 2 * half + 1 >= acquisition_beams {
-                    // The GNSS window would cost more than acquiring.
-                    let peak = acquire(probe, search.reacquisition)?;
-                    let beam = subbeam_peak(probe, peak.beam);
-                    self.hold.clear();
-                    self.hold.push(t_ns, peak.power_db);
-                    self.track = Some((self.start(beam, peak_var, 0.0, t_ns)?, t_ns));
-                    return Ok(SweepDecision { chosen_beam: peak.beam, reinitialised: true, track_beam: Some(beam) });
-                }
-                (self.start(gnss_beam, sigma_g * sigma_g, 0.0, t_ns)?, half)
-            }
-            Some((previous, previous_t_ns)) => {
-                let predicted = self.predictor.predict(&previous, dt_s(previous_t_ns, t_ns)?).map_err(filter_error)?;
-                let z = Col::from_fn(1, |_| gnss_beam);
-                (self.gnss.update(&predicted, &z).map_err(filter_error)?, search.half_window_beams)
-            }
+        if self.window.has_track() {
+            return self.window.step_aided(probe, None, Some((&self.gnss, gnss_beam)));
+        }
+        // A pass start: from the GNSS window, unless it would read at least
+        // as many beams as the acquisition does.
+        let search = self.window.config().search;
+        let sigma_g = self.gnss_sigma_beams;
+        let half = (self.initial_window_sigmas * sigma_g).ceil().min(probe.beam_count() as f64) as usize;
+        let half = half.max(search.half_window_beams);
+        let acquisition_beams = match search.reacquisition {
+            Reacquisition::Coarse { stride } => probe.beam_count().div_ceil(stride),
+            Reacquisition::FullSweep => probe.beam_count(),
         };
-        let outcome = search_sweep(probe, Window { center: prior.mean()[0], half }, &search, &mut self.hold)?;
-        let posterior = if outcome.reacquired {
-            self.start(outcome.subbeam, peak_var, prior.mean()[1], t_ns)?
-        } else {
-            self.peak.update(&prior, &Col::from_fn(1, |_| outcome.subbeam)).map_err(filter_error)?
-        };
-        let track_beam = posterior.mean()[0];
-        self.track = Some((posterior, t_ns));
-        Ok(SweepDecision {
-            chosen_beam: outcome.peak.beam,
-            reinitialised: outcome.reacquired,
-            track_beam: Some(track_beam),
-        })
+        let start = (2 * half + 1 < acquisition_beams).then_some((gnss_beam, sigma_g * sigma_g, half));
+        self.window.step_aided(probe, start, None)
     }
 }

@@ -108,17 +108,77 @@ impl WindowTracker {
         })
     }
 
-    /// The track restarted at `beam` with rate `rate_beams_per_s`.
-    fn restart(&self, beam: f64, rate_beams_per_s: f64, t_ns: i64) -> Result<Gaussian, SweepError> {
+    /// A track at `beam` (variance `beam_var`, beams^2) with rate
+    /// `rate_beams_per_s` (variance from `initial_rate_sigma_beams_per_s`).
+    fn track_at(&self, beam: f64, beam_var: f64, rate_beams_per_s: f64, t_ns: i64) -> Result<Gaussian, SweepError> {
         let mean = Col::from_fn(2, |i| if i == 0 { beam } else { rate_beams_per_s });
-        let position_var = self.config.measurement_sigma_beams.powi(2);
         let rate_var = self.config.initial_rate_sigma_beams_per_s.powi(2);
         let cov = Mat::from_fn(2, 2, |i, j| match (i, j) {
-            (0, 0) => position_var,
+            (0, 0) => beam_var,
             (1, 1) => rate_var,
             _ => 0.0,
         });
         Gaussian::new(mean, cov).map_err(|source| SweepError::Filter { t_ns, source })
+    }
+
+    /// One sweep of the filter, with two hooks for a tracker that adds a
+    /// measurement source ([`super::GnssWindowTracker`]): at a pass start,
+    /// `pass_start` (beam, variance, half-width of the first window) replaces
+    /// the acquisition; on a running track, `aid` (an updater and its
+    /// measurement of the beam index) updates the predicted state before the
+    /// window is placed. With neither, the steps of the type docs.
+    pub(super) fn step_aided(
+        &mut self,
+        probe: &mut BeamProbe<'_>,
+        pass_start: Option<(f64, f64, usize)>,
+        aid: Option<(&KalmanUpdater, f64)>,
+    ) -> Result<SweepDecision, SweepError> {
+        let t_ns = probe.t_ns();
+        let filter_error = |source| SweepError::Filter { t_ns, source };
+        let peak_var = self.config.measurement_sigma_beams.powi(2);
+        let search = self.config.search;
+        let (prior, half) = match (self.track.take(), pass_start) {
+            (None, None) => {
+                let peak = acquire(probe, search.reacquisition)?;
+                let beam = subbeam_peak(probe, peak.beam);
+                self.hold.clear();
+                self.hold.push(t_ns, peak.power_db);
+                self.track = Some((self.track_at(beam, peak_var, 0.0, t_ns)?, t_ns));
+                return Ok(SweepDecision { chosen_beam: peak.beam, reinitialised: true, track_beam: Some(beam) });
+            }
+            (None, Some((beam, beam_var, half))) => (self.track_at(beam, beam_var, 0.0, t_ns)?, half),
+            (Some((previous, previous_t_ns)), _) => {
+                let predicted = self.predictor.predict(&previous, dt_s(previous_t_ns, t_ns)?).map_err(filter_error)?;
+                let prior = match aid {
+                    Some((updater, z)) => updater.update(&predicted, &Col::from_fn(1, |_| z)).map_err(filter_error)?,
+                    None => predicted,
+                };
+                (prior, search.half_window_beams)
+            }
+        };
+        let outcome = search_sweep(probe, Window { center: prior.mean()[0], half }, &search, &mut self.hold)?;
+        let posterior = if outcome.reacquired {
+            self.track_at(outcome.subbeam, peak_var, prior.mean()[1], t_ns)?
+        } else {
+            self.updater.update(&prior, &Col::from_fn(1, |_| outcome.subbeam)).map_err(filter_error)?
+        };
+        let track_beam = posterior.mean()[0];
+        self.track = Some((posterior, t_ns));
+        Ok(SweepDecision {
+            chosen_beam: outcome.peak.beam,
+            reinitialised: outcome.reacquired,
+            track_beam: Some(track_beam),
+        })
+    }
+
+    /// Whether a pass is under way (a track is held).
+    pub(super) fn has_track(&self) -> bool {
+        self.track.is_some()
+    }
+
+    /// The settings.
+    pub(super) fn config(&self) -> &WindowTrackerConfig {
+        &self.config
     }
 }
 
@@ -129,36 +189,6 @@ impl SweepTracker for WindowTracker {
     }
 
     fn step(&mut self, probe: &mut BeamProbe<'_>, _gnss_beam: Option<f64>) -> Result<SweepDecision, SweepError> {
-        let t_ns = probe.t_ns();
-        let Some((prior, previous_t_ns)) = self.track.take() else {
-            let peak = acquire(probe, self.config.search.reacquisition)?;
-            let beam = subbeam_peak(probe, peak.beam);
-            self.hold.clear();
-            self.hold.push(t_ns, peak.power_db);
-            self.track = Some((self.restart(beam, 0.0, t_ns)?, t_ns));
-            return Ok(SweepDecision { chosen_beam: peak.beam, reinitialised: true, track_beam: Some(beam) });
-        };
-        let filter_error = |source| SweepError::Filter { t_ns, source };
-        let predicted = self.predictor.predict(&prior, dt_s(previous_t_ns, t_ns)?).map_err(filter_error)?;
-        let center = predicted.mean()[0];
-        let outcome = search_sweep(
-            probe,
-            Window { center, half: self.config.search.half_window_beams },
-            &self.config.search,
-            &mut self.hold,
-        )?;
-        let posterior = if outcome.reacquired {
-            self.restart(outcome.subbeam, predicted.mean()[1], t_ns)?
-        } else {
-            let z = Col::from_fn(1, |_| outcome.subbeam);
-            self.updater.update(&predicted, &z).map_err(filter_error)?
-        };
-        let track_beam = posterior.mean()[0];
-        self.track = Some((posterior, t_ns));
-        Ok(SweepDecision {
-            chosen_beam: outcome.peak.beam,
-            reinitialised: outcome.reacquired,
-            track_beam: Some(track_beam),
-        })
+        self.step_aided(probe, None, None)
     }
 }

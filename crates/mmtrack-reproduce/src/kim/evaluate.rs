@@ -6,7 +6,7 @@
 use anyhow::Context;
 pub use mmtrack_analysis::slam::metrics::{EpochErrors, RunOutcome};
 use mmtrack_analysis::slam::metrics::{EpochView, MapTruth, evaluate};
-use mmtrack_core::slam::PathOrigin;
+use mmtrack_core::slam::{PathOrigin, norm3, sub3};
 use mmtrack_sim::slam::SlamRun;
 use mmtrack_slam::{SlamConfig, SlamFilter, SourceStatus};
 
@@ -47,12 +47,7 @@ fn last_found(
     measured: &[Vec<usize>],
     radius_m: f64,
 ) -> Option<LastFound> {
-    let found_epoch = |p: [f64; 3]| {
-        confirmed.iter().position(|est| {
-            est.iter()
-                .any(|q| ((q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)).sqrt() <= radius_m)
-        })
-    };
+    let found_epoch = |p: [f64; 3]| confirmed.iter().position(|est| est.iter().any(|q| norm3(sub3(*q, p)) <= radius_m));
     sources
         .iter()
         .map(|&(source, p)| {
@@ -101,20 +96,20 @@ pub fn run_filter(
     let mut detections = vec![0usize; true_sp.len()];
     let mut sp_measured = vec![Vec::new(); true_sp.len()];
     let mut va_measured = vec![Vec::new(); run.world.virtual_anchors_m.len()];
+    // Epoch `epoch` into a source's list of measured epochs (once per epoch).
+    let note = |epochs: &mut Vec<usize>, epoch: usize| {
+        if epochs.last() != Some(&epoch) {
+            epochs.push(epoch);
+        }
+    };
     for (k, truth) in run.truth.iter().enumerate() {
         for origin in &truth.origins {
             match *origin {
                 PathOrigin::ScatteringPoint(i) if i < true_sp.len() => {
                     detections[i] += 1;
-                    if sp_measured[i].last() != Some(&(k + 1)) {
-                        sp_measured[i].push(k + 1);
-                    }
+                    note(&mut sp_measured[i], k + 1);
                 }
-                PathOrigin::VirtualAnchor(j) if j < va_measured.len() => {
-                    if va_measured[j].last() != Some(&(k + 1)) {
-                        va_measured[j].push(k + 1);
-                    }
-                }
+                PathOrigin::VirtualAnchor(j) if j < va_measured.len() => note(&mut va_measured[j], k + 1),
                 _ => {}
             }
         }
