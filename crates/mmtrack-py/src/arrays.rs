@@ -263,9 +263,8 @@ pub fn track_beams(
         })
         .collect();
     let run = track_site(&kinds, reacquire, site, &inputs)?;
-    let mut names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
-    names.sort_unstable();
-    names.dedup();
+    // The policies run, once each, in `process beam`'s order.
+    let names: Vec<&str> = run.summaries.iter().map(|(kind, _)| kind.name()).collect();
     let info = run_info(
         "mmtrack.track_beams",
         serde_json::json!({ "trackers": names, "reacquire": format!("{reacquire:?}"), "beam_map": "fitted leave-one-pass-out over the passes given" }),
