@@ -228,13 +228,8 @@ pub fn tracks_vs_power_svg(points: &[SweepPoint], two_tracks_down_to_db: f64) ->
             .y_label_area_size(60)
             .build_cartesian_2d(xs.clone(), 0.0..y_max)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
+        crate::plot_common::axes(&mut chart, "MPC power (dB)", "mean number of tracks")
             .light_line_style(LIGHT_LINES)
-            .x_desc("MPC power (dB)")
-            .y_desc("mean number of tracks")
             .draw()
             .map_err(err)?;
         chart
@@ -283,13 +278,8 @@ pub fn delay_error_vs_power_svg(
             .y_label_area_size(70)
             .build_cartesian_2d(xs.clone(), ys.log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
+        crate::plot_common::axes(&mut chart, "MPC power (dB)", "mean delay error (ns)")
             .light_line_style(LIGHT_LINES)
-            .x_desc("MPC power (dB)")
-            .y_desc("mean delay error (ns)")
             .draw()
             .map_err(err)?;
         let target = BLACK.stroke_width(1);
@@ -355,13 +345,8 @@ pub fn delay_error_vs_separation_svg(
             .y_label_area_size(70)
             .build_cartesian_2d(xs.clone(), ys.log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
+        crate::plot_common::axes(&mut chart, "separation of the two MPCs (ns, band centre)", "mean delay error (ns)")
             .light_line_style(LIGHT_LINES)
-            .x_desc("separation of the two MPCs (ns, band centre)")
-            .y_desc("mean delay error (ns)")
             .draw()
             .map_err(err)?;
         let target = BLACK.stroke_width(1);

@@ -54,13 +54,7 @@ pub fn count_svg(result: &MpcResult) -> anyhow::Result<String> {
             .y_label_area_size(60)
             .build_cartesian_2d(-0.5..max_count, 0.0..max_sets * 1.1)
             .map_err(err)?;
-        hist.configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("MPCs per set")
-            .y_desc("sets")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut hist, "MPCs per set", "sets")?;
         hist.draw_series(result.counts.iter().map(|c| {
             let x = c.mpcs as f64;
             Rectangle::new([(x - 0.4, 0.0), (x + 0.4, c.sets as f64)], BLUE.mix(0.6).filled())
@@ -72,13 +66,7 @@ pub fn count_svg(result: &MpcResult) -> anyhow::Result<String> {
             .y_label_area_size(60)
             .build_cartesian_2d(-0.5..max_count, 0.0..1.05)
             .map_err(err)?;
-        cdf.configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("MPCs per set")
-            .y_desc("CDF")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut cdf, "MPCs per set", "CDF")?;
         let steps: Vec<(f64, f64)> = result
             .counts
             .iter()
@@ -107,21 +95,10 @@ fn cdf_chart(
         .y_label_area_size(60)
         .build_cartesian_2d(xs, 0.0..1.05)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc(x_desc)
-        .y_desc("CDF")
-        .draw()
-        .map_err(err)?;
+    crate::plot_common::draw_axes(&mut chart, x_desc, "CDF")?;
     for (label, points, color) in series {
         let color = *color;
-        chart
-            .draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(2)))
-            .map_err(err)?
-            .label(*label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+        crate::plot_common::draw_labelled_line(&mut chart, points.iter().copied(), color.stroke_width(2), *label)?;
     }
     crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     Ok(())
@@ -202,14 +179,7 @@ pub fn power_loss_svg(result: &MpcResult) -> anyhow::Result<String> {
                 .y_label_area_size(60)
                 .build_cartesian_2d(xs, ys)
                 .map_err(err)?;
-            chart
-                .configure_mesh()
-                .label_style(crate::plot_common::TICK_FONT)
-                .axis_desc_style(crate::plot_common::AXIS_FONT)
-                .x_desc("time (s)")
-                .y_desc(y_desc)
-                .draw()
-                .map_err(err)?;
+            crate::plot_common::draw_axes(&mut chart, "time (s)", y_desc)?;
             for (label, p, color) in points {
                 chart
                     .draw_series(LineSeries::new(p, color.stroke_width(1)))
@@ -282,14 +252,7 @@ pub fn delay_tracks_svg(result: &MpcResult) -> anyhow::Result<String> {
             .y_label_area_size(60)
             .build_cartesian_2d(xs, ys)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("time (s)")
-            .y_desc("delay (ns)")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut chart, "time (s)", "delay (ns)")?;
         let span = (p_hi - p_lo).max(1e-9);
         chart
             .draw_series(detections.iter().map(|d| {

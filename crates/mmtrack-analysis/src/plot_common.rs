@@ -4,6 +4,8 @@
 
 use std::ops::Range;
 
+use plotters::chart::MeshStyle;
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::prelude::*;
 
 /// Font of tick labels. plotters' SVG backend writes `font-size` as the
@@ -38,6 +40,60 @@ where
         .label_font(LEGEND_FONT)
         .draw()
         .map_err(err)
+}
+
+/// The axes of every figure here: tick labels in [`TICK_FONT`], axis
+/// descriptions (name and unit) in [`AXIS_FONT`]. Further settings (label
+/// formatters, light lines) go on the returned style before its `draw()`;
+/// [`draw_axes`] draws it as it is.
+pub(crate) fn axes<'a, 'b, DB, XT, YT, X, Y>(
+    chart: &'b mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    x_desc: impl Into<String>,
+    y_desc: impl Into<String>,
+) -> MeshStyle<'a, 'b, X, Y, DB>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = XT> + ValueFormatter<XT>,
+    Y: Ranged<ValueType = YT> + ValueFormatter<YT>,
+{
+    let mut mesh = chart.configure_mesh();
+    mesh.label_style(TICK_FONT).axis_desc_style(AXIS_FONT).x_desc(x_desc).y_desc(y_desc);
+    mesh
+}
+
+/// Draws the axes of [`axes`] with nothing added.
+pub(crate) fn draw_axes<DB, XT, YT, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    x_desc: impl Into<String>,
+    y_desc: impl Into<String>,
+) -> anyhow::Result<()>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = XT> + ValueFormatter<XT>,
+    Y: Ranged<ValueType = YT> + ValueFormatter<YT>,
+{
+    axes(chart, x_desc, y_desc).draw().map_err(err)
+}
+
+/// Draws `points` joined by a line in `style` and enters it in the legend as
+/// `label`, keyed by a short line of the same style.
+pub(crate) fn draw_labelled_line<'a, DB, X, Y>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    points: impl IntoIterator<Item = (f64, f64)>,
+    style: ShapeStyle,
+    label: impl Into<String>,
+) -> anyhow::Result<()>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64>,
+    Y: Ranged<ValueType = f64>,
+{
+    chart
+        .draw_series(LineSeries::new(points, style))
+        .map_err(err)?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+    Ok(())
 }
 
 /// Decimals that tell ticks over `range` apart: plotters places about ten

@@ -38,26 +38,21 @@ fn xy_svg(frame: &str, truth: &[Se2], estimates: &[(String, Vec<Se2>)]) -> anyho
             .y_label_area_size(80)
             .build_cartesian_2d((cx - half)..(cx + half), (cy - half)..(cy + half))
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc(format!("x (m), {frame}"))
-            .y_desc(format!("y (m), {frame}"))
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(truth.iter().map(|p| (p.x_m, p.y_m)), BLACK.stroke_width(2)))
-            .map_err(err)?
-            .label("ground truth")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+        crate::plot_common::draw_axes(&mut chart, format!("x (m), {frame}"), format!("y (m), {frame}"))?;
+        crate::plot_common::draw_labelled_line(
+            &mut chart,
+            truth.iter().map(|p| (p.x_m, p.y_m)),
+            BLACK.stroke_width(2),
+            "ground truth",
+        )?;
         for (k, (label, poses)) in estimates.iter().enumerate() {
             let color = RUN_COLORS[k % RUN_COLORS.len()];
-            chart
-                .draw_series(LineSeries::new(poses.iter().map(|p| (p.x_m, p.y_m)), color.stroke_width(2)))
-                .map_err(err)?
-                .label(label.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            crate::plot_common::draw_labelled_line(
+                &mut chart,
+                poses.iter().map(|p| (p.x_m, p.y_m)),
+                color.stroke_width(2),
+                label.as_str(),
+            )?;
         }
         if let Some(first) = truth.first() {
             chart.draw_series(std::iter::once(Circle::new((first.x_m, first.y_m), 5, BLUE.filled()))).map_err(err)?;
@@ -127,21 +122,10 @@ pub fn errors_overlay_svg(runs: &[(&str, &TrajectoryResult)]) -> anyhow::Result<
                     padded_range(series.iter().flat_map(|s| s.1.iter().map(|p| p.1)).chain(std::iter::once(0.0))),
                 )
                 .map_err(err)?;
-            chart
-                .configure_mesh()
-                .label_style(crate::plot_common::TICK_FONT)
-                .axis_desc_style(crate::plot_common::AXIS_FONT)
-                .x_desc("distance travelled (m)")
-                .y_desc(y_desc)
-                .draw()
-                .map_err(err)?;
+            crate::plot_common::draw_axes(&mut chart, "distance travelled (m)", y_desc)?;
             for (k, (label, points)) in series.into_iter().enumerate() {
                 let color = RUN_COLORS[k % RUN_COLORS.len()];
-                chart
-                    .draw_series(LineSeries::new(points, color.stroke_width(2)))
-                    .map_err(err)?
-                    .label(label)
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+                crate::plot_common::draw_labelled_line(&mut chart, points, color.stroke_width(2), label)?;
             }
             draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }
@@ -167,14 +151,7 @@ fn line_chart(
             padded_range(points.iter().map(|p| p.1).chain(std::iter::once(0.0))),
         )
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc(x_desc)
-        .y_desc(y_desc)
-        .draw()
-        .map_err(err)?;
+    crate::plot_common::draw_axes(&mut chart, x_desc, y_desc)?;
     chart.draw_series(LineSeries::new(points.iter().copied(), color.stroke_width(1))).map_err(err)?;
     if points.len() <= 50 {
         chart.draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled()))).map_err(err)?;

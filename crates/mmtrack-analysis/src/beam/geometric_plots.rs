@@ -73,14 +73,7 @@ fn chart<'a, 'b>(
         .y_label_area_size(70)
         .build_cartesian_2d(0f64..t_end, y)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc("time since the first epoch (s)")
-        .y_desc(y_desc)
-        .draw()
-        .map_err(err)?;
+    crate::plot_common::draw_axes(&mut chart, "time since the first epoch (s)", y_desc)?;
     Ok(chart)
 }
 

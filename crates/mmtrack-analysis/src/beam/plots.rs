@@ -45,14 +45,7 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
             .y_label_area_size(65)
             .build_cartesian_2d(0f64..(blocks - 1) as f64, (y_lo..y_hi).log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("block (1 ms)")
-            .y_desc("RMS AoD error (deg)")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut chart, "block (1 ms)", "RMS AoD error (deg)")?;
         for (curve, color) in curves.iter().zip(PALETTE.iter().cycle()) {
             let points = curve
                 .rms_deg
@@ -61,18 +54,15 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
                 .filter(|(_, v)| **v > 0.0 && v.is_finite())
                 .map(|(k, v)| (k as f64, v.clamp(y_lo, y_hi)));
             let style = color.stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(err)?
-                .label(curve.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
         }
         let threshold = BLACK.stroke_width(1);
-        chart
-            .draw_series(LineSeries::new([(0.0, threshold_deg), ((blocks - 1) as f64, threshold_deg)], threshold))
-            .map_err(err)?
-            .label(format!("half beamwidth ({threshold_deg:.2} deg)"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], threshold));
+        crate::plot_common::draw_labelled_line(
+            &mut chart,
+            [(0.0, threshold_deg), ((blocks - 1) as f64, threshold_deg)],
+            threshold,
+            format!("half beamwidth ({threshold_deg:.2} deg)"),
+        )?;
         crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;
     }
@@ -118,14 +108,11 @@ pub fn rms_against_distance_svg(title: &str, curves: &[DistanceCurve], threshold
             .y_label_area_size(65)
             .build_cartesian_2d(x.clone(), (y_lo..y_hi).log_scale())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("horizontal distance from the overpass d (m), negative before it")
-            .y_desc("RMS AoD error (deg)")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(
+            &mut chart,
+            "horizontal distance from the overpass d (m), negative before it",
+            "RMS AoD error (deg)",
+        )?;
         for curve in curves {
             let color = PALETTE[curve.color % PALETTE.len()];
             let points: Vec<(f64, f64)> = curve
@@ -148,11 +135,12 @@ pub fn rms_against_distance_svg(title: &str, curves: &[DistanceCurve], threshold
             });
         }
         let thin = BLACK.stroke_width(1);
-        chart
-            .draw_series(LineSeries::new([(x.start, threshold_deg), (x.end, threshold_deg)], thin))
-            .map_err(err)?
-            .label(format!("half beamwidth ({threshold_deg:.2} deg)"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], thin));
+        crate::plot_common::draw_labelled_line(
+            &mut chart,
+            [(x.start, threshold_deg), (x.end, threshold_deg)],
+            thin,
+            format!("half beamwidth ({threshold_deg:.2} deg)"),
+        )?;
         let grey = RGBColor(120, 120, 120).stroke_width(1);
         chart
             .draw_series(DashedLineSeries::new([(0.0, y_lo), (0.0, y_hi)], 8, 5, grey))
@@ -234,14 +222,7 @@ pub fn beam_index_svg(
             .y_label_area_size(55)
             .build_cartesian_2d(0f64..t_end, -0.5..beams + 0.5)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("time (s)")
-            .y_desc("beam index")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut chart, "time (s)", "beam index")?;
         let dots = best.t_s.iter().zip(&best.beam).map(|(&t, &b)| Circle::new((t, b), 3, BLACK.filled()));
         chart
             .draw_series(dots)
@@ -260,11 +241,7 @@ pub fn beam_index_svg(
                 points.push((t, b));
             }
             let style = color.stroke_width(4u32.saturating_sub(k as u32).max(1));
-            chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(err)?
-                .label(series.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            crate::plot_common::draw_labelled_line(&mut chart, points, style, series.label.clone())?;
         }
         crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
@@ -301,14 +278,7 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
             .y_label_area_size(55)
             .build_cartesian_2d(0f64..x_end, 0f64..1.0)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("received-power loss (dB)")
-            .y_desc("CDF")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut chart, "received-power loss (dB)", "CDF")?;
         for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
             let mut sorted: Vec<f64> = curve.loss_db.iter().copied().filter(|v| v.is_finite()).collect();
             sorted.sort_by(f64::total_cmp);
@@ -321,11 +291,7 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
             }
             points.push((x_end, if sorted.is_empty() { 0.0 } else { 1.0 }));
             let style = color.stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(err)?
-                .label(curve.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
         }
         crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;

@@ -55,12 +55,7 @@ pub fn spebt_tracking_svg(title: &str, series: &SpebtTrackingSeries) -> anyhow::
             .y_label_area_size(80)
             .build_cartesian_2d(x_range.clone(), range.clone())
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("slot")
-            .y_desc("|alpha| (dB, 20 log10)")
+        crate::plot_common::axes(&mut chart, "slot", "|alpha| (dB, 20 log10)")
             .y_label_formatter(&|v| format!("{v:.decimals$}", decimals = tick_decimals(&range)))
             .draw()
             .map_err(err)?;
@@ -77,12 +72,7 @@ pub fn spebt_tracking_svg(title: &str, series: &SpebtTrackingSeries) -> anyhow::
                 .y_label_area_size(80)
                 .build_cartesian_2d(x_range.clone(), range.clone())
                 .map_err(err)?;
-            chart
-                .configure_mesh()
-                .label_style(crate::plot_common::TICK_FONT)
-                .axis_desc_style(crate::plot_common::AXIS_FONT)
-                .x_desc("slot")
-                .y_desc(label)
+            crate::plot_common::axes(&mut chart, "slot", label)
                 .y_label_formatter(&|v| format!("{v:.decimals$}", decimals = tick_decimals(&range)))
                 .draw()
                 .map_err(err)?;

@@ -79,20 +79,9 @@ fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace:
         .y_label_area_size(55)
         .build_cartesian_2d(x, y)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc("x along the receiver's heading (m)")
-        .y_desc("y (m)")
-        .draw()
-        .map_err(err)?;
+    crate::plot_common::draw_axes(&mut chart, "x along the receiver's heading (m)", "y (m)")?;
     let truth = BLACK.stroke_width(2);
-    chart
-        .draw_series(LineSeries::new(trace.truth_m.iter().map(|p| (p[0], p[1])), truth))
-        .map_err(err)?
-        .label("true path")
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], truth));
+    crate::plot_common::draw_labelled_line(&mut chart, trace.truth_m.iter().map(|p| (p[0], p[1])), truth, "true path")?;
     chart
         .draw_series(inside.iter().map(|&p| Cross::new(p, 3, RED.stroke_width(1))))
         .map_err(err)?
@@ -128,14 +117,7 @@ fn draw_nmse(
         .y_label_area_size(55)
         .build_cartesian_2d(0f64..t_end, y.clone())
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc("time (s)")
-        .y_desc("NMSE of the range (dB)")
-        .draw()
-        .map_err(err)?;
+    crate::plot_common::draw_axes(&mut chart, "time (s)", "NMSE of the range (dB)")?;
     // Variants (after the paper's four) thin and first, so the four stay on top.
     let order: Vec<usize> = (4..curves.len()).chain(0..curves.len().min(4)).collect();
     for index in order {
@@ -147,11 +129,7 @@ fn draw_nmse(
             .enumerate()
             .filter(|(_, v)| **v > 0.0 && v.is_finite())
             .map(|(k, v)| (k as f64 * epoch_s, db(*v).clamp(y.start, y.end)));
-        chart
-            .draw_series(LineSeries::new(points, style))
-            .map_err(err)?
-            .label(curve.label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
     }
     crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
@@ -220,14 +198,7 @@ fn draw_nlos_map(
         .y_label_area_size(55)
         .build_cartesian_2d(x.clone(), y.clone())
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc("x along the receiver's heading (m)")
-        .y_desc("y (m)")
-        .draw()
-        .map_err(err)?;
+    crate::plot_common::draw_axes(&mut chart, "x along the receiver's heading (m)", "y (m)")?;
     let wall = BLACK.stroke_width(3);
     for (i, wall_y) in walls_y_m.into_iter().enumerate() {
         let drawn = chart.draw_series(LineSeries::new([(x.start, wall_y), (x.end, wall_y)], wall)).map_err(err)?;
@@ -244,11 +215,12 @@ fn draw_nlos_map(
         let color = PATH_COLORS[i % PATH_COLORS.len()];
         let rows: Vec<&ZoechmannPathLabelRow> = labels.iter().filter(|l| l.path == *path).collect();
         let truth = color.stroke_width(2);
-        chart
-            .draw_series(LineSeries::new(rows.iter().map(|l| (l.true_x_m, l.true_y_m)), truth))
-            .map_err(err)?
-            .label(format!("{path}: true apparent source"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], truth));
+        crate::plot_common::draw_labelled_line(
+            &mut chart,
+            rows.iter().map(|l| (l.true_x_m, l.true_y_m)),
+            truth,
+            format!("{path}: true apparent source"),
+        )?;
         let estimates: Vec<(f64, f64)> = rows.iter().map(|l| (l.x_m, l.y_m)).collect();
         let inside: Vec<(f64, f64)> =
             estimates.iter().copied().filter(|(a, b)| x.contains(a) && y.contains(b)).collect();
@@ -301,12 +273,7 @@ fn draw_nlos_errors(
         .y_label_area_size(55)
         .build_cartesian_2d(0f64..t_end, (lo..hi).log_scale())
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .label_style(crate::plot_common::TICK_FONT)
-        .axis_desc_style(crate::plot_common::AXIS_FONT)
-        .x_desc("time (s)")
-        .y_desc("RMS position error (m)")
+    crate::plot_common::axes(&mut chart, "time (s)", "RMS position error (m)")
         .y_label_formatter(&|v| format!("{v:.2}"))
         .draw()
         .map_err(err)?;
@@ -314,11 +281,7 @@ fn draw_nlos_errors(
         let style = PATH_COLORS[i % PATH_COLORS.len()].stroke_width(2);
         let points =
             errors.iter().filter(|e| e.path == *path).filter(shown).map(|e| (e.t_ns as f64 * 1e-9, e.position_rmse_m));
-        chart
-            .draw_series(LineSeries::new(points, style))
-            .map_err(err)?
-            .label(format!("{path}: RMS position error"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        crate::plot_common::draw_labelled_line(&mut chart, points, style, format!("{path}: RMS position error"))?;
     }
     crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())

@@ -58,26 +58,21 @@ pub fn map_svg(title: &str, figure: &MapFigure) -> anyhow::Result<String> {
             .y_label_area_size(55)
             .build_cartesian_2d((cx - half)..(cx + half), (cy - half)..(cy + half))
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut chart, "x (m)", "y (m)")?;
         let track = |points: &[[f64; 2]]| points.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>();
         let grey = RGBColor(120, 120, 120);
-        chart
-            .draw_series(LineSeries::new(track(&figure.true_track_m), grey.stroke_width(3)))
-            .map_err(err)?
-            .label("true track")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey.stroke_width(3)));
-        chart
-            .draw_series(LineSeries::new(track(&figure.estimated_track_m), BLUE.stroke_width(1)))
-            .map_err(err)?
-            .label("estimated track")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE.stroke_width(1)));
+        crate::plot_common::draw_labelled_line(
+            &mut chart,
+            track(&figure.true_track_m),
+            grey.stroke_width(3),
+            "true track",
+        )?;
+        crate::plot_common::draw_labelled_line(
+            &mut chart,
+            track(&figure.estimated_track_m),
+            BLUE.stroke_width(1),
+            "estimated track",
+        )?;
         let markers: [Markers<'_>; 5] = [
             (std::slice::from_ref(&figure.bs_m), "BS", BLACK, true, false),
             (&figure.true_va_m, "true VA", RED, false, false),
@@ -128,23 +123,12 @@ pub fn epoch_curves_svg(title: &str, y_desc: &str, curves: &[EpochCurve]) -> any
             .y_label_area_size(65)
             .build_cartesian_2d(1f64..epochs as f64, 0f64.min(range.start)..range.end)
             .map_err(err)?;
-        chart
-            .configure_mesh()
-            .label_style(crate::plot_common::TICK_FONT)
-            .axis_desc_style(crate::plot_common::AXIS_FONT)
-            .x_desc("epoch k (200 ms)")
-            .y_desc(y_desc)
-            .draw()
-            .map_err(err)?;
+        crate::plot_common::draw_axes(&mut chart, "epoch k (200 ms)", y_desc)?;
         for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
             let points =
                 curve.values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(k, v)| ((k + 1) as f64, *v));
             let style = color.stroke_width(2);
-            chart
-                .draw_series(LineSeries::new(points, style))
-                .map_err(err)?
-                .label(curve.label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
         }
         crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
