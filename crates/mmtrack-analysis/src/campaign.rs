@@ -613,7 +613,7 @@ pub fn section(rows: &[ComparedRow], runs: &[String]) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -645,7 +645,15 @@ mod tests {
         assert_eq!(discover_runs(std::slice::from_ref(&empty)).unwrap()[0].tables, empty);
     }
 
-    fn trajectory(poses: u64, segments: u64, kitti_pct: Option<f64>, ate_m: f64) -> TrajectoryMetrics {
+    /// Metrics of a run for the pooling tests (here and in `report`): only
+    /// the counts and errors given vary.
+    pub(crate) fn trajectory(
+        poses: u64,
+        segments: u64,
+        kitti_pct: Option<f64>,
+        ate_m: f64,
+        rpe_m: f64,
+    ) -> TrajectoryMetrics {
         TrajectoryMetrics {
             estimate_poses: poses,
             associated_poses: poses,
@@ -668,7 +676,7 @@ mod tests {
             position_rmse_m: ate_m,
             yaw_rmse_rad: 0.01,
             final_position_error_m: 5.0,
-            rpe_translation_rmse_m: 0.1,
+            rpe_translation_rmse_m: rpe_m,
             rpe_yaw_rmse_rad: 0.001,
         }
     }
@@ -690,8 +698,8 @@ mod tests {
             )
             .unwrap();
         };
-        let (a1, a2) = (trajectory(11, 3, Some(1.0), 1.0), trajectory(31, 1, Some(5.0), 2.0));
-        let b1 = trajectory(5, 0, None, 1.5);
+        let (a1, a2) = (trajectory(11, 3, Some(1.0), 1.0, 0.1), trajectory(31, 1, Some(5.0), 2.0, 0.1));
+        let b1 = trajectory(5, 0, None, 1.5, 0.1);
         write("a", "s1", &a1);
         write("a", "s2", &a2);
         write("b", "s1", &b1);

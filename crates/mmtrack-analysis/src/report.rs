@@ -180,35 +180,7 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
 #[cfg(test)]
 mod tests {
     use crate::campaign::pooled_trajectory_metrics;
-    use mmtrack_io::table::TrajectoryMetrics;
-
-    fn metrics(poses: u64, segments: u64, kitti_pct: Option<f64>, ate_m: f64, rpe_m: f64) -> TrajectoryMetrics {
-        TrajectoryMetrics {
-            estimate_poses: poses,
-            associated_poses: poses,
-            interpolated_poses: 0,
-            dropped_poses: 0,
-            first_t_ns: 0,
-            last_t_ns: 1,
-            path_length_m: 100.0,
-            estimate_path_length_m: 101.0,
-            segment_lengths_m: vec![10.0],
-            step_frames: Some(1),
-            step_m: None,
-            kitti_segments: segments,
-            kitti_translational_pct: kitti_pct,
-            kitti_rotational_deg_per_100m: kitti_pct,
-            ate_rmse_m: ate_m,
-            ate_max_m: 2.0 * ate_m,
-            x_rmse_m: ate_m,
-            y_rmse_m: ate_m,
-            position_rmse_m: ate_m,
-            yaw_rmse_rad: 0.01,
-            final_position_error_m: 5.0,
-            rpe_translation_rmse_m: rpe_m,
-            rpe_yaw_rmse_rad: 0.001,
-        }
-    }
+    use crate::campaign::tests::trajectory as metrics;
 
     #[test]
     fn pooled_row_weights_segments_poses_and_frame_pairs_by_hand() {
