@@ -122,7 +122,7 @@ struct Prepared {
     posterior_cov: Cov,
 }
 
-/// `s + sum_k a_k b_k`, the sum formed from `0.0` in order of `k` and then
+/// `dst + sum_k a_k b_k`, the sum formed from `0.0` in order of `k` and then
 /// added (`linalg::mul_add` with `alpha = 1`).
 #[inline]
 fn dot_add(dst: f64, a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -168,26 +168,18 @@ fn mul_transpose_add(dst: Cov, a: &Cov, b: &Cov) -> Cov {
 
 /// `(P + P^T) / 2` (`linalg::symmetrise`).
 #[inline]
-fn symmetrise(mut m: Cov) -> Cov {
-    for j in 0..2 {
-        for i in 0..=j {
-            let mean = (m[i][j] + m[j][i]) * 0.5;
-            m[i][j] = mean;
-            m[j][i] = mean;
-        }
-    }
-    m
+fn symmetrise(m: Cov) -> Cov {
+    let off = (m[0][1] + m[1][0]) * 0.5;
+    [[(m[0][0] + m[0][0]) * 0.5, off], [off, (m[1][1] + m[1][1]) * 0.5]]
 }
 
 /// `gaussian::checked_spd` for a 2 x 2 matrix: finite (the first bad element
 /// in column-major order is named), symmetric to [`SYMMETRY_TOLERANCE`]
 /// relative, positive definite; returns the symmetrised matrix.
 fn checked_spd(what: &'static str, m: Cov) -> Result<Cov, FilterError> {
-    for c in 0..2 {
-        for r in 0..2 {
-            if !m[r][c].is_finite() {
-                return Err(FilterError::NotFinite { what, row: r, col: c, value: m[r][c] });
-            }
+    for (r, c) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+        if !m[r][c].is_finite() {
+            return Err(FilterError::NotFinite { what, row: r, col: c, value: m[r][c] });
         }
     }
     let scale = m.iter().flatten().fold(0.0_f64, |a, x| a.max(x.abs())).max(1.0);
@@ -212,11 +204,9 @@ fn is_positive_definite(m: &Cov) -> bool {
 /// `sqrt(a)` for a positive `a` whose root is finite and non-zero.
 #[inline]
 fn pivot(a: f64) -> Option<f64> {
-    if !(a > 0.0) {
-        return None;
-    }
+    let positive = a > 0.0;
     let root = a.sqrt();
-    (root != 0.0 && root.is_finite()).then_some(root)
+    (positive && root != 0.0 && root.is_finite()).then_some(root)
 }
 
 /// faer's `L L^T` factor of a 2 x 2 symmetric positive definite matrix (on
@@ -363,7 +353,8 @@ impl Filter {
             for i in 0..2 {
                 let mut s = 0.0;
                 s += gain[i] * H[j];
-                i_kh[i][j] += -1.0 * s;
+                // -1 * s, exactly.
+                i_kh[i][j] += -s;
             }
         }
         let i_kh_p = mul_add([[0.0; 2]; 2], &i_kh, p);
@@ -422,12 +413,15 @@ impl Filter {
                 let nu = z - prep.eta;
                 // The delay part of the gate first: it needs neither the
                 // distance nor the label's power.
-                if !(nu.abs() <= gate.max_innovation_m) {
+                let delay_ok = nu.abs() <= gate.max_innovation_m;
+                if !delay_ok {
                     continue;
                 }
-                if let (Some(last), Some(now)) = (last_power[i], power_now)
-                    && !((now - last).abs() <= gate.max_magnitude_change_db)
-                {
+                let magnitude_ok = match (last_power[i], power_now) {
+                    (Some(last), Some(now)) => (now - last).abs() <= gate.max_magnitude_change_db,
+                    _ => true,
+                };
+                if !magnitude_ok {
                     continue;
                 }
                 let y = nu / prep.l;
