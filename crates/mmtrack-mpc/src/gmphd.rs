@@ -1,6 +1,9 @@
 //! The GM-PHD baseline tracker of Mahler et al. 2017 (Sec. III-B, Table I),
-//! assembled from the `mmtrack-filter` roles so that it runs on the same
-//! detections as the proposed short-term tracker.
+//! run on the same detections as the proposed short-term tracker. Its filter
+//! is `mmtrack-filter`'s labelled GM-PHD (`GmPhdFilter` with the roles below)
+//! written out for this two-state model on stack arrays (`gmphd/filter.rs`),
+//! with the same results number for number (checked against the generic
+//! filter by the integration test `gmphd_generic`).
 //!
 //! # Model
 //! - State `x = [d, d_dot]`: path length `d = c tau` (m, `c` =
@@ -50,6 +53,7 @@
 //! B.-N. Vo and W.-K. Ma, IEEE TSP 54(11), 2006 (the filter).
 
 mod config;
+mod filter;
 mod tracks;
 
 pub use config::GmPhdConfig;
@@ -57,15 +61,11 @@ pub use config::GmPhdConfig;
 use std::collections::{BTreeMap, BTreeSet};
 
 use mmtrack_core::{MpcDetection, MpcTrack};
-use mmtrack_filter::faer::{Col, ColRef, Mat, MatRef};
-use mmtrack_filter::gmphd::{MixtureReducer, StateExtractor, WeightedGaussian};
-use mmtrack_filter::{
-    ConstantVelocity, FilterError, Gate, GateCandidate, Gaussian, GmPhdFilter, GmPhdParams, KalmanPredictor,
-    KalmanUpdater, Label, LinearMeasurement,
-};
+use mmtrack_filter::{FilterError, Label};
 use thiserror::Error;
 
 use crate::SPEED_OF_LIGHT_M_PER_S;
+use filter::{ChangeGate, Filter, Params};
 use tracks::TrackBook;
 
 /// The detections of one snapshot, with the snapshot's time and indices.
@@ -158,9 +158,9 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
     config.validate()?;
     check_snapshots(snapshots)?;
     let c = SPEED_OF_LIGHT_M_PER_S;
-    let setup = |e: FilterError| GmPhdError::Filter { snapshot: 0, source: e };
-    let mut filter = build_filter(config).map_err(setup)?;
-    let birth = BirthModel::new(config).map_err(setup)?;
+    let mut filter = Filter::new(filter_params(config));
+    let (sd, sv) = (config.sigma_measurement_m, config.birth_sigma_rate_mps);
+    let birth_cov = [[sd * sd, 0.0], [0.0, sv * sv]];
 
     // (path length m, power dB) of the previous snapshot's unexplained detections.
     let mut unexplained: Vec<(f64, f64)> = Vec::new();
@@ -172,13 +172,14 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
         let dt_s = previous_t_ns.map_or(0.0, |p| (i128::from(snap.t_ns) - i128::from(p)) as f64 * 1e-9);
         previous_t_ns = Some(snap.t_ns);
 
-        let births = birth.at_all(unexplained.iter().map(|&(d, _)| d), dt_s).map_err(wrap)?;
-        let labels = filter.predict(dt_s, births).map_err(wrap)?;
+        let birth_d_m: Vec<f64> = unexplained.iter().map(|&(d, _)| d).collect();
+        let births = filter.births(&birth_d_m, &birth_cov, dt_s).map_err(wrap)?;
+        let labels = filter.predict(dt_s, &births, config.birth_weight).map_err(wrap)?;
         for (label, &(_, power_db)) in labels.iter().zip(&unexplained) {
             last_power_db.insert(*label, power_db);
         }
 
-        let zs: Vec<Col<f64>> = snap.detections.iter().map(|d| Col::full(1, c * d.delay_s)).collect();
+        let zs: Vec<f64> = snap.detections.iter().map(|d| c * d.delay_s).collect();
         let powers_db: Vec<f64> = snap.detections.iter().map(MpcDetection::power_db).collect();
         let gate = ChangeGate {
             max_innovation_m: c * config.max_delay_change_s,
@@ -186,7 +187,7 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
             last_power_db: &last_power_db,
             powers_db: &powers_db,
         };
-        let report = filter.update(&zs, &gate).map_err(wrap)?;
+        let measurement_weights = filter.update(&zs, &gate).map_err(wrap)?;
         filter.reduce().map_err(wrap)?;
 
         for estimate in filter.extract() {
@@ -198,7 +199,7 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
                 t_ns: snap.t_ns,
                 set_index: snap.set_index,
                 snapshot_index: snap.snapshot_index,
-                delay_s: estimate.density.mean().iter().next().copied().unwrap_or(f64::NAN) / c,
+                delay_s: estimate.mean[0] / c,
                 amplitude: mmtrack_core::Complex64::new(0.0, 0.0),
             };
             book.push(estimate.label, detection, source.map(|d| d.amplitude));
@@ -207,9 +208,9 @@ pub fn track_gmphd(snapshots: &[GmPhdSnapshot], config: &GmPhdConfig) -> Result<
         unexplained = zs
             .iter()
             .zip(&powers_db)
-            .zip(&report.measurement_weights)
+            .zip(&measurement_weights)
             .filter(|(_, w)| **w < config.birth_association_threshold)
-            .map(|((z, p), _)| (z[0], *p))
+            .map(|((z, p), _)| (*z, *p))
             .collect();
         // Forget the powers of labels that left the mixture (bounded memory).
         let alive: BTreeSet<Label> = filter.mixture().iter().map(|comp| comp.label).collect();
@@ -246,66 +247,17 @@ fn check_snapshots(snapshots: &[GmPhdSnapshot]) -> Result<(), GmPhdError> {
     Ok(())
 }
 
-/// The filter of Table I: CV in one axis, position measurement, the reducer
-/// and extractor thresholds.
-fn build_filter(config: &GmPhdConfig) -> Result<GmPhdFilter<ConstantVelocity>, FilterError> {
-    GmPhdFilter::new(
-        KalmanPredictor::new(ConstantVelocity::new(1, config.sigma_process_mps2)?),
-        KalmanUpdater::new(LinearMeasurement::position(1, config.sigma_measurement_m)?),
-        GmPhdParams {
-            p_survival: config.p_survival,
-            p_detection: config.p_detection,
-            clutter_intensity: config.clutter_intensity_per_m,
-        },
-        MixtureReducer::new(config.truncation_threshold, config.merge_threshold, config.max_components)?,
-        StateExtractor::new(config.extraction_threshold)?,
-    )
-}
-
-/// Builds birth terms from detections of the previous snapshot.
-struct BirthModel {
-    predictor: KalmanPredictor<ConstantVelocity>,
-    cov: Mat<f64>,
-    weight: f64,
-}
-
-impl BirthModel {
-    fn new(config: &GmPhdConfig) -> Result<Self, FilterError> {
-        let (sd, sv) = (config.sigma_measurement_m, config.birth_sigma_rate_mps);
-        Ok(Self {
-            predictor: KalmanPredictor::new(ConstantVelocity::new(1, config.sigma_process_mps2)?),
-            cov: MatRef::from_row_major_slice(&[sd * sd, 0.0, 0.0, sv * sv], 2, 2).to_owned(),
-            weight: config.birth_weight,
-        })
-    }
-
-    /// `w_b N([d, 0], diag(sigma_d^2, sigma_rate^2))` predicted over `dt_s`,
-    /// for each path length `d` (m).
-    fn at_all(&self, d_m: impl Iterator<Item = f64>, dt_s: f64) -> Result<Vec<WeightedGaussian>, FilterError> {
-        let at_detections = d_m
-            .map(|d| Gaussian::new(ColRef::from_slice(&[d, 0.0]).to_owned(), self.cov.clone()))
-            .collect::<Result<Vec<_>, _>>()?;
-        let predicted = self.predictor.predict_each(&at_detections, dt_s)?;
-        Ok(predicted.into_iter().map(|density| WeightedGaussian { weight: self.weight, density }).collect())
-    }
-}
-
-/// The maximum delay / magnitude change gate (see the module docs).
-struct ChangeGate<'a> {
-    max_innovation_m: f64,
-    max_magnitude_change_db: f64,
-    last_power_db: &'a BTreeMap<Label, f64>,
-    powers_db: &'a [f64],
-}
-
-impl Gate for ChangeGate<'_> {
-    fn admits(&self, candidate: &GateCandidate<'_>) -> bool {
-        let delay_ok = candidate.innovation.iter().all(|nu| nu.abs() <= self.max_innovation_m);
-        let magnitude_ok =
-            match (self.last_power_db.get(&candidate.label), self.powers_db.get(candidate.measurement_index)) {
-                (Some(last), Some(now)) => (now - last).abs() <= self.max_magnitude_change_db,
-                _ => true,
-            };
-        delay_ok && magnitude_ok
+/// The parameters of Table I for [`Filter`].
+fn filter_params(config: &GmPhdConfig) -> Params {
+    Params {
+        sigma_process_mps2: config.sigma_process_mps2,
+        r_m2: config.sigma_measurement_m * config.sigma_measurement_m,
+        p_survival: config.p_survival,
+        p_detection: config.p_detection,
+        clutter_intensity_per_m: config.clutter_intensity_per_m,
+        truncation_threshold: config.truncation_threshold,
+        merge_threshold: config.merge_threshold,
+        max_components: config.max_components,
+        extraction_threshold: config.extraction_threshold,
     }
 }

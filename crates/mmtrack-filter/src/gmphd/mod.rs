@@ -49,7 +49,7 @@ mod extract;
 mod reduce;
 mod update;
 
-pub use extract::{Estimate, StateExtractor};
+pub use extract::{Estimate, MAX_COPIES_PER_COMPONENT, StateExtractor};
 pub use reduce::{MixtureReducer, ReductionReport};
 pub use update::{Association, UpdateReport};
 

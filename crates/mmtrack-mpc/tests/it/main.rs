@@ -4,6 +4,7 @@
 mod common;
 mod detect;
 mod gmphd;
+mod gmphd_generic;
 mod long_term;
 mod pipeline;
 mod realdata_cir;
