@@ -25,6 +25,7 @@
 //!
 //! Layers: `run` (simulate, detect, track, score) <- [`report`] <- [`run()`].
 
+pub mod causes;
 pub mod report;
 mod run;
 
