@@ -335,7 +335,11 @@ fn causes_section(m: &Measured) -> String {
         if bridges.is_empty() {
             "-".to_string()
         } else {
-            bridges.iter().map(|(c, n)| format!("{n} {}", c.describe())).collect::<Vec<_>>().join(", ")
+            bridges
+                .iter()
+                .map(|(c, n)| format!("{n} {}", c.describe().trim_start_matches("adjacent sets: ")))
+                .collect::<Vec<_>>()
+                .join(", ")
         }
     );
     out.push_str(
