@@ -21,10 +21,20 @@
 //!   detection is classified by the snapshot's truth: `P` merged with another
 //!   true path within 0.5 ns (no resolvable MPC of its own), `P` below floor
 //!   + 6 dB in that snapshot, a stronger true path within the detector's
-//!   blocked half-width (the +-1.24 ns range, Sec. III-A step 4), or none of
-//!   these (missed although above the threshold and clear). The birth's
+//!   blocked half-width (the +-1.24 ns range, Sec. III-A step 4), an
+//!   unmatched detection 0.5-1.24 ns from it (a delay estimate off by more
+//!   than the match tolerance), or none of these (missed although above the
+//!   threshold and clear). The birth's
 //!   cause is that of the first gap set where `P` is in the truth (or
 //!   "absent from the truth" when it is in none).
+//!
+//! For a gap the tracker may bridge ([`LongTermConfig::max_missed_sets`]),
+//! [`Birth::bridge`] names the step the bridge failed at. [`NoiseRow`]s
+//! measure what breaks the short-term search: for the sets where a path is
+//! detected in all snapshots, the delay error against the truth and the
+//! second differences of the detections against `epsilon_tau` (eqs.
+//! (17)-(23) predict from the last two detections, so a search misses when
+//! `|tau[m+1] - 2 tau[m] + tau[m-1]| > epsilon_tau`).
 //!
 //! Pure: the scene's tables in, counts out.
 
@@ -89,10 +99,8 @@ pub enum Cause {
     MissedClear,
     /// Gap: all snapshots detected but no full-lifetime track on the path.
     ShortTermSplit,
-    /// Gap of one set: bridging should have applied (all gap sets had
-    /// the path's full-lifetime track missing for one of the reasons
-    /// above), listed apart when the gap set itself had a full-lifetime track
-    /// on another path's majority.
+    /// None of the above (an adjacent pair without both entries; not seen
+    /// in the convoy runs).
     Other,
 }
 
@@ -352,7 +360,8 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
             return (Cause::ShortTermSplit, missed);
         }
         let th = threshold(set);
-        // The worst missing snapshot decides: merged, then below, then blocked.
+        // The first cause in this order over the missing snapshots decides:
+        // merged, below the threshold, blocked, off by 0.5-1.24 ns, clear.
         let mut cause = Cause::MissedClear;
         for &n in &missed {
             let here = by_snapshot.get(&(set, n)).map_or(&[][..], Vec::as_slice);
