@@ -23,8 +23,14 @@
 //! fair truths, and fewer births on true paths than the paper's eq. (35).
 //! The paper's eq. (35) is reported beside them, not judged.
 //!
-//! Layers: `run` (simulate, detect, track, score) <- [`report`] <- [`run()`].
+//! Why the births on true paths happen, for every (truth, tracker) pair:
+//! [`causes`] (what ended the previous long-term track on the path; the
+//! traced cause of the missed row is in docs/results/multipath.md).
+//!
+//! Layers: `run` (simulate, detect, track, score, [`causes`]) <- [`report`]
+//! <- [`run()`].
 
+pub mod causes;
 pub mod report;
 mod run;
 

@@ -1,6 +1,7 @@
 //! What the convoy experiment reports: the claims and verdicts, the
 //! metrics, `reproduce.md`, `results.csv` and the README block.
 
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -8,6 +9,9 @@ use anyhow::Context;
 use mmtrack_io::Overwrite;
 use mmtrack_io::table::MpcSummary;
 
+use mmtrack_sim::sounder::PathKind;
+
+use super::causes::{Cause, MARGIN_BIN_DB, NoiseRow};
 use super::run::{LITERAL, Measured, OURS, PATH_KINDS, Row, Truth, variants};
 use crate::model::{Claim, METRICS_FILE, Metric, Rule, Verdict, verdict_rows, write_metrics};
 
@@ -223,10 +227,11 @@ pub fn markdown(m: &Measured, verdicts: &[Verdict]) -> String {
 fn body(m: &Measured, verdicts: &[Verdict]) -> String {
     format!(
         "| claim | paper | measured | verdict |\n|---|---|---|---|\n{}\n{}\nDetection against each truth \
-         (the same detections; only the truth differs):\n\n{}",
+         (the same detections; only the truth differs):\n\n{}\n{}",
         verdict_rows(verdicts),
         rates_table(m),
-        detection_table(m)
+        detection_table(m),
+        causes_section(m)
     )
 }
 
@@ -277,9 +282,149 @@ fn csv(m: &Measured) -> String {
 /// A file that cannot be written.
 pub fn write_outputs(output: &Path, m: &Measured, markdown: &str, metrics: &[Metric]) -> anyhow::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(output).with_context(|| output.display().to_string())?;
-    for (name, text) in [("results.csv", csv(m)), ("reproduce.md", markdown.to_string())] {
+    for (name, text) in [("results.csv", csv(m)), ("reproduce.md", markdown.to_string()), ("causes.csv", causes_csv(m))]
+    {
         mmtrack_io::atomic::write_file(&output.join(name), text.as_bytes(), Overwrite::Replace)?;
     }
     write_metrics(output, metrics)?;
-    Ok(["results.csv", "reproduce.md", METRICS_FILE].into_iter().map(|n| output.join(n)).collect())
+    Ok(["results.csv", "reproduce.md", "causes.csv", METRICS_FILE].into_iter().map(|n| output.join(n)).collect())
+}
+
+/// Births on true paths of ours against the scatter-free tunnel (the missed
+/// row), by cause and path kind; then the traffic cars' presence and their
+/// delay noise against the short-term tolerance (issue 25: the traced
+/// cause of the miss).
+fn causes_section(m: &Measured) -> String {
+    let Some((row, d)) =
+        m.rows.iter().zip(&m.diagnoses).find(|(r, _)| r.truth == Truth::NoDiffuse && r.variant == OURS)
+    else {
+        return String::new();
+    };
+    let kinds: Vec<(PathKind, &str)> =
+        PATH_KINDS.iter().copied().filter(|(k, _)| *k != PathKind::Los && *k != PathKind::Diffuse).collect();
+    let histograms: Vec<BTreeMap<Cause, u64>> =
+        kinds.iter().map(|(kind, _)| d.histogram(|p| PathKind::of(p) == Some(*kind))).collect();
+    let mut causes: Vec<Cause> = histograms.iter().flat_map(|h| h.keys().copied()).collect();
+    causes.sort();
+    causes.dedup();
+    let mut out = format!(
+        "Why the births on true paths happen ({}, {}; `causes.csv` lists each): what ended the previous \
+         long-term track on the path (`crates/mmtrack-reproduce/src/mpc_convoy/causes.rs`).\n\n| cause | {} |\n|---|{}\n",
+        row.variant,
+        row.truth.describe(),
+        kinds.iter().map(|k| k.1).collect::<Vec<_>>().join(" | "),
+        "---|".repeat(kinds.len())
+    );
+    for cause in causes {
+        let counts: Vec<String> = histograms.iter().map(|h| h.get(&cause).copied().unwrap_or(0).to_string()).collect();
+        let _ = writeln!(out, "| {} | {} |", cause.describe(), counts.join(" | "));
+    }
+    let totals: Vec<String> = histograms.iter().map(|h| h.values().sum::<u64>().to_string()).collect();
+    let _ = writeln!(out, "| all | {} |", totals.join(" | "));
+    let mut bridges: BTreeMap<Cause, u64> = BTreeMap::new();
+    for b in d.births.iter().filter(|b| PathKind::of(b.path_id) == Some(PathKind::Traffic)) {
+        if let Some(c) = b.bridge {
+            *bridges.entry(c).or_default() += 1;
+        }
+    }
+    let bridged: u64 = bridges.values().sum();
+    let _ = writeln!(
+        out,
+        "\nTraffic births after a gap of one set (which the one-set gap could have bridged): {bridged}; the bridge \
+         (`T_r` = 20 ms) failed at {}.\n",
+        if bridges.is_empty() {
+            "-".to_string()
+        } else {
+            bridges
+                .iter()
+                .map(|(c, n)| format!("{n} {}", c.describe().trim_start_matches("adjacent sets: ")))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    );
+    out.push_str(
+        "| traffic car | sets present in the truth | of them all 6 snapshots above floor + 6 dB | all 6 detected | \
+         followed (a full-lifetime track) | long-term tracks |\n|---|---|---|---|---|---|\n",
+    );
+    for p in d.paths.iter().filter(|p| PathKind::of(p.path_id) == Some(PathKind::Traffic)) {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} ({} present) | {} |",
+            p.path_id,
+            p.present_sets,
+            p.all_snapshots_above_sets,
+            p.all_detected_sets,
+            p.followed_sets,
+            p.followed_present_sets,
+            p.long_term_tracks
+        );
+    }
+    // Delay noise of the cars, per margin bin, summed over the cars.
+    let mut bins: BTreeMap<i64, NoiseRow> = BTreeMap::new();
+    for r in d.noise.iter().filter(|r| PathKind::of(r.path_id) == Some(PathKind::Traffic)) {
+        let slot = bins.entry((r.margin_from_db / MARGIN_BIN_DB).round() as i64).or_insert_with(|| NoiseRow {
+            path_id: 0,
+            sets: 0,
+            chain_passes: 0,
+            full_lifetime: 0,
+            delay_error_sq_sum_s2: 0.0,
+            detections: 0,
+            second_differences_over: 0,
+            second_differences: 0,
+            ..r.clone()
+        });
+        slot.sets += r.sets;
+        slot.chain_passes += r.chain_passes;
+        slot.full_lifetime += r.full_lifetime;
+        slot.delay_error_sq_sum_s2 += r.delay_error_sq_sum_s2;
+        slot.detections += r.detections;
+        slot.second_differences_over += r.second_differences_over;
+        slot.second_differences += r.second_differences;
+    }
+    out.push_str(
+        "\nThe traffic cars' sets with all 6 snapshots detected, by the car's mean power over the set above floor + \
+         6 dB: the delay error of the detections against the truth, the share of second differences `tau[m+1] - \
+         2 tau[m] + tau[m-1]` of the detections beyond `epsilon_tau` = 0.5 ns (the search of eqs. (17)-(23) around \
+         the linear prediction), the share of sets whose detections pass every search, and the share with a \
+         full-lifetime track on the car.\n\n| above floor + 6 dB | sets | rms delay error | second differences beyond \
+         0.5 ns | sets passing every search | sets with a full-lifetime track |\n|---|---|---|---|---|---|\n",
+    );
+    let pct = |a: u64, b: u64| if b == 0 { "-".to_string() } else { format!("{:.0} %", 100.0 * a as f64 / b as f64) };
+    for r in bins.values() {
+        let _ = writeln!(
+            out,
+            "| {:.0} .. {:.0} dB | {} | {} ns | {} | {} | {} |",
+            r.margin_from_db,
+            r.margin_from_db + MARGIN_BIN_DB,
+            r.sets,
+            opt(r.rms_delay_error_s().map(|x| x * 1e9), 3),
+            pct(r.second_differences_over, r.second_differences),
+            pct(r.chain_passes, r.sets),
+            pct(r.full_lifetime, r.sets)
+        );
+    }
+    out
+}
+
+/// `causes.csv`: every birth on a true path, per (truth, tracker).
+fn causes_csv(m: &Measured) -> String {
+    let mut out = String::from("truth,tracker,path_id,set_index,gap_sets,cause,bridge,margin_db,missed_snapshots\n");
+    for (row, d) in m.rows.iter().zip(&m.diagnoses) {
+        for b in &d.births {
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{},{:?},{},{},{}",
+                row.truth.key(),
+                row.variant,
+                b.path_id,
+                b.set_index,
+                b.gap_sets.map_or(String::new(), |g| g.to_string()),
+                b.cause,
+                b.bridge.map_or(String::new(), |c| format!("{c:?}")),
+                b.margin_db.map_or(String::new(), |x| format!("{x:.2}")),
+                b.missed_snapshots.iter().map(u32::to_string).collect::<Vec<_>>().join(" "),
+            );
+        }
+    }
+    out
 }

@@ -8,8 +8,12 @@ use mmtrack_core::progress::Progress;
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth, StampedPose};
 use mmtrack_io::table::MpcSummary;
 use mmtrack_mpc::short_term::is_full_lifetime;
-use mmtrack_mpc::{CandidateGate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, SounderPulse};
+use mmtrack_mpc::{
+    CandidateGate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, ShortTermConfig, SounderPulse,
+};
 use mmtrack_sim::sounder::{ConvoyConfig, ConvoySimulator, PathKind};
+
+use super::causes::{Diagnosis, Tables, diagnose};
 
 /// One long-term tracker of the comparison.
 #[derive(Debug, Clone, PartialEq)]
@@ -131,6 +135,9 @@ pub struct Measured {
     /// Every (truth, variant) pair, truth-major in [`Truth::ALL`] order,
     /// variants in [`variants`] order.
     pub rows: Vec<Row>,
+    /// Why the births on true paths happened, per (truth, variant) pair
+    /// of [`Measured::rows`] (same order).
+    pub diagnoses: Vec<Diagnosis>,
 }
 
 impl Measured {
@@ -150,6 +157,9 @@ struct Scene {
     tx: Vec<StampedPose>,
     rx: Vec<StampedPose>,
     long_term: Vec<Vec<MpcLongTermEntry>>,
+    carrier_hz: f64,
+    blocked_half_width_s: f64,
+    snapshots_per_set: u32,
 }
 
 /// Simulates `convoy` (seed `seed`), detects and short-term tracks with the
@@ -172,6 +182,9 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::
         tx: Vec::new(),
         rx: Vec::new(),
         long_term: vec![Vec::new(); variants.len()],
+        carrier_hz,
+        blocked_half_width_s: 0.5 * pipeline.detector().blocked_width_s(),
+        snapshots_per_set: convoy.snapshots_per_set,
     };
     let batch = MpcPipeline::SETS_PER_THREAD * rayon::current_num_threads();
     let mut sets = simulator.peekable();
@@ -193,6 +206,23 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::
         }
     }
     Ok(scene)
+}
+
+fn diagnosis(scene: &Scene, truth: &[MpcTruth], long_term: &[MpcLongTermEntry], config: &LongTermConfig) -> Diagnosis {
+    let mut sets = scene.sets.clone();
+    sets.sort_by_key(|s| s.set_index);
+    diagnose(&Tables {
+        truth,
+        detections: &scene.detections,
+        tracks: &scene.tracks,
+        long_term,
+        sets: &sets,
+        config,
+        short_term: &ShortTermConfig::default(),
+        carrier_hz: scene.carrier_hz,
+        blocked_half_width_s: scene.blocked_half_width_s,
+        snapshots_per_set: scene.snapshots_per_set,
+    })
 }
 
 fn score(scene: &Scene, truth: Vec<MpcTruth>, long_term: &[MpcLongTermEntry]) -> (MpcSummary, [u64; 5]) {
@@ -230,6 +260,7 @@ fn summarise(scene: &Scene, truth: Vec<MpcTruth>, long_term: &[MpcLongTermEntry]
 pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Progress) -> anyhow::Result<Measured> {
     let variants = variants();
     let mut rows = Vec::new();
+    let mut diagnoses = Vec::new();
     let mut with_diffuse = convoy.clone();
     with_diffuse.sets = sets;
     with_diffuse.diffuse.in_truth = true;
@@ -240,6 +271,7 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     for (truth, table) in [(Truth::SpecularOnly, specular), (Truth::WithDiffuse, scene.truth.clone())] {
         for (variant, entries) in variants.iter().zip(&scene.long_term) {
             let (summary, births_by_kind) = score(&scene, table.clone(), entries);
+            diagnoses.push(diagnosis(&scene, &table, entries, &variant.config));
             rows.push(Row { truth, variant: variant.name, summary, births_by_kind });
         }
     }
@@ -249,7 +281,8 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     let scene = run_scene(&no_diffuse, seed, &variants)?;
     for (variant, entries) in variants.iter().zip(&scene.long_term) {
         let (summary, births_by_kind) = score(&scene, scene.truth.clone(), entries);
+        diagnoses.push(diagnosis(&scene, &scene.truth, entries, &variant.config));
         rows.push(Row { truth: Truth::NoDiffuse, variant: variant.name, summary, births_by_kind });
     }
-    Ok(Measured { sets, seed, rows })
+    Ok(Measured { sets, seed, rows, diagnoses })
 }
