@@ -19,14 +19,14 @@
 //!   detection missing in some snapshot, or all six snapshots detected but
 //!   no full-lifetime track (short-term tracking, Sec. III-B). A missing
 //!   detection is classified by the snapshot's truth: `P` merged with another
-//!   true path within 0.5 ns (no resolvable MPC of its own), `P` below floor
-//!   + 6 dB in that snapshot, a stronger true path within the detector's
-//!   blocked half-width (the +-1.24 ns range, Sec. III-A step 4), an
-//!   unmatched detection 0.5-1.24 ns from it (a delay estimate off by more
+//!   true path within 0.5 ns (no resolvable MPC of its own), `P` below
+//!   floor + 6 dB in that snapshot, a stronger true path within the
+//!   detector's blocked half-width (the +-1.24 ns range, Sec. III-A step 4),
+//!   an unmatched detection 0.5-1.24 ns from it (a delay estimate off by more
 //!   than the match tolerance), or none of these (missed although above the
-//!   threshold and clear). The birth's
-//!   cause is that of the first gap set where `P` is in the truth (or
-//!   "absent from the truth" when it is in none).
+//!   threshold and clear). The birth's cause is that of the first gap set
+//!   where `P` is in the truth (or "absent from the truth" when it is in
+//!   none).
 //!
 //! For a gap the tracker may bridge ([`LongTermConfig::max_missed_sets`]),
 //! [`Birth::bridge`] names the step the bridge failed at. [`NoiseRow`]s
