@@ -485,3 +485,58 @@ fn correlation_at(band: &SounderBand, spectrum: &[Complex64], x_taps: f64) -> Co
     let phasors = Phasors::new(band.taps(), x_taps);
     spectrum.iter().enumerate().map(|(k, g)| g * phasors.at(band.signed_bin(k))).sum()
 }
+
+#[cfg(test)]
+mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    use super::*;
+
+    /// The per-tap lookup answers as the pass over every earlier detection
+    /// did, across the circular wrap and for blocked widths under one tap
+    /// (where two detections can share a nearest tap).
+    #[test]
+    fn detections_near_a_delay_are_those_a_full_pass_finds() {
+        let mut rng = Pcg64::seed_from_u64(29);
+        let (mut near, mut far) = (0, 0);
+        for &(taps, half_width_taps) in &[(64_usize, 1.235), (64, 0.3), (16, 2.6), (7, 5.0)] {
+            let mut delays = DetectedDelays::new(taps);
+            let mut all: Vec<f64> = Vec::new();
+            for _ in 0..40 {
+                // Delays as the search makes them: a tap plus up to one tap either way.
+                let x = rng.random_range(0..taps) as f64 + rng.random_range(-1.0..1.0);
+                let full_pass = all.iter().any(|&d| circular_distance(x, d, taps as f64) <= half_width_taps);
+                assert_eq!(delays.any_within(x, half_width_taps), full_pass, "taps {taps}, x {x}, detections {all:?}");
+                if full_pass {
+                    near += 1
+                } else {
+                    far += 1
+                }
+                delays.push(x);
+                all.push(x);
+            }
+        }
+        // Both answers were checked.
+        assert!(near > 10 && far > 10, "near {near}, far {far}");
+    }
+
+    /// The floor's windows average their even and odd taps as collected
+    /// vectors did, for even and odd window lengths and a short last window.
+    #[test]
+    fn quietest_windows_average_even_and_odd_taps() {
+        let mut rng = Pcg64::seed_from_u64(6);
+        let power: Vec<f64> = (0..101).map(|_| rng.random_range(0.0..1.0)).collect();
+        for window_taps in [2, 5, 32] {
+            let mean = |taps: &[f64], parity: usize| {
+                let values: Vec<f64> = taps.iter().skip(parity).step_by(2).copied().collect();
+                if values.is_empty() { 0.0 } else { values.iter().sum::<f64>() / values.len() as f64 }
+            };
+            let mut windows: Vec<(f64, f64)> = power.chunks(window_taps).map(|w| (mean(w, 0), mean(w, 1))).collect();
+            windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let keep = windows.len().div_ceil(4);
+            let expected = windows[..keep].iter().map(|w| w.1).sum::<f64>() / keep as f64;
+            assert_eq!(quietest_windows_power(&power, window_taps).to_bits(), expected.to_bits(), "{window_taps} taps");
+        }
+    }
+}
