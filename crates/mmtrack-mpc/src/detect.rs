@@ -238,22 +238,22 @@ impl Detector {
             .zip(&power)
             .map(|(h, p)| if zero && *p < threshold { Complex64::default() } else { *h })
             .collect();
-        self.fft.process(&mut spectrum);
+        // One scratch buffer for both transforms of the snapshot.
+        let scratch_len = self.fft.get_inplace_scratch_len().max(self.ifft.get_inplace_scratch_len());
+        let mut scratch = vec![Complex64::default(); scratch_len];
+        self.fft.process_with_scratch(&mut spectrum, &mut scratch);
         let u = self.band.taps() as f64;
         let mut channel_gain = 0.0;
-        // G = conj(P) z H / U: the correlation spectrum, c = IFFT(G) without further scaling.
-        let correlation_spectrum: Vec<Complex64> = spectrum
-            .iter()
-            .zip(&self.window)
-            .zip(&self.template)
-            .map(|((h, z), p)| {
-                let hw = h * z;
-                channel_gain += hw.norm_sqr();
-                p.conj() * hw / u
-            })
-            .collect();
+        // G = conj(P) z H / U: the correlation spectrum, c = IFFT(G) without
+        // further scaling, in place of H.
+        for ((h, z), p) in spectrum.iter_mut().zip(&self.window).zip(&self.template) {
+            let hw = *h * z;
+            channel_gain += hw.norm_sqr();
+            *h = p.conj() * hw / u;
+        }
         channel_gain /= u;
-        let detections = self.search_and_subtract(snapshot, correlation_spectrum, threshold);
+        self.ifft.process_with_scratch(&mut spectrum, &mut scratch);
+        let detections = self.search_and_subtract(snapshot, spectrum, threshold);
         let detected_gain: f64 = detections.iter().map(|d| d.amplitude.norm_sqr()).sum::<f64>() * self.pulse_energy;
         Ok(SnapshotDetections {
             detections,
@@ -318,22 +318,20 @@ impl Detector {
         }
     }
 
-    /// Steps 3-6 on the correlation spectrum `G = conj(P) H_w / U`.
+    /// Steps 3-6 on the correlation `c = IFFT(conj(P) H_w / U)`.
     fn search_and_subtract(
         &self,
         snapshot: &CirSnapshot,
-        mut correlation: Vec<Complex64>,
+        correlation: Vec<Complex64>,
         threshold: f64,
     ) -> Vec<MpcDetection> {
-        self.ifft.process(&mut correlation);
         let mut residual = Residual::new(correlation);
         let spacing_s = self.band.tap_spacing_s();
         let half_block_taps = self.blocked_half_width_s / spacing_s;
         let threshold_amplitude = threshold.sqrt();
-        let taps = self.band.taps() as f64;
         let mut detections = Vec::new();
         // Delays of the detections so far, taps: the centres of the blocked ranges.
-        let mut detected_taps: Vec<f64> = Vec::new();
+        let mut detected_taps = DetectedDelays::new(self.band.taps());
         let mut around = Neighbourhood::default();
         while detections.len() < self.config.max_mpcs {
             let Some(coarse) = residual.strongest() else { break };
@@ -348,7 +346,7 @@ impl Detector {
             // earlier detection's blocked range: that is the earlier path
             // found again (see the module docs), not a peak outside the
             // blocked ranges.
-            let found_again = detected_taps.iter().any(|&d| circular_distance(delay_taps, d, taps) <= half_block_taps);
+            let found_again = detected_taps.any_within(delay_taps, half_block_taps);
             // Eq. (9) on the correlation: c[n] -= alpha kappa(n - tau); a
             // re-detection is subtracted too, as residue of the earlier path.
             let reach = self.kernel_rows.reach_taps(amplitude.norm() / threshold_amplitude);
@@ -389,13 +387,62 @@ impl Detector {
 fn quietest_windows_power(power: &[f64], window_taps: usize) -> f64 {
     let window_taps = window_taps.max(2).min(power.len());
     let mean = |taps: &[f64], parity: usize| {
-        let values: Vec<f64> = taps.iter().skip(parity).step_by(2).copied().collect();
-        if values.is_empty() { 0.0 } else { values.iter().sum::<f64>() / values.len() as f64 }
+        let count = (taps.len() + 1 - parity.min(1)) / 2;
+        if count == 0 { 0.0 } else { taps.iter().skip(parity).step_by(2).sum::<f64>() / count as f64 }
     };
     let mut windows: Vec<(f64, f64)> = power.chunks(window_taps).map(|w| (mean(w, 0), mean(w, 1))).collect();
     windows.sort_by(|a, b| a.0.total_cmp(&b.0));
     let keep = windows.len().div_ceil(4);
     windows[..keep].iter().map(|w| w.1).sum::<f64>() / keep as f64
+}
+
+/// Delays of the detections of one snapshot, taps, listed by the tap nearest
+/// each, so that those near a delay are found without a pass over all.
+struct DetectedDelays {
+    delays_taps: Vec<f64>,
+    /// Per tap: 1 + the index of the last detection nearest it, 0 for none.
+    last: Vec<u32>,
+    /// Per detection: 1 + the index of the one before it at the same tap, 0 for none.
+    before: Vec<u32>,
+}
+
+impl DetectedDelays {
+    fn new(taps: usize) -> Self {
+        Self { delays_taps: Vec::new(), last: vec![0; taps], before: Vec::new() }
+    }
+
+    fn tap(&self, delay_taps: f64) -> usize {
+        (delay_taps.round() as i64).rem_euclid(self.last.len() as i64) as usize
+    }
+
+    fn push(&mut self, delay_taps: f64) {
+        let n = self.tap(delay_taps);
+        self.before.push(self.last[n]);
+        self.delays_taps.push(delay_taps);
+        self.last[n] = self.delays_taps.len() as u32;
+    }
+
+    /// Whether a detection lies within `half_width_taps` of `x_taps`
+    /// (circularly). Such a detection's nearest tap is within
+    /// `half_width_taps + 1/2` of `x_taps`; one more tap on each side is read
+    /// so that rounding cannot miss it.
+    fn any_within(&self, x_taps: f64, half_width_taps: f64) -> bool {
+        let taps = self.last.len() as i64;
+        let first = (x_taps - half_width_taps - 0.5).floor() as i64 - 1;
+        let last = (x_taps + half_width_taps + 0.5).ceil() as i64 + 1;
+        let count = (last - first + 1).min(taps);
+        (first..first + count).any(|n| {
+            let mut i = self.last[n.rem_euclid(taps) as usize];
+            while i != 0 {
+                let k = i as usize - 1;
+                if circular_distance(x_taps, self.delays_taps[k], taps as f64) <= half_width_taps {
+                    return true;
+                }
+                i = self.before[k];
+            }
+            false
+        })
+    }
 }
 
 /// Distance between delays `a` and `b` on the circular delay axis of `taps` taps.
@@ -437,4 +484,59 @@ impl Phasors {
 fn correlation_at(band: &SounderBand, spectrum: &[Complex64], x_taps: f64) -> Complex64 {
     let phasors = Phasors::new(band.taps(), x_taps);
     spectrum.iter().enumerate().map(|(k, g)| g * phasors.at(band.signed_bin(k))).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    use super::*;
+
+    /// The per-tap lookup answers as the pass over every earlier detection
+    /// did, across the circular wrap and for blocked widths under one tap
+    /// (where two detections can share a nearest tap).
+    #[test]
+    fn detections_near_a_delay_are_those_a_full_pass_finds() {
+        let mut rng = Pcg64::seed_from_u64(29);
+        let (mut near, mut far) = (0, 0);
+        for &(taps, half_width_taps) in &[(64_usize, 1.235), (64, 0.3), (16, 2.6), (7, 5.0)] {
+            let mut delays = DetectedDelays::new(taps);
+            let mut all: Vec<f64> = Vec::new();
+            for _ in 0..40 {
+                // Delays as the search makes them: a tap plus up to one tap either way.
+                let x = rng.random_range(0..taps) as f64 + rng.random_range(-1.0..1.0);
+                let full_pass = all.iter().any(|&d| circular_distance(x, d, taps as f64) <= half_width_taps);
+                assert_eq!(delays.any_within(x, half_width_taps), full_pass, "taps {taps}, x {x}, detections {all:?}");
+                if full_pass {
+                    near += 1
+                } else {
+                    far += 1
+                }
+                delays.push(x);
+                all.push(x);
+            }
+        }
+        // Both answers were checked.
+        assert!(near > 10 && far > 10, "near {near}, far {far}");
+    }
+
+    /// The floor's windows average their even and odd taps as collected
+    /// vectors did, for even and odd window lengths and a short last window.
+    #[test]
+    fn quietest_windows_average_even_and_odd_taps() {
+        let mut rng = Pcg64::seed_from_u64(6);
+        let power: Vec<f64> = (0..101).map(|_| rng.random_range(0.0..1.0)).collect();
+        for window_taps in [2, 5, 32] {
+            let mean = |taps: &[f64], parity: usize| {
+                let values: Vec<f64> = taps.iter().skip(parity).step_by(2).copied().collect();
+                if values.is_empty() { 0.0 } else { values.iter().sum::<f64>() / values.len() as f64 }
+            };
+            let mut windows: Vec<(f64, f64)> = power.chunks(window_taps).map(|w| (mean(w, 0), mean(w, 1))).collect();
+            windows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let keep = windows.len().div_ceil(4);
+            let expected = windows[..keep].iter().map(|w| w.1).sum::<f64>() / keep as f64;
+            assert_eq!(quietest_windows_power(&power, window_taps).to_bits(), expected.to_bits(), "{window_taps} taps");
+        }
+    }
 }

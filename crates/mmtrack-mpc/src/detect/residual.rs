@@ -75,14 +75,16 @@ impl Residual {
             let b = b % blocks;
             let start = b * BLOCK_TAPS;
             let end = (start + BLOCK_TAPS).min(self.correlation.len());
-            let mut best: Option<(f64, usize)> = None;
-            for n in start..end {
-                let p = self.correlation[n].norm_sqr();
-                if !self.blocked[n] && best.is_none_or(|(q, _)| p > q) {
-                    best = Some((p, n));
+            // The first unblocked tap of the largest `|c|^2` (never negative:
+            // a blocked tap's -1 is never chosen).
+            let (mut best_power, mut best_tap) = (-1.0, start);
+            for (n, (c, blocked)) in self.correlation[start..end].iter().zip(&self.blocked[start..end]).enumerate() {
+                let p = if *blocked { -1.0 } else { c.norm_sqr() };
+                if p > best_power {
+                    (best_power, best_tap) = (p, start + n);
                 }
             }
-            self.best[b] = best;
+            self.best[b] = (best_power >= 0.0).then_some((best_power, best_tap));
         }
     }
 }

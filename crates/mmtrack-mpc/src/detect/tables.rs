@@ -298,8 +298,9 @@ impl PeakInterpolator {
     /// successive quadratic fits of `c` through three nodes: 1/16 tap apart,
     /// then neighbouring nodes (1/256 tap) around the best, moved until the
     /// maximum lies within half a node of the middle one. About six
-    /// evaluations of `c` per peak.
+    /// evaluations of `c` per peak, each node once.
     fn search(&self, local: &Neighbourhood) -> Peak {
+        let mut evaluated = Evaluated::default();
         let reach = self.reach;
         let (left, middle, right) = (local.centre(reach, -1), local.centre(reach, 0), local.centre(reach, 1));
         let curvature = left - 2.0 * middle + right;
@@ -309,7 +310,7 @@ impl PeakInterpolator {
         let mut q = ((start + 1.0) * PHASES as f64).round() as usize;
         for _ in 0..8 {
             q = q.clamp(coarse, last - coarse);
-            let (t, _) = self.fit(local, q, coarse);
+            let (t, _) = self.fit(local, &mut evaluated, q, coarse);
             q = (q as f64 + t * coarse as f64).round() as usize;
             if t.abs() < 1.0 {
                 break;
@@ -318,7 +319,7 @@ impl PeakInterpolator {
         let mut best = (q, 0.0, Complex64::default());
         for _ in 0..8 {
             let q_fit = q.clamp(1, last - 1);
-            let (t, value) = self.fit(local, q_fit, 1);
+            let (t, value) = self.fit(local, &mut evaluated, q_fit, 1);
             best = (q_fit, t, value);
             q = (q_fit as f64 + t).round() as usize;
             if t.abs() <= 0.5 || q == q_fit {
@@ -333,8 +334,12 @@ impl PeakInterpolator {
     /// `q + step` (`t` in steps) and returns the `t` in `[-1, 1]` where
     /// `|c(t)|^2` peaks (Newton steps; the larger end when the fit is not
     /// concave) and `c` there.
-    fn fit(&self, local: &Neighbourhood, q: usize, step: usize) -> (f64, Complex64) {
-        let (before, here, after) = (self.at(local, q - step), self.at(local, q), self.at(local, q + step));
+    fn fit(&self, local: &Neighbourhood, evaluated: &mut Evaluated, q: usize, step: usize) -> (f64, Complex64) {
+        let mut at_node = |node: usize| match evaluated.get(node) {
+            Some(value) => value,
+            None => evaluated.insert(node, self.at(local, node)),
+        };
+        let (before, here, after) = (at_node(q - step), at_node(q), at_node(q + step));
         let b = (after - before) * 0.5;
         let a = (after + before) * 0.5 - here;
         let at = |t: f64| here + b * t + a * t * t;
@@ -351,6 +356,34 @@ impl PeakInterpolator {
             }
         }
         (t, at(t))
+    }
+}
+
+/// The nodes one peak search has evaluated and `c` there: successive fits
+/// share nodes, and each is evaluated once (at most 48 per search: 8 fits
+/// of three nodes in each of its two loops; kept on the stack).
+struct Evaluated {
+    count: usize,
+    nodes: [usize; 48],
+    values: [Complex64; 48],
+}
+
+impl Default for Evaluated {
+    fn default() -> Self {
+        Self { count: 0, nodes: [0; 48], values: [Complex64::default(); 48] }
+    }
+}
+
+impl Evaluated {
+    fn get(&self, node: usize) -> Option<Complex64> {
+        self.nodes[..self.count].iter().position(|&n| n == node).map(|i| self.values[i])
+    }
+
+    fn insert(&mut self, node: usize, value: Complex64) -> Complex64 {
+        self.nodes[self.count] = node;
+        self.values[self.count] = value;
+        self.count += 1;
+        value
     }
 }
 
