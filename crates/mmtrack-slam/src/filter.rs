@@ -3,6 +3,8 @@
 //! the UE (Sec. IV-D), the source updates and the map maintenance (Sec.
 //! III-D). See the crate docs for how this maps onto the paper.
 
+use std::sync::Arc;
+
 use faer::Mat;
 use mmtrack_core::random::standard_normal;
 use mmtrack_core::slam::{PathMeasurement, SlamEpoch, SourceType, UeState};
@@ -14,8 +16,9 @@ use crate::config::SlamConfig;
 use crate::error::SlamError;
 use crate::map::{Gauss3, Hypotheses, MapSource, SourceStatus, fuse};
 use crate::model::{FastPath, UE_MEAS_DIM, invert, jacobians};
-use crate::particles::{Moments, Particles, PreparedPath, STATE_DIM};
+use crate::particles::{Moments, NextStage, Particles, PreparedPath, STATE_DIM};
 use crate::small::{cholesky_lower, col, from3, mul, sandwich, spd_inverse, symmetrise, to3, to5};
+use crate::team::{Team, with_team};
 
 /// The UE estimate of an epoch: the posterior mean and spreads.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,6 +98,7 @@ pub struct SlamFilter {
     initialised: bool,
     prior_mean: UeState,
     sigma_var: [f64; 5],
+    parallel_phases: u64,
 }
 
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
@@ -146,16 +150,19 @@ impl SlamFilter {
         }
         let c = config.clone();
         let pos_std = c.prior_position_std_m / std::f64::consts::SQRT_2;
-        let particles = Particles::draw(c.particles, c.chunk_size, p.position_m[2], seed, 0x7072_696f, move |rng| {
-            let s = [
-                p.position_m[0] + pos_std * standard_normal(rng),
-                p.position_m[1] + pos_std * standard_normal(rng),
-                p.heading_rad + c.prior_heading_std_rad * standard_normal(rng),
-                p.speed_mps + c.prior_speed_std_mps * standard_normal(rng),
-                p.turn_rate_radps + c.prior_turn_rate_std_radps * standard_normal(rng),
-                p.clock_bias_m + c.prior_clock_bias_std_m * standard_normal(rng),
-            ];
-            (s, 0.0)
+        let chunks = c.particles.div_ceil(c.chunk_size);
+        let particles = with_team(chunks, |team| {
+            Particles::draw(team, c.particles, c.chunk_size, p.position_m[2], seed, 0x7072_696f, move |rng| {
+                let s = [
+                    p.position_m[0] + pos_std * standard_normal(rng),
+                    p.position_m[1] + pos_std * standard_normal(rng),
+                    p.heading_rad + c.prior_heading_std_rad * standard_normal(rng),
+                    p.speed_mps + c.prior_speed_std_mps * standard_normal(rng),
+                    p.turn_rate_radps + c.prior_turn_rate_std_radps * standard_normal(rng),
+                    p.clock_bias_m + c.prior_clock_bias_std_m * standard_normal(rng),
+                ];
+                (s, 0.0)
+            })
         });
         let bs = MapSource {
             id: 0,
@@ -180,6 +187,7 @@ impl SlamFilter {
             initialised: false,
             prior_mean,
             sigma_var,
+            parallel_phases: 0,
         })
     }
 
@@ -195,6 +203,14 @@ impl SlamFilter {
         &self.config
     }
 
+    /// Parallel phases run so far (phases of more than one task: each is a
+    /// synchronisation point of the threads when there are more than one;
+    /// the same count for any thread count).
+    #[must_use]
+    pub fn parallel_phases(&self) -> u64 {
+        self.parallel_phases
+    }
+
     /// Runs one epoch.
     ///
     /// Unusable paths (a NaN, an elevation outside `[-pi/2, pi/2]`) are
@@ -205,6 +221,16 @@ impl SlamFilter {
     /// [`SlamError::TimeNotIncreasing`], [`SlamError::BadPath`] (strict
     /// mode), [`SlamError::WeightsDegenerate`], [`SlamError::Association`].
     pub fn step(&mut self, epoch: &SlamEpoch) -> Result<EpochReport, SlamError> {
+        with_team(self.particles.chunk_count(), |team| {
+            let report = self.step_on(team, epoch);
+            self.parallel_phases += team.phases();
+            report
+        })
+    }
+
+    /// [`SlamFilter::step`] in one parallel region: `team` runs its
+    /// per-particle phases.
+    fn step_on(&mut self, team: &Team, epoch: &SlamEpoch) -> Result<EpochReport, SlamError> {
         let k = self.epoch;
         if let Some(prev) = self.last_t_ns
             && epoch.t_ns <= prev
@@ -228,6 +254,7 @@ impl SlamFilter {
             let dt_s = (epoch.t_ns - prev) as f64 * 1e-9;
             let c = &self.config;
             self.particles.predict(
+                team,
                 dt_s,
                 [c.speed_std_mps, c.turn_rate_std_radps, c.clock_bias_std_m],
                 self.seed,
@@ -237,7 +264,7 @@ impl SlamFilter {
         self.last_t_ns = Some(epoch.t_ns);
         self.epoch += 1;
 
-        let prior = self.particles.moments();
+        let prior = self.particles.moments(team);
         let assignment = self.associate(&paths, &prior, k)?;
         let mut associations = Vec::with_capacity(paths.len());
         let mut init_path = None;
@@ -245,7 +272,7 @@ impl SlamFilter {
             let los = assignment.iter().position(|a| a.0 == Some(0));
             match los {
                 Some(l) => {
-                    self.initialise_from_los(&paths[l]);
+                    self.initialise_from_los(team, &paths[l]);
                     self.initialised = true;
                     init_path = Some(l);
                 }
@@ -257,14 +284,15 @@ impl SlamFilter {
                             log_score: *score,
                         });
                     }
-                    return Ok(self.report(k, epoch.t_ns, skipped_paths, associations, 0, 0, Vec::new(), &prior));
+                    let ess = self.particles.ess_with(team, 0.0, &[]);
+                    return Ok(self.report(k, epoch.t_ns, skipped_paths, associations, 0, 0, Vec::new(), &prior, ess));
                 }
             }
         }
 
         // UE update with the paths of the BS and of confirmed sources.
         // The particles changed since `prior` only if the LOS initialised them.
-        let ue_now = if init_path.is_some() { self.particles.moments() } else { prior.clone() };
+        let ue_now = if init_path.is_some() { self.particles.moments(team) } else { prior.clone() };
         let ue_mean = ue_of(&ue_now.mean, self.particles.z_m);
         let mut prepared = Vec::new();
         for (l, (column, _)) in assignment.iter().enumerate() {
@@ -283,32 +311,56 @@ impl SlamFilter {
                 prepared.push(p);
             }
         }
-        let stages = self.update_particles(&prepared, k)?;
-        let post = self.particles.moments();
-        let weights = self.particles.weights();
+        let paths_in_update = prepared.len();
+        let stages = self.update_particles(team, prepared, k)?;
+        let post = self.particles.moments(team);
+        let weights = self.particles.weights(team);
 
         // Sources: confirmed ones by an iterated EKF, unconfirmed and new ones
         // by their two hypotheses.
+        // Each path touches one source (eq. (7d)), so what it does to it is
+        // found for all paths at once on the team, then applied in path order.
         let post_mean = ue_of(&post.mean, self.particles.z_m);
         let pre_cov = meas_cov(&ue_now.cov);
+        let asks: Vec<SourceAsk> = assignment
+            .iter()
+            .enumerate()
+            .map(|(l, (column, _))| match column {
+                _ if Some(l) == init_path => SourceAsk::Nothing,
+                Some(m) => match self.sources[*m].status {
+                    SourceStatus::BaseStation => SourceAsk::Nothing,
+                    SourceStatus::VirtualAnchor => SourceAsk::Ekf(self.sources[*m].belief, SourceType::VirtualAnchor),
+                    SourceStatus::ScatteringPoint => {
+                        SourceAsk::Ekf(self.sources[*m].belief, SourceType::ScatteringPoint)
+                    }
+                    SourceStatus::Unconfirmed => SourceAsk::Hypotheses,
+                },
+                None => SourceAsk::Hypotheses,
+            })
+            .collect();
+        let model = SourceModel { config: self.config.clone(), sigma_var: self.sigma_var };
+        let (states, z_m, paths_now) = (self.particles.states(), self.particles.z_m, paths.clone());
+        let updates = team.map(asks.len(), move |l| {
+            model.update(asks[l], &paths_now[l], (&ue_mean, &pre_cov), &post_mean, (&states, &weights, z_m))
+        });
         let mut confirmed = Vec::new();
-        for (l, (column, score)) in assignment.iter().enumerate() {
-            let z = &paths[l];
+        for (l, ((column, score), update)) in assignment.iter().zip(updates).enumerate() {
             let decision = if Some(l) == init_path {
                 self.sources[0].sightings += 1;
                 self.sources[0].last_seen_epoch = k;
                 Decision::Initialisation
             } else if let Some(m) = *column {
-                self.observe_source(m, z, (&ue_mean, &pre_cov), &post_mean, &weights, k, &mut confirmed);
+                self.observe_source(m, update, k, &mut confirmed);
                 Decision::Source(self.sources[m].id)
             } else {
-                let id = self.create_source(z, &post_mean, &weights, k);
+                let id = self.create_source(update, k);
                 Decision::NewSource(id)
             };
             associations.push(PathAssociation { path: path_index[l], decision, log_score: *score });
         }
         self.maintain(k);
-        Ok(self.report(k, epoch.t_ns, skipped_paths, associations, prepared.len(), stages, confirmed, &post))
+        let ess = self.particles.ess_with(team, 0.0, &[]);
+        Ok(self.report(k, epoch.t_ns, skipped_paths, associations, paths_in_update, stages, confirmed, &post, ess))
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -322,6 +374,7 @@ impl SlamFilter {
         stages: usize,
         confirmed: Vec<u64>,
         m: &Moments,
+        ess: f64,
     ) -> EpochReport {
         let estimate = UeEstimate {
             state: ue_of(&m.mean, self.particles.z_m),
@@ -339,7 +392,7 @@ impl SlamFilter {
             associations,
             paths_in_update,
             stages,
-            ess: self.particles.ess_with(0.0),
+            ess,
             confirmed,
         }
     }
@@ -431,7 +484,7 @@ impl SlamFilter {
     /// message (DOD azimuth and elevation give the position at the known
     /// height, the DOA azimuth the heading, the TOA the clock bias), each
     /// with its perturbed measurement, weighted by the prior.
-    fn initialise_from_los(&mut self, z: &PathMeasurement) {
+    fn initialise_from_los(&mut self, team: &Team, z: &PathMeasurement) {
         let c = self.config.clone();
         let p = self.prior_mean;
         let bs = c.bs_m;
@@ -444,8 +497,8 @@ impl SlamFilter {
             c.prior_clock_bias_std_m * c.prior_clock_bias_std_m,
         ];
         let seed = self.seed;
-        let prior_draw = self.particles.clone();
-        self.particles = Particles::draw(c.particles, c.chunk_size, z_m, seed, 0x696e_6974, move |rng| {
+        let prior_draw = self.particles.states();
+        self.particles = Particles::draw(team, c.particles, c.chunk_size, z_m, seed, 0x696e_6974, move |rng| {
             let a = c.angle_std_rad;
             for _ in 0..16 {
                 let dod_az = z.dod_az_rad + a * standard_normal(rng);
@@ -472,12 +525,10 @@ impl SlamFilter {
                 return ([x, y, heading, speed, turn, bias], logw);
             }
             // The LOS elevation gives no position (UE at the BS height): keep a prior draw.
-            let i = rng.random_range(0..prior_draw.n);
-            let chunk = &prior_draw.chunks[i / c.chunk_size];
-            let j = i % c.chunk_size;
-            ([chunk.x[j], chunk.y[j], chunk.heading[j], chunk.speed[j], chunk.turn[j], chunk.bias[j]], 0.0)
+            let i = rng.random_range(0..prior_draw.len());
+            (prior_draw[i], 0.0)
         });
-        self.particles.absorb(0.0);
+        self.particles.absorb(team, 0.0);
     }
 
     /// The path's likelihood as a message to the UE: the source belief
@@ -500,83 +551,85 @@ impl SlamFilter {
     /// remaining likelihood as keeps the effective sample size at
     /// `ess_fraction`, with a regularised resampling between stages
     /// (progressive correction). Returns the number of stages.
-    fn update_particles(&mut self, paths: &[PreparedPath], k: usize) -> Result<usize, SlamError> {
+    fn update_particles(&mut self, team: &Team, paths: Vec<PreparedPath>, k: usize) -> Result<usize, SlamError> {
         let n = self.particles.n as f64;
         let target = self.config.ess_fraction * n;
         let h = self.config.jitter_bandwidth;
+        let iterations = self.config.iterations;
         let mut remaining = 1.0;
         let mut stages = 0;
         if paths.is_empty() {
-            if self.particles.ess_with(0.0) < target {
-                self.regularised_resample(h, k, 0)?;
+            if self.particles.ess_with(team, 0.0, &[]) < target {
+                self.regularised_resample(team, h, k, 0, None)?;
             }
             return Ok(0);
         }
-        while remaining > 0.0 && stages < self.config.iterations {
-            self.particles.log_likelihood(paths);
+        let paths: Arc<[PreparedPath]> = paths.into();
+        // The exponents a stage tries first: all that remains, then the
+        // bisection's first midpoint. Their maxima come with the likelihood.
+        let first = |remaining: f64| vec![remaining, 0.5 * (0.0 + remaining)];
+        // The first stage's likelihood; the resampling's pass computes the others'.
+        self.particles.log_likelihood(team, &paths, &first(remaining));
+        while remaining > 0.0 && stages < iterations {
             stages += 1;
-            let delta = if stages == self.config.iterations || self.particles.ess_with(remaining) >= target {
+            let delta = if stages == iterations
+                || self.particles.ess_with(team, remaining, &[0.5 * (0.0 + remaining)]) >= target
+            {
                 remaining
             } else {
                 let (mut lo, mut hi) = (0.0, remaining);
                 for _ in 0..10 {
                     let mid = 0.5 * (lo + hi);
-                    if self.particles.ess_with(mid) >= target { lo = mid } else { hi = mid }
+                    // The next step tries one of these: their maxima come with this pass.
+                    let next = [0.5 * (mid + hi), 0.5 * (lo + mid)];
+                    if self.particles.ess_with(team, mid, &next) >= target { lo = mid } else { hi = mid }
                 }
                 lo.max(remaining * 1e-3)
             };
-            if self.particles.ess_with(delta) == 0.0 {
+            if self.particles.ess_with(team, delta, &[]) == 0.0 {
                 return Err(SlamError::WeightsDegenerate { epoch: k });
             }
-            self.particles.absorb(delta);
+            self.particles.absorb(team, delta);
             remaining -= delta;
             if remaining <= 1e-12 {
                 remaining = 0.0;
             }
-            if remaining > 0.0 || self.particles.ess_with(0.0) < target {
-                self.regularised_resample(h, k, stages)?;
+            if remaining > 0.0 || self.particles.ess_with(team, 0.0, &[]) < target {
+                let next = (remaining > 0.0 && stages < iterations)
+                    .then(|| NextStage { paths: paths.clone(), prefetch: first(remaining) });
+                self.regularised_resample(team, h, k, stages, next)?;
             }
         }
         Ok(stages)
     }
 
-    fn regularised_resample(&mut self, h: f64, k: usize, stage: usize) -> Result<(), SlamError> {
-        let m = self.particles.moments();
+    fn regularised_resample(
+        &mut self,
+        team: &Team,
+        h: f64,
+        k: usize,
+        stage: usize,
+        next: Option<NextStage>,
+    ) -> Result<(), SlamError> {
+        let m = self.particles.moments(team);
         let l = cholesky_lower(&m.cov, 1e-12)
             .ok_or(SlamError::NotPositiveDefinite { epoch: k, what: "particle covariance" })?;
-        self.particles.resample(Some(&l), h, self.seed, [k as u64, stage as u64]);
+        self.particles.resample(team, Some(&l), h, self.seed, [k as u64, stage as u64], next);
         Ok(())
     }
 
     /// A path from an existing source: the iterated EKF of a confirmed
     /// source (the message from the UE is its posterior, Gaussian), or the
-    /// hypotheses of an unconfirmed one and footnote 3's test.
-    #[allow(clippy::too_many_arguments)]
-    fn observe_source(
-        &mut self,
-        m: usize,
-        z: &PathMeasurement,
-        (ue_prior, p_prior): (&UeState, &Mat<f64>),
-        ue: &UeState,
-        weights: &[f64],
-        k: usize,
-        confirmed: &mut Vec<u64>,
-    ) {
-        let status = self.sources[m].status;
-        match status {
-            SourceStatus::BaseStation => {}
-            SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint => {
-                let kind = if status == SourceStatus::VirtualAnchor {
-                    SourceType::VirtualAnchor
-                } else {
-                    SourceType::ScatteringPoint
-                };
-                if let Some(g) = self.ekf_source(&self.sources[m].belief, kind, z, ue_prior, p_prior) {
+    /// hypotheses of an unconfirmed one and footnote 3's test; `update` is
+    /// what [`SourceModel::update`] found for the path.
+    fn observe_source(&mut self, m: usize, update: SourceUpdate, k: usize, confirmed: &mut Vec<u64>) {
+        match (self.sources[m].status, update) {
+            (SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint, SourceUpdate::Ekf(g)) => {
+                if let Some(g) = g {
                     self.sources[m].belief = g;
                 }
             }
-            SourceStatus::Unconfirmed => {
-                let (va, sp) = self.hypotheses_of(z, ue, weights);
+            (SourceStatus::Unconfirmed, SourceUpdate::Hypotheses(va, sp)) => {
                 let c = &self.config;
                 let (ratio, min_drift, min_sightings) = (c.confirm_ratio, c.confirm_min_drift, c.confirm_min_sightings);
                 let source = &mut self.sources[m];
@@ -603,10 +656,137 @@ impl SlamFilter {
                     }
                 }
             }
+            _ => {}
         }
         let source = &mut self.sources[m];
         source.sightings += 1;
         source.last_seen_epoch = k;
+    }
+
+    /// A new source from a path's hypotheses (`update`, from
+    /// [`SourceModel::update`]).
+    fn create_source(&mut self, update: SourceUpdate, k: usize) -> u64 {
+        let id = self.next_id;
+        self.next_id += 1;
+        let SourceUpdate::Hypotheses(Some(va), sp) = update else { return id };
+        let h = Hypotheses::new(va, sp);
+        self.sources.push(MapSource {
+            id,
+            status: SourceStatus::Unconfirmed,
+            belief: sp.unwrap_or(va),
+            first_seen_epoch: k,
+            last_seen_epoch: k,
+            sightings: 1,
+            confirmed_epoch: None,
+            hypotheses: Some(h),
+        });
+        id
+    }
+
+    /// Sec. III-D: merge confirmed sources of one type closer than
+    /// `merge_distance_m`, drop unconfirmed ones that duplicate a confirmed
+    /// source, forget unconfirmed ones not seen for a while.
+    fn maintain(&mut self, k: usize) {
+        let d_merge = self.config.merge_distance_m;
+        let dist =
+            |a: [f64; 3], b: [f64; 3]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        let mut i = 1;
+        while i < self.sources.len() {
+            let mut j = i + 1;
+            while j < self.sources.len() {
+                let (a, b) = (&self.sources[i], &self.sources[j]);
+                let confirmed_pair = a.status == b.status
+                    && matches!(a.status, SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint);
+                if confirmed_pair && dist(a.belief.mean_m, b.belief.mean_m) < d_merge {
+                    let merged = fuse(&a.belief, &b.belief);
+                    let (sightings, last) = (b.sightings, b.last_seen_epoch);
+                    let a = &mut self.sources[i];
+                    a.belief = merged;
+                    a.sightings += sightings;
+                    a.last_seen_epoch = a.last_seen_epoch.max(last);
+                    self.sources.remove(j);
+                } else {
+                    j += 1;
+                }
+            }
+            i += 1;
+        }
+        let confirmed: Vec<(SourceStatus, [f64; 3])> = self
+            .sources
+            .iter()
+            .filter(|s| matches!(s.status, SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint))
+            .map(|s| (s.status, s.belief.mean_m))
+            .collect();
+        let forget = self.config.forget_unconfirmed_after_epochs;
+        self.sources.retain(|s| {
+            if s.status != SourceStatus::Unconfirmed {
+                return true;
+            }
+            if s.last_seen_epoch + forget < k {
+                return false;
+            }
+            let Some(h) = &s.hypotheses else { return false };
+            let duplicate = s.sightings >= 2
+                && confirmed.iter().any(|(status, at)| match status {
+                    SourceStatus::VirtualAnchor => dist(h.va_last.mean_m, *at) < d_merge,
+                    _ => h.sp_last.is_some_and(|sp| dist(sp.mean_m, *at) < d_merge),
+                });
+            !duplicate
+        });
+    }
+}
+
+/// What a path asks of its source.
+#[derive(Debug, Clone, Copy)]
+enum SourceAsk {
+    /// Nothing (the BS, or the path that initialised the UE).
+    Nothing,
+    /// The iterated EKF of a confirmed source from its belief before the epoch.
+    Ekf(Gauss3, SourceType),
+    /// The VA and SP hypotheses of the path (an unconfirmed or new source).
+    Hypotheses,
+}
+
+/// What a path does to its source.
+#[derive(Debug, Clone, Copy)]
+enum SourceUpdate {
+    /// Nothing.
+    Nothing,
+    /// A confirmed source's belief after its EKF (`None`: it failed, the
+    /// belief stays).
+    Ekf(Option<Gauss3>),
+    /// The VA and SP hypotheses of the path.
+    Hypotheses(Option<Gauss3>, Option<Gauss3>),
+}
+
+/// The source updates' part of the filter: what they need of it, owned, so
+/// the paths' updates can run on the epoch's team.
+struct SourceModel {
+    config: SlamConfig,
+    sigma_var: [f64; 5],
+}
+
+impl SourceModel {
+    /// What `ask` finds for path `z`: the EKF with the predicted UE belief
+    /// (`ue_prior`, the covariance of `[x, y, heading, bias]`) as the
+    /// message, or the hypotheses under the posterior (`ue`, the particles
+    /// and their weights).
+    fn update(
+        &self,
+        ask: SourceAsk,
+        z: &PathMeasurement,
+        (ue_prior, p_prior): (&UeState, &Mat<f64>),
+        ue: &UeState,
+        particles: (&[[f64; STATE_DIM]], &[f64], f64),
+    ) -> SourceUpdate {
+        match ask {
+            SourceAsk::Nothing => SourceUpdate::Nothing,
+            SourceAsk::Ekf(belief, kind) => SourceUpdate::Ekf(self.ekf_source(&belief, kind, z, ue_prior, p_prior)),
+            SourceAsk::Hypotheses => {
+                let (va, sp) = self.hypotheses_of(z, ue, particles);
+                SourceUpdate::Hypotheses(va, sp)
+            }
+        }
     }
 
     /// Iterated EKF update of a source belief with one path, the UE
@@ -673,12 +853,16 @@ impl SlamFilter {
     /// IV-A): the inversion of [`invert`] per particle (a subsample of at
     /// most 256), weighted, plus the measurement noise mapped through the
     /// inversion at the mean.
-    fn hypotheses_of(&self, z: &PathMeasurement, ue: &UeState, weights: &[f64]) -> (Option<Gauss3>, Option<Gauss3>) {
+    fn hypotheses_of(
+        &self,
+        z: &PathMeasurement,
+        ue: &UeState,
+        (states, weights, z_m): (&[[f64; STATE_DIM]], &[f64], f64),
+    ) -> (Option<Gauss3>, Option<Gauss3>) {
         let bs = self.config.bs_m;
-        let stride = (self.particles.n / 256).max(1);
-        let z_m = self.particles.z_m;
+        let stride = (states.len() / 256).max(1);
         let mut acc = [Acc::default(), Acc::default()];
-        for (i, (s, w)) in self.particles.states().zip(weights).enumerate() {
+        for (i, (s, w)) in states.iter().zip(weights).enumerate() {
             if i % stride != 0 {
                 continue;
             }
@@ -726,77 +910,6 @@ impl SlamFilter {
             })
         };
         (finish(&acc[0], 0), finish(&acc[1], 1))
-    }
-
-    fn create_source(&mut self, z: &PathMeasurement, ue: &UeState, weights: &[f64], k: usize) -> u64 {
-        let id = self.next_id;
-        self.next_id += 1;
-        let (va, sp) = self.hypotheses_of(z, ue, weights);
-        let Some(va) = va else { return id };
-        let h = Hypotheses::new(va, sp);
-        self.sources.push(MapSource {
-            id,
-            status: SourceStatus::Unconfirmed,
-            belief: sp.unwrap_or(va),
-            first_seen_epoch: k,
-            last_seen_epoch: k,
-            sightings: 1,
-            confirmed_epoch: None,
-            hypotheses: Some(h),
-        });
-        id
-    }
-
-    /// Sec. III-D: merge confirmed sources of one type closer than
-    /// `merge_distance_m`, drop unconfirmed ones that duplicate a confirmed
-    /// source, forget unconfirmed ones not seen for a while.
-    fn maintain(&mut self, k: usize) {
-        let d_merge = self.config.merge_distance_m;
-        let dist =
-            |a: [f64; 3], b: [f64; 3]| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-        let mut i = 1;
-        while i < self.sources.len() {
-            let mut j = i + 1;
-            while j < self.sources.len() {
-                let (a, b) = (&self.sources[i], &self.sources[j]);
-                let confirmed_pair = a.status == b.status
-                    && matches!(a.status, SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint);
-                if confirmed_pair && dist(a.belief.mean_m, b.belief.mean_m) < d_merge {
-                    let merged = fuse(&a.belief, &b.belief);
-                    let (sightings, last) = (b.sightings, b.last_seen_epoch);
-                    let a = &mut self.sources[i];
-                    a.belief = merged;
-                    a.sightings += sightings;
-                    a.last_seen_epoch = a.last_seen_epoch.max(last);
-                    self.sources.remove(j);
-                } else {
-                    j += 1;
-                }
-            }
-            i += 1;
-        }
-        let confirmed: Vec<(SourceStatus, [f64; 3])> = self
-            .sources
-            .iter()
-            .filter(|s| matches!(s.status, SourceStatus::VirtualAnchor | SourceStatus::ScatteringPoint))
-            .map(|s| (s.status, s.belief.mean_m))
-            .collect();
-        let forget = self.config.forget_unconfirmed_after_epochs;
-        self.sources.retain(|s| {
-            if s.status != SourceStatus::Unconfirmed {
-                return true;
-            }
-            if s.last_seen_epoch + forget < k {
-                return false;
-            }
-            let Some(h) = &s.hypotheses else { return false };
-            let duplicate = s.sightings >= 2
-                && confirmed.iter().any(|(status, at)| match status {
-                    SourceStatus::VirtualAnchor => dist(h.va_last.mean_m, *at) < d_merge,
-                    _ => h.sp_last.is_some_and(|sp| dist(sp.mean_m, *at) < d_merge),
-                });
-            !duplicate
-        });
     }
 }
 

@@ -65,9 +65,15 @@
 //!   a tighter gate ([`SlamConfig::initialisation_gate`]); until then the
 //!   filter only predicts and maps nothing.
 //!
-//! Particles live in structure-of-arrays chunks of 256 processed in parallel
-//! on rayon; every random draw comes from a stream seeded by `(seed, epoch,
-//! stage, chunk)`, so a run is identical for any thread count.
+//! Particles live in structure-of-arrays chunks of 256. An epoch is one
+//! parallel region: a team of the calling thread and one helper per other
+//! thread of the rayon pool runs the per-particle phases (prediction,
+//! likelihood, weights, moments, resampling and jitter) and the paths'
+//! source updates, the calling thread alone the serial steps in between
+//! (`team`). Every random draw comes from a stream seeded by `(seed, epoch,
+//! stage, chunk)` and every sum that reaches the output is taken in
+//! particle order, so a run is identical for any thread count, and to a
+//! sequential run.
 
 pub mod association;
 mod config;
@@ -77,6 +83,7 @@ mod map;
 mod model;
 mod particles;
 mod small;
+mod team;
 
 pub use association::associate;
 pub use config::SlamConfig;

@@ -1,7 +1,32 @@
 //! UE particles in structure-of-arrays chunks of fixed size, processed in
-//! parallel on rayon. Each chunk draws from its own random stream, seeded
-//! from `(seed, epoch, stage, chunk index)`, so the particles do not depend
-//! on the number of threads.
+//! parallel by the epoch's [`Team`]. Each chunk draws from its own random
+//! stream, seeded from `(seed, epoch, stage, chunk index)`, so the particles
+//! do not depend on the number of threads.
+//!
+//! ## What runs in parallel, and why the results do not depend on it
+//!
+//! Every per-particle computation runs chunk by chunk on the team: the
+//! prediction, the likelihood, the exponentials of the weights and of the
+//! effective sample size, the sines and cosines of the headings, the
+//! resampling's jitter, the covariance of the moments (one task per row,
+//! each summing over the particles in order). Maxima are reduced per chunk,
+//! then across chunks. The sums that reach the output (the effective sample
+//! size, the normalised weights, the means) are taken by the leader,
+//! particle by particle in particle order, over the values the parallel
+//! phase stored: a floating-point sum depends on its order, and this is the
+//! order of a sequential loop, so every result is bit for bit that of a
+//! sequential run for any thread count. They are one add per particle and
+//! quantity; the exponentials and trigonometry they replace are tens of
+//! cycles.
+//!
+//! Values a later step needs again are kept until the particles change:
+//! the maximum of `logw + delta ll` and the effective sample size per
+//! exponent `delta` (the tempering search asks for the same exponent more
+//! than once), the exponentials of the last pass, and the normalised
+//! weights. A phase that knows which exponents come next takes their maxima
+//! in the same pass.
+
+use std::sync::{Arc, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
 use faer::Mat;
 use mmtrack_core::random::{keyed_stream, standard_normal, standard_normal_pair};
@@ -9,15 +34,16 @@ use mmtrack_core::slam::ctrv_displacement_m;
 use mmtrack_core::wrap_angle_rad;
 use rand::RngExt;
 use rand_pcg::Pcg64;
-use rayon::prelude::*;
 
 use crate::model::FastPath;
+use crate::team::Team;
 
 /// Dimensions of a particle's varying state: `[x, y, heading, speed, turn
 /// rate, clock bias]` (the height is fixed).
 pub(crate) const STATE_DIM: usize = 6;
 
-/// A fixed-size block of particles (structure of arrays).
+/// A fixed-size block of particles (structure of arrays), with the working
+/// space of the parallel phases.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Chunk {
     pub(crate) x: Vec<f64>,
@@ -30,12 +56,32 @@ pub(crate) struct Chunk {
     pub(crate) logw: Vec<f64>,
     /// Log-likelihood of the current stage.
     pub(crate) ll: Vec<f64>,
+    /// `exp(logw + delta ll - max)` of the last exponential pass.
+    exp: Vec<f64>,
+    /// Cosine and sine of the heading.
+    cos_heading: Vec<f64>,
+    sin_heading: Vec<f64>,
+    /// Normalised weight.
+    weight: Vec<f64>,
 }
 
 impl Chunk {
     fn with_len(n: usize) -> Self {
         let v = || vec![0.0; n];
-        Self { x: v(), y: v(), heading: v(), speed: v(), turn: v(), bias: v(), logw: v(), ll: v() }
+        Self {
+            x: v(),
+            y: v(),
+            heading: v(),
+            speed: v(),
+            turn: v(),
+            bias: v(),
+            logw: v(),
+            ll: v(),
+            exp: v(),
+            cos_heading: v(),
+            sin_heading: v(),
+            weight: v(),
+        }
     }
 
     fn len(&self) -> usize {
@@ -54,6 +100,47 @@ impl Chunk {
         self.turn[i] = s[4];
         self.bias[i] = s[5];
     }
+
+    /// `max_i (logw_i + delta ll_i)` for each `delta`.
+    fn max_at(&self, deltas: &[f64]) -> Vec<f64> {
+        deltas
+            .iter()
+            .map(|d| {
+                self.logw.iter().zip(&self.ll).map(|(w, l)| tempered(*w, *l, *d)).fold(f64::NEG_INFINITY, f64::max)
+            })
+            .collect()
+    }
+
+    /// Cosine and sine of every heading.
+    fn trigonometry(&mut self) {
+        for i in 0..self.len() {
+            self.cos_heading[i] = self.heading[i].cos();
+            self.sin_heading[i] = self.heading[i].sin();
+        }
+    }
+}
+
+/// `sum_l -r^T W_l r / 2` of one particle, `-inf` when a path cannot come
+/// from it.
+fn particle_log_likelihood(paths: &[PreparedPath], x: [f64; 3], heading_rad: f64, bias_m: f64) -> f64 {
+    let heading = heading_rad.sin_cos();
+    let mut ll = 0.0;
+    for p in paths {
+        let Some(r) = p.fast.residual(x, heading, bias_m) else {
+            return f64::NEG_INFINITY;
+        };
+        let w = &p.information;
+        let mut q = 0.0;
+        for a in 0..5 {
+            let mut row = w[a][a] * r[a];
+            for b in (a + 1)..5 {
+                row += 2.0 * w[a][b] * r[b];
+            }
+            q += r[a] * row;
+        }
+        ll -= 0.5 * q;
+    }
+    ll
 }
 
 /// One path prepared for the per-particle likelihood: the source, the
@@ -71,13 +158,92 @@ fn tempered(logw: f64, ll: f64, delta: f64) -> f64 {
     if delta == 0.0 { logw } else { logw + delta * ll }
 }
 
+/// Element-wise maximum of per-chunk maxima, in chunk order.
+fn max_over(per_chunk: &[Vec<f64>], k: usize) -> Vec<f64> {
+    (0..k).map(|j| per_chunk.iter().map(|m| m[j]).fold(f64::NEG_INFINITY, f64::max)).collect()
+}
+
+fn read(chunk: &RwLock<Chunk>) -> RwLockReadGuard<'_, Chunk> {
+    chunk.read().unwrap_or_else(PoisonError::into_inner)
+}
+
+fn write(chunk: &RwLock<Chunk>) -> RwLockWriteGuard<'_, Chunk> {
+    chunk.write().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// The chunks of one generation, shared with the team's tasks.
+type Generation = Arc<Vec<RwLock<Chunk>>>;
+
+fn generation(chunks: Vec<Chunk>) -> Generation {
+    Arc::new(chunks.into_iter().map(RwLock::new).collect())
+}
+
+fn deep_copy(g: &Generation) -> Generation {
+    generation(g.iter().map(|c| read(c).clone()).collect())
+}
+
+/// What is known about the current particles (cleared when they change).
+#[derive(Debug, Clone, Default)]
+struct Known {
+    /// `max (logw + delta ll)` per `delta` (bits).
+    max: Vec<(u64, f64)>,
+    /// Effective sample size per `delta` (bits).
+    ess: Vec<(u64, f64)>,
+    /// The chunks' `exp` holds `exp(logw + delta ll - max)` for this `delta` (bits).
+    exp_at: Option<u64>,
+    /// The chunks' `cos_heading` and `sin_heading` are current.
+    trigonometry: bool,
+    /// The chunks' `weight` holds the normalised weights.
+    weights: bool,
+}
+
+impl Known {
+    fn max(&self, delta: f64) -> Option<f64> {
+        self.max.iter().find(|(d, _)| *d == delta.to_bits()).map(|(_, m)| *m)
+    }
+
+    fn ess(&self, delta: f64) -> Option<f64> {
+        self.ess.iter().find(|(d, _)| *d == delta.to_bits()).map(|(_, e)| *e)
+    }
+
+    fn set_max(&mut self, deltas: &[f64], max: &[f64]) {
+        for (d, m) in deltas.iter().zip(max) {
+            if self.max(*d).is_none() {
+                self.max.push((d.to_bits(), *m));
+            }
+        }
+    }
+
+    /// The weights or the likelihoods changed (the states did not).
+    fn weights_changed(&mut self) {
+        let trigonometry = self.trigonometry;
+        *self = Self { trigonometry, ..Self::default() };
+    }
+}
+
 /// The particle set.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub(crate) struct Particles {
-    pub(crate) chunks: Vec<Chunk>,
+    chunks: Generation,
+    /// The next generation, written by the resampling.
+    spare: Generation,
     pub(crate) z_m: f64,
     pub(crate) n: usize,
     chunk_size: usize,
+    known: Known,
+}
+
+impl Clone for Particles {
+    fn clone(&self) -> Self {
+        Self {
+            chunks: deep_copy(&self.chunks),
+            spare: deep_copy(&self.spare),
+            z_m: self.z_m,
+            n: self.n,
+            chunk_size: self.chunk_size,
+            known: self.known.clone(),
+        }
+    }
 }
 
 /// The key of the filter's streams (`"slam_mmt"`): every draw comes from
@@ -93,33 +259,59 @@ pub(crate) struct Moments {
     pub(crate) cov: Mat<f64>,
 }
 
+/// The next stage's likelihood, computed in the resampling's pass: the
+/// paths and the exponents whose maxima the tempering search asks first.
+pub(crate) struct NextStage {
+    pub(crate) paths: Arc<[PreparedPath]>,
+    pub(crate) prefetch: Vec<f64>,
+}
+
 impl Particles {
     /// `n` particles drawn by `draw(rng) -> (state, logw)`, chunk by chunk.
     pub(crate) fn draw(
+        team: &Team,
         n: usize,
         chunk_size: usize,
         z_m: f64,
         seed: u64,
         tag: u64,
-        draw: impl Fn(&mut Pcg64) -> ([f64; STATE_DIM], f64) + Sync,
+        draw: impl Fn(&mut Pcg64) -> ([f64; STATE_DIM], f64) + Send + Sync + 'static,
     ) -> Self {
-        let mut chunks: Vec<Chunk> =
-            (0..n.div_ceil(chunk_size)).map(|c| Chunk::with_len(chunk_size.min(n - c * chunk_size))).collect();
-        chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
+        let chunks = team.map(n.div_ceil(chunk_size), move |c| {
+            let mut chunk = Chunk::with_len(chunk_size.min(n - c * chunk_size));
             let mut rng = keyed_stream(STREAM_KEY, seed, &[tag, c as u64]);
             for i in 0..chunk.len() {
                 let (s, logw) = draw(&mut rng);
                 chunk.set(i, s);
                 chunk.logw[i] = logw;
             }
+            chunk
         });
-        Self { chunks, z_m, n, chunk_size }
+        let spare = generation(chunks.clone());
+        Self { chunks: generation(chunks), spare, z_m, n, chunk_size, known: Known::default() }
+    }
+
+    /// Number of chunks.
+    pub(crate) fn chunk_count(&self) -> usize {
+        self.chunks.len()
+    }
+
+    /// The states, flat, in particle order.
+    pub(crate) fn states(&self) -> Vec<[f64; STATE_DIM]> {
+        let mut out = Vec::with_capacity(self.n);
+        for c in self.chunks.iter() {
+            let c = read(c);
+            out.extend((0..c.len()).map(|i| c.get(i)));
+        }
+        out
     }
 
     /// The constant turn-rate velocity prediction of eq. (1) with process
     /// noise on speed, turn rate and clock bias.
-    pub(crate) fn predict(&mut self, dt_s: f64, noise: [f64; 3], seed: u64, epoch: u64) {
-        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
+    pub(crate) fn predict(&mut self, team: &Team, dt_s: f64, noise: [f64; 3], seed: u64, epoch: u64) {
+        let chunks = self.chunks.clone();
+        team.map(chunks.len(), move |c| {
+            let mut chunk = write(&chunks[c]);
             let mut rng = keyed_stream(STREAM_KEY, seed, &[epoch, 0x7072_6564, c as u64]);
             for i in 0..chunk.len() {
                 let (dx, dy) = ctrv_displacement_m(chunk.heading[i], chunk.speed[i], chunk.turn[i], dt_s);
@@ -132,157 +324,274 @@ impl Particles {
                 chunk.bias[i] += noise[2] * standard_normal(&mut rng);
             }
         });
+        self.known = Known::default();
     }
 
     /// Stores in `ll` the log-likelihood `sum_l -r^T W_l r / 2` of every
-    /// particle (`-inf` for a degenerate geometry).
-    pub(crate) fn log_likelihood(&mut self, paths: &[PreparedPath]) {
-        let z_m = self.z_m;
-        self.chunks.par_iter_mut().for_each(|chunk| {
+    /// particle (`-inf` for a degenerate geometry), and takes the maxima of
+    /// `logw + delta ll` at the exponents `prefetch`.
+    pub(crate) fn log_likelihood(&mut self, team: &Team, paths: &Arc<[PreparedPath]>, prefetch: &[f64]) {
+        let (chunks, paths, z_m) = (self.chunks.clone(), paths.clone(), self.z_m);
+        let deltas = prefetch.to_vec();
+        let maxima = team.map(chunks.len(), move |c| {
+            let mut chunk = write(&chunks[c]);
             for i in 0..chunk.len() {
-                let x = [chunk.x[i], chunk.y[i], z_m];
-                let heading = chunk.heading[i].sin_cos();
-                let bias = chunk.bias[i];
-                let mut ll = 0.0;
-                for p in paths {
-                    let Some(r) = p.fast.residual(x, heading, bias) else {
-                        ll = f64::NEG_INFINITY;
-                        break;
-                    };
-                    let w = &p.information;
-                    let mut q = 0.0;
-                    for a in 0..5 {
-                        let mut row = w[a][a] * r[a];
-                        for b in (a + 1)..5 {
-                            row += 2.0 * w[a][b] * r[b];
-                        }
-                        q += r[a] * row;
-                    }
-                    ll -= 0.5 * q;
-                }
-                chunk.ll[i] = ll;
+                chunk.ll[i] =
+                    particle_log_likelihood(&paths, [chunk.x[i], chunk.y[i], z_m], chunk.heading[i], chunk.bias[i]);
             }
+            chunk.max_at(&deltas)
         });
+        self.known.weights_changed();
+        self.known.set_max(prefetch, &max_over(&maxima, prefetch.len()));
     }
 
-    /// Effective sample size of `logw + delta * ll`.
-    pub(crate) fn ess_with(&self, delta: f64) -> f64 {
-        let max = self.fold_max(delta);
+    /// The maximum of `logw + delta ll`.
+    fn max_at(&mut self, team: &Team, delta: f64) -> f64 {
+        if let Some(m) = self.known.max(delta) {
+            return m;
+        }
+        let chunks = self.chunks.clone();
+        let maxima = team.map(chunks.len(), move |c| read(&chunks[c]).max_at(&[delta]));
+        let m = max_over(&maxima, 1)[0];
+        self.known.set_max(&[delta], &[m]);
+        m
+    }
+
+    /// Effective sample size `(sum e)^2 / sum e^2` of `e = exp(logw + delta
+    /// ll - max)`, `max` the maximum of the exponent (0 when it is not
+    /// finite), summed in particle order; the same pass takes the maxima at
+    /// the exponents `prefetch`.
+    pub(crate) fn ess_with(&mut self, team: &Team, delta: f64, prefetch: &[f64]) -> f64 {
+        if let Some(ess) = self.known.ess(delta) {
+            return ess;
+        }
+        let max = self.max_at(team, delta);
         if !max.is_finite() {
+            self.known.ess.push((delta.to_bits(), 0.0));
             return 0.0;
         }
-        let (s, s2) = self
-            .chunks
-            .iter()
-            .flat_map(|c| c.logw.iter().zip(&c.ll))
-            .map(|(w, l)| {
-                let e = (tempered(*w, *l, delta) - max).exp();
-                (e, e * e)
-            })
-            .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
-        if s2 > 0.0 { s * s / s2 } else { 0.0 }
+        self.exponentials(team, delta, max, prefetch);
+        let (mut s, mut s2) = (0.0, 0.0);
+        for c in self.chunks.iter() {
+            for e in &read(c).exp {
+                s += e;
+                s2 += e * e;
+            }
+        }
+        let ess = if s2 > 0.0 { s * s / s2 } else { 0.0 };
+        self.known.ess.push((delta.to_bits(), ess));
+        ess
     }
 
-    fn fold_max(&self, delta: f64) -> f64 {
-        self.chunks
-            .iter()
-            .flat_map(|c| c.logw.iter().zip(&c.ll))
-            .map(|(w, l)| tempered(*w, *l, delta))
-            .fold(f64::NEG_INFINITY, f64::max)
+    /// `exp(logw + delta ll - max)` of every particle into the chunks'
+    /// `exp` (unless already there), and the maxima at `prefetch`.
+    fn exponentials(&mut self, team: &Team, delta: f64, max: f64, prefetch: &[f64]) {
+        let prefetch: Vec<f64> = prefetch.iter().copied().filter(|d| self.known.max(*d).is_none()).collect();
+        if self.known.exp_at == Some(delta.to_bits()) && prefetch.is_empty() {
+            return;
+        }
+        let (chunks, deltas) = (self.chunks.clone(), prefetch.clone());
+        let maxima = team.map(chunks.len(), move |c| {
+            let mut chunk = write(&chunks[c]);
+            let chunk = &mut *chunk;
+            for ((e, w), l) in chunk.exp.iter_mut().zip(&chunk.logw).zip(&chunk.ll) {
+                *e = (tempered(*w, *l, delta) - max).exp();
+            }
+            chunk.max_at(&deltas)
+        });
+        self.known.exp_at = Some(delta.to_bits());
+        self.known.set_max(&prefetch, &max_over(&maxima, prefetch.len()));
     }
 
     /// `logw += delta * ll`, then normalised so the largest is 0.
-    pub(crate) fn absorb(&mut self, delta: f64) {
-        for c in &mut self.chunks {
-            for (w, l) in c.logw.iter_mut().zip(&c.ll) {
+    pub(crate) fn absorb(&mut self, team: &Team, delta: f64) {
+        let chunks = self.chunks.clone();
+        let maxima = team.map(chunks.len(), move |c| {
+            let mut chunk = write(&chunks[c]);
+            let chunk = &mut *chunk;
+            for (w, l) in chunk.logw.iter_mut().zip(&chunk.ll) {
                 *w = tempered(*w, *l, delta);
             }
-        }
-        let max = self.fold_max(0.0);
-        for c in &mut self.chunks {
-            for w in &mut c.logw {
+            chunk.max_at(&[0.0])
+        });
+        let max = max_over(&maxima, 1)[0];
+        // The largest is now 0 (or all are -inf): the weights' exponentials
+        // `exp(logw - 0)` and the headings' trigonometry come in the same pass.
+        let (chunks, trigonometry) = (self.chunks.clone(), !self.known.trigonometry);
+        let maxima = team.map(chunks.len(), move |c| {
+            let mut chunk = write(&chunks[c]);
+            let chunk = &mut *chunk;
+            for (w, e) in chunk.logw.iter_mut().zip(chunk.exp.iter_mut()) {
                 *w -= max;
+                *e = (*w - 0.0).exp();
+            }
+            if trigonometry {
+                chunk.trigonometry();
+            }
+            chunk.max_at(&[0.0])
+        });
+        let new_max = max_over(&maxima, 1)[0];
+        self.known.weights_changed();
+        self.known.trigonometry = true;
+        self.known.set_max(&[0.0], &[new_max]);
+        // `exp(logw - new_max)` equals `exp(logw - 0)` when `new_max` is
+        // +0 or -0 (the difference is `logw` or a zero of either sign).
+        if new_max == 0.0 {
+            self.known.exp_at = Some(0f64.to_bits());
+        }
+    }
+
+    /// The normalised weights into the chunks' `weight` (the
+    /// exponentials at `delta = 0` over their sum in particle order, as
+    /// is when that sum is 0 or not finite), and the headings' cosine and
+    /// sine; returns the normalised weights' `(sum w cos, sum w sin)` in
+    /// particle order.
+    fn normalise(&mut self, team: &Team) -> (f64, f64) {
+        let max = self.max_at(team, 0.0);
+        let trigonometry = !self.known.trigonometry;
+        if self.known.exp_at != Some(0f64.to_bits()) || trigonometry {
+            let chunks = self.chunks.clone();
+            team.map(chunks.len(), move |c| {
+                let mut chunk = write(&chunks[c]);
+                let chunk = &mut *chunk;
+                for (e, w) in chunk.exp.iter_mut().zip(&chunk.logw) {
+                    *e = (w - max).exp();
+                }
+                if trigonometry {
+                    chunk.trigonometry();
+                }
+            });
+            self.known.exp_at = Some(0f64.to_bits());
+            self.known.trigonometry = true;
+        }
+        let s: f64 = {
+            let guards: Vec<_> = self.chunks.iter().map(|c| read(c)).collect();
+            guards.iter().flat_map(|c| c.exp.iter()).sum()
+        };
+        let scale = s > 0.0 && s.is_finite();
+        let (mut sx, mut sy) = (0.0, 0.0);
+        for c in self.chunks.iter() {
+            let mut c = write(c);
+            let c = &mut *c;
+            for i in 0..c.exp.len() {
+                let w = if scale { c.exp[i] / s } else { c.exp[i] };
+                c.weight[i] = w;
+                sx += w * c.cos_heading[i];
+                sy += w * c.sin_heading[i];
             }
         }
+        self.known.weights = true;
+        (sx, sy)
     }
 
     /// Normalised weights, flat, in particle order.
-    pub(crate) fn weights(&self) -> Vec<f64> {
-        let max = self.fold_max(0.0);
-        let mut w: Vec<f64> = self.chunks.iter().flat_map(|c| c.logw.iter()).map(|l| (l - max).exp()).collect();
-        let s: f64 = w.iter().sum();
-        if s > 0.0 && s.is_finite() {
-            for v in &mut w {
-                *v /= s;
-            }
+    pub(crate) fn weights(&mut self, team: &Team) -> Vec<f64> {
+        if !self.known.weights {
+            self.normalise(team);
         }
-        w
-    }
-
-    /// Iterates `(state, normalised weight)`.
-    pub(crate) fn states(&self) -> impl Iterator<Item = [f64; STATE_DIM]> + '_ {
-        self.chunks.iter().flat_map(|c| (0..c.len()).map(move |i| c.get(i)))
+        let mut out = Vec::with_capacity(self.n);
+        for c in self.chunks.iter() {
+            out.extend_from_slice(&read(c).weight);
+        }
+        out
     }
 
     /// Weighted mean and covariance.
-    pub(crate) fn moments(&self) -> Moments {
-        let w = self.weights();
-        let (mut sx, mut sy) = (0.0, 0.0);
-        for (s, wi) in self.states().zip(&w) {
-            sx += wi * s[2].cos();
-            sy += wi * s[2].sin();
-        }
+    pub(crate) fn moments(&mut self, team: &Team) -> Moments {
+        let (sx, sy) = self.normalise(team);
         let heading = sy.atan2(sx);
         let mut mean = [0.0; STATE_DIM];
-        for (s, wi) in self.states().zip(&w) {
-            for d in 0..STATE_DIM {
-                mean[d] += wi * if d == 2 { wrap_angle_rad(s[2] - heading) } else { s[d] };
-            }
-        }
-        mean[2] = wrap_angle_rad(mean[2] + heading);
-        let mut cov = Mat::zeros(STATE_DIM, STATE_DIM);
-        for (s, wi) in self.states().zip(&w) {
-            let d: [f64; STATE_DIM] =
-                std::array::from_fn(|k| if k == 2 { wrap_angle_rad(s[2] - mean[2]) } else { s[k] - mean[k] });
-            for a in 0..STATE_DIM {
-                for b in a..STATE_DIM {
-                    cov[(a, b)] += wi * d[a] * d[b];
+        for c in self.chunks.iter() {
+            let c = read(c);
+            for i in 0..c.len() {
+                let (s, wi) = (c.get(i), c.weight[i]);
+                for d in 0..STATE_DIM {
+                    mean[d] += wi * if d == 2 { wrap_angle_rad(s[2] - heading) } else { s[d] };
                 }
             }
         }
-        for a in 0..STATE_DIM {
-            for b in 0..a {
-                cov[(a, b)] = cov[(b, a)];
+        mean[2] = wrap_angle_rad(mean[2] + heading);
+        // One task per row of the covariance, each summing its entries over
+        // the particles in order.
+        let chunks = self.chunks.clone();
+        let rows = team.map(STATE_DIM, move |a| {
+            let mut acc = vec![0.0; STATE_DIM - a];
+            for c in chunks.iter() {
+                let c = read(c);
+                for i in 0..c.len() {
+                    let (s, wi) = (c.get(i), c.weight[i]);
+                    // The deviations this row needs (`b >= a`), as a plain
+                    // loop: an `array::from_fn` here was left un-inlined in
+                    // one build and took a fifth of the one-thread time.
+                    let mut d = [0.0; STATE_DIM];
+                    for k in a..STATE_DIM {
+                        d[k] = if k == 2 { wrap_angle_rad(s[2] - mean[2]) } else { s[k] - mean[k] };
+                    }
+                    for b in a..STATE_DIM {
+                        acc[b - a] += wi * d[a] * d[b];
+                    }
+                }
             }
-        }
+            acc
+        });
+        let cov = Mat::from_fn(STATE_DIM, STATE_DIM, |a, b| if a <= b { rows[a][b - a] } else { rows[b][a - b] });
         Moments { mean, cov }
     }
 
-    /// Systematic resampling (one uniform from `(seed, epoch, stage)`),
-    /// then a Gaussian kernel jitter `h L n` (regularised particle filter,
-    /// `L` the Cholesky factor of the weighted covariance), drawn per chunk.
-    pub(crate) fn resample(&mut self, jitter_chol: Option<&Mat<f64>>, h: f64, seed: u64, words: [u64; 2]) {
-        let w = self.weights();
-        let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x7265_7361]);
-        let u0: f64 = rng.random::<f64>() / self.n as f64;
-        let flat: Vec<[f64; STATE_DIM]> = self.states().collect();
-        let mut picked = Vec::with_capacity(self.n);
-        let mut cum = 0.0;
-        let mut j = 0;
-        for i in 0..self.n {
-            let u = u0 + i as f64 / self.n as f64;
-            while j + 1 < self.n && cum + w[j] < u {
-                cum += w[j];
-                j += 1;
-            }
-            picked.push(flat[j]);
+    /// Systematic resampling (one uniform from `(seed, epoch, stage)`) with
+    /// the last normalised weights, then a Gaussian kernel jitter `h L n`
+    /// (regularised particle filter, `L` the Cholesky factor of the
+    /// weighted covariance), drawn per chunk; with `next`, the new
+    /// particles' likelihoods in the same pass.
+    pub(crate) fn resample(
+        &mut self,
+        team: &Team,
+        jitter_chol: Option<&Mat<f64>>,
+        h: f64,
+        seed: u64,
+        words: [u64; 2],
+        next: Option<NextStage>,
+    ) {
+        if !self.known.weights {
+            self.normalise(team);
         }
-        let chunk_size = self.chunk_size;
-        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
+        let n = self.n;
+        let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x7265_7361]);
+        let u0: f64 = rng.random::<f64>() / n as f64;
+        let mut picked = Vec::with_capacity(n);
+        {
+            let guards: Vec<_> = self.chunks.iter().map(|c| read(c)).collect();
+            let mut w = guards.iter().flat_map(|c| c.weight.iter().copied());
+            let mut cum = 0.0;
+            let mut j = 0;
+            let mut wj = w.next().unwrap_or(0.0);
+            for i in 0..n {
+                let u = u0 + i as f64 / n as f64;
+                while j + 1 < n && cum + wj < u {
+                    cum += wj;
+                    j += 1;
+                    wj = w.next().unwrap_or(0.0);
+                }
+                picked.push(j);
+            }
+        }
+        let l: Option<[[f64; STATE_DIM]; STATE_DIM]> =
+            jitter_chol.map(|l| std::array::from_fn(|a| std::array::from_fn(|b| l[(a, b)])));
+        let (old, new, chunk_size, z_m) = (self.chunks.clone(), self.spare.clone(), self.chunk_size, self.z_m);
+        let (paths, deltas) = next.map_or((None, Vec::new()), |s| (Some(s.paths), s.prefetch));
+        let prefetch = deltas.clone();
+        let picked = Arc::new(picked);
+        let maxima = team.map(new.len(), move |c| {
+            let mut chunk = write(&new[c]);
             let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x6a69_7474, c as u64]);
+            let mut from: Option<(usize, RwLockReadGuard<'_, Chunk>)> = None;
             for i in 0..chunk.len() {
-                let mut s = picked[c * chunk_size + i];
-                if let Some(l) = jitter_chol {
+                let j = picked[c * chunk_size + i];
+                if from.as_ref().is_none_or(|(k, _)| *k != j / chunk_size) {
+                    from = Some((j / chunk_size, read(&old[j / chunk_size])));
+                }
+                let mut s = from.as_ref().map_or([0.0; STATE_DIM], |(_, g)| g.get(j % chunk_size));
+                if let Some(l) = &l {
                     let pairs = [
                         standard_normal_pair(&mut rng),
                         standard_normal_pair(&mut rng),
@@ -293,15 +602,24 @@ impl Particles {
                     for a in 0..STATE_DIM {
                         let mut v = 0.0;
                         for b in 0..=a {
-                            v += l[(a, b)] * n[b];
+                            v += l[a][b] * n[b];
                         }
                         s[a] += h * v;
                     }
                 }
                 chunk.set(i, s);
                 chunk.logw[i] = 0.0;
+                if let Some(paths) = &paths {
+                    chunk.ll[i] = particle_log_likelihood(paths, [s[0], s[1], z_m], chunk.heading[i], s[5]);
+                }
             }
+            if paths.is_some() { chunk.max_at(&deltas) } else { Vec::new() }
         });
+        std::mem::swap(&mut self.chunks, &mut self.spare);
+        self.known = Known::default();
+        if !prefetch.is_empty() {
+            self.known.set_max(&prefetch, &max_over(&maxima, prefetch.len()));
+        }
     }
 }
 
@@ -313,18 +631,20 @@ mod tests {
     fn three() -> Particles {
         let mut chunk = Chunk::with_len(3);
         chunk.ll = vec![f64::NEG_INFINITY, -1.0, -1.0];
-        Particles { chunks: vec![chunk], z_m: 0.0, n: 3, chunk_size: 3 }
+        let chunks = generation(vec![chunk]);
+        Particles { spare: deep_copy(&chunks), chunks, z_m: 0.0, n: 3, chunk_size: 3, known: Known::default() }
     }
 
     #[test]
     fn a_particle_with_minus_infinite_likelihood_keeps_the_untempered_ess() {
-        let particles = three();
+        let team = Team::solo();
+        let mut particles = three();
         // Untempered: three equal weights, ESS 3 (it was NaN: 0 * -inf).
-        assert_eq!(particles.ess_with(0.0), 3.0);
+        assert_eq!(particles.ess_with(&team, 0.0, &[]), 3.0);
         // Tempered: the -inf particle drops out, two equal weights remain.
-        assert_eq!(particles.ess_with(0.5), 2.0);
-        let mut absorbed = particles.clone();
-        absorbed.absorb(0.0);
-        assert_eq!(absorbed.chunks[0].logw, [0.0, 0.0, 0.0]);
+        assert_eq!(particles.ess_with(&team, 0.5, &[]), 2.0);
+        let mut absorbed = three();
+        absorbed.absorb(&team, 0.0);
+        assert_eq!(read(&absorbed.chunks[0]).logw, [0.0, 0.0, 0.0]);
     }
 }

@@ -31,10 +31,12 @@ fn same_seed_same_run_for_any_thread_count() {
         pool.install(|| {
             let mut filter = SlamFilter::new(config.clone(), r.truth[0].ue, 9).unwrap();
             let reports: Vec<_> = r.epochs.iter().map(|e| filter.step(e).unwrap()).collect();
-            (reports, filter.sources().to_vec())
+            (reports, filter.sources().to_vec(), filter.parallel_phases())
         })
     };
     let one = in_pool(1);
+    // Tens of parallel phases per epoch (the same count on any pool).
+    assert!(one.2 > 10 * r.epochs.len() as u64, "{} phases", one.2);
     assert_eq!(one, in_pool(2));
     assert_eq!(one, in_pool(3));
     // A different seed gives a different run.
