@@ -29,8 +29,8 @@
 //! threshold's amplitude (about 30 taps each side for a path 40 dB above the
 //! threshold with the Kaiser window; every tap without it). This replaces
 //! one inverse FFT and a dozen exact O(U) evaluations of `c(tau)` per found
-//! path, and is what makes 10 000 snapshots of 2048 taps take 1.5 s on two
-//! cores (`mmtrack bench mpc`). Precision: the refinement's truncated interpolation
+//! path, and is what makes 10 000 snapshots of 2048 taps take about 1.2 s on
+//! two cores (`mmtrack bench mpc`). Precision: the refinement's truncated interpolation
 //! biases a lone path's delay by up to 1.5e-4 taps; that bias depends only
 //! on the fractional delay, is measured on the kernel itself when the
 //! detector is built and removed, leaving 1e-7 taps (3e-5 without the
