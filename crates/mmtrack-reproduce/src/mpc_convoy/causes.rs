@@ -210,6 +210,22 @@ pub struct NoiseRow {
 }
 
 impl NoiseRow {
+    /// A row of `path_id` in the bin from `margin_from_db` with nothing counted yet.
+    #[must_use]
+    pub fn empty(path_id: u64, margin_from_db: f64) -> Self {
+        Self {
+            path_id,
+            margin_from_db,
+            sets: 0,
+            chain_passes: 0,
+            full_lifetime: 0,
+            delay_error_sq_sum_s2: 0.0,
+            detections: 0,
+            second_differences_over: 0,
+            second_differences: 0,
+        }
+    }
+
     /// Root mean square delay error, seconds.
     #[must_use]
     pub fn rms_delay_error_s(&self) -> Option<f64> {
@@ -233,17 +249,8 @@ fn delay_noise(sets: &[AllDetected], config: &ShortTermConfig) -> Vec<NoiseRow> 
     let mut rows: BTreeMap<(u64, i64), NoiseRow> = BTreeMap::new();
     for s in sets {
         let bin = (s.margin_db / MARGIN_BIN_DB).floor() as i64;
-        let row = rows.entry((s.path_id, bin)).or_insert_with(|| NoiseRow {
-            path_id: s.path_id,
-            margin_from_db: bin as f64 * MARGIN_BIN_DB,
-            sets: 0,
-            chain_passes: 0,
-            full_lifetime: 0,
-            delay_error_sq_sum_s2: 0.0,
-            detections: 0,
-            second_differences_over: 0,
-            second_differences: 0,
-        });
+        let row =
+            rows.entry((s.path_id, bin)).or_insert_with(|| NoiseRow::empty(s.path_id, bin as f64 * MARGIN_BIN_DB));
         row.sets += 1;
         row.full_lifetime += u64::from(s.full_lifetime);
         for &(d, t) in &s.delays_s {

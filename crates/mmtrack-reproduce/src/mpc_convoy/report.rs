@@ -362,17 +362,9 @@ fn causes_section(m: &Measured) -> String {
     // Delay noise of the cars, per margin bin, summed over the cars.
     let mut bins: BTreeMap<i64, NoiseRow> = BTreeMap::new();
     for r in d.noise.iter().filter(|r| PathKind::of(r.path_id) == Some(PathKind::Traffic)) {
-        let slot = bins.entry((r.margin_from_db / MARGIN_BIN_DB).round() as i64).or_insert_with(|| NoiseRow {
-            path_id: 0,
-            sets: 0,
-            chain_passes: 0,
-            full_lifetime: 0,
-            delay_error_sq_sum_s2: 0.0,
-            detections: 0,
-            second_differences_over: 0,
-            second_differences: 0,
-            ..r.clone()
-        });
+        let slot = bins
+            .entry((r.margin_from_db / MARGIN_BIN_DB).round() as i64)
+            .or_insert_with(|| NoiseRow::empty(0, r.margin_from_db));
         slot.sets += r.sets;
         slot.chain_passes += r.chain_passes;
         slot.full_lifetime += r.full_lifetime;
