@@ -129,11 +129,23 @@ pub enum Rule {
         /// The relation, in words ("nullspace <= error-free <= proposed < Ho-Chan").
         description: String,
     },
+    /// A numeric rule on the measured value that counts only when a further
+    /// condition holds, which the experiment checks itself and passes to
+    /// [`Verdict::judged_given`]; `condition` says which, and the summary
+    /// prints both ("within 42.67 +- 2.13 x, given the window holds the
+    /// strongest beam in >= 90 % of epochs").
+    Given {
+        /// The rule on the measured value.
+        rule: Box<Rule>,
+        /// The further condition, in words.
+        condition: String,
+    },
 }
 
 impl Rule {
     /// Whether `measured` satisfies a numeric rule (`None` for
-    /// [`Rule::Ordering`], which the experiment decides).
+    /// [`Rule::Ordering`], which the experiment decides, and for
+    /// [`Rule::Given`], whose condition only the experiment knows).
     #[must_use]
     pub fn holds(&self, measured: f64) -> Option<bool> {
         Some(match *self {
@@ -141,7 +153,7 @@ impl Rule {
             Self::AtMost { bound } => measured <= bound,
             Self::AtLeast { bound } => measured >= bound,
             Self::Within { target, tolerance } => (measured - target).abs() <= tolerance,
-            Self::Ordering { .. } => return None,
+            Self::Ordering { .. } | Self::Given { .. } => return None,
         })
     }
 }
@@ -160,6 +172,7 @@ impl Rule {
                 format!("within {} +- {}{unit}", short_number(*target), short_number(*tolerance))
             }
             Self::Ordering { description } => description.clone(),
+            Self::Given { rule, condition } => format!("{}, given {condition}", rule.describe(unit.trim_start())),
         }
     }
 }
@@ -238,6 +251,19 @@ impl Verdict {
     /// [`Verdict::decided`]).
     pub fn judged(claim: Claim, measured: Option<f64>, note: impl Into<String>) -> Self {
         let met = measured.and_then(|m| claim.rule.holds(m)).unwrap_or(false);
+        Self { claim, measured, met, note: note.into() }
+    }
+
+    /// Judges `measured` by a [`Rule::Given`] claim: met when the inner
+    /// numeric rule holds and the experiment's `condition_holds`.
+    ///
+    /// # Panics
+    /// When the claim's rule is not [`Rule::Given`] (a programming error).
+    pub fn judged_given(claim: Claim, measured: Option<f64>, condition_holds: bool, note: impl Into<String>) -> Self {
+        let Rule::Given { rule, .. } = &claim.rule else {
+            panic!("judged_given needs a Rule::Given claim, got {:?}", claim.rule)
+        };
+        let met = condition_holds && measured.and_then(|m| rule.holds(m)).unwrap_or(false);
         Self { claim, measured, met, note: note.into() }
     }
 
@@ -323,6 +349,16 @@ mod tests {
         let ordering = claim(Rule::Ordering { description: "a < b".into() });
         assert!(!Verdict::judged(ordering.clone(), Some(0.0), "").met, "orderings are decided, not judged");
         assert!(Verdict::decided(ordering, true, "").met);
+        let given = claim(Rule::Given {
+            rule: Box::new(Rule::Within { target: 10.0, tolerance: 1.5 }),
+            condition: "the link is kept".into(),
+        });
+        assert!(!Verdict::judged(given.clone(), Some(10.0), "").met, "the condition is the experiment's");
+        assert!(Verdict::judged_given(given.clone(), Some(10.0), true, "").met);
+        assert!(!Verdict::judged_given(given.clone(), Some(10.0), false, "").met, "condition fails");
+        assert!(!Verdict::judged_given(given.clone(), Some(12.0), true, "").met, "value outside");
+        assert!(!Verdict::judged_given(given.clone(), None, true, "").met, "nothing measured");
+        assert_eq!(given.rule.describe("x"), "within 10 +- 1.5 x, given the link is kept");
     }
 
     #[test]

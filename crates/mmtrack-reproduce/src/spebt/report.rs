@@ -79,6 +79,7 @@ fn target_text(claim: &Claim) -> String {
         Rule::AtLeast { bound } => format!(">= {bound}{unit}"),
         Rule::Within { target, tolerance } => format!("{target} +- {tolerance}{unit}"),
         Rule::Ordering { ref description } => description.clone(),
+        Rule::Given { .. } => claim.rule.describe(&claim.unit),
     }
 }
 

@@ -182,9 +182,15 @@ pub fn verdicts(experiment: &Config, results: &[ManoeuvreResult], runs: u64, ela
             "x",
             Some(experiment.paper_saving),
             format!("{:.1}x", experiment.paper_saving),
-            Rule::Within {
-                target: experiment.paper_saving,
-                tolerance: experiment.saving_tolerance * experiment.paper_saving,
+            Rule::Given {
+                rule: Box::new(Rule::Within {
+                    target: experiment.paper_saving,
+                    tolerance: experiment.saving_tolerance * experiment.paper_saving,
+                }),
+                condition: format!(
+                    "the window holds the strongest beam in >= {:.0} % of epochs",
+                    100.0 * experiment.saving_min_window_hit_share
+                ),
             },
         );
         let measured = format!(
@@ -198,9 +204,7 @@ pub fn verdicts(experiment: &Config, results: &[ManoeuvreResult], runs: u64, ela
         );
         // 128 / 3 holds by construction; the saving is worth it only with the link kept.
         let holds_beam = hit_share >= experiment.saving_min_window_hit_share;
-        let mut verdict = Verdict::judged(claim, windowed, measured);
-        verdict.met &= holds_beam;
-        out.push(verdict);
+        out.push(Verdict::judged_given(claim, windowed, holds_beam, measured));
     }
     if runs >= experiment.time_target_runs {
         let claim = Claim::new(
