@@ -169,8 +169,9 @@ fn pilot_sensitivity(e: &SpebtExperiment, claims_run: &ExperimentRun, variants: 
     let mut out = format!(
         "\n**Pilot power** (not in the paper; the claims above are at {} dBm): experiment (a) at other pilot powers, \
          same seed, pose errors and noise draws.\n\n| pilot dBm | runs | RMSE abs(alpha) (%) | RMSE AoD (deg) | RMSE \
-         AoA (deg) | AoD / AoA before re-initialisation (deg) | re-initialisations (share of tracked slots) | role \
-         |\n|---|---|---|---|---|---|---|---|\n",
+         AoA (deg) | AoD / AoA before re-initialisation (deg) | re-initialisations (share of tracked slots) | AoA \
+         updates that moved it away from the truth | RMS AoA step of an update (deg) | role \
+         |\n|---|---|---|---|---|---|---|---|---|---|\n",
         e.scenario.pilot_power_dbm
     );
     for (power, r, claims) in rows {
@@ -179,13 +180,15 @@ fn pilot_sensitivity(e: &SpebtExperiment, claims_run: &ExperimentRun, variants: 
         let share_pct = 100.0 * r.mean_reinitialisations() / r.tracked_slots().max(1) as f64;
         let _ = writeln!(
             out,
-            "| {power} | {} | {:.3} | {:.3} | {:.3} | {:.3} / {:.3} | {share_pct:.2} % | {} |",
+            "| {power} | {} | {:.3} | {:.3} | {:.3} | {:.3} / {:.3} | {share_pct:.2} % | {:.1} % | {:.3} | {} |",
             r.runs,
             100.0 * gain,
             aod.to_degrees(),
             aoa.to_degrees(),
             aod_before.to_degrees(),
             aoa_before.to_degrees(),
+            100.0 * r.aoa_updates.away_share(),
+            r.aoa_updates.rms_step_rad().to_degrees(),
             if claims { "the claims' run" } else { "variant, not a target" }
         );
     }

@@ -148,6 +148,8 @@ pub struct ExperimentResult {
     pub causes: [u64; 3],
     /// Run 0's estimates per slot and whether the slot re-initialised.
     pub run0: Vec<(SpebtState, bool)>,
+    /// What the updates did to the AoA estimate.
+    pub aoa_updates: UpdateSteps,
     /// CPU seconds in the tracker (summed over threads).
     pub tracker_cpu_s: f64,
 }
@@ -164,6 +166,7 @@ impl ExperimentResult {
             reinitialisations: Vec::new(),
             causes: [0; 3],
             run0: Vec::new(),
+            aoa_updates: UpdateSteps::default(),
             tracker_cpu_s: 0.0,
         }
     }
@@ -191,6 +194,7 @@ impl ExperimentResult {
         if self.run0.is_empty() {
             self.run0 = other.run0;
         }
+        self.aoa_updates.merge(&other.aoa_updates);
         self.tracker_cpu_s += other.tracker_cpu_s;
     }
 
@@ -223,6 +227,53 @@ impl ExperimentResult {
     #[must_use]
     pub fn mean_reinitialisations(&self) -> f64 {
         self.reinitialisations.iter().sum::<u64>() as f64 / self.reinitialisations.len().max(1) as f64
+    }
+}
+
+/// What the measurement updates did to one angle of the estimate, over
+/// every update of every run: how far they moved it and whether towards the
+/// truth. The pilot's power `h(s)` of eq. (20) through beams steered at the
+/// previous estimate falls off alike on both sides of the beam, so its
+/// gradient (26) takes its sign from where the *prediction* sits against
+/// the beam, not from where the truth does; a stronger pilot shrinks the
+/// noise variance (21) relative to `h` and makes the update trust that sign
+/// more. These sums show it (`reproduce spebt`, the pilot-power table).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct UpdateSteps {
+    /// Updates counted.
+    pub updates: u64,
+    /// Updates after which the angle's error was larger than before.
+    pub away: u64,
+    /// Sum of the squared step `angle_k|k - angle_k|k-1`, rad^2.
+    pub sum_squared_step_rad2: f64,
+}
+
+impl UpdateSteps {
+    /// Counts one update from `prior_error_rad` to `posterior_error_rad`
+    /// (errors against the truth, wrapped).
+    pub fn add(&mut self, prior_error_rad: f64, posterior_error_rad: f64) {
+        self.updates += 1;
+        self.away += u64::from(posterior_error_rad.abs() > prior_error_rad.abs());
+        let step = wrap_angle_rad(posterior_error_rad - prior_error_rad);
+        self.sum_squared_step_rad2 += step * step;
+    }
+
+    fn merge(&mut self, other: &UpdateSteps) {
+        self.updates += other.updates;
+        self.away += other.away;
+        self.sum_squared_step_rad2 += other.sum_squared_step_rad2;
+    }
+
+    /// Share of the updates that moved the angle away from the truth.
+    #[must_use]
+    pub fn away_share(&self) -> f64 {
+        self.away as f64 / self.updates.max(1) as f64
+    }
+
+    /// RMS of the update's step, radians.
+    #[must_use]
+    pub fn rms_step_rad(&self) -> f64 {
+        (self.sum_squared_step_rad2 / self.updates.max(1) as f64).sqrt()
     }
 }
 
@@ -328,9 +379,11 @@ fn run_chunk(
         let mut reinitialisations = 0;
         for (k, slot) in truth.iter().enumerate().skip(1) {
             let beams = ekf.predict(&poses[k]).with_context(|| format!("run {run_index}"))?;
+            let prior_errors = estimate_errors(&ekf.estimate(), slot);
             let pilot = link.pilot(k, beams.rx_steer_u, beams.tx_steer_u, realisation.noise[k]);
             let deviation = ekf.update(pilot).with_context(|| format!("run {run_index}"))?;
             let errors_before_reset = estimate_errors(&ekf.estimate(), slot);
+            chunk.aoa_updates.add(prior_errors[2], errors_before_reset[2]);
             for (sums, e) in chunk.sum_squared_before_reset.iter_mut().zip(errors_before_reset) {
                 sums[k] += e * e;
             }
@@ -394,6 +447,22 @@ pub fn into_link_frame(first_truth: Se2, estimates: &[Se2]) -> Vec<Se2> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn update_steps_count_the_moves_away_from_the_truth_and_their_size() {
+        let mut steps = UpdateSteps::default();
+        steps.add(0.10, 0.05); // towards the truth
+        steps.add(0.10, -0.20); // past it, further away
+        steps.add(-0.10, -0.13); // away
+        let mut other = UpdateSteps::default();
+        other.add(0.0, 0.0); // no move: not away
+        steps.merge(&other);
+        assert_eq!((steps.updates, steps.away), (4, 2));
+        assert!((steps.away_share() - 0.5).abs() < 1e-15);
+        let expected = ((0.05f64.powi(2) + 0.30f64.powi(2) + 0.03f64.powi(2)) / 4.0).sqrt();
+        assert!((steps.rms_step_rad() - expected).abs() < 1e-12, "{}", steps.rms_step_rad());
+        assert_eq!(UpdateSteps::default().away_share(), 0.0, "no update: no share, not NaN");
+    }
 
     #[test]
     fn the_embedded_experiment_parses_with_table_i() {
