@@ -8,8 +8,8 @@
 //! Every per-particle computation runs chunk by chunk on the team: the
 //! prediction, the likelihood, the exponentials of the weights and of the
 //! effective sample size, the sines and cosines of the headings, the
-//! resampling's jitter, the covariance of the moments (one task per row,
-//! each summing over the particles in order). Maxima are reduced per chunk,
+//! resampling's jitter, the covariance of the moments (a group of rows per
+//! member, each entry summed over the particles in order). Maxima are reduced per chunk,
 //! then across chunks. The sums that reach the output (the effective sample
 //! size, the normalised weights, the means) are taken by the leader,
 //! particle by particle in particle order, over the values the parallel
@@ -156,6 +156,42 @@ pub(crate) struct PreparedPath {
 /// from), where `0 * -inf` would make it NaN.
 fn tempered(logw: f64, ll: f64, delta: f64) -> f64 {
     if delta == 0.0 { logw } else { logw + delta * ll }
+}
+
+/// The covariance rows one member sums when the team has two or more: the
+/// first two rows (11 entries) and the other four (10). Each group costs a
+/// pass over the particles, so a lone leader sums all rows in one.
+const COVARIANCE_ROW_GROUPS: [std::ops::Range<usize>; 2] = [0..2, 2..STATE_DIM];
+
+/// Rows `rows` of the weighted covariance `sum_i w_i d_i d_i^T`, `d_i` the
+/// deviation of particle `i` from `mean` (heading wrapped), summed in
+/// particle order; entry `b` of a row `a` is kept for `b >= a` (0 below).
+fn covariance_rows(
+    chunks: &[RwLock<Chunk>],
+    mean: &[f64; STATE_DIM],
+    rows: std::ops::Range<usize>,
+) -> Vec<[f64; STATE_DIM]> {
+    let first = rows.start;
+    let mut acc = vec![[0.0; STATE_DIM]; rows.len()];
+    for c in chunks {
+        let c = read(c);
+        for i in 0..c.len() {
+            let (s, wi) = (c.get(i), c.weight[i]);
+            // The deviations these rows need (`b >= first`), as a plain
+            // loop: an `array::from_fn` here was left un-inlined in one
+            // build and took a fifth of the one-thread time.
+            let mut d = [0.0; STATE_DIM];
+            for k in first..STATE_DIM {
+                d[k] = if k == 2 { wrap_angle_rad(s[2] - mean[2]) } else { s[k] - mean[k] };
+            }
+            for (a, row) in rows.clone().zip(acc.iter_mut()) {
+                for b in a..STATE_DIM {
+                    row[b] += wi * d[a] * d[b];
+                }
+            }
+        }
+    }
+    acc
 }
 
 /// Element-wise maximum of per-chunk maxima, in chunk order.
@@ -511,30 +547,18 @@ impl Particles {
             }
         }
         mean[2] = wrap_angle_rad(mean[2] + heading);
-        // One task per row of the covariance, each summing its entries over
-        // the particles in order.
+        // The covariance's rows in one pass over the particles per member
+        // (at most two), each entry summed over the particles in order.
         let chunks = self.chunks.clone();
-        let rows = team.map(STATE_DIM, move |a| {
-            let mut acc = vec![0.0; STATE_DIM - a];
-            for c in chunks.iter() {
-                let c = read(c);
-                for i in 0..c.len() {
-                    let (s, wi) = (c.get(i), c.weight[i]);
-                    // The deviations this row needs (`b >= a`), as a plain
-                    // loop: an `array::from_fn` here was left un-inlined in
-                    // one build and took a fifth of the one-thread time.
-                    let mut d = [0.0; STATE_DIM];
-                    for k in a..STATE_DIM {
-                        d[k] = if k == 2 { wrap_angle_rad(s[2] - mean[2]) } else { s[k] - mean[k] };
-                    }
-                    for b in a..STATE_DIM {
-                        acc[b - a] += wi * d[a] * d[b];
-                    }
-                }
-            }
-            acc
-        });
-        let cov = Mat::from_fn(STATE_DIM, STATE_DIM, |a, b| if a <= b { rows[a][b - a] } else { rows[b][a - b] });
+        let rows: Vec<[f64; STATE_DIM]> = team
+            .map_per_member(COVARIANCE_ROW_GROUPS.len(), move |g, groups| {
+                let rows = if groups == 1 { 0..STATE_DIM } else { COVARIANCE_ROW_GROUPS[g].clone() };
+                covariance_rows(&chunks, &mean, rows)
+            })
+            .into_iter()
+            .flatten()
+            .collect();
+        let cov = Mat::from_fn(STATE_DIM, STATE_DIM, |a, b| if a <= b { rows[a][b] } else { rows[b][a] });
         Moments { mean, cov }
     }
 
