@@ -155,8 +155,9 @@ pub(crate) struct Team {
     members: usize,
     /// Generation of the last published phase.
     generation: std::cell::Cell<u64>,
-    /// Phases run with more than one task (synchronisation points when the
-    /// team has helpers).
+    /// Phases run with more than one task, or that would have on a team
+    /// of helpers ([`Team::map_per_member`]): synchronisation points when
+    /// the team has helpers, the same count on any team.
     phases: std::cell::Cell<u64>,
 }
 
@@ -166,7 +167,8 @@ impl Team {
         Self { shared: None, members: 1, generation: 0.into(), phases: 0.into() }
     }
 
-    /// Phases run with more than one task.
+    /// Phases run with more than one task, or that would have on a team of
+    /// helpers.
     pub(crate) fn phases(&self) -> u64 {
         self.phases.get()
     }
