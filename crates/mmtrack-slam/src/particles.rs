@@ -11,13 +11,13 @@
 //! resampling's jitter, the covariance of the moments (a group of rows per
 //! member, each entry summed over the particles in order). Maxima are
 //! reduced per chunk, then across chunks. The sums that reach the output
-//! (the effective sample size, the normalised weights, the means) are
-//! taken by the leader, particle by particle in particle order, over the
-//! values the parallel phase stored: a floating-point sum depends on its order, and this is the
-//! order of a sequential loop, so every result is bit for bit that of a
-//! sequential run for any thread count. They are one add per particle and
-//! quantity; the exponentials and trigonometry they replace are tens of
-//! cycles.
+//! (the effective sample size, the normalised weights, the means) are taken
+//! by the leader, particle by particle in particle order, over the values
+//! the parallel phase stored: a floating-point sum depends on its order,
+//! and this is the order of a sequential loop, so every result is bit for
+//! bit that of a sequential run for any thread count. They are one add per
+//! particle and quantity; the exponentials and trigonometry they replace
+//! are tens of cycles.
 //!
 //! Values a later step needs again are kept until the particles change:
 //! the maximum of `logw + delta ll` and the effective sample size per
