@@ -42,7 +42,8 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use mmtrack_analysis::mpc::{match_detections, resolvable_truth};
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth};
-use mmtrack_mpc::{CandidateGate, LongTermConfig, ShortTermConfig};
+use mmtrack_mpc::short_term::extrapolate;
+use mmtrack_mpc::{CandidateGate, LongTermConfig, ShortTermConfig, ShortTermPrediction};
 
 /// Margin of the detection threshold over the noise floor, dB (Sec. III-A).
 const FLOOR_MARGIN_DB: f64 = 6.0;
@@ -192,8 +193,10 @@ pub struct NoiseRow {
     /// Sets in the bin.
     pub sets: u64,
     /// Sets whose detections pass the initial delay gate `xi_tau` (eq.
-    /// (13)) and every delay search `|tau[m+1] - (2 tau[m] - tau[m-1])| <=
-    /// epsilon_tau` (eqs. (17)-(23)).
+    /// (13)) and every delay search `|tau[m+1] - tau~[m+1]| <= epsilon_tau`
+    /// (eqs. (17)-(23)), `tau~` the search's prediction: `2 tau[m] -
+    /// tau[m-1]` (eq. (17)), or the least-squares line through `tau[0..=m]`
+    /// ([`ShortTermPrediction::LeastSquares`]).
     pub chain_passes: u64,
     /// Sets with a full-lifetime track on the path.
     pub full_lifetime: u64,
@@ -259,11 +262,17 @@ fn delay_noise(sets: &[AllDetected], config: &ShortTermConfig) -> Vec<NoiseRow> 
         }
         let tau: Vec<f64> = s.delays_s.iter().map(|p| p.0).collect();
         let mut passes = tau.len() < 2 || (tau[1] - tau[0]).abs() <= config.initial_delay_gate_s;
+        let last_difference = config.prediction == ShortTermPrediction::LastDifference;
         for w in tau.windows(3) {
             let over = (w[2] - 2.0 * w[1] + w[0]).abs() > config.delay_tolerance_s;
             row.second_differences += 1;
             row.second_differences_over += u64::from(over);
-            passes &= !over;
+            passes &= !(last_difference && over);
+        }
+        if !last_difference {
+            for m in 2..tau.len() {
+                passes &= (tau[m] - extrapolate(config.prediction, &tau[..m])).abs() <= config.delay_tolerance_s;
+            }
         }
         row.chain_passes += u64::from(passes);
     }
