@@ -781,6 +781,35 @@ mod tests {
     }
 
     #[test]
+    fn the_search_replay_follows_the_configured_prediction() {
+        // Delay errors 0, 0, 0, +0.3, -0.1, -0.1 ns on a line of 0.1 ns per
+        // snapshot: eq. (17) misses the fifth point by 0.7 ns, the
+        // least-squares line by 0.4 ns (mmtrack_mpc::short_term's tests)
+        // and the sixth by 0.17 ns (second difference 0.4 ns).
+        let noise_ns = [0.0, 0.0, 0.0, 0.3, -0.1, -0.1];
+        let delays_s: Vec<(f64, f64)> = noise_ns
+            .iter()
+            .enumerate()
+            .map(|(m, e)| {
+                let true_ns = 300.0 + 0.1 * m as f64;
+                ((true_ns + e) * 1e-9, true_ns * 1e-9)
+            })
+            .collect();
+        let set = AllDetected { path_id: CAR, margin_db: 5.0, delays_s, full_lifetime: false };
+        let paper = ShortTermConfig::default();
+        let ours = ShortTermConfig { prediction: ShortTermPrediction::LeastSquares, ..paper.clone() };
+        let replay = |config: &ShortTermConfig| {
+            let rows = delay_noise(std::slice::from_ref(&set), config);
+            let r = &rows[0];
+            (r.chain_passes, r.second_differences_over, r.second_differences)
+        };
+        // The second differences are the detections' (one beyond 0.5 ns:
+        // -0.1 - 0.6 + 0 = -0.7 ns), whatever the search.
+        assert_eq!(replay(&paper), (0, 1, 4));
+        assert_eq!(replay(&ours), (1, 1, 4));
+    }
+
+    #[test]
     fn delay_noise_counts_second_differences_beyond_the_search_tolerance() {
         // Set 0: a zigzag of +-0.2 ns (second differences 0.8 ns); set 1: straight.
         let s = scene(

@@ -41,7 +41,7 @@ use mmtrack_core::progress::Progress;
 use mmtrack_sim::sounder::{ConvoyConfig, SounderScenario};
 
 pub use self::report::README_BLOCK;
-pub use self::run::{LITERAL, Measured, OURS, Row, Truth, Variant, measure, variants};
+pub use self::run::{LITERAL, LS_OURS, Measured, OURS, Row, Truth, Variant, measure, variants};
 use crate::model::{Outcome, ReadmeBlock, RunOptions};
 
 /// The experiment's name (`mmtrack reproduce mpc-convoy`).
