@@ -95,6 +95,36 @@ pub struct ShortTermConfig {
     pub magnitude_tolerance_db: f64,
     /// Fewest consecutive detections that make a track (paper: 3).
     pub min_track_length: usize,
+    /// How the next point of a track is predicted before the search of
+    /// eqs. (20)-(23) (default: the paper's eq. (17), from the last two
+    /// points).
+    pub prediction: ShortTermPrediction,
+}
+
+/// The linear prediction of the short-term search (eqs. (17)-(19)).
+///
+/// Both choices extrapolate a straight line in snapshot index `m` (the
+/// snapshots of a set are equally spaced, as eq. (17) assumes), for the
+/// magnitude and the delay alike. With delay noise `sigma` per detection,
+/// independent between snapshots, the search's miss
+/// `tau[m + 1] - tau~[m + 1]` of a path moving linearly has the variance
+/// `sigma^2 (1 + 1/k + (k - mbar)^2 / S_mm)` for a line fitted to `k` points
+/// (`mbar = (k - 1) / 2`, `S_mm = k (k^2 - 1) / 12`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShortTermPrediction {
+    /// The paper's eq. (17): `s~[m + 1] = s[m] + (s[m] - s[m - 1])`, the
+    /// line through the last two points. Its miss is the second difference
+    /// `tau[m + 1] - 2 tau[m] + tau[m - 1]`: `sqrt(6) sigma` at every step.
+    #[default]
+    LastDifference,
+    /// Ours: the least-squares line through all `k` points of the track so
+    /// far, evaluated at the next snapshot. At `k = 2` it is eq. (17); from
+    /// the third point on its miss shrinks to `sqrt(10/3) sigma` (`k = 3`),
+    /// `sqrt(5/2) sigma` (4) and `sqrt(21/10) sigma` (5), where eq. (17)
+    /// stays at `sqrt(6) sigma`. The tolerance `epsilon_tau` of eq. (23) is
+    /// unchanged; there is no parameter to set.
+    LeastSquares,
 }
 
 impl Default for ShortTermConfig {
@@ -105,6 +135,7 @@ impl Default for ShortTermConfig {
             delay_tolerance_s: 0.5e-9,
             magnitude_tolerance_db: 10.0,
             min_track_length: 3,
+            prediction: ShortTermPrediction::LastDifference,
         }
     }
 }

@@ -29,7 +29,9 @@ mod pipeline;
 mod pulse;
 pub mod short_term;
 
-pub use config::{CandidateGate, DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig};
+pub use config::{
+    CandidateGate, DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig, ShortTermPrediction,
+};
 pub use detect::{Detector, SnapshotDetections};
 pub use error::MpcError;
 pub use gmphd::{GmPhdConfig, GmPhdError, GmPhdSnapshot, track_gmphd};

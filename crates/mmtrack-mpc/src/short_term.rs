@@ -17,7 +17,10 @@
 //!    candidate" without ordering them, and the delay is the quantity its
 //!    tracker trusts most (eq. (25) also decides by delay).
 //! 3. **Prediction** (eqs. (17)-(19)): from the last two points,
-//!    `s~[m + 1] = s[m] + (s[m] - s[m - 1])`, in dB and seconds.
+//!    `s~[m + 1] = s[m] + (s[m] - s[m - 1])`, in dB and seconds. Opt-in
+//!    ([`ShortTermPrediction::LeastSquares`], not the paper's): from the
+//!    least-squares line through all the track's points so far, of which
+//!    eq. (17) is the two-point case; see [`extrapolate`].
 //! 4. **Search** (eqs. (20)-(23)): the unassigned detections of snapshot
 //!    `m + 1` within `s~ +- epsilon`, componentwise (`epsilon_a` =
 //!    [`ShortTermConfig::magnitude_tolerance_db`], `epsilon_tau` =
@@ -57,7 +60,7 @@
 
 use mmtrack_core::{MpcDetection, MpcTrack};
 
-use crate::ShortTermConfig;
+use crate::{ShortTermConfig, ShortTermPrediction};
 
 /// The tracking state of one detection: `s = (a, tau)` of eq. (12).
 #[derive(Debug, Clone, Copy)]
@@ -146,24 +149,68 @@ fn identify(
     let s_hat = points[n][start];
     for candidate in initial_candidates(&points[n + 1], &used[n + 1], s_hat, config) {
         let mut path = vec![start, candidate];
-        let mut previous = s_hat;
-        let mut last = points[n + 1][candidate];
+        let second = points[n + 1][candidate];
+        let mut a_db = vec![s_hat.a_db, second.a_db];
+        let mut tau_s = vec![s_hat.tau_s, second.tau_s];
         loop {
             let m = n + path.len();
             if m >= points.len() {
                 break;
             }
-            let predicted = Point { a_db: 2.0 * last.a_db - previous.a_db, tau_s: 2.0 * last.tau_s - previous.tau_s };
+            let predicted =
+                Point { a_db: extrapolate(config.prediction, &a_db), tau_s: extrapolate(config.prediction, &tau_s) };
             let Some(found) = nearest_in_search_range(&points[m], &used[m], predicted, config) else { break };
             path.push(found);
-            previous = last;
-            last = points[m][found];
+            a_db.push(points[m][found].a_db);
+            tau_s.push(points[m][found].tau_s);
         }
         if path.len() >= min_len {
             return Some(path);
         }
     }
     None
+}
+
+/// The value the next snapshot is predicted to hold, from `values` of one
+/// component (magnitude in dB or delay in seconds) over consecutive,
+/// equally spaced snapshots `m = 0 .. k - 1` (eqs. (17)-(19)); `k >= 2`.
+///
+/// - [`ShortTermPrediction::LastDifference`] (the paper's eq. (17)):
+///   `v~[k] = 2 v[k - 1] - v[k - 2]`.
+/// - [`ShortTermPrediction::LeastSquares`] (ours): the least-squares line
+///   `v(m) = vbar + b (m - mbar)` through all `k` points, at `m = k`:
+///   `v~[k] = vbar + b (k - mbar)`, with `mbar = (k - 1) / 2`,
+///   `b = sum (m - mbar)(v[m] - vbar) / S_mm` and
+///   `S_mm = sum (m - mbar)^2`. Through two points it is eq. (17). Why: the
+///   miss of eq. (17) is the second difference of the detections, `sqrt(6)`
+///   times their delay noise at every step, so a noisy path leaves the fixed
+///   `epsilon_tau` of eq. (23) although it moves on a line; the fitted
+///   line's miss shrinks with the points behind it
+///   ([`ShortTermPrediction`]).
+///
+/// With fewer than two values there is no line: the last value (or NaN for
+/// none) is returned, which the tracker never asks for.
+#[must_use]
+pub fn extrapolate(prediction: ShortTermPrediction, values: &[f64]) -> f64 {
+    let k = values.len();
+    match (prediction, values) {
+        (_, []) => f64::NAN,
+        (_, [only]) => *only,
+        (ShortTermPrediction::LastDifference, [.., previous, last]) => 2.0 * last - previous,
+        (ShortTermPrediction::LeastSquares, [first, ..]) => {
+            // Relative to the first value, so a large common delay keeps its
+            // precision.
+            let m_mean = (k as f64 - 1.0) / 2.0;
+            let v_mean = values.iter().map(|v| v - first).sum::<f64>() / k as f64;
+            let (mut s_mv, mut s_mm) = (0.0, 0.0);
+            for (m, v) in values.iter().enumerate() {
+                let dm = m as f64 - m_mean;
+                s_mv += dm * (v - first - v_mean);
+                s_mm += dm * dm;
+            }
+            first + v_mean + s_mv / s_mm * (k as f64 - m_mean)
+        }
+    }
 }
 
 /// The unassigned detections within the initial gates `xi` of `s_hat`
@@ -221,4 +268,85 @@ pub fn doppler_hz(detections: &[MpcDetection], carrier_hz: f64) -> Option<f64> {
         sxx += (t - t_mean) * (t - t_mean);
     }
     (sxx > 0.0).then(|| -carrier_hz * sxy / sxx)
+}
+
+#[cfg(test)]
+mod tests {
+    use mmtrack_core::Complex64;
+
+    use super::*;
+
+    /// The paper's snapshot period, 0.717 ms.
+    const SNAPSHOT_NS: i64 = 717_000;
+
+    /// One path of constant magnitude over six snapshots: a delay line of
+    /// 0.1 ns per snapshot plus `noise_ns` (the detections' delay errors).
+    fn noisy_path(noise_ns: [f64; 6]) -> Vec<Vec<MpcDetection>> {
+        (0..6u32)
+            .map(|n| {
+                let delay_s = (40.0 + 0.1 * f64::from(n) + noise_ns[n as usize]) * 1e-9;
+                vec![MpcDetection {
+                    t_ns: i64::from(n) * SNAPSHOT_NS,
+                    set_index: 0,
+                    snapshot_index: n,
+                    delay_s,
+                    amplitude: Complex64::new(1e-6, 0.0),
+                }]
+            })
+            .collect()
+    }
+
+    fn lengths(tracks: &[MpcTrack]) -> Vec<usize> {
+        tracks.iter().map(|t| t.detections.len()).collect()
+    }
+
+    #[test]
+    fn the_least_squares_line_is_eq_17_through_two_points_and_exact_on_a_line() {
+        for prediction in [ShortTermPrediction::LastDifference, ShortTermPrediction::LeastSquares] {
+            // Two points: both are eq. (17), 2 * 5 - 3 = 7 (to rounding).
+            assert!((extrapolate(prediction, &[3.0, 5.0]) - 7.0).abs() < 1e-12, "{prediction:?}");
+            // Points on a line: both continue it.
+            let line: Vec<f64> = (0..5).map(|m| 40e-9 + 0.3e-9 * f64::from(m)).collect();
+            let next = 40e-9 + 0.3e-9 * 5.0;
+            assert!((extrapolate(prediction, &line) - next).abs() < 1e-21, "{prediction:?}");
+        }
+    }
+
+    #[test]
+    fn the_least_squares_line_averages_the_noise_eq_17_follows() {
+        // Noise on the last point only: eq. (17) doubles it (2 * 0.3 - 0 =
+        // 0.6); the line through 0, 0, 0, 0.3 (mean 0.075, slope 0.45 / 5 =
+        // 0.09) gives 0.075 + 0.09 * 2.5 = 0.3 at m = 4.
+        let values = [0.0, 0.0, 0.0, 0.3];
+        assert!((extrapolate(ShortTermPrediction::LastDifference, &values) - 0.6).abs() < 1e-12);
+        assert!((extrapolate(ShortTermPrediction::LeastSquares, &values) - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_noisy_linear_path_is_followed_over_the_set_by_the_least_squares_search_only() {
+        // Delay errors 0, 0, 0, +0.3, -0.1, 0 ns. Eq. (17) misses the fifth
+        // point by -0.1 - (2 * 0.3 - 0) = -0.7 ns, beyond epsilon_tau =
+        // 0.5 ns: its track ends after four points and the last two make
+        // none. The least-squares line through the first four points
+        // predicts +0.3 ns (previous test): a miss of -0.4 ns; through five
+        // it predicts 0.04 + 0.01 * 3 = 0.07 ns: a miss of -0.07 ns.
+        let set = noisy_path([0.0, 0.0, 0.0, 0.3, -0.1, 0.0]);
+        let paper = ShortTermConfig::default();
+        assert_eq!(lengths(&short_term_tracks(&set, 28e9, &paper, 0)), vec![4]);
+        let ours = ShortTermConfig { prediction: ShortTermPrediction::LeastSquares, ..paper };
+        let tracks = short_term_tracks(&set, 28e9, &ours, 0);
+        assert_eq!(lengths(&tracks), vec![6]);
+        assert!(is_full_lifetime(&tracks[0], set.len()));
+    }
+
+    #[test]
+    fn the_least_squares_search_keeps_the_tolerance_of_eq_23() {
+        // A step of 0.8 ns at the fourth point leaves the line by more than
+        // epsilon_tau whatever the prediction: both end the track there.
+        let set = noisy_path([0.0, 0.0, 0.0, 0.8, 0.8, 0.8]);
+        for prediction in [ShortTermPrediction::LastDifference, ShortTermPrediction::LeastSquares] {
+            let config = ShortTermConfig { prediction, ..ShortTermConfig::default() };
+            assert_eq!(lengths(&short_term_tracks(&set, 28e9, &config, 0)), vec![3, 3], "{prediction:?}");
+        }
+    }
 }

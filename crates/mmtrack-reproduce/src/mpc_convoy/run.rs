@@ -1,7 +1,8 @@
-//! The runs of the convoy experiment: each scene simulated once, detected
-//! and short-term tracked once (the paper's configuration), and long-term
-//! tracked by every variant of eq. (35) on the same full-lifetime tracks;
-//! then each (truth, variant) pair scored by `mmtrack_analysis::mpc`.
+//! The runs of the convoy experiment: each scene simulated and detected
+//! once, short-term tracked once per short-term search (the paper's
+//! configuration for all but one variant), and long-term tracked by every
+//! variant on its search's full-lifetime tracks; then each (truth, variant)
+//! pair scored by `mmtrack_analysis::mpc`.
 
 use mmtrack_analysis::mpc::{DistanceSource, MpcInput, MpcOptions, analyze_mpc};
 use mmtrack_core::progress::Progress;
@@ -9,30 +10,42 @@ use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTru
 use mmtrack_io::table::MpcSummary;
 use mmtrack_mpc::short_term::is_full_lifetime;
 use mmtrack_mpc::{
-    CandidateGate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, ShortTermConfig, SounderPulse,
+    CandidateGate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, ShortTermConfig, ShortTermPrediction,
+    SounderPulse, short_term_tracks,
 };
 use mmtrack_sim::sounder::{ConvoyConfig, ConvoySimulator, PathKind};
 
 use super::causes::{Diagnosis, Tables, diagnose};
 
-/// One long-term tracker of the comparison.
+/// One tracker of the comparison: a short-term search and a long-term
+/// tracker on its full-lifetime tracks.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Variant {
     /// Short name for tables and metric keys.
     pub name: &'static str,
     /// Whose it is and what it changes, as the report prints it.
     pub what: &'static str,
-    /// Its configuration (the paper's defaults but for the gate and gap).
+    /// Its long-term configuration (the paper's defaults but for the gate
+    /// and gap).
     pub config: LongTermConfig,
+    /// Its short-term configuration (the paper's but for [`LS_OURS`]).
+    pub short_term: ShortTermConfig,
 }
 
 /// The paper's eq. (35) as printed (the default configuration).
 pub const LITERAL: &str = "eq35-literal";
 /// Ours: gated around the Doppler-predicted delay, one missed set allowed.
 pub const OURS: &str = "doppler-gated+gap";
+/// Ours with the least-squares short-term search
+/// ([`ShortTermPrediction::LeastSquares`]): the long-term tracker of
+/// [`OURS`] on the full-lifetime tracks of a search that predicts from the
+/// line through all the track's points instead of its last two (the traced
+/// cause of the scatter-free miss: the cars' delay noise against eq. (17)).
+pub const LS_OURS: &str = "ls-search+doppler-gated+gap";
 
-/// The four long-term trackers: the paper's, ours, and each of our two
-/// changes alone (which of them moves the births).
+/// The five trackers: the paper's long-term tracker, ours, each of our two
+/// long-term changes alone (which of them moves the births), all on the
+/// paper's short-term search; and ours on the least-squares search.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
     let with = |candidate_gate, max_missed_sets| LongTermConfig {
@@ -45,21 +58,33 @@ pub fn variants() -> Vec<Variant> {
             name: LITERAL,
             what: "the paper's eq. (35): 1 ns gate on the raw delay change, adjacent sets only",
             config: with(CandidateGate::RawDelay, 0),
+            short_term: ShortTermConfig::default(),
         },
         Variant {
             name: "doppler-gated",
             what: "ours, gate only: 1 ns around the eq. (37) prediction, adjacent sets only",
             config: with(CandidateGate::PredictedDelay, 0),
+            short_term: ShortTermConfig::default(),
         },
         Variant {
             name: "gap",
             what: "ours, gap only: the paper's raw gate, one missed set bridged",
             config: with(CandidateGate::RawDelay, 1),
+            short_term: ShortTermConfig::default(),
         },
         Variant {
             name: OURS,
             what: "ours: 1 ns around the eq. (37) prediction, one missed set bridged",
             config: with(CandidateGate::PredictedDelay, 1),
+            short_term: ShortTermConfig::default(),
+        },
+        Variant {
+            name: LS_OURS,
+            what: "ours with the least-squares short-term search: each point predicted from the line through all \
+                   the track's points (eq. (17): the last two), epsilon_tau = 0.5 ns of eq. (23) unchanged; \
+                   long-term as doppler-gated+gap",
+            config: with(CandidateGate::PredictedDelay, 1),
+            short_term: ShortTermConfig { prediction: ShortTermPrediction::LeastSquares, ..ShortTermConfig::default() },
         },
     ]
 }
@@ -148,10 +173,16 @@ impl Measured {
     }
 }
 
-/// One scene's tables, long-term entries per variant.
+/// One scene's tables: short-term tracks per distinct short-term search,
+/// long-term entries per variant.
 struct Scene {
     detections: Vec<MpcDetection>,
-    tracks: Vec<MpcTrack>,
+    /// Short-term tracks per search of `searches`.
+    tracks: Vec<Vec<MpcTrack>>,
+    /// The distinct short-term searches, the paper's (the pipeline's) first.
+    searches: Vec<ShortTermConfig>,
+    /// Index into `searches` / `tracks` of each variant's search.
+    search_of: Vec<usize>,
     sets: Vec<MpcSetStats>,
     truth: Vec<MpcTruth>,
     tx: Vec<StampedPose>,
@@ -163,7 +194,9 @@ struct Scene {
 }
 
 /// Simulates `convoy` (seed `seed`), detects and short-term tracks with the
-/// paper's configuration, long-term tracks with every variant.
+/// paper's configuration (the pipeline) and every other short-term search
+/// of `variants` (on the same detections, track ids from 0), long-term
+/// tracks with every variant on its search's full-lifetime tracks.
 fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::Result<Scene> {
     let simulator = ConvoySimulator::new(convoy, seed)?;
     let carrier_hz = convoy.sounder.carrier_hz;
@@ -174,9 +207,22 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::
     let mut pipeline = MpcPipeline::new(MpcConfig::default(), &pulse, tap_spacing_s, carrier_hz)?;
     let mut trackers: Vec<LongTermTracker> =
         variants.iter().map(|v| LongTermTracker::new(v.config.clone(), carrier_hz, 0)).collect::<Result<_, _>>()?;
+    let mut searches = vec![ShortTermConfig::default()];
+    let mut search_of = Vec::new();
+    for v in variants {
+        if let Some(i) = searches.iter().position(|c| *c == v.short_term) {
+            search_of.push(i);
+        } else {
+            search_of.push(searches.len());
+            searches.push(v.short_term.clone());
+        }
+    }
+    let mut next_track_id = vec![0u64; searches.len()];
     let mut scene = Scene {
         detections: Vec::new(),
-        tracks: Vec::new(),
+        tracks: vec![Vec::new(); searches.len()],
+        searches,
+        search_of,
         sets: Vec::new(),
         truth: Vec::new(),
         tx: Vec::new(),
@@ -192,13 +238,25 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::
         let chunk: Vec<_> = sets.by_ref().take(batch).collect();
         let snapshots: Vec<_> = chunk.iter().map(|s| s.snapshots.as_slice()).collect();
         for (set, output) in chunk.iter().zip(pipeline.push_sets(&snapshots)?) {
-            let full: Vec<MpcTrack> =
-                output.short_term_tracks.iter().filter(|t| is_full_lifetime(t, set.snapshots.len())).cloned().collect();
-            for (tracker, entries) in trackers.iter_mut().zip(&mut scene.long_term) {
-                entries.extend(tracker.push_set(&full));
+            let per_snapshot: Vec<Vec<MpcDetection>> =
+                output.per_snapshot.iter().map(|s| s.detections.clone()).collect();
+            let mut by_search = vec![output.short_term_tracks];
+            for (config, next_id) in scene.searches.iter().zip(&mut next_track_id).skip(1) {
+                let tracks = short_term_tracks(&per_snapshot, carrier_hz, config, *next_id);
+                *next_id += tracks.len() as u64;
+                by_search.push(tracks);
             }
-            scene.detections.extend(output.per_snapshot.into_iter().flat_map(|s| s.detections));
-            scene.tracks.extend(output.short_term_tracks);
+            let full: Vec<Vec<MpcTrack>> = by_search
+                .iter()
+                .map(|tracks| tracks.iter().filter(|t| is_full_lifetime(t, set.snapshots.len())).cloned().collect())
+                .collect();
+            for ((tracker, entries), &search) in trackers.iter_mut().zip(&mut scene.long_term).zip(&scene.search_of) {
+                entries.extend(tracker.push_set(&full[search]));
+            }
+            scene.detections.extend(per_snapshot.into_iter().flatten());
+            for (table, tracks) in scene.tracks.iter_mut().zip(by_search) {
+                table.extend(tracks);
+            }
             scene.sets.push(output.stats);
             scene.truth.extend(set.truth.iter().cloned());
             scene.tx.push(set.tx_pose.clone());
@@ -208,40 +266,48 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::
     Ok(scene)
 }
 
-fn diagnosis(scene: &Scene, truth: &[MpcTruth], long_term: &[MpcLongTermEntry], config: &LongTermConfig) -> Diagnosis {
+/// Why the births of variant `v` (index into `variants`) happened.
+fn diagnosis(scene: &Scene, truth: &[MpcTruth], v: usize, config: &LongTermConfig) -> Diagnosis {
     let mut sets = scene.sets.clone();
     sets.sort_by_key(|s| s.set_index);
+    let search = scene.search_of[v];
     diagnose(&Tables {
         truth,
         detections: &scene.detections,
-        tracks: &scene.tracks,
-        long_term,
+        tracks: &scene.tracks[search],
+        long_term: &scene.long_term[v],
         sets: &sets,
         config,
-        short_term: &ShortTermConfig::default(),
+        short_term: &scene.searches[search],
         carrier_hz: scene.carrier_hz,
         blocked_half_width_s: scene.blocked_half_width_s,
         snapshots_per_set: scene.snapshots_per_set,
     })
 }
 
-fn score(scene: &Scene, truth: Vec<MpcTruth>, long_term: &[MpcLongTermEntry]) -> (MpcSummary, [u64; 5]) {
+/// Scores variant `v` (index into `variants`) against `truth`.
+fn score(scene: &Scene, truth: Vec<MpcTruth>, v: usize) -> (MpcSummary, [u64; 5]) {
     let mut sets = scene.sets.clone();
     sets.sort_by_key(|s| s.set_index);
-    let scores = mmtrack_analysis::mpc::truth::score(&truth, &scene.detections, &scene.tracks, long_term, &sets);
+    let tracks = &scene.tracks[scene.search_of[v]];
+    let long_term = &scene.long_term[v];
+    let scores = mmtrack_analysis::mpc::truth::score(&truth, &scene.detections, tracks, long_term, &sets);
     let mut by_kind = [0u64; 5];
     for (&path, &births) in &scores.births_by_path {
         if let Some(k) = PATH_KINDS.iter().position(|(kind, _)| PathKind::of(path) == Some(*kind)) {
             by_kind[k] += births;
         }
     }
-    (summarise(scene, truth, long_term), by_kind)
+    (summarise(scene, truth, tracks, long_term), by_kind)
 }
 
-fn summarise(scene: &Scene, truth: Vec<MpcTruth>, long_term: &[MpcLongTermEntry]) -> MpcSummary {
+/// The summary of one variant's tables. The per-set gains of `scene.sets`
+/// are the pipeline's (the paper's search) for every variant; the report
+/// uses none of them.
+fn summarise(scene: &Scene, truth: Vec<MpcTruth>, tracks: &[MpcTrack], long_term: &[MpcLongTermEntry]) -> MpcSummary {
     let input = MpcInput {
         detections: scene.detections.clone(),
-        tracks: scene.tracks.clone(),
+        tracks: tracks.to_vec(),
         long_term: long_term.to_vec(),
         sets: scene.sets.clone(),
         snapshots: None,
@@ -269,9 +335,9 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     let specular: Vec<MpcTruth> =
         scene.truth.iter().filter(|t| PathKind::of(t.path_id) != Some(PathKind::Diffuse)).cloned().collect();
     for (truth, table) in [(Truth::SpecularOnly, specular), (Truth::WithDiffuse, scene.truth.clone())] {
-        for (variant, entries) in variants.iter().zip(&scene.long_term) {
-            let (summary, births_by_kind) = score(&scene, table.clone(), entries);
-            diagnoses.push(diagnosis(&scene, &table, entries, &variant.config));
+        for (v, variant) in variants.iter().enumerate() {
+            let (summary, births_by_kind) = score(&scene, table.clone(), v);
+            diagnoses.push(diagnosis(&scene, &table, v, &variant.config));
             rows.push(Row { truth, variant: variant.name, summary, births_by_kind });
         }
     }
@@ -279,9 +345,9 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     no_diffuse.diffuse.scatterers_per_m = 0.0;
     progress.note(&format!("simulating and tracking {sets} sets of the tunnel without diffuse scatterers"));
     let scene = run_scene(&no_diffuse, seed, &variants)?;
-    for (variant, entries) in variants.iter().zip(&scene.long_term) {
-        let (summary, births_by_kind) = score(&scene, scene.truth.clone(), entries);
-        diagnoses.push(diagnosis(&scene, &scene.truth, entries, &variant.config));
+    for (v, variant) in variants.iter().enumerate() {
+        let (summary, births_by_kind) = score(&scene, scene.truth.clone(), v);
+        diagnoses.push(diagnosis(&scene, &scene.truth, v, &variant.config));
         rows.push(Row { truth: Truth::NoDiffuse, variant: variant.name, summary, births_by_kind });
     }
     Ok(Measured { sets, seed, rows, diagnoses })

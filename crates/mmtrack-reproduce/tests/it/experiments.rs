@@ -107,13 +107,15 @@ fn mpc_convoy_smoke_meets_its_expectations_and_ours_beats_the_paper_gate() {
         v
     };
     let targets: Vec<_> = outcome.verdicts.iter().filter(|v| !v.claim.informational).collect();
-    assert_eq!(targets.len(), 3, "two birth-rate targets and the ordering");
-    let ours_diffuse = verdict(&["(ours)", "diffuse scatterers", "specular paths and"]);
+    assert_eq!(targets.len(), 5, "four birth-rate targets (two searches, two truths) and the ordering");
+    // Ours on the paper's search (its whose-text starts the claim); the
+    // least-squares search's claims name it first.
+    let ours_diffuse = verdict(&["/ true, Doppler-gated", "diffuse scatterers", "specular paths and"]);
     assert!(ours_diffuse.met, "{}: {}", ours_diffuse.claim.what, ours_diffuse.note);
     let ordering = verdict(&["fragments true paths less"]);
     assert!(ordering.met, "{}", ordering.note);
     let ratio = |v: &mmtrack_reproduce::Verdict| v.measured.unwrap_or(f64::INFINITY);
-    let ours = ratio(verdict(&["(ours)", "without diffuse"]));
+    let ours = ratio(verdict(&["/ true, Doppler-gated", "without diffuse"]));
     let paper = ratio(verdict(&["the paper's", "without diffuse"]));
     assert!(ours < paper, "without diffuse scatterers: ours {ours} x, the paper's {paper} x");
     let literal = outcome.verdicts.iter().filter(|v| v.claim.informational && v.claim.what.contains("the paper's"));
@@ -166,4 +168,43 @@ fn mpc_convoy_smoke_traces_the_traffic_births_to_the_cars_own_delay_noise() {
     // The search explains the short-term tracker: full-lifetime tracks
     // where the detections pass, within a tenth of the sets.
     assert!((share((weak.0, weak.2)) - share((weak.0, weak.1))).abs() < 0.1, "weak: {weak:?}");
+}
+
+/// What the least-squares short-term search (ours, not the paper's eq.
+/// (17)) is for: on the traffic cars of the scatter-free tunnel it follows
+/// more sets with a full-lifetime track than the paper's search, and fewer
+/// births follow a set where all six snapshots were detected but the
+/// search lost the car. Its birth-rate rows are judged like ours (a missed
+/// 2x is a verdict, docs/results/multipath.md), not asserted here.
+#[test]
+fn mpc_convoy_smoke_least_squares_search_follows_the_cars_in_more_sets() {
+    use mmtrack_reproduce::mpc_convoy::causes::Cause;
+    use mmtrack_sim::sounder::PathKind;
+
+    let config = mpc_convoy::Config::embedded().unwrap();
+    let measured = mpc_convoy::measure(&config.convoy, config.seed, mpc_convoy::SMOKE_SETS, &NoProgress).unwrap();
+    let diagnosis = |variant: &str| {
+        measured
+            .rows
+            .iter()
+            .zip(&measured.diagnoses)
+            .find(|(r, _)| r.truth == mpc_convoy::Truth::NoDiffuse && r.variant == variant)
+            .map(|(_, d)| d)
+            .unwrap()
+    };
+    let (paper, ls) = (diagnosis(mpc_convoy::OURS), diagnosis(mpc_convoy::LS_OURS));
+    let is_car = |p: u64| PathKind::of(p) == Some(PathKind::Traffic);
+    let followed = |d: &mmtrack_reproduce::mpc_convoy::causes::Diagnosis| -> u64 {
+        d.paths.iter().filter(|p| is_car(p.path_id)).map(|p| p.followed_sets).sum()
+    };
+    // Smoke run (measured): 206 sets followed on the paper's search, 236 on
+    // the least-squares one; a gain of at least 5 % is asked, well below the
+    // measured 15 % and well above zero (the same search gives equal counts).
+    let (f_paper, f_ls) = (followed(paper), followed(ls));
+    assert!(f_paper >= 100, "too few followed sets to judge: {f_paper}");
+    assert!(20 * f_ls >= 21 * f_paper, "cars' sets followed: least-squares {f_ls}, paper's search {f_paper}");
+    let lost = |d: &mmtrack_reproduce::mpc_convoy::causes::Diagnosis| {
+        d.histogram(is_car).get(&Cause::ShortTermSplit).copied().unwrap_or(0)
+    };
+    assert!(lost(ls) < lost(paper), "births after the search lost a detected car: {} vs {}", lost(ls), lost(paper));
 }
