@@ -43,7 +43,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use mmtrack_analysis::mpc::{match_detections, resolvable_truth};
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth};
 use mmtrack_mpc::short_term::extrapolate;
-use mmtrack_mpc::{CandidateGate, LongTermConfig, ShortTermConfig, ShortTermPrediction};
+use mmtrack_mpc::{CandidateGate, LongTermConfig, ShortTermConfig};
 
 /// Margin of the detection threshold over the noise floor, dB (Sec. III-A).
 const FLOOR_MARGIN_DB: f64 = 6.0;
@@ -196,7 +196,7 @@ pub struct NoiseRow {
     /// (13)) and every delay search `|tau[m+1] - tau~[m+1]| <= epsilon_tau`
     /// (eqs. (17)-(23)), `tau~` the search's prediction: `2 tau[m] -
     /// tau[m-1]` (eq. (17)), or the least-squares line through `tau[0..=m]`
-    /// ([`ShortTermPrediction::LeastSquares`]).
+    /// ([`mmtrack_mpc::ShortTermPrediction::LeastSquares`]).
     pub chain_passes: u64,
     /// Sets with a full-lifetime track on the path.
     pub full_lifetime: u64,
@@ -261,19 +261,14 @@ fn delay_noise(sets: &[AllDetected], config: &ShortTermConfig) -> Vec<NoiseRow> 
             row.detections += 1;
         }
         let tau: Vec<f64> = s.delays_s.iter().map(|p| p.0).collect();
-        let mut passes = tau.len() < 2 || (tau[1] - tau[0]).abs() <= config.initial_delay_gate_s;
-        let last_difference = config.prediction == ShortTermPrediction::LastDifference;
         for w in tau.windows(3) {
-            let over = (w[2] - 2.0 * w[1] + w[0]).abs() > config.delay_tolerance_s;
             row.second_differences += 1;
-            row.second_differences_over += u64::from(over);
-            passes &= !(last_difference && over);
+            row.second_differences_over += u64::from((w[2] - 2.0 * w[1] + w[0]).abs() > config.delay_tolerance_s);
         }
-        if !last_difference {
-            for m in 2..tau.len() {
-                passes &= (tau[m] - extrapolate(config.prediction, &tau[..m])).abs() <= config.delay_tolerance_s;
-            }
-        }
+        let gate = tau.len() < 2 || (tau[1] - tau[0]).abs() <= config.initial_delay_gate_s;
+        let searches = (2..tau.len())
+            .all(|m| (tau[m] - extrapolate(config.prediction, &tau[..m])).abs() <= config.delay_tolerance_s);
+        let passes = gate && searches;
         row.chain_passes += u64::from(passes);
     }
     rows.into_values().collect()
@@ -557,6 +552,7 @@ fn link_cause(a: &MpcLongTermEntry, b: &MpcLongTermEntry, config: &LongTermConfi
 #[cfg(test)]
 mod tests {
     use mmtrack_core::Complex64;
+    use mmtrack_mpc::ShortTermPrediction;
 
     use super::*;
 

@@ -24,10 +24,10 @@
 //!   the paper's eq. (17)): the traced cause of the scatter-free miss is the
 //!   cars' delay noise against eq. (17)'s two-point prediction.
 //!
-//! Targets (issue 25): ours within 2x of the true birth rate against both
-//! fair truths (on either short-term search), and fewer births on true
-//! paths than the paper's eq. (35).
-//! The paper's eq. (35) is reported beside them, not judged.
+//! Targets (issue 25): ours (on the paper's short-term search) within 2x of
+//! the true birth rate against both fair truths, and fewer births on true
+//! paths than the paper's eq. (35). Ours on the least-squares search and
+//! the paper's eq. (35) are reported beside them, not judged.
 //!
 //! Why the births on true paths happen, for every (truth, tracker) pair:
 //! [`causes`] (what ended the previous long-term track on the path; the

@@ -238,8 +238,7 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::
         let chunk: Vec<_> = sets.by_ref().take(batch).collect();
         let snapshots: Vec<_> = chunk.iter().map(|s| s.snapshots.as_slice()).collect();
         for (set, output) in chunk.iter().zip(pipeline.push_sets(&snapshots)?) {
-            let per_snapshot: Vec<Vec<MpcDetection>> =
-                output.per_snapshot.iter().map(|s| s.detections.clone()).collect();
+            let per_snapshot: Vec<Vec<MpcDetection>> = output.per_snapshot.into_iter().map(|s| s.detections).collect();
             let mut by_search = vec![output.short_term_tracks];
             for (config, next_id) in scene.searches.iter().zip(&mut next_track_id).skip(1) {
                 let tracks = short_term_tracks(&per_snapshot, carrier_hz, config, *next_id);
