@@ -30,7 +30,8 @@ mod pulse;
 pub mod short_term;
 
 pub use config::{
-    CandidateGate, DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig, ShortTermPrediction,
+    CandidateGate, DelayRate, DetectionConfig, LongTermConfig, MpcConfig, NoiseFloor, ShortTermConfig,
+    ShortTermPrediction,
 };
 pub use detect::{Detector, SnapshotDetections};
 pub use error::MpcError;

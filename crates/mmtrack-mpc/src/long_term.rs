@@ -56,7 +56,7 @@
 
 use mmtrack_core::{MpcLongTermEntry, MpcTrack};
 
-use crate::{CandidateGate, LongTermConfig, MpcError};
+use crate::{CandidateGate, DelayRate, LongTermConfig, MpcError};
 
 /// A full-lifetime track as long-term tracking sees it: `q_k` of eq. (34)
 /// plus its identity and mean time.
@@ -99,6 +99,20 @@ impl TrackSummary {
     }
 }
 
+impl From<&MpcLongTermEntry> for TrackSummary {
+    /// The summary a long-term entry was made from.
+    fn from(e: &MpcLongTermEntry) -> Self {
+        Self {
+            short_track_id: e.short_track_id,
+            set_index: e.set_index,
+            t_ns: e.t_ns,
+            mean_delay_s: e.mean_delay_s,
+            mean_power_db: e.mean_power_db,
+            doppler_hz: e.doppler_hz,
+        }
+    }
+}
+
 /// `a / b` rounded to the nearest integer (halves away from zero), `b > 0`.
 fn div_round(a: i128, b: i128) -> i128 {
     let q = a.div_euclid(b);
@@ -130,12 +144,115 @@ impl LongTermLink {
     }
 }
 
+/// The first step of eqs. (35)-(42) a pair of tracks fails.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LinkRefusal {
+    /// Their mean powers differ by more than `xi_a` (eq. (36)).
+    MagnitudeGate,
+    /// The candidate's delay is outside the gate of eq. (35).
+    DelayGate,
+    /// A two-way prediction error exceeds the largest class (eqs. (40)-(42)).
+    TwoWayCheck,
+}
+
+/// A candidate of the next set as steps 1-2 see it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// `T_r = t_c - t_k`, seconds.
+    pub t_r_s: f64,
+    /// Forward prediction error `d_r = |tau~_r - tau_c|`, seconds (eq. (41)).
+    pub forward_error_s: f64,
+}
+
+/// Steps 1-2 for the open track `q_k`, predicted with the delay rate
+/// `rate_k` (s/s; see [`forward_delay_rate`]), and the track `q_c` of a
+/// later set: the gates of eqs. (35)-(36) and the forward prediction error
+/// of eqs. (37) and (41).
+///
+/// # Errors
+/// [`LinkRefusal::MagnitudeGate`] or [`LinkRefusal::DelayGate`].
+pub fn candidate(
+    q_k: &TrackSummary,
+    rate_k: f64,
+    q_c: &TrackSummary,
+    config: &LongTermConfig,
+) -> Result<Candidate, LinkRefusal> {
+    if (q_c.mean_power_db - q_k.mean_power_db).abs() > config.magnitude_gate_db {
+        return Err(LinkRefusal::MagnitudeGate);
+    }
+    let t_r_s = (i128::from(q_c.t_ns) - i128::from(q_k.t_ns)) as f64 * 1e-9;
+    let predicted_s = q_k.mean_delay_s + rate_k * t_r_s;
+    let gated_from_s = match config.candidate_gate {
+        CandidateGate::RawDelay => q_k.mean_delay_s,
+        CandidateGate::PredictedDelay => predicted_s,
+    };
+    if (q_c.mean_delay_s - gated_from_s).abs() > config.delay_gate_s {
+        return Err(LinkRefusal::DelayGate);
+    }
+    Ok(Candidate { t_r_s, forward_error_s: (predicted_s - q_c.mean_delay_s).abs() })
+}
+
+/// Steps 4-5 for `q_k` and its closest candidate `q_eta` (`found` by
+/// [`candidate`]): the backward prediction of eq. (39) with `q_eta`'s own
+/// Doppler and the check of eqs. (40)-(42). Returns `(d_k, chi)`.
+///
+/// # Errors
+/// [`LinkRefusal::TwoWayCheck`].
+pub fn two_way_check(
+    q_k: &TrackSummary,
+    q_eta: &TrackSummary,
+    found: Candidate,
+    carrier_hz: f64,
+    config: &LongTermConfig,
+) -> Result<(f64, f64), LinkRefusal> {
+    let back_predicted_s = q_eta.mean_delay_s + q_eta.doppler_hz / carrier_hz * found.t_r_s;
+    let backward_error_s = (back_predicted_s - q_k.mean_delay_s).abs();
+    let worst = found.forward_error_s.max(backward_error_s);
+    let chi_class_s = config.chi_classes_s.iter().find(|&&chi| worst <= chi).ok_or(LinkRefusal::TwoWayCheck)?;
+    Ok((backward_error_s, *chi_class_s))
+}
+
+/// The delay rate (s/s) `q_k` is predicted forward with
+/// ([`LongTermConfig::delay_rate`]): `-nu_k / f_c` (eq. (31)) for the
+/// paper's [`DelayRate::TrackDoppler`] or a track without a predecessor,
+/// else for [`DelayRate::ChainSlope`] the slope of the mean delays from its
+/// long-term predecessor `q_p`.
+#[must_use]
+pub fn forward_delay_rate(
+    q_k: &TrackSummary,
+    predecessor: Option<&TrackSummary>,
+    carrier_hz: f64,
+    rate: DelayRate,
+) -> f64 {
+    match (rate, predecessor) {
+        (DelayRate::ChainSlope, Some(q_p)) if q_k.t_ns != q_p.t_ns => {
+            (q_k.mean_delay_s - q_p.mean_delay_s) / ((i128::from(q_k.t_ns) - i128::from(q_p.t_ns)) as f64 * 1e-9)
+        }
+        _ => -q_k.doppler_hz / carrier_hz,
+    }
+}
+
 /// Relates the tracks of the current set to those of the next set (steps
-/// 1-5 of the module docs). Links come in the order they were made
-/// (strongest current track first); each `next` index appears at most once.
+/// 1-5 of the module docs), each current track predicted with its Doppler
+/// (the paper's). Links come in the order they were made (strongest
+/// current track first); each `next` index appears at most once.
 #[must_use]
 pub fn relate_sets(
     current: &[TrackSummary],
+    next: &[TrackSummary],
+    carrier_hz: f64,
+    config: &LongTermConfig,
+) -> Vec<LongTermLink> {
+    let rates: Vec<f64> = current.iter().map(|q| -q.doppler_hz / carrier_hz).collect();
+    relate_sets_at_rates(current, &rates, next, carrier_hz, config)
+}
+
+/// [`relate_sets`] with the forward delay rate (s/s) of each current track
+/// given (`rates[k]` for `current[k]`, from [`forward_delay_rate`]).
+#[must_use]
+pub fn relate_sets_at_rates(
+    current: &[TrackSummary],
+    rates: &[f64],
     next: &[TrackSummary],
     carrier_hz: f64,
     config: &LongTermConfig,
@@ -149,32 +266,39 @@ pub fn relate_sets(
     let mut links = Vec::new();
     for k in order {
         let q_k = &current[k];
-        // (index, T_r, forward prediction error d_r) of each candidate.
         let closest = next
             .iter()
             .enumerate()
-            .filter(|&(c, q_c)| !taken[c] && (q_c.mean_power_db - q_k.mean_power_db).abs() <= config.magnitude_gate_db)
-            .map(|(c, q_c)| {
-                let t_r_s = (i128::from(q_c.t_ns) - i128::from(q_k.t_ns)) as f64 * 1e-9;
-                let predicted_s = q_k.mean_delay_s - q_k.doppler_hz / carrier_hz * t_r_s;
-                let gated_from_s = match config.candidate_gate {
-                    CandidateGate::RawDelay => q_k.mean_delay_s,
-                    CandidateGate::PredictedDelay => predicted_s,
-                };
-                (c, t_r_s, (predicted_s - q_c.mean_delay_s).abs(), (q_c.mean_delay_s - gated_from_s).abs())
-            })
-            .filter(|&(_, _, _, gate_distance_s)| gate_distance_s <= config.delay_gate_s)
-            .min_by(|x, y| x.2.total_cmp(&y.2).then(x.0.cmp(&y.0)));
-        let Some((eta, t_r_s, forward_error_s, _)) = closest else { continue };
-        let q_eta = &next[eta];
-        let back_predicted_s = q_eta.mean_delay_s + q_eta.doppler_hz / carrier_hz * t_r_s;
-        let backward_error_s = (back_predicted_s - q_k.mean_delay_s).abs();
-        let worst = forward_error_s.max(backward_error_s);
-        let Some(&chi_class_s) = config.chi_classes_s.iter().find(|&&chi| worst <= chi) else { continue };
+            .filter(|&(c, _)| !taken[c])
+            .filter_map(|(c, q_c)| candidate(q_k, rates[k], q_c, config).ok().map(|found| (c, found)))
+            .min_by(|x, y| x.1.forward_error_s.total_cmp(&y.1.forward_error_s).then(x.0.cmp(&y.0)));
+        let Some((eta, found)) = closest else { continue };
+        let Ok((backward_error_s, chi_class_s)) = two_way_check(q_k, &next[eta], found, carrier_hz, config) else {
+            continue;
+        };
         taken[eta] = true;
-        links.push(LongTermLink { current: k, next: eta, forward_error_s, backward_error_s, chi_class_s });
+        links.push(LongTermLink {
+            current: k,
+            next: eta,
+            forward_error_s: found.forward_error_s,
+            backward_error_s,
+            chi_class_s,
+        });
     }
     links
+}
+
+/// A long-term track waiting for its successor.
+#[derive(Debug, Clone)]
+struct OpenTrack {
+    /// Its last entry.
+    summary: TrackSummary,
+    /// Its long-term id.
+    long_track_id: u64,
+    /// Sets missed since `summary` (0: the previous set's tracks).
+    missed_sets: u32,
+    /// Its forward delay rate, s/s ([`forward_delay_rate`]).
+    rate: f64,
 }
 
 /// Chains [`relate_sets`] over a stream of sets into long-term tracks.
@@ -187,9 +311,7 @@ pub struct LongTermTracker {
     config: LongTermConfig,
     carrier_hz: f64,
     next_long_id: u64,
-    /// Open tracks: summary, long-term id, sets missed since (0: the
-    /// previous set's tracks).
-    previous: Vec<(TrackSummary, u64, u32)>,
+    previous: Vec<OpenTrack>,
 }
 
 impl LongTermTracker {
@@ -223,14 +345,16 @@ impl LongTermTracker {
         let mut link_of: Vec<Option<LongTermLink>> = vec![None; summaries.len()];
         let mut continued = vec![false; self.previous.len()];
         for missed in 0..=self.config.max_missed_sets {
-            let open: Vec<usize> = (0..self.previous.len()).filter(|&k| self.previous[k].2 == missed).collect();
+            let open: Vec<usize> =
+                (0..self.previous.len()).filter(|&k| self.previous[k].missed_sets == missed).collect();
             let free: Vec<usize> = (0..summaries.len()).filter(|&c| link_of[c].is_none()).collect();
             if open.is_empty() || free.is_empty() {
                 continue;
             }
-            let current: Vec<TrackSummary> = open.iter().map(|&k| self.previous[k].0.clone()).collect();
+            let current: Vec<TrackSummary> = open.iter().map(|&k| self.previous[k].summary.clone()).collect();
+            let rates: Vec<f64> = open.iter().map(|&k| self.previous[k].rate).collect();
             let next: Vec<TrackSummary> = free.iter().map(|&c| summaries[c].clone()).collect();
-            for link in relate_sets(&current, &next, self.carrier_hz, &self.config) {
+            for link in relate_sets_at_rates(&current, &rates, &next, self.carrier_hz, &self.config) {
                 continued[open[link.current]] = true;
                 link_of[free[link.next]] =
                     Some(LongTermLink { current: open[link.current], next: free[link.next], ..link });
@@ -239,13 +363,20 @@ impl LongTermTracker {
         let mut entries = Vec::with_capacity(summaries.len());
         let mut previous = Vec::with_capacity(summaries.len());
         for (summary, link) in summaries.into_iter().zip(&link_of) {
-            let long_track_id = match link {
-                Some(link) => self.previous[link.current].1,
+            let predecessor = link.as_ref().map(|l| &self.previous[l.current]);
+            let long_track_id = match predecessor {
+                Some(open) => open.long_track_id,
                 None => {
                     self.next_long_id += 1;
                     self.next_long_id - 1
                 }
             };
+            let rate = forward_delay_rate(
+                &summary,
+                predecessor.map(|open| &open.summary),
+                self.carrier_hz,
+                self.config.delay_rate,
+            );
             entries.push(MpcLongTermEntry {
                 long_track_id,
                 set_index: summary.set_index,
@@ -257,12 +388,12 @@ impl LongTermTracker {
                 link_error_s: link.as_ref().map(LongTermLink::error_s),
                 chi_class_s: link.as_ref().map(|l| l.chi_class_s),
             });
-            previous.push((summary, long_track_id, 0));
+            previous.push(OpenTrack { summary, long_track_id, missed_sets: 0, rate });
         }
         // Open tracks without a successor wait while they may miss more sets.
         for (open, continued) in self.previous.drain(..).zip(continued) {
-            if !continued && open.2 < self.config.max_missed_sets {
-                previous.push((open.0, open.1, open.2 + 1));
+            if !continued && open.missed_sets < self.config.max_missed_sets {
+                previous.push(OpenTrack { missed_sets: open.missed_sets + 1, ..open });
             }
         }
         self.previous = previous;

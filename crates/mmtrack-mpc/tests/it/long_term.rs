@@ -4,7 +4,7 @@
 use mmtrack_core::{Complex64, MpcDetection, MpcTrack};
 use mmtrack_mpc::long_term::{TrackSummary, relate_sets};
 use mmtrack_mpc::short_term::doppler_hz;
-use mmtrack_mpc::{CandidateGate, LongTermConfig, LongTermTracker, MpcError};
+use mmtrack_mpc::{CandidateGate, DelayRate, LongTermConfig, LongTermTracker, MpcError};
 
 use crate::common::CARRIER_HZ;
 
@@ -233,6 +233,66 @@ fn the_doppler_gated_variant_with_a_one_set_gap_keeps_a_fast_path_whole_where_th
     let (fast, slow) = ids_of_a_fast_path_with_a_missing_set(variant(CandidateGate::PredictedDelay, 1));
     assert_eq!((fast.len(), distinct(&fast)), (9, 1), "{fast:?}");
     assert_eq!(distinct(&slow), 1, "{slow:?}");
+}
+
+/// A full-lifetime track of set `set` whose mean delay is
+/// `tau0 + rate t_mid + offset_s` (`t_mid` its mean time) and whose delays
+/// within the set run at `in_set_rate` (its Doppler is `-in_set_rate f_c`):
+/// a noisy set as eq. (30) sees it.
+fn noisy_track(id: u64, set: u64, tau0_s: f64, rate: f64, in_set_rate: f64, offset_s: f64) -> MpcTrack {
+    let t_mid_ns = set as i64 * SET_NS + 5 * SNAPSHOT_NS / 2;
+    let detections: Vec<MpcDetection> = (0..6u32)
+        .map(|n| {
+            let t_ns = set as i64 * SET_NS + i64::from(n) * SNAPSHOT_NS;
+            MpcDetection {
+                t_ns,
+                set_index: set,
+                snapshot_index: n,
+                delay_s: tau0_s
+                    + rate * t_mid_ns as f64 * 1e-9
+                    + in_set_rate * (t_ns - t_mid_ns) as f64 * 1e-9
+                    + offset_s,
+                amplitude: Complex64::from_polar(1e-5, 0.0),
+            }
+        })
+        .collect();
+    MpcTrack { track_id: id, doppler_hz: doppler_hz(&detections, CARRIER_HZ), detections }
+}
+
+#[test]
+fn the_chain_slope_links_a_set_whose_own_doppler_misses_the_next_set_by_more_than_the_class() {
+    // A path closing at 1 ns per 10 ms set. Set 1's in-set slope says 1.7 ns
+    // per 10 ms (eq. (30)'s noise), set 2's mean delay is 0.4 ns late: set
+    // 1's Doppler predicts set 2 1.1 ns off (outside the 1 ns gate and
+    // class); the slope of set 0 -> 1 predicts it 0.4 ns off, and set 2's
+    // own Doppler back to set 1 is 0.4 ns off (the two-way check holds).
+    let rate = -1e-7;
+    let sets = || {
+        vec![
+            noisy_track(0, 0, 60e-9, rate, rate, 0.0),
+            noisy_track(1, 1, 60e-9, rate, -1.7e-7, 0.0),
+            noisy_track(2, 2, 60e-9, rate, rate, 0.4e-9),
+            noisy_track(3, 3, 60e-9, rate, rate, 0.0),
+            noisy_track(4, 4, 60e-9, rate, rate, 0.0),
+        ]
+    };
+    let ids = |delay_rate| {
+        let config = LongTermConfig { candidate_gate: CandidateGate::PredictedDelay, delay_rate, ..Default::default() };
+        let mut lt = LongTermTracker::new(config, CARRIER_HZ, 0).unwrap();
+        sets().iter().map(|t| lt.push_set(std::slice::from_ref(t))[0].clone()).collect::<Vec<_>>()
+    };
+    let paper = ids(DelayRate::TrackDoppler);
+    assert_eq!(paper.iter().map(|e| e.long_track_id).collect::<Vec<_>>(), [0, 0, 1, 1, 1]);
+    let chain = ids(DelayRate::ChainSlope);
+    assert_eq!(chain.iter().map(|e| e.long_track_id).collect::<Vec<_>>(), [0, 0, 0, 0, 0]);
+    // The larger of the two errors per link. Set 0 -> 1: set 1's Doppler
+    // back to set 0 is 0.7 ns off (set 0 has no chain: its own Doppler
+    // forward, exact). Set 1 -> 2 through the chain: 0.4 ns both ways. Set
+    // 2 -> 3: the chain's slope carries set 2's 0.4 ns twice (0.8 ns).
+    let errors: Vec<f64> = chain.iter().skip(1).map(|e| e.link_error_s.unwrap() * 1e9).collect();
+    for (got, want) in errors.iter().zip([0.7, 0.4, 0.8, 0.4]) {
+        assert!((got - want).abs() < 1e-6, "{errors:?}");
+    }
 }
 
 #[test]

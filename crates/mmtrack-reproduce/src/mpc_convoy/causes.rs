@@ -42,8 +42,9 @@ use std::collections::{BTreeMap, BTreeSet};
 
 use mmtrack_analysis::mpc::{match_detections, resolvable_truth};
 use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTruth};
+use mmtrack_mpc::long_term::{LinkRefusal, TrackSummary, candidate, forward_delay_rate, two_way_check};
 use mmtrack_mpc::short_term::extrapolate;
-use mmtrack_mpc::{CandidateGate, LongTermConfig, ShortTermConfig};
+use mmtrack_mpc::{LongTermConfig, ShortTermConfig};
 
 /// Margin of the detection threshold over the noise floor, dB (Sec. III-A).
 const FLOOR_MARGIN_DB: f64 = 6.0;
@@ -362,6 +363,14 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
         }
     }
     let first_set = t.sets.iter().map(|s| s.set_index).min();
+    let mut chains: BTreeMap<u64, BTreeMap<u64, &MpcLongTermEntry>> = BTreeMap::new();
+    for e in t.long_term {
+        chains.entry(e.long_track_id).or_default().insert(e.set_index, e);
+    }
+    let link_cause = |a: &MpcLongTermEntry, b: &MpcLongTermEntry| {
+        let before_a = chains.get(&a.long_track_id).and_then(|c| c.range(..a.set_index).next_back()).map(|(_, e)| *e);
+        link_cause(a, before_a, b, t.config, t.carrier_hz)
+    };
     let snapshots: Vec<u32> = (0..t.snapshots_per_set).collect();
 
     // Why set `set` has no full-lifetime track on `path` (it is present).
@@ -426,7 +435,7 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
                 let later: Vec<&MpcLongTermEntry> =
                     t.long_term.iter().filter(|x| x.long_track_id == long_id && x.set_index == f).collect();
                 let cause = match (earlier.first(), later.first()) {
-                    (Some(a), Some(b)) => link_cause(a, b, t.config, t.carrier_hz),
+                    (Some(a), Some(b)) => link_cause(a, b),
                     _ => Cause::Other,
                 };
                 Birth {
@@ -443,7 +452,7 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
                 let gap: Vec<u64> = (e_set + 1..f).collect();
                 let bridge = if gap.len() as u64 <= u64::from(t.config.max_missed_sets) {
                     let later = t.long_term.iter().find(|x| x.long_track_id == long_id && x.set_index == f);
-                    earlier.first().zip(later).map(|(a, b)| link_cause(a, b, t.config, t.carrier_hz))
+                    earlier.first().zip(later).map(|(a, b)| link_cause(a, b))
                 } else {
                     None
                 };
@@ -526,33 +535,34 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
 }
 
 /// The first step of eqs. (35)-(42) the pair (`a` of set `i`, `b` of set
-/// `i + 1`) fails, or [`Cause::LinkTaken`] when it passes them all.
-fn link_cause(a: &MpcLongTermEntry, b: &MpcLongTermEntry, config: &LongTermConfig, carrier_hz: f64) -> Cause {
-    if (b.mean_power_db - a.mean_power_db).abs() > config.magnitude_gate_db {
-        return Cause::LinkMagnitudeGate;
+/// `i + 1`) fails, or [`Cause::LinkTaken`] when it passes them all;
+/// `before_a` is `a`'s long-term predecessor (for
+/// [`mmtrack_mpc::DelayRate::ChainSlope`]).
+fn link_cause(
+    a: &MpcLongTermEntry,
+    before_a: Option<&MpcLongTermEntry>,
+    b: &MpcLongTermEntry,
+    config: &LongTermConfig,
+    carrier_hz: f64,
+) -> Cause {
+    let (q_a, q_b) = (TrackSummary::from(a), TrackSummary::from(b));
+    let q_before = before_a.map(TrackSummary::from);
+    let rate = forward_delay_rate(&q_a, q_before.as_ref(), carrier_hz, config.delay_rate);
+    let refusal = candidate(&q_a, rate, &q_b, config)
+        .and_then(|found| two_way_check(&q_a, &q_b, found, carrier_hz, config))
+        .err();
+    match refusal {
+        None => Cause::LinkTaken,
+        Some(LinkRefusal::MagnitudeGate) => Cause::LinkMagnitudeGate,
+        Some(LinkRefusal::DelayGate) => Cause::LinkDelayGate,
+        Some(LinkRefusal::TwoWayCheck) => Cause::LinkTwoWayCheck,
     }
-    let t_r_s = (i128::from(b.t_ns) - i128::from(a.t_ns)) as f64 * 1e-9;
-    let predicted_s = a.mean_delay_s - a.doppler_hz / carrier_hz * t_r_s;
-    let gated_from_s = match config.candidate_gate {
-        CandidateGate::RawDelay => a.mean_delay_s,
-        CandidateGate::PredictedDelay => predicted_s,
-    };
-    if (b.mean_delay_s - gated_from_s).abs() > config.delay_gate_s {
-        return Cause::LinkDelayGate;
-    }
-    let forward = (predicted_s - b.mean_delay_s).abs();
-    let backward = (b.mean_delay_s + b.doppler_hz / carrier_hz * t_r_s - a.mean_delay_s).abs();
-    let largest = config.chi_classes_s.last().copied().unwrap_or(0.0);
-    if forward.max(backward) > largest {
-        return Cause::LinkTwoWayCheck;
-    }
-    Cause::LinkTaken
 }
 
 #[cfg(test)]
 mod tests {
     use mmtrack_core::Complex64;
-    use mmtrack_mpc::ShortTermPrediction;
+    use mmtrack_mpc::{CandidateGate, ShortTermPrediction};
 
     use super::*;
 

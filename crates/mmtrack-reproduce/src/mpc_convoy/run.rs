@@ -10,8 +10,8 @@ use mmtrack_core::{MpcDetection, MpcLongTermEntry, MpcSetStats, MpcTrack, MpcTru
 use mmtrack_io::table::MpcSummary;
 use mmtrack_mpc::short_term::is_full_lifetime;
 use mmtrack_mpc::{
-    CandidateGate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, ShortTermConfig, ShortTermPrediction,
-    SounderPulse, short_term_tracks,
+    CandidateGate, DelayRate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, ShortTermConfig,
+    ShortTermPrediction, SounderPulse, short_term_tracks,
 };
 use mmtrack_sim::sounder::{ConvoyConfig, ConvoySimulator, PathKind};
 
@@ -42,10 +42,16 @@ pub const OURS: &str = "doppler-gated+gap";
 /// line through all the track's points instead of its last two (the traced
 /// cause of the scatter-free miss: the cars' delay noise against eq. (17)).
 pub const LS_OURS: &str = "ls-search+doppler-gated+gap";
+/// Ours with the chain's delay slope ([`DelayRate::ChainSlope`]): the
+/// long-term tracker of [`OURS`] predicting a continued track from the
+/// slope of its last two mean delays (10 ms or more apart) instead of its
+/// in-set Doppler (eq. (30), 3.6 ms; the traced cause of the failed links).
+pub const CHAIN_OURS: &str = "chain-slope+gated+gap";
 
-/// The five trackers: the paper's long-term tracker, ours, each of our two
+/// The six trackers: the paper's long-term tracker, ours, each of our two
 /// long-term changes alone (which of them moves the births), all on the
-/// paper's short-term search; and ours on the least-squares search.
+/// paper's short-term search; ours on the least-squares search; and ours
+/// predicting continued tracks from the chain's delay slope.
 #[must_use]
 pub fn variants() -> Vec<Variant> {
     let with = |candidate_gate, max_missed_sets| LongTermConfig {
@@ -53,6 +59,7 @@ pub fn variants() -> Vec<Variant> {
         max_missed_sets,
         ..LongTermConfig::default()
     };
+    let chain = LongTermConfig { delay_rate: DelayRate::ChainSlope, ..with(CandidateGate::PredictedDelay, 1) };
     vec![
         Variant {
             name: LITERAL,
@@ -85,6 +92,14 @@ pub fn variants() -> Vec<Variant> {
                    long-term as doppler-gated+gap",
             config: with(CandidateGate::PredictedDelay, 1),
             short_term: ShortTermConfig { prediction: ShortTermPrediction::LeastSquares, ..ShortTermConfig::default() },
+        },
+        Variant {
+            name: CHAIN_OURS,
+            what: "ours with the chain's delay slope: a continued track predicted (eqs. (35), (37), (41)) from the \
+                   slope of its last two mean delays instead of its own Doppler; the backward prediction (39) \
+                   keeps the candidate's Doppler; otherwise as doppler-gated+gap",
+            config: chain,
+            short_term: ShortTermConfig::default(),
         },
     ]
 }
