@@ -362,6 +362,13 @@ mod tests {
     }
 
     #[test]
+    fn a_rule_prints_its_bound_with_the_unit() {
+        assert_eq!(Rule::AtMost { bound: 0.22 }.describe("deg"), "<= 0.22 deg");
+        assert_eq!(Rule::Below { bound: 5.0 }.describe("%"), "< 5 %");
+        assert_eq!(Rule::AtLeast { bound: 1.0 / 3.0 }.describe(""), ">= 0.3333");
+    }
+
+    #[test]
     fn informational_claims_do_not_set_the_outcome_and_print_their_own_words() {
         let missed =
             Verdict::decided(Claim::new("v", "", None, "-", Rule::AtLeast { bound: 1.0 }).informational(), false, "0");
