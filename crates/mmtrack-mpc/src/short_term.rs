@@ -147,11 +147,19 @@ fn identify(
         return None;
     }
     let s_hat = points[n][start];
+    // The track so far: detection indices and both components, reused from
+    // one initial candidate to the next.
+    let longest = points.len() - n;
+    let (mut path, mut a_db, mut tau_s) =
+        (Vec::with_capacity(longest), Vec::with_capacity(longest), Vec::with_capacity(longest));
     for candidate in initial_candidates(&points[n + 1], &used[n + 1], s_hat, config) {
-        let mut path = vec![start, candidate];
         let second = points[n + 1][candidate];
-        let mut a_db = vec![s_hat.a_db, second.a_db];
-        let mut tau_s = vec![s_hat.tau_s, second.tau_s];
+        path.clear();
+        path.extend([start, candidate]);
+        a_db.clear();
+        a_db.extend([s_hat.a_db, second.a_db]);
+        tau_s.clear();
+        tau_s.extend([s_hat.tau_s, second.tau_s]);
         loop {
             let m = n + path.len();
             if m >= points.len() {
