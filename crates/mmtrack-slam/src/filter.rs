@@ -104,6 +104,19 @@ pub struct SlamFilter {
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
 type Hypothesis = (f64, [f64; 5], [[f64; 5]; 5], f64);
 
+/// The midpoints the bisection of `(lo, hi)` can try `depth` steps on
+/// (`2^depth` of them; depth 0: `(lo + hi) / 2`), computed as the search
+/// computes them, so that their maxima can be taken ahead.
+fn bisection_midpoints(lo: f64, hi: f64, depth: u32) -> Vec<f64> {
+    let mid = 0.5 * (lo + hi);
+    if depth == 0 {
+        return vec![mid];
+    }
+    let mut out = bisection_midpoints(mid, hi, depth - 1);
+    out.extend(bisection_midpoints(lo, mid, depth - 1));
+    out
+}
+
 /// The UE state of a particle-state vector.
 fn ue_of(s: &[f64; STATE_DIM], z_m: f64) -> UeState {
     UeState {
@@ -314,7 +327,8 @@ impl SlamFilter {
         let paths_in_update = prepared.len();
         let stages = self.update_particles(team, prepared, k)?;
         let post = self.particles.moments(team);
-        let weights = self.particles.weights(team);
+        // The hypotheses use at most 256 particles (`SourceModel::hypotheses_of`).
+        let sample = self.particles.weighted_sample(team, 256);
 
         // Sources: confirmed ones by an iterated EKF, unconfirmed and new ones
         // by their two hypotheses.
@@ -339,9 +353,9 @@ impl SlamFilter {
             })
             .collect();
         let model = SourceModel { config: self.config.clone(), sigma_var: self.sigma_var };
-        let (states, z_m, paths_now) = (self.particles.states(), self.particles.z_m, paths.clone());
+        let (z_m, paths_now) = (self.particles.z_m, paths.clone());
         let updates = team.map(asks.len(), move |l| {
-            model.update(asks[l], &paths_now[l], (&ue_mean, &pre_cov), &post_mean, (&states, &weights, z_m))
+            model.update(asks[l], &paths_now[l], (&ue_mean, &pre_cov), &post_mean, (&sample, z_m))
         });
         let mut confirmed = Vec::new();
         for (l, ((column, score), update)) in assignment.iter().zip(updates).enumerate() {
@@ -565,9 +579,20 @@ impl SlamFilter {
             return Ok(0);
         }
         let paths: Arc<[PreparedPath]> = paths.into();
+        // A team takes two steps of the bisection per pass over the
+        // particles (`Particles::exponentials_ahead`); the leader alone one.
+        let ahead = team.members() > 1;
         // The exponents a stage tries first: all that remains, then the
-        // bisection's first midpoint. Their maxima come with the likelihood.
-        let first = |remaining: f64| vec![remaining, 0.5 * (0.0 + remaining)];
+        // bisection's first midpoint (and for a team the two after it).
+        // Their maxima come with the likelihood.
+        let first = |remaining: f64| {
+            let mut first = vec![remaining];
+            first.extend(bisection_midpoints(0.0, remaining, 0));
+            if ahead {
+                first.extend(bisection_midpoints(0.0, remaining, 1));
+            }
+            first
+        };
         // The first stage's likelihood; the resampling's pass computes the others'.
         self.particles.log_likelihood(team, &paths, &first(remaining));
         while remaining > 0.0 && stages < iterations {
@@ -578,10 +603,17 @@ impl SlamFilter {
                 remaining
             } else {
                 let (mut lo, mut hi) = (0.0, remaining);
-                for _ in 0..10 {
+                for step in 0..10 {
                     let mid = 0.5 * (lo + hi);
                     // The next step tries one of these: their maxima come with this pass.
                     let next = [0.5 * (mid + hi), 0.5 * (lo + mid)];
+                    if ahead && step + 1 < 10 {
+                        // This step's and the next's exponentials in one pass,
+                        // with the maxima of the two steps after.
+                        let mut later = bisection_midpoints(lo, hi, 2);
+                        later.extend(bisection_midpoints(lo, hi, 3));
+                        self.particles.exponentials_ahead(team, mid, next, &later);
+                    }
                     if self.particles.ess_with(team, mid, &next) >= target { lo = mid } else { hi = mid }
                 }
                 lo.max(remaining * 1e-3)
@@ -769,15 +801,15 @@ struct SourceModel {
 impl SourceModel {
     /// What `ask` finds for path `z`: the EKF with the predicted UE belief
     /// (`ue_prior`, the covariance of `[x, y, heading, bias]`) as the
-    /// message, or the hypotheses under the posterior (`ue`, the particles
-    /// and their weights).
+    /// message, or the hypotheses under the posterior (`ue`, a sample of
+    /// the particles with their weights, and the height).
     fn update(
         &self,
         ask: SourceAsk,
         z: &PathMeasurement,
         (ue_prior, p_prior): (&UeState, &Mat<f64>),
         ue: &UeState,
-        particles: (&[[f64; STATE_DIM]], &[f64], f64),
+        particles: (&[([f64; STATE_DIM], f64)], f64),
     ) -> SourceUpdate {
         match ask {
             SourceAsk::Nothing => SourceUpdate::Nothing,
@@ -850,22 +882,20 @@ impl SourceModel {
     }
 
     /// The VA and SP hypotheses of a path under the UE posterior (Sec.
-    /// IV-A): the inversion of [`invert`] per particle (a subsample of at
-    /// most 256), weighted, plus the measurement noise mapped through the
-    /// inversion at the mean.
+    /// IV-A): the inversion of [`invert`] per particle of `sample` (every
+    /// `n / 256`-th particle, [`Particles::weighted_sample`]), weighted,
+    /// plus the measurement noise mapped through the inversion at the mean.
+    ///
+    /// [`Particles::weighted_sample`]: crate::particles::Particles::weighted_sample
     fn hypotheses_of(
         &self,
         z: &PathMeasurement,
         ue: &UeState,
-        (states, weights, z_m): (&[[f64; STATE_DIM]], &[f64], f64),
+        (sample, z_m): (&[([f64; STATE_DIM], f64)], f64),
     ) -> (Option<Gauss3>, Option<Gauss3>) {
         let bs = self.config.bs_m;
-        let stride = (states.len() / 256).max(1);
         let mut acc = [Acc::default(), Acc::default()];
-        for (i, (s, w)) in states.iter().zip(weights).enumerate() {
-            if i % stride != 0 {
-                continue;
-            }
+        for (s, w) in sample {
             let (va, sp) = invert([s[0], s[1], z_m], s[2], s[5], bs, z);
             acc[0].add(*w, va);
             if let Some(sp) = sp {
