@@ -104,19 +104,6 @@ pub struct SlamFilter {
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
 type Hypothesis = (f64, [f64; 5], [[f64; 5]; 5], f64);
 
-/// The midpoints the bisection of `(lo, hi)` can try `depth` steps on
-/// (`2^depth` of them; depth 0: `(lo + hi) / 2`), computed as the search
-/// computes them, so that their maxima can be taken ahead.
-fn bisection_midpoints(lo: f64, hi: f64, depth: u32) -> Vec<f64> {
-    let mid = 0.5 * (lo + hi);
-    if depth == 0 {
-        return vec![mid];
-    }
-    let mut out = bisection_midpoints(mid, hi, depth - 1);
-    out.extend(bisection_midpoints(lo, mid, depth - 1));
-    out
-}
-
 /// The UE state of a particle-state vector.
 fn ue_of(s: &[f64; STATE_DIM], z_m: f64) -> UeState {
     UeState {
@@ -579,20 +566,9 @@ impl SlamFilter {
             return Ok(0);
         }
         let paths: Arc<[PreparedPath]> = paths.into();
-        // A team takes two steps of the bisection per pass over the
-        // particles (`Particles::exponentials_ahead`); the leader alone one.
-        let ahead = team.members() > 1;
         // The exponents a stage tries first: all that remains, then the
-        // bisection's first midpoint (and for a team the two after it).
-        // Their maxima come with the likelihood.
-        let first = |remaining: f64| {
-            let mut first = vec![remaining];
-            first.extend(bisection_midpoints(0.0, remaining, 0));
-            if ahead {
-                first.extend(bisection_midpoints(0.0, remaining, 1));
-            }
-            first
-        };
+        // bisection's first midpoint. Their maxima come with the likelihood.
+        let first = |remaining: f64| vec![remaining, 0.5 * (0.0 + remaining)];
         // The first stage's likelihood; the resampling's pass computes the others'.
         self.particles.log_likelihood(team, &paths, &first(remaining));
         while remaining > 0.0 && stages < iterations {
@@ -603,17 +579,10 @@ impl SlamFilter {
                 remaining
             } else {
                 let (mut lo, mut hi) = (0.0, remaining);
-                for step in 0..10 {
+                for _ in 0..10 {
                     let mid = 0.5 * (lo + hi);
                     // The next step tries one of these: their maxima come with this pass.
                     let next = [0.5 * (mid + hi), 0.5 * (lo + mid)];
-                    if ahead && step + 1 < 10 {
-                        // This step's and the next's exponentials in one pass,
-                        // with the maxima of the two steps after.
-                        let mut later = bisection_midpoints(lo, hi, 2);
-                        later.extend(bisection_midpoints(lo, hi, 3));
-                        self.particles.exponentials_ahead(team, mid, next, &later);
-                    }
                     if self.particles.ess_with(team, mid, &next) >= target { lo = mid } else { hi = mid }
                 }
                 lo.max(remaining * 1e-3)

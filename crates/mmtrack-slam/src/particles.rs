@@ -19,12 +19,20 @@
 //! particle and quantity; the exponentials and trigonometry they replace
 //! are tens of cycles.
 //!
+//! The systematic resampling's running weight sums are such a chain too;
+//! the picks they give (a division and a walk per particle) are found per
+//! chunk in the resampling's pass ([`Picks`]).
+//!
 //! Values a later step needs again are kept until the particles change:
 //! the maximum of `logw + delta ll` and the effective sample size per
 //! exponent `delta` (the tempering search asks for the same exponent more
 //! than once), the exponentials of the last pass, and the normalised
 //! weights. A phase that knows which exponents come next takes their maxima
-//! in the same pass.
+//! in the same pass, and a phase that writes values a later step would
+//! compute in a pass of its own writes them too: the prediction the
+//! headings' trigonometry (the log-weights, and so everything at `delta =
+//! 0`, stay valid), the resampling the trigonometry, the exponentials
+//! (all 1) and the maximum at 0 of the new particles.
 
 use std::sync::{Arc, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
@@ -58,9 +66,6 @@ pub(crate) struct Chunk {
     pub(crate) ll: Vec<f64>,
     /// `exp(logw + delta ll - max)` of the last exponential pass.
     exp: Vec<f64>,
-    /// The same at the two exponents the tempering search tries after it
-    /// ([`Particles::exponentials_ahead`]).
-    ahead: [Vec<f64>; 2],
     /// Cosine and sine of the heading.
     cos_heading: Vec<f64>,
     sin_heading: Vec<f64>,
@@ -81,7 +86,6 @@ impl Chunk {
             logw: v(),
             ll: v(),
             exp: v(),
-            ahead: [v(), v()],
             cos_heading: v(),
             sin_heading: v(),
             weight: v(),
@@ -228,8 +232,6 @@ struct Known {
     ess: Vec<(u64, f64)>,
     /// The chunks' `exp` holds `exp(logw + delta ll - max)` for this `delta` (bits).
     exp_at: Option<u64>,
-    /// The chunks' `ahead` hold the exponentials at these `delta` (bits).
-    ahead_at: [Option<u64>; 2],
     /// The chunks' `cos_heading` and `sin_heading` are current.
     trigonometry: bool,
     /// The chunks' `weight` holds the normalised weights.
@@ -268,7 +270,6 @@ impl Known {
         self.max.retain(|(d, _)| *d == zero);
         self.ess.retain(|(d, _)| *d == zero);
         self.exp_at = self.exp_at.filter(|d| *d == zero);
-        self.ahead_at = [None; 2];
         self.trigonometry = true;
     }
 }
@@ -507,16 +508,10 @@ impl Particles {
             self.known.ess.push((delta.to_bits(), 0.0));
             return 0.0;
         }
-        // The exponentials a pass ahead took, unless a pass is needed anyway.
-        let ahead = self.known.ahead_at.iter().position(|d| *d == Some(delta.to_bits()));
-        let ahead = ahead.filter(|_| prefetch.iter().all(|d| self.known.max(*d).is_some()));
-        if ahead.is_none() {
-            self.exponentials(team, delta, max, prefetch);
-        }
+        self.exponentials(team, delta, max, prefetch);
         let (mut s, mut s2) = (0.0, 0.0);
         for c in self.chunks.iter() {
-            let c = read(c);
-            for e in ahead.map_or(&c.exp, |k| &c.ahead[k]) {
+            for e in &read(c).exp {
                 s += e;
                 s2 += e * e;
             }
@@ -524,45 +519,6 @@ impl Particles {
         let ess = if s2 > 0.0 { s * s / s2 } else { 0.0 };
         self.known.ess.push((delta.to_bits(), ess));
         ess
-    }
-
-    /// Two steps of the tempering search in one pass: the exponentials of
-    /// [`Particles::ess_with`] at `delta` and at the two exponents the
-    /// search tries next (`ahead`, one of them), and the maxima at
-    /// `prefetch`; the effective sample sizes are then sums over what is
-    /// stored, taken when asked (the same values in the same order). For a
-    /// team of more than one member: a third exponential per particle
-    /// costs less than a second synchronisation (`team`). Does nothing
-    /// unless the maxima at `delta` and `ahead` are known and finite, or
-    /// when the exponentials at `delta` are already stored.
-    pub(crate) fn exponentials_ahead(&mut self, team: &Team, delta: f64, ahead: [f64; 2], prefetch: &[f64]) {
-        let bits = Some(delta.to_bits());
-        if self.known.ess(delta).is_some() || self.known.exp_at == bits || self.known.ahead_at.contains(&bits) {
-            return;
-        }
-        let Some(max) = [delta, ahead[0], ahead[1]]
-            .iter()
-            .map(|d| self.known.max(*d).filter(|m| m.is_finite()))
-            .collect::<Option<Vec<f64>>>()
-        else {
-            return;
-        };
-        let prefetch: Vec<f64> = prefetch.iter().copied().filter(|d| self.known.max(*d).is_none()).collect();
-        let (chunks, deltas) = (self.chunks.clone(), prefetch.clone());
-        let maxima = team.map(chunks.len(), move |c| {
-            let mut chunk = write(&chunks[c]);
-            let chunk = &mut *chunk;
-            let [a0, a1] = &mut chunk.ahead;
-            for ((((e, e0), e1), w), l) in chunk.exp.iter_mut().zip(a0).zip(a1).zip(&chunk.logw).zip(&chunk.ll) {
-                *e = (tempered(*w, *l, delta) - max[0]).exp();
-                *e0 = (tempered(*w, *l, ahead[0]) - max[1]).exp();
-                *e1 = (tempered(*w, *l, ahead[1]) - max[2]).exp();
-            }
-            chunk.max_at(&deltas)
-        });
-        self.known.exp_at = bits;
-        self.known.ahead_at = ahead.map(|d| Some(d.to_bits()));
-        self.known.set_max(&prefetch, &max_over(&maxima, prefetch.len()));
     }
 
     /// `exp(logw + delta ll - max)` of every particle into the chunks'

@@ -167,11 +167,6 @@ impl Team {
         Self { shared: None, members: 1, generation: 0.into(), phases: 0.into() }
     }
 
-    /// The leader and its helpers (1: the leader alone).
-    pub(crate) fn members(&self) -> usize {
-        self.members
-    }
-
     /// Phases run with more than one task, or that would have on a team of
     /// helpers.
     pub(crate) fn phases(&self) -> u64 {

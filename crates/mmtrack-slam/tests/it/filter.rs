@@ -34,15 +34,11 @@ fn same_seed_same_run_for_any_thread_count() {
             (reports, filter.sources().to_vec(), filter.parallel_phases())
         })
     };
-    let (one, two, three) = (in_pool(1), in_pool(2), in_pool(3));
-    assert!(one.0 == two.0 && one.0 == three.0, "reports differ between 1, 2 and 3 threads");
-    assert!(one.1 == two.1 && one.1 == three.1, "maps differ between 1, 2 and 3 threads");
-    // Tens of parallel phases per epoch; a team of more than one member
-    // takes two steps of the tempering search per phase, so fewer, the
-    // same on 2 and 3 threads.
+    let one = in_pool(1);
+    // Tens of parallel phases per epoch (the same count on any pool).
     assert!(one.2 > 10 * r.epochs.len() as u64, "{} phases", one.2);
-    assert!(two.2 < one.2, "{} phases on 2 threads, {} on one", two.2, one.2);
-    assert_eq!(two.2, three.2);
+    assert_eq!(one, in_pool(2));
+    assert_eq!(one, in_pool(3));
     // A different seed gives a different run.
     let mut other = SlamFilter::new(config.clone(), r.truth[0].ue, 10).unwrap();
     let reports: Vec<_> = r.epochs.iter().map(|e| other.step(e).unwrap()).collect();
