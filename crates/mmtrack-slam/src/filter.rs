@@ -265,7 +265,7 @@ impl SlamFilter {
         self.epoch += 1;
 
         let prior = self.particles.moments(team);
-        let assignment = self.associate(&paths, &prior, k)?;
+        let assignment = self.associate(team, &paths, &prior, k)?;
         let mut associations = Vec::with_capacity(paths.len());
         let mut init_path = None;
         if !self.initialised {
@@ -400,9 +400,12 @@ impl SlamFilter {
 
     /// `log S^D_lm` of eq. (3)-(5) for every (path, source) pair, the
     /// unconfirmed sources as the mixture (4) of their two hypotheses, then
-    /// the assignment (7). Returns `(column, log S)` per path.
+    /// the assignment (7). Returns `(column, log S)` per path. Each
+    /// source's predicted paths (a linearisation and a `5 x 5` inverse per
+    /// hypothesis) are one task on `team`.
     fn associate(
         &self,
+        team: &Team,
         paths: &[PathMeasurement],
         prior: &Moments,
         k: usize,
@@ -411,35 +414,33 @@ impl SlamFilter {
         let p_s = meas_cov(&prior.cov);
         let log_pd = (self.config.detection_probability / (1.0 - self.config.detection_probability)).ln();
         // Per source: its hypotheses as (weight, eta, S^-1, ln det S).
-        let mut predicted: Vec<Vec<Hypothesis>> = Vec::with_capacity(self.sources.len());
-        for source in &self.sources {
-            let mut hyps = Vec::new();
-            let mut push = |w: f64, kind: SourceType, g: &Gauss3| {
-                if let Some((eta, h_ue, h_src)) = jacobians(&ue, self.config.bs_m, kind, g.mean_m) {
-                    let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
-                    for i in 0..5 {
-                        s[(i, i)] += self.sigma_var[i];
-                    }
-                    if let Some((inv, log_det)) = spd_inverse(&s) {
-                        hyps.push((w, eta, to5(&inv), log_det));
-                    }
+        let asked: Vec<Vec<(f64, SourceType, Gauss3)>> = self
+            .sources
+            .iter()
+            .map(|source| match source.status {
+                SourceStatus::BaseStation => vec![(1.0, SourceType::BaseStation, source.belief)],
+                SourceStatus::VirtualAnchor => vec![(1.0, SourceType::VirtualAnchor, source.belief)],
+                SourceStatus::ScatteringPoint => vec![(1.0, SourceType::ScatteringPoint, source.belief)],
+                SourceStatus::Unconfirmed => source.hypotheses.as_ref().map_or_else(Vec::new, |h| {
+                    let mut hyps = vec![(0.5, SourceType::VirtualAnchor, h.va_last)];
+                    hyps.extend(h.sp_last.map(|sp| (0.5, SourceType::ScatteringPoint, sp)));
+                    hyps
+                }),
+            })
+            .collect();
+        let (bs_m, sigma_var) = (self.config.bs_m, self.sigma_var);
+        let predicted: Vec<Vec<Hypothesis>> = team.map(asked.len(), move |m| {
+            let predict = |(w, kind, g): &(f64, SourceType, Gauss3)| {
+                let (eta, h_ue, h_src) = jacobians(&ue, bs_m, *kind, g.mean_m)?;
+                let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
+                for i in 0..5 {
+                    s[(i, i)] += sigma_var[i];
                 }
+                let (inv, log_det) = spd_inverse(&s)?;
+                Some((*w, eta, to5(&inv), log_det))
             };
-            match source.status {
-                SourceStatus::BaseStation => push(1.0, SourceType::BaseStation, &source.belief),
-                SourceStatus::VirtualAnchor => push(1.0, SourceType::VirtualAnchor, &source.belief),
-                SourceStatus::ScatteringPoint => push(1.0, SourceType::ScatteringPoint, &source.belief),
-                SourceStatus::Unconfirmed => {
-                    if let Some(h) = &source.hypotheses {
-                        push(0.5, SourceType::VirtualAnchor, &h.va_last);
-                        if let Some(sp) = &h.sp_last {
-                            push(0.5, SourceType::ScatteringPoint, sp);
-                        }
-                    }
-                }
-            }
-            predicted.push(hyps);
-        }
+            asked[m].iter().filter_map(predict).collect()
+        });
         let norm = 2.5 * std::f64::consts::TAU.ln();
         // Before the UE is initialised only the BS is in the map, and a wrong
         // LOS cannot be undone: the LOS must be the shortest path (triangle
