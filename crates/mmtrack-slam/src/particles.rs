@@ -300,8 +300,7 @@ impl Picks {
         let mut sum = 0.0;
         cum.push(sum);
         for w in weights.clone().take(n) {
-            // `!(w >= 0)`: also NaN.
-            if !(w >= 0.0) {
+            if w.is_nan() || w < 0.0 {
                 return Self::Walked(walk(weights, n, u0));
             }
             sum += w;
