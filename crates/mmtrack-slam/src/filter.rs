@@ -265,7 +265,7 @@ impl SlamFilter {
         self.epoch += 1;
 
         let prior = self.particles.moments(team);
-        let assignment = self.associate(&paths, &prior, k)?;
+        let assignment = self.associate(team, &paths, &prior, k)?;
         let mut associations = Vec::with_capacity(paths.len());
         let mut init_path = None;
         if !self.initialised {
@@ -314,7 +314,8 @@ impl SlamFilter {
         let paths_in_update = prepared.len();
         let stages = self.update_particles(team, prepared, k)?;
         let post = self.particles.moments(team);
-        let weights = self.particles.weights(team);
+        // The hypotheses use at most 256 particles (`SourceModel::hypotheses_of`).
+        let sample = self.particles.weighted_sample(team, 256);
 
         // Sources: confirmed ones by an iterated EKF, unconfirmed and new ones
         // by their two hypotheses.
@@ -339,9 +340,9 @@ impl SlamFilter {
             })
             .collect();
         let model = SourceModel { config: self.config.clone(), sigma_var: self.sigma_var };
-        let (states, z_m, paths_now) = (self.particles.states(), self.particles.z_m, paths.clone());
+        let (z_m, paths_now) = (self.particles.z_m, paths.clone());
         let updates = team.map(asks.len(), move |l| {
-            model.update(asks[l], &paths_now[l], (&ue_mean, &pre_cov), &post_mean, (&states, &weights, z_m))
+            model.update(asks[l], &paths_now[l], (&ue_mean, &pre_cov), &post_mean, (&sample, z_m))
         });
         let mut confirmed = Vec::new();
         for (l, ((column, score), update)) in assignment.iter().zip(updates).enumerate() {
@@ -399,9 +400,12 @@ impl SlamFilter {
 
     /// `log S^D_lm` of eq. (3)-(5) for every (path, source) pair, the
     /// unconfirmed sources as the mixture (4) of their two hypotheses, then
-    /// the assignment (7). Returns `(column, log S)` per path.
+    /// the assignment (7). Returns `(column, log S)` per path. Each
+    /// source's predicted paths (a linearisation and a `5 x 5` inverse per
+    /// hypothesis) are one task on `team`.
     fn associate(
         &self,
+        team: &Team,
         paths: &[PathMeasurement],
         prior: &Moments,
         k: usize,
@@ -410,35 +414,33 @@ impl SlamFilter {
         let p_s = meas_cov(&prior.cov);
         let log_pd = (self.config.detection_probability / (1.0 - self.config.detection_probability)).ln();
         // Per source: its hypotheses as (weight, eta, S^-1, ln det S).
-        let mut predicted: Vec<Vec<Hypothesis>> = Vec::with_capacity(self.sources.len());
-        for source in &self.sources {
-            let mut hyps = Vec::new();
-            let mut push = |w: f64, kind: SourceType, g: &Gauss3| {
-                if let Some((eta, h_ue, h_src)) = jacobians(&ue, self.config.bs_m, kind, g.mean_m) {
-                    let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
-                    for i in 0..5 {
-                        s[(i, i)] += self.sigma_var[i];
-                    }
-                    if let Some((inv, log_det)) = spd_inverse(&s) {
-                        hyps.push((w, eta, to5(&inv), log_det));
-                    }
+        let asked: Vec<Vec<(f64, SourceType, Gauss3)>> = self
+            .sources
+            .iter()
+            .map(|source| match source.status {
+                SourceStatus::BaseStation => vec![(1.0, SourceType::BaseStation, source.belief)],
+                SourceStatus::VirtualAnchor => vec![(1.0, SourceType::VirtualAnchor, source.belief)],
+                SourceStatus::ScatteringPoint => vec![(1.0, SourceType::ScatteringPoint, source.belief)],
+                SourceStatus::Unconfirmed => source.hypotheses.as_ref().map_or_else(Vec::new, |h| {
+                    let mut hyps = vec![(0.5, SourceType::VirtualAnchor, h.va_last)];
+                    hyps.extend(h.sp_last.map(|sp| (0.5, SourceType::ScatteringPoint, sp)));
+                    hyps
+                }),
+            })
+            .collect();
+        let (bs_m, sigma_var) = (self.config.bs_m, self.sigma_var);
+        let predicted: Vec<Vec<Hypothesis>> = team.map(asked.len(), move |m| {
+            let predict = |(w, kind, g): &(f64, SourceType, Gauss3)| {
+                let (eta, h_ue, h_src) = jacobians(&ue, bs_m, *kind, g.mean_m)?;
+                let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
+                for i in 0..5 {
+                    s[(i, i)] += sigma_var[i];
                 }
+                let (inv, log_det) = spd_inverse(&s)?;
+                Some((*w, eta, to5(&inv), log_det))
             };
-            match source.status {
-                SourceStatus::BaseStation => push(1.0, SourceType::BaseStation, &source.belief),
-                SourceStatus::VirtualAnchor => push(1.0, SourceType::VirtualAnchor, &source.belief),
-                SourceStatus::ScatteringPoint => push(1.0, SourceType::ScatteringPoint, &source.belief),
-                SourceStatus::Unconfirmed => {
-                    if let Some(h) = &source.hypotheses {
-                        push(0.5, SourceType::VirtualAnchor, &h.va_last);
-                        if let Some(sp) = &h.sp_last {
-                            push(0.5, SourceType::ScatteringPoint, sp);
-                        }
-                    }
-                }
-            }
-            predicted.push(hyps);
-        }
+            asked[m].iter().filter_map(predict).collect()
+        });
         let norm = 2.5 * std::f64::consts::TAU.ln();
         // Before the UE is initialised only the BS is in the map, and a wrong
         // LOS cannot be undone: the LOS must be the shortest path (triangle
@@ -769,15 +771,15 @@ struct SourceModel {
 impl SourceModel {
     /// What `ask` finds for path `z`: the EKF with the predicted UE belief
     /// (`ue_prior`, the covariance of `[x, y, heading, bias]`) as the
-    /// message, or the hypotheses under the posterior (`ue`, the particles
-    /// and their weights).
+    /// message, or the hypotheses under the posterior (`ue`, a sample of
+    /// the particles with their weights, and the height).
     fn update(
         &self,
         ask: SourceAsk,
         z: &PathMeasurement,
         (ue_prior, p_prior): (&UeState, &Mat<f64>),
         ue: &UeState,
-        particles: (&[[f64; STATE_DIM]], &[f64], f64),
+        particles: (&[([f64; STATE_DIM], f64)], f64),
     ) -> SourceUpdate {
         match ask {
             SourceAsk::Nothing => SourceUpdate::Nothing,
@@ -850,22 +852,20 @@ impl SourceModel {
     }
 
     /// The VA and SP hypotheses of a path under the UE posterior (Sec.
-    /// IV-A): the inversion of [`invert`] per particle (a subsample of at
-    /// most 256), weighted, plus the measurement noise mapped through the
-    /// inversion at the mean.
+    /// IV-A): the inversion of [`invert`] per particle of `sample` (every
+    /// `n / 256`-th particle, [`Particles::weighted_sample`]), weighted,
+    /// plus the measurement noise mapped through the inversion at the mean.
+    ///
+    /// [`Particles::weighted_sample`]: crate::particles::Particles::weighted_sample
     fn hypotheses_of(
         &self,
         z: &PathMeasurement,
         ue: &UeState,
-        (states, weights, z_m): (&[[f64; STATE_DIM]], &[f64], f64),
+        (sample, z_m): (&[([f64; STATE_DIM], f64)], f64),
     ) -> (Option<Gauss3>, Option<Gauss3>) {
         let bs = self.config.bs_m;
-        let stride = (states.len() / 256).max(1);
         let mut acc = [Acc::default(), Acc::default()];
-        for (i, (s, w)) in states.iter().zip(weights).enumerate() {
-            if i % stride != 0 {
-                continue;
-            }
+        for (s, w) in sample {
             let (va, sp) = invert([s[0], s[1], z_m], s[2], s[5], bs, z);
             acc[0].add(*w, va);
             if let Some(sp) = sp {

@@ -68,8 +68,9 @@
 //! Particles live in structure-of-arrays chunks of 256. An epoch is one
 //! parallel region: a team of the calling thread and one helper per other
 //! thread of the rayon pool runs the per-particle phases (prediction,
-//! likelihood, weights, moments, resampling and jitter) and the paths'
-//! source updates, the calling thread alone the serial steps in between
+//! likelihood, weights, moments, resampling and jitter), the association's
+//! per-source predictions and the paths' source updates, the calling
+//! thread alone the serial steps in between
 //! (`team`). Every random draw comes from a stream seeded by `(seed, epoch,
 //! stage, chunk)` and every sum that reaches the output is taken in
 //! particle order, so a run is identical for any thread count, and to a

@@ -19,12 +19,20 @@
 //! particle and quantity; the exponentials and trigonometry they replace
 //! are tens of cycles.
 //!
+//! The systematic resampling's running weight sums are such a chain too;
+//! the picks they give (a division and a walk per particle) are found per
+//! chunk in the resampling's pass ([`Picks`]).
+//!
 //! Values a later step needs again are kept until the particles change:
 //! the maximum of `logw + delta ll` and the effective sample size per
 //! exponent `delta` (the tempering search asks for the same exponent more
 //! than once), the exponentials of the last pass, and the normalised
 //! weights. A phase that knows which exponents come next takes their maxima
-//! in the same pass.
+//! in the same pass, and a phase that writes values a later step would
+//! compute in a pass of its own writes them too: the prediction the
+//! headings' trigonometry (the log-weights, and so everything at `delta =
+//! 0`, stay valid), the resampling the trigonometry, the exponentials
+//! (all 1) and the maximum at 0 of the new particles.
 
 use std::sync::{Arc, PoisonError, RwLock, RwLockReadGuard, RwLockWriteGuard};
 
@@ -252,6 +260,99 @@ impl Known {
         let trigonometry = self.trigonometry;
         *self = Self { trigonometry, ..Self::default() };
     }
+
+    /// The states moved (the prediction) and their trigonometry was taken
+    /// in the same pass; the log-weights did not change, so what depends on
+    /// them alone (the values at `delta = 0`: maximum, effective sample
+    /// size, exponentials, normalised weights) stays.
+    fn states_moved(&mut self) {
+        let zero = 0f64.to_bits();
+        self.max.retain(|(d, _)| *d == zero);
+        self.ess.retain(|(d, _)| *d == zero);
+        self.exp_at = self.exp_at.filter(|d| *d == zero);
+        self.trigonometry = true;
+    }
+}
+
+/// The picks of the systematic resampling: output particle `i` takes the
+/// first `j` whose running weight sum reaches `u0 + i / n` (the last
+/// particle when none does).
+///
+/// The running sums are taken in particle order (a chain of adds, the
+/// only serial part); each chunk of outputs then finds its picks by a
+/// binary search for its first output and a walk for the rest, on the
+/// team. The sums of non-negative weights do not decrease, which the
+/// search needs; with a negative or NaN weight the picks are made by the
+/// sequential walk over all outputs instead. Either way they equal the
+/// walk's: `j` advances past `j` while `j + 1 < n` and the sum up to and
+/// including `w_j` is below `u`, the same adds in the same order.
+#[derive(Debug)]
+enum Picks {
+    /// `cum[k]` is the sum of the first `k` weights (`cum[0] = 0`).
+    Search { cum: Vec<f64>, n: usize, u0: f64 },
+    /// A weight is negative or NaN: every pick, by the sequential walk.
+    Walked(Vec<usize>),
+}
+
+impl Picks {
+    fn new(weights: impl Iterator<Item = f64> + Clone, n: usize, u0: f64) -> Self {
+        let mut cum = Vec::with_capacity(n + 1);
+        let mut sum = 0.0;
+        cum.push(sum);
+        for w in weights.clone().take(n) {
+            if w.is_nan() || w < 0.0 {
+                return Self::Walked(walk(weights, n, u0));
+            }
+            sum += w;
+            cum.push(sum);
+        }
+        cum.resize(n + 1, sum);
+        Self::Search { cum, n, u0 }
+    }
+
+    /// The picks of outputs `first..first + len`.
+    fn chunk(&self, first: usize, len: usize) -> Vec<usize> {
+        match self {
+            Self::Walked(picked) => picked[first..first + len].to_vec(),
+            Self::Search { cum, n, u0 } => {
+                let n = *n;
+                let u = |i: usize| u0 + i as f64 / n as f64;
+                // First `j` in `0..n - 1` with `cum[j + 1] >= u`, else `n - 1`.
+                let advances = |j: usize, u: f64| j + 1 < n && cum[j + 1] < u;
+                let mut j = cum[1..n].partition_point(|c| *c < u(first));
+                let mut out = Vec::with_capacity(len);
+                for i in first..first + len {
+                    let u = u(i);
+                    while advances(j, u) {
+                        j += 1;
+                    }
+                    out.push(j);
+                }
+                out
+            }
+        }
+    }
+}
+
+/// The systematic resampling's sequential walk over the weights in
+/// particle order: for each output `i`, `u = u0 + i / n`, `j` advances
+/// while `j + 1 < n` and `cum + w_j < u` (then `cum += w_j`).
+fn walk(weights: impl Iterator<Item = f64>, n: usize, u0: f64) -> Vec<usize> {
+    let mut w = weights;
+    let mut picked = Vec::with_capacity(n);
+    let mut cum = 0.0;
+    let mut j = 0;
+    let mut wj = w.next().unwrap_or(0.0);
+    for i in 0..n {
+        let u = u0 + i as f64 / n as f64;
+        while j + 1 < n && cum + wj < u {
+            cum += wj;
+            j += 1;
+            wj = w.next().unwrap_or(0.0);
+        }
+        picked.push(j);
+    }
+    picked
 }
 
 /// The particle set.
@@ -356,8 +457,11 @@ impl Particles {
                 chunk.turn[i] += noise[1] * b;
                 chunk.bias[i] += noise[2] * standard_normal(&mut rng);
             }
+            // The moments after the prediction need them; taking them here
+            // saves the normalisation a pass of its own.
+            chunk.trigonometry();
         });
-        self.known = Known::default();
+        self.known.states_moved();
     }
 
     /// Stores in `ll` the log-likelihood `sum_l -r^T W_l r / 2` of every
@@ -437,25 +541,20 @@ impl Particles {
     }
 
     /// `logw += delta * ll`, then normalised so the largest is 0.
+    ///
+    /// The largest `logw + delta ll` is the maximum the effective sample
+    /// size at `delta` took (the same values, folded in the same order), so
+    /// the sum and the normalisation are one pass.
     pub(crate) fn absorb(&mut self, team: &Team, delta: f64) {
-        let chunks = self.chunks.clone();
-        let maxima = team.map(chunks.len(), move |c| {
-            let mut chunk = write(&chunks[c]);
-            let chunk = &mut *chunk;
-            for (w, l) in chunk.logw.iter_mut().zip(&chunk.ll) {
-                *w = tempered(*w, *l, delta);
-            }
-            chunk.max_at(&[0.0])
-        });
-        let max = max_over(&maxima, 1)[0];
+        let max = self.max_at(team, delta);
         // The largest is now 0 (or all are -inf): the weights' exponentials
         // `exp(logw - 0)` and the headings' trigonometry come in the same pass.
         let (chunks, trigonometry) = (self.chunks.clone(), !self.known.trigonometry);
         let maxima = team.map(chunks.len(), move |c| {
             let mut chunk = write(&chunks[c]);
             let chunk = &mut *chunk;
-            for (w, e) in chunk.logw.iter_mut().zip(chunk.exp.iter_mut()) {
-                *w -= max;
+            for ((w, e), l) in chunk.logw.iter_mut().zip(chunk.exp.iter_mut()).zip(&chunk.ll) {
+                *w = tempered(*w, *l, delta) - max;
                 *e = (*w - 0.0).exp();
             }
             if trigonometry {
@@ -517,14 +616,22 @@ impl Particles {
         (sx, sy)
     }
 
-    /// Normalised weights, flat, in particle order.
-    pub(crate) fn weights(&mut self, team: &Team) -> Vec<f64> {
+    /// Every `stride`-th particle (`stride = max(1, n / at_most)`, from the
+    /// first) with its normalised weight, in particle order: at most about
+    /// `at_most` of them, copied instead of all.
+    pub(crate) fn weighted_sample(&mut self, team: &Team, at_most: usize) -> Vec<([f64; STATE_DIM], f64)> {
         if !self.known.weights {
             self.normalise(team);
         }
-        let mut out = Vec::with_capacity(self.n);
+        let stride = (self.n / at_most.max(1)).max(1);
+        let mut out = Vec::with_capacity(self.n / stride + 1);
+        let mut first = 0;
         for c in self.chunks.iter() {
-            out.extend_from_slice(&read(c).weight);
+            let c = read(c);
+            // Indices `i` of this chunk with `first + i` a multiple of `stride`.
+            let start = (stride - first % stride) % stride;
+            out.extend((start..c.len()).step_by(stride).map(|i| (c.get(i), c.weight[i])));
+            first += c.len();
         }
         out
     }
@@ -533,14 +640,20 @@ impl Particles {
     pub(crate) fn moments(&mut self, team: &Team) -> Moments {
         let (sx, sy) = self.normalise(team);
         let heading = sy.atan2(sx);
+        // Each sum over the particles in order, as zipped slices (no bounds
+        // checks in the chain of adds the leader runs alone).
         let mut mean = [0.0; STATE_DIM];
         for c in self.chunks.iter() {
             let c = read(c);
-            for i in 0..c.len() {
-                let (s, wi) = (c.get(i), c.weight[i]);
-                for d in 0..STATE_DIM {
-                    mean[d] += wi * if d == 2 { wrap_angle_rad(s[2] - heading) } else { s[d] };
-                }
+            let [mx, my, mh, mv, mt, mb] = &mut mean;
+            let states = c.x.iter().zip(&c.y).zip(&c.heading).zip(&c.speed).zip(&c.turn).zip(&c.bias);
+            for ((((((x, y), h), v), t), b), w) in states.zip(&c.weight) {
+                *mx += w * x;
+                *my += w * y;
+                *mh += w * wrap_angle_rad(h - heading);
+                *mv += w * v;
+                *mt += w * t;
+                *mb += w * b;
             }
         }
         mean[2] = wrap_angle_rad(mean[2] + heading);
@@ -581,35 +694,26 @@ impl Particles {
         let n = self.n;
         let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x7265_7361]);
         let u0: f64 = rng.random::<f64>() / n as f64;
-        let mut picked = Vec::with_capacity(n);
-        {
+        let picks = {
             let guards: Vec<_> = self.chunks.iter().map(|c| read(c)).collect();
-            let mut w = guards.iter().flat_map(|c| c.weight.iter().copied());
-            let mut cum = 0.0;
-            let mut j = 0;
-            let mut wj = w.next().unwrap_or(0.0);
-            for i in 0..n {
-                let u = u0 + i as f64 / n as f64;
-                while j + 1 < n && cum + wj < u {
-                    cum += wj;
-                    j += 1;
-                    wj = w.next().unwrap_or(0.0);
-                }
-                picked.push(j);
-            }
-        }
+            Picks::new(guards.iter().flat_map(|c| c.weight.iter().copied()), n, u0)
+        };
         let l: Option<[[f64; STATE_DIM]; STATE_DIM]> =
             jitter_chol.map(|l| std::array::from_fn(|a| std::array::from_fn(|b| l[(a, b)])));
         let (old, new, chunk_size, z_m) = (self.chunks.clone(), self.spare.clone(), self.chunk_size, self.z_m);
         let (paths, deltas) = next.map_or((None, Vec::new()), |s| (Some(s.paths), s.prefetch));
-        let prefetch = deltas.clone();
-        let picked = Arc::new(picked);
+        let paths_given = paths.is_some();
+        // The new particles' log-weights are 0, so the maximum at `delta =
+        // 0` (taken with the others) is 0 and their exponentials are 1.
+        let maxima_at: Vec<f64> = std::iter::once(0.0).chain(deltas.iter().copied()).collect();
+        let prefetch = maxima_at.clone();
+        let picks = Arc::new(picks);
         let maxima = team.map(new.len(), move |c| {
             let mut chunk = write(&new[c]);
             let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x6a69_7474, c as u64]);
             let mut from: Option<(usize, RwLockReadGuard<'_, Chunk>)> = None;
-            for i in 0..chunk.len() {
-                let j = picked[c * chunk_size + i];
+            let picked = picks.chunk(c * chunk_size, chunk.len());
+            for (i, j) in picked.into_iter().enumerate() {
                 if from.as_ref().is_none_or(|(k, _)| *k != j / chunk_size) {
                     from = Some((j / chunk_size, read(&old[j / chunk_size])));
                 }
@@ -632,17 +736,26 @@ impl Particles {
                 }
                 chunk.set(i, s);
                 chunk.logw[i] = 0.0;
+                chunk.exp[i] = 1.0;
                 if let Some(paths) = &paths {
                     chunk.ll[i] = particle_log_likelihood(paths, [s[0], s[1], z_m], chunk.heading[i], s[5]);
                 }
             }
-            if paths.is_some() { chunk.max_at(&deltas) } else { Vec::new() }
+            // Needed before the states move again (by the next stage's
+            // weights or the moments): taken here, not in a pass of their own.
+            chunk.trigonometry();
+            if paths.is_some() { chunk.max_at(&maxima_at) } else { chunk.max_at(&maxima_at[..1]) }
         });
         std::mem::swap(&mut self.chunks, &mut self.spare);
         self.known = Known::default();
-        if !prefetch.is_empty() {
-            self.known.set_max(&prefetch, &max_over(&maxima, prefetch.len()));
+        let prefetch = if paths_given { &prefetch[..] } else { &prefetch[..1] };
+        let max = max_over(&maxima, prefetch.len());
+        self.known.set_max(prefetch, &max);
+        // `exp(0 - max) = exp(0) = 1` when the maximum is a zero of either sign.
+        if max[0] == 0.0 {
+            self.known.exp_at = Some(0f64.to_bits());
         }
+        self.known.trigonometry = true;
     }
 }
 
@@ -669,5 +782,38 @@ mod tests {
         let mut absorbed = three();
         absorbed.absorb(&team, 0.0);
         assert_eq!(read(&absorbed.chunks[0]).logw, [0.0, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn the_resampling_picks_by_chunk_equal_the_sequential_walk() {
+        let mut rng = keyed_stream(STREAM_KEY, 1, &[2]);
+        for (n, chunk) in [(1, 1), (7, 3), (100, 16), (1000, 256)] {
+            for case in 0..6 {
+                // Weights with zeros, ties, a dominant one; case 5 has a NaN
+                // and case 4 a negative one (the walk's fallback).
+                let mut w: Vec<f64> = (0..n)
+                    .map(|i| match case {
+                        0 => 1.0 / n as f64,
+                        1 if i % 3 == 1 => 0.0,
+                        2 if i == n / 2 => 1e3,
+                        _ => rng.random::<f64>(),
+                    })
+                    .collect();
+                let sum: f64 = w.iter().sum();
+                w.iter_mut().for_each(|v| *v /= sum);
+                if case == 4 {
+                    w[n - 1] = -0.1;
+                }
+                if case == 5 {
+                    w[n / 2] = f64::NAN;
+                }
+                let u0 = rng.random::<f64>() / n as f64;
+                let picks = Picks::new(w.iter().copied(), n, u0);
+                let by_chunk: Vec<usize> =
+                    (0..n.div_ceil(chunk)).flat_map(|c| picks.chunk(c * chunk, chunk.min(n - c * chunk))).collect();
+                assert_eq!(by_chunk, walk(w.iter().copied(), n, u0), "n {n} case {case}");
+                assert_eq!(matches!(picks, Picks::Walked(_)), case >= 4, "n {n} case {case}");
+            }
+        }
     }
 }

@@ -19,7 +19,7 @@
 //! third slower on two threads, the chunks moving between the cores'
 //! caches). Between phases the
 //! leader alone runs the serial steps (sums in particle order, the tempering
-//! decisions, the association) while the helpers wait, spinning a little
+//! decisions, the assignment) while the helpers wait, spinning a little
 //! and then yielding the core.
 //!
 //! The leader never waits for a helper that has not started: it claims
