@@ -243,7 +243,8 @@ pub fn relate_sets(
     carrier_hz: f64,
     config: &LongTermConfig,
 ) -> Vec<LongTermLink> {
-    let rates: Vec<f64> = current.iter().map(|q| -q.doppler_hz / carrier_hz).collect();
+    let rates: Vec<f64> =
+        current.iter().map(|q| forward_delay_rate(q, None, carrier_hz, DelayRate::TrackDoppler)).collect();
     relate_sets_at_rates(current, &rates, next, carrier_hz, config)
 }
 

@@ -16,6 +16,12 @@ const SET_NS: i64 = 10_000_000;
 /// `tau0 + rate t` (t from 0 at set 0), power `power_db` and an extra delay
 /// offset `offset_s` (to mimic a wrong association).
 fn track(id: u64, set: u64, tau0_s: f64, rate: f64, power_db: f64, offset_s: f64) -> MpcTrack {
+    track_of(id, set, power_db, |t_ns| tau0_s + rate * t_ns as f64 * 1e-9 + offset_s)
+}
+
+/// A full-lifetime track of set `set` (6 snapshots at the paper's timing)
+/// with power `power_db` and the delay `delay_s(t_ns)` at each snapshot.
+fn track_of(id: u64, set: u64, power_db: f64, delay_s: impl Fn(i64) -> f64) -> MpcTrack {
     let detections: Vec<MpcDetection> = (0..6u32)
         .map(|n| {
             let t_ns = set as i64 * SET_NS + i64::from(n) * SNAPSHOT_NS;
@@ -23,7 +29,7 @@ fn track(id: u64, set: u64, tau0_s: f64, rate: f64, power_db: f64, offset_s: f64
                 t_ns,
                 set_index: set,
                 snapshot_index: n,
-                delay_s: tau0_s + rate * t_ns as f64 * 1e-9 + offset_s,
+                delay_s: delay_s(t_ns),
                 amplitude: Complex64::from_polar(10f64.powf(power_db / 20.0), 0.0),
             }
         })
@@ -241,22 +247,9 @@ fn the_doppler_gated_variant_with_a_one_set_gap_keeps_a_fast_path_whole_where_th
 /// a noisy set as eq. (30) sees it.
 fn noisy_track(id: u64, set: u64, tau0_s: f64, rate: f64, in_set_rate: f64, offset_s: f64) -> MpcTrack {
     let t_mid_ns = set as i64 * SET_NS + 5 * SNAPSHOT_NS / 2;
-    let detections: Vec<MpcDetection> = (0..6u32)
-        .map(|n| {
-            let t_ns = set as i64 * SET_NS + i64::from(n) * SNAPSHOT_NS;
-            MpcDetection {
-                t_ns,
-                set_index: set,
-                snapshot_index: n,
-                delay_s: tau0_s
-                    + rate * t_mid_ns as f64 * 1e-9
-                    + in_set_rate * (t_ns - t_mid_ns) as f64 * 1e-9
-                    + offset_s,
-                amplitude: Complex64::from_polar(1e-5, 0.0),
-            }
-        })
-        .collect();
-    MpcTrack { track_id: id, doppler_hz: doppler_hz(&detections, CARRIER_HZ), detections }
+    track_of(id, set, -100.0, |t_ns| {
+        tau0_s + rate * t_mid_ns as f64 * 1e-9 + in_set_rate * (t_ns - t_mid_ns) as f64 * 1e-9 + offset_s
+    })
 }
 
 #[test]

@@ -53,9 +53,9 @@ fn rate_note(s: &MpcSummary) -> String {
 
 /// The claims: ours within 2x of the true birth rate against both fair
 /// truths (targets; on the least-squares short-term search and with the
-/// chain's delay slope variants, not targets), ours fragmenting true paths less than the paper's
-/// eq. (35) (target), and the paper's eq. (35) and the old score beside
-/// them (variants, not targets).
+/// chain's delay slope variants, not targets), ours fragmenting true paths
+/// less than the paper's eq. (35) (target), and the paper's eq. (35) and
+/// the old score beside them (variants, not targets).
 #[must_use]
 pub fn verdicts(m: &Measured) -> Vec<Verdict> {
     let mut out = Vec::new();
@@ -78,7 +78,7 @@ pub fn verdicts(m: &Measured) -> Vec<Verdict> {
             LS_OURS => "least-squares short-term search (not eq. (17)), Doppler-gated eq. (35), one-set gap (ours)",
             CHAIN_OURS => {
                 "continued tracks predicted from the chain's delay slope (not eq. (31)'s Doppler), gated eq. \
-                           (35), one-set gap (ours)"
+                 (35), one-set gap (ours)"
             }
             _ => "eq. (35) as printed (the paper's)",
         };
