@@ -101,6 +101,10 @@ pub struct SlamFilter {
     parallel_phases: u64,
 }
 
+/// About how many particles (every `n / 256`-th) a path's VA and SP
+/// hypotheses are inverted for ([`SourceModel::hypotheses_of`]).
+const HYPOTHESIS_PARTICLES: usize = 256;
+
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
 type Hypothesis = (f64, [f64; 5], [[f64; 5]; 5], f64);
 
@@ -314,8 +318,7 @@ impl SlamFilter {
         let paths_in_update = prepared.len();
         let stages = self.update_particles(team, prepared, k)?;
         let post = self.particles.moments(team);
-        // The hypotheses use at most 256 particles (`SourceModel::hypotheses_of`).
-        let sample = self.particles.weighted_sample(team, 256);
+        let sample = self.particles.weighted_sample(team, HYPOTHESIS_PARTICLES);
 
         // Sources: confirmed ones by an iterated EKF, unconfirmed and new ones
         // by their two hypotheses.
@@ -853,8 +856,9 @@ impl SourceModel {
 
     /// The VA and SP hypotheses of a path under the UE posterior (Sec.
     /// IV-A): the inversion of [`invert`] per particle of `sample` (every
-    /// `n / 256`-th particle, [`Particles::weighted_sample`]), weighted,
-    /// plus the measurement noise mapped through the inversion at the mean.
+    /// `n / HYPOTHESIS_PARTICLES`-th particle,
+    /// [`Particles::weighted_sample`]), weighted, plus the measurement noise
+    /// mapped through the inversion at the mean.
     ///
     /// [`Particles::weighted_sample`]: crate::particles::Particles::weighted_sample
     fn hypotheses_of(
