@@ -120,6 +120,30 @@ pub const ARRAY_FILE_BYTES: Limit =
 pub const SCAN_PNG_BYTES: Limit =
     Limit { max: 134_217_728.0, expected: "a scan PNG of at most 134217728 bytes (128 MiB)" };
 
+/// Runs per measurement of a benchmark (`--repeats`, `bench odometry
+/// --passes`): each is a whole run of the measured pipeline; the benches
+/// default to 3-20.
+pub const BENCH_RUNS: Limit = Limit { max: 1000.0, expected: "between 1 and 1000 runs per measurement" };
+
+/// Oxford-size scans (400 x 3768, about 1.5 MB each) a benchmark holds in
+/// memory at once (`bench io --scans`): the bound is 3 GB.
+pub const BENCH_SCANS_IN_MEMORY: Limit =
+    Limit { max: 2000.0, expected: "between 1 and 2000 scans (1.5 MB each, held in memory)" };
+
+/// Oxford-size scans a benchmark writes to disk (`bench ingest --scans`,
+/// `bench odometry --memory-scans`): about 0.6-1.5 MB each, so the bound is
+/// 12-30 GB of temporary files.
+pub const BENCH_SCANS_ON_DISK: Limit =
+    Limit { max: 20_000.0, expected: "between 4 and 20000 scans (up to 1.5 MB each on disk)" };
+
+/// Snapshots of `bench mpc` (`--snapshots`), generated 64 sets at a time:
+/// bounded by run time (about half an hour on one thread at the bound).
+pub const BENCH_SNAPSHOTS: Limit = Limit { max: 10_000_000.0, expected: "between 1 and 10000000 snapshots" };
+
+/// Paths per simulated snapshot of `bench mpc` (`--mpcs`): the detector
+/// stops at `detection.max_mpcs` (200) in any case.
+pub const BENCH_PATHS: Limit = Limit { max: 1000.0, expected: "between 1 and 1000 paths per snapshot" };
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,6 +168,11 @@ mod tests {
             CONFIG_FILE_BYTES,
             ARRAY_FILE_BYTES,
             SCAN_PNG_BYTES,
+            BENCH_RUNS,
+            BENCH_SCANS_IN_MEMORY,
+            BENCH_SCANS_ON_DISK,
+            BENCH_SNAPSHOTS,
+            BENCH_PATHS,
         ];
         for limit in limits {
             assert!(limit.expected.contains(&format!("{}", limit.max)), "{limit:?}");

@@ -6,12 +6,13 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+use mmtrack_core::limits;
 use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_io::recording::Compression;
 use mmtrack_io::{Durability, Overwrite, RecordingOptions};
 
 use super::measure::{best_of, dir_bytes, peak_rss_bytes, reset_peak_rss};
-use super::verdict_cell;
+use super::{check_count, verdict_cell};
 
 /// Ingest of an Oxford folder, bytes carried, on this 2-core machine.
 pub const INGEST_TARGET_SCANS_PER_S: f64 = 200.0;
@@ -38,6 +39,18 @@ pub struct IngestBenchOptions {
 impl Default for IngestBenchOptions {
     fn default() -> Self {
         Self { scans: 200, repeats: 3, dir: None, from: None }
+    }
+}
+
+impl IngestBenchOptions {
+    /// Refuses absurd counts before any folder is written.
+    ///
+    /// # Errors
+    /// `scans` or `repeats` outside [`limits::BENCH_SCANS_ON_DISK`] or
+    /// [`limits::BENCH_RUNS`].
+    pub fn validate(&self) -> anyhow::Result<()> {
+        check_count("--scans", self.scans, 4, limits::BENCH_SCANS_ON_DISK)?;
+        check_count("--repeats", self.repeats, 1, limits::BENCH_RUNS)
     }
 }
 
@@ -88,6 +101,7 @@ pub struct IngestBench {
 /// `from` is not an Oxford folder with scans, the simulation child fails, or
 /// a file cannot be written or ingested.
 pub fn run(options: &IngestBenchOptions, simulate_oxford: SimulateOxfordCommand<'_>) -> anyhow::Result<IngestBench> {
+    options.validate()?;
     let temp = match &options.dir {
         Some(d) => tempfile::tempdir_in(d)?,
         None => tempfile::tempdir()?,

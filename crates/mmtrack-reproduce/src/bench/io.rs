@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use mmtrack_core::PolarScan;
+use mmtrack_core::{PolarScan, limits};
 use mmtrack_io::recording::{Compression, RecordingMetadata, TimeBase};
 use mmtrack_io::{Durability, Overwrite, RecordingEvent, RecordingOptions, RecordingReader, RecordingWriter};
 use mmtrack_sim::radar::{
@@ -16,7 +16,7 @@ use mmtrack_sim::radar::{
 use serde_json::json;
 
 use super::measure::best_of;
-use super::verdict_cell;
+use super::{check_count, verdict_cell};
 
 /// MCAP write at least this fraction of the speed of copying the same bytes.
 pub const WRITE_TARGET_RATIO: f64 = 0.5;
@@ -38,6 +38,18 @@ pub struct IoBenchOptions {
 impl Default for IoBenchOptions {
     fn default() -> Self {
         Self { scans: 60, repeats: 3, dir: None }
+    }
+}
+
+impl IoBenchOptions {
+    /// Refuses absurd counts before any scan is made.
+    ///
+    /// # Errors
+    /// `scans` or `repeats` outside [`limits::BENCH_SCANS_IN_MEMORY`] or
+    /// [`limits::BENCH_RUNS`].
+    pub fn validate(&self) -> anyhow::Result<()> {
+        check_count("--scans", self.scans, 1, limits::BENCH_SCANS_IN_MEMORY)?;
+        check_count("--repeats", self.repeats, 1, limits::BENCH_RUNS)
     }
 }
 
@@ -151,6 +163,7 @@ fn read_recording(path: &Path) -> anyhow::Result<usize> {
 /// The scans cannot be simulated, a temporary file cannot be written, or a
 /// recording reads back other bytes than were written.
 pub fn run(options: &IoBenchOptions) -> anyhow::Result<IoBench> {
+    options.validate()?;
     let IoBenchOptions { scans, repeats, ref dir } = *options;
     let scans_data = oxford_size_scans(scans)?;
     let payload_bytes: usize = scans_data.iter().map(|s| s.power.len()).sum();

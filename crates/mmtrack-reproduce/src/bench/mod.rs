@@ -29,6 +29,23 @@ pub mod mpc;
 pub mod odometry;
 pub mod slam;
 
+use mmtrack_core::limits::Limit;
+
+/// Refuses the count `value` of the flag `flag` (e.g. `--repeats`) below
+/// `min` or beyond `limit`, before a benchmark does any work: the error names
+/// the flag, the value and what was expected.
+///
+/// # Errors
+/// `value < min` or `value` beyond `limit`.
+pub fn check_count(flag: &str, value: usize, min: usize, limit: Limit) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        value >= min && limit.allows_count(value as u64),
+        "{flag} {value}: expected {} (nothing was done)",
+        limit.expected
+    );
+    Ok(())
+}
+
 /// The verdict cell of a benchmark table: `met` or `**missed**`.
 #[must_use]
 pub fn verdict_cell(met: bool) -> &'static str {

@@ -22,6 +22,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context;
+use mmtrack_core::limits;
 use mmtrack_core::random::standard_normal;
 use mmtrack_core::sounder::{SounderBand, cir_from_spectrum};
 use mmtrack_core::{CirSnapshot, Complex64, MpcDetection, MpcTrack};
@@ -34,7 +35,7 @@ use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use rustfft::{Fft, FftPlanner};
 
-use super::verdict_cell;
+use super::{check_count, verdict_cell};
 use crate::common::load_average;
 
 /// The target: this many snapshots ...
@@ -86,6 +87,24 @@ pub struct MpcBenchOptions {
 impl Default for MpcBenchOptions {
     fn default() -> Self {
         Self { snapshots: MPC_TARGET_SNAPSHOTS, mpcs: 40, threads: vec![1, 2] }
+    }
+}
+
+impl MpcBenchOptions {
+    /// Refuses absurd counts before any snapshot is made or pool started.
+    ///
+    /// # Errors
+    /// `snapshots`, `mpcs` or a thread count outside
+    /// [`limits::BENCH_SNAPSHOTS`], [`limits::BENCH_PATHS`] or
+    /// [`limits::THREADS`] (each at least 1 here), or no thread count.
+    pub fn validate(&self) -> anyhow::Result<()> {
+        check_count("--snapshots", self.snapshots, 1, limits::BENCH_SNAPSHOTS)?;
+        check_count("--mpcs", self.mpcs, 1, limits::BENCH_PATHS)?;
+        anyhow::ensure!(!self.threads.is_empty(), "--threads: give at least one thread count (nothing was done)");
+        for &threads in &self.threads {
+            check_count("--threads", threads, 1, limits::THREADS)?;
+        }
+        Ok(())
     }
 }
 
@@ -360,11 +379,11 @@ fn per_target(seconds: f64, snapshots: usize) -> f64 {
 /// GM-PHD on the same generated snapshots.
 ///
 /// # Errors
-/// No snapshots, a thread count of 0 or none, or a stage fails.
+/// The options are refused ([`MpcBenchOptions::validate`]), or a stage
+/// fails.
 pub fn run(options: &MpcBenchOptions) -> anyhow::Result<MpcBench> {
-    anyhow::ensure!(options.snapshots > 0, "--snapshots must be at least 1");
+    options.validate()?;
     let load_before = load_average();
-    anyhow::ensure!(!options.threads.is_empty() && !options.threads.contains(&0), "--threads: counts of at least 1");
     let channel = Channel::new(options.mpcs)?;
     let config = MpcConfig::default();
     let gmphd_config = GmPhdConfig { carrier_hz: CARRIER_HZ, ..GmPhdConfig::default() };

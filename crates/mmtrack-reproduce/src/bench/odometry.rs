@@ -9,6 +9,7 @@ use std::process::Command;
 use std::time::Instant;
 
 use anyhow::Context;
+use mmtrack_core::limits;
 use mmtrack_core::progress::NoProgress;
 use mmtrack_ingest::oxford::{OxfordFolder, OxfordOptions, ingest_oxford};
 use mmtrack_io::recording::Compression;
@@ -18,7 +19,7 @@ use mmtrack_process::events::for_each_event;
 use mmtrack_process::odometry::run_odometry;
 
 use super::measure::{ChildMemory, child_memory};
-use super::verdict_cell;
+use super::{check_count, verdict_cell};
 
 /// End-to-end scans per second on this 2-core machine (CFEAR-1 reports
 /// about 160 Hz for filtering and registration alone, without decode).
@@ -51,6 +52,18 @@ pub struct OdometryBenchOptions {
     /// Scans of the long simulated drive of the memory check (laps of
     /// [`MEMORY_LAP_SCANS`]; one lap is the short drive).
     pub memory_scans: usize,
+}
+
+impl OdometryBenchOptions {
+    /// Refuses absurd counts before the bench recording is built.
+    ///
+    /// # Errors
+    /// `passes` or `memory_scans` outside [`limits::BENCH_RUNS`] or
+    /// [`limits::BENCH_SCANS_ON_DISK`].
+    pub fn validate(&self) -> anyhow::Result<()> {
+        check_count("--passes", self.passes, 1, limits::BENCH_RUNS)?;
+        check_count("--memory-scans", self.memory_scans, 4, limits::BENCH_SCANS_ON_DISK)
+    }
 }
 
 /// How to start `process odometry` with the `cfear` preset on a recording,
@@ -146,6 +159,7 @@ pub fn run(
     options: &OdometryBenchOptions,
     process_odometry: ProcessOdometryCommand<'_>,
 ) -> anyhow::Result<OdometryBench> {
+    options.validate()?;
     let dir = tempfile::tempdir()?;
     let recording = dir.path().join("bench.mcap");
     ingest_quietly(&options.from, &recording)

@@ -9,11 +9,12 @@
 use std::time::Instant;
 
 use anyhow::Context;
+use mmtrack_core::limits;
 use mmtrack_sim::slam::{SlamRun, SlamScenario};
 use mmtrack_slam::{SlamConfig, SlamFilter};
 
 use super::measure::process_cpu_s;
-use super::verdict_cell;
+use super::{check_count, verdict_cell};
 use crate::common::load_average;
 
 /// Target time per epoch, milliseconds, at [`TARGET_PARTICLES`].
@@ -47,6 +48,26 @@ pub struct SlamBenchOptions {
 impl Default for SlamBenchOptions {
     fn default() -> Self {
         Self { particles: vec![500, TARGET_PARTICLES, 8000], iterations: 10, epochs: 100, repeats: 3, threads: 0 }
+    }
+}
+
+impl SlamBenchOptions {
+    /// Refuses absurd counts before the drive is simulated or a pool
+    /// started.
+    ///
+    /// # Errors
+    /// No particle count, or a count outside [`limits::PARTICLES`],
+    /// [`limits::ITERATIONS`], [`limits::SLAM_EPOCHS`], [`limits::BENCH_RUNS`]
+    /// or [`limits::THREADS`].
+    pub fn validate(&self) -> anyhow::Result<()> {
+        anyhow::ensure!(!self.particles.is_empty(), "--particles: give at least one particle count (nothing was done)");
+        for &particles in &self.particles {
+            check_count("--particles", particles, 2, limits::PARTICLES)?;
+        }
+        check_count("--iterations", self.iterations, 1, limits::ITERATIONS)?;
+        check_count("--epochs", self.epochs, 1, limits::SLAM_EPOCHS)?;
+        check_count("--repeats", self.repeats, 1, limits::BENCH_RUNS)?;
+        check_count("--threads", self.threads, 0, limits::THREADS)
     }
 }
 
@@ -170,7 +191,7 @@ fn pool_of(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
 /// The options are invalid (no particle counts, no epochs, a bad filter
 /// configuration), or a thread pool cannot start.
 pub fn run(options: &SlamBenchOptions) -> anyhow::Result<SlamBench> {
-    anyhow::ensure!(!options.particles.is_empty(), "--particles: give at least one particle count");
+    options.validate()?;
     let scenario = SlamScenario { epochs: options.epochs, ..SlamScenario::default() };
     let drive = scenario.realise(1, 0)?;
     let paths: usize = drive.epochs.iter().map(|e| e.paths.len()).sum();

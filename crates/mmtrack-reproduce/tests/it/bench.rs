@@ -221,3 +221,47 @@ fn bench_ingest_and_odometry_run_on_a_small_simulated_oxford_folder() {
     assert_eq!(text.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| preset")).count(), presets.len());
     assert!(text.contains("\nMemory (`cfear`"), "{text}");
 }
+
+/// Every bench refuses an absurd or empty count in one of its flags before
+/// any work (no scan simulated, no pool of 100 000 threads started): the
+/// error names the flag and the value. Each case returns at once; with the
+/// checks gone, the large ones would allocate terabytes or run for days.
+#[test]
+fn every_bench_refuses_absurd_counts_naming_the_flag_before_any_work() {
+    let refused = |result: anyhow::Result<()>, flag_and_value: &str| {
+        let message = format!("{:#}", result.expect_err(flag_and_value));
+        assert!(message.contains(flag_and_value) && message.contains("nothing was done"), "{message}");
+    };
+    let never = |_: &Path, _: &Path| -> Command { panic!("no child process may start") };
+    let mpc_with = |snapshots, mpcs, threads: Vec<usize>| mpc::MpcBenchOptions { snapshots, mpcs, threads };
+    refused(mpc::run(&mpc_with(1_000_000_000_000, 40, vec![1])).map(drop), "--snapshots 1000000000000");
+    refused(mpc::run(&mpc_with(12, 0, vec![1])).map(drop), "--mpcs 0");
+    refused(mpc::run(&mpc_with(12, 100_000_000, vec![1])).map(drop), "--mpcs 100000000");
+    refused(mpc::run(&mpc_with(12, 40, vec![1, 100_000])).map(drop), "--threads 100000");
+    refused(mpc::run(&mpc_with(12, 40, vec![0])).map(drop), "--threads 0");
+
+    let slam_with = |f: &dyn Fn(&mut slam::SlamBenchOptions)| {
+        let mut options = slam::SlamBenchOptions { particles: vec![100], epochs: 2, repeats: 1, ..Default::default() };
+        f(&mut options);
+        slam::run(&options).map(drop)
+    };
+    refused(slam_with(&|o| o.threads = 100_000), "--threads 100000");
+    refused(slam_with(&|o| o.repeats = 0), "--repeats 0");
+    refused(slam_with(&|o| o.particles = vec![100, 10_000_000_000]), "--particles 10000000000");
+    refused(slam_with(&|o| o.epochs = 100_000_000), "--epochs 100000000");
+
+    let io_with = |scans, repeats| io::IoBenchOptions { scans, repeats, dir: None };
+    refused(io::run(&io_with(1_000_000, 1)).map(drop), "--scans 1000000");
+    refused(io::run(&io_with(2, 0)).map(drop), "--repeats 0");
+
+    let ingest_with = |scans, repeats| ingest::IngestBenchOptions { scans, repeats, dir: None, from: None };
+    refused(ingest::run(&ingest_with(10_000_000, 1), &never).map(drop), "--scans 10000000");
+    refused(ingest::run(&ingest_with(0, 1), &never).map(drop), "--scans 0");
+    refused(ingest::run(&ingest_with(8, 5000), &never).map(drop), "--repeats 5000");
+
+    let odometry_with =
+        |passes, memory_scans| odometry::OdometryBenchOptions { from: "/nonexistent".into(), passes, memory_scans };
+    refused(odometry::run(&odometry_with(0, 200), &never).map(drop), "--passes 0");
+    refused(odometry::run(&odometry_with(100_000_000_000, 200), &never).map(drop), "--passes 100000000000");
+    refused(odometry::run(&odometry_with(1, 1_000_000_000_000), &never).map(drop), "--memory-scans 1000000000000");
+}
