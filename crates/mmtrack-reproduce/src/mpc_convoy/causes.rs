@@ -36,6 +36,13 @@
 //! (17)-(23) predict from the last two detections, so a search misses when
 //! `|tau[m+1] - 2 tau[m] + tau[m-1]| > epsilon_tau`).
 //!
+//! Long-term tracks on no true path (none of their detections matched) are
+//! [`Ghost`]s, placed against the strongest true path within
+//! [`GHOST_REACH_S`] of their first detection: the delay offset and the
+//! power below that path say what they are a residue of (in the convoy, the
+//! search-and-subtract of Sec. III-A fitting one pulse to the LOS and the
+//! wall bounce 1.1 ns behind it leaves a residue before the LOS).
+//!
 //! Pure: the scene's tables in, counts out.
 
 use std::collections::{BTreeMap, BTreeSet};
@@ -169,11 +176,41 @@ pub struct PathSummary {
     pub long_term_tracks: u64,
 }
 
+/// How far from a ghost's first detection the strong path it sits beside
+/// is looked for, seconds.
+pub const GHOST_REACH_S: f64 = 20e-9;
+
+/// A long-term track on no true path (none of its detections matches a true
+/// MPC; the score's false long-term track), placed against the strongest
+/// true path near it: what it is a residue of.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ghost {
+    /// The long-term track.
+    pub long_track_id: u64,
+    /// Its first set.
+    pub first_set: u64,
+    /// Whether it is a birth (its first set is not the run's first).
+    pub is_birth: bool,
+    /// Sets it spans.
+    pub sets: u64,
+    /// The strongest resolvable true path within [`GHOST_REACH_S`] of its
+    /// first detection in that snapshot (`None`: no path that near).
+    pub beside: Option<u64>,
+    /// Mean over its first short-term track's detections of the detection's
+    /// delay minus that path's, seconds (negative: before the path).
+    pub offset_s: f64,
+    /// Mean over the same detections of that path's power minus the
+    /// detection's, dB.
+    pub below_db: f64,
+}
+
 /// Every birth on a true path and every path's summary.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Diagnosis {
     /// Births on true paths, in (path, set) order.
     pub births: Vec<Birth>,
+    /// Long-term tracks on no true path, in track order.
+    pub ghosts: Vec<Ghost>,
     /// Per true path.
     pub paths: Vec<PathSummary>,
     /// Delay noise of the sets where a path is detected in every snapshot,
@@ -481,6 +518,43 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
     }
     births.sort_by_key(|b| (b.path_id, b.set_index));
 
+    // Long-term tracks on no true path, against the strongest path beside them.
+    let track_of: BTreeMap<u64, &MpcTrack> = t.tracks.iter().map(|track| (track.track_id, track)).collect();
+    let mut ghosts = Vec::new();
+    for (&long_id, votes) in &long_votes {
+        if majority(votes).is_some() {
+            continue;
+        }
+        let Some(chain) = chains.get(&long_id) else { continue };
+        let Some((&first, entry)) = chain.iter().next() else { continue };
+        let detections = track_of.get(&entry.short_track_id).map_or(&[][..], |track| track.detections.as_slice());
+        let here = |d: &MpcDetection| by_snapshot.get(&(d.set_index, d.snapshot_index)).map_or(&[][..], Vec::as_slice);
+        let beside = detections.first().and_then(|d| {
+            here(d)
+                .iter()
+                .filter(|m| (m.delay_s - d.delay_s).abs() <= GHOST_REACH_S)
+                .max_by(|a, b| a.amplitude.norm_sqr().total_cmp(&b.amplitude.norm_sqr()))
+                .map(|m| m.path_id)
+        });
+        let pairs: Vec<(f64, f64)> = detections
+            .iter()
+            .filter_map(|d| {
+                let m = here(d).iter().find(|m| Some(m.path_id) == beside)?;
+                Some((d.delay_s - m.delay_s, m.power_db() - d.power_db()))
+            })
+            .collect();
+        let mean = |f: fn(&(f64, f64)) -> f64| pairs.iter().map(f).sum::<f64>() / pairs.len() as f64;
+        ghosts.push(Ghost {
+            long_track_id: long_id,
+            first_set: first,
+            is_birth: Some(first) != first_set,
+            sets: chain.len() as u64,
+            beside,
+            offset_s: mean(|p| p.0),
+            below_db: mean(|p| p.1),
+        });
+    }
+
     // Per path summaries.
     let paths_all: BTreeSet<u64> = truth.iter().map(|m| m.path_id).collect();
     let sets: Vec<u64> = t.sets.iter().map(|s| s.set_index).collect();
@@ -531,7 +605,7 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
         }
         paths.push(s);
     }
-    Diagnosis { births, paths, noise: delay_noise(&sets_all_detected, t.short_term) }
+    Diagnosis { births, ghosts, paths, noise: delay_noise(&sets_all_detected, t.short_term) }
 }
 
 /// The first step of eqs. (35)-(42) the pair (`a` of set `i`, `b` of set
@@ -696,6 +770,38 @@ mod tests {
     }
 
     const ALL: fn(u64) -> Vec<Vec<u32>> = |_| vec![(0..6).collect()];
+
+    #[test]
+    fn a_long_term_track_on_no_true_path_is_a_ghost_placed_against_the_strongest_path_beside_it() {
+        // The car is followed in sets 0-2 (long-term track 0); a residue
+        // 1.3 ns before it and 15 dB weaker is tracked in sets 1-2 (track 1):
+        // none of its detections is within 0.5 ns of a true path.
+        let mut s = scene(3, |_, _| -120.0, |_, _| Some(300e-9), ALL, &[(0, 0), (0, 1), (0, 2)]);
+        for set in 1..3 {
+            let detections: Vec<MpcDetection> = (0..6).map(|n| detection(set, n, 298.7e-9, -135.0)).collect();
+            s.detections.extend(detections.iter().cloned());
+            let track_id = s.tracks.len() as u64;
+            s.long_term.push(MpcLongTermEntry {
+                long_track_id: 1,
+                set_index: set,
+                t_ns: t_ns(set, 0),
+                short_track_id: track_id,
+                mean_delay_s: 298.7e-9,
+                mean_power_db: -135.0,
+                doppler_hz: 0.0,
+                link_error_s: None,
+                chi_class_s: None,
+            });
+            s.tracks.push(MpcTrack { track_id, doppler_hz: Some(0.0), detections });
+        }
+        let d = diagnosed(&s, &ours());
+        assert!(d.births.is_empty(), "{:?}", d.births);
+        assert_eq!(d.ghosts.len(), 1, "{:?}", d.ghosts);
+        let g = &d.ghosts[0];
+        assert_eq!((g.long_track_id, g.first_set, g.is_birth, g.sets, g.beside), (1, 1, true, 2, Some(CAR)));
+        assert!((g.offset_s + 1.3e-9).abs() < 1e-15, "{}", g.offset_s);
+        assert!((g.below_db - 15.0).abs() < 1e-9, "{}", g.below_db);
+    }
 
     #[test]
     fn a_missed_snapshot_in_a_gap_set_is_the_cause_and_the_bridge_is_checked() {

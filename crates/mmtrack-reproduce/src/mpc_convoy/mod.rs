@@ -36,7 +36,9 @@
 //!
 //! Why the births on true paths happen, for every (truth, tracker) pair:
 //! [`causes`] (what ended the previous long-term track on the path; the
-//! traced cause of the missed row is in docs/results/multipath.md).
+//! traced cause of the missed row is in docs/results/multipath.md), and
+//! where the long-term tracks on no true path sit ([`causes::Ghost`]: beside
+//! which true path, how far and how much weaker).
 //!
 //! Layers: `run` (simulate, detect, track, score, [`causes`]) <- [`report`]
 //! <- [`run()`].
@@ -97,7 +99,9 @@ pub fn check_start(output: &Path, force: bool, readme: Option<&Path>) -> anyhow:
 }
 
 /// Runs the experiment (full: the scenario's sets; smoke: [`SMOKE_SETS`])
-/// and writes `results.csv`, `reproduce.md` and `metrics.json` into
+/// and writes `results.csv`, `causes.csv` (every birth on a true path),
+/// `ghosts.csv` (every long-term track on no true path), `reproduce.md` and
+/// `metrics.json` into
 /// `options.output_dir`.
 ///
 /// # Errors

@@ -11,7 +11,7 @@ use mmtrack_io::table::MpcSummary;
 
 use mmtrack_sim::sounder::PathKind;
 
-use super::causes::{Cause, MARGIN_BIN_DB, NoiseRow};
+use super::causes::{Cause, Diagnosis, GHOST_REACH_S, MARGIN_BIN_DB, NoiseRow};
 use super::run::{CHAIN_OURS, LITERAL, LS_OURS, Measured, OURS, PATH_KINDS, Row, Truth, variants};
 use crate::model::{Claim, METRICS_FILE, Metric, Rule, Verdict, verdict_rows, write_metrics};
 
@@ -301,12 +301,17 @@ fn csv(m: &Measured) -> String {
 /// A file that cannot be written.
 pub fn write_outputs(output: &Path, m: &Measured, markdown: &str, metrics: &[Metric]) -> anyhow::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(output).with_context(|| output.display().to_string())?;
-    for (name, text) in [("results.csv", csv(m)), ("reproduce.md", markdown.to_string()), ("causes.csv", causes_csv(m))]
-    {
+    let files = [
+        ("results.csv", csv(m)),
+        ("reproduce.md", markdown.to_string()),
+        ("causes.csv", causes_csv(m)),
+        ("ghosts.csv", ghosts_csv(m)),
+    ];
+    for (name, text) in &files {
         mmtrack_io::atomic::write_file(&output.join(name), text.as_bytes(), Overwrite::Replace)?;
     }
     write_metrics(output, metrics)?;
-    Ok(["results.csv", "reproduce.md", "causes.csv", METRICS_FILE].into_iter().map(|n| output.join(n)).collect())
+    Ok(files.iter().map(|(name, _)| *name).chain([METRICS_FILE]).map(|n| output.join(n)).collect())
 }
 
 /// Births on true paths of `variant` against the scatter-free tunnel (the
@@ -414,6 +419,7 @@ fn causes_section(m: &Measured, variant: &str) -> String {
             pct(r.full_lifetime, r.sets)
         );
     }
+    out.push_str(&ghost_table(d));
     out
 }
 
@@ -452,6 +458,74 @@ fn cost_table(m: &Measured) -> String {
                 opt(s.recall_above_floor, 3),
             );
         }
+    }
+    out.push('\n');
+    out
+}
+
+/// `ghosts.csv`: every long-term track on no true path, per (truth, tracker).
+fn ghosts_csv(m: &Measured) -> String {
+    let mut out =
+        String::from("truth,tracker,long_track_id,first_set,is_birth,sets,beside_path_id,offset_ns,below_db\n");
+    for (row, d) in m.rows.iter().zip(&m.diagnoses) {
+        for g in &d.ghosts {
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{},{},{},{:.3},{:.2}",
+                row.truth.key(),
+                row.variant,
+                g.long_track_id,
+                g.first_set,
+                g.is_birth,
+                g.sets,
+                g.beside.map_or(String::new(), |p| p.to_string()),
+                g.offset_s * 1e9,
+                g.below_db,
+            );
+        }
+    }
+    out
+}
+
+/// The long-term tracks on no true path of `d`, grouped by the kind of the
+/// strongest true path beside them and the side they sit on.
+fn ghost_table(d: &Diagnosis) -> String {
+    // (kind order, side) -> (tracks, births, sets, offsets ns, dB below).
+    type Group = (u64, u64, u64, Vec<f64>, Vec<f64>);
+    let mut groups: BTreeMap<(usize, bool), Group> = BTreeMap::new();
+    for g in &d.ghosts {
+        let kind = g.beside.and_then(PathKind::of).and_then(|k| PATH_KINDS.iter().position(|(x, _)| *x == k));
+        let slot = groups.entry((kind.unwrap_or(PATH_KINDS.len()), g.offset_s > 0.0)).or_default();
+        slot.0 += 1;
+        slot.1 += u64::from(g.is_birth);
+        slot.2 += g.sets;
+        if g.beside.is_some() {
+            slot.3.push(g.offset_s * 1e9);
+            slot.4.push(g.below_db);
+        }
+    }
+    let mut out = format!(
+        "\nLong-term tracks on no true path (none of their detections within 0.5 ns of a true MPC; `ghosts.csv` \
+         lists each), by the strongest true path within {:.0} ns of their first detection: the side they sit on, \
+         their delay offset from it and how far below it they are (means over their first short-term track).\n\n\
+         | strongest true path beside | side | tracks | births | sets | offset min / median / max | below it, \
+         median |\n|---|---|---|---|---|---|---|\n",
+        GHOST_REACH_S * 1e9
+    );
+    for ((kind, after), (tracks, births, sets, mut offsets, mut below)) in groups {
+        offsets.sort_by(f64::total_cmp);
+        below.sort_by(f64::total_cmp);
+        let name = PATH_KINDS.get(kind).map_or("none", |k| k.1);
+        let spread = match (offsets.first(), offsets.get(offsets.len() / 2), offsets.last()) {
+            (Some(lo), Some(mid), Some(hi)) => format!("{lo:+.2} / {mid:+.2} / {hi:+.2} ns"),
+            _ => "-".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "| {name} | {} | {tracks} | {births} | {sets} | {spread} | {} |",
+            if after { "after" } else { "before" },
+            below.get(below.len() / 2).map_or("-".to_string(), |x| format!("{x:.1} dB"))
+        );
     }
     out.push('\n');
     out
