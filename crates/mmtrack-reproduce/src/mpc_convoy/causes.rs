@@ -775,8 +775,13 @@ mod tests {
     fn a_long_term_track_on_no_true_path_is_a_ghost_placed_against_the_strongest_path_beside_it() {
         // The car is followed in sets 0-2 (long-term track 0); a residue
         // 1.3 ns before it and 15 dB weaker is tracked in sets 1-2 (track 1):
-        // none of its detections is within 0.5 ns of a true path.
+        // none of its detections is within 0.5 ns of a true path. A weaker
+        // wall bounce 1.2 ns before the residue is nearer to it than the car
+        // but not the strongest path beside it.
         let mut s = scene(3, |_, _| -120.0, |_, _| Some(300e-9), ALL, &[(0, 0), (0, 1), (0, 2)]);
+        for set in 0..3 {
+            s.truth.extend((0..6).map(|n| truth(set, n, WALL, 297.5e-9, -128.0)));
+        }
         for set in 1..3 {
             let detections: Vec<MpcDetection> = (0..6).map(|n| detection(set, n, 298.7e-9, -135.0)).collect();
             s.detections.extend(detections.iter().cloned());
