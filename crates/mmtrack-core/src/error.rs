@@ -121,9 +121,11 @@ pub fn printable<T: AsRef<[u8]> + ?Sized>(input: &T) -> Cow<'_, str> {
 /// as context to an error that names the path), and other crates' errors may
 /// repeat their source in their message. So, for each cause after the first:
 /// it is left out when the part before it already ends with it (or equals it),
-/// and it replaces the part before it when it starts with that part. Quoted
-/// input was escaped where it was quoted; [`printable`] again here keeps
-/// multi-line messages of other crates (TOML parse errors) on one line.
+/// and it replaces the part before it when it starts with that part. A
+/// multi-line cause is folded ([`fold_snippet`]: a TOML parse error's source
+/// snippet becomes the quoted line). Quoted input was escaped where it was
+/// quoted; [`printable`] again here keeps any other line break visible as
+/// `\n` rather than breaking the line.
 ///
 /// `chain` is the error's own message followed by its causes', outermost
 /// first (`anyhow::Error::chain`, or [`std::error::Error::source`] followed).
@@ -134,7 +136,7 @@ where
 {
     let mut parts: Vec<String> = Vec::new();
     for cause in chain {
-        let text = cause.to_string().trim_end().to_string();
+        let text = fold_snippet(cause.to_string().trim_end());
         if text.is_empty() {
             continue;
         }
@@ -150,6 +152,40 @@ where
     printable(&parts.join(": ")).into_owned()
 }
 
+/// A multi-line message with an annotated source snippet (the style of TOML
+/// parse errors: a heading, gutter lines `  |`, numbered source lines
+/// `3 | bins = "x"`, caret lines `  |    ^^^`, then the message) as one line:
+/// `heading (`source line`): message`. Gutter and caret lines are dropped,
+/// each numbered source line is kept quoted, other lines are joined with
+/// `": "`. A single-line message is returned as it is.
+#[must_use]
+pub fn fold_snippet(text: &str) -> String {
+    if !text.contains('\n') {
+        return text.to_string();
+    }
+    let (mut parts, mut sources): (Vec<&str>, Vec<String>) = (Vec::new(), Vec::new());
+    for line in text.lines().map(str::trim_end) {
+        let trimmed = line.trim_start();
+        let gutter = trimmed.split_once('|').filter(|(number, _)| number.trim().chars().all(|c| c.is_ascii_digit()));
+        match gutter {
+            Some((number, source)) if !number.trim().is_empty() => sources.push(format!("`{}`", source.trim())),
+            Some(_) => {}
+            None if trimmed.is_empty() => {}
+            None => parts.push(trimmed),
+        }
+    }
+    let Some((heading, rest)) = parts.split_first() else { return sources.join(" ") };
+    let mut out = (*heading).to_string();
+    if !sources.is_empty() {
+        out = format!("{out} ({})", sources.join(" "));
+    }
+    for part in rest {
+        out.push_str(": ");
+        out.push_str(part);
+    }
+    out
+}
+
 /// Characters that must not reach a terminal as they are: C0/C1 controls and
 /// DEL, and the bidirectional-text overrides that reorder what is shown.
 fn needs_escape(c: char) -> bool {
@@ -158,7 +194,30 @@ fn needs_escape(c: char) -> bool {
 
 #[cfg(test)]
 mod tests {
-    use super::printable;
+    use super::{fold_snippet, one_line, printable};
+
+    /// A TOML parse error (the `toml` crate's own message) is one readable
+    /// line naming the position, the offending source line and the problem,
+    /// with no escaped line breaks.
+    #[test]
+    fn a_toml_parse_error_folds_to_one_line_with_its_source_line() {
+        let unclosed = toml::from_str::<toml::Table>("seed = 1\ngarbage = [").unwrap_err();
+        let line = one_line(["bad.toml: not valid TOML".to_string(), unclosed.to_string()]);
+        assert_eq!(
+            line,
+            "bad.toml: not valid TOML: TOML parse error at line 2, column 12 (`garbage = [`): unclosed array, expected `]`"
+        );
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct Sensor {
+            bins: usize,
+        }
+        let wrong = toml::from_str::<Sensor>("bins = \"x\"").unwrap_err().to_string();
+        let folded = fold_snippet(&wrong);
+        assert!(folded.starts_with("TOML parse error at line 1, column 8 (`bins = \"x\"`): invalid type"), "{folded}");
+        assert!(!folded.contains('\n') && !one_line([&wrong]).contains("\\n"), "{folded}");
+        assert_eq!(fold_snippet("one line: a | b"), "one line: a | b");
+    }
 
     #[test]
     fn printable_escapes_controls_and_invalid_bytes_and_keeps_the_rest() {
