@@ -484,6 +484,40 @@ pub fn time_bases(root: &Path) -> anyhow::Result<BTreeMap<String, TableTimeBase>
     Ok(stated.into_iter().filter_map(|(s, bases)| TableTimeBase::pooled(&bases).map(|t| (s, t))).collect())
 }
 
+/// Where the tables probably are when `root` holds none: a `tables`
+/// directory inside it (a run's or the demo's output directory was given),
+/// or the directory above `root` when `root` is itself one table's folder
+/// (`<table>/`, with `sequence=<id>/part-0.parquet` inside) or one sequence's
+/// (`sequence=<id>/`). Empty otherwise.
+fn layout_hint(root: &Path, found: &Inventory) -> String {
+    if !found.tables.is_empty() {
+        return String::new();
+    }
+    let inner = root.join("tables");
+    if inventory(&inner).is_ok_and(|i| !i.tables.is_empty()) {
+        return format!(" (the tables are in {}: pass that directory)", inner.display());
+    }
+    let is_sequence = |p: &Path| p.file_name().is_some_and(|n| n.to_string_lossy().starts_with("sequence="));
+    let holds_sequences = std::fs::read_dir(root).is_ok_and(|entries| {
+        entries.flatten().any(|e| is_sequence(&e.path()) && e.path().join("part-0.parquet").is_file())
+    });
+    let (table_dir, what) = if holds_sequences {
+        (Some(root), "one table's folder")
+    } else if is_sequence(root) && root.join("part-0.parquet").is_file() {
+        (root.parent(), "one sequence of one table")
+    } else {
+        (None, "")
+    };
+    match table_dir.and_then(Path::parent) {
+        Some(tables) => format!(
+            " ({} is {what}; pass the directory that holds the tables, {})",
+            root.display(),
+            if tables.as_os_str().is_empty() { Path::new(".") } else { tables }.display()
+        ),
+        None => String::new(),
+    }
+}
+
 /// Analyzes every sequence of the table directory `root`: the metrics that
 /// apply ([`plan`]). An error when nothing applies names what was looked for
 /// and what was found.
@@ -501,7 +535,7 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
         anyhow::bail!(
             "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
              {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT), {} (geometric tracker) and \
-             slam_ue with slam_map and slam_true_sources (SLAM); found {}{reasons}",
+             slam_ue with slam_map and slam_true_sources (SLAM); found {}{reasons}{}",
             root.display(),
             ODOMETRY.name,
             GROUND_TRUTH.name,
@@ -513,7 +547,8 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
             SPEBT_SUMMARY.name,
             SPEBT_PER_SLOT.name,
             GEOMETRIC_PER_EPOCH.name,
-            found.describe()
+            found.describe(),
+            layout_hint(root, &found)
         );
     }
     let trajectory = analyze_all(root, &plan, options)?;

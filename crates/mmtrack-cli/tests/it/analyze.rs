@@ -219,6 +219,28 @@ fn analyze_says_what_it_looked_for_and_what_is_wrong() {
         "{stderr}"
     );
 
+    // A run's output directory (tables inside `tables/`), one table's folder
+    // and one sequence's: the error says where the tables are.
+    write_pair(&dir.path().join("run").join("tables"), "s4", &estimate, Some(&truth));
+    for (given, hint) in [
+        ("run", "(the tables are in run/tables: pass that directory)"),
+        (
+            "run/tables/odometry",
+            "(run/tables/odometry is one table's folder; pass the directory that holds the tables, run/tables)",
+        ),
+        (
+            "run/tables/odometry/sequence=s4",
+            "(run/tables/odometry/sequence=s4 is one sequence of one table; pass the directory that holds the tables, \
+             run/tables)",
+        ),
+    ] {
+        let out = mmtrack(dir.path(), &["analyze", given, "-o", "res"]);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{given}");
+        assert!(stderr.contains("found no tables") && stderr.contains(hint), "{given}: {stderr}");
+    }
+    assert!(!dir.path().join("res").exists());
+
     let mut nan_truth = truth.clone();
     nan_truth[3].0.parent_from_child.y_m = f64::NAN;
     write_pair(&dir.path().join("nan"), "s3", &estimate, Some(&nan_truth));
