@@ -191,16 +191,17 @@ pub struct Ghost {
     pub first_set: u64,
     /// Whether it is a birth (its first set is not the run's first).
     pub is_birth: bool,
-    /// Sets it spans.
+    /// Sets with an entry of it.
     pub sets: u64,
     /// The strongest resolvable true path within [`GHOST_REACH_S`] of its
     /// first detection in that snapshot (`None`: no path that near).
     pub beside: Option<u64>,
     /// Mean over its first short-term track's detections of the detection's
-    /// delay minus that path's, seconds (negative: before the path).
+    /// delay minus that path's, seconds (negative: before the path); NaN
+    /// without [`Ghost::beside`].
     pub offset_s: f64,
     /// Mean over the same detections of that path's power minus the
-    /// detection's, dB.
+    /// detection's, dB; NaN without [`Ghost::beside`].
     pub below_db: f64,
 }
 

@@ -523,7 +523,11 @@ fn ghost_table(d: &Diagnosis) -> String {
         let _ = writeln!(
             out,
             "| {name} | {} | {tracks} | {births} | {sets} | {spread} | {} |",
-            if after { "after" } else { "before" },
+            match (PATH_KINDS.get(kind), after) {
+                (None, _) => "-",
+                (Some(_), true) => "after",
+                (Some(_), false) => "before",
+            },
             below.get(below.len() / 2).map_or("-".to_string(), |x| format!("{x:.1} dB"))
         );
     }
