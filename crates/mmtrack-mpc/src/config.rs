@@ -59,6 +59,13 @@ pub struct DetectionConfig {
     /// Most MPCs detected per snapshot (a guard; the search normally ends at
     /// the threshold).
     pub max_mpcs: usize,
+    /// Ours, not the paper's: after each detection, re-estimate it and the
+    /// detections within [`crate::detect::OVERLAP_TAPS`] of it, each with the
+    /// others subtracted (a few coordinate sweeps), so two paths closer than
+    /// a pulse width are fitted jointly instead of leaving the first one's
+    /// misfit as a residue the search picks up. Detections whose
+    /// re-estimated amplitude falls below the threshold are dropped.
+    pub refine_overlapping: bool,
 }
 
 impl Default for DetectionConfig {
@@ -70,6 +77,7 @@ impl Default for DetectionConfig {
             kaiser_beta: Some(6.0),
             blocked_width_s: None,
             max_mpcs: 200,
+            refine_overlapping: false,
         }
     }
 }

@@ -30,6 +30,10 @@ pub struct Variant {
     pub config: LongTermConfig,
     /// Its short-term configuration (the paper's but for [`LS_OURS`]).
     pub short_term: ShortTermConfig,
+    /// Whether it runs on the detections of the refined search
+    /// ([`mmtrack_mpc::DetectionConfig::refine_overlapping`], ours) instead
+    /// of the paper's search and subtract.
+    pub refined_detection: bool,
 }
 
 /// The paper's eq. (35) as printed (the default configuration).
@@ -47,11 +51,20 @@ pub const LS_OURS: &str = "ls-search+doppler-gated+gap";
 /// slope of its last two mean delays (10 ms or more apart) instead of its
 /// in-set Doppler (eq. (30), 3.6 ms; the traced cause of the failed links).
 pub const CHAIN_OURS: &str = "chain-slope+gated+gap";
+/// [`CHAIN_OURS`] on the detections of a search that re-estimates
+/// overlapping paths jointly
+/// ([`mmtrack_mpc::DetectionConfig::refine_overlapping`], not the paper's
+/// steps 3-6): the traced cause of the long-term tracks on no true path
+/// (the LOS and the wall bounce 1.1 ns behind it fitted one pulse at a
+/// time leave a residue before the LOS).
+pub const REFINED_CHAIN: &str = "refined+chain-slope+gated+gap";
 
-/// The six trackers: the paper's long-term tracker, ours, each of our two
+/// The seven trackers: the paper's long-term tracker, ours, each of our two
 /// long-term changes alone (which of them moves the births), all on the
-/// paper's short-term search; ours on the least-squares search; and ours
-/// predicting continued tracks from the chain's delay slope.
+/// paper's short-term search; ours on the least-squares search; ours
+/// predicting continued tracks from the chain's delay slope; and that one on
+/// the refined detections (last: the variants on the paper's detections
+/// come first, as the scenes are run).
 #[must_use]
 pub fn variants() -> Vec<Variant> {
     let with = |candidate_gate, max_missed_sets| LongTermConfig {
@@ -66,24 +79,28 @@ pub fn variants() -> Vec<Variant> {
             what: "the paper's eq. (35): 1 ns gate on the raw delay change, adjacent sets only",
             config: with(CandidateGate::RawDelay, 0),
             short_term: ShortTermConfig::default(),
+            refined_detection: false,
         },
         Variant {
             name: "doppler-gated",
             what: "ours, gate only: 1 ns around the eq. (37) prediction, adjacent sets only",
             config: with(CandidateGate::PredictedDelay, 0),
             short_term: ShortTermConfig::default(),
+            refined_detection: false,
         },
         Variant {
             name: "gap",
             what: "ours, gap only: the paper's raw gate, one missed set bridged",
             config: with(CandidateGate::RawDelay, 1),
             short_term: ShortTermConfig::default(),
+            refined_detection: false,
         },
         Variant {
             name: OURS,
             what: "ours: 1 ns around the eq. (37) prediction, one missed set bridged",
             config: with(CandidateGate::PredictedDelay, 1),
             short_term: ShortTermConfig::default(),
+            refined_detection: false,
         },
         Variant {
             name: LS_OURS,
@@ -92,14 +109,25 @@ pub fn variants() -> Vec<Variant> {
                    long-term as doppler-gated+gap",
             config: with(CandidateGate::PredictedDelay, 1),
             short_term: ShortTermConfig { prediction: ShortTermPrediction::LeastSquares, ..ShortTermConfig::default() },
+            refined_detection: false,
         },
         Variant {
             name: CHAIN_OURS,
             what: "ours with the chain's delay slope: a continued track predicted (eqs. (35), (37), (41)) from the \
                    slope of its last two mean delays instead of its own Doppler; the backward prediction (39) \
                    keeps the candidate's Doppler; otherwise as doppler-gated+gap",
+            config: chain.clone(),
+            short_term: ShortTermConfig::default(),
+            refined_detection: false,
+        },
+        Variant {
+            name: REFINED_CHAIN,
+            what: "chain-slope+gated+gap on the detections of a search that re-estimates each new detection and \
+                   those within 3 taps of it jointly, dropping any that falls below the threshold (ours, not the \
+                   paper's steps 3-6)",
             config: chain,
             short_term: ShortTermConfig::default(),
+            refined_detection: true,
         },
     ]
 }
@@ -208,18 +236,22 @@ struct Scene {
     snapshots_per_set: u32,
 }
 
-/// Simulates `convoy` (seed `seed`), detects and short-term tracks with the
-/// paper's configuration (the pipeline) and every other short-term search
-/// of `variants` (on the same detections, track ids from 0), long-term
-/// tracks with every variant on its search's full-lifetime tracks.
-fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant]) -> anyhow::Result<Scene> {
+/// Simulates `convoy` (seed `seed`), detects (the paper's search and
+/// subtract, or with `refined` the refined search) and short-term tracks
+/// with the paper's configuration (the pipeline) and every other short-term
+/// search of `variants` (on the same detections, track ids from 0),
+/// long-term tracks with every variant on its search's full-lifetime
+/// tracks.
+fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant], refined: bool) -> anyhow::Result<Scene> {
     let simulator = ConvoySimulator::new(convoy, seed)?;
     let carrier_hz = convoy.sounder.carrier_hz;
     let pulse = SounderPulse::from_spectrum(simulator.pulse_spectrum().to_vec())?;
     let tap_spacing_s = simulator.band().tap_spacing_s();
     // The pipeline runs the paper's long-term tracker; the variants take the
     // same full-lifetime tracks.
-    let mut pipeline = MpcPipeline::new(MpcConfig::default(), &pulse, tap_spacing_s, carrier_hz)?;
+    let mut config = MpcConfig::default();
+    config.detection.refine_overlapping = refined;
+    let mut pipeline = MpcPipeline::new(config, &pulse, tap_spacing_s, carrier_hz)?;
     let mut trackers: Vec<LongTermTracker> =
         variants.iter().map(|v| LongTermTracker::new(v.config.clone(), carrier_hz, 0)).collect::<Result<_, _>>()?;
     let mut searches = vec![ShortTermConfig::default()];
@@ -338,31 +370,42 @@ fn summarise(scene: &Scene, truth: Vec<MpcTruth>, tracks: &[MpcTrack], long_term
 /// # Errors
 /// A bad scenario, a simulator or pipeline failure.
 pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Progress) -> anyhow::Result<Measured> {
-    let variants = variants();
     let mut rows = Vec::new();
     let mut diagnoses = Vec::new();
     let mut with_diffuse = convoy.clone();
     with_diffuse.sets = sets;
     with_diffuse.diffuse.in_truth = true;
-    progress.note(&format!("simulating and tracking {sets} sets of the tunnel (diffuse scatterers in the truth)"));
-    let scene = run_scene(&with_diffuse, seed, &variants)?;
-    let specular: Vec<MpcTruth> =
-        scene.truth.iter().filter(|t| PathKind::of(t.path_id) != Some(PathKind::Diffuse)).cloned().collect();
-    for (truth, table) in [(Truth::SpecularOnly, specular), (Truth::WithDiffuse, scene.truth.clone())] {
-        for (v, variant) in variants.iter().enumerate() {
-            let (summary, births_by_kind) = score(&scene, table.clone(), v);
-            diagnoses.push(diagnosis(&scene, &table, v, &variant.config));
-            rows.push(Row { truth, variant: variant.name, summary, births_by_kind });
-        }
-    }
-    let mut no_diffuse = with_diffuse;
+    let mut no_diffuse = with_diffuse.clone();
     no_diffuse.diffuse.scatterers_per_m = 0.0;
-    progress.note(&format!("simulating and tracking {sets} sets of the tunnel without diffuse scatterers"));
-    let scene = run_scene(&no_diffuse, seed, &variants)?;
-    for (v, variant) in variants.iter().enumerate() {
-        let (summary, births_by_kind) = score(&scene, scene.truth.clone(), v);
-        diagnoses.push(diagnosis(&scene, &scene.truth, v, &variant.config));
-        rows.push(Row { truth: Truth::NoDiffuse, variant: variant.name, summary, births_by_kind });
+    for (scenario, truths, what) in [
+        (&with_diffuse, &[Truth::SpecularOnly, Truth::WithDiffuse][..], "the tunnel (diffuse scatterers in the truth)"),
+        (&no_diffuse, &[Truth::NoDiffuse][..], "the tunnel without diffuse scatterers"),
+    ] {
+        // One scene per detector: the paper's search, then the refined one.
+        let mut scenes = Vec::new();
+        for refined in [false, true] {
+            let group: Vec<Variant> = variants().into_iter().filter(|v| v.refined_detection == refined).collect();
+            if group.is_empty() {
+                continue;
+            }
+            let detector = if refined { "refined search" } else { "paper's search" };
+            progress.note(&format!("simulating and tracking {sets} sets of {what}, {detector}"));
+            scenes.push((run_scene(scenario, seed, &group, refined)?, group));
+        }
+        for &truth in truths {
+            for (scene, group) in &scenes {
+                let table: Vec<MpcTruth> = if truth == Truth::SpecularOnly {
+                    scene.truth.iter().filter(|t| PathKind::of(t.path_id) != Some(PathKind::Diffuse)).cloned().collect()
+                } else {
+                    scene.truth.clone()
+                };
+                for (v, variant) in group.iter().enumerate() {
+                    let (summary, births_by_kind) = score(scene, table.clone(), v);
+                    diagnoses.push(diagnosis(scene, &table, v, &variant.config));
+                    rows.push(Row { truth, variant: variant.name, summary, births_by_kind });
+                }
+            }
+        }
     }
     Ok(Measured { sets, seed, rows, diagnoses })
 }
