@@ -108,9 +108,12 @@ const HYPOTHESIS_PARTICLES: usize = 256;
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
 type Hypothesis = (f64, [f64; 5], [[f64; 5]; 5], f64);
 
+/// The information `W` of a path's message to the UE (`5 x 5`).
+type Information = [[f64; 5]; 5];
+
 /// What [`SlamFilter::associate`] returns: `(column, log S)` per path, and
 /// per source the information of its message to the UE at the prior mean.
-type Association = (Vec<(Option<usize>, f64)>, Vec<Option<[[f64; 5]; 5]>>);
+type Association = (Vec<(Option<usize>, f64)>, Vec<Option<Information>>);
 
 /// The UE state of a particle-state vector.
 fn ue_of(s: &[f64; STATE_DIM], z_m: f64) -> UeState {
@@ -448,7 +451,7 @@ impl SlamFilter {
             .collect();
         let (bs_m, sigma_var) = (self.config.bs_m, self.sigma_var);
         let confirmed: Vec<bool> = self.sources.iter().map(|s| s.status != SourceStatus::Unconfirmed).collect();
-        let per_source: Vec<(Vec<Hypothesis>, Option<[[f64; 5]; 5]>)> = team.map(asked.len(), move |m| {
+        let per_source: Vec<(Vec<Hypothesis>, Option<Information>)> = team.map(asked.len(), move |m| {
             let mut information = None;
             let mut predict = |(w, kind, g): &(f64, SourceType, Gauss3)| {
                 let (eta, h_ue, h_src) = jacobians(&ue, bs_m, *kind, g.mean_m)?;

@@ -248,6 +248,9 @@ struct ChunkMoments {
 /// range known only at run time a covariance pass took 3.6 times the
 /// instructions: callgrind, session 18). `w d_a d_b` is taken as `(w d_a)
 /// d_b`.
+// Indexed loops: `a` and `b` are the covariance's entries, and the bounds
+// stay constants for the unrolling.
+#[allow(clippy::needless_range_loop)]
 fn chunk_moments(chunk: &mut Chunk, scale: Option<f64>, reference: &[f64; STATE_DIM]) -> ChunkMoments {
     let mut m =
         ChunkMoments { weight: 0.0, searchable: true, first: [0.0; STATE_DIM], second: [[0.0; STATE_DIM]; STATE_DIM] };
@@ -1049,8 +1052,8 @@ mod tests {
         mean[2] = wrap_angle_rad(mean[2] + circular);
         // Tolerance: sums of 1000 terms of size 300 in another order and
         // with another reference, a few hundred ulps of 300 (6e-14 m).
-        for k in 0..STATE_DIM {
-            assert!((m.mean[k] - mean[k]).abs() < 1e-11, "mean {k}: {} against {}", m.mean[k], mean[k]);
+        for (k, (got, want)) in m.mean.iter().zip(&mean).enumerate() {
+            assert!((got - want).abs() < 1e-11, "mean {k}: {got} against {want}");
         }
         for a in 0..STATE_DIM {
             for b in 0..STATE_DIM {
