@@ -108,6 +108,13 @@ const HYPOTHESIS_PARTICLES: usize = 256;
 /// A predicted path of one source hypothesis: `(weight, eta, S^-1, ln det S)`.
 type Hypothesis = (f64, [f64; 5], [[f64; 5]; 5], f64);
 
+/// The information `W` of a path's message to the UE (`5 x 5`).
+type Information = [[f64; 5]; 5];
+
+/// What [`SlamFilter::associate`] returns: `(column, log S)` per path, and
+/// per source the information of its message to the UE at the prior mean.
+type Association = (Vec<(Option<usize>, f64)>, Vec<Option<Information>>);
+
 /// The UE state of a particle-state vector.
 fn ue_of(s: &[f64; STATE_DIM], z_m: f64) -> UeState {
     UeState {
@@ -269,7 +276,7 @@ impl SlamFilter {
         self.epoch += 1;
 
         let prior = self.particles.moments(team);
-        let assignment = self.associate(team, &paths, &prior, k)?;
+        let (assignment, information) = self.associate(team, &paths, &prior, k)?;
         let mut associations = Vec::with_capacity(paths.len());
         let mut init_path = None;
         if !self.initialised {
@@ -311,9 +318,16 @@ impl SlamFilter {
                 SourceStatus::ScatteringPoint => SourceType::ScatteringPoint,
                 SourceStatus::Unconfirmed => continue,
             };
-            if let Some(p) = self.prepare(&paths[l], kind, &source.belief, &ue_mean) {
-                prepared.push(p);
-            }
+            // The association found `W` at the prior mean, which is the UE
+            // mean here unless the LOS initialised the particles.
+            let p = match (init_path, information[*m]) {
+                (None, Some(w)) => Some(PreparedPath {
+                    fast: FastPath::new(kind, source.belief.mean_m, self.config.bs_m, &paths[l].to_array()),
+                    information: w,
+                }),
+                _ => self.prepare(&paths[l], kind, &source.belief, &ue_mean),
+            };
+            prepared.extend(p);
         }
         let paths_in_update = prepared.len();
         let stages = self.update_particles(team, prepared, k)?;
@@ -403,16 +417,20 @@ impl SlamFilter {
 
     /// `log S^D_lm` of eq. (3)-(5) for every (path, source) pair, the
     /// unconfirmed sources as the mixture (4) of their two hypotheses, then
-    /// the assignment (7). Returns `(column, log S)` per path. Each
+    /// the assignment (7). Returns `(column, log S)` per path, and per
+    /// source the information `W = (Sigma + H_m P_m H_m^T)^-1` of its
+    /// message to the UE ([`SlamFilter::prepare`]) linearised at the prior
+    /// mean (confirmed sources and the BS; `None` for the others). Each
     /// source's predicted paths (a linearisation and a `5 x 5` inverse per
-    /// hypothesis) are one task on `team`.
+    /// hypothesis, and `W` from the same linearisation) are one task on
+    /// `team`.
     fn associate(
         &self,
         team: &Team,
         paths: &[PathMeasurement],
         prior: &Moments,
         k: usize,
-    ) -> Result<Vec<(Option<usize>, f64)>, SlamError> {
+    ) -> Result<Association, SlamError> {
         let ue = ue_of(&prior.mean, self.particles.z_m);
         let p_s = meas_cov(&prior.cov);
         let log_pd = (self.config.detection_probability / (1.0 - self.config.detection_probability)).ln();
@@ -432,18 +450,30 @@ impl SlamFilter {
             })
             .collect();
         let (bs_m, sigma_var) = (self.config.bs_m, self.sigma_var);
-        let predicted: Vec<Vec<Hypothesis>> = team.map(asked.len(), move |m| {
-            let predict = |(w, kind, g): &(f64, SourceType, Gauss3)| {
+        let confirmed: Vec<bool> = self.sources.iter().map(|s| s.status != SourceStatus::Unconfirmed).collect();
+        let per_source: Vec<(Vec<Hypothesis>, Option<Information>)> = team.map(asked.len(), move |m| {
+            let mut information = None;
+            let mut predict = |(w, kind, g): &(f64, SourceType, Gauss3)| {
                 let (eta, h_ue, h_src) = jacobians(&ue, bs_m, *kind, g.mean_m)?;
-                let mut s = sandwich(&h_ue, &p_s) + sandwich(&h_src, &from3(&g.cov_m2));
+                let from_source = sandwich(&h_src, &from3(&g.cov_m2));
+                if confirmed[m] {
+                    let mut s = from_source.clone();
+                    for i in 0..5 {
+                        s[(i, i)] += sigma_var[i];
+                    }
+                    information = spd_inverse(&s).map(|(inv, _)| to5(&inv));
+                }
+                let mut s = sandwich(&h_ue, &p_s) + from_source;
                 for i in 0..5 {
                     s[(i, i)] += sigma_var[i];
                 }
                 let (inv, log_det) = spd_inverse(&s)?;
                 Some((*w, eta, to5(&inv), log_det))
             };
-            asked[m].iter().filter_map(predict).collect()
+            let hypotheses = asked[m].iter().filter_map(&mut predict).collect();
+            (hypotheses, information)
         });
+        let (predicted, information): (Vec<Vec<Hypothesis>>, Vec<_>) = per_source.into_iter().unzip();
         let norm = 2.5 * std::f64::consts::TAU.ln();
         // Before the UE is initialised only the BS is in the map, and a wrong
         // LOS cannot be undone: the LOS must be the shortest path (triangle
@@ -482,7 +512,8 @@ impl SlamFilter {
         let columns = self.sources.len();
         let log_new = self.config.new_source_density.ln();
         let a = associate(&log_s, columns, log_new).map_err(|source| SlamError::Association { epoch: k, source })?;
-        Ok(a.iter().enumerate().map(|(l, m)| (*m, m.map_or(log_new, |m| log_s[l][m]))).collect())
+        let assignment = a.iter().enumerate().map(|(l, m)| (*m, m.map_or(log_new, |m| log_s[l][m]))).collect();
+        Ok((assignment, information))
     }
 
     /// Step 1 at the first epoch (Sec. IV-D): particles drawn from the LOS

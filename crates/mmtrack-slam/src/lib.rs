@@ -72,9 +72,12 @@
 //! per-source predictions and the paths' source updates, the calling
 //! thread alone the serial steps in between
 //! (`team`). Every random draw comes from a stream seeded by `(seed, epoch,
-//! stage, chunk)` and every sum that reaches the output is taken in
-//! particle order, so a run is identical for any thread count, and to a
-//! sequential run.
+//! stage, chunk)`, and every sum over the particles that reaches the output
+//! is taken per chunk, in particle order inside the chunk, in the pass that
+//! computes its terms, then the chunks' partial sums are added in chunk
+//! order. Chunks do not depend on the team, so a run is identical for any
+//! thread count (to the bit; it is not the bits of a loop over all
+//! particles in one chain of adds).
 
 pub mod association;
 mod config;

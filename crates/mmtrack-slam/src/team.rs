@@ -18,7 +18,8 @@
 //! (measured: taking tasks in one order for all made each task about a
 //! third slower on two threads, the chunks moving between the cores'
 //! caches). Between phases the
-//! leader alone runs the serial steps (sums in particle order, the tempering
+//! leader alone runs the serial steps (the chunks' partial sums added in
+//! chunk order, the tempering
 //! decisions, the assignment) while the helpers wait, spinning a little
 //! and then yielding the core.
 //!
@@ -151,24 +152,20 @@ fn wait(idle: &mut u32) {
 pub(crate) struct Team {
     /// `None`: the leader alone (one thread, or a single task).
     shared: Option<Arc<Shared>>,
-    /// The leader and its helpers (1 for the leader alone).
-    members: usize,
     /// Generation of the last published phase.
     generation: std::cell::Cell<u64>,
-    /// Phases run with more than one task, or that would have on a team
-    /// of helpers ([`Team::map_per_member`]): synchronisation points when
-    /// the team has helpers, the same count on any team.
+    /// Phases run with more than one task: synchronisation points when the
+    /// team has helpers, the same count on any team.
     phases: std::cell::Cell<u64>,
 }
 
 impl Team {
     /// A team of the calling thread alone: every phase runs inline.
     pub(crate) fn solo() -> Self {
-        Self { shared: None, members: 1, generation: 0.into(), phases: 0.into() }
+        Self { shared: None, generation: 0.into(), phases: 0.into() }
     }
 
-    /// Phases run with more than one task, or that would have on a team of
-    /// helpers.
+    /// Phases run with more than one task.
     pub(crate) fn phases(&self) -> u64 {
         self.phases.get()
     }
@@ -184,24 +181,6 @@ impl Team {
             self.phases.set(self.phases.get() + 1);
         }
         self.run_tasks(tasks, f)
-    }
-
-    /// Runs `f(t, tasks)` for `t` in `0..tasks`, `tasks` the team's members
-    /// but at most `max_tasks`, and returns the results in task order: for
-    /// work that splits into as many parts as there are members, where
-    /// each part costs a pass over the particles (the leader alone makes
-    /// one pass). Counted as a phase when `max_tasks > 1`, so the count does
-    /// not depend on the team.
-    pub(crate) fn map_per_member<R: Send + 'static>(
-        &self,
-        max_tasks: usize,
-        f: impl Fn(usize, usize) -> R + Send + Sync + 'static,
-    ) -> Vec<R> {
-        if max_tasks > 1 {
-            self.phases.set(self.phases.get() + 1);
-        }
-        let tasks = self.members.min(max_tasks);
-        self.run_tasks(tasks, move |t| f(t, tasks))
     }
 
     /// [`Team::map`] without counting the phase.
@@ -271,7 +250,7 @@ pub(crate) fn with_team<T>(max_members: usize, body: impl FnOnce(&Team) -> T) ->
             scope.spawn(move |_| helper.help());
         }
         let _finish = Finish(shared.clone());
-        let team = Team { shared: Some(shared.clone()), members, generation: 0.into(), phases: 0.into() };
+        let team = Team { shared: Some(shared.clone()), generation: 0.into(), phases: 0.into() };
         body(&team)
     })
 }
