@@ -13,7 +13,7 @@ use mmtrack_mpc::{
     CandidateGate, DelayRate, LongTermConfig, LongTermTracker, MpcConfig, MpcPipeline, ShortTermConfig,
     ShortTermPrediction, SounderPulse, short_term_tracks,
 };
-use mmtrack_sim::sounder::{ConvoyConfig, ConvoySimulator, PathKind};
+use mmtrack_sim::sounder::{ConvoyConfig, ConvoySimulator, PathKind, SounderSet};
 
 use super::causes::{Diagnosis, Tables, diagnose};
 
@@ -236,59 +236,70 @@ struct Scene {
     snapshots_per_set: u32,
 }
 
-/// Simulates `convoy` (seed `seed`), detects (the paper's search and
-/// subtract, or with `refined` the refined search) and short-term tracks
-/// with the paper's configuration (the pipeline) and every other short-term
-/// search of `variants` (on the same detections, track ids from 0),
-/// long-term tracks with every variant on its search's full-lifetime
-/// tracks.
-fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant], refined: bool) -> anyhow::Result<Scene> {
-    let simulator = ConvoySimulator::new(convoy, seed)?;
-    let carrier_hz = convoy.sounder.carrier_hz;
-    let pulse = SounderPulse::from_spectrum(simulator.pulse_spectrum().to_vec())?;
-    let tap_spacing_s = simulator.band().tap_spacing_s();
-    // The pipeline runs the paper's long-term tracker; the variants take the
-    // same full-lifetime tracks.
-    let mut config = MpcConfig::default();
-    config.detection.refine_overlapping = refined;
-    let mut pipeline = MpcPipeline::new(config, &pulse, tap_spacing_s, carrier_hz)?;
-    let mut trackers: Vec<LongTermTracker> =
-        variants.iter().map(|v| LongTermTracker::new(v.config.clone(), carrier_hz, 0)).collect::<Result<_, _>>()?;
-    let mut searches = vec![ShortTermConfig::default()];
-    let mut search_of = Vec::new();
-    for v in variants {
-        if let Some(i) = searches.iter().position(|c| *c == v.short_term) {
-            search_of.push(i);
-        } else {
-            search_of.push(searches.len());
-            searches.push(v.short_term.clone());
+/// One detector's run over a scene: its pipeline (detection with the
+/// paper's search and subtract, or with `refined` the refined search, and
+/// the paper's short-term search), every other short-term search of its
+/// variants (on the same detections, track ids from 0), and the long-term
+/// tracker of every variant on its search's full-lifetime tracks.
+struct Run {
+    pipeline: MpcPipeline,
+    trackers: Vec<LongTermTracker>,
+    next_track_id: Vec<u64>,
+    scene: Scene,
+}
+
+impl Run {
+    fn new(
+        variants: &[Variant],
+        refined: bool,
+        pulse: &SounderPulse,
+        tap_spacing_s: f64,
+        carrier_hz: f64,
+        snapshots_per_set: u32,
+    ) -> anyhow::Result<Self> {
+        // The pipeline runs the paper's long-term tracker; the variants take
+        // the same full-lifetime tracks.
+        let mut config = MpcConfig::default();
+        config.detection.refine_overlapping = refined;
+        let pipeline = MpcPipeline::new(config, pulse, tap_spacing_s, carrier_hz)?;
+        let trackers: Vec<LongTermTracker> =
+            variants.iter().map(|v| LongTermTracker::new(v.config.clone(), carrier_hz, 0)).collect::<Result<_, _>>()?;
+        let mut searches = vec![ShortTermConfig::default()];
+        let mut search_of = Vec::new();
+        for v in variants {
+            if let Some(i) = searches.iter().position(|c| *c == v.short_term) {
+                search_of.push(i);
+            } else {
+                search_of.push(searches.len());
+                searches.push(v.short_term.clone());
+            }
         }
+        let scene = Scene {
+            detections: Vec::new(),
+            tracks: vec![Vec::new(); searches.len()],
+            searches,
+            search_of,
+            sets: Vec::new(),
+            truth: Vec::new(),
+            tx: Vec::new(),
+            rx: Vec::new(),
+            long_term: vec![Vec::new(); variants.len()],
+            carrier_hz,
+            blocked_half_width_s: 0.5 * pipeline.detector().blocked_width_s(),
+            snapshots_per_set,
+        };
+        Ok(Self { pipeline, trackers, next_track_id: vec![0; scene.searches.len()], scene })
     }
-    let mut next_track_id = vec![0u64; searches.len()];
-    let mut scene = Scene {
-        detections: Vec::new(),
-        tracks: vec![Vec::new(); searches.len()],
-        searches,
-        search_of,
-        sets: Vec::new(),
-        truth: Vec::new(),
-        tx: Vec::new(),
-        rx: Vec::new(),
-        long_term: vec![Vec::new(); variants.len()],
-        carrier_hz,
-        blocked_half_width_s: 0.5 * pipeline.detector().blocked_width_s(),
-        snapshots_per_set: convoy.snapshots_per_set,
-    };
-    let batch = MpcPipeline::SETS_PER_THREAD * rayon::current_num_threads();
-    let mut sets = simulator.peekable();
-    while sets.peek().is_some() {
-        let chunk: Vec<_> = sets.by_ref().take(batch).collect();
+
+    /// Detects and tracks the next `chunk` of sets.
+    fn push(&mut self, chunk: &[SounderSet]) -> anyhow::Result<()> {
+        let scene = &mut self.scene;
         let snapshots: Vec<_> = chunk.iter().map(|s| s.snapshots.as_slice()).collect();
-        for (set, output) in chunk.iter().zip(pipeline.push_sets(&snapshots)?) {
+        for (set, output) in chunk.iter().zip(self.pipeline.push_sets(&snapshots)?) {
             let per_snapshot: Vec<Vec<MpcDetection>> = output.per_snapshot.into_iter().map(|s| s.detections).collect();
             let mut by_search = vec![output.short_term_tracks];
-            for (config, next_id) in scene.searches.iter().zip(&mut next_track_id).skip(1) {
-                let tracks = short_term_tracks(&per_snapshot, carrier_hz, config, *next_id);
+            for (config, next_id) in scene.searches.iter().zip(&mut self.next_track_id).skip(1) {
+                let tracks = short_term_tracks(&per_snapshot, scene.carrier_hz, config, *next_id);
                 *next_id += tracks.len() as u64;
                 by_search.push(tracks);
             }
@@ -296,7 +307,9 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant], refined: bo
                 .iter()
                 .map(|tracks| tracks.iter().filter(|t| is_full_lifetime(t, set.snapshots.len())).cloned().collect())
                 .collect();
-            for ((tracker, entries), &search) in trackers.iter_mut().zip(&mut scene.long_term).zip(&scene.search_of) {
+            for ((tracker, entries), &search) in
+                self.trackers.iter_mut().zip(&mut scene.long_term).zip(&scene.search_of)
+            {
                 entries.extend(tracker.push_set(&full[search]));
             }
             scene.detections.extend(per_snapshot.into_iter().flatten());
@@ -308,8 +321,32 @@ fn run_scene(convoy: &ConvoyConfig, seed: u64, variants: &[Variant], refined: bo
             scene.tx.push(set.tx_pose.clone());
             scene.rx.push(set.rx_pose.clone());
         }
+        Ok(())
     }
-    Ok(scene)
+}
+
+/// Simulates `convoy` (seed `seed`) once and runs every detector of
+/// `groups` (`(refined, variants)`, see [`Run`]) on the same snapshots; one
+/// scene per group, in order.
+fn run_scenes(convoy: &ConvoyConfig, seed: u64, groups: &[(bool, Vec<Variant>)]) -> anyhow::Result<Vec<Scene>> {
+    let simulator = ConvoySimulator::new(convoy, seed)?;
+    let pulse = SounderPulse::from_spectrum(simulator.pulse_spectrum().to_vec())?;
+    let tap_spacing_s = simulator.band().tap_spacing_s();
+    let mut runs = groups
+        .iter()
+        .map(|(refined, variants)| {
+            Run::new(variants, *refined, &pulse, tap_spacing_s, convoy.sounder.carrier_hz, convoy.snapshots_per_set)
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let batch = MpcPipeline::SETS_PER_THREAD * rayon::current_num_threads();
+    let mut sets = simulator.peekable();
+    while sets.peek().is_some() {
+        let chunk: Vec<SounderSet> = sets.by_ref().take(batch).collect();
+        for run in &mut runs {
+            run.push(&chunk)?;
+        }
+    }
+    Ok(runs.into_iter().map(|run| run.scene).collect())
 }
 
 /// Why the births of variant `v` (index into `variants`) happened.
@@ -381,17 +418,17 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
         (&with_diffuse, &[Truth::SpecularOnly, Truth::WithDiffuse][..], "the tunnel (diffuse scatterers in the truth)"),
         (&no_diffuse, &[Truth::NoDiffuse][..], "the tunnel without diffuse scatterers"),
     ] {
-        // One scene per detector: the paper's search, then the refined one.
-        let mut scenes = Vec::new();
-        for refined in [false, true] {
-            let group: Vec<Variant> = variants().into_iter().filter(|v| v.refined_detection == refined).collect();
-            if group.is_empty() {
-                continue;
-            }
-            let detector = if refined { "refined search" } else { "paper's search" };
-            progress.note(&format!("simulating and tracking {sets} sets of {what}, {detector}"));
-            scenes.push((run_scene(scenario, seed, &group, refined)?, group));
-        }
+        // One simulation, one scene per detector: the paper's search, then
+        // the refined one.
+        let groups: Vec<(bool, Vec<Variant>)> = [false, true]
+            .into_iter()
+            .map(|refined| (refined, variants().into_iter().filter(|v| v.refined_detection == refined).collect()))
+            .filter(|(_, group): &(bool, Vec<Variant>)| !group.is_empty())
+            .collect();
+        progress
+            .note(&format!("simulating and tracking {sets} sets of {what} (the paper's search and the refined one)"));
+        let scenes: Vec<(Scene, Vec<Variant>)> =
+            run_scenes(scenario, seed, &groups)?.into_iter().zip(groups.into_iter().map(|(_, g)| g)).collect();
         for &truth in truths {
             for (scene, group) in &scenes {
                 let table: Vec<MpcTruth> = if truth == Truth::SpecularOnly {
