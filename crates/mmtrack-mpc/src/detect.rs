@@ -63,7 +63,9 @@
 //! re-estimated, each with the others subtracted, until no delay moves by
 //! more than a thousandth of a tap (coordinate descent on the joint fit, as
 //! SAGE updates one path at a time); detections that fall below the
-//! threshold are dropped. Two paths closer than a pulse width are then
+//! threshold are dropped. The blocked ranges stay where the detections were
+//! first found (a refined delay moves by a fraction of a tap). Two paths
+//! closer than a pulse width are then
 //! fitted together instead of one at a time, which otherwise biases the
 //! first towards the second and leaves a residue on its far side that the
 //! search picks up as a path (the simulated convoy's LOS and wall bounce,

@@ -521,6 +521,7 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
 
     // Long-term tracks on no true path, against the strongest path beside them.
     let track_of: BTreeMap<u64, &MpcTrack> = t.tracks.iter().map(|track| (track.track_id, track)).collect();
+    let here = |d: &MpcDetection| by_snapshot.get(&(d.set_index, d.snapshot_index)).map_or(&[][..], Vec::as_slice);
     let mut ghosts = Vec::new();
     for (&long_id, votes) in &long_votes {
         if majority(votes).is_some() {
@@ -529,7 +530,6 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
         let Some(chain) = chains.get(&long_id) else { continue };
         let Some((&first, entry)) = chain.iter().next() else { continue };
         let detections = track_of.get(&entry.short_track_id).map_or(&[][..], |track| track.detections.as_slice());
-        let here = |d: &MpcDetection| by_snapshot.get(&(d.set_index, d.snapshot_index)).map_or(&[][..], Vec::as_slice);
         let beside = detections.first().and_then(|d| {
             here(d)
                 .iter()

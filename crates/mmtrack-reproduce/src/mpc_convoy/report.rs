@@ -489,23 +489,32 @@ fn cost_table(m: &Measured) -> String {
 
 /// `ghosts.csv`: every long-term track on no true path, per (truth, tracker).
 fn ghosts_csv(m: &Measured) -> String {
-    let mut out =
-        String::from("truth,tracker,long_track_id,first_set,is_birth,sets,beside_path_id,offset_ns,below_db\n");
+    per_pair_csv(m, "long_track_id,first_set,is_birth,sets,beside_path_id,offset_ns,below_db", |d| {
+        d.ghosts
+            .iter()
+            .map(|g| {
+                format!(
+                    "{},{},{},{},{},{:.3},{:.2}",
+                    g.long_track_id,
+                    g.first_set,
+                    g.is_birth,
+                    g.sets,
+                    g.beside.map_or(String::new(), |p| p.to_string()),
+                    g.offset_s * 1e9,
+                    g.below_db,
+                )
+            })
+            .collect()
+    })
+}
+
+/// A CSV of `truth,tracker,<columns>` with the `lines` of each (truth,
+/// tracker) pair's diagnosis.
+fn per_pair_csv(m: &Measured, columns: &str, lines: impl Fn(&Diagnosis) -> Vec<String>) -> String {
+    let mut out = format!("truth,tracker,{columns}\n");
     for (row, d) in m.rows.iter().zip(&m.diagnoses) {
-        for g in &d.ghosts {
-            let _ = writeln!(
-                out,
-                "{},{},{},{},{},{},{},{:.3},{:.2}",
-                row.truth.key(),
-                row.variant,
-                g.long_track_id,
-                g.first_set,
-                g.is_birth,
-                g.sets,
-                g.beside.map_or(String::new(), |p| p.to_string()),
-                g.offset_s * 1e9,
-                g.below_db,
-            );
+        for line in lines(d) {
+            let _ = writeln!(out, "{},{},{line}", row.truth.key(), row.variant);
         }
     }
     out
@@ -565,23 +574,21 @@ fn ghost_table(d: &Diagnosis) -> String {
 
 /// `causes.csv`: every birth on a true path, per (truth, tracker).
 fn causes_csv(m: &Measured) -> String {
-    let mut out = String::from("truth,tracker,path_id,set_index,gap_sets,cause,bridge,margin_db,missed_snapshots\n");
-    for (row, d) in m.rows.iter().zip(&m.diagnoses) {
-        for b in &d.births {
-            let _ = writeln!(
-                out,
-                "{},{},{},{},{},{:?},{},{},{}",
-                row.truth.key(),
-                row.variant,
-                b.path_id,
-                b.set_index,
-                b.gap_sets.map_or(String::new(), |g| g.to_string()),
-                b.cause,
-                b.bridge.map_or(String::new(), |c| format!("{c:?}")),
-                b.margin_db.map_or(String::new(), |x| format!("{x:.2}")),
-                b.missed_snapshots.iter().map(u32::to_string).collect::<Vec<_>>().join(" "),
-            );
-        }
-    }
-    out
+    per_pair_csv(m, "path_id,set_index,gap_sets,cause,bridge,margin_db,missed_snapshots", |d| {
+        d.births
+            .iter()
+            .map(|b| {
+                format!(
+                    "{},{},{},{:?},{},{},{}",
+                    b.path_id,
+                    b.set_index,
+                    b.gap_sets.map_or(String::new(), |g| g.to_string()),
+                    b.cause,
+                    b.bridge.map_or(String::new(), |c| format!("{c:?}")),
+                    b.margin_db.map_or(String::new(), |x| format!("{x:.2}")),
+                    b.missed_snapshots.iter().map(u32::to_string).collect::<Vec<_>>().join(" "),
+                )
+            })
+            .collect()
+    })
 }
