@@ -168,9 +168,21 @@ fn read_array(format: CirFormat, input: &Path, sidecar: &CirSidecar) -> Result<(
         }
         _ => {
             let Some(variable) = sidecar.variable.as_deref() else {
-                return Err(
-                    sidecar.error("variable", format!("required: name the MATLAB variable of {}", input.display()))
-                );
+                let held = super::matlab::list_variables(input)?;
+                let example = held.first().map_or("CIR", |(name, _)| name.as_str());
+                let present = if held.is_empty() {
+                    String::new()
+                } else {
+                    format!("; it holds {}", super::matlab::describe_variables(&held))
+                };
+                return Err(sidecar.error(
+                    "variable",
+                    format!(
+                        "required: name the MATLAB variable of {}{present} (a sidecar TOML with `variable = \"{example}\"`, \
+                         passed with --sidecar)",
+                        input.display()
+                    ),
+                ));
             };
             let array = super::matlab::read_mat_array(input, variable, sidecar.allow_real)?;
             Ok((format!("variable `{variable}`"), array))

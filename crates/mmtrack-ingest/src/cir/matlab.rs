@@ -286,6 +286,36 @@ fn element(bytes: &[u8], at: usize, endian: Endian) -> Result<Element<'_>, Strin
 
 /// Walks the top-level elements until `variable` is found.
 fn find_variable(path: &Path, bytes: &[u8], variable: &str) -> Result<MatArray, IngestError> {
+    match walk_variables(path, bytes, Some(variable))? {
+        Ok(array) => Ok(array),
+        Err(seen) => {
+            let present = if seen.is_empty() { "no variables".to_string() } else { describe_variables(&seen) };
+            Err(IngestError::BadLayout {
+                path: path.to_path_buf(),
+                detail: format!("no variable `{variable}` in the file; it holds {present}"),
+            })
+        }
+    }
+}
+
+/// The variables of the v5/v7 `.mat` file at `path` as (name, class and
+/// dims), in file order (none listed for a v7.3 file), for the error that
+/// asks which one to read.
+pub(crate) fn list_variables(path: &Path) -> Result<Vec<(String, String)>, IngestError> {
+    if super::hdf5::is_mat73(&super::hdf5::file_head(path)?) {
+        return Ok(Vec::new());
+    }
+    let bytes = crate::error::read_capped(path, &mmtrack_core::limits::ARRAY_FILE_BYTES)?;
+    Ok(walk_variables(path, &bytes, None)?.err().unwrap_or_default())
+}
+
+/// Walks the top-level elements until `wanted` is found (decoded) or the
+/// file ends: then the variables seen, described.
+fn walk_variables(
+    path: &Path,
+    bytes: &[u8],
+    wanted: Option<&str>,
+) -> Result<Result<MatArray, Vec<(String, String)>>, IngestError> {
     let endian = file_header(path, bytes)?;
     let bad = |record: String, detail: String| IngestError::BadRecord {
         path: path.to_path_buf(),
@@ -293,7 +323,7 @@ fn find_variable(path: &Path, bytes: &[u8], variable: &str) -> Result<MatArray, 
         field: "data element".into(),
         detail,
     };
-    let mut seen: Vec<String> = Vec::new();
+    let mut seen: Vec<(String, String)> = Vec::new();
     let mut at = 128;
     while at < bytes.len() {
         let record = format!("variable {} (byte {at})", seen.len() + 1);
@@ -331,7 +361,7 @@ fn find_variable(path: &Path, bytes: &[u8], variable: &str) -> Result<MatArray, 
             field: field.into(),
             detail,
         })?;
-        if array.name == variable {
+        if let Some(variable) = wanted.filter(|&v| v == array.name) {
             let record = format!("variable `{variable}`");
             decode_data(matrix_body, endian, &mut array).map_err(|(field, detail)| IngestError::BadRecord {
                 path: path.to_path_buf(),
@@ -339,16 +369,18 @@ fn find_variable(path: &Path, bytes: &[u8], variable: &str) -> Result<MatArray, 
                 field: field.into(),
                 detail,
             })?;
-            return Ok(array);
+            return Ok(Ok(array));
         }
-        seen.push(format!("`{}` ({})", array.name, array.describe()));
+        let description = array.describe();
+        seen.push((array.name, description));
         at = top.next;
     }
-    let present = if seen.is_empty() { "no variables".to_string() } else { seen.join(", ") };
-    Err(IngestError::BadLayout {
-        path: path.to_path_buf(),
-        detail: format!("no variable `{variable}` in the file; it holds {present}"),
-    })
+    Ok(Err(seen))
+}
+
+/// "`name` (class, dims)" for each variable, comma-separated.
+pub(crate) fn describe_variables(variables: &[(String, String)]) -> String {
+    variables.iter().map(|(name, what)| format!("`{name}` ({what})")).collect::<Vec<_>>().join(", ")
 }
 
 /// Checks the 128-byte header; returns the byte order.

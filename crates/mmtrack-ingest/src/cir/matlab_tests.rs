@@ -321,3 +321,15 @@ fn compressed_variable_bomb_is_refused() {
     assert!(e.contains("compressed variable: decompresses to more than"), "{e}");
     assert!(e.contains("more than 100 times its compressed size") && e.contains("save -v6"), "{e}");
 }
+
+/// Without a sidecar naming the variable, the error lists the file's
+/// variables and shows the sidecar line that picks one (the real BUT file:
+/// one variable, `CIR_mat`).
+#[test]
+fn a_mat_file_without_a_variable_named_lists_its_variables() {
+    let cir_path = Path::new(REAL_DIR).join("CIR.mat");
+    assert!(cir_path.exists(), "real data not found at {REAL_DIR}");
+    let err = crate::cir::read_cir_file(crate::cir::CirFormat::Mat, &cir_path, None).unwrap_err().to_string();
+    assert!(err.contains("key `variable`") && err.contains("it holds `CIR_mat` (double complex"), "{err}");
+    assert!(err.contains("`variable = \"CIR_mat\"`") && err.contains("--sidecar"), "{err}");
+}
