@@ -131,3 +131,67 @@ fn mimo_60ghz_detections_keep_out_of_each_others_blocked_range() {
     // Exact, as on the synthetic channels (detect.rs).
     assert_eq!(inside, 0, "closest pair {closest_s} s, half blocked width {half_width_s} s");
 }
+
+/// Energy of `cir` left after subtracting `detections` rendered through the
+/// flat pulse, weighted by the Kaiser window the detector fits through
+/// (`sum_k z_k^2 |H_k - sum_l alpha_l exp(-j 2 pi f_k tau_l)|^2 / U`),
+/// relative to the windowed CIR's own energy.
+fn windowed_residual_share(band: &SounderBand, cir: &CirSnapshot, detections: &[mmtrack_core::MpcDetection]) -> f64 {
+    let window = band.kaiser_window(DetectionConfig::default().kaiser_beta.unwrap());
+    let spectrum = mmtrack_core::sounder::spectrum_from_cir(&cir.taps);
+    let flat = vec![mmtrack_core::Complex64::new(1.0, 0.0); spectrum.len()];
+    let mut model = vec![mmtrack_core::Complex64::new(0.0, 0.0); spectrum.len()];
+    for d in detections {
+        band.add_path(&mut model, &flat, d.delay_s - cir.delay_offset_s, d.amplitude);
+    }
+    let (mut left, mut all) = (0.0, 0.0);
+    for ((h, m), z) in spectrum.iter().zip(&model).zip(&window) {
+        left += z * z * (h - m).norm_sqr();
+        all += z * z * h.norm_sqr();
+    }
+    left / all
+}
+
+/// The opt-in joint re-estimation of overlapping paths
+/// (`refine_overlapping`) on both real samples: it fits the channel better
+/// than the paper's one-pulse-at-a-time search (less windowed energy left
+/// over, on the mean over the CIRs) with no more detections. Measured:
+/// UWB 4.6 % -> 2.9 % left at 115.2 -> 114.7 detections per CIR; 60 GHz
+/// 1.28 % -> 1.07 % at 200 (the `max_mpcs` cap) both.
+#[test]
+fn refined_detection_on_real_channels() {
+    let uwb = realdata("uwb-cirs-2018").map(|dir| {
+        let log = read_decawave_log(&dir.join("1.log"), &DecawaveConfig::default()).unwrap();
+        log.frames.iter().map(|frame| frame.cir.clone()).collect::<Vec<_>>()
+    });
+    for (label, cirs) in [("UWB DW1000", uwb), ("60 GHz MIMO", mimo_60ghz_links())] {
+        let cirs = cirs.unwrap();
+        let band = SounderBand::new(cirs[0].taps.len(), cirs[0].tap_spacing_s).unwrap();
+        let mut rows = Vec::new();
+        for refine in [false, true] {
+            let config = DetectionConfig { refine_overlapping: refine, ..DetectionConfig::default() };
+            let detector = Detector::new(config, band.tap_spacing_s(), &SounderPulse::flat(&band)).unwrap();
+            let (mut count, mut residual, mut worst) = (0usize, 0.0, 0.0_f64);
+            for (index, cir) in cirs.iter().enumerate() {
+                let found = detector.detect(cir, index).unwrap();
+                count += found.detections.len();
+                let share = windowed_residual_share(&band, cir, &found.detections);
+                residual += share;
+                worst = worst.max(share);
+            }
+            println!(
+                "{label} refine={refine}: {:.1} detections per CIR, windowed residual {:.2e} of the energy (mean), worst {:.2e}",
+                count as f64 / cirs.len() as f64,
+                residual / cirs.len() as f64,
+                worst
+            );
+            rows.push((count, residual / cirs.len() as f64));
+        }
+        let [(paper_count, paper_left), (refined_count, refined_left)] = rows[..] else { unreachable!() };
+        assert!(
+            refined_left < paper_left,
+            "{label}: refined leaves {refined_left:.3e}, the paper's search {paper_left:.3e}"
+        );
+        assert!(refined_count <= paper_count, "{label}: {refined_count} detections against {paper_count}");
+    }
+}
