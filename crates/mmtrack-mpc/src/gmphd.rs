@@ -54,6 +54,7 @@
 
 mod config;
 mod filter;
+mod small;
 mod tracks;
 
 pub use config::GmPhdConfig;
