@@ -293,7 +293,7 @@ def test_reproduce_returns_the_claims_the_cli_reports(tmp_path: Path) -> None:
     report = (tmp_path / "cli" / "reproduce.md").read_text()
     for claim in done.claims:
         assert f"| {claim.claim} | {claim.paper} |" in report
-        assert claim.verdict in ("met", "missed", "holds (variant, not a target)", "does not hold (variant, not a target)")
+        assert claim.verdict in ("met", "missed", "holds (ours, not counted)", "does not hold (ours, not counted)")
     assert done.targets_met == all(c.met or c.informational for c in done.claims)
     assert any(c.paper_value is not None and c.measured is not None for c in done.claims)
     # The measured numbers are the CLI's (seeded), except wall-clock times.

@@ -199,8 +199,9 @@ pub struct Claim {
     pub paper_text: String,
     /// How the measured value is judged.
     pub rule: Rule,
-    /// Reported beside the targets, not a target: does not set the exit
-    /// status (a variant or diagnostic of ours).
+    /// Reported beside the paper's claims, not counted among them and not
+    /// setting the exit status: a variant, diagnostic or speed target of
+    /// ours.
     pub informational: bool,
 }
 
@@ -279,8 +280,8 @@ impl Verdict {
         match (self.met, self.claim.informational) {
             (true, false) => "met",
             (false, false) => "**missed**",
-            (true, true) => "holds (variant, not a target)",
-            (false, true) => "does not hold (variant, not a target)",
+            (true, true) => "holds (ours, not counted)",
+            (false, true) => "does not hold (ours, not counted)",
         }
     }
 }
@@ -372,7 +373,7 @@ mod tests {
     fn informational_claims_do_not_set_the_outcome_and_print_their_own_words() {
         let missed =
             Verdict::decided(Claim::new("v", "", None, "-", Rule::AtLeast { bound: 1.0 }).informational(), false, "0");
-        assert_eq!(missed.word(), "does not hold (variant, not a target)");
+        assert_eq!(missed.word(), "does not hold (ours, not counted)");
         let outcome = Outcome {
             experiment: "x",
             metrics: Vec::new(),
@@ -382,6 +383,6 @@ mod tests {
             readme: ReadmeBlock { name: "x", body: String::new() },
         };
         assert!(outcome.targets_met());
-        assert_eq!(verdict_rows(&[missed]), "| v | - | 0 | does not hold (variant, not a target) |\n");
+        assert_eq!(verdict_rows(&[missed]), "| v | - | 0 | does not hold (ours, not counted) |\n");
     }
 }

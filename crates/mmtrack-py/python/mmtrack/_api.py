@@ -282,7 +282,7 @@ class Claim:
     #: The measurement as the report prints it.
     measured_text: str
     met: bool
-    #: Reported beside the targets, not a target.
+    #: Reported beside the paper's claims, not counted (a variant, diagnostic or speed target of ours).
     informational: bool
     #: "met", "missed", or for informational claims whether the relation holds.
     verdict: str
