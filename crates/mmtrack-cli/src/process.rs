@@ -30,7 +30,8 @@ enum Pipeline {
     /// (time per stage; not deterministic, so kept apart) and, when the
     /// recording has ground truth, `ground_truth/...`. Then run
     /// `mmtrack analyze <out>` for drift and error metrics, or
-    /// `mmtrack export --format tum <out>` for evo / pyboreas / the KITTI devkit.
+    /// `mmtrack export --format tum|kitti|boreas <out>` for evo / the KITTI
+    /// devkit / pyboreas.
     #[command(verbatim_doc_comment)]
     Odometry(OdometryArgs),
     /// Multipath-component detection and tracking (Mahler et al. 2017) on the recording's CIR snapshots.
