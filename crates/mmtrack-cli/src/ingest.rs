@@ -291,7 +291,7 @@ enum Kind {
     ///
     /// A sidecar TOML gives what the file lacks (carrier_hz, tap_spacing_s or
     /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable, dataset);
-    /// see the mmtrack_ingest::cir::sidecar docs for every key.
+    /// every key, and an example for the real 60 GHz MIMO sample, in docs/commands.md ("mmtrack ingest cir").
     Cir {
         /// The file (.npy, .npz, .mat, .h5, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
         input: PathBuf,

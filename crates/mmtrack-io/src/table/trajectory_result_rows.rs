@@ -33,8 +33,12 @@ KITTI devkit (evaluate_odometry.cpp).",
 papers report, CFEAR's 0.60 deg/100 m; the devkit's deg/m times 100); null without segments";
         ate_rmse_m: f64, "m", "absolute trajectory error: position RMSE after least-squares SE(2) alignment";
         ate_max_m: f64, "m", "largest position error after alignment";
-        x_rmse_m: f64, "m", "RMSE of x without alignment";
-        y_rmse_m: f64, "m", "RMSE of y without alignment";
+        x_rmse_m: f64, "m",
+            "RMSE of x without alignment, both trajectories moved to start at the identity (x along the first \
+pose's heading)";
+        y_rmse_m: f64, "m",
+            "RMSE of y without alignment, both trajectories moved to start at the identity (y to the left of the \
+first pose's heading)";
         position_rmse_m: f64, "m", "RMSE of the planar position without alignment";
         yaw_rmse_rad: f64, "rad", "RMSE of the wrapped yaw difference without alignment";
         final_position_error_m: f64, "m", "position error at the last associated pose, without alignment";
