@@ -40,15 +40,11 @@ use std::collections::BTreeMap;
 use mmtrack_filter::gmphd::MAX_COPIES_PER_COMPONENT;
 use mmtrack_filter::{FilterError, Label};
 
+use super::small::{Cov, Mean};
 use super::small::{
     checked_spd, cholesky_2x2, col, dot_add, log_sum_exp, mahalanobis_squared_2, mul_add, mul_transpose_add, pivot,
     row, symmetrise,
 };
-
-/// A mean `[d, d_dot]`.
-pub(super) type Mean = [f64; 2];
-/// A covariance, row-major: `p[i][j]` is element `(i, j)`.
-pub(super) type Cov = [[f64; 2]; 2];
 
 /// One weighted Gaussian of the intensity, with its label (as
 /// [`mmtrack_filter::gmphd::Component`]).

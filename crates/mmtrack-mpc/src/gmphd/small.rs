@@ -11,7 +11,10 @@ use mmtrack_filter::faer::linalg::cholesky::llt;
 use mmtrack_filter::faer::{MatMut, Par};
 use mmtrack_filter::{FilterError, SYMMETRY_TOLERANCE};
 
-use super::filter::{Cov, Mean};
+/// A mean `[d, d_dot]`.
+pub(super) type Mean = [f64; 2];
+/// A covariance, row-major: `p[i][j]` is element `(i, j)`.
+pub(super) type Cov = [[f64; 2]; 2];
 
 /// `dst + sum_k a_k b_k`, the sum formed from `0.0` in order of `k` and then
 /// added (`linalg::mul_add` with `alpha = 1`).
