@@ -108,7 +108,8 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
     crate::trajectory::kitti_drift(&[], &[], &options.drift).context("--segment-lengths-m / --step-*")?;
     let range_db = options.mpc.first_path_dynamic_range_db;
     if !(range_db.is_finite() && range_db >= 0.0) {
-        bail!("--first-path-range-db {range_db}: expected a finite, non-negative number of dB");
+        let message = format!("--first-path-range-db {range_db}: expected a finite, non-negative number of dB");
+        return Err(mmtrack_core::error::UsageError(message).into());
     }
     let runs = discover_runs(tables)?;
     // The run's time base: its inputs' (each sequence's tables then carry their own, `RunResults::time_bases`).

@@ -124,6 +124,21 @@ fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyho
     }
 }
 
+/// A flag value found wrong after parsing, as a usage error (exit 2, see
+/// [`mmtrack_core::error::UsageError`]).
+fn usage(message: impl Into<String>) -> anyhow::Error {
+    mmtrack_core::error::UsageError::new(message).into()
+}
+
+/// Exit 2 for a usage error anywhere in `error`'s chain, 1 for any other.
+fn exit_code_of(error: &anyhow::Error) -> ExitCode {
+    if error.chain().any(|cause| cause.is::<mmtrack_core::error::UsageError>()) {
+        ExitCode::from(2)
+    } else {
+        ExitCode::FAILURE
+    }
+}
+
 /// `path` as a command-line word.
 ///
 /// # Errors
@@ -243,7 +258,7 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(error) => {
             eprintln!("error: {}", one_line(&error));
-            ExitCode::FAILURE
+            exit_code_of(&error)
         }
     }
 }
