@@ -265,6 +265,24 @@ fn hdf5_inputs_without_the_feature_say_how_to_rebuild() {
 fn schema_documents_are_current() {
     let out = mmtrack(&root(), &["schemas", "--check", "schemas"]);
     assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(&root(), &["schemas"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+}
+
+/// Before: without `schemas/` here, `mmtrack schemas` listed every
+/// document as "stale".
+#[test]
+fn schemas_without_a_folder_says_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["schemas"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("no such folder") && stderr.contains("--write DIR") && stderr.contains("--check DIR"));
+    assert!(!stderr.contains("stale"), "{stderr}");
+    let out = mmtrack(dir.path(), &["schemas", "--check", "docs"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("docs: no such folder to check"), "{stderr}");
 }
 
 #[test]
