@@ -95,3 +95,26 @@ fn bad_flag_values_found_after_parsing_exit_2() {
     let out = mmtrack(dir.path(), &["ingest", "poses", "missing.tum", "--format", "tum", "-o", "o.mcap"]);
     assert_eq!(out.status.code(), Some(1), "{}", text(&out).1);
 }
+
+/// Before: `--max-scans 0` wrote an empty recording (exit 0) and `--sets
+/// 1000000000000` silently gave the scenario's 1666 sets.
+#[test]
+fn simulations_asked_for_nothing_or_too_much_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let radar = super::common::root().join("data/demo/radar-scenario.toml");
+    let out = mmtrack(
+        dir.path(),
+        &["simulate", "radar", "--scenario", radar.to_str().unwrap(), "--max-scans", "0", "-o", "r.mcap"],
+    );
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--max-scans 0") && !dir.path().join("r.mcap").exists(), "{stderr}");
+    let convoy = super::common::root().join("data/sounder/convoy-tunnel.toml");
+    let args =
+        ["simulate", "sounder", "--scenario", convoy.to_str().unwrap(), "--sets", "1000000000000", "-o", "s.mcap"];
+    let out = mmtrack(dir.path(), &args);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--sets 1000000000000") && stderr.contains("at most"), "{stderr}");
+    assert!(!dir.path().join("s.mcap").exists());
+}
