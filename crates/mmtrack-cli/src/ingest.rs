@@ -253,6 +253,11 @@ enum Kind {
         sequence_id: Option<String>,
     },
     /// Trajectory file (TUM, KITTI, Oxford radar_odometry.csv) into a new recording or added to one.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Poses {
         /// The trajectory file.
         input: PathBuf,
@@ -278,6 +283,11 @@ enum Kind {
         plane: PlaneArg,
     },
     /// NMEA 0183 GNSS log (GGA with RMC or ZDA, or RMC alone; any talker) into a new recording or added to one.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Nmea {
         /// The log.
         input: PathBuf,
@@ -292,6 +302,11 @@ enum Kind {
     /// A sidecar TOML gives what the file lacks (carrier_hz, tap_spacing_s or
     /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable, dataset);
     /// see the mmtrack_ingest::cir::sidecar docs for every key.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Cir {
         /// The file (.npy, .npz, .mat, .h5, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
         input: PathBuf,

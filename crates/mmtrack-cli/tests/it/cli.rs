@@ -434,3 +434,17 @@ fn inspect_shortens_long_metadata_values() {
     assert!(line.contains(&whole[..40]) && line.contains(&format!("({} bytes; `--json`", whole.len())), "{line}");
     assert!(stdout.lines().all(|l| l.chars().count() < 200), "{stdout}");
 }
+
+/// Before: `ingest cir`, `ingest nmea` and `ingest poses` listed the radar
+/// Cartesian view's options, which only the radar kinds use.
+#[test]
+fn radar_view_options_are_listed_only_where_they_apply() {
+    for kind in ["cir", "nmea", "poses"] {
+        let out = mmtrack(&root(), &["ingest", kind, "--help"]);
+        let (stdout, _) = text(&out);
+        assert!(out.status.success() && stdout.contains("--force"), "{stdout}");
+        assert!(!stdout.contains("radar-cartesian"), "ingest {kind}: {stdout}");
+    }
+    let (stdout, _) = text(&mmtrack(&root(), &["ingest", "oxford", "--help"]));
+    assert!(stdout.contains("--radar-cartesian-m-per-px"), "{stdout}");
+}
