@@ -105,10 +105,12 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
     }
     check_output(output, options.overwrite)?;
     // Options are checked by the metric too, but a usage error should not wait for the tables to load.
-    crate::trajectory::kitti_drift(&[], &[], &options.drift).context("--segment-lengths-m / --step-*")?;
+    crate::trajectory::kitti_drift(&[], &[], &options.drift)
+        .map_err(|e| mmtrack_core::error::UsageError(format!("--segment-lengths-m / --step-*: {e}")))?;
     let range_db = options.mpc.first_path_dynamic_range_db;
     if !(range_db.is_finite() && range_db >= 0.0) {
-        bail!("--first-path-range-db {range_db}: expected a finite, non-negative number of dB");
+        let message = format!("--first-path-range-db {range_db}: expected a finite, non-negative number of dB");
+        return Err(mmtrack_core::error::UsageError(message).into());
     }
     let runs = discover_runs(tables)?;
     // The run's time base: its inputs' (each sequence's tables then carry their own, `RunResults::time_bases`).

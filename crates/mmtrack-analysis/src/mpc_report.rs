@@ -36,10 +36,10 @@ pub fn one_line(r: &MpcResult) -> String {
     let s = &r.summary;
     let (b, d, unit) = rates(r);
     format!(
-        "{}: {} sets, {:.1} MPCs per set, births {b} / deaths {d} {unit} (distance: {}), detection loss {} dB, tracking loss {} dB{}{}",
+        "{}: {} sets, {} MPCs per set, births {b} / deaths {d} {unit} (distance: {}), detection loss {} dB, tracking loss {} dB{}{}",
         r.sequence,
         s.sets,
-        s.mean_mpcs_per_set,
+        opt(s.mean_mpcs_per_set, 1),
         s.distance_source,
         opt(s.mean_detection_loss_db, 2),
         opt(s.mean_tracking_loss_db, 2),
@@ -118,11 +118,11 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
             s.distance_m.map_or_else(|| s.distance_source.clone(), |m| format!("{m:.1} m ({})", s.distance_source));
         let _ = writeln!(
             out,
-            "| {} | {} | {:.2} ({:.1}) | {b} | {d} | {unit} | {distance} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} ({}) | {b} | {d} | {unit} | {distance} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.sequence,
             s.sets,
-            s.mean_mpcs_per_set,
-            s.median_mpcs_per_set,
+            opt(s.mean_mpcs_per_set, 2),
+            opt(s.median_mpcs_per_set, 1),
             opt(s.mean_detection_loss_db, 2),
             opt(s.mean_tracking_loss_db, 2),
             opt(s.mean_full_lifetime_loss_db, 2),
@@ -171,10 +171,10 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
                 pct(s.false_track_share),
                 pct(s.false_long_term_share),
                 opt(s.long_term_tracks_per_path, 1),
-                s.births,
+                n(s.births),
                 n(s.births_on_true_paths),
                 n(s.true_births),
-                s.deaths,
+                n(s.deaths),
                 n(s.deaths_on_true_paths),
                 n(s.true_deaths),
                 opt(s.birth_rate_per_m, 3),

@@ -73,7 +73,7 @@ pub fn run(args: &ExportArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         return export_mcap(args, overwrite, quiet);
     }
     if args.recording.is_some() {
-        bail!("--recording is only used with --format mcap");
+        return Err(crate::usage("--recording is only used with --format mcap"));
     }
     let mut inputs = read_trajectories(&args.tables)?;
     if inputs.is_empty() {
@@ -125,7 +125,11 @@ fn recording_metadata(path: &Path) -> anyhow::Result<RecordingMetadata> {
 /// `--format mcap`: the recording plus the estimate of its sequence: the
 /// `odometry` table, or a SLAM run's `slam_ue` and `slam_map` tables.
 fn export_mcap(args: &ExportArgs, overwrite: Overwrite, quiet: bool) -> anyhow::Result<ExitCode> {
-    let Some(recording) = &args.recording else { bail!("--format mcap needs --recording <RECORDING.mcap>") };
+    let Some(recording) = &args.recording else {
+        return Err(crate::usage("--format mcap needs --recording <RECORDING.mcap>"));
+    };
+    // An output that is the recording is refused by the copy itself ("never modified").
+    mmtrack_io::check_output_file(&args.output)?;
     let metadata = recording_metadata(recording)?;
     let sequence = args.sequence.clone().unwrap_or_else(|| metadata.sequence_id.clone());
     let odometry = table_path(&args.tables, "odometry", &sequence)?;

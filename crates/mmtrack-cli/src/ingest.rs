@@ -88,7 +88,7 @@ impl OutputArgs {
             radar_cartesian_size_px: self.radar_cartesian_size_px,
             no_sync: self.no_sync,
         };
-        flags.options().map_err(anyhow::Error::msg)
+        flags.options().map_err(crate::usage)
     }
 }
 
@@ -253,6 +253,11 @@ enum Kind {
         sequence_id: Option<String>,
     },
     /// Trajectory file (TUM, KITTI, Oxford radar_odometry.csv) into a new recording or added to one.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Poses {
         /// The trajectory file.
         input: PathBuf,
@@ -278,6 +283,11 @@ enum Kind {
         plane: PlaneArg,
     },
     /// NMEA 0183 GNSS log (GGA with RMC or ZDA, or RMC alone; any talker) into a new recording or added to one.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Nmea {
         /// The log.
         input: PathBuf,
@@ -292,6 +302,11 @@ enum Kind {
     /// A sidecar TOML gives what the file lacks (carrier_hz, tap_spacing_s or
     /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable, dataset);
     /// every key, and an example for the real 60 GHz MIMO sample, in docs/commands.md ("mmtrack ingest cir").
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Cir {
         /// The file (.npy, .npz, .mat, .h5, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
         input: PathBuf,
@@ -363,10 +378,38 @@ enum Kind {
     },
 }
 
+impl Kind {
+    /// Refuses, before any reading, an output that is one of the inputs or
+    /// that cannot be replaced by a new file (a directory, a FIFO, a device
+    /// node; [`mmtrack_io::check_output_file`]) or folder.
+    fn check_output(&self) -> anyhow::Result<()> {
+        let (output, inputs): (&std::path::Path, Vec<&std::path::Path>) = match self {
+            Self::Oxford { input, output, .. }
+            | Self::Boreas { input, output, .. }
+            | Self::Mulran { input, output, .. }
+            | Self::Nmea { input, output, .. }
+            | Self::Ros2 { input, output, .. } => (&output.output, vec![input]),
+            Self::Poses { input, output, times, .. } => {
+                (&output.output, [Some(input), times.as_ref()].into_iter().flatten().map(PathBuf::as_path).collect())
+            }
+            Self::Cir { input, sidecar, output, .. } => {
+                (&output.output, [Some(input), sidecar.as_ref()].into_iter().flatten().map(PathBuf::as_path).collect())
+            }
+            Self::Beams { input, output, .. } => {
+                mmtrack_io::check_output_is_not_input(&output.output, &[input])?;
+                return Ok(mmtrack_io::check_output_dir(&output.output)?);
+            }
+        };
+        mmtrack_io::check_output_is_not_input(output, &inputs)?;
+        Ok(mmtrack_io::check_output_file(output)?)
+    }
+}
+
 pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
+    args.kind.check_output()?;
     match args.kind {
         Kind::Oxford { input, output, threads, range_resolution_m, bins, decode, sequence_id } => {
-            let expected_bins = mmtrack_ingest::flags::parse_bins(&bins).map_err(anyhow::Error::msg)?;
+            let expected_bins = mmtrack_ingest::flags::parse_bins(&bins).map_err(crate::usage)?;
             positive_metres("--range-resolution-m", range_resolution_m)?;
             let options = OxfordOptions {
                 layout: oxford::NavtechLayout { range_resolution_m, expected_bins, ..oxford::OXFORD },
@@ -466,7 +509,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                     PositionsArg::Calibrated => VehiclePositions::Calibrated,
                     PositionsArg::Auto => VehiclePositions::Auto,
                 },
-                sweep_period_ns: mmtrack_ingest::flags::sweep_period_ns(sweep_period_s).map_err(anyhow::Error::msg)?,
+                sweep_period_ns: mmtrack_ingest::flags::sweep_period_ns(sweep_period_s).map_err(crate::usage)?,
             };
             deepsense_folder(&input, &output, &options, quiet)
         }
@@ -488,7 +531,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 radar_range_resolution_m,
                 sweep.timing()?,
             )
-            .map_err(anyhow::Error::msg)?;
+            .map_err(crate::usage)?;
             folders::ros2_bag(&input, &output, &topics, quiet)
         }
     }

@@ -77,6 +77,8 @@ enum Command {
     /// Run the whole chain on the embedded demo data and print where the outputs are.
     Demo(demo::DemoArgs),
     /// Write or check the schema documents (`schemas/`) generated from the code.
+    ///
+    /// Without options, checks `./schemas` (as `--check schemas`, from the project's root).
     Schemas {
         /// Directory to write the documents to.
         #[arg(long, value_name = "DIR", conflicts_with = "check")]
@@ -104,7 +106,21 @@ fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyho
         }
         return Ok(ExitCode::SUCCESS);
     }
+    let given = check.is_some();
     let dir = check.unwrap_or_else(|| PathBuf::from("schemas"));
+    if !dir.is_dir() {
+        if given {
+            anyhow::bail!(
+                "{}: no such folder to check; `mmtrack schemas --write {}` writes the documents there",
+                dir.display(),
+                dir.display()
+            );
+        }
+        return Err(usage(
+            "schemas: no such folder here (without options `mmtrack schemas` checks ./schemas, from the project's \
+             root); pass --write DIR to write the documents or --check DIR to check them",
+        ));
+    }
     let stale: Vec<&String> = documents
         .iter()
         .filter(|(relative, contents)| std::fs::read_to_string(dir.join(relative)).ok().as_deref() != Some(contents))
@@ -121,6 +137,21 @@ fn schemas(write: Option<PathBuf>, check: Option<PathBuf>, quiet: bool) -> anyho
             dir.display(),
             dir.display()
         )
+    }
+}
+
+/// A flag value found wrong after parsing, as a usage error (exit 2, see
+/// [`mmtrack_core::error::UsageError`]).
+fn usage(message: impl Into<String>) -> anyhow::Error {
+    mmtrack_core::error::UsageError::new(message).into()
+}
+
+/// Exit 2 for a usage error anywhere in `error`'s chain, 1 for any other.
+fn exit_code_of(error: &anyhow::Error) -> ExitCode {
+    if error.chain().any(|cause| cause.is::<mmtrack_core::error::UsageError>()) {
+        ExitCode::from(2)
+    } else {
+        ExitCode::FAILURE
     }
 }
 
@@ -243,7 +274,7 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(error) => {
             eprintln!("error: {}", one_line(&error));
-            ExitCode::FAILURE
+            exit_code_of(&error)
         }
     }
 }

@@ -283,6 +283,12 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
             "mpc {} (link tx{}:rx{}): {} sets, {} detections, {} short-term tracks, {} long-term entries",
             link.partition, link.link.0, link.link.1, link.sets, link.detections, link.tracks, link.long_term
         );
+        if link.snapshots_at_max_mpcs > 0 {
+            println!(
+                "  {}",
+                max_mpcs_note(link.snapshots_at_max_mpcs, link.snapshots_with_detections, config.detection.max_mpcs)
+            );
+        }
         let (most, needed) = (link.most_snapshots_per_set, config.short_term.min_track_length);
         if link.tracks == 0 && link.detections > 0 && (most as usize) < needed {
             println!(
@@ -296,6 +302,15 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
         println!("  wrote {} ({} {})", w.path.display(), w.rows, mpc::record_noun(&w.path));
     }
     Ok(done.written)
+}
+
+/// The summary line for snapshots whose detection stopped at the cap.
+fn max_mpcs_note(at_cap: usize, snapshots: usize, max_mpcs: usize) -> String {
+    format!(
+        "{at_cap} of {snapshots} snapshots stopped at [detection] max_mpcs = {max_mpcs} detections before the residual \
+         fell below the threshold: weaker paths were not searched; raise max_mpcs in the [detection] table of the \
+         --config file to detect them"
+    )
 }
 
 fn run_slam(args: &SlamArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>> {

@@ -186,9 +186,15 @@ pub fn run(args: &BeamArgs, quiet: bool) -> anyhow::Result<Vec<std::path::PathBu
     match done {
         BeamOutput::Geometric(done) => {
             for r in &done.recordings {
+                // As analyze says it: before the hand-over to RLS the range is unobservable.
+                let state = if r.last.filter == "rls" {
+                    r.last.filter.clone()
+                } else {
+                    format!("{} (not converged: never handed over to RLS)", r.last.filter)
+                };
                 println!(
-                    "{}: {} epochs, {}; last epoch range {:.2} m (true {:.2} m), {} beams measured in all",
-                    r.sequence_id, r.epochs, r.last.filter, r.last.range_m, r.last.true_range_m, r.beams_measured
+                    "{}: {} epochs, {state}; last epoch range {:.2} m (true {:.2} m), {} beams measured in all",
+                    r.sequence_id, r.epochs, r.last.range_m, r.last.true_range_m, r.beams_measured
                 );
             }
         }

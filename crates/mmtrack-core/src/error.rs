@@ -5,6 +5,23 @@ use std::fmt::Write as _;
 
 use thiserror::Error;
 
+/// A command-line flag (or a combination of flags) whose value the command
+/// cannot use, found after parsing (a range, a combination, a flag of
+/// another mode): the user's command line is wrong, not the data. The CLI
+/// exits with 2 (a usage error, as for what its parser rejects) when this is
+/// anywhere in an error's chain, and with 1 for everything else. The
+/// message names the flag and what it expects.
+#[derive(Debug, Error, PartialEq, Eq)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+impl UsageError {
+    /// The error for `message` (a `String` from a flag check).
+    pub fn new(message: impl Into<String>) -> Self {
+        Self(message.into())
+    }
+}
+
 /// Errors raised when a core type is constructed from inconsistent parts.
 ///
 /// Constructors validate their input in release builds too: invalid data is an

@@ -28,8 +28,9 @@ pub enum IngestError {
         /// What is missing or wrong.
         detail: String,
     },
-    /// A record is malformed.
-    #[error("{path}: {}: {}: {}", printable(.record), printable(.field), printable(.detail))]
+    /// A record is malformed. A field named as its record (the `data` of a
+    /// `.npy` file's `data`) is said once.
+    #[error("{path}: {}: {}", record_and_field(.record, .field), printable(.detail))]
     BadRecord {
         /// The file.
         path: PathBuf,
@@ -208,5 +209,36 @@ mod tests {
         std::fs::write(&path, b"ok\xff").unwrap();
         let err = read_text(&path).unwrap_err().to_string();
         assert!(err.contains("not UTF-8 text: invalid byte at offset 2"), "{err}");
+    }
+}
+
+/// `record: field`, or `record` alone when the field is the record itself
+/// (before: "data: data: truncated").
+fn record_and_field(record: &str, field: &str) -> String {
+    if record == field {
+        printable(record).into_owned()
+    } else {
+        format!("{}: {}", printable(record), printable(field))
+    }
+}
+
+#[cfg(test)]
+mod record_field_tests {
+    use super::*;
+
+    #[test]
+    fn a_field_named_as_its_record_is_said_once() {
+        let error = |record: &str, field: &str| {
+            IngestError::BadRecord {
+                path: "x.npy".into(),
+                record: record.into(),
+                field: field.into(),
+                detail: "truncated".into(),
+            }
+            .to_string()
+        };
+        assert_eq!(error("data", "data"), "x.npy: data: truncated");
+        assert_eq!(error("header", "header"), "x.npy: header: truncated");
+        assert_eq!(error("line 5", "t_ns"), "x.npy: line 5: t_ns: truncated");
     }
 }

@@ -76,6 +76,7 @@ impl AtomicFile {
     /// `.<name>.<pid>.<random>.partial` in the same directory (so the final
     /// rename never crosses file systems).
     pub fn create(target: &Path, overwrite: Overwrite) -> Result<Self> {
+        check_output_file(target)?;
         if overwrite == Overwrite::Refuse && target.exists() {
             return Err(IoError::OutputExists { path: target.to_path_buf() });
         }
@@ -214,6 +215,8 @@ fn publish_one(temp: NamedTempFile, target: &Path, overwrite: Overwrite, keep_ol
     let os = |source: std::io::Error| IoError::Os { path: target.to_path_buf(), source };
     match overwrite {
         Overwrite::Replace => {
+            // Re-checked: a directory, FIFO or device node may have appeared meanwhile.
+            check_output_file(target)?;
             let is_file = std::fs::symlink_metadata(target).is_ok_and(|m| !m.is_dir());
             let aside = (keep_old && is_file).then(|| {
                 let partial = temp.path().file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -366,11 +369,9 @@ pub fn check_replaceable_dir(
     owns: &dyn Fn(&Path, bool) -> bool,
     overwrite: Overwrite,
 ) -> Result<()> {
+    check_output_dir(dir)?;
     if !dir.exists() {
         return Ok(());
-    }
-    if !dir.is_dir() {
-        return Err(IoError::NotADirectory { path: dir.to_path_buf() });
     }
     let mut foreign = Vec::new();
     let mut any = false;
@@ -401,6 +402,93 @@ pub fn check_replaceable_dir(
         return Err(IoError::OutputExists { path: dir.to_path_buf() });
     }
     Ok(())
+}
+
+/// Checks that the output file `target` can be replaced by renaming a new
+/// file over it: absent, or a regular file (a symbolic link is followed:
+/// one to a regular file is replaced by the new file, one to anything else
+/// is refused), and its nearest existing ancestor a directory. Every file
+/// output goes through [`AtomicFile::create`], which calls this with or
+/// without [`Overwrite::Replace`], so no command's `--force` replaces a
+/// directory, a FIFO or a device node.
+///
+/// # Errors
+/// [`IoError::NotARegularFile`] naming what `target` is, or
+/// [`IoError::NotADirectory`] for an ancestor that is not a directory.
+pub fn check_output_file(target: &Path) -> Result<()> {
+    match std::fs::metadata(target) {
+        Ok(meta) if meta.is_file() => Ok(()),
+        Ok(meta) => Err(IoError::NotARegularFile { path: target.to_path_buf(), kind: kind_in_words(meta.file_type()) }),
+        // Absent (or a dangling link, replaced as before): the parent must be a directory.
+        Err(_) => target.parent().map_or(Ok(()), check_output_dir),
+    }
+}
+
+/// Checks that the output directory `dir` is absent or a directory (a
+/// symbolic link is followed), and that its nearest existing ancestor is a
+/// directory, so it can be created or replaced.
+///
+/// # Errors
+/// [`IoError::NotADirectory`] naming the path in the way and what it is.
+pub fn check_output_dir(dir: &Path) -> Result<()> {
+    for ancestor in dir.ancestors().take_while(|a| !a.as_os_str().is_empty()) {
+        match std::fs::metadata(ancestor) {
+            Ok(meta) if meta.is_dir() => return Ok(()),
+            Ok(meta) => {
+                return Err(IoError::NotADirectory {
+                    path: ancestor.to_path_buf(),
+                    kind: kind_in_words(meta.file_type()),
+                });
+            }
+            Err(_) => {}
+        }
+    }
+    Ok(())
+}
+
+/// Refuses an `output` that is the same file or directory as one of
+/// `inputs` (compared after resolving links and `..`), before any work: a
+/// replaced input would be lost, and a folder input cannot be a file output.
+///
+/// # Errors
+/// [`IoError::OutputIsInput`] naming both.
+pub fn check_output_is_not_input(output: &Path, inputs: &[&Path]) -> Result<()> {
+    let Ok(resolved) = std::fs::canonicalize(output) else { return Ok(()) };
+    for input in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|i| i == resolved) {
+            return Err(IoError::OutputIsInput { path: output.to_path_buf(), input: input.to_path_buf() });
+        }
+    }
+    Ok(())
+}
+
+/// What a file type is, in words with an article, for error messages.
+fn kind_in_words(file_type: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if file_type.is_fifo() {
+            return "a FIFO";
+        }
+        if file_type.is_char_device() {
+            return "a character device";
+        }
+        if file_type.is_block_device() {
+            return "a block device";
+        }
+        if file_type.is_socket() {
+            return "a socket";
+        }
+    }
+    if file_type.is_dir() {
+        "a directory"
+    } else if file_type.is_file() {
+        "a regular file"
+    } else if file_type.is_symlink() {
+        "a symbolic link"
+    } else {
+        "neither a regular file nor a directory"
+    }
 }
 
 /// The end of every partial output's name.
@@ -699,9 +787,9 @@ mod tests {
             f
         };
         std::fs::write(dir.path().join("a"), b"old a").unwrap();
-        // A directory where the last file goes: its rename fails.
-        std::fs::create_dir_all(dir.path().join("c/inner")).unwrap();
         let set = vec![staged("a", b"new a"), staged("b", b"new b"), staged("c", b"new c")];
+        // A directory appears where the last file goes while the set is written: its publication fails.
+        std::fs::create_dir_all(dir.path().join("c/inner")).unwrap();
         assert!(commit_all(set, Overwrite::Replace, Durability::PageCache).is_err());
         let mut left: Vec<String> = std::fs::read_dir(dir.path())
             .unwrap()
@@ -719,6 +807,56 @@ mod tests {
         }
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3, "the aside copy of a is gone");
         assert!(live_partials().keys().all(|p| !p.starts_with(dir.path())), "the set left the registry");
+    }
+
+    /// Before: `--force` renamed the new file over whatever was at the
+    /// target (a FIFO, a device node became a regular file), and a directory
+    /// failed only at the final rename, after all the work. Now neither is
+    /// started, with or without `Replace`. A FIFO stands in for a device node
+    /// (never touch real ones in /dev).
+    #[cfg(unix)]
+    #[test]
+    fn a_target_that_is_not_a_regular_file_is_refused_up_front() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("pipe");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        assert!(made.success());
+        let folder = dir.path().join("folder");
+        std::fs::create_dir(&folder).unwrap();
+        for overwrite in [Overwrite::Refuse, Overwrite::Replace] {
+            for (target, kind) in [(&fifo, "a FIFO"), (&folder, "a directory")] {
+                let error = AtomicFile::create(target, overwrite).unwrap_err();
+                assert!(matches!(error, IoError::NotARegularFile { kind: k, .. } if k == kind), "{error}");
+                assert!(error.to_string().contains("not a regular file"), "{error}");
+            }
+            // An output inside the FIFO, and an output folder that is the FIFO.
+            let inside = AtomicFile::create(&fifo.join("t/part-0.parquet"), overwrite).unwrap_err();
+            assert!(matches!(inside, IoError::NotADirectory { kind: "a FIFO", .. }), "{inside}");
+            let owns = |_: &Path, _: bool| true;
+            let as_dir = check_replaceable_dir(&fifo, "mmtrack x", &owns, overwrite).unwrap_err();
+            assert!(matches!(as_dir, IoError::NotADirectory { kind: "a FIFO", .. }), "{as_dir}");
+        }
+        let metadata = std::fs::symlink_metadata(&fifo).unwrap();
+        assert!(!metadata.is_file() && !metadata.is_dir(), "the FIFO is still there");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2, "no partial left");
+        // The same check at the rename: a FIFO that appears while writing.
+        let late = dir.path().join("late");
+        let file = AtomicFile::create(&late, Overwrite::Replace).unwrap();
+        assert!(std::process::Command::new("mkfifo").arg(&late).status().unwrap().success());
+        let error = file.commit(Overwrite::Replace, Durability::PageCache).unwrap_err();
+        assert!(matches!(error, IoError::NotARegularFile { .. }), "{error}");
+        assert!(!std::fs::symlink_metadata(&late).unwrap().is_file());
+    }
+
+    #[test]
+    fn an_output_that_is_an_input_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("in.mat");
+        std::fs::write(&input, b"x").unwrap();
+        let spelled_otherwise = dir.path().join(".").join("in.mat");
+        let error = check_output_is_not_input(&spelled_otherwise, &[Path::new("/nonexistent"), &input]).unwrap_err();
+        assert!(matches!(error, IoError::OutputIsInput { .. }), "{error}");
+        check_output_is_not_input(&dir.path().join("out.mcap"), &[&input]).unwrap();
     }
 
     #[test]

@@ -30,11 +30,32 @@ pub enum IoError {
         /// The existing output.
         path: PathBuf,
     },
-    /// The output directory exists as a file.
-    #[error("{path}: exists and is not a directory; choose another output")]
+    /// The output directory exists as something else (a file, a FIFO, a
+    /// device node).
+    #[error("{path}: exists and is {kind}, not a directory; choose another output")]
     NotADirectory {
         /// The file in the way.
         path: PathBuf,
+        /// What it is, with its article (`a regular file`, `a FIFO`).
+        kind: &'static str,
+    },
+    /// An output file's path exists as something other than a regular file
+    /// (a directory, a FIFO, a device node, a socket): never replaced, with or
+    /// without `--force`, since replacing means renaming a new file over it.
+    #[error("{path}: exists and is {kind}, not a regular file; mmtrack only replaces files it can write atomically")]
+    NotARegularFile {
+        /// The path in the way.
+        path: PathBuf,
+        /// What it is, with its article (`a directory`, `a character device`).
+        kind: &'static str,
+    },
+    /// An output that is one of the command's inputs.
+    #[error("{path}: is also this command's input {}; choose another output", .input.display())]
+    OutputIsInput {
+        /// The output as given.
+        path: PathBuf,
+        /// The input as given.
+        input: PathBuf,
     },
     /// `--force` would replace a directory holding entries the command does
     /// not write.

@@ -25,7 +25,8 @@ pub mod table;
 pub mod table_kv;
 
 pub use atomic::{
-    AtomicFile, Durability, Overwrite, check_replaceable_dir, create_output_dirs, publish_dir, staging_dir,
+    AtomicFile, Durability, Overwrite, check_output_dir, check_output_file, check_output_is_not_input,
+    check_replaceable_dir, create_output_dirs, publish_dir, staging_dir,
 };
 pub use error::{IoError, Result};
 pub use png_gray::{Gray8Png, MAX_GRAY8_BYTES, decode_gray8};

@@ -124,17 +124,18 @@ impl RunDir {
     }
 
     /// Without `--force`, an error naming the first of `tables` that
-    /// `sequence` already has here; nothing with `--force`.
+    /// `sequence` already has here; with or without it, an error for a table
+    /// path (or a folder above it) that is neither a file nor a directory
+    /// ([`mmtrack_io::check_output_file`]).
     ///
     /// # Errors
     /// That table, or a `sequence` that is not a partition name.
     pub fn refuse_existing(&self, tables: &[&str], sequence: &str) -> anyhow::Result<()> {
-        if self.overwrite == Overwrite::Replace {
-            return Ok(());
-        }
         for table in tables {
             let path = table_path(&self.path, table, sequence)?;
-            if path.exists() {
+            // With or without --force: a table folder or file that is a FIFO or a device node.
+            mmtrack_io::check_output_file(&path)?;
+            if self.overwrite == Overwrite::Refuse && path.exists() {
                 return Err(exists_error(&path));
             }
         }

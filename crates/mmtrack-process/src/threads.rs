@@ -20,11 +20,10 @@ use anyhow::Context;
 /// pool that cannot start.
 pub fn install<R: Send>(threads: usize, work: impl FnOnce() -> R + Send) -> anyhow::Result<R> {
     let limit = mmtrack_core::limits::THREADS;
-    anyhow::ensure!(
-        limit.allows_count(threads as u64),
-        "--threads {threads}: expected {} (nothing was done)",
-        limit.expected
-    );
+    if !limit.allows_count(threads as u64) {
+        let message = format!("--threads {threads}: expected {} (nothing was done)", limit.expected);
+        return Err(mmtrack_core::error::UsageError(message).into());
+    }
     if threads == 0 && rayon::current_thread_index().is_some() {
         return Ok(work());
     }

@@ -23,6 +23,7 @@ use crate::model::Tier;
 /// `output` exists and `force` is off, or it is not an earlier output; the
 /// README lacks the block.
 pub fn check_start(output: &Path, force: bool, readme: Option<&Path>, block: &str) -> anyhow::Result<()> {
+    mmtrack_io::check_output_dir(output)?;
     if output.exists() && !force {
         bail!("{}: exists; use --force to replace it (nothing was done)", output.display());
     }
@@ -95,11 +96,10 @@ pub fn read_drive(path: &Path, format: TrajectoryFormat) -> anyhow::Result<Vec<S
 pub fn run_count(explicit: Option<u64>, tier: Tier, smoke_runs: u64, full_runs: u64) -> anyhow::Result<u64> {
     let runs = explicit.unwrap_or(if tier.is_smoke() { smoke_runs } else { full_runs });
     let limit = mmtrack_core::limits::MONTE_CARLO_RUNS;
-    anyhow::ensure!(
-        runs >= 1 && limit.allows_count(runs),
-        "--runs {runs}: expected {} (nothing was done)",
-        limit.expected
-    );
+    if !(runs >= 1 && limit.allows_count(runs)) {
+        let message = format!("--runs {runs}: expected {} (nothing was done)", limit.expected);
+        return Err(mmtrack_core::error::UsageError(message).into());
+    }
     Ok(runs)
 }
 

@@ -117,7 +117,10 @@ pub fn run_experiment(name: &str, request: &ExperimentRequest, progress: &dyn Pr
         }
         mpc_artificial::NAME => {
             let runs = request.runs.unwrap_or(mpc_artificial::Config::default().runs);
-            anyhow::ensure!(runs >= 1, "--runs must be at least 1 (nothing was done)");
+            if runs == 0 {
+                let message = "--runs 0: expected at least 1 (nothing was done)";
+                return Err(mmtrack_core::error::UsageError::new(message).into());
+            }
             mpc_artificial::check_start(output, force, readme)?;
             let pulse = match request.pulse.as_deref().unwrap_or("measured-like") {
                 "measured-like" => mpc_artificial::Pulse::MeasuredLike,

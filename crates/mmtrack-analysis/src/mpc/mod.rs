@@ -408,8 +408,13 @@ fn summarise(
     spans: &BTreeMap<u64, (u64, u64)>,
     truth: Option<&TruthScores>,
 ) -> MpcSummary {
-    let births: u64 = per_set.iter().filter_map(|s| s.births).sum();
-    let deaths: u64 = per_set.iter().filter_map(|s| s.deaths).sum();
+    // Without short-term tracks there are no long-term ones to count: the
+    // counts and the rates built on them are null, not 0 (as the report's
+    // note on empty metrics says), so a run that tracked nothing does not
+    // read as one that tracked a steady channel.
+    let tracked = !(input.tracks.is_empty() && input.long_term.is_empty());
+    let births: Option<u64> = tracked.then(|| per_set.iter().filter_map(|s| s.births).sum());
+    let deaths: Option<u64> = tracked.then(|| per_set.iter().filter_map(|s| s.deaths).sum());
     let transitions: Vec<&SetMetrics> = per_set.iter().skip(1).collect();
     let distance_m = if transitions.is_empty() || transitions.iter().any(|s| s.distance_m.is_none()) {
         None
@@ -420,7 +425,7 @@ fn summarise(
         (Some(a), Some(b)) => (b.t_ns - a.t_ns) as f64 * 1e-9,
         _ => 0.0,
     };
-    let per_m = |n: u64| distance_m.and_then(|d| ratio(n, d));
+    let per_m = |n: Option<u64>| n.zip(distance_m).and_then(|(n, d)| ratio(n, d));
     let counts: Vec<f64> = per_set.iter().map(|s| s.long_term_mpcs as f64).collect();
     let chi_01 = chi
         .iter()
@@ -434,8 +439,8 @@ fn summarise(
         short_term_tracks: input.tracks.len() as u64,
         full_lifetime_tracks: power_std.iter().filter(|p| p.full_lifetime).count() as u64,
         long_term_tracks: spans.len() as u64,
-        mean_mpcs_per_set: mean(counts.iter().copied()).unwrap_or(0.0),
-        median_mpcs_per_set: median(counts),
+        mean_mpcs_per_set: if tracked { mean(counts.iter().copied()) } else { None },
+        median_mpcs_per_set: tracked.then(|| median(counts)),
         distance_source: input.distance.label(),
         distance_m,
         duration_s,
@@ -443,8 +448,8 @@ fn summarise(
         deaths,
         birth_rate_per_m: per_m(births),
         death_rate_per_m: per_m(deaths),
-        birth_rate_per_s: ratio(births, duration_s),
-        death_rate_per_s: ratio(deaths, duration_s),
+        birth_rate_per_s: births.and_then(|n| ratio(n, duration_s)),
+        death_rate_per_s: deaths.and_then(|n| ratio(n, duration_s)),
         mean_detection_loss_db: mean(per_set.iter().map(|s| s.detection_loss_db)),
         mean_tracking_loss_db: mean(per_set.iter().map(|s| s.tracking_loss_db)),
         mean_full_lifetime_loss_db: mean(per_set.iter().map(|s| s.channel_gain_db - s.full_lifetime_gain_db)),
@@ -468,8 +473,8 @@ fn summarise(
         long_term_tracks_per_path: truth.and_then(|t| t.long_term_tracks_per_path),
         true_births: truth.map(|t| t.transitions.values().map(|v| v.0).sum()),
         true_deaths: truth.map(|t| t.transitions.values().map(|v| v.1).sum()),
-        true_birth_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.0).sum())),
-        true_death_rate_per_m: truth.and_then(|t| per_m(t.transitions.values().map(|v| v.1).sum())),
+        true_birth_rate_per_m: truth.and_then(|t| per_m(Some(t.transitions.values().map(|v| v.0).sum()))),
+        true_death_rate_per_m: truth.and_then(|t| per_m(Some(t.transitions.values().map(|v| v.1).sum()))),
         // Filled by analyze_mpc from the first paths.
         first_path_dynamic_range_db: DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB,
         first_path_snapshots: 0,

@@ -89,15 +89,33 @@ fn births_deaths_and_counts_follow_the_long_term_tracks() {
     assert!((r.per_set[3].death_rate_per_m.unwrap() - 1.0).abs() < 1e-12);
     assert!((r.per_set[3].death_rate_per_s.unwrap() - 200.0).abs() < 1e-9);
     let s = &r.summary;
-    assert_eq!((s.births, s.deaths, s.long_term_tracks), (3, 3, 5));
+    assert_eq!((s.births, s.deaths, s.long_term_tracks), (Some(3), Some(3), 5));
     assert!((s.distance_m.unwrap() - 6.0).abs() < 1e-12);
     assert!((s.birth_rate_per_m.unwrap() - 0.5).abs() < 1e-12);
     assert_eq!(s.distance_source, "ground_truth_tx+ground_truth_rx");
-    assert!((s.mean_mpcs_per_set - 2.25).abs() < 1e-12);
-    assert_eq!(s.median_mpcs_per_set, 2.0);
+    assert!((s.mean_mpcs_per_set.unwrap() - 2.25).abs() < 1e-12);
+    assert_eq!(s.median_mpcs_per_set, Some(2.0));
     assert_eq!(r.counts, vec![CountBin { mpcs: 2, sets: 3, cdf: 0.75 }, CountBin { mpcs: 3, sets: 1, cdf: 1.0 }]);
     assert!((s.mean_detection_loss_db.unwrap() - 2.0).abs() < 1e-12);
     assert!((s.mean_tracking_loss_db.unwrap() - 3.0).abs() < 1e-12);
+}
+
+/// Before: a run that tracked nothing reported 0.0 MPCs per set, 0 births
+/// and a birth rate of 0 (while its tracking loss was null and its note
+/// said births and deaths are empty). Now they are null, and "n/a" in the
+/// printed line.
+#[test]
+fn counts_are_null_when_nothing_was_tracked() {
+    let detection =
+        MpcDetection { t_ns: 0, set_index: 0, snapshot_index: 0, delay_s: 1e-7, amplitude: Complex64::new(1e-4, 0.0) };
+    let untracked = MpcInput { detections: vec![detection], long_term: Vec::new(), ..input(DistanceSource::None) };
+    let r = analyze_mpc("s", untracked, &MpcOptions::default());
+    let s = &r.summary;
+    assert_eq!((s.births, s.deaths, s.mean_mpcs_per_set, s.median_mpcs_per_set), (None, None, None, None));
+    assert_eq!((s.birth_rate_per_s, s.death_rate_per_s, s.birth_rate_per_m), (None, None, None));
+    assert!(r.notes.iter().any(|n| n.contains("births, deaths")), "{:?}", r.notes);
+    let line = crate::mpc_report::one_line(&r);
+    assert!(line.contains("n/a MPCs per set, births n/a / deaths n/a"), "{line}");
 }
 
 #[test]
@@ -282,7 +300,11 @@ fn long_term_tracks_are_scored_by_the_path_they_follow() {
     let mut input = truth_input(4, detections, tracks, truth);
     input.long_term = long_term;
     let s = analyze_mpc("s", input, &MpcOptions::default()).summary;
-    assert_eq!((s.births, s.deaths), (2, 2), "tracks 2 and 3 are born in set 2; 1 and 3 die before the end");
+    assert_eq!(
+        (s.births, s.deaths),
+        (Some(2), Some(2)),
+        "tracks 2 and 3 are born in set 2; 1 and 3 die before the end"
+    );
     assert_eq!((s.births_on_true_paths, s.deaths_on_true_paths), (Some(1), Some(1)), "the split of path 2");
     assert_eq!((s.true_births, s.true_deaths), (Some(0), Some(0)));
     assert_eq!(s.false_long_term_share, Some(0.25));

@@ -360,7 +360,7 @@ pub fn one_lines(results: &[SlamSequenceResult]) -> Vec<String> {
         .map(|r| {
             let s = &r.summary;
             format!(
-                "{}: slam: UE {:.3} m / {:.4} rad / clock bias {:.3} m, VA {} m, SP {} m, all VAs at epoch {}, all SPs at epoch {}",
+                "{}: UE {:.3} m / {:.4} rad / clock bias {:.3} m, VA {} m, SP {} m, all VAs at epoch {}, all SPs at epoch {}",
                 r.sequence,
                 s.ue_position_error_m,
                 s.ue_heading_error_rad,

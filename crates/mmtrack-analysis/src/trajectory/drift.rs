@@ -33,6 +33,10 @@ pub enum FirstFrameStep {
     Metres(f64),
 }
 
+/// Longest segment length accepted, metres (10 000 km): a bound far beyond
+/// any recorded drive, so a mistyped value (1e300) is refused by name.
+pub const MAX_SEGMENT_LENGTH_M: f64 = 1e7;
+
 /// Options of [`kitti_drift`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct DriftOptions {
@@ -57,6 +61,18 @@ impl DriftOptions {
         }
         if let Some(l) = self.segment_lengths_m.iter().find(|l| !(l.is_finite() && **l > 0.0)) {
             return bad(format!("segment length {l} m is not a positive number"));
+        }
+        if let Some(l) = self.segment_lengths_m.iter().find(|l| **l > MAX_SEGMENT_LENGTH_M) {
+            return bad(format!(
+                "segment length {l} m is beyond {MAX_SEGMENT_LENGTH_M} m (longer than any drive); give lengths in metres"
+            ));
+        }
+        // Each length is a row of the report and a share of the mean drift:
+        // a repeated one would count its segments twice.
+        for (i, l) in self.segment_lengths_m.iter().enumerate() {
+            if self.segment_lengths_m[..i].contains(l) {
+                return bad(format!("segment length {l} m is given twice; give each length once"));
+            }
         }
         match self.step {
             FirstFrameStep::Frames(0) => bad("first-frame step of 0 frames".into()),
@@ -344,5 +360,11 @@ mod tests {
         assert_eq!(last_frame_from_segment_length(&dist, 20, 5.0), None);
         let bad = DriftOptions { segment_lengths_m: vec![f64::NAN], ..Default::default() };
         assert!(kitti_drift(&[], &[], &bad).is_err());
+        // Before: 8,2,2 counted the 2 m segments twice; 1e300 was accepted.
+        for (lengths, said) in [(vec![8.0, 2.0, 2.0], "2 m is given twice"), (vec![1e300], "beyond 10000000 m")] {
+            let bad = DriftOptions { segment_lengths_m: lengths, ..Default::default() };
+            let error = kitti_drift(&[], &[], &bad).unwrap_err().to_string();
+            assert!(error.contains(said), "{error}");
+        }
     }
 }

@@ -43,14 +43,14 @@ impl SweepArgs {
             StampAtArg::Start => "start",
             StampAtArg::End => "end",
         };
-        flags::sweep_timing(stamp_at, self.scan_period_s).map_err(anyhow::Error::msg)
+        flags::sweep_timing(stamp_at, self.scan_period_s).map_err(crate::usage)
     }
 }
 
 /// Checks that a length flag is a positive, finite number of metres
 /// ([`flags::positive_metres`]).
 pub(super) fn positive_metres(flag: &str, value: f64) -> anyhow::Result<()> {
-    flags::positive_metres(flag, value).map(|_| ()).map_err(anyhow::Error::msg)
+    flags::positive_metres(flag, value).map(|_| ()).map_err(crate::usage)
 }
 
 /// Ingests one Boreas folder, with a progress bar.
@@ -232,7 +232,7 @@ impl RecordingDirArgs {
             no_sync: self.no_sync,
             ..Default::default()
         };
-        flags.options().map_err(anyhow::Error::msg)
+        flags.options().map_err(crate::usage)
     }
 }
 

@@ -265,6 +265,24 @@ fn hdf5_inputs_without_the_feature_say_how_to_rebuild() {
 fn schema_documents_are_current() {
     let out = mmtrack(&root(), &["schemas", "--check", "schemas"]);
     assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(&root(), &["schemas"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+}
+
+/// Before: without `schemas/` here, `mmtrack schemas` listed every
+/// document as "stale".
+#[test]
+fn schemas_without_a_folder_says_what_is_missing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = mmtrack(dir.path(), &["schemas"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("no such folder") && stderr.contains("--write DIR") && stderr.contains("--check DIR"));
+    assert!(!stderr.contains("stale"), "{stderr}");
+    let out = mmtrack(dir.path(), &["schemas", "--check", "docs"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("docs: no such folder to check"), "{stderr}");
 }
 
 #[test]
@@ -415,4 +433,18 @@ fn inspect_shortens_long_metadata_values() {
     assert!(line.chars().count() < 200, "{line}");
     assert!(line.contains(&whole[..40]) && line.contains(&format!("({} bytes; `--json`", whole.len())), "{line}");
     assert!(stdout.lines().all(|l| l.chars().count() < 200), "{stdout}");
+}
+
+/// Before: `ingest cir`, `ingest nmea` and `ingest poses` listed the radar
+/// Cartesian view's options, which only the radar kinds use.
+#[test]
+fn radar_view_options_are_listed_only_where_they_apply() {
+    for kind in ["cir", "nmea", "poses"] {
+        let out = mmtrack(&root(), &["ingest", kind, "--help"]);
+        let (stdout, _) = text(&out);
+        assert!(out.status.success() && stdout.contains("--force"), "{stdout}");
+        assert!(!stdout.contains("radar-cartesian"), "ingest {kind}: {stdout}");
+    }
+    let (stdout, _) = text(&mmtrack(&root(), &["ingest", "oxford", "--help"]));
+    assert!(stdout.contains("--radar-cartesian-m-per-px"), "{stdout}");
 }

@@ -20,6 +20,7 @@ mod independent_readers;
 mod ingest_navtech;
 mod interrupt;
 mod odometry_frames;
+mod output_safety;
 mod process_beam_geometric;
 mod process_beam_spebt;
 mod process_manifest;

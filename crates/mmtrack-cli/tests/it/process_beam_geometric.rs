@@ -20,6 +20,8 @@ fn geometric_tracker_on_the_convoy_writes_its_table_and_refuses_mixing() {
     assert!(out.status.success(), "{}", text(&out).1);
     let out = mmtrack(dir.path(), &["process", "beam", "c.mcap", "--tracker", "geometric", "-o", "t"]);
     assert!(out.status.success(), "{}", text(&out).1);
+    // Before: "h-infinity; last epoch range 6.66 m (true 86.42 m)" without saying it had not converged.
+    assert!(text(&out).0.contains("h-infinity (not converged"), "{}", text(&out).0);
     // One partition, named after the recording's sequence.
     let partitions: Vec<_> = std::fs::read_dir(dir.path().join("t/geometric_per_epoch")).unwrap().collect();
     assert_eq!(partitions.len(), 1);

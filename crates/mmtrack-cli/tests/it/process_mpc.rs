@@ -342,3 +342,26 @@ fn the_documented_sidecar_reads_the_real_60ghz_sample() {
     assert!(out.status.success(), "{err}");
     assert!(stdout.contains("16 CIR snapshots of 1001 taps, 0.0999 ns apart"), "{stdout}");
 }
+
+/// Before: a run whose detection stopped at `[detection] max_mpcs` in every
+/// snapshot (the real BUT 60 GHz sample at 200) said only "N detections".
+/// With a cap of 2 every snapshot of the convoy (more than 2 paths above
+/// the threshold) stops there; with the default none does.
+#[test]
+fn snapshots_that_stop_at_max_mpcs_are_counted_with_the_key_that_raises_it() {
+    let dir = tempfile::tempdir().unwrap();
+    simulate(dir.path());
+    std::fs::write(dir.path().join("cap.toml"), "[detection]\nmax_mpcs = 2\n").unwrap();
+    let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "capped", "--config", "cap.toml"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let line = stdout.lines().find(|l| l.contains("stopped at")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(line.contains("[detection] max_mpcs = 2") && line.contains("raise max_mpcs"), "{line}");
+    let counts: Vec<usize> = line.split_whitespace().take(3).filter_map(|w| w.parse().ok()).collect();
+    assert_eq!(counts.len(), 2, "`<at cap> of <snapshots>`: {line}");
+    assert!(counts[0] > 0 && counts[0] <= counts[1], "{line}");
+    let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "default"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stdout.contains("stopped at"), "{stdout}");
+}

@@ -102,13 +102,13 @@ they are null without one, and the per-second rates always apply. Truth columns 
         short_term_tracks: u64, "", "short-term tracks";
         full_lifetime_tracks: u64, "", "short-term tracks spanning their set";
         long_term_tracks: u64, "", "long-term tracks";
-        mean_mpcs_per_set: f64, "", "mean number of long-term MPCs per set";
-        median_mpcs_per_set: f64, "", "median number of long-term MPCs per set";
+        mean_mpcs_per_set: Option<f64>, "", "mean number of long-term MPCs per set (null when nothing was tracked)";
+        median_mpcs_per_set: Option<f64>, "", "median number of long-term MPCs per set (null when nothing was tracked)";
         distance_source: String, "", "tables the distance comes from, or none";
         distance_m: Option<f64>, "m", "distance driven from the first to the last set";
         duration_s: f64, "s", "time from the first to the last set";
-        births: u64, "", "long-term track births (not counting the first set)";
-        deaths: u64, "", "long-term track deaths (not counting the last set)";
+        births: Option<u64>, "", "long-term track births (not counting the first set; null when nothing was tracked)";
+        deaths: Option<u64>, "", "long-term track deaths (not counting the last set; null when nothing was tracked)";
         birth_rate_per_m: Option<f64>, "1/m", "births / distance_m";
         death_rate_per_m: Option<f64>, "1/m", "deaths / distance_m";
         birth_rate_per_s: Option<f64>, "1/s", "births / duration_s";

@@ -103,31 +103,33 @@ pub fn process_beam(output: &Path, request: &BeamRequest, progress: &dyn Progres
     kinds.sort();
     kinds.dedup();
     if kinds.is_empty() {
-        bail!("--tracker: name at least one of {}", BeamTracker::NAMES.join(", "));
+        return Err(mmtrack_core::error::UsageError(format!(
+            "--tracker: name at least one of {}",
+            BeamTracker::NAMES.join(", ")
+        ))
+        .into());
     }
     let files = sweep::expand(&request.recordings)?;
     if kinds.contains(&BeamTracker::Geometric) {
         if kinds.len() > 1 {
-            bail!(
-                "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call"
-            );
+            let message = "--tracker geometric runs alone (it tracks between two vehicles' ground truth); give the others in another call";
+            return Err(mmtrack_core::error::UsageError::new(message).into());
         }
         return Ok(BeamOutput::Geometric(geometric::process_geometric(&files, &out, &request.geometric)?));
     }
     if let Some(flag) = request.geometric.given().first() {
-        bail!("{flag} is an option of --tracker geometric only");
+        return Err(mmtrack_core::error::UsageError(format!("{flag} is an option of --tracker geometric only")).into());
     }
     if kinds.contains(&BeamTracker::Spebt) {
         if kinds.len() > 1 {
-            bail!(
-                "--tracker spebt runs alone (it tracks a simulated link along the ground truth, not measured sweeps); \
-                 give the sweep trackers in another call"
-            );
+            let message = "--tracker spebt runs alone (it tracks a simulated link along the ground truth, not measured sweeps); \
+                 give the sweep trackers in another call";
+            return Err(mmtrack_core::error::UsageError::new(message).into());
         }
         return Ok(BeamOutput::Spebt(spebt::process_spebt(&files, &out, &request.spebt, progress)?));
     }
     if let Some(flag) = request.spebt.given().first() {
-        bail!("{flag} is an option of --tracker spebt only");
+        return Err(mmtrack_core::error::UsageError(format!("{flag} is an option of --tracker spebt only")).into());
     }
     let sweep_kinds: Vec<SweepTrackerKind> = kinds
         .iter()

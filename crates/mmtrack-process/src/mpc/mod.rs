@@ -389,6 +389,23 @@ pub struct LinkSummary {
     /// Most snapshots a set held after skipped ones (no short-term track
     /// can be longer).
     pub most_snapshots_per_set: u64,
+    /// Snapshots with detections.
+    pub snapshots_with_detections: usize,
+    /// Snapshots whose detections stopped at `[detection] max_mpcs`: the
+    /// search (Mahler et al. 2017, Sec. III-A, repeated until the residual
+    /// is below the threshold) ended on the cap, not on the threshold, so
+    /// weaker paths above the threshold were left undetected.
+    pub snapshots_at_max_mpcs: usize,
+}
+
+/// Per snapshot (set, snapshot index) with detections: how many there are
+/// and how many of those reached `max_mpcs`.
+fn snapshots_at_cap(detections: &[mmtrack_core::MpcDetection], max_mpcs: usize) -> (usize, usize) {
+    let mut per_snapshot = std::collections::BTreeMap::<(u64, u32), usize>::new();
+    for d in detections {
+        *per_snapshot.entry((d.set_index, d.snapshot_index)).or_default() += 1;
+    }
+    (per_snapshot.len(), per_snapshot.values().filter(|&&n| n >= max_mpcs).count())
 }
 
 /// What [`process_mpc`] did.
@@ -450,7 +467,11 @@ pub fn process_mpc(
     for (key, partition) in partitions(&run, &sequence, options.link.is_some()) {
         let link = &run.links[&key];
         write_link(&mut tables, &partition, link, &run, config.run_gmphd, &info)?;
+        let (snapshots_with_detections, snapshots_at_max_mpcs) =
+            snapshots_at_cap(&link.detections, config.detection.max_mpcs);
         links.push(LinkSummary {
+            snapshots_with_detections,
+            snapshots_at_max_mpcs,
             partition,
             link: key,
             sets: link.sets.len(),

@@ -217,6 +217,11 @@ fn write_recording(
 /// A bad scenario or trajectory, an existing output without overwrite, or
 /// a file that cannot be written.
 pub fn simulate_radar(args: &RadarSimulation, progress: &dyn Progress) -> anyhow::Result<RadarSimulated> {
+    if args.max_scans == Some(0) {
+        let message =
+            "--max-scans 0: expected at least 1 scan (an empty recording is not a simulation; nothing was done)";
+        return Err(mmtrack_core::error::UsageError::new(message).into());
+    }
     let mut scenario = load_scenario(&args.scenario)?;
     if args.max_scans.is_some() {
         scenario.max_scans = args.max_scans;

@@ -94,6 +94,14 @@ fn write_convoy(
     // `--sets N` keeps the first N sets of the scenario's run: the world (its
     // length, traffic and scatterers) is laid out for the scenario's own
     // number of sets, so a shorter run is a prefix of the full one.
+    if let Some(n) = args.sets.filter(|&n| usize::try_from(n).map_or(true, |n| n > config.sets)) {
+        let message = format!(
+            "--sets {n}: the scenario {} runs {} sets (its `sets`); give at most that (nothing was done)",
+            args.scenario.display(),
+            config.sets
+        );
+        return Err(mmtrack_core::error::UsageError(message).into());
+    }
     let simulator = ConvoySimulator::new(config, seed).with_context(|| args.scenario.display().to_string())?;
     let sets = args.sets.map_or(config.sets, |n| usize::try_from(n).unwrap_or(usize::MAX).min(config.sets));
     let mut extra = BTreeMap::from([

@@ -92,11 +92,10 @@ impl Sweep {
 /// A detector or tracker set-up fails, or the simulator does.
 pub fn measure(config: &Config, powers_db: &[f64], runs: u64, progress: &dyn Progress) -> anyhow::Result<Sweep> {
     let limit = mmtrack_core::limits::MONTE_CARLO_RUNS;
-    anyhow::ensure!(
-        runs >= 1 && limit.allows_count(runs),
-        "--runs {runs}: expected {} (nothing was done)",
-        limit.expected
-    );
+    if !(runs >= 1 && limit.allows_count(runs)) {
+        let message = format!("--runs {runs}: expected {} (nothing was done)", limit.expected);
+        return Err(mmtrack_core::error::UsageError(message).into());
+    }
     let pulse = config.pulse.model();
     let mut sweep = Sweep {
         channel: channel_config(powers_db.first().copied().unwrap_or(-116.0), &pulse),

@@ -339,7 +339,10 @@ pub fn process_spebt(
     let (experiment, link_source) = experiment(options)?;
     let runs = options.runs.unwrap_or(1);
     let limit = mmtrack_core::limits::MONTE_CARLO_RUNS;
-    ensure!(runs >= 1 && limit.allows_count(runs), "--runs {runs}: expected {} (nothing was done)", limit.expected);
+    if !(runs >= 1 && limit.allows_count(runs)) {
+        let message = format!("--runs {runs}: expected {} (nothing was done)", limit.expected);
+        return Err(mmtrack_core::error::UsageError(message).into());
+    }
     let config = tracker_config(&experiment);
     let recordings = recordings.iter().map(|p| read_truth(p)).collect::<anyhow::Result<Vec<_>>>()?;
     for r in &recordings {
