@@ -90,6 +90,57 @@ impl SameSize {
     }
 }
 
+/// What is wrong with `path` as an input file: `None` for a regular file
+/// (or a symbolic link to one) that opens for reading, else what it is
+/// ("does not exist", "is a directory", "is a broken symbolic link to ...",
+/// "is a device", "cannot be opened: ..."). Nothing is read: a FIFO or a
+/// device is named, never opened.
+#[must_use]
+pub fn not_a_readable_file(path: &Path) -> Option<String> {
+    let link = match std::fs::symlink_metadata(path) {
+        Ok(link) => link,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Some("does not exist".into()),
+        Err(e) => return Some(format!("cannot be examined: {e}")),
+    };
+    let target = match std::fs::metadata(path) {
+        Ok(target) => target,
+        Err(_) if link.is_symlink() => {
+            let to = std::fs::read_link(path).map(|t| t.display().to_string()).unwrap_or_default();
+            return Some(format!("is a broken symbolic link (to '{to}'), not a file"));
+        }
+        Err(e) => return Some(format!("cannot be examined: {e}")),
+    };
+    let kind = if target.is_file() {
+        return std::fs::File::open(path).err().map(|e| format!("cannot be opened for reading: {e}"));
+    } else if target.is_dir() {
+        "a directory"
+    } else if mmtrack_io::paths::is_device(&target) {
+        "a device"
+    } else {
+        "a FIFO, socket or other special file"
+    };
+    Some(format!("is {kind}, not a regular file"))
+}
+
+/// An optional input file of a folder layout: `None` when nothing exists at
+/// `path`, the path when it is a readable regular file (or a symbolic link to
+/// one), and an error naming the path and what it is otherwise. A directory
+/// or a broken link where `gps/gps.csv` belongs is a damaged folder, not a
+/// folder without GNSS: taking it as absent would write "0 GNSS fixes"
+/// without a word.
+pub fn optional_file(path: &Path) -> Result<Option<PathBuf>, IngestError> {
+    if std::fs::symlink_metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+        return Ok(None);
+    }
+    match not_a_readable_file(path) {
+        None => Ok(Some(path.to_path_buf())),
+        Some(what) => Err(IngestError::BadLayout {
+            path: path.to_path_buf(),
+            detail: format!("{what}: expected a readable file here or nothing at all (the file is optional)"),
+        }),
+    }
+}
+
 /// Every `*.png` of `dir` whose name is all digits, in time order. Fails when
 /// the folder holds none or two files carry the same stamp.
 pub fn list_scan_pngs(dir: &Path, unit: StampUnit) -> Result<Vec<ScanFile>, IngestError> {
