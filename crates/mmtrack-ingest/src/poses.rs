@@ -411,17 +411,20 @@ pub fn read_text(path: &Path) -> Result<String, IngestError> {
 }
 
 /// Writes `poses` as `stream` into `out`: a new recording, or, with `extend`,
-/// a copy of that recording plus the poses (see [`crate::target`]).
+/// a copy of that recording plus the poses (see [`crate::target`]; poses
+/// none of which falls within that recording's time span are refused).
+/// `input` is the file they came from, `source` how the metadata names it.
 pub fn write_poses(
     poses: &[StampedPose],
     stream: PoseStream,
+    input: &Path,
     source: &str,
     extend: Option<&Path>,
     out: &Path,
     recording: &RecordingOptions,
 ) -> Result<WriteSummary, IngestError> {
     let extra = BTreeMap::from([(format!("{}.source", stream.topic().trim_start_matches('/')), source.to_string())]);
-    let mut writer = crate::target::open_writer(
+    let mut target = crate::target::open_writer(
         out,
         extend,
         source,
@@ -431,9 +434,10 @@ pub fn write_poses(
         recording,
     )?;
     for pose in poses {
-        writer.write_pose(stream, pose, "world")?;
+        target.writer().write_pose(stream, pose, "world")?;
+        target.added(pose.t_ns);
     }
-    Ok(writer.finish()?)
+    target.finish(input, "poses")
 }
 
 /// A trajectory file to ingest (`mmtrack ingest poses`).
@@ -467,7 +471,7 @@ pub fn ingest_poses(
 ) -> Result<(WriteSummary, usize), IngestError> {
     let trajectory = read_trajectory(file.path, file.format, file.times, file.t0_ns, file.plane)?;
     let source = format!("{}:{}", file.format.name(), mmtrack_io::paths::canonical(file.path));
-    let summary = write_poses(&trajectory, stream, &source, extend, out, recording)?;
+    let summary = write_poses(&trajectory, stream, file.path, &source, extend, out, recording)?;
     Ok((summary, trajectory.len()))
 }
 

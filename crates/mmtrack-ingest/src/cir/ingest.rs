@@ -269,7 +269,7 @@ pub fn ingest_cir(
     };
     let tap_spacing_s = first.tap_spacing_s;
     let source = format!("cir-{}:{}", format.name(), mmtrack_io::paths::canonical(input));
-    let mut writer = crate::target::open_writer(
+    let mut target = crate::target::open_writer(
         out,
         None,
         &source,
@@ -280,10 +280,10 @@ pub fn ingest_cir(
     )?;
     let total = file.snapshots.len() as u64;
     for (i, snapshot) in file.snapshots.iter().enumerate() {
-        writer.write_cir(snapshot)?;
+        target.writer().write_cir(snapshot)?;
         progress(i as u64 + 1, total);
     }
-    let output = writer.finish()?;
+    let output = target.finish(input, "CIR snapshots")?;
     let taps = file.snapshots.iter().map(|s| s.taps.len());
     Ok(CirIngestReport {
         output,
