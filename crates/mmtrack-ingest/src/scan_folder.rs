@@ -181,6 +181,24 @@ pub fn folder_name(root: &Path) -> String {
         .unwrap_or_else(|| "sequence".into())
 }
 
+/// The sequence id a folder ingest writes into its recording: `given`
+/// (`--sequence-id`) or else the folder's name ([`folder_name`]), checked
+/// with the rule the table writer applies to partition names
+/// ([`mmtrack_io::table::check_partition_name`]), so that a recording
+/// `process` would refuse is refused when it is made. The error names the
+/// folder, where the id came from, and the flag that sets it.
+pub fn checked_sequence_id(root: &Path, given: Option<&str>) -> Result<String, IngestError> {
+    let (id, from) = match given {
+        Some(id) => (id.to_string(), "--sequence-id"),
+        None => (folder_name(root), "the folder name"),
+    };
+    mmtrack_io::table::check_partition_name(&id).map_err(|detail| IngestError::BadLayout {
+        path: root.to_path_buf(),
+        detail: format!("sequence id (from {from}): {detail}; pass --sequence-id with a name that is"),
+    })?;
+    Ok(id)
+}
+
 /// Scans decoded ahead of the writer, per thread of the pool.
 const DECODED_PER_THREAD: usize = 2;
 
@@ -301,6 +319,29 @@ mod tests {
         let empty = tempfile::tempdir().unwrap();
         let err = list_scan_pngs(empty.path(), StampUnit::Nanos).unwrap_err().to_string();
         assert!(err.contains("no scans found"), "{err}");
+    }
+
+    /// Before: a folder named "my drive" ingested, and `process` then failed
+    /// with "not a valid partition name" without naming the flag.
+    #[test]
+    fn sequence_ids_that_cannot_name_a_partition_are_refused_naming_the_flag() {
+        let parent = tempfile::tempdir().unwrap();
+        let root = parent.path().join("my drive");
+        std::fs::create_dir(&root).unwrap();
+        let err = checked_sequence_id(&root, None).unwrap_err().to_string();
+        assert!(
+            err.contains("my drive: sequence id (from the folder name): 'my drive' is not a valid partition name")
+                && err.ends_with("pass --sequence-id with a name that is"),
+            "{err}"
+        );
+        for bad in ["", "a=b", "../../evil", ".."] {
+            let err = checked_sequence_id(&root, Some(bad)).unwrap_err().to_string();
+            assert!(err.contains(&format!("(from --sequence-id): '{bad}' is not a valid partition name")), "{err}");
+        }
+        assert_eq!(checked_sequence_id(&root, Some("drive-1_a.b")).unwrap(), "drive-1_a.b");
+        let good = parent.path().join("2019-01-10-14-36-48");
+        std::fs::create_dir(&good).unwrap();
+        assert_eq!(checked_sequence_id(&good, None).unwrap(), "2019-01-10-14-36-48");
     }
 
     /// MulRan names scans by 19-digit nanoseconds; `000001.png` is not a

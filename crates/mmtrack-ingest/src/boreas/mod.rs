@@ -204,6 +204,7 @@ pub fn ingest_boreas(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<BoreasReport, IngestError> {
+    let sequence_id = crate::scan_folder::checked_sequence_id(&folder.root, options.sequence_id.as_deref())?;
     let (range_resolution_m, source) = match options.range_resolution_m {
         Some(given) => (given, "given by the caller".to_string()),
         None => folder.range_resolution()?,
@@ -259,7 +260,7 @@ pub fn ingest_boreas(
     let gps_source = folder.gps.as_ref().map(|path| path.display().to_string()).unwrap_or_default();
     let fixes = within_scan_span(&folder.scans, "fixes", &gps_source, &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
-        sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
+        sequence_id,
         source: format!("boreas:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,

@@ -251,6 +251,7 @@ pub fn ingest_oxford(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<IngestReport, IngestError> {
+    let sequence_id = crate::scan_folder::checked_sequence_id(&folder.root, options.sequence_id.as_deref())?;
     let layout = &options.layout;
     let mut extra = BTreeMap::from([
         ("radar.format".to_string(), "oxford-navtech-png".to_string()),
@@ -265,7 +266,7 @@ pub fn ingest_oxford(
         within_scan_span(&folder.scans, "poses", &source("ground_truth.source"), &aux.ground_truth, |p| p.t_ns)?;
     let fixes_in_span = within_scan_span(&folder.scans, "fixes", &source("gnss.source"), &aux.fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
-        sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
+        sequence_id,
         source: format!("oxford:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,
