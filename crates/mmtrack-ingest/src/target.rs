@@ -71,7 +71,8 @@ impl Target {
             return Err(IngestError::BadLayout {
                 path: input.to_path_buf(),
                 detail: format!(
-                    "none of its {} {what} falls within the time span of {} ({first_ns} to {last_ns} ns): its times                      run from {added_first} to {added_last} ns (another unit, clock or drive?)",
+                    "none of its {} {what} falls within the time span of {} ({first_ns} to {last_ns} ns): its times \
+                     run from {added_first} to {added_last} ns (another unit, clock or drive?)",
                     added.count,
                     existing.path.display(),
                 ),
