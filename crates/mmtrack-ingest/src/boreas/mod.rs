@@ -90,7 +90,7 @@ pub fn sequence_date(name: &str) -> Option<(u32, u32, u32)> {
 fn find_poses(root: &Path) -> Result<Option<(PathBuf, String)>, IngestError> {
     let dir = root.join("applanix");
     let radar = dir.join("radar_poses.csv");
-    if radar.is_file() {
+    if let Some(radar) = crate::scan_folder::optional_file(&radar)? {
         return Ok(Some((radar, "radar".into())));
     }
     if !dir.is_dir() {
@@ -121,7 +121,12 @@ impl BoreasFolder {
         }
         let scans = list_scan_pngs(&radar_dir, StampUnit::Micros)?;
         let gps = root.join("applanix").join("gps_post_process.csv");
-        Ok(Self { root: root.to_path_buf(), scans, poses: find_poses(root)?, gps: gps.is_file().then_some(gps) })
+        Ok(Self {
+            root: root.to_path_buf(),
+            scans,
+            poses: find_poses(root)?,
+            gps: crate::scan_folder::optional_file(&gps)?,
+        })
     }
 
     /// Sequence id: the folder name.

@@ -71,8 +71,8 @@ impl MulranFolder {
         Ok(Self {
             root: root.to_path_buf(),
             scans,
-            global_pose: pose.is_file().then_some(pose),
-            gps: gps.is_file().then_some(gps),
+            global_pose: crate::scan_folder::optional_file(&pose)?,
+            gps: crate::scan_folder::optional_file(&gps)?,
         })
     }
 
