@@ -561,8 +561,10 @@ fn cir_file(
     if !quiet {
         let (fewest, most) = report.taps;
         let taps = if fewest == most { format!("{most}") } else { format!("{fewest}-{most}") };
+        let (times, tx, rx) = report.times_tx_rx;
         println!(
-            "{}: {} CIR snapshots of {taps} taps, {:.4} ns apart; {} with a first-path hint; {} receptions skipped; domain {}",
+            "{}: {} CIR snapshots ({times} times x {tx} TX x {rx} RX antennas) of {taps} taps, {:.4} ns apart; {} with \
+             a first-path hint; {} receptions skipped; domain {}",
             report.output.path.display(),
             report.snapshots,
             report.tap_spacing_s * 1e9,

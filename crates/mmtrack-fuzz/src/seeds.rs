@@ -173,7 +173,8 @@ pub fn cdr(realdata: Option<&Path>) -> Vec<Vec<u8>> {
 }
 
 /// DecaWave logs: a written log (two 8-tap frames and an `RX E` reception),
-/// the real log's first two frames, and the same frames cut to 16 taps.
+/// the real log's first two frames, and the same frames cut to 16 taps
+/// (their first paths moved to tap 8.5).
 #[must_use]
 pub fn decawave(realdata: Option<&Path>) -> Vec<Vec<u8>> {
     let frame = |hlp: &str, rc: &str| {
@@ -216,6 +217,11 @@ pub fn decawave(realdata: Option<&Path>) -> Vec<Vec<u8>> {
                 keep_left -= 1;
                 cut += line;
             }
+        } else if let Some((before, after)) = line.split_once("HLP(").filter(|_| line.starts_with("RX OK")) {
+            // The first path moved within the 16 kept taps (the reader
+            // refuses one beyond the accumulator).
+            let rest = after.split_once(')').map_or("", |(_, rest)| rest);
+            cut += &format!("{before}HLP(0008.5000){rest}");
         } else {
             cut += line;
         }

@@ -262,8 +262,9 @@ pub fn parse_tum(path: &Path, text: &str, plane: Plane) -> Result<Vec<StampedPos
     Ok(poses)
 }
 
-/// Parses a KITTI `times.txt` (decimal seconds per line), plus `t0_ns`
-/// (`--t0-ns` of `mmtrack ingest poses`). A time that is not non-negative
+/// Parses a KITTI `times.txt` (decimal seconds per line, increasing), plus
+/// `t0_ns` (`--t0-ns` of `mmtrack ingest poses`). A time that does not
+/// increase is the times file's fault, named by its line. A time that is not non-negative
 /// seconds within the i64 nanosecond range is the file's fault; a time that
 /// only overflows once `t0_ns` is added is `t0_ns`'s, and the error says so.
 pub fn parse_times(path: &Path, text: &str, t0_ns: i64) -> Result<Vec<i64>, IngestError> {
@@ -296,9 +297,46 @@ pub fn parse_times(path: &Path, text: &str, t0_ns: i64) -> Result<Vec<i64>, Inge
                 format!("{raw} s plus the offset {t0_ns} ns overflows i64 nanoseconds: the offset is too large"),
             )
         })?;
+        if let Some(&previous) = times.last()
+            && t_ns <= previous
+        {
+            return Err(IngestError::bad_line(
+                path,
+                index + 1,
+                "time",
+                format!("{raw} s does not increase (previous {} ns after the offset)", previous),
+            ));
+        }
         times.push(t_ns);
     }
     Ok(times)
+}
+
+/// Refuses a KITTI times file with fewer or more times than the pose file
+/// has poses (non-blank lines), naming the times file and its last time's
+/// line: the poses cannot be matched to times.
+fn check_times_count(
+    times_path: &Path,
+    times_text: &str,
+    times: usize,
+    poses_path: &Path,
+    poses_text: &str,
+) -> Result<(), IngestError> {
+    let poses = poses_text.lines().filter(|l| !l.trim().is_empty()).count();
+    if poses == times || poses == 0 {
+        return Ok(()); // an empty pose file is reported by its parser
+    }
+    let last_line =
+        times_text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()).last().map_or(0, |(i, _)| i + 1);
+    let detail = format!(
+        "{times} times for the {poses} poses of {}: expected one time per pose ({})",
+        poses_path.display(),
+        if times < poses { "the times file is short" } else { "the times file is long" }
+    );
+    Err(match last_line {
+        0 => IngestError::BadLayout { path: times_path.to_path_buf(), detail },
+        line => IngestError::bad_line(times_path, line, "time", detail),
+    })
 }
 
 /// Parses a KITTI pose file with one time per line from `times_ns`: at
@@ -399,8 +437,11 @@ pub fn read_trajectory(
                     detail: "KITTI pose files carry no time: give --times <times.txt>".into(),
                 });
             };
-            let times = parse_times(times_path, &read_text(times_path)?, t0_ns)?;
-            parse_kitti(path, &read_text(path)?, &times, plane)
+            let times_text = read_text(times_path)?;
+            let times = parse_times(times_path, &times_text, t0_ns)?;
+            let text = read_text(path)?;
+            check_times_count(times_path, &times_text, times.len(), path, &text)?;
+            parse_kitti(path, &text, &times, plane)
         }
     }
 }
@@ -411,17 +452,20 @@ pub fn read_text(path: &Path) -> Result<String, IngestError> {
 }
 
 /// Writes `poses` as `stream` into `out`: a new recording, or, with `extend`,
-/// a copy of that recording plus the poses (see [`crate::target`]).
+/// a copy of that recording plus the poses (see [`crate::target`]; poses
+/// none of which falls within that recording's time span are refused).
+/// `input` is the file they came from, `source` how the metadata names it.
 pub fn write_poses(
     poses: &[StampedPose],
     stream: PoseStream,
+    input: &Path,
     source: &str,
     extend: Option<&Path>,
     out: &Path,
     recording: &RecordingOptions,
 ) -> Result<WriteSummary, IngestError> {
     let extra = BTreeMap::from([(format!("{}.source", stream.topic().trim_start_matches('/')), source.to_string())]);
-    let mut writer = crate::target::open_writer(
+    let mut target = crate::target::open_writer(
         out,
         extend,
         source,
@@ -431,9 +475,10 @@ pub fn write_poses(
         recording,
     )?;
     for pose in poses {
-        writer.write_pose(stream, pose, "world")?;
+        target.writer().write_pose(stream, pose, "world")?;
+        target.added(pose.t_ns);
     }
-    Ok(writer.finish()?)
+    target.finish(input, "poses")
 }
 
 /// A trajectory file to ingest (`mmtrack ingest poses`).
@@ -467,7 +512,7 @@ pub fn ingest_poses(
 ) -> Result<(WriteSummary, usize), IngestError> {
     let trajectory = read_trajectory(file.path, file.format, file.times, file.t0_ns, file.plane)?;
     let source = format!("{}:{}", file.format.name(), mmtrack_io::paths::canonical(file.path));
-    let summary = write_poses(&trajectory, stream, &source, extend, out, recording)?;
+    let summary = write_poses(&trajectory, stream, file.path, &source, extend, out, recording)?;
     Ok((summary, trajectory.len()))
 }
 
@@ -540,6 +585,34 @@ mod tests {
         let far = "1 0 0 0 0 1 0 -2e8 0 0 1 0\n";
         let err = parse_kitti(Path::new("p.txt"), far, &[1], Plane::Xy).unwrap_err().to_string();
         assert!(err.starts_with("p.txt: line 1: ty: -200000000 is not a coordinate"), "{err}");
+    }
+
+    /// Before: a times file going backwards or too short was blamed on the
+    /// pose file ("p.txt: line 2: timestamp: ... does not increase").
+    #[test]
+    fn a_bad_times_file_is_named_with_its_line_not_the_pose_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let poses = dir.path().join("gt.kitti.txt");
+        let times = dir.path().join("times.txt");
+        std::fs::write(&poses, "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 1 0 1 0 0 0 0 1 0\n1 0 0 2 0 1 0 0 0 0 1 0\n").unwrap();
+        let read = |times_text: &str| {
+            std::fs::write(&times, times_text).unwrap();
+            read_trajectory(&poses, TrajectoryFormat::Kitti, Some(&times), 0, Plane::Xy)
+        };
+        assert_eq!(read("0.0\n0.1\n0.2\n").unwrap().len(), 3);
+        let err = read("0.0\n0.2\n0.1\n").unwrap_err().to_string();
+        assert!(err.starts_with(&format!("{}: line 3: time: 0.1 s does not increase", times.display())), "{err}");
+        let err = read("0.0\n\n0.1\n").unwrap_err().to_string();
+        assert!(
+            err.starts_with(&format!(
+                "{}: line 3: time: 2 times for the 3 poses of {}",
+                times.display(),
+                poses.display()
+            )) && err.contains("the times file is short"),
+            "{err}"
+        );
+        let err = read("0.0\n0.1\n0.2\n0.3\n").unwrap_err().to_string();
+        assert!(err.contains("times.txt: line 4: time: 4 times for the 3 poses") && err.contains("long"), "{err}");
     }
 
     #[test]

@@ -343,7 +343,9 @@ fn metadata(bag: &Path, topics: &Ros2Topics, first_stamp_ns: Option<i64>) -> Rec
 /// Ingests the chosen topics of a ROS 2 bag into a new recording. Messages
 /// must come in increasing header time per topic; a chosen topic missing
 /// from the bag, or of a message type its role does not take
-/// ([`Ros2Topics::check_type`]), is an error.
+/// ([`Ros2Topics::check_type`]), is an error. A bad message is named by its
+/// topic, its 0-based index among that topic's messages in file order and
+/// its log time.
 pub fn ingest_ros2(
     bag: &Path,
     out: &Path,
@@ -361,13 +363,18 @@ pub fn ingest_ros2(
     let mut reader = RawReader::open(bag)?;
     let writer = RecordingWriter::create(out, &metadata(bag, topics, first_stamp), recording)?;
     let mut sink = Sink { topics, writer, poses: 0, gnss_fixes: 0, no_fix: 0, radar_scans: 0, last_ns: [i64::MIN; 3] };
-    let mut found_topics = std::collections::BTreeSet::new();
+    // Messages seen per topic: a message is named by its 0-based index among
+    // its topic's messages in file order, and its log time. Not by the MCAP
+    // sequence number: rosbag2 writers leave it 0.
+    let mut per_topic: BTreeMap<String, u64> = BTreeMap::new();
     while let Some(message) = reader.next_message()? {
         let channel = &message.channel;
-        found_topics.insert(channel.topic.clone());
+        let seen = per_topic.entry(channel.topic.clone()).or_insert(0);
+        let index = *seen;
+        *seen += 1;
         let bad = |detail: String| IngestError::BadRecord {
             path: bag.to_path_buf(),
-            record: format!("message {} on {}", message.sequence, channel.topic),
+            record: format!("message {index} on {} (0-based, log time {} ns)", channel.topic, message.log_time_ns),
             field: channel.schema_name.clone(),
             detail,
         };
@@ -382,12 +389,12 @@ pub fn ingest_ros2(
         sink.handle(&channel.topic, &channel.schema_name, &message.data)?.map_err(bad)?;
         progress(reader.bytes_read(), bag_bytes);
     }
-    if let Some(topic) = wanted.iter().find(|t| !found_topics.contains(**t)) {
+    if let Some(topic) = wanted.iter().find(|t| !per_topic.contains_key(**t)) {
         return Err(IngestError::BadLayout {
             path: bag.to_path_buf(),
             detail: format!(
                 "no topic {topic} in the bag (topics: {})",
-                found_topics.iter().cloned().collect::<Vec<_>>().join(", ")
+                per_topic.keys().cloned().collect::<Vec<_>>().join(", ")
             ),
         });
     }

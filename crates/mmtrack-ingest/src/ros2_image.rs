@@ -186,11 +186,12 @@ pub(crate) mod tests {
             ..mmtrack_io::RecordingOptions::default()
         };
         let mut writer = mmtrack_io::RecordingWriter::create(path, &metadata, &options).unwrap();
-        for (sequence, data) in messages.iter().enumerate() {
+        for (index, data) in messages.iter().enumerate() {
+            // Sequence 0 on every message, as rosbag2 writes them.
             let message = RawMessage {
                 channel: channel.clone(),
-                sequence: sequence as u32,
-                log_time_ns: 1,
+                sequence: 0,
+                log_time_ns: 1_000 + index as u64,
                 data: bytes::Bytes::from(data.clone()),
             };
             writer.copy_message(&message).unwrap();
@@ -235,7 +236,19 @@ pub(crate) mod tests {
         bag(&input, &backwards);
         let out = dir.path().join("bad.mcap");
         let err = ingest_ros2(&input, &out, &topics, &Default::default(), &mut |_, _| {}).unwrap_err().to_string();
-        assert!(err.contains("message 1 on /Navtech/Polar") && err.contains("does not increase"), "{err}");
+        assert!(
+            err.contains("message 1 on /Navtech/Polar (0-based, log time 1001 ns)")
+                && err.contains("does not increase"),
+            "{err}"
+        );
+        // Before: every message was "message 0" (the MCAP sequence, which
+        // rosbag2 leaves 0); the 51st message is message 50.
+        let mut long: Vec<Vec<u8>> =
+            (0..60).map(|i| image_message((1_600_000_000 + i, 0), 8, 5, "mono8", 5, &[0; 40])).collect();
+        long[50] = messages[0].clone();
+        bag(&input, &long);
+        let err = ingest_ros2(&input, &out, &topics, &Default::default(), &mut |_, _| {}).unwrap_err().to_string();
+        assert!(err.contains("message 50 on /Navtech/Polar (0-based, log time 1050 ns)"), "{err}");
         let cut = messages[0][..messages[0].len() - 3].to_vec();
         bag(&input, &[cut]);
         let err = ingest_ros2(&input, &out, &topics, &Default::default(), &mut |_, _| {}).unwrap_err().to_string();

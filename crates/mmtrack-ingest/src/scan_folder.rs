@@ -90,6 +90,57 @@ impl SameSize {
     }
 }
 
+/// What is wrong with `path` as an input file: `None` for a regular file
+/// (or a symbolic link to one) that opens for reading, else what it is
+/// ("does not exist", "is a directory", "is a broken symbolic link to ...",
+/// "is a device", "cannot be opened: ..."). Nothing is read: a FIFO or a
+/// device is named, never opened.
+#[must_use]
+pub fn not_a_readable_file(path: &Path) -> Option<String> {
+    let link = match std::fs::symlink_metadata(path) {
+        Ok(link) => link,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Some("does not exist".into()),
+        Err(e) => return Some(format!("cannot be examined: {e}")),
+    };
+    let target = match std::fs::metadata(path) {
+        Ok(target) => target,
+        Err(_) if link.is_symlink() => {
+            let to = std::fs::read_link(path).map(|t| t.display().to_string()).unwrap_or_default();
+            return Some(format!("is a broken symbolic link (to '{to}'), not a file"));
+        }
+        Err(e) => return Some(format!("cannot be examined: {e}")),
+    };
+    let kind = if target.is_file() {
+        return std::fs::File::open(path).err().map(|e| format!("cannot be opened for reading: {e}"));
+    } else if target.is_dir() {
+        "a directory"
+    } else if mmtrack_io::paths::is_device(&target) {
+        "a device"
+    } else {
+        "a FIFO, socket or other special file"
+    };
+    Some(format!("is {kind}, not a regular file"))
+}
+
+/// An optional input file of a folder layout: `None` when nothing exists at
+/// `path`, the path when it is a readable regular file (or a symbolic link to
+/// one), and an error naming the path and what it is otherwise. A directory
+/// or a broken link where `gps/gps.csv` belongs is a damaged folder, not a
+/// folder without GNSS: taking it as absent would write "0 GNSS fixes"
+/// without a word.
+pub fn optional_file(path: &Path) -> Result<Option<PathBuf>, IngestError> {
+    if std::fs::symlink_metadata(path).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound) {
+        return Ok(None);
+    }
+    match not_a_readable_file(path) {
+        None => Ok(Some(path.to_path_buf())),
+        Some(what) => Err(IngestError::BadLayout {
+            path: path.to_path_buf(),
+            detail: format!("{what}: expected a readable file here or nothing at all (the file is optional)"),
+        }),
+    }
+}
+
 /// Every `*.png` of `dir` whose name is all digits, in time order. Fails when
 /// the folder holds none or two files carry the same stamp.
 pub fn list_scan_pngs(dir: &Path, unit: StampUnit) -> Result<Vec<ScanFile>, IngestError> {
@@ -128,6 +179,24 @@ pub fn folder_name(root: &Path) -> String {
         .ok()
         .and_then(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
         .unwrap_or_else(|| "sequence".into())
+}
+
+/// The sequence id a folder ingest writes into its recording: `given`
+/// (`--sequence-id`) or else the folder's name ([`folder_name`]), checked
+/// with the rule the table writer applies to partition names
+/// ([`mmtrack_io::table::check_partition_name`]), so that a recording
+/// `process` would refuse is refused when it is made. The error names the
+/// folder, where the id came from, and the flag that sets it.
+pub fn checked_sequence_id(root: &Path, given: Option<&str>) -> Result<String, IngestError> {
+    let (id, from) = match given {
+        Some(id) => (id.to_string(), "--sequence-id"),
+        None => (folder_name(root), "the folder name"),
+    };
+    mmtrack_io::table::check_partition_name(&id).map_err(|detail| IngestError::BadLayout {
+        path: root.to_path_buf(),
+        detail: format!("sequence id (from {from}): {detail}; pass --sequence-id with a name that is"),
+    })?;
+    Ok(id)
 }
 
 /// Scans decoded ahead of the writer, per thread of the pool.
@@ -250,6 +319,29 @@ mod tests {
         let empty = tempfile::tempdir().unwrap();
         let err = list_scan_pngs(empty.path(), StampUnit::Nanos).unwrap_err().to_string();
         assert!(err.contains("no scans found"), "{err}");
+    }
+
+    /// Before: a folder named "my drive" ingested, and `process` then failed
+    /// with "not a valid partition name" without naming the flag.
+    #[test]
+    fn sequence_ids_that_cannot_name_a_partition_are_refused_naming_the_flag() {
+        let parent = tempfile::tempdir().unwrap();
+        let root = parent.path().join("my drive");
+        std::fs::create_dir(&root).unwrap();
+        let err = checked_sequence_id(&root, None).unwrap_err().to_string();
+        assert!(
+            err.contains("my drive: sequence id (from the folder name): 'my drive' is not a valid partition name")
+                && err.ends_with("pass --sequence-id with a name that is"),
+            "{err}"
+        );
+        for bad in ["", "a=b", "../../evil", ".."] {
+            let err = checked_sequence_id(&root, Some(bad)).unwrap_err().to_string();
+            assert!(err.contains(&format!("(from --sequence-id): '{bad}' is not a valid partition name")), "{err}");
+        }
+        assert_eq!(checked_sequence_id(&root, Some("drive-1_a.b")).unwrap(), "drive-1_a.b");
+        let good = parent.path().join("2019-01-10-14-36-48");
+        std::fs::create_dir(&good).unwrap();
+        assert_eq!(checked_sequence_id(&good, None).unwrap(), "2019-01-10-14-36-48");
     }
 
     /// MulRan names scans by 19-digit nanoseconds; `000001.png` is not a

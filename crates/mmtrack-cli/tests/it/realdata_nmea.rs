@@ -11,8 +11,18 @@ fn nmea_drive_gives_1653_fixes_and_reports_bad_checksums() {
     let log = realdata.join("nmea-ublox-f9k/MTV.Local1.ublox-F9K.20200206-181434.nmea");
     let dir = tempfile::tempdir().unwrap();
     assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
-    let rec = "d/recording.mcap";
-    let out = mmtrack(dir.path(), &["ingest", "nmea", log.to_str().unwrap(), "--add-to", rec, "-o", rec]);
+    // The demo's scans are of 2023; the drive of 2020-02-06: adding its fixes
+    // to the demo is refused, and the demo left as it was.
+    let demo = "d/recording.mcap";
+    let before = std::fs::read(dir.path().join(demo)).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "nmea", log.to_str().unwrap(), "--add-to", demo, "-o", demo]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("none of its 1653 GNSS fixes falls within the time span of d/recording.mcap"), "{stderr}");
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert_eq!(std::fs::read(dir.path().join(demo)).unwrap(), before);
+    let rec = "nmea.mcap";
+    let out = mmtrack(dir.path(), &["ingest", "nmea", log.to_str().unwrap(), "-o", rec]);
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
     // 13 lines fail their checksum: counted independently with a Python XOR over each line.
@@ -26,7 +36,7 @@ fn nmea_drive_gives_1653_fixes_and_reports_bad_checksums() {
             _ => {}
         }
     }
-    assert_eq!((fixes, scans), (1653, 160));
+    assert_eq!((fixes, scans), (1653, 0));
     let meta = mmtrack(dir.path(), &["inspect", "--json", rec]);
     let summary: serde_json::Value = serde_json::from_slice(&meta.stdout).unwrap();
     let m = &summary["metadata"]["mmtrack.recording"];

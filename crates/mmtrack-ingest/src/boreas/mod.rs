@@ -90,7 +90,7 @@ pub fn sequence_date(name: &str) -> Option<(u32, u32, u32)> {
 fn find_poses(root: &Path) -> Result<Option<(PathBuf, String)>, IngestError> {
     let dir = root.join("applanix");
     let radar = dir.join("radar_poses.csv");
-    if radar.is_file() {
+    if let Some(radar) = crate::scan_folder::optional_file(&radar)? {
         return Ok(Some((radar, "radar".into())));
     }
     if !dir.is_dir() {
@@ -121,7 +121,12 @@ impl BoreasFolder {
         }
         let scans = list_scan_pngs(&radar_dir, StampUnit::Micros)?;
         let gps = root.join("applanix").join("gps_post_process.csv");
-        Ok(Self { root: root.to_path_buf(), scans, poses: find_poses(root)?, gps: gps.is_file().then_some(gps) })
+        Ok(Self {
+            root: root.to_path_buf(),
+            scans,
+            poses: find_poses(root)?,
+            gps: crate::scan_folder::optional_file(&gps)?,
+        })
     }
 
     /// Sequence id: the folder name.
@@ -204,6 +209,7 @@ pub fn ingest_boreas(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<BoreasReport, IngestError> {
+    let sequence_id = crate::scan_folder::checked_sequence_id(&folder.root, options.sequence_id.as_deref())?;
     let (range_resolution_m, source) = match options.range_resolution_m {
         Some(given) => (given, "given by the caller".to_string()),
         None => folder.range_resolution()?,
@@ -259,7 +265,7 @@ pub fn ingest_boreas(
     let gps_source = folder.gps.as_ref().map(|path| path.display().to_string()).unwrap_or_default();
     let fixes = within_scan_span(&folder.scans, "fixes", &gps_source, &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
-        sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
+        sequence_id,
         source: format!("boreas:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,

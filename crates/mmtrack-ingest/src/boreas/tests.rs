@@ -270,3 +270,18 @@ fn poses_or_fixes_that_miss_every_scan_are_refused_naming_both_spans() {
     let err = ingest(&root, &dir.path().join("b.mcap"), &BoreasOptions::default()).unwrap_err().to_string();
     assert!(err.contains("gps_post_process.csv: none of its 6 fixes falls within"), "{err}");
 }
+
+/// Before: `applanix/radar_poses.csv` or `applanix/gps_post_process.csv` as
+/// a directory was taken as absent (exit 0 without poses or GNSS).
+#[test]
+fn an_optional_file_that_is_a_directory_is_an_error_naming_it() {
+    for optional in ["applanix/radar_poses.csv", "applanix/gps_post_process.csv"] {
+        let dir = tempfile::tempdir().unwrap();
+        let root = folder(dir.path(), "boreas-2021-09-02-11-42", 20);
+        let path = root.join(optional);
+        let _ = std::fs::remove_file(&path);
+        std::fs::create_dir(&path).unwrap();
+        let err = BoreasFolder::open(&root).unwrap_err().to_string();
+        assert!(err.contains(optional) && err.contains("is a directory, not a regular file"), "{err}");
+    }
+}

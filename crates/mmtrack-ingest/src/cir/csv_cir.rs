@@ -14,7 +14,9 @@
 //!   complete, contiguous and in order.
 //!
 //! Any other column, a duplicate, a gap in the tap numbering or a row with the
-//! wrong number of fields is an error naming the line and the column. Lines
+//! wrong number of fields is an error naming the line and the column, and so
+//! is a row whose set or time comes before the previous row of its link (tx,
+//! rx antenna): each link's snapshots must be in set and time order. Lines
 //! starting with `#` and blank lines are skipped, and so is a UTF-8 byte
 //! order mark at the start of the file. Values that are NaN or
 //! infinite are errors (a CIR with a hole is not a CIR).
@@ -52,6 +54,7 @@ pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Re
     let rows: Vec<(usize, &str)> = lines.collect();
     let mut planner = FftPlanner::<f64>::new();
     let mut out = Vec::with_capacity(rows.len());
+    let mut last_on_link = std::collections::BTreeMap::new();
     for (row, &(line, text)) in rows.iter().enumerate() {
         let fields: Vec<&str> = text.split(',').map(str::trim).collect();
         if fields.len() != columns.len() {
@@ -104,12 +107,48 @@ pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Re
             first_path_hint_s: None,
         };
         snapshot.validate().map_err(|e| bad(line, "snapshot", e.to_string()))?;
+        check_link_order(&mut last_on_link, line, &snapshot).map_err(|(field, detail)| bad(line, field, detail))?;
         out.push(snapshot);
     }
     if out.is_empty() {
         return Err(bad(header_line, "rows", "a header but no snapshot rows".into()));
     }
     Ok(out)
+}
+
+/// The line, set and time of the last snapshot of each link (tx, rx antenna).
+type LastOnLink = std::collections::BTreeMap<(u32, u32), (usize, u64, i64)>;
+
+/// Refuses a snapshot whose set comes before, or whose time lies before,
+/// the previous snapshot of its link (what `process mpc` requires: each
+/// link's snapshots in set and time order), naming the field and the line
+/// of that previous snapshot.
+fn check_link_order(last: &mut LastOnLink, line: usize, snapshot: &CirSnapshot) -> Result<(), (&'static str, String)> {
+    let link = (snapshot.tx_antenna, snapshot.rx_antenna);
+    if let Some(&(previous_line, set, t_ns)) = last.get(&link) {
+        let on = format!("link tx{}:rx{}", link.0, link.1);
+        if snapshot.set_index < set {
+            return Err((
+                "set_index",
+                format!(
+                    "set {} after set {set} (line {previous_line}) on {on}: expected each link's snapshots in set order",
+                    snapshot.set_index
+                ),
+            ));
+        }
+        if snapshot.t_ns < t_ns {
+            return Err((
+                "t_ns",
+                format!(
+                    "{} ns before the {t_ns} ns of line {previous_line} on {on}: expected each link's snapshots in time \
+                     order",
+                    snapshot.t_ns
+                ),
+            ));
+        }
+    }
+    last.insert(link, (line, snapshot.set_index, snapshot.t_ns));
+    Ok(())
 }
 
 fn check_header(index_cols: &[&str], tap_cols: &[&str]) -> Result<(), (String, String)> {
@@ -203,6 +242,30 @@ mod tests {
         assert!(err("\u{feff}time,re_0,im_0\n1,2,3\n").contains("line 1: time: column 1 is `time`"));
         let e = parse_cir_csv(Path::new("c.csv"), "re_0,im_0\n1,2\n", &sidecar("tap_spacing_s = 1e-9"));
         assert!(e.unwrap_err().to_string().contains("key `carrier_hz`"));
+    }
+
+    /// Before: rows out of set or time order were taken, and `process mpc`
+    /// refused the recording ("snapshots must come in set order").
+    #[test]
+    fn rows_out_of_set_or_time_order_on_a_link_are_refused_naming_the_line() {
+        let s = sidecar(SIDECAR);
+        let parse = |text: &str| parse_cir_csv(Path::new("c.csv"), text, &s);
+        let header = "t_ns,set_index,tx_antenna,rx_antenna,re_0,im_0\n";
+        let e = parse(&format!("{header}10,5,0,0,1,0\n20,5,0,1,1,0\n30,3,0,0,1,0\n")).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "c.csv: line 4: set_index: set 3 after set 5 (line 2) on link tx0:rx0: expected each link's snapshots \
+             in set order"
+        );
+        let e = parse(&format!("{header}30,5,0,0,1,0\n20,6,0,0,1,0\n")).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "c.csv: line 3: t_ns: 20 ns before the 30 ns of line 2 on link tx0:rx0: expected each link's snapshots \
+             in time order"
+        );
+        // Two links interleaved, each in order; the same time on two antennas.
+        let ok = parse(&format!("{header}10,1,0,0,1,0\n10,1,0,1,1,0\n20,2,0,0,1,0\n20,2,0,1,1,0\n")).unwrap();
+        assert_eq!(ok.len(), 4);
     }
 
     /// Seen while adding the CSV fuzz target: with two snapshots per set, a

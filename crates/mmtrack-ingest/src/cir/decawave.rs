@@ -248,9 +248,33 @@ pub fn parse_decawave_log_detailed(
             }
             let samples = &lines[i + 1..i + 1 + taps_count];
             i += 1 + taps_count;
+            // The next line that is not blank must not be one more sample.
+            if let Some(k) = lines[i..].iter().position(|l| !l.trim().is_empty())
+                && parse_iq(lines[i + k].trim()).is_some()
+            {
+                return Err(bad(
+                    i + k + 1,
+                    "Accum Len",
+                    format!(
+                        "`Accum Len {taps_count}` (line {line_no}) but another I/Q line follows its {taps_count} \
+                         samples: expected the header's count to match the accumulator"
+                    ),
+                ));
+            }
             let Some(header) = p.header else {
                 continue;
             };
+            if header.hlp_taps >= taps_count as f64 {
+                return Err(bad(
+                    p.line,
+                    "HLP",
+                    format!(
+                        "first path at tap {}, beyond the accumulator of {taps_count} taps (`Accum Len`, line \
+                         {line_no}): expected an index within it",
+                        header.hlp_taps
+                    ),
+                ));
+            }
             let mut taps = Vec::with_capacity(taps_count);
             for (k, sample) in samples.iter().enumerate() {
                 let tap = parse_iq(sample).ok_or_else(|| {
@@ -507,11 +531,12 @@ mod tests {
         FFE(0000), T(82BE), RSL(-078.4136), FSL(-081.8368), RSMPL(34)\nAccum Len 2\n725, 443\n525, 158\n\n";
 
     fn sample_log() -> String {
+        // Three taps a frame, so first paths (HLP) at taps 1 and 2.
         // Second frame's RC is below the first: the 40-bit counter wrapped.
         let mut text = PREAMBLE.to_string();
-        text.push_str(&frame("0745.3125", "00FF FFFFFFF0", &[(-24, 100), (-242, 87), (5, -6)]));
+        text.push_str(&frame("0001.3125", "00FF FFFFFFF0", &[(-24, 100), (-242, 87), (5, -6)]));
         text.push_str(ERROR_RECEPTION);
-        text.push_str(&frame("0751.2969", "0000 00000010", &[(1, 2), (3, 4), (5, 6)]));
+        text.push_str(&frame("0002.2969", "0000 00000010", &[(1, 2), (3, 4), (5, 6)]));
         text
     }
 
@@ -528,15 +553,15 @@ mod tests {
                 a.cir.taps,
                 [Complex64::new(-24.0, 100.0), Complex64::new(-242.0, 87.0), Complex64::new(5.0, -6.0)]
             );
-            assert_eq!((a.hlp_taps, b.hlp_taps), (745.3125, 751.2969));
+            assert_eq!((a.hlp_taps, b.hlp_taps), (1.3125, 2.2969));
             assert_eq!(a.rx_timestamp_ticks, Some(0xFF_FFFF_FFF0));
             assert_eq!((a.rx_level_dbm, a.first_path_level_dbm), (Some(-78.9641), Some(-81.7507)));
             assert_eq!(a.header_fields[2], ("PSC".to_string(), "0274".to_string()));
             assert_eq!((a.cir.set_index, b.cir.set_index), (0, 1));
             assert_eq!((a.cir.carrier_hz, a.cir.delay_offset_s), (3993.6e6, 0.0));
             assert!((a.cir.tap_spacing_s - 1.001_602_564e-9).abs() < 1e-18);
-            // HLP kept as a delay: 745.3125 taps of 1.0016 ns (1e-21 s: rounding of one product).
-            assert!((a.cir.first_path_hint_s.unwrap() - 745.3125 / 998.4e6).abs() < 1e-21);
+            // HLP kept as a delay: 1.3125 taps of 1.0016 ns (1e-21 s: rounding of one product).
+            assert!((a.cir.first_path_hint_s.unwrap() - 1.3125 / 998.4e6).abs() < 1e-21);
             // 0x20 ticks across the wrap = 32 / 63.8976 GHz = 0.5 ns, rounded to 1 ns.
             assert_eq!((a.cir.t_ns, b.cir.t_ns), (0, 1));
             assert_eq!(text.lines().nth(b.header_line - 1).map(|l| l.starts_with("RX OK")), Some(true));
@@ -554,7 +579,7 @@ mod tests {
         let frames = parse_decawave_log(Path::new("1.log"), &sample_log(), &config).unwrap();
         assert_eq!(frames.iter().map(|f| f.cir.t_ns).collect::<Vec<_>>(), [1_000, 350_001_000]);
         let f = &frames[0];
-        assert!((f.cir.delay_s(745) - (745.0 - 745.3125) * f.cir.tap_spacing_s).abs() < 1e-18);
+        assert!((f.cir.delay_s(1) - (1.0 - 1.3125) * f.cir.tap_spacing_s).abs() < 1e-18);
         // The HLP hint sits at delay 0 when the first path is the reference.
         assert_eq!(f.cir.first_path_hint_s, Some(0.0));
         // The frame period does not need RC.
@@ -590,10 +615,30 @@ mod tests {
         // The next header where I/Q lines were promised.
         let err = err_of(&good.replace("Accum Len 3", "Accum Len 4"));
         assert!(err.contains("I/Q") && err.contains("found ``"), "{err}");
+        // More I/Q lines than `Accum Len` says (before: the surplus was
+        // dropped), and a first path beyond the accumulator (before: kept).
+        let surplus = good.replace("-24, 100\n-242, 87\n5, -6\n", "-24, 100\n-242, 87\n5, -6\n7, 8\n");
+        let err = err_of(&surplus);
+        let extra = surplus.lines().position(|l| l == "7, 8").unwrap() + 1;
+        assert!(
+            err.starts_with(&format!(
+                "bad.log: frame 0 (line {extra}): Accum Len: `Accum Len 3` (line {}) but",
+                extra - 4
+            )) && err.contains("another I/Q line follows its 3 samples"),
+            "{err}"
+        );
+        let err = err_of(&good.replace("HLP(0001.3125)", "HLP(99999.0)"));
+        assert!(
+            err.starts_with(&format!("bad.log: frame 0 (line {}): HLP: first path at tap 99999", line_of("HLP(0001")))
+                && err.contains("beyond the accumulator of 3 taps"),
+            "{err}"
+        );
+        let err = err_of(&good.replace("HLP(0001.3125)", "HLP(3.0)"));
+        assert!(err.contains("HLP: first path at tap 3, beyond the accumulator of 3 taps"), "{err}");
         // A missing or malformed HLP.
-        let err = err_of(&good.replace("HLP(0751.2969), ", ""));
-        assert!(err.contains(&format!("frame 1 (line {}): HLP: missing", line_of("HLP(0751.2969)"))), "{err}");
-        let err = err_of(&good.replace("HLP(0745.3125)", "HLP(74x)"));
+        let err = err_of(&good.replace("HLP(0002.2969), ", ""));
+        assert!(err.contains(&format!("frame 1 (line {}): HLP: missing", line_of("HLP(0002.2969)"))), "{err}");
+        let err = err_of(&good.replace("HLP(0001.3125)", "HLP(74x)"));
         assert!(err.contains("frame 0") && err.contains("HLP: `74x`"), "{err}");
         // A header without accumulator, an accumulator without header.
         let err = err_of(&good.replace("Accum Len 3\n-24", "-24"));

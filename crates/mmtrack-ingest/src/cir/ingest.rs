@@ -239,8 +239,13 @@ fn read_decawave(
 pub struct CirIngestReport {
     /// The recording written.
     pub output: WriteSummary,
-    /// Snapshots written.
+    /// Snapshots written (one per time, TX and RX antenna).
     pub snapshots: usize,
+    /// Distinct snapshot times, TX antennas and RX antennas among them: what
+    /// the snapshots are. A 3-D array without `axes` is `[rx, tx, tap]`
+    /// (see [`super::array`]): 252 snapshots of it are 252 RX antennas at
+    /// one time, not 252 times.
+    pub times_tx_rx: (usize, usize, usize),
     /// Fewest and most taps of a snapshot.
     pub taps: (usize, usize),
     /// Tap spacing of the first snapshot, seconds.
@@ -251,6 +256,15 @@ pub struct CirIngestReport {
     pub skipped: usize,
     /// The `cir.*` metadata written.
     pub metadata: BTreeMap<String, String>,
+}
+
+/// Distinct times, TX antennas and RX antennas of `snapshots`.
+fn times_tx_rx(snapshots: &[mmtrack_core::CirSnapshot]) -> (usize, usize, usize) {
+    use std::collections::BTreeSet;
+    let times: BTreeSet<i64> = snapshots.iter().map(|s| s.t_ns).collect();
+    let tx: BTreeSet<u32> = snapshots.iter().map(|s| s.tx_antenna).collect();
+    let rx: BTreeSet<u32> = snapshots.iter().map(|s| s.rx_antenna).collect();
+    (times.len(), tx.len(), rx.len())
 }
 
 /// Reads `input` and writes its snapshots into a new recording `out`.
@@ -269,7 +283,7 @@ pub fn ingest_cir(
     };
     let tap_spacing_s = first.tap_spacing_s;
     let source = format!("cir-{}:{}", format.name(), mmtrack_io::paths::canonical(input));
-    let mut writer = crate::target::open_writer(
+    let mut target = crate::target::open_writer(
         out,
         None,
         &source,
@@ -280,14 +294,15 @@ pub fn ingest_cir(
     )?;
     let total = file.snapshots.len() as u64;
     for (i, snapshot) in file.snapshots.iter().enumerate() {
-        writer.write_cir(snapshot)?;
+        target.writer().write_cir(snapshot)?;
         progress(i as u64 + 1, total);
     }
-    let output = writer.finish()?;
+    let output = target.finish(input, "CIR snapshots")?;
     let taps = file.snapshots.iter().map(|s| s.taps.len());
     Ok(CirIngestReport {
         output,
         snapshots: file.snapshots.len(),
+        times_tx_rx: times_tx_rx(&file.snapshots),
         taps: (taps.clone().min().unwrap_or(0), taps.max().unwrap_or(0)),
         tap_spacing_s,
         with_first_path_hint: file.snapshots.iter().filter(|s| s.first_path_hint_s.is_some()).count(),

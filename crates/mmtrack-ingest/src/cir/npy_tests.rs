@@ -197,3 +197,26 @@ fn npz_member_inflating_past_its_declared_size_is_refused() {
         format!("{} bytes when inflated from {} compressed bytes: more than 100 times", zeros.len(), stream.len());
     assert!(e.starts_with("bomb.npz: member `h.npy`: ZIP member: ") && e.contains(&expected), "{e}");
 }
+
+/// Before: a 3-D array without `axes` was reported as "252 CIR snapshots"
+/// although it is read as 252 RX antennas at one time ([rx, tx, tap], the
+/// module's default); the report now says which.
+#[test]
+fn a_3d_array_without_axes_is_reported_as_antennas_at_one_time() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("uwb-3d.npy");
+    std::fs::write(&input, npy("<c16", false, "(252, 1, 4)", &c16(&[(1.0, 0.0); 252 * 4]))).unwrap();
+    let sidecar = dir.path().join("uwb.toml");
+    std::fs::write(&sidecar, "carrier_hz = 3.9936e9\ntap_spacing_s = 1.0016e-9\n").unwrap();
+    let out = dir.path().join("c.mcap");
+    let report = crate::cir::ingest_cir(
+        crate::cir::CirFormat::Npy,
+        &input,
+        Some(&sidecar),
+        &out,
+        &Default::default(),
+        &mut |_, _| {},
+    )
+    .unwrap();
+    assert_eq!((report.snapshots, report.times_tx_rx), (252, (1, 1, 252)));
+}

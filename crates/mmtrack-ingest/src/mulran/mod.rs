@@ -71,8 +71,8 @@ impl MulranFolder {
         Ok(Self {
             root: root.to_path_buf(),
             scans,
-            global_pose: pose.is_file().then_some(pose),
-            gps: gps.is_file().then_some(gps),
+            global_pose: crate::scan_folder::optional_file(&pose)?,
+            gps: crate::scan_folder::optional_file(&gps)?,
         })
     }
 
@@ -239,6 +239,7 @@ pub fn ingest_mulran(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<MulranReport, IngestError> {
+    let sequence_id = crate::scan_folder::checked_sequence_id(&folder.root, options.sequence_id.as_deref())?;
     let (mut extra, truth) = metadata(folder, options)?;
     let fixes = match &folder.gps {
         Some(path) => {
@@ -252,7 +253,7 @@ pub fn ingest_mulran(
     let truth = within_scan_span(&folder.scans, "poses", &source(&folder.global_pose), &truth, |p| p.t_ns)?;
     let fixes = within_scan_span(&folder.scans, "fixes", &source(&folder.gps), &fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
-        sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
+        sequence_id,
         source: format!("mulran:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,

@@ -170,3 +170,19 @@ fn implausible_file_stamp_and_odd_scan_size_are_refused() {
         "{err}"
     );
 }
+
+/// Before: `global_pose.csv` or `sensor_data/gps.csv` as a directory was
+/// taken as absent (no ground truth, no GNSS, exit 0).
+#[test]
+fn an_optional_file_that_is_a_directory_is_an_error_naming_it() {
+    for optional in ["global_pose.csv", "sensor_data/gps.csv"] {
+        let dir = tempfile::tempdir().unwrap();
+        let root = folder(dir.path());
+        let path = root.join(optional);
+        std::fs::remove_file(&path).unwrap();
+        MulranFolder::open(&root).unwrap();
+        std::fs::create_dir(&path).unwrap();
+        let err = MulranFolder::open(&root).unwrap_err().to_string();
+        assert!(err.contains(optional) && err.contains("is a directory, not a regular file"), "{err}");
+    }
+}

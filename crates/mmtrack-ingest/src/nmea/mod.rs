@@ -407,7 +407,7 @@ pub fn ingest_nmea(
         extra.insert("gnss.enu_origin_altitude_m".to_string(), altitude_m.to_string());
     }
     let source = format!("nmea:{}", mmtrack_io::paths::canonical(input));
-    let mut writer = crate::target::open_writer(
+    let mut target = crate::target::open_writer(
         out,
         extend,
         &source,
@@ -418,9 +418,10 @@ pub fn ingest_nmea(
     )?;
     if !regular {
         for fix in &first_pass.log.fixes {
-            writer.write_gnss_fix(fix)?;
+            target.writer().write_gnss_fix(fix)?;
+            target.added(fix.t_ns);
         }
-        let output = writer.finish()?;
+        let output = target.finish(input, "GNSS fixes")?;
         return Ok(NmeaReport { log: first_pass.log, output });
     }
     let file = std::fs::File::open(input).map_err(os_err(input))?;
@@ -431,7 +432,11 @@ pub fn ingest_nmea(
         ),
         current: None,
     };
-    let second_pass = run(input, std::io::BufReader::new(file), write, &mut |fix| Ok(writer.write_gnss_fix(fix)?))?;
+    let second_pass = run(input, std::io::BufReader::new(file), write, &mut |fix| {
+        target.writer().write_gnss_fix(fix)?;
+        target.added(fix.t_ns);
+        Ok(())
+    })?;
     if second_pass.log != first_pass.log {
         return Err(IngestError::BadLayout {
             path: input.to_path_buf(),
@@ -441,6 +446,6 @@ pub fn ingest_nmea(
             ),
         });
     }
-    let output = writer.finish()?;
+    let output = target.finish(input, "GNSS fixes")?;
     Ok(NmeaReport { log: second_pass.log, output })
 }

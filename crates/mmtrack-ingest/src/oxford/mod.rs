@@ -11,6 +11,9 @@
 //! the scans. Without `radar.timestamps`, every `radar/*.png` with a numeric
 //! name is taken in time order. Scan stamps outside 2000-2100 are refused.
 //!
+//! An optional file that exists but is no readable regular file (a
+//! directory, a broken link, a device) is an error, not an absent file.
+//!
 //! Attribution for the real sample used in tests: Oxford Radar RobotCar
 //! Dataset (Barnes et al., ICRA 2020), CC BY-NC-SA 4.0.
 
@@ -28,7 +31,8 @@ use mmtrack_io::{RecordingOptions, RecordingWriter};
 
 use crate::error::os_err;
 use crate::scan_folder::{
-    SameSize, StampUnit, decode_in_order, folder_name, list_scan_pngs, sort_and_check, within_scan_span,
+    SameSize, StampUnit, decode_in_order, folder_name, list_scan_pngs, not_a_readable_file, optional_file,
+    sort_and_check, within_scan_span,
 };
 use crate::{IngestError, Progress};
 pub use png_scan::{
@@ -65,6 +69,15 @@ fn parse_stamp(path: &Path, line: usize, raw: &str) -> Result<i64, IngestError> 
 impl OxfordFolder {
     /// Lists a folder, checking that it holds scans.
     pub fn open(root: &Path) -> Result<Self, IngestError> {
+        if !root.is_dir() {
+            let what = if root.exists() { "is not a folder" } else { "does not exist" };
+            return Err(IngestError::BadLayout {
+                path: root.to_path_buf(),
+                detail: format!(
+                    "{what}; expected an Oxford Radar RobotCar sequence folder (radar/<t_us>.png, radar.timestamps)"
+                ),
+            });
+        }
         let radar_dir = root.join("radar");
         if !radar_dir.is_dir() {
             return Err(IngestError::BadLayout {
@@ -78,7 +91,7 @@ impl OxfordFolder {
         let mut skipped_invalid = 0;
         let mut scans = Vec::new();
         let mut unlisted_pngs = Vec::new();
-        if timestamps.is_file() {
+        if optional_file(&timestamps)?.is_some() {
             let text = crate::error::read_text(&timestamps)?;
             let mut listed = BTreeSet::new();
             for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
@@ -90,15 +103,10 @@ impl OxfordFolder {
                     skipped_invalid += 1;
                     continue;
                 }
-                if !path.is_file() {
+                if let Some(what) = not_a_readable_file(&path) {
                     return Err(IngestError::BadLayout {
                         path: timestamps.clone(),
-                        detail: format!(
-                            "line {} lists scan {} but {} does not exist",
-                            index + 1,
-                            t_ns / 1000,
-                            path.display()
-                        ),
+                        detail: format!("line {} lists scan {} but {} {what}", index + 1, t_ns / 1000, path.display()),
                     });
                 }
                 scans.push(ScanFile { t_ns, path });
@@ -116,9 +124,9 @@ impl OxfordFolder {
             scans,
             skipped_invalid,
             unlisted_pngs,
-            ground_truth: gt.is_file().then_some(gt),
-            gps: gps.is_file().then_some(gps),
-            ins: ins.is_file().then_some(ins),
+            ground_truth: optional_file(&gt)?,
+            gps: optional_file(&gps)?,
+            ins: optional_file(&ins)?,
         })
     }
 
@@ -243,6 +251,7 @@ pub fn ingest_oxford(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<IngestReport, IngestError> {
+    let sequence_id = crate::scan_folder::checked_sequence_id(&folder.root, options.sequence_id.as_deref())?;
     let layout = &options.layout;
     let mut extra = BTreeMap::from([
         ("radar.format".to_string(), "oxford-navtech-png".to_string()),
@@ -257,7 +266,7 @@ pub fn ingest_oxford(
         within_scan_span(&folder.scans, "poses", &source("ground_truth.source"), &aux.ground_truth, |p| p.t_ns)?;
     let fixes_in_span = within_scan_span(&folder.scans, "fixes", &source("gnss.source"), &aux.fixes, |f| f.t_ns)?;
     let metadata = RecordingMetadata {
-        sequence_id: options.sequence_id.clone().unwrap_or_else(|| folder.sequence_id()),
+        sequence_id,
         source: format!("oxford:{}", mmtrack_io::paths::canonical(&folder.root)),
         time_base: TimeBase::UnixEpoch,
         extra,
@@ -411,3 +420,6 @@ pub fn write_oxford_folder(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests;

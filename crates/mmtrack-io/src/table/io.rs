@@ -85,20 +85,35 @@ impl RunInfo {
     }
 }
 
-/// Path of one partition: `<root>/<table>/sequence=<id>/part-0.parquet`.
-pub fn table_path(root: &Path, table: &str, sequence_id: &str) -> Result<PathBuf> {
+/// Checks that `sequence_id` can name a table partition (the folder
+/// `sequence=<id>`): not empty, not `.` or `..`, and only ASCII letters,
+/// digits, `-`, `_` and `.` (no path separator, space or `=`). The error is
+/// what is wrong, for the caller to place. Ingest checks the id it writes
+/// into a recording with this, so a recording that `process` would refuse
+/// is refused when it is made.
+pub fn check_partition_name(sequence_id: &str) -> std::result::Result<(), String> {
     let safe = !sequence_id.is_empty()
         && sequence_id != "."
         && sequence_id != ".."
         && sequence_id.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
-    if !safe {
-        return Err(IoError::BadValue {
-            path: root.to_path_buf(),
-            record: format!("table {table}"),
-            field: "sequence_id",
-            detail: format!("'{sequence_id}' is not a valid partition name (use letters, digits, '-', '_', '.')"),
-        });
+    if safe {
+        Ok(())
+    } else {
+        Err(format!(
+            "'{}' is not a valid partition name (use letters, digits, '-', '_', '.')",
+            sequence_id.escape_debug()
+        ))
     }
+}
+
+/// Path of one partition: `<root>/<table>/sequence=<id>/part-0.parquet`.
+pub fn table_path(root: &Path, table: &str, sequence_id: &str) -> Result<PathBuf> {
+    check_partition_name(sequence_id).map_err(|detail| IoError::BadValue {
+        path: root.to_path_buf(),
+        record: format!("table {table}"),
+        field: "sequence_id",
+        detail,
+    })?;
     Ok(root.join(table).join(format!("sequence={sequence_id}")).join("part-0.parquet"))
 }
 
