@@ -562,8 +562,9 @@ fn cir_file(
         let (fewest, most) = report.taps;
         let taps = if fewest == most { format!("{most}") } else { format!("{fewest}-{most}") };
         let (times, tx, rx) = report.times_tx_rx;
+        let times = if times == 1 { "1 time".to_string() } else { format!("{times} times") };
         println!(
-            "{}: {} CIR snapshots ({times} times x {tx} TX x {rx} RX antennas) of {taps} taps, {:.4} ns apart; {} with \
+            "{}: {} CIR snapshots ({times} x {tx} TX x {rx} RX antennas) of {taps} taps, {:.4} ns apart; {} with \
              a first-path hint; {} receptions skipped; domain {}",
             report.output.path.display(),
             report.snapshots,

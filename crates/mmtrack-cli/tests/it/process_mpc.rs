@@ -340,7 +340,10 @@ fn the_documented_sidecar_reads_the_real_60ghz_sample() {
         mmtrack(dir.path(), &["ingest", "cir", "--format", "mat", "--sidecar", "but-cir.toml", mat, "-o", "but.mcap"]);
     let (stdout, err) = text(&out);
     assert!(out.status.success(), "{err}");
-    assert!(stdout.contains("16 CIR snapshots of 1001 taps, 0.0999 ns apart"), "{stdout}");
+    assert!(
+        stdout.contains("16 CIR snapshots (1 time x 4 TX x 4 RX antennas) of 1001 taps, 0.0999 ns apart"),
+        "{stdout}"
+    );
 }
 
 /// Before: a run whose detection stopped at `[detection] max_mpcs` in every
