@@ -64,8 +64,8 @@ impl Target {
     /// truth outside the scans' span, see [`crate::scan_folder`]).
     pub fn finish(self, input: &Path, what: &str) -> Result<mmtrack_io::recording::WriteSummary, IngestError> {
         let added = &self.added;
-        if let (Some(existing), Some((first_ns, last_ns)), Some(added_first), Some(added_last)) =
-            (&self.existing, self.existing.as_ref().and_then(|e| e.span_ns), added.first_t_ns, added.last_t_ns)
+        if let (Some(Existing { path, span_ns: Some((first_ns, last_ns)) }), Some(added_first), Some(added_last)) =
+            (&self.existing, added.first_t_ns, added.last_t_ns)
             && added.within == 0
         {
             return Err(IngestError::BadLayout {
@@ -74,7 +74,7 @@ impl Target {
                     "none of its {} {what} falls within the time span of {} ({first_ns} to {last_ns} ns): its times \
                      run from {added_first} to {added_last} ns (another unit, clock or drive?)",
                     added.count,
-                    existing.path.display(),
+                    path.display(),
                 ),
             });
         }

@@ -155,36 +155,18 @@ mod tests {
 
     #[test]
     fn an_oxford_folder_takes_ins_for_whatever_it_lacks() {
-        use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader};
         use mmtrack_io::recording::PoseStream;
         use mmtrack_io::{RecordingEvent, RecordingOptions, RecordingReader};
 
+        use super::super::tests::{T0_US, scan_folder};
+
         let dir = tempfile::tempdir().unwrap();
-        let t0_us = 1_547_131_000_000_000i64;
-        let scans: Vec<PolarScan> = (0..3)
-            .map(|i| {
-                let t_ns = (t0_us + i * 250_000) * 1000;
-                let azimuths = (0..4)
-                    .map(|a| AzimuthSample { t_ns: t_ns + a * 1000, azimuth_rad: a as f64, valid: true })
-                    .collect();
-                let header = PolarScanHeader {
-                    t_ns,
-                    range_resolution_m: 0.0432,
-                    range_offset_m: 0.0,
-                    bins_per_azimuth: 5,
-                    azimuths,
-                };
-                PolarScan::new(header, vec![7; 20]).unwrap()
-            })
-            .collect();
-        let layout =
-            super::super::NavtechLayout { expected_bins: Some(5), expected_azimuths: Some(4), ..super::super::OXFORD };
-        super::super::write_oxford_folder(dir.path(), &scans, &[], &layout).unwrap();
+        let layout = scan_folder(dir.path(), 3);
         std::fs::create_dir(dir.path().join("gps")).unwrap();
         let mut text = format!("{HEADER}\n");
         for i in 0..5 {
             let status = if i == 0 { "INS_ALIGNING" } else { "INS_SOLUTION_GOOD" };
-            text.push_str(&row(t0_us + i * 125_000, status, 5_736_000.0 + i as f64, 619_890.0, 0.0));
+            text.push_str(&row(T0_US + i * 125_000, status, 5_736_000.0 + i as f64, 619_890.0, 0.0));
         }
         std::fs::write(dir.path().join("gps/ins.csv"), text).unwrap();
 

@@ -4,13 +4,16 @@ use mmtrack_core::{AzimuthSample, PolarScan, PolarScanHeader};
 
 use super::*;
 
-/// An Oxford folder of two 4 x 5 scans (PNGs and `radar.timestamps`), no
-/// optional files.
-fn two_scan_folder(root: &Path) {
-    let t0_us = 1_547_131_000_000_000i64;
-    let scans: Vec<PolarScan> = (0..2)
+/// Time of the first scan of [`scan_folder`], microseconds.
+pub(super) const T0_US: i64 = 1_547_131_000_000_000;
+
+/// Writes an Oxford folder of `count` 4 x 5 scans 0.25 s apart from
+/// [`T0_US`] (PNGs and `radar.timestamps`), no optional files; returns its
+/// layout. Shared with the INS tests (`ins.rs`).
+pub(super) fn scan_folder(root: &Path, count: i64) -> NavtechLayout {
+    let scans: Vec<PolarScan> = (0..count)
         .map(|i| {
-            let t_ns = (t0_us + i * 250_000) * 1000;
+            let t_ns = (T0_US + i * 250_000) * 1000;
             let azimuths =
                 (0..4).map(|a| AzimuthSample { t_ns: t_ns + a * 1000, azimuth_rad: a as f64, valid: true }).collect();
             let header = PolarScanHeader {
@@ -25,6 +28,7 @@ fn two_scan_folder(root: &Path) {
         .collect();
     let layout = NavtechLayout { expected_bins: Some(5), expected_azimuths: Some(4), ..OXFORD };
     write_oxford_folder(root, &scans, &[], &layout).unwrap();
+    layout
 }
 
 fn open_err(root: &Path) -> String {
@@ -39,7 +43,7 @@ fn open_err(root: &Path) -> String {
 fn an_optional_file_that_exists_but_is_no_readable_file_is_an_error_naming_it() {
     for optional in ["gt/radar_odometry.csv", "gps/gps.csv", "gps/ins.csv", "radar.timestamps"] {
         let dir = tempfile::tempdir().unwrap();
-        two_scan_folder(dir.path());
+        scan_folder(dir.path(), 2);
         let folder = OxfordFolder::open(dir.path()).unwrap();
         assert_eq!(folder.scans.len(), 2, "absent optional files stay optional");
         assert!(folder.ground_truth.is_none() && folder.gps.is_none() && folder.ins.is_none());
@@ -74,7 +78,7 @@ fn an_optional_file_that_exists_but_is_no_readable_file_is_an_error_naming_it() 
 #[test]
 fn an_optional_file_reached_through_a_symlink_is_taken() {
     let dir = tempfile::tempdir().unwrap();
-    two_scan_folder(dir.path());
+    scan_folder(dir.path(), 2);
     std::fs::create_dir(dir.path().join("gps")).unwrap();
     let real = dir.path().join("elsewhere.csv");
     std::fs::write(&real, "").unwrap();
@@ -88,7 +92,7 @@ fn an_optional_file_reached_through_a_symlink_is_taken() {
 #[test]
 fn a_listed_png_that_is_a_directory_and_a_missing_folder_say_what_they_are() {
     let dir = tempfile::tempdir().unwrap();
-    two_scan_folder(dir.path());
+    scan_folder(dir.path(), 2);
     let png = dir.path().join("radar/1547131000000000.png");
     std::fs::remove_file(&png).unwrap();
     std::fs::create_dir(&png).unwrap();
