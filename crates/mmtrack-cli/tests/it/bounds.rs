@@ -93,9 +93,11 @@ fn pipeline_flags_and_keys_beyond_the_limits_are_refused() {
         refused(
             d,
             &["process", "slam", "w.mcap", "-o", "p", "--particles", particles, "-q"],
-            &["particles", "1000000"],
+            &["--particles", "1000000"],
         );
     }
+    // A flag's value is a usage error (exit 2), as clap's own checks; exit 1 before.
+    refused(d, &["process", "slam", "w.mcap", "-o", "p", "--particles", "1", "-q"], &["--particles 1", "between 2"]);
 
     let out = mmtrack(d, &["simulate", "radar", "--scenario", "r.toml", "-o", "r.mcap", "-q"]);
     assert!(!out.status.success());
@@ -118,6 +120,13 @@ fn pipeline_flags_and_keys_beyond_the_limits_are_refused() {
         &["process", "beam", "r.mcap", "--tracker", "spebt", "--runs", "100000000", "-o", "b", "-q"],
         &["--runs", "1000000"],
     );
+    for (flag, value) in [("--sigma-r-m", "NaN"), ("--sigma-theta-deg", "inf")] {
+        refused(
+            d,
+            &["process", "beam", "r.mcap", "--tracker", "spebt", flag, value, "-o", "b", "-q"],
+            &[flag, "finite value >= 0"],
+        );
+    }
 }
 
 /// Configuration files are read within a cap: `/dev/zero` or a 17 MiB file

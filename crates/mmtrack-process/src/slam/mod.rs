@@ -128,6 +128,11 @@ fn filter_config(path: &Path, args: &SlamOptions, recording: &SlamRecording) -> 
         None => SlamConfig::default(),
     };
     if let Some(p) = args.particles {
+        let limit = mmtrack_core::limits::PARTICLES;
+        if !(p >= 2 && limit.allows_count(p as u64)) {
+            let message = format!("--particles {p}: expected {} (nothing was done)", limit.expected);
+            return Err(mmtrack_core::error::UsageError(message).into());
+        }
         config.particles = p;
     }
     config.strict = config.strict || args.strict;

@@ -276,15 +276,18 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(SpebtExperiment, String
         source = crate::provenance::canonical(path);
     }
     if let Some(sigma_r_m) = options.sigma_r_m {
-        ensure!(sigma_r_m.is_finite() && sigma_r_m >= 0.0, "--sigma-r-m {sigma_r_m}: need a finite value >= 0");
+        if !(sigma_r_m.is_finite() && sigma_r_m >= 0.0) {
+            let message = format!("--sigma-r-m {sigma_r_m}: need a finite value >= 0");
+            return Err(mmtrack_core::error::UsageError(message).into());
+        }
         experiment.scenario.position_sigma_m = sigma_r_m;
         experiment.tracker.position_sigma_m = sigma_r_m;
     }
     if let Some(sigma_theta_deg) = options.sigma_theta_deg {
-        ensure!(
-            sigma_theta_deg.is_finite() && sigma_theta_deg >= 0.0,
-            "--sigma-theta-deg {sigma_theta_deg}: need a finite value >= 0"
-        );
+        if !(sigma_theta_deg.is_finite() && sigma_theta_deg >= 0.0) {
+            let message = format!("--sigma-theta-deg {sigma_theta_deg}: need a finite value >= 0");
+            return Err(mmtrack_core::error::UsageError(message).into());
+        }
         experiment.scenario.yaw_sigma_deg = sigma_theta_deg;
         experiment.tracker.yaw_sigma_deg = sigma_theta_deg;
     }
