@@ -56,8 +56,9 @@ pub const DEMO_SEQUENCE: &str = "oxford-demo";
 
 #[derive(Args)]
 pub struct DemoArgs {
-    /// Output directory; the demo replaces its own previous outputs there.
-    #[arg(long, default_value = "out/demo")]
+    /// Output directory; the demo replaces its own previous outputs there
+    /// (`-o` as on every other command; `--out` still works).
+    #[arg(short = 'o', long = "output", visible_alias = "out", value_name = "DIR", default_value = "out/demo")]
     out: PathBuf,
 }
 

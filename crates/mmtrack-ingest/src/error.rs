@@ -155,6 +155,31 @@ pub(crate) fn read_text(path: &std::path::Path) -> Result<String, IngestError> {
     })
 }
 
+/// [`read_text`] for files of line records (CSV, timestamps, TUM / KITTI
+/// poses): a last line without its line end is refused, naming it. Every
+/// writer of these formats ends each record with a newline, so a file that
+/// stops inside a line was cut off (a copy or download interrupted), and
+/// its last number may be shortened ("12.3" of "12.345") without any parse
+/// error to show it.
+pub(crate) fn read_line_records(path: &std::path::Path) -> Result<String, IngestError> {
+    let text = read_text(path)?;
+    let tail = text.rsplit_once('\n').map_or(text.as_str(), |(_, tail)| tail);
+    if !tail.trim().is_empty() {
+        let line = text.lines().count();
+        let shown: String = tail.chars().take(60).collect();
+        return Err(IngestError::bad_line(
+            path,
+            line,
+            "line end",
+            format!(
+                "the file ends inside this line (\"{shown}\" has no newline after it): it looks cut off, and its \
+                 last record may be shortened; if the file is complete, end it with a newline"
+            ),
+        ));
+    }
+    Ok(text)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -187,6 +212,21 @@ mod tests {
             assert!(err.starts_with("/dev/zero") && !err.contains('\n'), "{reader}: {err:?}");
             assert!(err.contains("is a device") || err.contains("longer than 4096 bytes"), "{reader}: {err}");
             println!("{reader}: {err} ({:.1} ms)", start.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+
+    /// Before: a CSV cut off inside its last number ingested the shortened
+    /// number without a word.
+    #[test]
+    fn a_record_file_cut_off_inside_its_last_line_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("radar_odometry.csv");
+        std::fs::write(&path, "a,b\n1,2.5\n3,4.12").unwrap();
+        let err = read_line_records(&path).unwrap_err().to_string();
+        assert!(err.contains("radar_odometry.csv: line 3: line end") && err.contains("\"3,4.12\""), "{err}");
+        for complete in ["a,b\n1,2.5\n3,4.125\n", "a,b\n1,2\n  ", "a,b\r\n1,2\r\n", ""] {
+            std::fs::write(&path, complete).unwrap();
+            assert_eq!(read_line_records(&path).unwrap(), complete);
         }
     }
 

@@ -446,9 +446,10 @@ pub fn read_trajectory(
     }
 }
 
-/// Reads a file as text.
+/// Reads a file of line records as text; a last line without its newline
+/// (a cut-off file) is an error naming it.
 pub fn read_text(path: &Path) -> Result<String, IngestError> {
-    crate::error::read_text(path)
+    crate::error::read_line_records(path)
 }
 
 /// Writes `poses` as `stream` into `out`: a new recording, or, with `extend`,

@@ -302,7 +302,7 @@ fn first_stamp_ns(bag: &Path, wanted: &[&str]) -> Result<Option<i64>, IngestErro
     Ok(None)
 }
 
-fn metadata(bag: &Path, topics: &Ros2Topics, first_stamp_ns: Option<i64>) -> RecordingMetadata {
+fn metadata(bag: &Path, sequence_id: String, topics: &Ros2Topics, first_stamp_ns: Option<i64>) -> RecordingMetadata {
     let time_base = first_stamp_ns.map_or(TimeBase::UnixEpoch, |t| TimeBase::unix_or(t, TimeBase::SimTime));
     let time_note = match (first_stamp_ns, time_base) {
         (Some(t), TimeBase::SimTime) => format!(
@@ -332,12 +332,7 @@ fn metadata(bag: &Path, topics: &Ros2Topics, first_stamp_ns: Option<i64>) -> Rec
         extra.insert("radar.scan_period_ns".into(), radar.timing.period_ns.to_string());
         extra.insert("radar.stamp_at".into(), radar.timing.stamp_at.name().into());
     }
-    RecordingMetadata {
-        sequence_id: bag.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "bag".into()),
-        source: format!("ros2:{}", mmtrack_io::paths::canonical(bag)),
-        time_base,
-        extra,
-    }
+    RecordingMetadata { sequence_id, source: format!("ros2:{}", mmtrack_io::paths::canonical(bag)), time_base, extra }
 }
 
 /// Ingests the chosen topics of a ROS 2 bag into a new recording. Messages
@@ -353,6 +348,7 @@ pub fn ingest_ros2(
     recording: &RecordingOptions,
     progress: Progress<'_>,
 ) -> Result<Ros2Report, IngestError> {
+    let sequence_id = crate::scan_folder::sequence_id_of_file(bag, "bag")?;
     let bag_bytes = std::fs::metadata(bag).map(|m| m.len()).unwrap_or(0);
     let wanted: Vec<&str> = [topics.pose_topic.as_deref(), topics.gnss_topic.as_deref()]
         .into_iter()
@@ -361,7 +357,7 @@ pub fn ingest_ros2(
         .collect();
     let first_stamp = first_stamp_ns(bag, &wanted)?;
     let mut reader = RawReader::open(bag)?;
-    let writer = RecordingWriter::create(out, &metadata(bag, topics, first_stamp), recording)?;
+    let writer = RecordingWriter::create(out, &metadata(bag, sequence_id, topics, first_stamp), recording)?;
     let mut sink = Sink { topics, writer, poses: 0, gnss_fixes: 0, no_fix: 0, radar_scans: 0, last_ns: [i64::MIN; 3] };
     // Messages seen per topic: a message is named by its 0-based index among
     // its topic's messages in file order, and its log time. Not by the MCAP

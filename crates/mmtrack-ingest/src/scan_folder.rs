@@ -199,6 +199,22 @@ pub fn checked_sequence_id(root: &Path, given: Option<&str>) -> Result<String, I
     Ok(id)
 }
 
+/// The sequence id of a recording named after a file: the file's name
+/// without its extension (the output of `ingest poses / nmea / cir`, a ROS 2
+/// bag), checked like [`checked_sequence_id`]. `role` says which file in
+/// the error ("output", "bag"), which also says to rename it.
+pub fn sequence_id_of_file(path: &Path, role: &str) -> Result<String, IngestError> {
+    let id = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    mmtrack_io::table::check_partition_name(&id).map_err(|detail| IngestError::BadLayout {
+        path: path.to_path_buf(),
+        detail: format!(
+            "sequence id (the {role}'s file name without its extension): {detail}; rename the {role} (nothing was \
+             written)"
+        ),
+    })?;
+    Ok(id)
+}
+
 /// Scans decoded ahead of the writer, per thread of the pool.
 const DECODED_PER_THREAD: usize = 2;
 
@@ -342,6 +358,15 @@ mod tests {
         let good = parent.path().join("2019-01-10-14-36-48");
         std::fs::create_dir(&good).unwrap();
         assert_eq!(checked_sequence_id(&good, None).unwrap(), "2019-01-10-14-36-48");
+        // Before: `ingest poses -o "my drive.mcap"` wrote a recording that
+        // `process` refused for its sequence id "my drive".
+        let err = sequence_id_of_file(Path::new("out/my drive.mcap"), "output").unwrap_err().to_string();
+        assert!(
+            err.starts_with("out/my drive.mcap: sequence id (the output's file name")
+                && err.contains("rename the output"),
+            "{err}"
+        );
+        assert_eq!(sequence_id_of_file(Path::new("out/drive-1.mcap"), "output").unwrap(), "drive-1");
     }
 
     /// MulRan names scans by 19-digit nanoseconds; `000001.png` is not a

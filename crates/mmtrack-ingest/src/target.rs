@@ -120,7 +120,7 @@ pub fn open_writer(
             });
         }
         let metadata = RecordingMetadata {
-            sequence_id: out.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "sequence".into()),
+            sequence_id: crate::scan_folder::sequence_id_of_file(out, "output")?,
             source: source.to_string(),
             time_base,
             extra,

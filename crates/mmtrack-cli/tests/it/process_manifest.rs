@@ -656,7 +656,7 @@ fn campaign_figures_example_draws_the_demo_tables_with_polars() {
         }
     }
     let dir = tempfile::tempdir().unwrap();
-    assert!(mmtrack(dir.path(), &["demo", "--out", "d", "--quiet"]).status.success());
+    assert!(mmtrack(dir.path(), &["demo", "-o", "d", "--quiet"]).status.success());
     let run = Command::new(&python)
         .arg(root().join("examples/campaign_figures.py"))
         .args(["d/tables", "d/analysis/tables", "-o", "figures"])

@@ -63,7 +63,7 @@ pub fn parse_boreas_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
 
 /// Reads `gps_post_process.csv`.
 pub fn read_boreas_gps(path: &Path) -> Result<Vec<GnssFix>, IngestError> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::error::read_line_records(path)?;
     parse_boreas_gps(path, &text)
 }
 

@@ -234,7 +234,7 @@ pub fn ingest_boreas(
     ]);
     let truth = match &folder.poses {
         Some((path, sensor)) => {
-            let text = crate::error::read_text(path)?;
+            let text = crate::error::read_line_records(path)?;
             let parsed = applanix::parse_applanix_poses(path, &text)?;
             extra.insert("ground_truth.source".into(), mmtrack_io::paths::canonical(path));
             extra.insert("ground_truth.frame".into(), sensor.clone());

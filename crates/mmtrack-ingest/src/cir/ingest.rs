@@ -116,7 +116,7 @@ pub fn read_cir_file(format: CirFormat, input: &Path, sidecar: Option<&CirSideca
     let (snapshots, skipped) = match format {
         CirFormat::Decawave => return read_decawave(input, sidecar, metadata),
         CirFormat::Csv => {
-            let text = crate::error::read_text(input)?;
+            let text = crate::error::read_line_records(input)?;
             (super::csv_cir::parse_cir_csv(input, &text, sidecar)?, 0)
         }
         CirFormat::Sigmf => {

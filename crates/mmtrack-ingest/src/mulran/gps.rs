@@ -93,7 +93,7 @@ pub fn parse_mulran_gps(path: &Path, text: &str) -> Result<Vec<GnssFix>, IngestE
 
 /// Reads `gps.csv`.
 pub fn read_mulran_gps(path: &Path) -> Result<Vec<GnssFix>, IngestError> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::error::read_line_records(path)?;
     parse_mulran_gps(path, &text)
 }
 

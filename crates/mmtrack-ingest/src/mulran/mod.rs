@@ -221,7 +221,7 @@ fn metadata(
         ("radar.stamp_at".to_string(), timing.stamp_at.name().to_string()),
     ]);
     let Some(path) = &folder.global_pose else { return Ok((extra, Vec::new())) };
-    let text = crate::error::read_text(path)?;
+    let text = crate::error::read_line_records(path)?;
     let parsed = global_pose::parse_global_pose(path, &text)?;
     extra.insert("ground_truth.source".into(), mmtrack_io::paths::canonical(path));
     extra.insert("ground_truth.frame".into(), "vehicle".into());

@@ -84,7 +84,7 @@ pub fn parse_gps_csv(path: &Path, text: &str) -> Result<Vec<OxfordGpsRow>, Inges
 
 /// Reads `gps.csv`.
 pub fn read_gps_csv(path: &Path) -> Result<Vec<OxfordGpsRow>, IngestError> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::error::read_line_records(path)?;
     parse_gps_csv(path, &text)
 }
 

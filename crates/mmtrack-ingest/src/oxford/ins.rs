@@ -95,7 +95,7 @@ pub fn parse_ins_csv(path: &Path, text: &str) -> Result<InsSolution, IngestError
 
 /// Reads `ins.csv`.
 pub fn read_ins_csv(path: &Path) -> Result<InsSolution, IngestError> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::error::read_line_records(path)?;
     parse_ins_csv(path, &text)
 }
 

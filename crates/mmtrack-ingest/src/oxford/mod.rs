@@ -92,7 +92,7 @@ impl OxfordFolder {
         let mut scans = Vec::new();
         let mut unlisted_pngs = Vec::new();
         if optional_file(&timestamps)?.is_some() {
-            let text = crate::error::read_text(&timestamps)?;
+            let text = crate::error::read_line_records(&timestamps)?;
             let mut listed = BTreeSet::new();
             for (index, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
                 let mut parts = line.split_whitespace();

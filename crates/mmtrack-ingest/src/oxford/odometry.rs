@@ -108,7 +108,7 @@ pub fn chain(path: &Path, rows: &[RelativePose]) -> Result<Vec<StampedPose>, Ing
 
 /// Reads and chains a `radar_odometry.csv` file.
 pub fn read_radar_odometry(path: &Path) -> Result<Vec<StampedPose>, IngestError> {
-    let text = crate::error::read_text(path)?;
+    let text = crate::error::read_line_records(path)?;
     chain(path, &parse_radar_odometry(path, &text)?)
 }
 

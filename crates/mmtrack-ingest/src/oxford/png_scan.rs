@@ -478,7 +478,7 @@ mod tests {
         super::super::write_oxford_folder(dir.path(), &scans, &[], &auto).unwrap();
         let timestamps = dir.path().join("radar.timestamps");
         let all = std::fs::read_to_string(&timestamps).unwrap();
-        std::fs::write(&timestamps, all.lines().nth(4).unwrap()).unwrap();
+        std::fs::write(&timestamps, format!("{}\n", all.lines().nth(4).unwrap())).unwrap();
         let folder = super::super::OxfordFolder::open(dir.path()).unwrap();
         assert_eq!((folder.scans.len(), folder.unlisted_pngs.len()), (1, 10));
         assert!(folder.unlisted_pngs[0].ends_with("radar/1547131046353776.png"), "{:?}", folder.unlisted_pngs);
