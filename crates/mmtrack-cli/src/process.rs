@@ -275,20 +275,26 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
     };
     let progress = IndicatifProgress::new(quiet);
     let done = args.threads.install(|| mpc::process_mpc(recording, output, &config, &options, &progress))??;
+    // A warning, so on stderr and also with -q: once for the run, not per link.
+    let capped_links = done.links.iter().filter(|l| l.snapshots_at_max_mpcs > 0).count();
+    if capped_links > 0 {
+        let at_cap = done.links.iter().map(|l| l.snapshots_at_max_mpcs).sum();
+        let snapshots = done.links.iter().map(|l| l.snapshots_with_detections).sum();
+        let links = (capped_links, done.links.len());
+        eprintln!("warning: {}", max_mpcs_note(at_cap, snapshots, links, config.detection.max_mpcs));
+    }
     if quiet {
         return Ok(done.written);
     }
     for link in &done.links {
+        let capped = match link.snapshots_at_max_mpcs {
+            0 => String::new(),
+            n => format!(" ({n} snapshots at max_mpcs)"),
+        };
         println!(
-            "mpc {} (link tx{}:rx{}): {} sets, {} detections, {} short-term tracks, {} long-term entries",
+            "mpc {} (link tx{}:rx{}): {} sets, {} detections{capped}, {} short-term tracks, {} long-term entries",
             link.partition, link.link.0, link.link.1, link.sets, link.detections, link.tracks, link.long_term
         );
-        if link.snapshots_at_max_mpcs > 0 {
-            println!(
-                "  {}",
-                max_mpcs_note(link.snapshots_at_max_mpcs, link.snapshots_with_detections, config.detection.max_mpcs)
-            );
-        }
         let (most, needed) = (link.most_snapshots_per_set, config.short_term.min_track_length);
         if link.tracks == 0 && link.detections > 0 && (most as usize) < needed {
             println!(
@@ -304,12 +310,14 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
     Ok(done.written)
 }
 
-/// The summary line for snapshots whose detection stopped at the cap.
-fn max_mpcs_note(at_cap: usize, snapshots: usize, max_mpcs: usize) -> String {
+/// The warning for snapshots whose detection stopped at the cap, over
+/// `links` = (links with such snapshots, links).
+fn max_mpcs_note(at_cap: usize, snapshots: usize, links: (usize, usize), max_mpcs: usize) -> String {
+    let (capped, all) = links;
     format!(
-        "{at_cap} of {snapshots} snapshots stopped at [detection] max_mpcs = {max_mpcs} detections before the residual \
-         fell below the threshold: weaker paths were not searched; raise max_mpcs in the [detection] table of the \
-         --config file to detect them"
+        "{at_cap} of {snapshots} snapshots ({capped} of {all} links) stopped at [detection] max_mpcs = {max_mpcs} \
+         detections before the residual fell below the threshold: weaker paths were not searched; raise max_mpcs in \
+         the [detection] table of the --config file to detect them"
     )
 }
 

@@ -355,16 +355,20 @@ fn snapshots_that_stop_at_max_mpcs_are_counted_with_the_key_that_raises_it() {
     let dir = tempfile::tempdir().unwrap();
     simulate(dir.path());
     std::fs::write(dir.path().join("cap.toml"), "[detection]\nmax_mpcs = 2\n").unwrap();
-    let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "capped", "--config", "cap.toml"]);
+    // A warning: on stderr, once, and also with -q (it was on stdout, once
+    // per link, and -q dropped it).
+    let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "capped", "--config", "cap.toml", "-q"]);
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
-    let line = stdout.lines().find(|l| l.contains("stopped at")).unwrap_or_else(|| panic!("{stdout}"));
+    assert!(stdout.is_empty(), "{stdout}");
+    assert_eq!(stderr.matches("stopped at").count(), 1, "{stderr}");
+    let line = stderr.lines().find(|l| l.starts_with("warning: ")).unwrap_or_else(|| panic!("{stderr}"));
     assert!(line.contains("[detection] max_mpcs = 2") && line.contains("raise max_mpcs"), "{line}");
-    let counts: Vec<usize> = line.split_whitespace().take(3).filter_map(|w| w.parse().ok()).collect();
+    let counts: Vec<usize> = line.split_whitespace().take(4).filter_map(|w| w.parse().ok()).collect();
     assert_eq!(counts.len(), 2, "`<at cap> of <snapshots>`: {line}");
     assert!(counts[0] > 0 && counts[0] <= counts[1], "{line}");
     let out = mmtrack(dir.path(), &["process", "mpc", "rec.mcap", "-o", "default"]);
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
-    assert!(!stdout.contains("stopped at"), "{stdout}");
+    assert!(!stdout.contains("stopped at") && !stderr.contains("stopped at"), "{stdout}{stderr}");
 }
