@@ -18,7 +18,7 @@ as typed after `mmtrack`; `{suite}` is the suite file's directory, `{work}` the 
 entries: `name`, `table` (a table directory under the work directory, e.g. \"analysis/tables/trajectory_metrics\"), \
 optional `sequence`, `run` and `where = { column = value }` to pick rows, `column`, `aggregate` (mean, min, max, sum, \
 count) when several rows are picked, `expected`, and `tolerance` (absolute) or `relative_tolerance`. \
-Example: examples/oxford-regression.toml; format: docs/check.md.\n\n\
+Example: examples/regression-suite.toml; format: docs/check.md.\n\n\
 Exit codes: 0 every metric within its tolerance (or blessed), 1 a regression, a metric not measured, or a step \
 that failed (named on stderr).")]
 pub struct CheckArgs {

@@ -125,7 +125,7 @@ pub enum ScheduleArg {
 /// The options of `--tracker geometric` (refused with the other trackers).
 #[derive(Args, Debug, Clone, Default)]
 pub struct GeometricArgs {
-    /// geometric: beams measured per epoch.
+    /// geometric: beams measured per epoch (default: paper).
     #[arg(long, value_enum)]
     pub beam_schedule: Option<ScheduleArg>,
     /// geometric: epoch (scan) interval, milliseconds (default 20).

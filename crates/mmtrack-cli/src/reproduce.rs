@@ -35,7 +35,7 @@ enum Experiment {
     /// through a generated street scene, runs the `fast-cfear` and `cfear`
     /// presets on the same scans, and computes KITTI drift exactly as the
     /// devkit does (segments of 100..800 m, a first frame every 10 frames)
-    /// against the simulator's ground truth. Targets (PAPERS.md section 1):
+    /// against the simulator's ground truth. Targets (the paper's; docs/results/radar-odometry.md):
     /// fast-cfear below 6.56 % (the paper's Oxford figure); cfear at most
     /// 1.5 % and 0.5 deg/100 m. Writes the odometry tables, the analysis
     /// (tables, plots, report) and `reproduce.md`; exits 1 when a target is
@@ -51,7 +51,7 @@ enum Experiment {
     /// to the detector's delay noise at each point, a sensitivity variant)
     /// run on the same detections; reported per point: the mean number of
     /// tracks and the mean delay error of the track points, also per 2.5 ns
-    /// band of the separation. Targets (PAPERS.md section 2): mean delay
+    /// band of the separation. Targets (the paper's; docs/results/multipath.md): mean delay
     /// error below 0.03 ns at -116 dB and two tracks in every run down to
     /// -126 dB (proposed tracker, Kaiser window). Writes results.csv,
     /// results_by_separation.csv, reproduce.md and SVG figures (Figs. 4-5,
@@ -71,7 +71,7 @@ enum Experiment {
     /// missed set bridged) and each change alone. Reported per truth and
     /// tracker: births and deaths per metre against the true ones, births
     /// on true paths, false long-term tracks, detection precision and
-    /// recall. Targets (issue 25): ours within 2x of the true birth rate
+    /// recall. Targets (ours: the paper gives no number; docs/results/multipath.md): ours within 2x of the true birth rate
     /// against both fair truths, and fewer births on true paths than the
     /// paper's eq. (35). Writes results.csv, reproduce.md and metrics.json;
     /// `--readme docs/results/multipath.md` rewrites its block there; exits
@@ -88,7 +88,7 @@ enum Experiment {
     /// (`angle-ekf`). Valid tracking ends at the first block where the RMS
     /// pointing error exceeds half the beamwidth. Points: SNR 0/5/10 dB at
     /// 60 km/h and 50..80 km/h at 0 dB, 3000 runs each. Targets
-    /// (PAPERS.md section 3): 99/142/193 and 109/100/91/83 blocks within
+    /// (the paper's; docs/results/shaham.md): 99/142/193 and 109/100/91/83 blocks within
     /// 15 %, both orderings, and at least 49 % longer than the angle-state
     /// EKF. Writes Parquet tables (RMS error per block, valid tracking),
     /// three SVG figures and reproduce.md; `--readme docs/results/shaham.md`
@@ -110,7 +110,7 @@ enum Experiment {
     /// simulated along the same trajectory (`--skip-odometry` leaves it
     /// out). Reported per experiment: RMSE of |alpha| (%), AoD and AoA (deg)
     /// and re-initialisations per run beside the paper's 1.580 % / 0.220 /
-    /// 4.616 deg and < 300 of 6388. Targets (PAPERS.md section 1): AoD <=
+    /// 4.616 deg and < 300 of 6388. Targets (the paper's; docs/results/spebt.md): AoD <=
     /// 0.22 deg, AoA <= 4.6 deg, re-initialisations < 5 % of slots. Writes
     /// Parquet tables (summary, per slot), Fig. 5-style figures and
     /// reproduce.md; `--readme docs/results/spebt.md` rewrites its block
@@ -127,10 +127,11 @@ enum Experiment {
     /// Four estimators on the same runs: the proposed recursive tracker
     /// (H-infinity, then RLS, on its own 3-beam window after 10 full scans),
     /// the Ho-Chan batch baseline, and the error-free and nullspace genies.
-    /// Targets (PAPERS.md section 4): NMSE of the range at the end
+    /// Targets (the paper's; docs/results/zoechmann.md): NMSE of the range at the end
     /// nullspace <= error-free <= proposed < Ho-Chan in both manoeuvres;
     /// full-overtaking hand-over after about 0.5 s; 128/3 = 43x fewer beam
-    /// measurements per tracked epoch; 100 000 runs in under 60 s. Writes
+    /// measurements per tracked epoch; and, ours and not counted, 100 000
+    /// runs in under 60 s. Writes
     /// Parquet tables (NMSE per epoch, summary), one Fig. 4/5-style SVG per
     /// manoeuvre and reproduce.md; `--readme docs/results/zoechmann.md`
     /// rewrites its block there; exits 1 when a target is missed. `--quick`
@@ -145,7 +146,7 @@ enum Experiment {
     /// each path's TOA, DOA and DOD. The SLAM filter (2000 particles, 10
     /// iterations) tracks position, heading and clock bias and maps the
     /// sources. Rows: the paper's setting, detection probability 0.9, one
-    /// clutter path per epoch; 20 runs each. Targets (PAPERS.md section 5):
+    /// clutter path per epoch; 20 runs each. Targets (the paper's; docs/results/kim.md):
     /// UE errors 0.5 m / 0.02 rad / 0.3 m, VA 0.8 m, SP 0.6 m, all VAs
     /// confirmed by epoch 26 and all SPs by epoch 91. Writes Parquet tables
     /// (summary, per epoch), SVG figures (map, errors, confirmed sources),

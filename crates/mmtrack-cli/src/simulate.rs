@@ -38,6 +38,11 @@ enum Kind {
     /// the CIRs (/channel/cir), the true MPCs (/channel/mpc_truth), both cars' poses per set
     /// (/ground_truth/tx, /ground_truth/rx) and the pulse spectrum in its metadata. Same scenario
     /// and seed give identical bytes.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Sounder(Box<crate::simulate_sounder::SounderArgs>),
     /// 5G mmWave SLAM world (Kim et al. 2018): per-epoch path measurements with ground truth.
     ///
@@ -48,6 +53,11 @@ enum Kind {
     /// carries the paths of each epoch (/slam/paths: TOA, DOA and DOD azimuth and elevation), the
     /// true UE state and path origins (/slam/ue_truth), the UE pose (/ground_truth/pose) and the
     /// base station and true sources (/slam/sources). Same world and seed give identical bytes.
+    #[command(
+        mut_arg("no_radar_cartesian", |a| a.hide(true)),
+        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
+        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
+    )]
     Slam(Box<crate::slam::simulate::SlamSimArgs>),
 }
 

@@ -19,7 +19,7 @@ pub struct MpcBenchArgs {
     /// Thread counts to measure, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2")]
     threads: Vec<usize>,
-    /// Exit 1 when the one-thread row misses the target (issue 29: time, FFT ratio and detections per path).
+    /// Exit 1 when the one-thread row misses the target (time, FFT ratio and detections per path; docs/benchmarks.md).
     #[arg(long)]
     check: bool,
     /// Replace the block `<!-- bench-mpc:begin -->` ... `end` in this file (docs/benchmarks.md).
