@@ -51,6 +51,22 @@ fn utc(ns: i64) -> String {
     mmtrack_core::calendar::utc_text(ns.div_euclid(1_000_000_000))
 }
 
+/// Where the recording's first time lies: a UTC date when its time base
+/// dates its times (UNIX time, a scenario's stated date), else the time
+/// base's name (sim time or a relative log shown as a date would read as
+/// 1970).
+fn start_words(summary: &RecordingSummary, start_ns: u64) -> String {
+    use mmtrack_io::recording::{METADATA_NAME, TimeBase};
+    let time_base =
+        summary.metadata.get(METADATA_NAME).and_then(|m| m.get("time_base")).and_then(|t| TimeBase::parse(t));
+    match time_base {
+        Some(TimeBase::SimTime | TimeBase::Relative) => {
+            format!("time_base = {}: not a date", time_base.map_or("", TimeBase::as_str))
+        }
+        _ => format!("from {}", utc(i64::try_from(start_ns).unwrap_or(i64::MAX))),
+    }
+}
+
 fn seconds(ns: u64) -> f64 {
     ns as f64 * 1e-9
 }
@@ -81,11 +97,7 @@ fn print_recording(summary: &RecordingSummary) {
     let start = summary.channels.iter().map(|c| c.start_ns).min();
     let end = summary.channels.iter().map(|c| c.end_ns).max();
     if let (Some(start), Some(end)) = (start, end) {
-        println!(
-            "  time span: {:.3} s ({start} .. {end} ns; from {})",
-            seconds(end - start),
-            utc(i64::try_from(start).unwrap_or(i64::MAX))
-        );
+        println!("  time span: {:.3} s ({start} .. {end} ns; {})", seconds(end - start), start_words(summary, start));
     }
     let topic_width = summary.channels.iter().map(|c| c.topic.len()).max().unwrap_or(0).max(5);
     let schema_width = summary.channels.iter().map(|c| c.schema_name.len()).max().unwrap_or(0).max(6);

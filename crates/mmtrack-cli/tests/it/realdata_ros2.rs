@@ -27,6 +27,11 @@ fn ros2_bag_odom_becomes_poses() {
     assert!(poses.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
     // A TurtleBot in a small simulated world: positions within tens of metres.
     assert!(poses.iter().all(|p| p.parent_from_child.translation_norm_m() < 50.0));
+    // Stamped with the simulator's clock: `inspect` says so instead of a
+    // date in 1970 (before: "from 1970-01-01 00:15:28 UTC").
+    let out = mmtrack(dir.path(), &["inspect", "bag.mcap"]);
+    let span = text(&out).0.lines().find(|l| l.contains("time span")).map(str::to_string).unwrap_or_default();
+    assert!(span.contains("time_base = sim_time: not a date") && !span.contains("1970"), "{span}");
 
     // /amcl_pose is a PoseWithCovarianceStamped topic.
     let out = mmtrack(
