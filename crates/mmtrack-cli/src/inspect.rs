@@ -157,7 +157,7 @@ pub fn run(args: &InspectArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             print_tables(&args.path, &tables);
         }
     } else {
-        let bar = crate::progress::bytes_bar("inspect", quiet);
+        let bar = crate::progress::bytes_bar(std::fs::metadata(&args.path).map_or(0, |m| m.len()), "inspect", quiet);
         let summary = inspect_recording_with_progress(&args.path, &mut |done, total| {
             bar.set_length(total);
             bar.set_position(done);

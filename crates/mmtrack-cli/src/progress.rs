@@ -5,24 +5,40 @@ use std::sync::{PoisonError, RwLock};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mmtrack_core::progress::Progress;
 
+/// Items per second as a person reads it: "3.2/s", "361/s" (indicatif's
+/// own `{per_sec}` prints "3.2071/s").
+fn rate_text(per_sec: f64) -> String {
+    if !per_sec.is_finite() || per_sec <= 0.0 {
+        "-/s".to_string()
+    } else if per_sec < 10.0 {
+        format!("{per_sec:.1}/s")
+    } else {
+        format!("{per_sec:.0}/s")
+    }
+}
+
 /// A bar for `total` items of `unit` (e.g. "scans").
 pub fn bar(total: u64, message: &str, unit: &str, quiet: bool) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(
         Some(total),
         if quiet { ProgressDrawTarget::hidden() } else { ProgressDrawTarget::stderr() },
     );
-    let template = format!("{{msg}} [{{bar:30}}] {{pos}}/{{len}} {unit} ({{per_sec}}, eta {{eta}})");
+    let template = format!("{{msg}} [{{bar:30}}] {{pos}}/{{len}} {unit} ({{rate}}, eta {{eta}})");
     if let Ok(style) = ProgressStyle::with_template(&template) {
+        let style = style.with_key("rate", |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = w.write_str(&rate_text(state.per_sec()));
+        });
         bar.set_style(style.progress_chars("=> "));
     }
     bar.set_message(message.to_string());
     bar
 }
 
-/// A bar counting bytes, for reading large files.
-pub fn bytes_bar(message: &str, quiet: bool) -> ProgressBar {
+/// A bar counting `total` bytes, for reading large files (created with its
+/// length: a bar of length 0 is drawn full, "0 B/0 B").
+pub fn bytes_bar(total: u64, message: &str, quiet: bool) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(
-        Some(0),
+        Some(total),
         if quiet { ProgressDrawTarget::hidden() } else { ProgressDrawTarget::stderr() },
     );
     if let Ok(style) =
@@ -58,13 +74,8 @@ impl IndicatifProgress {
 
 impl Progress for IndicatifProgress {
     fn start(&self, stage: &str, total: u64, unit: &str) {
-        let new = if unit == "bytes" {
-            let new = bytes_bar(stage, self.quiet);
-            new.set_length(total);
-            new
-        } else {
-            bar(total, stage, unit, self.quiet)
-        };
+        let new =
+            if unit == "bytes" { bytes_bar(total, stage, self.quiet) } else { bar(total, stage, unit, self.quiet) };
         let old = std::mem::replace(&mut *self.bar.write().unwrap_or_else(PoisonError::into_inner), new);
         old.finish_and_clear();
     }
@@ -93,5 +104,18 @@ impl Progress for IndicatifProgress {
         } else {
             current.println(text);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rates_read_as_a_person_reads_them() {
+        assert_eq!(rate_text(3.207_123), "3.2/s");
+        assert_eq!(rate_text(361.4), "361/s");
+        assert_eq!(rate_text(0.0), "-/s");
+        assert_eq!(rate_text(f64::NAN), "-/s");
     }
 }

@@ -184,7 +184,7 @@ pub(super) fn ros2_bag(
     topics: &Ros2Topics,
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
-    let bar = progress::bytes_bar("ingest ros2", quiet);
+    let bar = progress::bytes_bar(std::fs::metadata(input).map_or(0, |m| m.len()), "ingest ros2", quiet);
     let report = ros2::ingest_ros2(input, &output.output, topics, &output.recording_options()?, &mut |done, total| {
         bar.set_length(total);
         bar.set_position(done);
