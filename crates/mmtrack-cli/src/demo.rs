@@ -185,8 +185,11 @@ pub fn run(args: &DemoArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     if !quiet {
         for link in &done.links {
             println!(
-                "mpc {}: {} sets, {} detections, {} tracks",
-                link.partition, link.sets, link.detections, link.tracks
+                "mpc {}: {}, {}, {}",
+                link.partition,
+                mmtrack_core::words::counted(link.sets as u64, "set"),
+                mmtrack_core::words::counted(link.detections as u64, "detection"),
+                mmtrack_core::words::counted(link.tracks as u64, "track")
             );
         }
     }

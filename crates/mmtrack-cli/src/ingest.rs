@@ -565,12 +565,12 @@ fn cir_file(
         let times = if times == 1 { "1 time".to_string() } else { format!("{times} times") };
         println!(
             "{}: {} CIR snapshots ({times} x {tx} TX x {rx} RX antennas) of {taps} taps, {:.4} ns apart; {} with \
-             a first-path hint; {} receptions skipped; domain {}",
+             a first-path hint; {} skipped; domain {}",
             report.output.path.display(),
             report.snapshots,
             report.tap_spacing_s * 1e9,
             report.with_first_path_hint,
-            report.skipped,
+            mmtrack_core::words::counted(report.skipped as u64, "reception"),
             report.metadata.get("cir.domain").and_then(|d| d.split(':').next()).unwrap_or("cir"),
         );
     }

@@ -6,6 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use clap::{Args, Subcommand};
+use mmtrack_core::words::{counted, counted_as};
 use mmtrack_core::{OdometryTiming, StampedPose, path_length_m};
 use mmtrack_io::table::TableWriteSummary;
 use mmtrack_odometry::OdometryConfig;
@@ -292,8 +293,14 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
             n => format!(" ({n} snapshots at max_mpcs)"),
         };
         println!(
-            "mpc {} (link tx{}:rx{}): {} sets, {} detections{capped}, {} short-term tracks, {} long-term entries",
-            link.partition, link.link.0, link.link.1, link.sets, link.detections, link.tracks, link.long_term
+            "mpc {} (link tx{}:rx{}): {}, {}{capped}, {}, {}",
+            link.partition,
+            link.link.0,
+            link.link.1,
+            counted(link.sets as u64, "set"),
+            counted(link.detections as u64, "detection"),
+            counted(link.tracks as u64, "short-term track"),
+            counted_as(link.long_term as u64, "long-term entry", "long-term entries")
         );
         let (most, needed) = (link.most_snapshots_per_set, config.short_term.min_track_length);
         if link.tracks == 0 && link.detections > 0 && (most as usize) < needed {

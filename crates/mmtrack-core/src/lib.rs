@@ -51,6 +51,7 @@ pub mod random;
 pub mod slam;
 pub mod sounder;
 pub mod stats;
+pub mod words;
 
 pub use beam_sweep::BeamSweep;
 pub use cir::CirSnapshot;
