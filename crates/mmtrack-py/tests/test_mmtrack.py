@@ -309,6 +309,42 @@ def test_reproduce_returns_the_claims_the_cli_reports(tmp_path: Path) -> None:
     assert compared > 0
 
 
+def interrupted_after(delay_s: float, call) -> float:
+    """Seconds from a Ctrl-C (``_thread.interrupt_main``, the SIGINT handler's
+    KeyboardInterrupt) sent `delay_s` into `call` until `call` raised it."""
+    import _thread
+    import threading
+    import time
+
+    sent = []
+
+    def interrupt() -> None:
+        sent.append(time.monotonic())
+        _thread.interrupt_main()
+
+    timer = threading.Timer(delay_s, interrupt)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        timer.cancel()
+    assert sent, "the call ended before the interrupt was sent: make it longer"
+    return time.monotonic() - sent[0]
+
+
+def test_ctrl_c_stops_a_long_call_and_leaves_no_partial_output(tmp_path: Path) -> None:
+    # Before: the interrupt waited for the call to end (28 s for mpc-convoy,
+    # all outputs written). Now the call stops at its next progress check.
+    # The bound is loose for a shared 2-core machine: a check comes at least
+    # once per batch of sets, well under a second apart.
+    out = tmp_path / "convoy"
+    waited_s = interrupted_after(2.0, lambda: mmtrack.reproduce("mpc-convoy", output=out))
+    assert waited_s < 3.0, waited_s
+    left = sorted(p.name for p in tmp_path.rglob("*"))
+    assert left == [], left  # neither the output folder nor a hidden partial
+
+
 def test_errors_carry_the_cli_line(tmp_path: Path) -> None:
     missing = tmp_path / "missing.mcap"
     with pytest.raises(mmtrack.MmtrackError) as caught:
