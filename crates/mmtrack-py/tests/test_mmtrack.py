@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import polars as pl
@@ -382,3 +383,76 @@ def test_stubs_name_every_native_function_and_the_package_is_typed() -> None:
     exported = {name for name in dir(native) if not name.startswith("_")}
     assert stubbed == exported
     assert set(mmtrack.__all__) <= set(dir(mmtrack))
+
+
+def test_an_older_polars_is_named_at_import(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Before: pyproject allowed polars >= 1.0 and polars < 1.43.2 failed on
+    # every read ("Invalid thrift: bad data"). Now import names the version needed.
+    from mmtrack import _polars_version
+
+    for old in ("1.42.1", "1.43.0", "1.43"):
+        problem = _polars_version.polars_version_problem(old)
+        assert problem is not None and "polars >= 1.43.2" in problem and f"polars {old} is" in problem, old
+    for fine in ("1.43.2", "1.44.2", "1.100.0", "2.1.0", "2.2.0b1", "not-a-version"):
+        assert _polars_version.polars_version_problem(fine) is None, fine
+    monkeypatch.setattr(pl, "__version__", "1.30.0")
+    with pytest.raises(ImportError, match=r"polars >= 1\.43\.2 .* polars 1\.30\.0 is installed"):
+        _polars_version.check_polars_version()
+
+
+def python_blocks(doc: str, heading: str) -> list[str]:
+    """The ```python blocks of `doc`'s section `heading`."""
+    import re
+
+    section = (ROOT / doc).read_text().split(heading + "\n", 1)[1].split("\n## ", 1)[0]
+    return re.findall(r"```python\n(.*?)```", section, re.S)
+
+
+def run_block(code: str) -> tuple[dict[str, Any], list[Any]]:
+    """Runs a documented snippet: its names, and the value of each expression statement."""
+    import ast
+
+    namespace: dict[str, Any] = {}
+    values = []
+    for statement in ast.parse(code).body:
+        if isinstance(statement, ast.Expr):
+            values.append(eval(compile(ast.Expression(statement.value), "<doc>", "eval"), namespace))
+        else:
+            exec(compile(ast.Module(body=[statement], type_ignores=[]), "<doc>", "exec"), namespace)
+    return namespace, values
+
+
+def sequences_of(value: Any) -> set[str]:
+    """The `sequence` values of a DuckDB relation or a polars / pandas frame, as read."""
+    if hasattr(value, "fetchall"):
+        columns = [c for c in value.columns]
+        return {row[columns.index("sequence")] for row in value.fetchall()}
+    if isinstance(value, pl.LazyFrame):
+        value = value.collect()
+    return set(value["sequence"].to_list()) if isinstance(value, pl.DataFrame) else set(value["sequence"].tolist())
+
+
+def test_documented_readers_keep_a_numeric_looking_sequence_id(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Before: the README's and docs/campaigns.md's snippets read `sequence=007`
+    # as 7 (polars, pandas) and `2019-01-10` as a date (DuckDB, polars). Now
+    # every snippet names the partition column's type.
+    pytest.importorskip("duckdb")
+    mmtrack.ingest("oxford", DEMO_FOLDER, tmp_path / "r.mcap", bins="auto", sequence_id="007")
+    mmtrack.process("odometry", tmp_path / "r.mcap", tmp_path / "tables")
+    mmtrack.analyze(tmp_path / "tables", tmp_path / "analysis", segment_lengths_m=[2, 4, 6, 8])
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "campaign").symlink_to(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    blocks = python_blocks("README.md", "## Python and DuckDB") + python_blocks(
+        "docs/campaigns.md", "## DuckDB and polars over the tables"
+    )
+    assert len(blocks) == 3
+    checked = 0
+    for code in blocks:
+        namespace, values = run_block(code)
+        for frame in values + [namespace[n] for n in ("odometry",) if n in namespace]:
+            if frame is not None:
+                assert sequences_of(frame) == {"007"}, code
+                checked += 1
+    # The README's DuckDB join, polars and pandas; the campaign's DuckDB and polars.
+    assert checked == 5

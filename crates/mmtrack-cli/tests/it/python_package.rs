@@ -21,8 +21,9 @@ use std::time::Instant;
 use super::common::root;
 
 /// PyPI packages of the suite, pinned (maturin comes from the package's
-/// `build-system.requires`).
-const REQUIREMENTS: &[&str] = &["polars==2.1.0", "numpy==2.4.6", "pytest==9.2.0", "pandas==3.1.1", "pyarrow==26.0.1"];
+/// `build-system.requires`); DuckDB runs the documented snippets.
+const REQUIREMENTS: &[&str] =
+    &["polars==2.1.0", "numpy==2.4.6", "pytest==9.2.0", "pandas==3.1.1", "pyarrow==26.0.1", "duckdb==2.0.1"];
 
 fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")

@@ -17,6 +17,10 @@ Errors raise :class:`MmtrackError` with the one line the CLI prints after
 
 from __future__ import annotations
 
+from ._polars_version import check_polars_version as _check_polars_version
+
+_check_polars_version()
+
 from ._api import Claim, Reproduced, analyze, effective_config, ingest, process, reproduce
 from ._arrays import MpcDetections, TrajectoryMetrics, detect_mpc, track_beams, trajectory_metrics
 from ._native import MmtrackError, __version__
