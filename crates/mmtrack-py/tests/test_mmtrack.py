@@ -456,3 +456,64 @@ def test_documented_readers_keep_a_numeric_looking_sequence_id(tmp_path: Path, m
                 checked += 1
     # The README's DuckDB join, polars and pandas; the campaign's DuckDB and polars.
     assert checked == 5
+
+
+def test_tables_reads_a_multi_run_analyze_per_run_tables(demo: dict[str, Path], tmp_path: Path) -> None:
+    # Before: analyze of two runs writes run=<ID>/tables/<table>/..., and
+    # mmtrack.tables(out) said "no tables". Now they come with a `run` column.
+    runs = tmp_path / "runs"
+    for run_id in ("a", "b"):
+        mmtrack.process("odometry", demo["recording"], runs, run_id=run_id)
+    out = tmp_path / "cmp"
+    done = mmtrack.analyze(runs, out, segment_lengths_m=[2, 4, 6, 8])
+    per_run = mmtrack.tables(out)
+    assert "trajectory_metrics" in per_run
+    metrics = per_run["trajectory_metrics"].collect()
+    assert sorted(set(metrics["run"].to_list())) == ["a", "b"]
+    assert set(metrics["sequence"].to_list()) == {"oxford-demo"}
+    # One run's folder alone: its `run` folder is a string column too.
+    alone = mmtrack.read_table(out / "run=a" / "tables", "trajectory_metrics").collect()
+    assert set(alone["run"].to_list()) == {"a"}
+    assert_frames_close(metrics.filter(pl.col("run") == "a"), alone.select(metrics.columns))
+    assert list(mmtrack.tables(done["tables"])) == ["run_comparison"]
+    assert mmtrack.table_info(out, "trajectory_metrics").files[0].endswith("part-0.parquet")
+
+
+def test_every_error_is_an_mmtrack_error(tmp_path: Path) -> None:
+    # Before: arguments numpy or pyo3 could not convert raised plain
+    # ValueError / TypeError / OverflowError, though the docstring promised
+    # MmtrackError. Now they are MmtrackError subclasses that are still
+    # ValueError / TypeError, named after the call.
+    with pytest.raises(mmtrack.MmtrackValueError, match="track_beams: could not convert string to float") as raised:
+        mmtrack.track_beams(np.array([["x"] * 64] * 3))
+    assert isinstance(raised.value, ValueError) and isinstance(raised.value, mmtrack.MmtrackError)
+    with pytest.raises(mmtrack.MmtrackValueError, match="detect_mpc: "):
+        mmtrack.detect_mpc(np.array([["a"] * 8]), tap_spacing_s=1e-9)
+    with pytest.raises(mmtrack.MmtrackValueError, match="negative"):
+        mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t", threads=-1)
+    with pytest.raises(mmtrack.MmtrackTypeError) as raised:
+        mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t", no_such_option=1)
+    assert isinstance(raised.value, TypeError)
+    # The data's own errors stay plain MmtrackError with the CLI's line.
+    with pytest.raises(mmtrack.MmtrackError) as raised:
+        mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t")
+    assert type(raised.value) is mmtrack.MmtrackError
+    # `config` is a path (str or pathlib.Path), as documented.
+    with pytest.raises(mmtrack.MmtrackError, match="none.toml"):
+        mmtrack.detect_mpc(np.ones((1, 8), dtype=complex), tap_spacing_s=1e-9, config=tmp_path / "none.toml")
+    assert "oxford" in mmtrack.INGEST_OPTIONS and "INGEST_OPTIONS" in mmtrack.ingest.__doc__
+    assert "odometry" in mmtrack.PROCESS_OPTIONS and "PROCESS_OPTIONS" in mmtrack.process.__doc__
+
+
+def test_a_corrupt_partition_is_named_when_the_table_is_opened(demo: dict[str, Path], tmp_path: Path) -> None:
+    # Before: polars' error at collect() ("The file must end with PAR1") named no file.
+    bad = tmp_path / "odometry" / "sequence=x" / "part-0.parquet"
+    bad.parent.mkdir(parents=True)
+    bad.write_text("not parquet\n")
+    with pytest.raises(mmtrack.MmtrackError, match=r"sequence=x/part-0\.parquet: not a readable Parquet table"):
+        mmtrack.tables(tmp_path)
+    cut = tmp_path / "odometry" / "sequence=x" / "part-0.parquet"
+    good = next((demo["tables"] / "odometry").glob("sequence=*/part-0.parquet")).read_bytes()
+    cut.write_bytes(good[:-1])
+    with pytest.raises(mmtrack.MmtrackError, match="no Parquet footer"):
+        mmtrack.read_table(tmp_path, "odometry")

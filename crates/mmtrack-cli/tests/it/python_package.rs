@@ -163,4 +163,7 @@ fn quickstart_notebook_runs_top_to_bottom(python: &Path) {
     // The Oxford tables' time base, and both trackers' rows of the DeepSense passes.
     assert!(text.contains("time base: unix_epoch"), "{text}");
     assert!(text.contains("window") && text.contains("last-full-sweep"), "{text}");
+    // Before: every run left its temporary outputs in /tmp. The last cell removes them.
+    let removed = text.lines().find_map(|l| l.strip_prefix("removed ")).unwrap_or_else(|| panic!("{text}"));
+    assert!(!Path::new(removed.trim()).exists(), "{removed}");
 }
