@@ -521,6 +521,30 @@ wc -l < \"$SBATCH_LOG\" | awk '{print $1 + 100}'
     assert!(text(&out).1.contains("array index 2: the task list '0,2' has 2 tasks"), "{:?}", text(&out));
 }
 
+/// Before: `ray_process.py` without a reachable binary (no `--mmtrack`, none
+/// on PATH, as after `pip install crates/mmtrack-py`) ended in a Python
+/// traceback with exit 1. Now it is a usage problem (exit 2) naming
+/// `--mmtrack`, told before Ray is imported (so no Ray is needed here).
+#[test]
+fn ray_example_without_the_binary_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = root().join("examples/ray_process.py");
+    for extra in [&["--mmtrack", "/nonexistent/mmtrack"][..], &[]] {
+        let out = Command::new("python3")
+            .arg(&example)
+            .args(["campaign.toml", "tables"])
+            .args(extra)
+            .env("PATH", "/usr/bin:/bin")
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("cannot run the mmtrack binary") && stderr.contains("--mmtrack PATH"), "{stderr}");
+        assert!(!stderr.contains("Traceback"), "{stderr}");
+    }
+}
+
 /// A Python venv with Ray from PyPI, made on first use under the target
 /// directory. Ray is a requirement of the test: no skip.
 fn ray_python() -> PathBuf {
