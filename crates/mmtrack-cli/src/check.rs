@@ -121,7 +121,14 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let named: Vec<String> = failed
         .iter()
         .map(|c| match &c.measured {
-            Ok(m) => format!("`{}` measured {} against {} {}", c.name, m.value, c.expected, c.tolerance),
+            Ok(m) => format!(
+                "`{}` measured {} against {} {} (change {})",
+                c.name,
+                m.value,
+                c.expected,
+                c.tolerance,
+                suite::change(c.expected, m.value)
+            ),
             Err(_) => format!("`{}` not measured", c.name),
         })
         .collect();

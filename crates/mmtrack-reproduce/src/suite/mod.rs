@@ -319,24 +319,53 @@ fn number(v: f64) -> String {
     if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
 }
 
-/// The plain-text table of `checks`: metric, expected, measured, tolerance,
-/// verdict (and the reason under a metric not measured).
+/// `expected` and `measured` for the table: six significant digits, or
+/// every digit (the shortest text that reads back as the same number) when
+/// six would show two different values as equal.
+fn expected_and_measured(expected: f64, measured: f64) -> (String, String) {
+    let (e, m) = (number(expected), number(measured));
+    if e == m && expected.to_bits() != measured.to_bits() {
+        (format!("{expected}"), format!("{measured}"))
+    } else {
+        (e, m)
+    }
+}
+
+/// How far `measured` moved from `expected`: the signed difference and,
+/// where `expected` is not zero, the same relative to it in percent
+/// (`+0.5001 (+5.001%)`), the two ways a tolerance is given; `0` when the
+/// value did not move.
+#[must_use]
+pub fn change(expected: f64, measured: f64) -> String {
+    let signed = |v: f64| if v > 0.0 { format!("+{}", number(v)) } else { number(v) };
+    let difference = measured - expected;
+    if expected == 0.0 || difference == 0.0 || !difference.is_finite() {
+        signed(difference)
+    } else {
+        format!("{} ({}%)", signed(difference), signed(difference / expected.abs() * 100.0))
+    }
+}
+
+/// The plain-text table of `checks`: metric, expected, measured, change
+/// (measured - expected, absolute and relative), tolerance, verdict (and
+/// the reason under a metric not measured).
 #[must_use]
 pub fn table(checks: &[SuiteCheck]) -> String {
-    let rows: Vec<[String; 5]> = checks
+    let rows: Vec<[String; 6]> = checks
         .iter()
         .map(|c| {
-            [
-                c.name.clone(),
-                number(c.expected),
-                c.measured.as_ref().map_or_else(|_| "-".to_string(), |m| number(m.value)),
-                c.tolerance.to_string(),
-                c.verdict().to_string(),
-            ]
+            let (expected, measured, moved) = match &c.measured {
+                Ok(m) => {
+                    let (e, v) = expected_and_measured(c.expected, m.value);
+                    (e, v, change(c.expected, m.value))
+                }
+                Err(_) => (number(c.expected), "-".to_string(), "-".to_string()),
+            };
+            [c.name.clone(), expected, measured, moved, c.tolerance.to_string(), c.verdict().to_string()]
         })
         .collect();
-    let header = ["metric", "expected", "measured", "tolerance", "verdict"].map(str::to_string);
-    let widths: Vec<usize> = (0..5)
+    let header = ["metric", "expected", "measured", "change", "tolerance", "verdict"].map(str::to_string);
+    let widths: Vec<usize> = (0..header.len())
         .map(|i| rows.iter().chain(std::iter::once(&header)).map(|r| r[i].chars().count()).max().unwrap_or(0))
         .collect();
     let mut out = String::new();

@@ -118,8 +118,32 @@ fn a_value_past_its_tolerance_regresses_and_nan_never_passes() {
     let missing = SuiteCheck { measured: Err("gone".into()), ..check(0.0, Tolerance::Absolute(1.0)) };
     assert_eq!(missing.verdict(), "NOT MEASURED");
     let text = table(&[check(10.5001, Tolerance::Absolute(0.5)), missing]);
-    assert!(text.contains("m       10        10.5001   +-0.5      REGRESSED"), "{text}");
+    assert!(text.contains("m       10        10.5001   +0.5001 (+5.001%)  +-0.5      REGRESSED"), "{text}");
     assert!(text.contains("\n    gone\n"), "{text}");
+}
+
+/// Before: a value that moved past a zero tolerance in its eighth digit
+/// showed `0.0883317  0.0883317  +-0  REGRESSED`, and no row said how far a
+/// metric moved. Now both values get every digit when six would look equal,
+/// and a change column gives the difference, absolute and relative.
+#[test]
+fn a_regressed_row_shows_how_far_the_value_moved() {
+    let check = |expected: f64, measured: f64, tolerance| SuiteCheck {
+        name: "ATE".into(),
+        expected,
+        tolerance,
+        measured: Ok(Selected { value: measured, rows: 1 }),
+    };
+    let text = table(&[check(0.088_331_717, 0.088_331_717_221_385_15, Tolerance::Absolute(0.0))]);
+    let row = text.lines().nth(1).unwrap();
+    let cells: Vec<&str> = row.split("  ").map(str::trim).filter(|c| !c.is_empty()).collect();
+    assert_eq!(cells, ["ATE", "0.088331717", "0.08833171722138515", "+2.21385e-10 (+2.50629e-7%)", "+-0", "REGRESSED"]);
+    // Values six digits tell apart keep six digits; a fall is negative.
+    let text = table(&[check(2.0, 1.5, Tolerance::Relative(0.1))]);
+    assert!(text.lines().nth(1).unwrap().contains("2         1.5       -0.5 (-25%)"), "{text}");
+    // Against an expected zero, only the difference.
+    let text = table(&[check(0.0, 0.25, Tolerance::Absolute(0.1))]);
+    assert!(text.lines().nth(1).unwrap().contains("0         0.25      +0.25"), "{text}");
 }
 
 #[test]
