@@ -64,7 +64,7 @@ fn metrics_select_rows_by_partition_and_column_and_reduce_them() {
     let suite = parse_suite(Path::new("s.toml"), SUITE).unwrap();
     assert_eq!(suite.steps[0][2], "{suite}/rec.mcap");
     assert_eq!(
-        step_words(&suite.steps[0], Path::new("/d"), Path::new("/w")).unwrap(),
+        step_words(&suite.steps[0], Path::new("/d"), Path::new("/w"), &suite.env, &|_| None).unwrap(),
         ["process", "odometry", "/d/rec.mcap", "-o", "/w/tables"]
     );
     let checks = measure(&suite, dir.path());
@@ -201,4 +201,38 @@ fn suites_are_refused_naming_the_file_the_entry_and_the_key() {
         assert!(err.contains(message), "{text}\n-> {err}");
         assert!(err.starts_with("s.toml"), "{err}");
     }
+}
+
+/// Before: a suite could point at data only through `{suite}`, so the
+/// example suite failed from a clone not beside `shared/` even with
+/// MMTRACK_REALDATA set (the notebook honours it). Now `{env:NAME}` takes
+/// the variable, else the suite's `[env]` default.
+#[test]
+fn env_placeholders_take_the_variable_else_the_suite_default() {
+    let text = SUITE.replace(
+        "[[step]]",
+        "[env]\nDATA = \"{suite}/data\"\n\n[[step]]\nargs = [\"ingest\", \"oxford\", \"{env:DATA}/x\", \"{env:OTHER}\"]\n\n[[step]]",
+    );
+    let suite = parse_suite(Path::new("s.toml"), &text).unwrap();
+    let words = |lookup: &dyn Fn(&str) -> Option<String>| {
+        step_words(&suite.steps[0], Path::new("/d"), Path::new("/w"), &suite.env, lookup)
+    };
+    let set = |name: &str| Some(format!("/set/{name}"));
+    assert_eq!(words(&set).unwrap()[2..], ["/set/DATA/x", "/set/OTHER"]);
+    let only_other = |name: &str| (name == "OTHER").then(|| "o".to_string());
+    assert_eq!(words(&only_other).unwrap()[2..], ["/d/data/x", "o"]);
+    let error = format!("{:#}", words(&|_| None).unwrap_err());
+    assert!(error.contains("{env:OTHER}: the environment variable OTHER is not set"), "{error}");
+    for (bad, message) in [
+        ("{env:1X}", "unknown placeholder `{env:1X}`"),
+        ("{env:}", "unknown placeholder `{env:}`"),
+        ("{home}", "unknown placeholder `{home}`"),
+    ] {
+        let text = SUITE.replace("{suite}/rec.mcap", bad);
+        let error = format!("{:#}", parse_suite(Path::new("s.toml"), &text).unwrap_err());
+        assert!(error.contains(message), "{error}");
+    }
+    let text = SUITE.replace("[[step]]", "[env]\nD = \"{work}/x\"\n\n[[step]]");
+    let error = format!("{:#}", parse_suite(Path::new("s.toml"), &text).unwrap_err());
+    assert!(error.contains("[env] D") && error.contains("unknown placeholder `{work}`"), "{error}");
 }
