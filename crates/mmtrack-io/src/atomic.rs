@@ -305,9 +305,12 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
 /// copy after the new one is in place (the error names the copy left).
 pub fn publish_dir(staged: &Path, out: &Path) -> Result<()> {
     let name = staged.file_name().and_then(|n| n.to_str()).unwrap_or_default();
-    // The staging prefix: the name up to `<pid>.<random>.partial`.
-    let prefix =
-        name.strip_suffix(PARTIAL_SUFFIX).and_then(|stem| stem.rsplitn(3, '.').nth(2)).map(|head| format!("{head}."));
+    // The staging prefix: the name before `<pid>.<random>.partial`.
+    let prefix = name
+        .strip_suffix(PARTIAL_SUFFIX)
+        .and_then(|stem| stem.rsplit_once('.'))
+        .map(|(head, _random)| head.trim_end_matches(|c: char| c.is_ascii_digit()).to_string())
+        .filter(|prefix| prefix.len() > 1);
     let aside = swap_dir_into_place(staged, out)?;
     if let (Some(prefix), Some(parent)) = (prefix, out.parent()) {
         // The new output is in place: asides of killed runs are superseded.
@@ -880,6 +883,15 @@ mod tests {
         let staged_dir = staging_dir(dir.path(), ".results.").unwrap().keep();
         publish_dir(&staged_dir, &out).unwrap();
         assert!(!dead_dir.exists() && running_dir.exists() && out.exists());
+        // A staging prefix not ending in '.' (`.simulate-`): its own asides only.
+        let sim = dir.path().join("sim");
+        let dead_sim = dir.path().join(format!(".simulate-{}.dir003.replaced", u32::MAX));
+        let not_ours = dir.path().join(format!(".{}.dir004.replaced", u32::MAX));
+        for d in [&sim, &dead_sim, &not_ours] {
+            std::fs::create_dir(d).unwrap();
+        }
+        publish_dir(&staging_dir(dir.path(), ".simulate-").unwrap().keep(), &sim).unwrap();
+        assert!(!dead_sim.exists() && not_ours.exists());
     }
 
     /// A zombie (exited, not yet reaped) writes nothing: its partials are stale.
