@@ -26,7 +26,10 @@ def scan(root, table):
     files = sorted((root / table).glob("sequence=*/part-0.parquet"))
     if not files:
         return None
-    return pl.scan_parquet(str(root / table / "*" / "*.parquet"), hive_partitioning=True)
+    # The sequence id as written (polars would read `007` as the number 7).
+    return pl.scan_parquet(
+        str(root / table / "*" / "*.parquet"), hive_partitioning=True, hive_schema={"sequence": pl.String}
+    )
 
 
 def main():

@@ -36,8 +36,6 @@ import os
 import subprocess
 import sys
 
-import ray
-
 
 def run_task(command, cwd, index, *needed):
     """Runs one `mmtrack process manifest ... --task N`; returns (index, "ok" or "skipped").
@@ -70,11 +68,21 @@ def main():
 
     mmtrack = os.path.abspath(args.mmtrack) if os.sep in args.mmtrack else args.mmtrack
     listed = [mmtrack, "process", "manifest", args.manifest, "-o", args.output, "--print-tasks"]
-    printed = subprocess.run(listed, capture_output=True, text=True)
+    try:
+        printed = subprocess.run(listed, capture_output=True, text=True)
+    except OSError as error:
+        # A usage problem, found before Ray starts: no such binary (not on PATH).
+        print(
+            f"{args.mmtrack}: cannot run the mmtrack binary ({error.strerror}); give its path with --mmtrack PATH",
+            file=sys.stderr,
+        )
+        sys.exit(2)
     if printed.returncode != 0:
         print(printed.stderr.strip(), file=sys.stderr)
         sys.exit(printed.returncode)
     tasks = [json.loads(line) for line in printed.stdout.splitlines()]
+
+    import ray  # here, so that a usage problem is told without Ray installed
 
     address = args.address or os.environ.get("RAY_ADDRESS")
     if address:

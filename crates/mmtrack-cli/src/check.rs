@@ -82,7 +82,7 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     }
     let steps = suite.steps.len();
     for (i, step) in suite.steps.iter().enumerate() {
-        let words = suite::step_words(step, &suite_dir, work.path())
+        let words = suite::step_words(step, &suite_dir, work.path(), &suite.env, &|name| std::env::var(name).ok())
             .with_context(|| format!("{suite_name}: step {}", i + 1))?;
         let shown = words.iter().map(|w| mmtrack_process::manifest::shell_word(w)).collect::<Vec<_>>().join(" ");
         if !quiet {
@@ -121,7 +121,14 @@ pub fn run(args: &CheckArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     let named: Vec<String> = failed
         .iter()
         .map(|c| match &c.measured {
-            Ok(m) => format!("`{}` measured {} against {} {}", c.name, m.value, c.expected, c.tolerance),
+            Ok(m) => format!(
+                "`{}` measured {} against {} {} (change {})",
+                c.name,
+                m.value,
+                c.expected,
+                c.tolerance,
+                suite::change(c.expected, m.value)
+            ),
             Err(_) => format!("`{}` not measured", c.name),
         })
         .collect();

@@ -5,6 +5,11 @@
 //! it got (`set_position` / `advance`) and notes for the user (`note`: a
 //! skipped record, a warning). It never prints itself. [`NoProgress`]
 //! discards everything, for tests and quiet callers.
+//!
+//! The long loops also ask [`Progress::check_cancelled`] once per item: a
+//! front end that cannot stop the process to interrupt a call (Python's
+//! Ctrl-C) answers [`Cancelled`] there, and the call returns that error
+//! like any other, dropping its partial outputs on the way out.
 
 /// Receives the progress of a long-running library call.
 ///
@@ -22,7 +27,27 @@ pub trait Progress: Sync {
     fn finish(&self);
     /// A line the user should see (a warning, a count of skipped records).
     fn note(&self, text: &str);
+    /// `Err(Cancelled)` once the caller wants the call to stop early; the
+    /// library returns that error at once. Never cancelled by default.
+    ///
+    /// # Errors
+    /// [`Cancelled`] when the front end asked to stop.
+    fn check_cancelled(&self) -> Result<(), Cancelled> {
+        Ok(())
+    }
 }
+
+/// The error of a call stopped by its front end ([`Progress::check_cancelled`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Cancelled;
+
+impl std::fmt::Display for Cancelled {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("interrupted")
+    }
+}
+
+impl std::error::Error for Cancelled {}
 
 /// A [`Progress`] that discards everything.
 #[derive(Debug, Default, Clone, Copy)]

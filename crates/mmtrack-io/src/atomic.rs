@@ -27,7 +27,22 @@
 //!   Liveness is read from `/proc`, so it holds for writers in the same PID
 //!   namespace (one machine, one container); where there is no `/proc`, only
 //!   partials of this process's own pid are removed. Files that do not match
-//!   the pattern exactly are never touched.
+//!   the pattern exactly are never touched. A process counts as gone once
+//!   it has exited, also while it is still a zombie waiting to be reaped.
+//!
+//! # Replaced outputs moved aside
+//!
+//! Replacing a set of files ([`commit_all`]) or an output directory
+//! ([`publish_dir`]) first renames the old output aside, to
+//! `.<name>.<pid>.<random>.replaced` (a directory:
+//! `<prefix><pid>.<random>.replaced`), and deletes it once the new output
+//! is in place. A process killed outright between those steps leaves the
+//! aside copy; readers that glob a folder recursively (DuckDB `dir/**`,
+//! `pl.scan_parquet(dir)`) would read it as data. Once a later run has
+//! published a new output at the same target, that output supersedes the
+//! old one, and the run removes the asides of that target whose writer is
+//! gone (by the same pid rule as partials). An aside is kept until then:
+//! it is the only copy of the previous output while the target is missing.
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -155,8 +170,9 @@ pub fn write_file(target: &Path, contents: &[u8], overwrite: Overwrite) -> Resul
 /// first renamed aside (`.<name>.<pid>.<random>.replaced`), so it can be put
 /// back if a later rename fails, and is deleted once the set is in place: a
 /// reader may see that table missing for the instant between the two
-/// renames. A process killed outright in that instant leaves the aside file
-/// (never deleted by a later run: it is the previous output).
+/// renames. A process killed outright in that instant leaves the aside file;
+/// the next run that publishes the same target removes it then (see the
+/// module docs).
 ///
 /// # Errors
 /// [`IoError::OutputExists`] for a target that appeared meanwhile (with
@@ -203,6 +219,7 @@ pub fn commit_all(files: Vec<AtomicFile>, overwrite: Overwrite, durability: Dura
         // Best effort: a leftover is a hidden copy of the replaced output.
         let _ = std::fs::remove_file(aside);
     }
+    remove_stale_asides_of(published.iter().map(|(target, _)| target.as_path()), &live);
     drop(live);
     drop(registrations);
     Ok(published.into_iter().map(|(target, _)| target).collect())
@@ -287,7 +304,21 @@ pub fn staging_dir(parent: &Path, prefix: &str) -> std::io::Result<tempfile::Tem
 /// The OS error of a rename (nothing changed then), or of deleting the old
 /// copy after the new one is in place (the error names the copy left).
 pub fn publish_dir(staged: &Path, out: &Path) -> Result<()> {
-    match swap_dir_into_place(staged, out)? {
+    let name = staged.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+    // The staging prefix: the name before `<pid>.<random>.partial`.
+    let prefix = name
+        .strip_suffix(PARTIAL_SUFFIX)
+        .and_then(|stem| stem.rsplit_once('.'))
+        .map(|(head, _random)| head.trim_end_matches(|c: char| c.is_ascii_digit()).to_string())
+        .filter(|prefix| prefix.len() > 1);
+    let aside = swap_dir_into_place(staged, out)?;
+    if let (Some(prefix), Some(parent)) = (prefix, out.parent()) {
+        // The new output is in place: asides of killed runs are superseded.
+        let parent = if parent.as_os_str().is_empty() { Path::new(".") } else { parent };
+        let live = live_partials();
+        remove_stale(parent, &[prefix.as_str()], REPLACED_SUFFIX, &live);
+    }
+    match aside {
         Some(aside) => aside.remove(),
         None => Ok(()),
     }
@@ -592,11 +623,43 @@ fn remove_directory_being_written(path: &Path) -> std::io::Result<()> {
 /// process and `live` (this process's registry) does not hold it. Best
 /// effort: what cannot be read or removed is left. Returns how many went.
 fn remove_stale_partials(dir: &Path, prefix: &str, live: &BTreeMap<PathBuf, PartialKind>) -> usize {
+    remove_stale(dir, &[prefix], PARTIAL_SUFFIX, live)
+}
+
+/// Removes the asides `.<name>.<pid>.<random>.replaced` of `targets` (just
+/// published, so superseded) whose writer is gone, by the rule of
+/// [`remove_stale_partials`]; one directory listing per parent directory.
+/// Called with the registry held, so no commit of this process is between
+/// its two renames.
+fn remove_stale_asides_of<'t>(targets: impl Iterator<Item = &'t Path>, live: &BTreeMap<PathBuf, PartialKind>) -> usize {
+    let mut prefixes_by_dir: BTreeMap<PathBuf, Vec<String>> = BTreeMap::new();
+    for target in targets {
+        let Some(name) = target.file_name().and_then(|n| n.to_str()) else { continue };
+        let dir = match target.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        prefixes_by_dir.entry(dir).or_default().push(format!(".{name}."));
+    }
+    prefixes_by_dir
+        .iter()
+        .map(|(dir, prefixes)| {
+            let prefixes: Vec<&str> = prefixes.iter().map(String::as_str).collect();
+            remove_stale(dir, &prefixes, REPLACED_SUFFIX, live)
+        })
+        .sum()
+}
+
+/// Removes the entries of `dir` named `<prefix><pid>.<random><suffix>`, for
+/// any of `prefixes`, whose writer is gone (see [`remove_stale_partials`]).
+fn remove_stale(dir: &Path, prefixes: &[&str], suffix: &str, live: &BTreeMap<PathBuf, PartialKind>) -> usize {
     let Ok(entries) = std::fs::read_dir(dir) else { return 0 };
     let mut removed = 0;
     for entry in entries.flatten() {
         let name = entry.file_name();
-        let Some(pid) = name.to_str().and_then(|n| partial_writer_pid(n, prefix)) else { continue };
+        let Some(pid) = name.to_str().and_then(|n| prefixes.iter().find_map(|p| writer_pid(n, p, suffix))) else {
+            continue;
+        };
         let path = entry.path();
         // By name: the registry holds the paths as created (tempfile makes
         // them absolute), `path` is as listed under `dir` (maybe relative);
@@ -619,19 +682,42 @@ fn remove_stale_partials(dir: &Path, prefix: &str, live: &BTreeMap<PathBuf, Part
 
 /// The writer's pid of a partial output named `<prefix><pid>.<random>.partial`
 /// (`<random>`: ASCII letters and digits), `None` for any other name.
+#[cfg(test)]
 fn partial_writer_pid(name: &str, prefix: &str) -> Option<u32> {
-    let middle = name.strip_prefix(prefix)?.strip_suffix(PARTIAL_SUFFIX)?;
+    writer_pid(name, prefix, PARTIAL_SUFFIX)
+}
+
+/// The writer's pid of a name `<prefix><pid>.<random><suffix>` (`<random>`:
+/// ASCII letters and digits), `None` for any other name.
+fn writer_pid(name: &str, prefix: &str, suffix: &str) -> Option<u32> {
+    let middle = name.strip_prefix(prefix)?.strip_suffix(suffix)?;
     let (pid, random) = middle.split_once('.')?;
     let all_digits = !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit());
     let random_ok = !random.is_empty() && random.bytes().all(|b| b.is_ascii_alphanumeric());
     if all_digits && random_ok { pid.parse().ok() } else { None }
 }
 
-/// Whether process `pid` may be running: `/proc/<pid>` exists, or there is
-/// no `/proc` to tell (then every other process is assumed alive).
+/// Whether process `pid` may be running: `/proc/<pid>` exists and its state
+/// (`/proc/<pid>/stat`, the field after the command name) is not zombie
+/// (`Z`) or dead (`X`), or there is no `/proc` to tell (then every other
+/// process is assumed alive). A zombie has exited and writes nothing; its
+/// parent may reap it late.
 fn process_may_be_running(pid: u32) -> bool {
     let proc = Path::new("/proc");
-    !proc.join("self").exists() || proc.join(pid.to_string()).exists()
+    if !proc.join("self").exists() {
+        return true;
+    }
+    let dir = proc.join(pid.to_string());
+    if !dir.exists() {
+        return false;
+    }
+    match std::fs::read_to_string(dir.join("stat")) {
+        // `<pid> (<comm>) <state> ...`; the command name may hold ')'.
+        Ok(stat) => {
+            !matches!(stat.rsplit_once(')').and_then(|(_, rest)| rest.trim_start().chars().next()), Some('Z' | 'X'))
+        }
+        Err(_) => true,
+    }
 }
 
 /// Asks for `mode` less the umask, as `File::create` (0666) and `create_dir`
@@ -748,6 +834,86 @@ mod tests {
         drop(second);
         first.commit(Overwrite::Refuse, Durability::PageCache).unwrap();
         assert!(!first_partial.exists() && target.exists());
+    }
+
+    /// Before: a process killed between the two renames of `commit_all`
+    /// left `.<name>.<pid>.<random>.replaced` for good, and readers globbing
+    /// the folder read it as data. Now the next run that publishes the same
+    /// target removes the asides of dead writers, and only those: not before
+    /// its own output is in place, not a running writer's, not other names.
+    #[test]
+    fn asides_of_killed_runs_are_removed_once_the_target_is_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let plant = |name: &str| {
+            let path = dir.path().join(name);
+            std::fs::write(&path, b"old copy").unwrap();
+            path
+        };
+        // No process has pid u32::MAX (Linux pids stop at 2^22); pid 1 always runs.
+        let dead = [plant(&format!(".a.{}.AbC123.replaced", u32::MAX)), plant(&format!(".b.{}.x9.replaced", u32::MAX))];
+        let earlier_same_pid = plant(&format!(".a.{}.QwE456.replaced", std::process::id()));
+        let kept = [
+            plant(".a.1.QQQ111.replaced"),                          // a running writer's
+            plant(".a.AbC123.replaced"),                            // no pid: not our pattern
+            plant(&format!(".c.{}.AbC123.replaced", u32::MAX)),     // another target's
+            plant(&format!(".a.{}.AbC123.replaced.bak", u32::MAX)), // not an aside
+            plant("notes.txt"),
+        ];
+        std::fs::write(dir.path().join("a"), b"old a").unwrap();
+        let staged = |name: &str| {
+            let f = AtomicFile::create(&dir.path().join(name), Overwrite::Replace).unwrap();
+            f.writer().unwrap().write_all(b"new").unwrap();
+            f
+        };
+        let set = vec![staged("a"), staged("b")];
+        assert!(dead.iter().all(|p| p.exists()), "kept while the old output may be the only copy");
+        commit_all(set, Overwrite::Replace, Durability::PageCache).unwrap();
+        assert!(dead.iter().all(|p| !p.exists()) && !earlier_same_pid.exists());
+        assert!(kept.iter().all(|p| p.exists()));
+        assert_eq!(std::fs::read(dir.path().join("a")).unwrap(), b"new");
+
+        // The same for an output directory replaced by `publish_dir`.
+        let out = dir.path().join("results");
+        std::fs::create_dir(&out).unwrap();
+        let dead_dir = dir.path().join(format!(".results.{}.dir001.replaced", u32::MAX));
+        std::fs::create_dir(&dead_dir).unwrap();
+        std::fs::write(dead_dir.join("old.txt"), b"old").unwrap();
+        let running_dir = dir.path().join(".results.1.dir002.replaced");
+        std::fs::create_dir(&running_dir).unwrap();
+        let staged_dir = staging_dir(dir.path(), ".results.").unwrap().keep();
+        publish_dir(&staged_dir, &out).unwrap();
+        assert!(!dead_dir.exists() && running_dir.exists() && out.exists());
+        // A staging prefix not ending in '.' (`.simulate-`): its own asides only.
+        let sim = dir.path().join("sim");
+        let dead_sim = dir.path().join(format!(".simulate-{}.dir003.replaced", u32::MAX));
+        let not_ours = dir.path().join(format!(".{}.dir004.replaced", u32::MAX));
+        for d in [&sim, &dead_sim, &not_ours] {
+            std::fs::create_dir(d).unwrap();
+        }
+        publish_dir(&staging_dir(dir.path(), ".simulate-").unwrap().keep(), &sim).unwrap();
+        assert!(!dead_sim.exists() && not_ours.exists());
+    }
+
+    /// A zombie (exited, not yet reaped) writes nothing: its partials are stale.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_zombie_process_is_not_running() {
+        let mut child = std::process::Command::new("true").spawn().unwrap();
+        let pid = child.id();
+        // Not reaped until `wait`: a zombie once it has exited.
+        let mut zombie = false;
+        for _ in 0..500 {
+            let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap();
+            if stat.rsplit_once(')').unwrap().1.trim_start().starts_with('Z') {
+                zombie = true;
+                break;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+        assert!(zombie, "`true` exited within 5 s");
+        assert!(!process_may_be_running(pid));
+        assert!(process_may_be_running(std::process::id()));
+        child.wait().unwrap();
     }
 
     /// Before: the old output `publish_dir` moved aside was not in the

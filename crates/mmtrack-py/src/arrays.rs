@@ -15,6 +15,7 @@ use std::path::Path;
 use anyhow::{Context, bail, ensure};
 use mmtrack_analysis::analyze::AnalyzeOptions;
 use mmtrack_analysis::pipeline::analyze_trajectory;
+use mmtrack_core::progress::Progress;
 use mmtrack_core::sounder::SounderBand;
 use mmtrack_core::{BeamSweep, CirSnapshot, Complex64, MpcDetection, Se2, StampedPose};
 use mmtrack_io::table::{RunInfo, TableTimeBase, table_bytes};
@@ -92,8 +93,14 @@ pub struct CirArray<'a> {
 ///
 /// # Errors
 /// Arrays of different lengths, a bad configuration or pulse, and the
-/// detector's errors (naming the snapshot).
-pub fn detect_mpc(cir: &CirArray<'_>, config: Option<&Path>, pulse: Option<&[Complex64]>) -> anyhow::Result<Vec<u8>> {
+/// detector's errors (naming the snapshot); [`Progress::check_cancelled`]'s
+/// error, asked once per snapshot.
+pub fn detect_mpc(
+    cir: &CirArray<'_>,
+    config: Option<&Path>,
+    pulse: Option<&[Complex64]>,
+    progress: &dyn Progress,
+) -> anyhow::Result<Vec<u8>> {
     let n = cir.t_ns.len();
     ensure!(cir.taps_per_snapshot > 0, "cir: no taps");
     ensure!(
@@ -118,6 +125,7 @@ pub fn detect_mpc(cir: &CirArray<'_>, config: Option<&Path>, pulse: Option<&[Com
     let detector = Detector::new(mpc_config.detection.clone(), cir.tap_spacing_s, &pulse)?;
     let mut rows: Vec<MpcDetection> = Vec::new();
     for (i, taps) in cir.taps.chunks_exact(cir.taps_per_snapshot).enumerate() {
+        progress.check_cancelled()?;
         let snapshot = CirSnapshot {
             t_ns: cir.t_ns[i],
             set_index: cir.set_index[i],
@@ -180,12 +188,15 @@ pub enum CarFrame<'a> {
 /// # Errors
 /// A power array that is not `t_ns.len() x beams`; pass indices, car or
 /// array positions of the wrong length or not finite; a pass split into
-/// pieces; an unknown policy; bad sweeps, and the trackers' errors.
+/// pieces; an unknown policy; bad sweeps, and the trackers' errors;
+/// [`Progress::check_cancelled`]'s error, asked per sweep read and per pass
+/// and policy tracked.
 pub fn track_beams(
     sweeps: &SweepArrays<'_>,
     trackers: &[String],
     reacquire: &str,
     site: &str,
+    progress: &dyn Progress,
 ) -> anyhow::Result<Vec<(i64, Vec<u8>)>> {
     let SweepArrays { power, beams, t_ns, pass_index, car, car_frame } = *sweeps;
     let n = t_ns.len();
@@ -228,6 +239,7 @@ pub fn track_beams(
         .zip(t_ns)
         .enumerate()
         .map(|(i, (row, &t))| {
+            progress.check_cancelled()?;
             BeamSweep::new(t, row.to_vec(), vec![true; beams]).with_context(|| format!("power: sweep {i} (t_ns {t})"))
         })
         .collect::<anyhow::Result<Vec<_>>>()?;
@@ -262,7 +274,7 @@ pub fn track_beams(
             east_north_m: positions.as_deref().map(|p| &p[range.clone()]),
         })
         .collect();
-    let run = track_site(&kinds, reacquire, site, &inputs)?;
+    let run = track_site(&kinds, reacquire, site, &inputs, progress)?;
     // The policies run, once each, in `process beam`'s order.
     let names: Vec<&str> = run.summaries.iter().map(|(kind, _)| kind.name()).collect();
     let info = run_info(

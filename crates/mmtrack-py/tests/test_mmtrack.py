@@ -13,6 +13,7 @@ import json
 import os
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import polars as pl
@@ -309,6 +310,42 @@ def test_reproduce_returns_the_claims_the_cli_reports(tmp_path: Path) -> None:
     assert compared > 0
 
 
+def interrupted_after(delay_s: float, call) -> float:
+    """Seconds from a Ctrl-C (``_thread.interrupt_main``, the SIGINT handler's
+    KeyboardInterrupt) sent `delay_s` into `call` until `call` raised it."""
+    import _thread
+    import threading
+    import time
+
+    sent = []
+
+    def interrupt() -> None:
+        sent.append(time.monotonic())
+        _thread.interrupt_main()
+
+    timer = threading.Timer(delay_s, interrupt)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            call()
+    finally:
+        timer.cancel()
+    assert sent, "the call ended before the interrupt was sent: make it longer"
+    return time.monotonic() - sent[0]
+
+
+def test_ctrl_c_stops_a_long_call_and_leaves_no_partial_output(tmp_path: Path) -> None:
+    # Before: the interrupt waited for the call to end (28 s for mpc-convoy,
+    # all outputs written). Now the call stops at its next progress check.
+    # The bound is loose for a shared 2-core machine: a check comes at least
+    # once per batch of sets, well under a second apart.
+    out = tmp_path / "convoy"
+    waited_s = interrupted_after(2.0, lambda: mmtrack.reproduce("mpc-convoy", output=out))
+    assert waited_s < 3.0, waited_s
+    left = sorted(p.name for p in tmp_path.rglob("*"))
+    assert left == [], left  # neither the output folder nor a hidden partial
+
+
 def test_errors_carry_the_cli_line(tmp_path: Path) -> None:
     missing = tmp_path / "missing.mcap"
     with pytest.raises(mmtrack.MmtrackError) as caught:
@@ -346,3 +383,137 @@ def test_stubs_name_every_native_function_and_the_package_is_typed() -> None:
     exported = {name for name in dir(native) if not name.startswith("_")}
     assert stubbed == exported
     assert set(mmtrack.__all__) <= set(dir(mmtrack))
+
+
+def test_an_older_polars_is_named_at_import(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Before: pyproject allowed polars >= 1.0 and polars < 1.43.2 failed on
+    # every read ("Invalid thrift: bad data"). Now import names the version needed.
+    from mmtrack import _polars_version
+
+    for old in ("1.42.1", "1.43.0", "1.43"):
+        problem = _polars_version.polars_version_problem(old)
+        assert problem is not None and "polars >= 1.43.2" in problem and f"polars {old} is" in problem, old
+    for fine in ("1.43.2", "1.44.2", "1.100.0", "2.1.0", "2.2.0b1", "not-a-version"):
+        assert _polars_version.polars_version_problem(fine) is None, fine
+    monkeypatch.setattr(pl, "__version__", "1.30.0")
+    with pytest.raises(ImportError, match=r"polars >= 1\.43\.2 .* polars 1\.30\.0 is installed"):
+        _polars_version.check_polars_version()
+
+
+def python_blocks(doc: str, heading: str) -> list[str]:
+    """The ```python blocks of `doc`'s section `heading`."""
+    import re
+
+    section = (ROOT / doc).read_text().split(heading + "\n", 1)[1].split("\n## ", 1)[0]
+    return re.findall(r"```python\n(.*?)```", section, re.S)
+
+
+def run_block(code: str) -> tuple[dict[str, Any], list[Any]]:
+    """Runs a documented snippet: its names, and the value of each expression statement."""
+    import ast
+
+    namespace: dict[str, Any] = {}
+    values = []
+    for statement in ast.parse(code).body:
+        if isinstance(statement, ast.Expr):
+            values.append(eval(compile(ast.Expression(statement.value), "<doc>", "eval"), namespace))
+        else:
+            exec(compile(ast.Module(body=[statement], type_ignores=[]), "<doc>", "exec"), namespace)
+    return namespace, values
+
+
+def sequences_of(value: Any) -> set[str]:
+    """The `sequence` values of a DuckDB relation or a polars / pandas frame, as read."""
+    if hasattr(value, "fetchall"):
+        columns = [c for c in value.columns]
+        return {row[columns.index("sequence")] for row in value.fetchall()}
+    if isinstance(value, pl.LazyFrame):
+        value = value.collect()
+    return set(value["sequence"].to_list()) if isinstance(value, pl.DataFrame) else set(value["sequence"].tolist())
+
+
+def test_documented_readers_keep_a_numeric_looking_sequence_id(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Before: the README's and docs/campaigns.md's snippets read `sequence=007`
+    # as 7 (polars, pandas) and `2019-01-10` as a date (DuckDB, polars). Now
+    # every snippet names the partition column's type.
+    pytest.importorskip("duckdb")
+    mmtrack.ingest("oxford", DEMO_FOLDER, tmp_path / "r.mcap", bins="auto", sequence_id="007")
+    mmtrack.process("odometry", tmp_path / "r.mcap", tmp_path / "tables")
+    mmtrack.analyze(tmp_path / "tables", tmp_path / "analysis", segment_lengths_m=[2, 4, 6, 8])
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "campaign").symlink_to(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    blocks = python_blocks("README.md", "## Python and DuckDB") + python_blocks(
+        "docs/campaigns.md", "## DuckDB and polars over the tables"
+    )
+    assert len(blocks) == 3
+    checked = 0
+    for code in blocks:
+        namespace, values = run_block(code)
+        for frame in values + [namespace[n] for n in ("odometry",) if n in namespace]:
+            if frame is not None:
+                assert sequences_of(frame) == {"007"}, code
+                checked += 1
+    # The README's DuckDB join, polars and pandas; the campaign's DuckDB and polars.
+    assert checked == 5
+
+
+def test_tables_reads_a_multi_run_analyze_per_run_tables(demo: dict[str, Path], tmp_path: Path) -> None:
+    # Before: analyze of two runs writes run=<ID>/tables/<table>/..., and
+    # mmtrack.tables(out) said "no tables". Now they come with a `run` column.
+    runs = tmp_path / "runs"
+    for run_id in ("a", "b"):
+        mmtrack.process("odometry", demo["recording"], runs, run_id=run_id)
+    out = tmp_path / "cmp"
+    done = mmtrack.analyze(runs, out, segment_lengths_m=[2, 4, 6, 8])
+    per_run = mmtrack.tables(out)
+    assert "trajectory_metrics" in per_run
+    metrics = per_run["trajectory_metrics"].collect()
+    assert sorted(set(metrics["run"].to_list())) == ["a", "b"]
+    assert set(metrics["sequence"].to_list()) == {"oxford-demo"}
+    # One run's folder alone: its `run` folder is a string column too.
+    alone = mmtrack.read_table(out / "run=a" / "tables", "trajectory_metrics").collect()
+    assert set(alone["run"].to_list()) == {"a"}
+    assert_frames_close(metrics.filter(pl.col("run") == "a"), alone.select(metrics.columns))
+    assert list(mmtrack.tables(done["tables"])) == ["run_comparison"]
+    assert mmtrack.table_info(out, "trajectory_metrics").files[0].endswith("part-0.parquet")
+
+
+def test_every_error_is_an_mmtrack_error(tmp_path: Path) -> None:
+    # Before: arguments numpy or pyo3 could not convert raised plain
+    # ValueError / TypeError / OverflowError, though the docstring promised
+    # MmtrackError. Now they are MmtrackError subclasses that are still
+    # ValueError / TypeError, named after the call.
+    with pytest.raises(mmtrack.MmtrackValueError, match="track_beams: could not convert string to float") as raised:
+        mmtrack.track_beams(np.array([["x"] * 64] * 3))
+    assert isinstance(raised.value, ValueError) and isinstance(raised.value, mmtrack.MmtrackError)
+    with pytest.raises(mmtrack.MmtrackValueError, match="detect_mpc: "):
+        mmtrack.detect_mpc(np.array([["a"] * 8]), tap_spacing_s=1e-9)
+    with pytest.raises(mmtrack.MmtrackValueError, match="negative"):
+        mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t", threads=-1)
+    with pytest.raises(mmtrack.MmtrackTypeError) as raised:
+        mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t", no_such_option=1)
+    assert isinstance(raised.value, TypeError)
+    # The data's own errors stay plain MmtrackError with the CLI's line.
+    with pytest.raises(mmtrack.MmtrackError) as raised:
+        mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t")
+    assert type(raised.value) is mmtrack.MmtrackError
+    # `config` is a path (str or pathlib.Path), as documented.
+    with pytest.raises(mmtrack.MmtrackError, match="none.toml"):
+        mmtrack.detect_mpc(np.ones((1, 8), dtype=complex), tap_spacing_s=1e-9, config=tmp_path / "none.toml")
+    assert "oxford" in mmtrack.INGEST_OPTIONS and "INGEST_OPTIONS" in mmtrack.ingest.__doc__
+    assert "odometry" in mmtrack.PROCESS_OPTIONS and "PROCESS_OPTIONS" in mmtrack.process.__doc__
+
+
+def test_a_corrupt_partition_is_named_when_the_table_is_opened(demo: dict[str, Path], tmp_path: Path) -> None:
+    # Before: polars' error at collect() ("The file must end with PAR1") named no file.
+    bad = tmp_path / "odometry" / "sequence=x" / "part-0.parquet"
+    bad.parent.mkdir(parents=True)
+    bad.write_text("not parquet\n")
+    with pytest.raises(mmtrack.MmtrackError, match=r"sequence=x/part-0\.parquet: not a readable Parquet table"):
+        mmtrack.tables(tmp_path)
+    cut = tmp_path / "odometry" / "sequence=x" / "part-0.parquet"
+    good = next((demo["tables"] / "odometry").glob("sequence=*/part-0.parquet")).read_bytes()
+    cut.write_bytes(good[:-1])
+    with pytest.raises(mmtrack.MmtrackError, match="no Parquet footer"):
+        mmtrack.read_table(tmp_path, "odometry")

@@ -438,6 +438,113 @@ fn slurm_array_tasks_give_the_local_tables() {
     assert!(text(&out).0.starts_with("skipped"), "{}", text(&out).0);
 }
 
+/// Before: `slurm_campaign.sh --submit` read `--print-levels` through a
+/// process substitution, so a broken manifest printed its error and exited
+/// 0 with nothing submitted; a level was one `--array` of task ids, however
+/// many (SLURM's MaxArraySize is 1001 by default). Now the broken manifest
+/// fails the script before any `sbatch`, and a level larger than
+/// `MMTRACK_MAX_ARRAY_SIZE` is split into arrays `0-<n-1>` given their task
+/// lists, each level depending on every array of the previous one. `sbatch`
+/// is a stand-in on PATH that records its arguments.
+#[test]
+fn slurm_submit_fails_on_a_broken_manifest_and_splits_large_levels() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let bin = d.join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let log = d.join("sbatch.log");
+    let sbatch = bin.join("sbatch");
+    // Prints job ids 101, 102, ... as `sbatch --parsable` would.
+    std::fs::write(
+        &sbatch,
+        "#!/usr/bin/env bash
+echo \"$*\" >> \"$SBATCH_LOG\"
+wc -l < \"$SBATCH_LOG\" | awk '{print $1 + 100}'
+",
+    )
+    .unwrap();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&sbatch, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default());
+    let script = root().join("examples/slurm_campaign.sh");
+    let submit = |manifest: &str, max_array: &str| {
+        Command::new("bash")
+            .arg(&script)
+            .args(["--submit", manifest, "tables"])
+            .env("PATH", &path)
+            .env("SBATCH_LOG", &log)
+            .env("MMTRACK", env!("CARGO_BIN_EXE_mmtrack"))
+            .env("MMTRACK_MAX_ARRAY_SIZE", max_array)
+            .current_dir(d)
+            .output()
+            .unwrap()
+    };
+    std::fs::write(d.join("broken.toml"), "[[task]]\nargs = [\"odometry\", \"x.mcap\"]\nneeds = [\"nope\"]\n").unwrap();
+    let out = submit("broken.toml", "1001");
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stdout}\n{stderr}");
+    assert!(stderr.contains("no task is named 'nope'"), "{stderr}");
+    assert!(!log.exists(), "nothing submitted");
+
+    // Levels 0,2 / 1 / 3; at most one task per array.
+    std::fs::write(d.join("steps.toml"), STEPS).unwrap();
+    let out = submit("steps.toml", "1");
+    assert!(out.status.success(), "{:?}", text(&out));
+    let calls = std::fs::read_to_string(&log).unwrap();
+    let script = script.display();
+    let expected = [
+        format!("--parsable --array=0-0 {script} steps.toml tables 0"),
+        format!("--parsable --array=0-0 {script} steps.toml tables 2"),
+        format!("--parsable --array=0-0 --dependency=afterok:101:102 {script} steps.toml tables 1"),
+        format!("--parsable --array=0-0 --dependency=afterok:103 {script} steps.toml tables 3"),
+    ];
+    assert_eq!(calls.lines().collect::<Vec<_>>(), expected);
+    std::fs::remove_file(&log).unwrap();
+    // The default: one array per level, indices 0..n-1 over the level's tasks.
+    assert!(submit("steps.toml", "1001").status.success());
+    let calls = std::fs::read_to_string(&log).unwrap();
+    assert_eq!(calls.lines().next(), Some(format!("--parsable --array=0-1 {script} steps.toml tables 0,2").as_str()));
+
+    // In the job, an index past its task list is refused.
+    let out = Command::new("bash")
+        .arg(root().join("examples/slurm_campaign.sh"))
+        .args(["steps.toml", "tables", "0,2"])
+        .env("SLURM_ARRAY_TASK_ID", "2")
+        .env("MMTRACK", env!("CARGO_BIN_EXE_mmtrack"))
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out).1.contains("array index 2: the task list '0,2' has 2 tasks"), "{:?}", text(&out));
+}
+
+/// Before: `ray_process.py` without a reachable binary (no `--mmtrack`, none
+/// on PATH, as after `pip install crates/mmtrack-py`) ended in a Python
+/// traceback with exit 1. Now it is a usage problem (exit 2) naming
+/// `--mmtrack`, told before Ray is imported (so no Ray is needed here).
+#[test]
+fn ray_example_without_the_binary_is_a_usage_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let example = root().join("examples/ray_process.py");
+    for extra in [&["--mmtrack", "/nonexistent/mmtrack"][..], &[]] {
+        let out = Command::new("python3")
+            .arg(&example)
+            .args(["campaign.toml", "tables"])
+            .args(extra)
+            .env("PATH", "/usr/bin:/bin")
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("cannot run the mmtrack binary") && stderr.contains("--mmtrack PATH"), "{stderr}");
+        assert!(!stderr.contains("Traceback"), "{stderr}");
+    }
+}
+
 /// A Python venv with Ray from PyPI, made on first use under the target
 /// directory. Ray is a requirement of the test: no skip.
 fn ray_python() -> PathBuf {

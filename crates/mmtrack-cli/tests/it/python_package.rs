@@ -21,8 +21,9 @@ use std::time::Instant;
 use super::common::root;
 
 /// PyPI packages of the suite, pinned (maturin comes from the package's
-/// `build-system.requires`).
-const REQUIREMENTS: &[&str] = &["polars==2.1.0", "numpy==2.4.6", "pytest==9.2.0", "pandas==3.1.1", "pyarrow==26.0.1"];
+/// `build-system.requires`); DuckDB runs the documented snippets.
+const REQUIREMENTS: &[&str] =
+    &["polars==2.1.0", "numpy==2.4.6", "pytest==9.2.0", "pandas==3.1.1", "pyarrow==26.0.1", "duckdb==2.0.1"];
 
 fn target_dir() -> PathBuf {
     std::env::var_os("CARGO_TARGET_DIR")
@@ -162,4 +163,7 @@ fn quickstart_notebook_runs_top_to_bottom(python: &Path) {
     // The Oxford tables' time base, and both trackers' rows of the DeepSense passes.
     assert!(text.contains("time base: unix_epoch"), "{text}");
     assert!(text.contains("window") && text.contains("last-full-sweep"), "{text}");
+    // Before: every run left its temporary outputs in /tmp. The last cell removes them.
+    let removed = text.lines().find_map(|l| l.strip_prefix("removed ")).unwrap_or_else(|| panic!("{text}"));
+    assert!(!Path::new(removed.trim()).exists(), "{removed}");
 }

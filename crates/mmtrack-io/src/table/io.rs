@@ -90,8 +90,14 @@ impl RunInfo {
 /// digits, `-`, `_` and `.` (no path separator, space or `=`). The error is
 /// what is wrong, for the caller to place. Ingest checks the id it writes
 /// into a recording with this, so a recording that `process` would refuse
-/// is refused when it is made.
+/// is refused when it is made. [`HIVE_NULL_PARTITION`] is refused too: Hive
+/// readers (DuckDB, polars, pyarrow) read that value as a missing id.
 pub fn check_partition_name(sequence_id: &str) -> std::result::Result<(), String> {
+    if sequence_id == HIVE_NULL_PARTITION {
+        return Err(format!(
+            "'{HIVE_NULL_PARTITION}' is not a valid partition name (Hive readers take it for a missing value)"
+        ));
+    }
     let safe = !sequence_id.is_empty()
         && sequence_id != "."
         && sequence_id != ".."
@@ -105,6 +111,9 @@ pub fn check_partition_name(sequence_id: &str) -> std::result::Result<(), String
         ))
     }
 }
+
+/// The partition value Hive readers read as null.
+pub const HIVE_NULL_PARTITION: &str = "__HIVE_DEFAULT_PARTITION__";
 
 /// Path of one partition: `<root>/<table>/sequence=<id>/part-0.parquet`.
 pub fn table_path(root: &Path, table: &str, sequence_id: &str) -> Result<PathBuf> {

@@ -190,3 +190,18 @@ fn unsafe_sequence_names_are_refused() {
         assert!(err.to_string().contains("sequence_id"), "{bad}: {err}");
     }
 }
+
+/// Before: `__HIVE_DEFAULT_PARTITION__` was accepted as a sequence id, and
+/// DuckDB, polars and pyarrow read its rows with a null sequence. Now it is
+/// refused like any name that cannot be a partition; ordinary ids pass.
+#[test]
+fn the_hive_null_partition_is_not_a_sequence_id() {
+    let error = mmtrack_io::table::check_partition_name("__HIVE_DEFAULT_PARTITION__").unwrap_err();
+    assert!(error.contains("missing value"), "{error}");
+    assert!(
+        mmtrack_io::table::table_path(std::path::Path::new("t"), "odometry", "__HIVE_DEFAULT_PARTITION__").is_err()
+    );
+    for fine in ["007", "2019-01-10", "__HIVE_DEFAULT_PARTITION__x", "oxford-demo"] {
+        mmtrack_io::table::check_partition_name(fine).unwrap();
+    }
+}

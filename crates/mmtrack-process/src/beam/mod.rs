@@ -138,5 +138,12 @@ pub fn process_beam(output: &Path, request: &BeamRequest, progress: &dyn Progres
             BeamTracker::Spebt | BeamTracker::Geometric => None,
         })
         .collect();
-    Ok(BeamOutput::Sweeps(sweep::process_sweeps(&files, output, &sweep_kinds, request.reacquire, &request.output)?))
+    Ok(BeamOutput::Sweeps(sweep::process_sweeps(
+        &files,
+        output,
+        &sweep_kinds,
+        request.reacquire,
+        &request.output,
+        progress,
+    )?))
 }

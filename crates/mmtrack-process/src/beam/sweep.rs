@@ -34,6 +34,7 @@ use mmtrack_beam::sweep::{
     Reacquisition, SearchConfig, SweepPass, SweepRecord, SweepSummary, SweepTracker, WindowTracker,
     WindowTrackerConfig, evaluate,
 };
+use mmtrack_core::progress::Progress;
 use mmtrack_core::{BeamSweep, GnssFix};
 use mmtrack_ingest::nmea::{EnuOrigin, geodetic_to_enu_m};
 use mmtrack_io::recording::{BEAM_SITE_KEY, RecordingMetadata, TimeBase};
@@ -246,12 +247,14 @@ pub struct SiteRun {
 /// # Errors
 /// No policy or no pass; a GNSS policy with fewer than two passes or a pass
 /// without positions (or with one per sweep missing); a degenerate map; the
-/// trackers' errors; each naming the pass.
+/// trackers' errors; each naming the pass. [`Progress::check_cancelled`]'s
+/// error, asked per pass and policy.
 pub fn track_site(
     kinds: &[SweepTrackerKind],
     reacquire: Reacquire,
     site: &str,
     passes: &[PassInput<'_>],
+    progress: &dyn Progress,
 ) -> anyhow::Result<SiteRun> {
     let mut kinds = kinds.to_vec();
     kinds.sort();
@@ -268,6 +271,7 @@ pub fn track_site(
     for &kind in &kinds {
         let mut records_of_kind = Vec::new();
         for (i, pass) in passes.iter().enumerate() {
+            progress.check_cancelled()?;
             let map = maps.as_ref().map(|m| &m.per_pass[i]);
             let gnss_beam = maps.as_ref().map(|m| m.gnss_beam[i].as_slice());
             let mut policy = tracker(kind, reacquire, map)?;
@@ -469,6 +473,7 @@ pub fn process_sweeps(
     kinds: &[SweepTrackerKind],
     reacquire: Reacquire,
     options: &OutputOptions,
+    progress: &dyn Progress,
 ) -> anyhow::Result<SweepOutput> {
     let out = options.resolve(output)?;
     let mut kinds = kinds.to_vec();
@@ -513,7 +518,7 @@ pub fn process_sweeps(
                 east_north_m: positions.as_deref(),
             })
             .collect();
-        let run = track_site(&kinds, reacquire, name, &inputs)?;
+        let run = track_site(&kinds, reacquire, name, &inputs, progress)?;
         for (pass, rows) in passes.iter().zip(run.rows) {
             tables.entry(pass.sequence_id.clone()).or_default().extend(rows);
         }

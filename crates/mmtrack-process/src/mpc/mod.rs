@@ -256,6 +256,7 @@ fn read_and_process(
             RecordingItem::Scan(_) => continue,
         };
         progress.set_position(reader.bytes_read());
+        progress.check_cancelled()?;
         match event {
             RecordingEvent::Cir(snapshot) => {
                 let key = (snapshot.tx_antenna, snapshot.rx_antenna);

@@ -78,6 +78,7 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, progress: &dyn Pro
     let mut ground_truth = Vec::new();
     let metadata = for_each_event(recording, |event, bytes_read| {
         progress.set_position(bytes_read);
+        progress.check_cancelled()?;
         match event {
             RecordingEvent::RadarScan(scan) => {
                 let result = process_scan(&mut odometry, &scan, estimates.len())?;

@@ -122,6 +122,7 @@ pub fn write_oxford_streaming(
         timestamps.push_str(&format!("{t_us} 1\n"));
         truth.push(pose);
         progress.advance(1);
+        progress.check_cancelled()?;
     }
     // The ingest crate's writer produces gt/radar_odometry.csv (its frame conventions);
     // radar.timestamps is rewritten after it with the scans streamed above.
@@ -205,6 +206,7 @@ fn write_recording(
         writer.write_radar_scan(&scan)?;
         writer.write_pose(PoseStream::GroundTruth, &pose, "world")?;
         progress.advance(1);
+        progress.check_cancelled()?;
     }
     writer.finish()?;
     Ok(())

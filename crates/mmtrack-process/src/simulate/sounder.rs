@@ -135,6 +135,7 @@ fn write_convoy(
         written.snapshots += set.snapshots.len() as u64;
         written.truths += set.truth.len() as u64;
         progress.advance(1);
+        progress.check_cancelled()?;
     }
     writer.finish()?;
     progress.finish();

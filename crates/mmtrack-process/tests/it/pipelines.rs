@@ -40,6 +40,54 @@ fn radar_recording(dir: &Path, scans: usize) -> PathBuf {
     output
 }
 
+/// A front end that asks to stop after `allowed` checks (Python's Ctrl-C).
+struct CancelAfter {
+    allowed: std::sync::atomic::AtomicUsize,
+}
+
+impl mmtrack_core::progress::Progress for CancelAfter {
+    fn start(&self, _stage: &str, _total: u64, _unit: &str) {}
+    fn set_position(&self, _done: u64) {}
+    fn advance(&self, _by: u64) {}
+    fn finish(&self) {}
+    fn note(&self, _text: &str) {}
+    fn check_cancelled(&self) -> Result<(), mmtrack_core::progress::Cancelled> {
+        use std::sync::atomic::Ordering;
+        let left = self.allowed.load(Ordering::Relaxed);
+        if left == 0 {
+            return Err(mmtrack_core::progress::Cancelled);
+        }
+        self.allowed.store(left - 1, Ordering::Relaxed);
+        Ok(())
+    }
+}
+
+/// Before: a library call could not be stopped before its end (Python's
+/// Ctrl-C waited for it). Now a cancelled progress stops it at the next
+/// item with the `Cancelled` error, and the output folder holds nothing:
+/// no table, no partial file.
+#[test]
+fn a_cancelled_call_stops_early_and_leaves_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let recording = radar_recording(dir.path(), 6);
+    let tables = dir.path().join("tables");
+    let config = odometry::effective_config("fast-cfear", None).unwrap();
+    let progress = CancelAfter { allowed: 2.into() };
+    let error =
+        odometry::process_odometry(&recording, &tables, "fast-cfear", &config, &OutputOptions::default(), &progress)
+            .err()
+            .expect("cancelled");
+    assert!(error.chain().any(|e| e.is::<mmtrack_core::progress::Cancelled>()), "{error:#}");
+    let left: Vec<_> = walk(&tables);
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// Every file under `dir` (none when it does not exist).
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
+    entries.flatten().flat_map(|e| if e.path().is_dir() { walk(&e.path()) } else { vec![e.path()] }).collect()
+}
+
 #[test]
 fn odometry_writes_one_pose_per_scan_refuses_existing_tables_and_keeps_runs_apart() {
     let dir = tempfile::tempdir().unwrap();
@@ -140,8 +188,15 @@ fn sweep_trackers_run_on_real_deepsense_passes() {
     let files: Vec<PathBuf> =
         passes.iter().take(3).map(|p| dir.path().join("rec").join(format!("{}.mcap", p.sequence_id))).collect();
     let kinds = [SweepTrackerKind::Window, SweepTrackerKind::LastFullSweep, SweepTrackerKind::GnssMap];
-    let done = process_sweeps(&files, &dir.path().join("tables"), &kinds, Reacquire::Coarse, &OutputOptions::default())
-        .unwrap();
+    let done = process_sweeps(
+        &files,
+        &dir.path().join("tables"),
+        &kinds,
+        Reacquire::Coarse,
+        &OutputOptions::default(),
+        &NoProgress,
+    )
+    .unwrap();
     assert_eq!(done.sites.len(), 1);
     assert_eq!(done.sites[0].passes, 3);
     assert_eq!(done.summaries.len(), 3);

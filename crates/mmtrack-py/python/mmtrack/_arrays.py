@@ -8,6 +8,7 @@ units), as a polars DataFrame.
 from __future__ import annotations
 
 import io
+import os
 from dataclasses import dataclass
 from typing import Any, Optional, Sequence, Union
 
@@ -15,6 +16,8 @@ import numpy as np
 import polars as pl
 
 from . import _native
+
+PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _frame(data: bytes) -> pl.DataFrame:
@@ -47,14 +50,14 @@ def detect_mpc(
     t_ns: Optional[Any] = None,
     set_index: Optional[Any] = None,
     snapshot_index: Optional[Any] = None,
-    config: Optional[str] = None,
+    config: Optional[PathLike] = None,
     pulse: Optional[Any] = None,
 ) -> MpcDetections:
     """CLEAN detection of multipath components (Mahler et al. 2017, Sec. III-A).
 
     ``cir``: complex taps, shape (taps,) or (snapshots, taps), spaced
-    ``tap_spacing_s`` apart. ``config``: an MPC configuration TOML (as
-    ``process mpc --config``; its ``[detection]`` applies). ``pulse``: a
+    ``tap_spacing_s`` apart. ``config``: the path of an MPC configuration
+    TOML file (as ``process mpc --config``; its ``[detection]`` applies). ``pulse``: a
     back-to-back CIR of the sounder (as ``--pulse FILE.npy``), else the band's
     flat spectrum. ``t_ns``, ``set_index``, ``snapshot_index`` label the rows
     (default: 0, 1, ...; set 0; the row).
@@ -75,7 +78,7 @@ def detect_mpc(
         sets,
         rows,
         float(tap_spacing_s),
-        config,
+        None if config is None else os.fspath(config),
         None if pulse is None else _le(np.asarray(pulse).astype(np.complex128).ravel(), "c16"),
     )
     table = _frame(data)

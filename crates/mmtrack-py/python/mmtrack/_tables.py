@@ -2,7 +2,8 @@
 
 A table directory (what ``process`` and ``analyze`` write) holds
 ``<root>/<table>/sequence=<id>/part-0.parquet``, or one such tree per run
-under ``<root>/run=<ID>/``. :func:`read_table` scans every partition of one
+under ``<root>/run=<ID>/`` (``process --run-id``) or ``<root>/run=<ID>/tables/``
+(a multi-run ``analyze``'s per-run results). :func:`read_table` scans every partition of one
 table lazily, with the Hive columns ``sequence`` (and ``run``) as strings.
 """
 
@@ -104,39 +105,83 @@ def table_spec(name: str) -> TableSpec:
     return spec
 
 
+#: Where a table's partitions sit under a root, with the Hive columns of each
+#: layout: a table directory; ``process --run-id``'s ``run=<ID>/`` folders;
+#: a multi-run ``analyze``'s per-run results, ``run=<ID>/tables/``.
+_LAYOUTS = (
+    ("{name}/sequence=*/*.parquet", {"sequence": pl.String}),
+    ("run=*/{name}/sequence=*/*.parquet", {"run": pl.String, "sequence": pl.String}),
+    ("run=*/tables/{name}/sequence=*/*.parquet", {"run": pl.String, "sequence": pl.String}),
+)
+
+
+def _layout(root: Path, name: str) -> tuple[str, dict[str, Any], list[Path]]:
+    """The one layout of table `name` under `root`: glob pattern, Hive schema, files."""
+    found = [(pattern, hive, sorted(root.glob(pattern.format(name=name)))) for pattern, hive in _LAYOUTS]
+    found = [f for f in found if f[2]]
+    if len(found) > 1:
+        where = " and ".join(str(root / pattern.format(name=name)) for pattern, _, _ in found)
+        raise _native.MmtrackError(f"{root}: table {name} in more than one layout ({where}); read one of them")
+    if not found:
+        raise _native.MmtrackError(
+            f"{root}: no table {name} (expected {name}/sequence=<id>/part-0.parquet, or that under run=<ID>/ "
+            f"or run=<ID>/tables/)"
+        )
+    return found[0]
+
+
+def _check_parquet_footer(file: Path) -> None:
+    """Refuses a file that cannot be Parquet (shorter than a footer, or not
+    ending in ``PAR1``), naming it: polars' own error at ``collect()`` names
+    no file."""
+    try:
+        with open(file, "rb") as f:
+            size = f.seek(0, os.SEEK_END)
+            if size >= 12:
+                f.seek(-4, os.SEEK_END)
+                if f.read(4) == b"PAR1":
+                    return
+    except OSError as error:
+        raise _native.MmtrackError(f"{file}: cannot be read: {error.strerror}") from error
+    raise _native.MmtrackError(f"{file}: not a readable Parquet table (no Parquet footer: cut off or not Parquet)")
+
+
 def _files(root: Path, name: str) -> list[Path]:
-    direct = sorted(root.glob(f"{name}/sequence=*/*.parquet"))
-    runs = sorted(root.glob(f"run=*/{name}/sequence=*/*.parquet"))
-    return direct + runs
+    return _layout(root, name)[2]
 
 
 def read_table(root: PathLike, name: str) -> pl.LazyFrame:
     """Every partition of table ``name`` under ``root`` as one polars LazyFrame.
 
+    ``root`` is a table directory (``<root>/<name>/sequence=<id>/``), a
+    directory of runs (``<root>/run=<ID>/<name>/...``, what ``process
+    --run-id`` writes), or the output of a multi-run ``analyze``, whose
+    per-run result tables are under ``<root>/run=<ID>/tables/<name>/...``
+    (its comparison tables: ``read_table(<root>/tables, "run_comparison")``).
     The Hive columns ``sequence`` (and ``run`` for ``run=<ID>`` folders) are
     strings. Row order is file order (runs, then sequences, sorted) and row
     order within each file; sort explicitly after joins. ``.collect()`` for a
     DataFrame, ``.collect().to_pandas()`` for pandas.
     """
     base = Path(os.fspath(root))
-    direct = sorted(base.glob(f"{name}/sequence=*/*.parquet"))
-    runs = sorted(base.glob(f"run=*/{name}/sequence=*/*.parquet"))
-    if direct and runs:
-        raise _native.MmtrackError(
-            f"{base}: table {name} both directly and in run= folders; read {base}/run=<ID> or the table itself"
-        )
-    if not direct and not runs:
-        raise _native.MmtrackError(f"{base}: no table {name} (expected {name}/sequence=<id>/part-0.parquet)")
-    hive = {"sequence": pl.String} if direct else {"run": pl.String, "sequence": pl.String}
-    pattern = f"{base}/{name}/sequence=*/*.parquet" if direct else f"{base}/run=*/{name}/sequence=*/*.parquet"
-    return pl.scan_parquet(pattern, hive_partitioning=True, hive_schema=hive, try_parse_hive_dates=False)
+    pattern, hive, files = _layout(base, name)
+    for file in files:
+        _check_parquet_footer(file)
+    # polars takes every `key=value` folder of the path as a Hive column, also
+    # those of `root` itself (e.g. `<analysis>/run=a/tables`): strings too.
+    hive = {**{part.split("=", 1)[0]: pl.String for part in base.parts if "=" in part}, **hive}
+    return pl.scan_parquet(
+        f"{base}/{pattern.format(name=name)}", hive_partitioning=True, hive_schema=hive, try_parse_hive_dates=False
+    )
 
 
 def tables(root: PathLike) -> dict[str, pl.LazyFrame]:
-    """Every table under ``root`` (directly or in ``run=<ID>`` folders), by name, as LazyFrames."""
+    """Every table under ``root`` (directly, in ``run=<ID>`` folders, or in a
+    multi-run ``analyze``'s ``run=<ID>/tables`` folders), by name, as LazyFrames."""
     base = Path(os.fspath(root))
     names = {p.parent.parent.name for p in base.glob("*/sequence=*/*.parquet") if not p.parent.parent.name.startswith("run=")}
     names |= {p.parent.parent.name for p in base.glob("run=*/*/sequence=*/*.parquet")}
+    names |= {p.parent.parent.name for p in base.glob("run=*/tables/*/sequence=*/*.parquet")}
     if not names:
         raise _native.MmtrackError(f"{base}: no tables (expected <table>/sequence=<id>/part-0.parquet)")
     return {name: read_table(base, name) for name in sorted(names)}

@@ -2,7 +2,8 @@
 //! library calls, nothing else. The Python half (`python/mmtrack`) gives
 //! the public names, defaults and docs; `_native.pyi` types this module.
 //!
-//! Every call releases the GIL while the libraries work, runs on the pool
+//! Every call releases the GIL while the libraries work ([`interruptible`]:
+//! Ctrl-C stops the long loops and raises `KeyboardInterrupt`), runs on the pool
 //! of its `threads` argument where the CLI command has `--threads`
 //! ([`mmtrack_process::threads::install`]), and turns an error into
 //! `mmtrack.MmtrackError` with the one line the CLI prints after `error: `
@@ -10,9 +11,12 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
+use std::time::Duration;
 
 use mmtrack_analysis::analyze::{AnalyzeOptions, Analyzed, analyze};
-use mmtrack_core::progress::NoProgress;
+use mmtrack_core::progress::{Cancelled, Progress};
 use mmtrack_io::recording::RecordingFlags;
 use mmtrack_io::table::{ALL_TABLES, RESULT_TABLES, TableSpec, TableWriteSummary};
 use mmtrack_process::output::OutputOptions;
@@ -33,9 +37,81 @@ fn py_err(error: anyhow::Error) -> PyErr {
     MmtrackError::new_err(mmtrack_core::error::one_line(error.chain()))
 }
 
-/// Runs `work` without the GIL on a pool of `threads` threads.
+/// Runs `work` without the GIL on a pool of `threads` threads
+/// ([`interruptible`]; `work` has no hook to stop early, so an interruption
+/// waits for it).
 fn run<R: Send>(py: Python<'_>, threads: usize, work: impl FnOnce() -> anyhow::Result<R> + Send) -> PyResult<R> {
-    py.detach(|| mmtrack_process::threads::install(threads, work).and_then(|r| r)).map_err(py_err)
+    interruptible(py, threads, |_| work())
+}
+
+/// The [`Progress`] of a Python call: draws nothing, and is cancelled once
+/// the calling thread has seen a signal handler raise (Ctrl-C).
+#[derive(Debug, Default)]
+struct Interruption {
+    requested: AtomicBool,
+}
+
+impl Progress for Interruption {
+    fn start(&self, _stage: &str, _total: u64, _unit: &str) {}
+    fn set_position(&self, _done: u64) {}
+    fn advance(&self, _by: u64) {}
+    fn finish(&self) {}
+    fn note(&self, _text: &str) {}
+    fn check_cancelled(&self) -> Result<(), Cancelled> {
+        if self.requested.load(Ordering::Relaxed) { Err(Cancelled) } else { Ok(()) }
+    }
+}
+
+/// How often the waiting thread takes the GIL back to run signal handlers.
+const SIGNAL_CHECK_PERIOD: Duration = Duration::from_millis(50);
+
+/// Runs `work` on a thread of its own, on a pool of `threads` threads,
+/// while the calling thread waits without the GIL and every
+/// [`SIGNAL_CHECK_PERIOD`] takes it back to run Python's signal handlers
+/// (`Python::check_signals`; they run on the main thread only). When one
+/// raises (Ctrl-C: `KeyboardInterrupt`), `work`'s [`Progress`] is cancelled,
+/// the library stops at its next check and drops its partial outputs as on
+/// any error, and the handler's exception is raised once `work` has
+/// returned, as the CLI removes its partial outputs before it exits.
+fn interruptible<R: Send>(
+    py: Python<'_>,
+    threads: usize,
+    work: impl FnOnce(&dyn Progress) -> anyhow::Result<R> + Send,
+) -> PyResult<R> {
+    let interruption = Interruption::default();
+    let (done_tx, mut done_rx) = mpsc::channel::<()>();
+    let (interrupt, result) = std::thread::scope(|scope| {
+        let progress = &interruption;
+        let worker = scope.spawn(move || {
+            let result = mmtrack_process::threads::install(threads, || work(progress)).and_then(|r| r);
+            // The waiting thread may be gone only after a panic of its own.
+            let _ = done_tx.send(());
+            result
+        });
+        let mut interrupt: Option<PyErr> = None;
+        loop {
+            let (rx, waited) = py.detach(move || {
+                let waited = done_rx.recv_timeout(SIGNAL_CHECK_PERIOD);
+                (done_rx, waited)
+            });
+            done_rx = rx;
+            if !matches!(waited, Err(mpsc::RecvTimeoutError::Timeout)) {
+                break;
+            }
+            if interrupt.is_none()
+                && let Err(e) = py.check_signals()
+            {
+                interruption.requested.store(true, Ordering::Relaxed);
+                interrupt = Some(e);
+            }
+        }
+        let result = worker.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (interrupt, result)
+    });
+    match (interrupt, result) {
+        (Some(interrupt), _) => Err(interrupt),
+        (None, result) => result.map_err(py_err),
+    }
 }
 
 fn dict<'py>(py: Python<'py>, items: &[(&str, Bound<'py, PyAny>)]) -> PyResult<Bound<'py, PyDict>> {

@@ -19,9 +19,9 @@ pub(super) fn process_odometry<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     use mmtrack_process::odometry;
     let options = output_options(sequence, force, run_id);
-    let done = run(py, threads, || {
+    let done = interruptible(py, threads, |progress| {
         let config = odometry::effective_config(&preset, config.as_deref())?;
-        odometry::process_odometry(&recording, &output, &preset, &config, &options, &NoProgress)
+        odometry::process_odometry(&recording, &output, &preset, &config, &options, progress)
     })?;
     let low = done.run.estimates.iter().filter(|e| e.low_confidence).count();
     dict(
@@ -79,12 +79,12 @@ pub(super) fn process_mpc<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     use mmtrack_process::mpc;
     let output_options = output_options(sequence, force, run_id);
-    let done = run(py, threads, || {
+    let done = interruptible(py, threads, |progress| {
         let mut config = mpc::effective_config(config.as_deref())?;
         config.run_gmphd |= gmphd;
         let options =
             mpc::MpcOptions { pulse, link: link.as_deref().map(mpc::parse_link).transpose()?, output: output_options };
-        mpc::process_mpc(&recording, &output, &config, &options, &NoProgress)
+        mpc::process_mpc(&recording, &output, &config, &options, progress)
     })?;
     let links = PyList::empty(py);
     for l in &done.links {
@@ -140,7 +140,7 @@ pub(super) fn process_beam<'py>(
         epoch_ms: get(geometric, "epoch_ms")?.map(|v| v.extract()).transpose()?,
         doppler_seed: get(geometric, "doppler_seed")?.map(|v| v.extract()).transpose()?,
     };
-    let done = run(py, 0, || {
+    let done = interruptible(py, 0, |progress| {
         let beam_schedule = match schedule.as_deref() {
             None => None,
             Some("paper") => Some(Schedule::Paper),
@@ -155,7 +155,7 @@ pub(super) fn process_beam<'py>(
             spebt,
             geometric: GeometricOptions { beam_schedule, ..geometric_options },
         };
-        mmtrack_process::beam::process_beam(&output, &request, &NoProgress)
+        mmtrack_process::beam::process_beam(&output, &request, progress)
     })?;
     let written = match &done {
         BeamOutput::Sweeps(d) => &d.written,

@@ -57,7 +57,7 @@ pub(super) fn reproduce_experiment<'py>(
         pulse: get("pulse")?.map(|v| v.extract()).transpose()?,
         keep_taps_below_threshold: flag("keep_taps_below_threshold")?,
     };
-    let outcome = run(py, threads, || run_experiment(&experiment, &request, &NoProgress))?;
+    let outcome = interruptible(py, threads, |progress| run_experiment(&experiment, &request, progress))?;
     let metrics = PyList::empty(py);
     for m in &outcome.metrics {
         metrics.append(dict(
@@ -96,7 +96,7 @@ pub(super) fn reproduce_all<'py>(
     use mmtrack_reproduce::Tier;
     use mmtrack_reproduce::all::{AllOptions, run_all};
     let options = AllOptions { tier: if smoke { Tier::Smoke } else { Tier::Full }, output_dir: output, readme };
-    let outcome = run(py, 0, || run_all(&options, &NoProgress))?;
+    let outcome = interruptible(py, 0, |progress| run_all(&options, progress))?;
     dict(
         py,
         &[
@@ -186,7 +186,7 @@ pub(super) fn detect_mpc<'py>(
     let taps = arrays::complexes(taps.as_bytes(), "cir").map_err(py_err)?;
     let t_ns = arrays::i64s(t_ns.as_bytes(), "t_ns").map_err(py_err)?;
     let pulse = pulse.map(|p| arrays::complexes(p.as_bytes(), "pulse")).transpose().map_err(py_err)?;
-    let bytes = run(py, 0, || {
+    let bytes = interruptible(py, 0, |progress| {
         let cir = arrays::CirArray {
             taps: &taps,
             taps_per_snapshot,
@@ -195,7 +195,7 @@ pub(super) fn detect_mpc<'py>(
             snapshot_index: &snapshot_index,
             tap_spacing_s,
         };
-        arrays::detect_mpc(&cir, config.as_deref(), pulse.as_deref())
+        arrays::detect_mpc(&cir, config.as_deref(), pulse.as_deref(), progress)
     })?;
     Ok(PyBytes::new(py, &bytes))
 }
@@ -227,7 +227,7 @@ pub(super) fn track_beams<'py>(
         Ok((power, t_ns, pass_index, car, array))
     };
     let (power, t_ns, pass_index, car, array) = read().map_err(py_err)?;
-    let tables = run(py, 0, || {
+    let tables = interruptible(py, 0, |progress| {
         let car_frame = match (car_frame, array.as_deref()) {
             ("east_north_m", None) => arrays::CarFrame::EastNorthM,
             ("lat_lon_deg", Some(array_lat_lon_deg)) => arrays::CarFrame::LatLonDeg { array_lat_lon_deg },
@@ -245,7 +245,7 @@ pub(super) fn track_beams<'py>(
             car: car.as_deref(),
             car_frame,
         };
-        arrays::track_beams(&sweeps, &tracker, &reacquire, &site)
+        arrays::track_beams(&sweeps, &tracker, &reacquire, &site, progress)
     })?;
     Ok(tables.into_iter().map(|(pass, bytes)| (pass, PyBytes::new(py, &bytes))).collect())
 }

@@ -144,6 +144,7 @@ pub fn measure(
         let results: Vec<KimRunOutcome> = (0..runs)
             .into_par_iter()
             .map(|r| {
+                progress.check_cancelled()?;
                 let realised = scenario.realise(experiment.seed, r)?;
                 let filter_seed = experiment.seed.wrapping_mul(mmtrack_core::random::SPLITMIX_GAMMA) ^ r;
                 let outcome = run_filter(

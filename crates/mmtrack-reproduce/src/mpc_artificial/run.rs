@@ -118,6 +118,7 @@ pub fn measure(config: &Config, powers_db: &[f64], runs: u64, progress: &dyn Pro
             sweep.bins.extend(bins);
         }
         progress.advance(1);
+        progress.check_cancelled()?;
     }
     progress.finish();
     Ok(sweep)

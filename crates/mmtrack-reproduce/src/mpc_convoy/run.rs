@@ -328,7 +328,12 @@ impl Run {
 /// Simulates `convoy` (seed `seed`) once and runs every detector of
 /// `groups` (`(refined, variants)`, see [`Run`]) on the same snapshots; one
 /// scene per group, in order.
-fn run_scenes(convoy: &ConvoyConfig, seed: u64, groups: &[(bool, Vec<Variant>)]) -> anyhow::Result<Vec<Scene>> {
+fn run_scenes(
+    convoy: &ConvoyConfig,
+    seed: u64,
+    groups: &[(bool, Vec<Variant>)],
+    progress: &dyn Progress,
+) -> anyhow::Result<Vec<Scene>> {
     let simulator = ConvoySimulator::new(convoy, seed)?;
     let pulse = SounderPulse::from_spectrum(simulator.pulse_spectrum().to_vec())?;
     let tap_spacing_s = simulator.band().tap_spacing_s();
@@ -341,6 +346,7 @@ fn run_scenes(convoy: &ConvoyConfig, seed: u64, groups: &[(bool, Vec<Variant>)])
     let batch = MpcPipeline::SETS_PER_THREAD * rayon::current_num_threads();
     let mut sets = simulator.peekable();
     while sets.peek().is_some() {
+        progress.check_cancelled()?;
         let chunk: Vec<SounderSet> = sets.by_ref().take(batch).collect();
         for run in &mut runs {
             run.push(&chunk)?;
@@ -427,8 +433,10 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
             .collect();
         progress
             .note(&format!("simulating and tracking {sets} sets of {what} (the paper's search and the refined one)"));
-        let scenes: Vec<(Scene, Vec<Variant>)> =
-            run_scenes(scenario, seed, &groups)?.into_iter().zip(groups.into_iter().map(|(_, g)| g)).collect();
+        let scenes: Vec<(Scene, Vec<Variant>)> = run_scenes(scenario, seed, &groups, progress)?
+            .into_iter()
+            .zip(groups.into_iter().map(|(_, g)| g))
+            .collect();
         for &truth in truths {
             for (scene, group) in &scenes {
                 let table: Vec<MpcTruth> = if truth == Truth::SpecularOnly {

@@ -92,6 +92,7 @@ pub fn measure(config: &Config, tier: Tier, progress: &dyn Progress) -> anyhow::
         }
         ground_truth.push(pose);
         progress.advance(1);
+        progress.check_cancelled()?;
     }
     progress.finish();
     let elapsed_s = started.elapsed().as_secs_f64();

@@ -85,6 +85,7 @@ pub fn measure(config: &Config, runs: u64, progress: &dyn Progress) -> anyhow::R
             .into_par_iter()
             .map(|c| {
                 let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
+                progress.check_cancelled()?;
                 let chunk = run_chunk(&scenario, config, range);
                 progress.advance(RUNS_PER_CHUNK);
                 chunk

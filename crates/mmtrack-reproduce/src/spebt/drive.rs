@@ -81,6 +81,7 @@ pub fn drive(poses: Vec<StampedPose>, preset: &str, progress: &dyn Progress) -> 
         raw.push(result.estimate.world_from_vehicle);
         ground_truth.push(pose);
         progress.advance(1);
+        progress.check_cancelled()?;
     }
     progress.finish();
     anyhow::ensure!(ground_truth.len() >= 2, "the simulated drive gave {} scans; nothing to track", ground_truth.len());

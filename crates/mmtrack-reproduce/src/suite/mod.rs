@@ -29,7 +29,9 @@
 //!
 //! `{suite}` is the directory of the suite file and `{work}` the directory
 //! the steps write to (a fresh one per check), so a suite runs from any
-//! working directory. A metric selects rows by partition keys (`sequence`,
+//! working directory. `{env:NAME}` is the environment variable NAME, or
+//! where it is unset the suite's default for it (`[env] NAME = "..."`, which
+//! may use `{suite}`): data kept elsewhere on another machine. A metric selects rows by partition keys (`sequence`,
 //! `run`, any `key=value` folder) and column equalities, and needs an
 //! `aggregate` (mean, min, max, sum, count) when more than one row is
 //! selected ([`select`]). `--bless` writes the measured values into the
@@ -57,6 +59,9 @@ pub const STEP_COMMANDS: [&str; 5] = ["ingest", "simulate", "process", "analyze"
 #[serde(deny_unknown_fields)]
 struct SuiteFile {
     description: Option<String>,
+    /// Defaults of the `{env:NAME}` placeholders, used where NAME is unset.
+    #[serde(default)]
+    env: BTreeMap<String, String>,
     #[serde(default)]
     step: Vec<StepFile>,
     #[serde(default)]
@@ -138,6 +143,9 @@ pub struct Suite {
     pub description: Option<String>,
     /// Command lines after `mmtrack`, placeholders still in.
     pub steps: Vec<Vec<String>>,
+    /// The `[env]` table: the value of `{env:NAME}` where the environment
+    /// variable NAME is unset or empty (may hold `{suite}`).
+    pub env: BTreeMap<String, String>,
     /// The metrics, in file order.
     pub metrics: Vec<SuiteMetric>,
 }
@@ -177,6 +185,12 @@ pub fn parse_suite(path: &Path, text: &str) -> anyhow::Result<Suite> {
     if file.metric.len() > MAX_METRICS {
         bail!("{name}: {} metrics; at most {MAX_METRICS}", file.metric.len());
     }
+    for (key, value) in &file.env {
+        if !is_env_name(key) {
+            bail!("{name}: [env]: `{key}` is not an environment variable name (letters, digits, '_')");
+        }
+        check_placeholders(value, false).with_context(|| format!("{name}: [env] {key}"))?;
+    }
     let mut steps = Vec::with_capacity(file.step.len());
     for (i, step) in file.step.into_iter().enumerate() {
         let at = format!("{name}: step {}", i + 1);
@@ -185,7 +199,7 @@ pub fn parse_suite(path: &Path, text: &str) -> anyhow::Result<Suite> {
             bail!("{at}: `{command}` is not a step command (one of {})", STEP_COMMANDS.join(", "));
         }
         for word in &step.args {
-            check_placeholders(word).with_context(|| at.clone())?;
+            check_placeholders(word, true).with_context(|| at.clone())?;
         }
         steps.push(step.args);
     }
@@ -231,27 +245,90 @@ pub fn parse_suite(path: &Path, text: &str) -> anyhow::Result<Suite> {
             tolerance,
         });
     }
-    Ok(Suite { path: path.to_path_buf(), description: file.description, steps, metrics })
+    Ok(Suite { path: path.to_path_buf(), description: file.description, steps, env: file.env, metrics })
 }
 
-/// Refuses braces other than the `{suite}` and `{work}` placeholders.
-fn check_placeholders(word: &str) -> anyhow::Result<()> {
-    let rest = word.replace("{suite}", "").replace("{work}", "");
-    if let Some(start) = rest.find('{') {
-        let end = rest[start..].find('}').map_or(rest.len(), |e| start + e + 1);
-        bail!("`{word}`: unknown placeholder `{}` (use {{suite}} or {{work}})", &rest[start..end]);
+/// Whether `name` can name an environment variable in `{env:NAME}`.
+fn is_env_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
+}
+
+/// The placeholders of `word` in order: `(start, end, inside the braces)`.
+fn placeholders(word: &str) -> Vec<(usize, usize, &str)> {
+    let mut found = Vec::new();
+    let mut from = 0;
+    while let Some(start) = word[from..].find('{').map(|s| from + s) {
+        let end = word[start..].find('}').map_or(word.len(), |e| start + e + 1);
+        found.push((start, end, word[start + 1..end].trim_end_matches('}')));
+        from = end;
+    }
+    found
+}
+
+/// Refuses braces other than the `{suite}` and `{work}` placeholders and
+/// (with `env`) `{env:NAME}`.
+fn check_placeholders(word: &str, env: bool) -> anyhow::Result<()> {
+    for (start, end, inside) in placeholders(word) {
+        let known = inside == "suite"
+            || (env && inside == "work")
+            || (env && inside.strip_prefix("env:").is_some_and(is_env_name));
+        if !known {
+            let allowed = if env { "{suite}, {work} or {env:NAME}" } else { "{suite}" };
+            bail!("`{word}`: unknown placeholder `{}` (use {allowed})", &word[start..end]);
+        }
     }
     Ok(())
 }
 
-/// A step's words with `{suite}` and `{work}` replaced.
+/// A step's words with `{suite}`, `{work}` and `{env:NAME}` replaced:
+/// `lookup(NAME)` (the environment) where it is set and not empty, else
+/// the suite's `[env]` default (`env_defaults`, its `{suite}` replaced).
 ///
 /// # Errors
-/// A directory that is not UTF-8 (the words are command-line text).
-pub fn step_words(step: &[String], suite_dir: &Path, work_dir: &Path) -> anyhow::Result<Vec<String>> {
+/// A directory that is not UTF-8 (the words are command-line text); an
+/// `{env:NAME}` whose variable is unset with no default.
+pub fn step_words(
+    step: &[String],
+    suite_dir: &Path,
+    work_dir: &Path,
+    env_defaults: &BTreeMap<String, String>,
+    lookup: &dyn Fn(&str) -> Option<String>,
+) -> anyhow::Result<Vec<String>> {
     let utf8 = |p: &Path| p.to_str().map(str::to_string).with_context(|| format!("{}: not a UTF-8 path", p.display()));
     let (suite, work) = (utf8(suite_dir)?, utf8(work_dir)?);
-    Ok(step.iter().map(|w| w.replace("{suite}", &suite).replace("{work}", &work)).collect())
+    let env = |name: &str| -> anyhow::Result<String> {
+        if let Some(value) = lookup(name).filter(|v| !v.is_empty()) {
+            return Ok(value);
+        }
+        match env_defaults.get(name) {
+            Some(default) => Ok(default.replace("{suite}", &suite)),
+            None => bail!(
+                "{{env:{name}}}: the environment variable {name} is not set and the suite's [env] gives no default"
+            ),
+        }
+    };
+    step.iter()
+        .map(|word| {
+            let mut out = String::with_capacity(word.len());
+            let mut from = 0;
+            for (start, end, inside) in placeholders(word) {
+                out.push_str(&word[from..start]);
+                match inside {
+                    "suite" => out.push_str(&suite),
+                    "work" => out.push_str(&work),
+                    other => match other.strip_prefix("env:") {
+                        Some(name) => out.push_str(&env(name)?),
+                        None => out.push_str(&word[start..end]),
+                    },
+                }
+                from = end;
+            }
+            out.push_str(&word[from..]);
+            Ok(out)
+        })
+        .collect()
 }
 
 /// One metric, measured (or why not) against its expectation.
@@ -319,24 +396,53 @@ fn number(v: f64) -> String {
     if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_string() } else { text }
 }
 
-/// The plain-text table of `checks`: metric, expected, measured, tolerance,
-/// verdict (and the reason under a metric not measured).
+/// `expected` and `measured` for the table: six significant digits, or
+/// every digit (the shortest text that reads back as the same number) when
+/// six would show two different values as equal.
+fn expected_and_measured(expected: f64, measured: f64) -> (String, String) {
+    let (e, m) = (number(expected), number(measured));
+    if e == m && expected.to_bits() != measured.to_bits() {
+        (format!("{expected}"), format!("{measured}"))
+    } else {
+        (e, m)
+    }
+}
+
+/// How far `measured` moved from `expected`: the signed difference and,
+/// where `expected` is not zero, the same relative to it in percent
+/// (`+0.5001 (+5.001%)`), the two ways a tolerance is given; `0` when the
+/// value did not move.
+#[must_use]
+pub fn change(expected: f64, measured: f64) -> String {
+    let signed = |v: f64| if v > 0.0 { format!("+{}", number(v)) } else { number(v) };
+    let difference = measured - expected;
+    if expected == 0.0 || difference == 0.0 || !difference.is_finite() {
+        signed(difference)
+    } else {
+        format!("{} ({}%)", signed(difference), signed(difference / expected.abs() * 100.0))
+    }
+}
+
+/// The plain-text table of `checks`: metric, expected, measured, change
+/// (measured - expected, absolute and relative), tolerance, verdict (and
+/// the reason under a metric not measured).
 #[must_use]
 pub fn table(checks: &[SuiteCheck]) -> String {
-    let rows: Vec<[String; 5]> = checks
+    let rows: Vec<[String; 6]> = checks
         .iter()
         .map(|c| {
-            [
-                c.name.clone(),
-                number(c.expected),
-                c.measured.as_ref().map_or_else(|_| "-".to_string(), |m| number(m.value)),
-                c.tolerance.to_string(),
-                c.verdict().to_string(),
-            ]
+            let (expected, measured, moved) = match &c.measured {
+                Ok(m) => {
+                    let (e, v) = expected_and_measured(c.expected, m.value);
+                    (e, v, change(c.expected, m.value))
+                }
+                Err(_) => (number(c.expected), "-".to_string(), "-".to_string()),
+            };
+            [c.name.clone(), expected, measured, moved, c.tolerance.to_string(), c.verdict().to_string()]
         })
         .collect();
-    let header = ["metric", "expected", "measured", "tolerance", "verdict"].map(str::to_string);
-    let widths: Vec<usize> = (0..5)
+    let header = ["metric", "expected", "measured", "change", "tolerance", "verdict"].map(str::to_string);
+    let widths: Vec<usize> = (0..header.len())
         .map(|i| rows.iter().chain(std::iter::once(&header)).map(|r| r[i].chars().count()).max().unwrap_or(0))
         .collect();
     let mut out = String::new();

@@ -64,7 +64,7 @@ fn metrics_select_rows_by_partition_and_column_and_reduce_them() {
     let suite = parse_suite(Path::new("s.toml"), SUITE).unwrap();
     assert_eq!(suite.steps[0][2], "{suite}/rec.mcap");
     assert_eq!(
-        step_words(&suite.steps[0], Path::new("/d"), Path::new("/w")).unwrap(),
+        step_words(&suite.steps[0], Path::new("/d"), Path::new("/w"), &suite.env, &|_| None).unwrap(),
         ["process", "odometry", "/d/rec.mcap", "-o", "/w/tables"]
     );
     let checks = measure(&suite, dir.path());
@@ -118,8 +118,32 @@ fn a_value_past_its_tolerance_regresses_and_nan_never_passes() {
     let missing = SuiteCheck { measured: Err("gone".into()), ..check(0.0, Tolerance::Absolute(1.0)) };
     assert_eq!(missing.verdict(), "NOT MEASURED");
     let text = table(&[check(10.5001, Tolerance::Absolute(0.5)), missing]);
-    assert!(text.contains("m       10        10.5001   +-0.5      REGRESSED"), "{text}");
+    assert!(text.contains("m       10        10.5001   +0.5001 (+5.001%)  +-0.5      REGRESSED"), "{text}");
     assert!(text.contains("\n    gone\n"), "{text}");
+}
+
+/// Before: a value that moved past a zero tolerance in its eighth digit
+/// showed `0.0883317  0.0883317  +-0  REGRESSED`, and no row said how far a
+/// metric moved. Now both values get every digit when six would look equal,
+/// and a change column gives the difference, absolute and relative.
+#[test]
+fn a_regressed_row_shows_how_far_the_value_moved() {
+    let check = |expected: f64, measured: f64, tolerance| SuiteCheck {
+        name: "ATE".into(),
+        expected,
+        tolerance,
+        measured: Ok(Selected { value: measured, rows: 1 }),
+    };
+    let text = table(&[check(0.088_331_717, 0.088_331_717_221_385_15, Tolerance::Absolute(0.0))]);
+    let row = text.lines().nth(1).unwrap();
+    let cells: Vec<&str> = row.split("  ").map(str::trim).filter(|c| !c.is_empty()).collect();
+    assert_eq!(cells, ["ATE", "0.088331717", "0.08833171722138515", "+2.21385e-10 (+2.50629e-7%)", "+-0", "REGRESSED"]);
+    // Values six digits tell apart keep six digits; a fall is negative.
+    let text = table(&[check(2.0, 1.5, Tolerance::Relative(0.1))]);
+    assert!(text.lines().nth(1).unwrap().contains("2         1.5       -0.5 (-25%)"), "{text}");
+    // Against an expected zero, only the difference.
+    let text = table(&[check(0.0, 0.25, Tolerance::Absolute(0.1))]);
+    assert!(text.lines().nth(1).unwrap().contains("0         0.25      +0.25"), "{text}");
 }
 
 #[test]
@@ -177,4 +201,38 @@ fn suites_are_refused_naming_the_file_the_entry_and_the_key() {
         assert!(err.contains(message), "{text}\n-> {err}");
         assert!(err.starts_with("s.toml"), "{err}");
     }
+}
+
+/// Before: a suite could point at data only through `{suite}`, so the
+/// example suite failed from a clone not beside `shared/` even with
+/// MMTRACK_REALDATA set (the notebook honours it). Now `{env:NAME}` takes
+/// the variable, else the suite's `[env]` default.
+#[test]
+fn env_placeholders_take_the_variable_else_the_suite_default() {
+    let text = SUITE.replace(
+        "[[step]]",
+        "[env]\nDATA = \"{suite}/data\"\n\n[[step]]\nargs = [\"ingest\", \"oxford\", \"{env:DATA}/x\", \"{env:OTHER}\"]\n\n[[step]]",
+    );
+    let suite = parse_suite(Path::new("s.toml"), &text).unwrap();
+    let words = |lookup: &dyn Fn(&str) -> Option<String>| {
+        step_words(&suite.steps[0], Path::new("/d"), Path::new("/w"), &suite.env, lookup)
+    };
+    let set = |name: &str| Some(format!("/set/{name}"));
+    assert_eq!(words(&set).unwrap()[2..], ["/set/DATA/x", "/set/OTHER"]);
+    let only_other = |name: &str| (name == "OTHER").then(|| "o".to_string());
+    assert_eq!(words(&only_other).unwrap()[2..], ["/d/data/x", "o"]);
+    let error = format!("{:#}", words(&|_| None).unwrap_err());
+    assert!(error.contains("{env:OTHER}: the environment variable OTHER is not set"), "{error}");
+    for (bad, message) in [
+        ("{env:1X}", "unknown placeholder `{env:1X}`"),
+        ("{env:}", "unknown placeholder `{env:}`"),
+        ("{home}", "unknown placeholder `{home}`"),
+    ] {
+        let text = SUITE.replace("{suite}/rec.mcap", bad);
+        let error = format!("{:#}", parse_suite(Path::new("s.toml"), &text).unwrap_err());
+        assert!(error.contains(message), "{error}");
+    }
+    let text = SUITE.replace("[[step]]", "[env]\nD = \"{work}/x\"\n\n[[step]]");
+    let error = format!("{:#}", parse_suite(Path::new("s.toml"), &text).unwrap_err());
+    assert!(error.contains("[env] D") && error.contains("unknown placeholder `{work}`"), "{error}");
 }

@@ -210,6 +210,7 @@ pub fn measure(experiment: &Config, runs: u64, nlos_runs: u64, progress: &dyn Pr
             .map(|c| {
                 let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
                 let n = range.end - range.start;
+                progress.check_cancelled()?;
                 let chunk = run_chunk(experiment, manoeuvre, &receiver, range);
                 progress.advance(n);
                 chunk

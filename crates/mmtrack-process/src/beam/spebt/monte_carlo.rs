@@ -313,6 +313,7 @@ pub fn monte_carlo(
             .map(|c| {
                 let range = c * RUNS_PER_CHUNK..((c + 1) * RUNS_PER_CHUNK).min(runs);
                 let count = range.end - range.start;
+                progress.check_cancelled()?;
                 let chunk = run_chunk(link, config, seed, range, source);
                 progress.advance(count);
                 chunk
