@@ -32,7 +32,8 @@
 //! - [`campaign`]: several runs side by side, on polars: the runs'
 //!   Hive-partitioned result tables read into one frame, group-bys per run
 //!   for the pooled rows (the pooling rules are stated there and used by
-//!   every report).
+//!   every report); [`compared`]: what it compares and how a value is shown
+//!   (the single-run report's units and decimals).
 //!
 //! Polars stays inside this crate (ARCHITECTURE.md), with the feature `lazy`
 //! only (the `parquet` crate reads the files). The per-sequence metrics themselves (KITTI
@@ -48,6 +49,7 @@ pub mod analyze;
 pub mod beam;
 pub mod campaign;
 pub mod compare_plots;
+pub mod compared;
 pub mod export;
 pub mod mpc;
 pub mod mpc_artificial;
