@@ -16,6 +16,7 @@
 //! - [`plots`]: SVG plots of a trajectory evaluation (plotters, SVG backend
 //!   only); `plot_common`: the helpers every figure shares;
 //! - [`report`]: the Markdown report;
+//! - [`palette`]: the colours and dash patterns of every multi-series figure;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
 //!   and computes them per sequence (it calls the analyses; they never call
 //!   it back);
@@ -56,6 +57,7 @@ pub mod mpc_artificial;
 pub mod mpc_plots;
 pub mod mpc_report;
 pub mod output;
+pub mod palette;
 pub mod pipeline;
 mod plot_common;
 pub mod plots;
