@@ -30,67 +30,7 @@ use polars::prelude::{
     Column, DataFrame, DataType, Expr, IntoLazy, LazyFrame, NULL, PlSmallStr, SortMultipleOptions, col, lit, when,
 };
 
-/// A result table and the columns compared across runs.
-#[derive(Debug, Clone, Copy)]
-pub struct ComparedTable {
-    /// The table.
-    pub spec: &'static TableSpec,
-    /// String columns that tell rows of one sequence apart (joined by ` / `).
-    pub keys: &'static [&'static str],
-    /// Numeric columns compared, in report order.
-    pub metrics: &'static [&'static str],
-}
-
-/// The main metric columns of `trajectory_metrics`, compared and pooled.
-pub const TRAJECTORY_COMPARED: [&str; 7] = [
-    "kitti_translational_pct",
-    "kitti_rotational_deg_per_100m",
-    "ate_rmse_m",
-    "position_rmse_m",
-    "yaw_rmse_rad",
-    "rpe_translation_rmse_m",
-    "rpe_yaw_rmse_rad",
-];
-
-/// What the side-by-side compares, per result table.
-pub const COMPARED: [ComparedTable; 6] = [
-    ComparedTable { spec: &mmtrack_io::table::TRAJECTORY_METRICS, keys: &[], metrics: &TRAJECTORY_COMPARED },
-    ComparedTable {
-        spec: &mmtrack_io::table::MPC_SUMMARY,
-        keys: &[],
-        metrics: &[
-            "mean_mpcs_per_set",
-            "birth_rate_per_m",
-            "death_rate_per_m",
-            "mean_detection_loss_db",
-            "mean_tracking_loss_db",
-            "mean_gmphd_tracking_loss_db",
-            "precision",
-            "recall",
-            "track_purity",
-        ],
-    },
-    ComparedTable {
-        spec: &mmtrack_io::table::BEAM_SWEEP_SUMMARY,
-        keys: &["tracker"],
-        metrics: &["mean_loss_db", "p90_loss_db", "top1", "mean_beams_per_sweep"],
-    },
-    ComparedTable {
-        spec: &mmtrack_io::table::SPEBT_SUMMARY,
-        keys: &["experiment", "trajectory"],
-        metrics: &["rmse_gain_pct", "rmse_aod_deg", "rmse_aoa_deg", "reinitialisation_share_pct"],
-    },
-    ComparedTable {
-        spec: &mmtrack_io::table::GEOMETRIC_SUMMARY,
-        keys: &[],
-        metrics: &["handover_s", "rls_share", "range_rmse_m", "azimuth_rmse_rad", "saving"],
-    },
-    ComparedTable {
-        spec: &mmtrack_io::table::SLAM_SUMMARY,
-        keys: &["row"],
-        metrics: &["ue_position_error_m", "ue_heading_error_rad", "ue_clock_bias_error_m", "va_error_m", "sp_error_m"],
-    },
-];
+pub use crate::compared::{COMPARED, ComparedTable, Metric, TRAJECTORY_COMPARED};
 
 /// One run's table directory, as named on the command line.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -407,18 +347,52 @@ fn long_rows(
             None => string_at(df, "sequence", row)?,
         };
         let key = compared.keys.iter().map(|k| string_at(df, k, row)).collect::<anyhow::Result<Vec<_>>>()?.join(" / ");
-        for metric in compared.metrics {
+        for metric in compared.metrics.iter().map(|m| m.column) {
             rows.push(ComparedRow {
                 sequence: sequence_id.clone(),
                 row: RunComparisonRow {
                     run: run.clone(),
                     source_table: compared.spec.name.to_string(),
                     key: key.clone(),
-                    metric: (*metric).to_string(),
+                    metric: metric.to_string(),
                     unit: unit_of(compared.spec, metric),
                     value: f64_at(df, metric, row)?,
                 },
             });
+        }
+    }
+    Ok(())
+}
+
+/// A comparison query's error in the user's terms: the table compared and
+/// the first line of the engine's message (never its query plan).
+fn query_error(error: &polars::error::PolarsError, compared: &ComparedTable) -> anyhow::Error {
+    let message = error.to_string();
+    let first = message.split("Resolved plan").next().unwrap_or(&message).lines().next().unwrap_or("").trim();
+    anyhow::anyhow!(
+        "comparing table `{}` across runs (columns {}): {}",
+        compared.spec.name,
+        compared.metrics.iter().map(|m| m.column).collect::<Vec<_>>().join(", "),
+        first.trim_end_matches([':', ' '])
+    )
+}
+
+fn query(frame: LazyFrame, compared: &ComparedTable) -> anyhow::Result<DataFrame> {
+    frame.collect().map_err(|e| query_error(&e, compared))
+}
+
+/// Every compared key and metric is a column of the runs' table; else an
+/// error naming the table, the column and the columns there are.
+fn check_columns(frame: &LazyFrame, compared: &ComparedTable) -> anyhow::Result<()> {
+    let schema = frame.clone().collect_schema().map_err(|e| query_error(&e, compared))?;
+    let wanted = compared.keys.iter().copied().chain(compared.metrics.iter().map(|m| m.column));
+    for column in wanted {
+        if schema.get(column).is_none() {
+            bail!(
+                "comparing table `{}` across runs: the runs' tables have no column `{column}` (they have: {})",
+                compared.spec.name,
+                schema.iter_names().map(|n| n.as_str()).collect::<Vec<_>>().join(", ")
+            );
         }
     }
     Ok(())
@@ -432,31 +406,39 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
     let mut rows = Vec::new();
     for compared in &COMPARED {
         let Some(frame) = read_runs(out, compared.spec.name)? else { continue };
-        let what = || format!("{}: runs side by side", out.join("run=*/tables").join(compared.spec.name).display());
+        check_columns(&frame, compared)?;
         let mut select: Vec<Expr> = vec![col("run"), col("sequence")];
         select.extend(compared.keys.iter().map(|k| col(*k)));
-        select.extend(compared.metrics.iter().map(|m| col(*m).cast(DataType::Float64)));
+        select.extend(compared.metrics.iter().map(|m| col(m.column).cast(DataType::Float64)));
         let mut order: Vec<PlSmallStr> = vec!["sequence".into()];
         order.extend(compared.keys.iter().map(|k| PlSmallStr::from(*k)));
         order.push("run".into());
-        let wide =
-            frame.clone().select(select).sort(order, SortMultipleOptions::default()).collect().with_context(what)?;
+        let wide = query(frame.clone().select(select).sort(order, SortMultipleOptions::default()), compared)?;
         long_rows(&wide, compared, None, &mut rows)?;
         if compared.spec.name == mmtrack_io::table::TRAJECTORY_METRICS.name {
-            let pooled = frame
-                .clone()
-                .group_by([col("run")])
-                .agg(pooled_trajectory_exprs())
-                .sort(["run"], SortMultipleOptions::default())
-                .collect()
-                .with_context(what)?;
+            let mut pooled = query(
+                frame.clone().group_by([col("run")]).agg(pooled_trajectory_exprs()).sort(["run"], Default::default()),
+                compared,
+            )?;
+            // The pooled row has no end point (as in a run's report).
+            let height = pooled.height();
+            pooled
+                .with_column(Column::full_null("final_position_error_m".into(), height, &DataType::Float64))
+                .map_err(|e| query_error(&e, compared))?;
             long_rows(&pooled, compared, Some("all"), &mut rows)?;
-            let means = frame
-                .group_by([col("run")])
-                .agg(compared.metrics.iter().map(|m| col(*m).cast(DataType::Float64).mean()).collect::<Vec<_>>())
-                .sort(["run"], SortMultipleOptions::default())
-                .collect()
-                .with_context(what)?;
+            let means = query(
+                frame
+                    .group_by([col("run")])
+                    .agg(
+                        compared
+                            .metrics
+                            .iter()
+                            .map(|m| col(m.column).cast(DataType::Float64).mean())
+                            .collect::<Vec<_>>(),
+                    )
+                    .sort(["run"], SortMultipleOptions::default()),
+                compared,
+            )?;
             long_rows(&means, compared, Some("mean"), &mut rows)?;
         }
     }
@@ -465,7 +447,7 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
         COMPARED
             .iter()
             .find(|c| c.spec.name == row.source_table)
-            .and_then(|c| c.metrics.iter().position(|m| *m == row.metric))
+            .and_then(|c| c.metrics.iter().position(|m| m.column == row.metric))
             .unwrap_or(usize::MAX)
     };
     let sequence_rank = |s: &str| match s {
@@ -487,67 +469,91 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
     Ok(rows)
 }
 
-/// (sequence, key, metric, unit) of one line of the side-by-side table.
-type LineId = (String, String, String, String);
-
-fn cell(value: Option<f64>) -> String {
-    match value {
-        None => "n/a".into(),
-        Some(v) if v != 0.0 && v.abs() < 1e-3 => format!("{v:.3e}"),
-        Some(v) => format!("{v:.4}"),
-    }
-}
-
-/// `B - A` of two values, `n/a` when either is missing.
-fn difference(a: Option<f64>, b: Option<f64>) -> String {
-    match (a, b) {
-        (Some(a), Some(b)) => {
-            let d = b - a;
-            match cell(Some(d.abs())) {
-                text if d < 0.0 => format!("-{text}"),
-                text if d > 0.0 => format!("+{text}"),
-                text => text,
-            }
-        }
-        _ => "n/a".into(),
-    }
-}
+/// (sequence, key, metric column) of one line of the side-by-side table.
+type LineId = (String, String, String);
 
 /// `(B - A) / |A|` in percent, where meaningful: both values there, `A`
 /// not 0, and a unit on a ratio scale (a difference of dB values is already
 /// a ratio, so dB metrics get none).
 fn relative(a: Option<f64>, b: Option<f64>, unit: &str) -> String {
     match (a, b) {
-        (Some(a), Some(b)) if a != 0.0 && !unit.contains("dB") => format!("{:+.1} %", 100.0 * (b - a) / a.abs()),
+        (Some(a), Some(b)) if a != 0.0 && !unit.contains("dB") => {
+            let text = crate::compared::fixed(100.0 * (b - a) / a.abs(), 1);
+            let sign = if text.starts_with('-') || !text.chars().any(|c| matches!(c, '1'..='9')) { "" } else { "+" };
+            format!("{sign}{text} %")
+        }
         _ => "-".into(),
     }
 }
 
+/// The intro of the side-by-side section, with the pooling rules only when
+/// trajectory tables are compared.
+fn section_intro(runs: &[String], tables: &BTreeSet<&str>) -> String {
+    let baseline = runs.first().cloned().unwrap_or_default();
+    let mut text = format!(
+        "Runs: {}. Every value is the run's own result table (`run=<id>/tables/...`), in the units and with the \
+         decimals of the run's own report; `tables/run_comparison` holds the same values in the tables' stored units \
+         (long format). Differences are against the first run, `{baseline}`: `B - A` in the shown unit, and relative \
+         to `{baseline}`'s value where that is meaningful (not for dB values, whose difference is already a ratio, \
+         nor against 0).",
+        runs.iter().map(|r| format!("`{r}`")).collect::<Vec<_>>().join(", ")
+    );
+    if tables.contains(mmtrack_io::table::TRAJECTORY_METRICS.name) {
+        text.push_str(
+            " Pooled trajectory rows (runs with several sequences): `all` pools KITTI drift over the segments of \
+             every sequence (as the KITTI devkit pools a dataset), the RMSEs and ATE over the associated poses and \
+             the RPE over the frame pairs (no end point); `mean` is the plain mean of the per-sequence values.",
+        );
+    }
+    if tables.contains(mmtrack_io::table::BEAM_SWEEP_POOLED.name) {
+        text.push_str(
+            " Beam sweeps: the pooled rows per site and tracker (`beam_sweep_pooled`, every sweep weighted once); \
+             the per-pass rows are in `tables/run_comparison` (`source_table = 'beam_sweep_summary'`) and in each \
+             run's report.",
+        );
+    }
+    text.push_str("\n\n");
+    text
+}
+
+/// The header and rule of one compared table.
+fn table_header(compared: &ComparedTable, runs: &[String]) -> String {
+    let baseline = runs.first().cloned().unwrap_or_default();
+    let mut header = String::from("| sequence |");
+    let mut rule = String::from("|---|");
+    if !compared.keys.is_empty() {
+        header.push_str(&format!(" {} |", compared.keys.join(" / ")));
+        rule.push_str("---|");
+    }
+    header.push_str(" metric |");
+    rule.push_str("---|");
+    for (k, run) in runs.iter().enumerate() {
+        header.push_str(&format!(" {run} |"));
+        rule.push_str("---:|");
+        if k > 0 {
+            header.push_str(&format!(" {run} - {baseline} | {run} vs {baseline} |"));
+            rule.push_str("---:|---:|");
+        }
+    }
+    format!("{header}\n{rule}\n")
+}
+
 /// The side-by-side section of the campaign report: one Markdown table per
-/// compared result table, a column per run and, for every run after the
-/// first, its difference to the first (`B - A`) and the relative difference
-/// where meaningful ([`relative`]). The pooled rows `all` and `mean` are
-/// left out of a table where no run has more than one sequence (they would
-/// repeat the sequence's row).
+/// compared result table shown in the report, a column per run and, for
+/// every run after the first, its difference to the first (`B - A`) and the
+/// relative difference where meaningful ([`relative`]); values in the units,
+/// headers and decimals of the single-run report ([`Metric::cell`]). The
+/// pooled rows `all` and `mean` are left out of a table where no run has
+/// more than one sequence (they would repeat the sequence's row).
 #[must_use]
 pub fn section(rows: &[ComparedRow], runs: &[String]) -> String {
     use std::fmt::Write;
     let mut text = String::from("## Runs side by side\n\n");
     let baseline = runs.first().cloned().unwrap_or_default();
-    let _ = writeln!(
-        text,
-        "Runs: {}. Every value is the run's own result table (`run=<id>/tables/...`); the same numbers are in \
-         `tables/run_comparison` (long format). Differences are against the first run, `{baseline}`: `B - A` in the \
-         metric's unit, and relative to `{baseline}`'s value where that is meaningful (not for dB values, whose \
-         difference is already a ratio, nor against 0). Pooled trajectory rows (runs with several sequences): `all` \
-         pools KITTI drift over the segments of every sequence (as the KITTI devkit pools a dataset), the RMSEs and \
-         ATE over the associated poses and the RPE over the frame pairs; `mean` is the plain mean of the \
-         per-sequence values.\n",
-        runs.iter().map(|r| format!("`{r}`")).collect::<Vec<_>>().join(", ")
-    );
     let tables: BTreeSet<&str> = rows.iter().map(|r| r.row.source_table.as_str()).collect();
+    text.push_str(&section_intro(runs, &tables));
     let pooled = |s: &str| s == "all" || s == "mean";
-    for compared in COMPARED.iter().filter(|c| tables.contains(c.spec.name)) {
+    for compared in COMPARED.iter().filter(|c| c.in_report && tables.contains(c.spec.name)) {
         let _ = writeln!(text, "### {}\n", compared.spec.name);
         let of_table: Vec<&ComparedRow> = rows.iter().filter(|r| r.row.source_table == compared.spec.name).collect();
         let mut sequences_per_run: BTreeMap<&str, BTreeSet<&str>> = BTreeMap::new();
@@ -555,47 +561,36 @@ pub fn section(rows: &[ComparedRow], runs: &[String]) -> String {
             sequences_per_run.entry(compared_row.row.run.as_str()).or_default().insert(compared_row.sequence.as_str());
         }
         let show_pooled = sequences_per_run.values().any(|s| s.len() > 1);
-        let mut header = String::from("| sequence |");
-        let mut rule = String::from("|---|");
-        if !compared.keys.is_empty() {
-            header.push_str(&format!(" {} |", compared.keys.join(" / ")));
-            rule.push_str("---|");
-        }
-        header.push_str(" metric | unit |");
-        rule.push_str("---|---|");
-        for (k, run) in runs.iter().enumerate() {
-            header.push_str(&format!(" {run} |"));
-            rule.push_str("---:|");
-            if k > 0 {
-                header.push_str(&format!(" {run} - {baseline} | {run} vs {baseline} |"));
-                rule.push_str("---:|---:|");
-            }
-        }
-        let _ = writeln!(text, "{header}\n{rule}");
+        text.push_str(&table_header(compared, runs));
         // (sequence, key, metric) in row order -> run -> value.
-        let mut lines: Vec<(LineId, BTreeMap<String, Option<f64>>)> = Vec::new();
+        let mut lines: Vec<(LineId, String, BTreeMap<String, Option<f64>>)> = Vec::new();
         for ComparedRow { sequence, row } in of_table.into_iter().filter(|r| show_pooled || !pooled(&r.sequence)) {
-            let id = (sequence.clone(), row.key.clone(), row.metric.clone(), row.unit.clone());
+            let id = (sequence.clone(), row.key.clone(), row.metric.clone());
             match lines.last_mut() {
-                Some((last, values)) if *last == id => {
+                Some((last, _, values)) if *last == id => {
                     values.insert(row.run.clone(), row.value);
                 }
-                _ => lines.push((id, BTreeMap::from([(row.run.clone(), row.value)]))),
+                _ => lines.push((id, row.unit.clone(), BTreeMap::from([(row.run.clone(), row.value)]))),
             }
         }
-        for ((sequence, key, metric, unit), values) in lines {
+        for ((sequence, key, column), unit, values) in lines {
+            let Some(metric) = compared.metrics.iter().find(|m| m.column == column) else { continue };
             let mut line = format!("| {sequence} |");
             if !compared.keys.is_empty() {
                 line.push_str(&format!(" {key} |"));
             }
-            line.push_str(&format!(" {metric} | {unit} |"));
+            line.push_str(&format!(" {} |", metric.label));
             let a = values.get(&baseline).copied().flatten();
             for (k, run) in runs.iter().enumerate() {
-                let value = values.get(run).map_or_else(|| "-".to_string(), |v| cell(*v));
+                let value = values.get(run).map_or_else(|| "-".to_string(), |v| metric.cell(*v));
                 line.push_str(&format!(" {value} |"));
                 if k > 0 {
-                    let b = values.get(run).copied().flatten();
-                    line.push_str(&format!(" {} | {} |", difference(a, b), relative(a, b, &unit)));
+                    let (difference, relative) = match (values.get(&baseline), values.get(run)) {
+                        (Some(_), Some(b)) => (metric.difference(a, *b), relative(a, *b, &unit)),
+                        // Either run has no such row: no difference either.
+                        _ => ("-".to_string(), "-".to_string()),
+                    };
+                    line.push_str(&format!(" {difference} | {relative} |"));
                 }
             }
             let _ = writeln!(text, "{line}");
@@ -739,9 +734,9 @@ pub(crate) mod tests {
         assert_eq!(
             &order[..3],
             [
-                ("s1", TRAJECTORY_COMPARED[0], "a"),
-                ("s1", TRAJECTORY_COMPARED[0], "b"),
-                ("s1", TRAJECTORY_COMPARED[1], "a")
+                ("s1", TRAJECTORY_COMPARED[0].column, "a"),
+                ("s1", TRAJECTORY_COMPARED[0].column, "b"),
+                ("s1", TRAJECTORY_COMPARED[1].column, "a")
             ]
         );
         let sequences: Vec<&str> = order.iter().map(|o| o.0).collect::<Vec<_>>();
@@ -772,9 +767,10 @@ pub(crate) mod tests {
         };
         let rows = [row("a", "s1", Some(1.5)), row("b", "s1", None), row("a", "s2", Some(2.0))];
         let text = section(&rows, &["a".into(), "b".into()]);
-        assert!(text.contains("| sequence | metric | unit | a | b | b - a | b vs a |"), "{text}");
-        assert!(text.contains("| s1 | ate_rmse_m | m | 1.5000 | n/a | n/a | - |"), "{text}");
-        assert!(text.contains("| s2 | ate_rmse_m | m | 2.0000 | - | n/a | - |"), "{text}");
+        assert!(text.contains("| sequence | metric | a | b | b - a | b vs a |"), "{text}");
+        assert!(text.contains("| s1 | ATE (m) | 1.500 | n/a | n/a | - |"), "{text}");
+        // Run b has no row for s2: no value and no difference.
+        assert!(text.contains("| s2 | ATE (m) | 2.000 | - | - | - |"), "{text}");
         // B - A and (B - A) / A by hand: 1.2 - 1.5 = -0.3, -20 %; none for dB.
         let rows = [
             row("a", "s1", Some(1.5)),
@@ -783,12 +779,67 @@ pub(crate) mod tests {
             row("b", "all", Some(1.2)),
         ];
         let text = section(&rows, &["a".into(), "b".into()]);
-        assert!(text.contains("| s1 | ate_rmse_m | m | 1.5000 | 1.2000 | -0.3000 | -20.0 % |"), "{text}");
+        assert!(text.contains("| s1 | ATE (m) | 1.500 | 1.200 | -0.300 | -20.0 % |"), "{text}");
         // One sequence per run: the pooled row would repeat it and is left out.
         assert!(!text.contains("| all |"), "{text}");
         assert_eq!(relative(Some(-2.0), Some(-1.0), "dB"), "-");
         assert_eq!(relative(Some(0.0), Some(1.0), "m"), "-");
         assert_eq!(relative(Some(-2.0), Some(-1.0), "m"), "+50.0 %");
-        assert_eq!(difference(Some(1.0), Some(1.0)), "0.0000");
+        assert_eq!(relative(Some(1.0), Some(1.0), ""), "0.0 %");
+    }
+
+    fn write_rows<R: mmtrack_io::table::TableRow>(dir: &Path, run: &str, rows: &[R]) {
+        let tables = dir.join(format!("run={run}")).join("tables");
+        mmtrack_io::table::write_table(
+            &tables,
+            "s",
+            rows,
+            &mmtrack_io::table::RunInfo::new("{}", mmtrack_io::recording::TimeBase::UnixEpoch),
+            mmtrack_io::Overwrite::Refuse,
+        )
+        .unwrap();
+    }
+
+    /// SPEBT summaries store angles in radians: the comparison reads those
+    /// columns and shows them in degrees, as the run's report does.
+    #[test]
+    fn spebt_summaries_compare_in_degrees() {
+        use crate::beam::spebt_analysis::tests::summary;
+        let dir = tempfile::tempdir().unwrap();
+        write_rows(dir.path(), "a", &[summary("pose-error-model", 11, 2, [0.3, 0.312, 0.845], 1.0)]);
+        write_rows(dir.path(), "b", &[summary("pose-error-model", 11, 2, [0.4, 0.5, 0.845], 2.0)]);
+        let rows = compare_runs(dir.path()).unwrap();
+        assert_eq!(rows.len(), 2 * 4, "{rows:?}");
+        let text = section(&rows, &["a".into(), "b".into()]);
+        assert!(text.contains("### spebt_summary"), "{text}");
+        // 0.312 deg and 0.5 deg: B - A = 0.188 deg.
+        assert!(text.contains("| s | pose-error-model / t | AoD RMSE (deg) | 0.312 | 0.500 | +0.188 |"), "{text}");
+        // Re-initialisations 10 % and 20 % of the 10 tracked slots.
+        assert!(text.contains("| re-initialisations (%) | 10.00 | 20.00 | +10.00 | +100.0 % |"), "{text}");
+    }
+
+    /// A table whose columns are not the compared ones is an error naming
+    /// the table and column, never the engine's query plan.
+    #[test]
+    fn a_missing_column_is_named_in_user_terms() {
+        let dir = tempfile::tempdir().unwrap();
+        write_rows(dir.path(), "a", &[trajectory(3, 1, Some(1.0), 1.0, 0.1)]);
+        let frame = read_runs(dir.path(), "trajectory_metrics").unwrap().unwrap();
+        let wrong = ComparedTable {
+            spec: &mmtrack_io::table::TRAJECTORY_METRICS,
+            keys: &[],
+            metrics: &[Metric {
+                column: "no_such_m",
+                label: "x (m)",
+                scale: crate::compared::Scale::Same,
+                decimals: 1,
+            }],
+            in_report: true,
+        };
+        let err = check_columns(&frame, &wrong).unwrap_err().to_string();
+        assert!(err.contains("table `trajectory_metrics`") && err.contains("no column `no_such_m`"), "{err}");
+        let err = query(frame.select([col("no_such_m")]), &wrong).unwrap_err().to_string();
+        assert!(err.contains("comparing table `trajectory_metrics`") && !err.contains("plan"), "{err}");
+        assert!(!err.contains('\n'), "{err}");
     }
 }

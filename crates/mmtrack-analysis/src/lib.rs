@@ -16,6 +16,7 @@
 //! - [`plots`]: SVG plots of a trajectory evaluation (plotters, SVG backend
 //!   only); `plot_common`: the helpers every figure shares;
 //! - [`report`]: the Markdown report;
+//! - [`palette`]: the colours and dash patterns of every multi-series figure;
 //! - [`pipeline`]: discovers which tables exist, picks the metrics that apply
 //!   and computes them per sequence (it calls the analyses; they never call
 //!   it back);
@@ -32,7 +33,8 @@
 //! - [`campaign`]: several runs side by side, on polars: the runs'
 //!   Hive-partitioned result tables read into one frame, group-bys per run
 //!   for the pooled rows (the pooling rules are stated there and used by
-//!   every report).
+//!   every report); [`compared`]: what it compares and how a value is shown
+//!   (the single-run report's units and decimals).
 //!
 //! Polars stays inside this crate (ARCHITECTURE.md), with the feature `lazy`
 //! only (the `parquet` crate reads the files). The per-sequence metrics themselves (KITTI
@@ -48,12 +50,14 @@ pub mod analyze;
 pub mod beam;
 pub mod campaign;
 pub mod compare_plots;
+pub mod compared;
 pub mod export;
 pub mod mpc;
 pub mod mpc_artificial;
 pub mod mpc_plots;
 pub mod mpc_report;
 pub mod output;
+pub mod palette;
 pub mod pipeline;
 mod plot_common;
 pub mod plots;

@@ -13,10 +13,6 @@ use crate::plot_common::{draw_legend, err, padded_range};
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
-/// Colours of the estimates of several runs, in run order (the ground
-/// truth is black).
-pub(crate) const RUN_COLORS: [RGBColor; 6] = [RED, BLUE, RGBColor(0, 150, 0), MAGENTA, RGBColor(230, 140, 0), CYAN];
-
 /// x-y view of one ground truth and any number of labelled estimates, equal
 /// axes (a square plot area over a square range), a dot at the ground
 /// truth's first pose; `frame` names the axes' frame.
@@ -46,11 +42,10 @@ fn xy_svg(frame: &str, truth: &[Se2], estimates: &[(String, Vec<Se2>)]) -> anyho
             "ground truth",
         )?;
         for (k, (label, poses)) in estimates.iter().enumerate() {
-            let color = RUN_COLORS[k % RUN_COLORS.len()];
-            crate::plot_common::draw_labelled_line(
+            crate::palette::draw_series_line(
                 &mut chart,
                 poses.iter().map(|p| (p.x_m, p.y_m)),
-                color.stroke_width(2),
+                crate::palette::layered_style(k),
                 label.as_str(),
             )?;
         }
@@ -124,8 +119,7 @@ pub fn errors_overlay_svg(runs: &[(&str, &TrajectoryResult)]) -> anyhow::Result<
                 .map_err(err)?;
             crate::plot_common::draw_axes(&mut chart, "distance travelled (m)", y_desc)?;
             for (k, (label, points)) in series.into_iter().enumerate() {
-                let color = RUN_COLORS[k % RUN_COLORS.len()];
-                crate::plot_common::draw_labelled_line(&mut chart, points, color.stroke_width(2), label)?;
+                crate::palette::draw_series_line(&mut chart, points, crate::palette::layered_style(k), label)?;
             }
             draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         }

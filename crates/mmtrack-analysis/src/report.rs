@@ -4,11 +4,27 @@
 
 use std::fmt::Write;
 
+use crate::compared::{Metric, TRAJECTORY_COMPARED};
 use crate::pipeline::TrajectoryResult;
 use crate::trajectory::DriftOptions;
 
-fn opt(v: Option<f64>, decimals: usize) -> String {
-    v.map_or_else(|| "n/a".to_string(), |v| format!("{v:.decimals$}"))
+/// The stored value of a compared `trajectory_metrics` column
+/// ([`TRAJECTORY_COMPARED`]); the end point is given (none when pooled).
+fn value_of(m: &mmtrack_io::table::TrajectoryMetrics, column: &str, end_point_m: Option<f64>) -> Option<f64> {
+    match column {
+        "kitti_translational_pct" => m.kitti_translational_pct,
+        "kitti_rotational_deg_per_100m" => m.kitti_rotational_deg_per_100m,
+        "ate_rmse_m" => Some(m.ate_rmse_m),
+        "ate_max_m" => Some(m.ate_max_m),
+        "x_rmse_m" => Some(m.x_rmse_m),
+        "y_rmse_m" => Some(m.y_rmse_m),
+        "position_rmse_m" => Some(m.position_rmse_m),
+        "yaw_rmse_rad" => Some(m.yaw_rmse_rad),
+        "rpe_translation_rmse_m" => Some(m.rpe_translation_rmse_m),
+        "rpe_yaw_rmse_rad" => Some(m.rpe_yaw_rmse_rad),
+        "final_position_error_m" => end_point_m,
+        _ => None,
+    }
 }
 
 fn lengths(options: &DriftOptions) -> String {
@@ -81,6 +97,30 @@ pub fn not_analyzed(skipped: &[(String, String)]) -> String {
     out
 }
 
+/// One row of the trajectory table; the compared columns formatted as the
+/// compare report formats them ([`Metric::cell`]).
+fn trajectory_row(name: &str, m: &mmtrack_io::table::TrajectoryMetrics, end_point_m: Option<f64>) -> String {
+    let [kitti_t, kitti_r, ate, ate_max, x, y, _position, yaw, rpe_t, rpe_yaw, end_point] =
+        TRAJECTORY_COMPARED.map(|metric| (metric, value_of(m, metric.column, end_point_m)));
+    let cell = |(metric, value): (Metric, Option<f64>)| metric.cell(value);
+    format!(
+        "| {name} | {} | {} | {:.1} | {} | {} | {} | {} | ({}, {}) | {} | {} | {} | {} |",
+        m.associated_poses,
+        m.dropped_poses,
+        m.path_length_m,
+        cell(kitti_t),
+        cell(kitti_r),
+        cell(ate),
+        cell(ate_max),
+        cell(x),
+        cell(y),
+        cell(yaw),
+        cell(rpe_t),
+        cell(rpe_yaw),
+        if end_point_m.is_some() { cell(end_point) } else { "-".to_string() }
+    )
+}
+
 fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &DriftOptions) -> anyhow::Result<()> {
     let _ = write!(
         out,
@@ -113,23 +153,7 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
         .map(|r| (r.sequence.as_str(), &r.metrics, Some(r.metrics.final_position_error_m)))
         .chain(pooled.as_ref().map(|p| ("all (pooled)", p, None)));
     for (name, m, end_point_m) in rows {
-        let _ = writeln!(
-            out,
-            "| {name} | {} | {} | {:.1} | {} | {} | {:.3} | {:.3} | ({:.3}, {:.3}) | {:.3} | {:.4} | {:.4} | {} |",
-            m.associated_poses,
-            m.dropped_poses,
-            m.path_length_m,
-            opt(m.kitti_translational_pct, 3),
-            opt(m.kitti_rotational_deg_per_100m, 3),
-            m.ate_rmse_m,
-            m.ate_max_m,
-            m.x_rmse_m,
-            m.y_rmse_m,
-            m.yaw_rmse_rad.to_degrees(),
-            m.rpe_translation_rmse_m,
-            m.rpe_yaw_rmse_rad.to_degrees(),
-            end_point_m.map_or_else(|| "-".to_string(), |e| format!("{e:.3}"))
-        );
+        let _ = writeln!(out, "{}", trajectory_row(name, m, end_point_m));
     }
     out.push('\n');
     let without: Vec<&str> =
@@ -181,6 +205,20 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
 mod tests {
     use crate::campaign::pooled_trajectory_metrics;
     use crate::campaign::tests::trajectory as metrics;
+
+    /// The run report shows every compared column, with the compare
+    /// report's format (one formatting function for both).
+    #[test]
+    fn run_report_row_has_every_compared_column_in_the_compare_format() {
+        let m = metrics(11, 3, Some(1.0), 1.0, 0.1);
+        for metric in super::TRAJECTORY_COMPARED {
+            assert!(super::value_of(&m, metric.column, Some(5.0)).is_some(), "{}", metric.column);
+        }
+        let text = super::trajectory_row("s", &m, Some(5.0));
+        // yaw 0.01 rad = 0.573 deg; RPE yaw 0.001 rad = 0.0573 deg; end point 5 m.
+        assert!(text.ends_with("| 0.573 | 0.1000 | 0.0573 | 5.000 |"), "{text}");
+        assert!(super::trajectory_row("all", &m, None).ends_with("| 0.0573 | - |"));
+    }
 
     #[test]
     fn pooled_row_weights_segments_poses_and_frame_pairs_by_hand() {

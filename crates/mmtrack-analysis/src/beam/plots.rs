@@ -16,7 +16,7 @@ pub struct RmsCurve {
 }
 
 /// Colours of the trackers' curves, in tracker order.
-const PALETTE: [RGBColor; 7] = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0)];
+const PALETTE: [RGBColor; 7] = crate::palette::COLORS;
 
 /// Bottom of a log-scale RMS axis: below the smallest positive value and the
 /// threshold, never under 1e-3 deg.
@@ -46,15 +46,14 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
             .build_cartesian_2d(0f64..(blocks - 1) as f64, (y_lo..y_hi).log_scale())
             .map_err(err)?;
         crate::plot_common::draw_axes(&mut chart, "block (1 ms)", "RMS AoD error (deg)")?;
-        for (curve, color) in curves.iter().zip(PALETTE.iter().cycle()) {
+        for (k, curve) in curves.iter().enumerate() {
             let points = curve
                 .rms_deg
                 .iter()
                 .enumerate()
                 .filter(|(_, v)| **v > 0.0 && v.is_finite())
                 .map(|(k, v)| (k as f64, v.clamp(y_lo, y_hi)));
-            let style = color.stroke_width(2);
-            crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
+            crate::palette::draw_series_line(&mut chart, points, crate::palette::series_style(k), curve.label.clone())?;
         }
         let threshold = BLACK.stroke_width(1);
         crate::plot_common::draw_labelled_line(
@@ -210,7 +209,6 @@ pub fn beam_index_svg(
     let all_t = || best.t_s.iter().chain(chosen.iter().flat_map(|c| c.t_s.iter())).copied();
     let t_end = all_t().filter(|t| t.is_finite()).fold(0.0, f64::max).max(0.1);
     let beams = f64::from(beam_count.max(1)) - 1.0;
-    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, RGBColor(230, 140, 0)];
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 520)).into_drawing_area();
@@ -229,10 +227,10 @@ pub fn beam_index_svg(
             .map_err(err)?
             .label(best.label.clone())
             .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.filled()));
-        for (k, (series, color)) in chosen.iter().zip(palette.iter().cycle()).enumerate() {
+        for (k, series) in chosen.iter().enumerate() {
             // A step line: the chosen beam holds from its sweep to the next.
-            // Earlier trackers are drawn wider, so one that agrees with a
-            // later one still shows beside it.
+            // Later trackers dashed over the first ([`crate::palette::layered_style`]),
+            // so one that agrees with a later one still shows through its gaps.
             let mut points = Vec::with_capacity(2 * series.t_s.len());
             for (k, (&t, &b)) in series.t_s.iter().zip(&series.beam).enumerate() {
                 if k > 0 {
@@ -240,8 +238,12 @@ pub fn beam_index_svg(
                 }
                 points.push((t, b));
             }
-            let style = color.stroke_width(4u32.saturating_sub(k as u32).max(1));
-            crate::plot_common::draw_labelled_line(&mut chart, points, style, series.label.clone())?;
+            crate::palette::draw_series_line(
+                &mut chart,
+                points,
+                crate::palette::layered_style(k),
+                series.label.clone(),
+            )?;
         }
         crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         root.present().map_err(err)?;
@@ -266,7 +268,6 @@ pub struct LossCurve {
 pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String> {
     let finite = || curves.iter().flat_map(|c| c.loss_db.iter().copied()).filter(|v| v.is_finite());
     let x_end = finite().fold(0.0, f64::max).max(0.5) * 1.02;
-    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, RGBColor(230, 140, 0)];
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (760, 520)).into_drawing_area();
@@ -279,7 +280,7 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
             .build_cartesian_2d(0f64..x_end, 0f64..1.0)
             .map_err(err)?;
         crate::plot_common::draw_axes(&mut chart, "received-power loss (dB)", "CDF")?;
-        for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
+        for (index, curve) in curves.iter().enumerate() {
             let mut sorted: Vec<f64> = curve.loss_db.iter().copied().filter(|v| v.is_finite()).collect();
             sorted.sort_by(f64::total_cmp);
             let n = sorted.len().max(1) as f64;
@@ -290,8 +291,8 @@ pub fn loss_cdf_svg(title: &str, curves: &[LossCurve]) -> anyhow::Result<String>
                 points.push((loss, (k + 1) as f64 / n));
             }
             points.push((x_end, if sorted.is_empty() { 0.0 } else { 1.0 }));
-            let style = color.stroke_width(2);
-            crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
+            let style = crate::palette::layered_style(index);
+            crate::palette::draw_series_line(&mut chart, points, style, curve.label.clone())?;
         }
         crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         root.present().map_err(err)?;

@@ -267,10 +267,16 @@ pub fn one_lines(results: &SpebtResults) -> Vec<String> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn summary(experiment: &str, slots: u64, runs: u64, rmse: [f64; 3], reinit_mean: f64) -> SpebtSummaryRow {
+    pub(crate) fn summary(
+        experiment: &str,
+        slots: u64,
+        runs: u64,
+        rmse: [f64; 3],
+        reinit_mean: f64,
+    ) -> SpebtSummaryRow {
         SpebtSummaryRow {
             experiment: experiment.into(),
             trajectory: "t".into(),

@@ -110,7 +110,6 @@ fn draw_nmse(
     let y = padded_range(values());
     let epochs = curves.iter().map(|c| c.nmse.len()).max().unwrap_or(2).max(2);
     let t_end = (epochs - 1) as f64 * epoch_s;
-    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
     let mut chart = ChartBuilder::on(area)
         .margin(15)
         .x_label_area_size(40)
@@ -121,22 +120,26 @@ fn draw_nmse(
     // Variants (after the paper's four) thin and first, so the four stay on top.
     let order: Vec<usize> = (4..curves.len()).chain(0..curves.len().min(4)).collect();
     for index in order {
-        let (curve, color) = (&curves[index], palette[index % palette.len()]);
-        let style = color.stroke_width(if index < 4 { 2 } else { 1 });
+        let curve = &curves[index];
+        // The paper's four 3 px, the variants 2 px: each keeps its own colour and dash.
+        let style = crate::palette::SeriesStyle {
+            width_px: if index < 4 { 3 } else { 2 },
+            ..crate::palette::series_style(index)
+        };
         let points = curve
             .nmse
             .iter()
             .enumerate()
             .filter(|(_, v)| **v > 0.0 && v.is_finite())
             .map(|(k, v)| (k as f64 * epoch_s, db(*v).clamp(y.start, y.end)));
-        crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
+        crate::palette::draw_series_line(&mut chart, points, style, curve.label.clone())?;
     }
     crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())
 }
 
 /// Colours of the paths, in order of first appearance.
-const PATH_COLORS: [RGBColor; 6] = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
+const PATH_COLORS: [RGBColor; 7] = crate::palette::COLORS;
 
 /// The non-line-of-sight figure of `reproduce zoechmann`: a map of the scene
 /// (top: the walls at `y = walls_y_m[0]` and `walls_y_m[1]`, the receiver
@@ -342,7 +345,7 @@ mod tests {
         assert!(svg.starts_with("<svg") && svg.contains("x along the receiver"), "map panel");
         assert!(svg.contains("RMS position error (m)"), "error panel");
         // Text sits on its own line in plotters' SVG.
-        for ((path, _, _), color) in paths.iter().zip(["#FF0000", "#0000FF", "#00FF00"]) {
+        for ((path, _, _), color) in paths.iter().zip(["#E69F00", "#0072B2", "#009E73"]) {
             assert_eq!(svg.matches(&format!("\n{path}: RMS position error\n")).count(), 1, "{path}");
             assert!(svg.contains(&format!("\n{path}: estimates of the first run (1 outside the frame)\n")), "{path}");
             // In the path's colour at width 2: its true track and its error

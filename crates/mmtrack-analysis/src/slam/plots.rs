@@ -104,33 +104,74 @@ pub struct EpochCurve {
     pub values: Vec<f64>,
 }
 
-/// An SVG of `curves` against the epoch, linear axes.
+/// An SVG of `curves` against the epoch, linear axes, legend beside the
+/// plot ([`epoch_panels_svg`] with one panel).
 ///
 /// # Errors
 /// When plotters fails to draw (not expected for finite input).
 pub fn epoch_curves_svg(title: &str, y_desc: &str, curves: &[EpochCurve]) -> anyhow::Result<String> {
-    let epochs = curves.iter().map(|c| c.values.len()).max().unwrap_or(1).max(2);
-    let range = padded_range(curves.iter().flat_map(|c| c.values.iter().copied()).chain([0.0]));
-    let palette = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK, RGBColor(230, 140, 0)];
+    epoch_panels_svg(title, &[EpochPanel { y_desc: y_desc.to_string(), curves: curves.to_vec() }])
+}
+
+/// One panel of [`epoch_panels_svg`]: its y axis name and curves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EpochPanel {
+    /// y axis name with unit.
+    pub y_desc: String,
+    /// The curves; curve `k` of every panel gets the same style.
+    pub curves: Vec<EpochCurve>,
+}
+
+/// Panels stacked over one epoch axis (as the paper's figures split VA and
+/// SP, or position and clock bias), curve `k` in
+/// [`crate::palette::series_style`]`(k)` in every panel; one legend beside the
+/// panels, so it covers no data (the last epochs, where convergence is read).
+///
+/// # Errors
+/// When plotters fails to draw (not expected for finite input).
+pub fn epoch_panels_svg(title: &str, panels: &[EpochPanel]) -> anyhow::Result<String> {
+    let epochs = panels.iter().flat_map(|p| p.curves.iter()).map(|c| c.values.len()).max().unwrap_or(1).max(2);
+    let legend_px = 230;
+    let panel_px = 360;
+    let height_px = 40 + panel_px * panels.len().max(1) as u32;
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 520)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (900 + legend_px, height_px)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 18))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(65)
-            .build_cartesian_2d(1f64..epochs as f64, 0f64.min(range.start)..range.end)
-            .map_err(err)?;
-        crate::plot_common::draw_axes(&mut chart, "epoch k (200 ms)", y_desc)?;
-        for (curve, color) in curves.iter().zip(palette.iter().cycle()) {
-            let points =
-                curve.values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(k, v)| ((k + 1) as f64, *v));
-            let style = color.stroke_width(2);
-            crate::plot_common::draw_labelled_line(&mut chart, points, style, curve.label.clone())?;
+        let root = root.titled(title, ("sans-serif", 18)).map_err(err)?;
+        let (plots, legend) = root.split_horizontally(900);
+        for (panel, area) in panels.iter().zip(plots.split_evenly((panels.len().max(1), 1))) {
+            let range = padded_range(panel.curves.iter().flat_map(|c| c.values.iter().copied()).chain([0.0]));
+            let mut chart = ChartBuilder::on(&area)
+                .margin(15)
+                .x_label_area_size(45)
+                .y_label_area_size(65)
+                .build_cartesian_2d(1f64..epochs as f64, 0f64.min(range.start)..range.end)
+                .map_err(err)?;
+            // Epochs are whole numbers: no decimals on their ticks.
+            crate::plot_common::axes(&mut chart, "epoch k (200 ms)", panel.y_desc.as_str())
+                .x_label_formatter(&|v| format!("{v:.0}"))
+                .draw()
+                .map_err(err)?;
+            for (k, curve) in panel.curves.iter().enumerate() {
+                let points =
+                    curve.values.iter().enumerate().filter(|(_, v)| v.is_finite()).map(|(k, v)| ((k + 1) as f64, *v));
+                crate::palette::draw_series_line(
+                    &mut chart,
+                    points,
+                    crate::palette::series_style(k),
+                    curve.label.clone(),
+                )?;
+            }
         }
-        crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        // One entry per curve of the first panel, labelled as there.
+        let entries: Vec<(String, crate::palette::SeriesStyle)> = panels
+            .first()
+            .map(|p| {
+                p.curves.iter().enumerate().map(|(k, c)| (c.label.clone(), crate::palette::series_style(k))).collect()
+            })
+            .unwrap_or_default();
+        crate::palette::draw_side_legend(&legend, &entries)?;
         root.present().map_err(err)?;
     }
     Ok(svg)

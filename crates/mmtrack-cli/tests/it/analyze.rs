@@ -378,10 +378,10 @@ fn analyze_puts_runs_side_by_side_with_pooled_rows_a_duckdb_query_reproduces() {
             && report.contains("| a | b | b - a | b vs a | baseline | baseline - a | baseline vs a |"),
         "{report}"
     );
-    assert!(report.contains("| all | kitti_translational_pct | % |"), "{report}");
-    // Run baseline has no `long` sequence.
-    let long_ate = report.lines().find(|l| l.starts_with("| long | ate_rmse_m |")).unwrap();
-    assert!(long_ate.ends_with("| - | n/a | - |"), "{long_ate}");
+    assert!(report.contains("| all | KITTI t (%) |"), "{report}");
+    // Run baseline has no `long` sequence: no value, no difference.
+    let long_ate = report.lines().find(|l| l.starts_with("| long | ATE (m) |")).unwrap();
+    assert!(long_ate.ends_with("| - | - | - |"), "{long_ate}");
     // The runs' curves overlaid, per sequence.
     for sequence in ["long", "short"] {
         for plot in ["trajectory_overlay.svg", "errors_overlay.svg"] {

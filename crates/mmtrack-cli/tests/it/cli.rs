@@ -126,7 +126,9 @@ fn demo_runs_every_pipeline_and_its_tables_read_back_as_documented() {
     let compare = std::fs::read_to_string(d.join("compare/report.md")).unwrap();
     assert!(compare.contains("| cfear | fast-cfear | fast-cfear - cfear | fast-cfear vs cfear |"), "{compare}");
     // One sequence: no pooled rows repeating it.
-    assert!(compare.contains("| oxford-demo | ate_rmse_m | m |") && !compare.contains("| all |"), "{compare}");
+    assert!(compare.contains("| oxford-demo | ATE (m) |") && !compare.contains("| all |"), "{compare}");
+    // Angles in degrees, as each run's report shows them.
+    assert!(compare.contains("| oxford-demo | yaw RMSE (deg) |"), "{compare}");
     assert!(d.join("compare/run=fast-cfear/report.html").is_file());
 }
 

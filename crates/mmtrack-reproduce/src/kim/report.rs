@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use mmtrack_analysis::slam::plots::{EpochCurve, MapFigure, epoch_curves_svg, map_svg};
+use mmtrack_analysis::slam::plots::{EpochCurve, EpochPanel, MapFigure, epoch_panels_svg, map_svg};
 use mmtrack_io::Overwrite;
 use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{RunInfo, write_table};
@@ -388,31 +388,48 @@ fn figures(experiment: &Config, results: &[RowResult]) -> anyhow::Result<Vec<(&'
             map_svg(&format!("Map after {} epochs, run 0, row {}", scenario.epochs, row.name), &figure)?,
         ));
     }
-    let curves = |f: &dyn Fn(&SlamPerEpochRow) -> f64, suffix: &str| -> Vec<EpochCurve> {
-        results
+    // One curve per row, labelled by the row; the paper's quantities in
+    // separate panels (Figs. 4-5), each row in the same style in every panel.
+    let panel = |f: &dyn Fn(&SlamPerEpochRow) -> f64, y_desc: &str| EpochPanel {
+        y_desc: y_desc.to_string(),
+        curves: results
             .iter()
-            .map(|r| EpochCurve {
-                label: format!("{} {suffix}", r.row.name),
-                values: r.per_epoch.iter().map(f).collect(),
-            })
-            .collect()
+            .map(|r| EpochCurve { label: r.row.name.clone(), values: r.per_epoch.iter().map(f).collect() })
+            .collect(),
     };
-    let mut ue = curves(&|e| e.ue_position_error_m, "position (m)");
-    ue.extend(curves(&|e| e.ue_clock_bias_error_m, "clock bias (m)"));
-    out.push(("ue_errors.svg", epoch_curves_svg("UE errors, mean over runs (Kim et al. Fig. 5)", "error (m)", &ue)?));
-    let heading = curves(&|e| e.ue_heading_error_rad, "heading");
-    out.push(("heading_error.svg", epoch_curves_svg("UE heading error, mean over runs", "error (rad)", &heading)?));
-    let mut sources = curves(&|e| e.confirmed_va, "VA");
-    sources.extend(curves(&|e| e.confirmed_sp, "SP"));
+    out.push((
+        "ue_errors.svg",
+        epoch_panels_svg(
+            "UE errors, mean over runs (Kim et al. Fig. 5)",
+            &[
+                panel(&|e| e.ue_position_error_m, "UE position error (m)"),
+                panel(&|e| e.ue_clock_bias_error_m, "UE clock-bias error (m)"),
+            ],
+        )?,
+    ));
+    out.push((
+        "heading_error.svg",
+        epoch_panels_svg(
+            "UE heading error, mean over runs (Kim et al. Fig. 5)",
+            &[panel(&|e| e.ue_heading_error_rad, "UE heading error (rad)")],
+        )?,
+    ));
     out.push((
         "confirmed_sources.svg",
-        epoch_curves_svg("Confirmed sources, mean over runs (Fig. 4)", "sources", &sources)?,
+        epoch_panels_svg(
+            "Confirmed sources, mean over runs (Fig. 4)",
+            &[panel(&|e| e.confirmed_va, "confirmed VAs"), panel(&|e| e.confirmed_sp, "confirmed SPs")],
+        )?,
     ));
-    let mut errors = curves(&|e| e.va_error_m.unwrap_or(f64::NAN), "VA");
-    errors.extend(curves(&|e| e.sp_error_m.unwrap_or(f64::NAN), "SP"));
     out.push((
         "source_errors.svg",
-        epoch_curves_svg("Localisation error of confirmed sources (Fig. 4)", "error (m)", &errors)?,
+        epoch_panels_svg(
+            "Localisation error of confirmed sources (Fig. 4)",
+            &[
+                panel(&|e| e.va_error_m.unwrap_or(f64::NAN), "VA error (m)"),
+                panel(&|e| e.sp_error_m.unwrap_or(f64::NAN), "SP error (m)"),
+            ],
+        )?,
     ));
     Ok(out)
 }
