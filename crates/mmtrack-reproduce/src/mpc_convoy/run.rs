@@ -445,6 +445,9 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
                     scene.truth.clone()
                 };
                 for (v, variant) in group.iter().enumerate() {
+                    // Scoring one variant takes about a second: a Ctrl-C
+                    // from Python waits for one score, not for all of them.
+                    progress.check_cancelled()?;
                     let (summary, births_by_kind) = score(scene, table.clone(), v);
                     diagnoses.push(diagnosis(scene, &table, v, &variant.config));
                     rows.push(Row { truth, variant: variant.name, summary, births_by_kind });
