@@ -52,7 +52,7 @@ impl Inventory {
         let parts: Vec<String> = self
             .tables
             .iter()
-            .map(|(t, s)| format!("{t} ({} sequence{})", s.len(), if s.len() == 1 { "" } else { "s" }))
+            .map(|(t, s)| format!("{t} ({})", mmtrack_core::words::counted(s.len() as u64, "sequence")))
             .collect();
         parts.join(", ")
     }

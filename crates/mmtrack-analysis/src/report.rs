@@ -43,7 +43,9 @@ fn step(options: &DriftOptions) -> String {
 pub fn one_line(r: &TrajectoryResult) -> String {
     let m = &r.metrics;
     let kitti = match (m.kitti_translational_pct, m.kitti_rotational_deg_per_100m) {
-        (Some(t), Some(rot)) => format!("KITTI {t:.3} % {rot:.3} deg/100m ({} segments)", m.kitti_segments),
+        (Some(t), Some(rot)) => {
+            format!("KITTI {t:.3} % {rot:.3} deg/100m ({})", mmtrack_core::words::counted(m.kitti_segments, "segment"))
+        }
         _ => format!(
             "KITTI n/a (path {:.1} m shorter than the shortest segment length {} m)",
             m.path_length_m,
