@@ -9,6 +9,35 @@ use crate::mpc::MpcResult;
 /// 0.3 s at the paper's 10 ms set period, enough to see tracks evolve.
 pub const DELAY_PLOT_SETS: usize = 30;
 
+/// Why the plot `file` (of [`crate::mpc_report::PLOTS`]) of `result` would
+/// have nothing to draw, or `None` when it has data. `mmtrack analyze` writes
+/// no such file and the report says why in its place (a single-snapshot
+/// source, as the BUT 60 GHz sample, drew axes without curves).
+#[must_use]
+pub fn empty_because(result: &MpcResult, file: &str) -> Option<String> {
+    let sets = mmtrack_core::words::counted(result.per_set.len() as u64, "set");
+    match file {
+        "mpc_delay_tracks.svg" if result.detections.is_empty() => Some("no detections".into()),
+        "mpc_count.svg" if result.counts.is_empty() => {
+            Some("the MPCs of a set are its long-term tracks; this sequence has none".into())
+        }
+        "mpc_birth_death.svg"
+            if result.per_set.iter().all(|s| s.birth_rate_per_s.is_none() && s.birth_rate_per_m.is_none()) =>
+        {
+            Some(format!("birth and death rates are taken between consecutive sets; this sequence has {sets}"))
+        }
+        "mpc_power_loss.svg" if result.per_set.len() < 2 => {
+            Some(format!("gain and loss are drawn against time over sets; this sequence has {sets}"))
+        }
+        "mpc_power_std.svg" if result.power_std.is_empty() => Some(
+            "no short-term tracks (a track follows one path over at least short_term.min_track_length snapshots \
+             of one set)"
+                .into(),
+        ),
+        _ => None,
+    }
+}
+
 /// A labelled line: label, points, colour.
 type Series<'a> = (&'a str, Vec<(f64, f64)>, RGBColor);
 

@@ -189,6 +189,10 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
     for r in results {
         let _ = writeln!(out, "### `{}` (MPC)\n", r.sequence);
         for (file, title) in PLOTS {
+            if let Some(reason) = crate::mpc_plots::empty_because(r, file) {
+                let _ = writeln!(out, "\n*No plot ({title}): {reason}.*\n");
+                continue;
+            }
             let subset = match crate::mpc_plots::delay_plot_subset(r) {
                 Some(note) if file == PLOTS[0].0 => format!(" ({note})"),
                 _ => String::new(),

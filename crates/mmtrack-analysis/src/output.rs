@@ -294,11 +294,15 @@ fn write_mpc_into(dir: &Path, results: &[MpcResult], run: &SequenceRun<'_>) -> a
             mpc_plots::power_std_svg(r),
         ];
         for ((file, _), svg) in mpc_report::PLOTS.iter().zip(svgs) {
+            if mpc_plots::empty_because(r, file).is_some() {
+                continue;
+            }
             let path = plot_dir.join(file);
             let svg = svg.with_context(|| format!("sequence {seq}: {file}"))?;
             std::fs::write(&path, svg).with_context(|| path.display().to_string())?;
+            files += 1;
         }
-        files += 6 + mpc_report::PLOTS.len();
+        files += 6;
     }
     Ok(files)
 }

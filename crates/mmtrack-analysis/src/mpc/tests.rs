@@ -118,6 +118,49 @@ fn counts_are_null_when_nothing_was_tracked() {
     assert!(line.contains("n/a MPCs per set, births n/a / deaths n/a"), "{line}");
 }
 
+/// Before: a single-snapshot source (the real BUT 60 GHz sample: one set
+/// per link, nothing tracked) got five plot files, four of them axes
+/// without a curve. Now only plots with data are named in the report, and
+/// the others say why in their place.
+#[test]
+fn plots_without_data_are_not_drawn_and_the_report_says_why() {
+    let detection =
+        MpcDetection { t_ns: 0, set_index: 0, snapshot_index: 0, delay_s: 1e-7, amplitude: Complex64::new(1e-4, 0.0) };
+    let one_set = MpcInput {
+        detections: vec![detection],
+        long_term: Vec::new(),
+        sets: vec![set(0)],
+        ..input(DistanceSource::None)
+    };
+    let r = analyze_mpc("one", one_set, &MpcOptions::default());
+    let empty: Vec<&str> = crate::mpc_report::PLOTS
+        .iter()
+        .map(|(file, _)| *file)
+        .filter(|file| crate::mpc_plots::empty_because(&r, file).is_some())
+        .collect();
+    assert_eq!(empty, ["mpc_birth_death.svg", "mpc_power_loss.svg", "mpc_power_std.svg"]);
+    let mut report = String::new();
+    crate::mpc_report::section(&mut report, std::slice::from_ref(&r));
+    assert!(report.contains("](plots/one/mpc_delay_tracks.svg)"), "{report}");
+    assert!(!report.contains("](plots/one/mpc_birth_death.svg)"), "{report}");
+    assert!(
+        report.contains(
+            "*No plot (birth and death rates (Fig. 13)): birth and death rates are taken between consecutive sets; \
+             this sequence has 1 set.*"
+        ),
+        "{report}"
+    );
+
+    // Four sets with long-term tracks: every plot but the track power spread (no short-term tracks here).
+    let r = analyze_mpc("four", input(DistanceSource::None), &MpcOptions::default());
+    let empty: Vec<&str> = crate::mpc_report::PLOTS
+        .iter()
+        .map(|(file, _)| *file)
+        .filter(|file| crate::mpc_plots::empty_because(&r, file).is_some())
+        .collect();
+    assert_eq!(empty, ["mpc_delay_tracks.svg", "mpc_power_std.svg"]);
+}
+
 #[test]
 fn chi_shares_and_unrelated_power() {
     let r = analyze_mpc("s", input(DistanceSource::None), &MpcOptions::default());
