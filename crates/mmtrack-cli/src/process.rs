@@ -312,7 +312,8 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
         }
     }
     for w in &done.written {
-        println!("  wrote {} ({} {})", w.path.display(), w.rows, mpc::record_noun(&w.path));
+        let (one, many) = mpc::record_noun(&w.path);
+        println!("  wrote {} ({})", w.path.display(), counted_as(w.rows, one, many));
     }
     Ok(done.written)
 }

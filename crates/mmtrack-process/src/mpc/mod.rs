@@ -491,20 +491,21 @@ pub fn process_mpc(
     Ok(MpcOutput { links, written: tables.publish()? })
 }
 
-/// What the records counted in a table's [`TableWriteSummary::rows`] are,
-/// from the table's directory in `<output>/<table>/sequence=<id>/part-0.parquet`:
-/// one record of `mpc_tracks` is a whole track (one row per point).
+/// The records counted in a table's [`TableWriteSummary::rows`], as one
+/// and as many, from the table's directory in
+/// `<output>/<table>/sequence=<id>/part-0.parquet`: one record of
+/// `mpc_tracks` is a whole track (one row per point).
 #[must_use]
-pub fn record_noun(path: &Path) -> &'static str {
+pub fn record_noun(path: &Path) -> (&'static str, &'static str) {
     let table = path.parent().and_then(Path::parent).and_then(Path::file_name).and_then(|n| n.to_str());
     match table {
-        Some("mpc_detections") => "detections",
-        Some("mpc_tracks" | "mpc_tracks_gmphd") => "tracks",
-        Some("mpc_long_term") => "long-term entries",
-        Some("mpc_sets") => "sets",
-        Some("mpc_snapshots") => "snapshots",
-        Some("ground_truth_tx" | "ground_truth_rx") => "poses",
-        _ => "rows",
+        Some("mpc_detections") => ("detection", "detections"),
+        Some("mpc_tracks" | "mpc_tracks_gmphd") => ("track", "tracks"),
+        Some("mpc_long_term") => ("long-term entry", "long-term entries"),
+        Some("mpc_sets") => ("set", "sets"),
+        Some("mpc_snapshots") => ("snapshot", "snapshots"),
+        Some("ground_truth_tx" | "ground_truth_rx") => ("pose", "poses"),
+        _ => ("row", "rows"),
     }
 }
 
