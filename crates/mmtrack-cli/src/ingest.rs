@@ -42,6 +42,15 @@ pub struct OutputArgs {
     /// Omit the Foxglove display channels (/viz/..., /tf, /radar/cartesian).
     #[arg(long)]
     pub no_foxglove_views: bool,
+    /// Skip the fsync before the final rename: faster on large recordings, but a
+    /// power cut right afterwards may lose the new file.
+    #[arg(long)]
+    pub no_sync: bool,
+}
+
+/// The Cartesian radar view's options, on the commands that write radar scans.
+#[derive(Args, Clone)]
+pub struct RadarViewArgs {
     /// Omit the Cartesian radar view (/radar/cartesian: each scan resampled onto a square grid around the radar
     /// for Foxglove's image panel); the polar /radar/image is written either way.
     #[arg(long)]
@@ -53,10 +62,6 @@ pub struct OutputArgs {
     #[arg(long, default_value_t = CartesianGrid::default().size_px, value_name = "PX",
           value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_CARTESIAN_SIZE_PX)))]
     pub radar_cartesian_size_px: u32,
-    /// Skip the fsync before the final rename: faster on large recordings, but a
-    /// power cut right afterwards may lose the new file.
-    #[arg(long)]
-    pub no_sync: bool,
 }
 
 /// Chunk compression choices.
@@ -71,9 +76,25 @@ pub enum CompressionArg {
 }
 
 impl OutputArgs {
-    /// The writer's options ([`RecordingFlags::options`]).
+    /// The writer's options ([`RecordingFlags::options`]) of a command
+    /// without radar scans: no Cartesian view.
     pub fn recording_options(&self) -> anyhow::Result<RecordingOptions> {
+        self.flags().options().map_err(crate::usage)
+    }
+
+    /// The writer's options of a command that writes radar scans.
+    pub fn radar_recording_options(&self, view: &RadarViewArgs) -> anyhow::Result<RecordingOptions> {
         let flags = RecordingFlags {
+            no_radar_cartesian: view.no_radar_cartesian,
+            radar_cartesian_m_per_px: view.radar_cartesian_m_per_px,
+            radar_cartesian_size_px: view.radar_cartesian_size_px,
+            ..self.flags()
+        };
+        flags.options().map_err(crate::usage)
+    }
+
+    fn flags(&self) -> RecordingFlags {
+        RecordingFlags {
             force: self.force,
             compression: match self.compression {
                 CompressionArg::None => "none",
@@ -83,12 +104,10 @@ impl OutputArgs {
             .to_string(),
             zstd_level: self.zstd_level,
             no_foxglove_views: self.no_foxglove_views,
-            no_radar_cartesian: self.no_radar_cartesian,
-            radar_cartesian_m_per_px: self.radar_cartesian_m_per_px,
-            radar_cartesian_size_px: self.radar_cartesian_size_px,
+            no_radar_cartesian: true,
             no_sync: self.no_sync,
-        };
-        flags.options().map_err(crate::usage)
+            ..RecordingFlags::default()
+        }
     }
 }
 
@@ -193,6 +212,8 @@ enum Kind {
         #[command(flatten)]
         output: OutputArgs,
         #[command(flatten)]
+        radar_view: RadarViewArgs,
+        #[command(flatten)]
         threads: ThreadsArg,
         /// Range bin size in metres (dataset SDK: 0.0432; CFEAR uses 0.0438).
         #[arg(long, default_value_t = oxford::OXFORD.range_resolution_m)]
@@ -219,6 +240,8 @@ enum Kind {
         #[command(flatten)]
         output: OutputArgs,
         #[command(flatten)]
+        radar_view: RadarViewArgs,
+        #[command(flatten)]
         threads: ThreadsArg,
         /// Range bin size in metres (default: chosen by recording date).
         #[arg(long)]
@@ -242,6 +265,8 @@ enum Kind {
         #[command(flatten)]
         output: OutputArgs,
         #[command(flatten)]
+        radar_view: RadarViewArgs,
+        #[command(flatten)]
         threads: ThreadsArg,
         /// Range bin size in metres.
         #[arg(long, default_value_t = mulran::RANGE_RESOLUTION_M)]
@@ -253,11 +278,6 @@ enum Kind {
         sequence_id: Option<String>,
     },
     /// Trajectory file (TUM, KITTI, Oxford radar_odometry.csv) into a new recording or added to one.
-    #[command(
-        mut_arg("no_radar_cartesian", |a| a.hide(true)),
-        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
-        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
-    )]
     Poses {
         /// The trajectory file.
         input: PathBuf,
@@ -283,11 +303,6 @@ enum Kind {
         plane: PlaneArg,
     },
     /// NMEA 0183 GNSS log (GGA with RMC or ZDA, or RMC alone; any talker) into a new recording or added to one.
-    #[command(
-        mut_arg("no_radar_cartesian", |a| a.hide(true)),
-        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
-        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
-    )]
     Nmea {
         /// The log.
         input: PathBuf,
@@ -302,11 +317,6 @@ enum Kind {
     /// A sidecar TOML gives what the file lacks (carrier_hz, tap_spacing_s or
     /// bandwidth_hz, snapshot/set timing, domain = "cir" | "cfr", axes, variable, dataset);
     /// every key, and an example for the real 60 GHz MIMO sample, in docs/commands.md ("mmtrack ingest cir").
-    #[command(
-        mut_arg("no_radar_cartesian", |a| a.hide(true)),
-        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
-        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
-    )]
     Cir {
         /// The file (.npy, .npz, .mat, .h5, .sigmf-meta/.sigmf-data, .csv, DecaRanging .log).
         input: PathBuf,
@@ -358,6 +368,8 @@ enum Kind {
         input: PathBuf,
         #[command(flatten)]
         output: OutputArgs,
+        #[command(flatten)]
+        radar_view: RadarViewArgs,
         /// Pose topic (Odometry or PoseWithCovarianceStamped); `none` to skip poses.
         #[arg(long, default_value = "/odom")]
         pose_topic: String,
@@ -408,7 +420,7 @@ impl Kind {
 pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     args.kind.check_output()?;
     match args.kind {
-        Kind::Oxford { input, output, threads, range_resolution_m, bins, decode, sequence_id } => {
+        Kind::Oxford { input, output, radar_view, threads, range_resolution_m, bins, decode, sequence_id } => {
             let expected_bins = mmtrack_ingest::flags::parse_bins(&bins).map_err(crate::usage)?;
             positive_metres("--range-resolution-m", range_resolution_m)?;
             let options = OxfordOptions {
@@ -416,19 +428,19 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 carry_png: !decode,
                 sequence_id,
             };
-            threads.install(|| oxford_folder(&input, &output, &options, quiet))?
+            threads.install(|| oxford_folder(&input, &output, &radar_view, &options, quiet))?
         }
-        Kind::Boreas { input, output, threads, range_resolution_m, decode, sequence_id } => {
+        Kind::Boreas { input, output, radar_view, threads, range_resolution_m, decode, sequence_id } => {
             if let Some(r) = range_resolution_m {
                 positive_metres("--range-resolution-m", r)?;
             }
             let options = BoreasOptions { range_resolution_m, decode, sequence_id };
-            threads.install(|| boreas_folder(&input, &output, &options, quiet))?
+            threads.install(|| boreas_folder(&input, &output, &radar_view, &options, quiet))?
         }
-        Kind::Mulran { input, output, threads, range_resolution_m, sweep, sequence_id } => {
+        Kind::Mulran { input, output, radar_view, threads, range_resolution_m, sweep, sequence_id } => {
             positive_metres("--range-resolution-m", range_resolution_m)?;
             let options = MulranOptions { range_resolution_m, timing: sweep.timing()?, sequence_id };
-            threads.install(|| mulran_folder(&input, &output, &options, quiet))?
+            threads.install(|| mulran_folder(&input, &output, &radar_view, &options, quiet))?
         }
         Kind::Poses { input, format, mut output, add_to, estimate, times, t0_ns, plane } => {
             let plane = match plane {
@@ -516,6 +528,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         Kind::Ros2 {
             input,
             output,
+            radar_view,
             pose_topic,
             poses_are_ground_truth,
             gnss_topic,
@@ -532,7 +545,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 sweep.timing()?,
             )
             .map_err(crate::usage)?;
-            folders::ros2_bag(&input, &output, &topics, quiet)
+            folders::ros2_bag(&input, &output, &radar_view, &topics, quiet)
         }
     }
 }

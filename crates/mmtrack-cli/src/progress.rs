@@ -5,18 +5,6 @@ use std::sync::{PoisonError, RwLock};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use mmtrack_core::progress::Progress;
 
-/// Items per second as a person reads it: "3.2/s", "361/s" (indicatif's
-/// own `{per_sec}` prints "3.2071/s").
-fn rate_text(per_sec: f64) -> String {
-    if !per_sec.is_finite() || per_sec <= 0.0 {
-        "-/s".to_string()
-    } else if per_sec < 10.0 {
-        format!("{per_sec:.1}/s")
-    } else {
-        format!("{per_sec:.0}/s")
-    }
-}
-
 /// A bar for `total` items of `unit` (e.g. "scans").
 pub fn bar(total: u64, message: &str, unit: &str, quiet: bool) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(
@@ -26,7 +14,7 @@ pub fn bar(total: u64, message: &str, unit: &str, quiet: bool) -> ProgressBar {
     let template = format!("{{msg}} [{{bar:30}}] {{pos}}/{{len}} {unit} ({{rate}}, eta {{eta}})");
     if let Ok(style) = ProgressStyle::with_template(&template) {
         let style = style.with_key("rate", |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
-            let _ = w.write_str(&rate_text(state.per_sec()));
+            let _ = w.write_str(&mmtrack_core::words::rate_per_s(state.per_sec()));
         });
         bar.set_style(style.progress_chars("=> "));
     }
@@ -104,18 +92,5 @@ impl Progress for IndicatifProgress {
         } else {
             current.println(text);
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn rates_read_as_a_person_reads_them() {
-        assert_eq!(rate_text(3.207_123), "3.2/s");
-        assert_eq!(rate_text(361.4), "361/s");
-        assert_eq!(rate_text(0.0), "-/s");
-        assert_eq!(rate_text(f64::NAN), "-/s");
     }
 }

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use clap::{Args, Subcommand, ValueEnum};
 use mmtrack_process::simulate::radar::{RadarLayout, RadarSimulation, TrajectoryFile, simulate_radar};
 
-use crate::ingest::{OutputArgs, PoseFormat};
+use crate::ingest::{OutputArgs, PoseFormat, RadarViewArgs};
 use crate::progress::IndicatifProgress;
 use crate::threads::ThreadsArg;
 
@@ -38,11 +38,6 @@ enum Kind {
     /// the CIRs (/channel/cir), the true MPCs (/channel/mpc_truth), both cars' poses per set
     /// (/ground_truth/tx, /ground_truth/rx) and the pulse spectrum in its metadata. Same scenario
     /// and seed give identical bytes.
-    #[command(
-        mut_arg("no_radar_cartesian", |a| a.hide(true)),
-        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
-        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
-    )]
     Sounder(Box<crate::simulate_sounder::SounderArgs>),
     /// 5G mmWave SLAM world (Kim et al. 2018): per-epoch path measurements with ground truth.
     ///
@@ -53,11 +48,6 @@ enum Kind {
     /// carries the paths of each epoch (/slam/paths: TOA, DOA and DOD azimuth and elevation), the
     /// true UE state and path origins (/slam/ue_truth), the UE pose (/ground_truth/pose) and the
     /// base station and true sources (/slam/sources). Same world and seed give identical bytes.
-    #[command(
-        mut_arg("no_radar_cartesian", |a| a.hide(true)),
-        mut_arg("radar_cartesian_m_per_px", |a| a.hide(true)),
-        mut_arg("radar_cartesian_size_px", |a| a.hide(true))
-    )]
     Slam(Box<crate::slam::simulate::SlamSimArgs>),
 }
 
@@ -91,6 +81,8 @@ struct RadarArgs {
     format: Format,
     #[command(flatten)]
     output: OutputArgs,
+    #[command(flatten)]
+    radar_view: RadarViewArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
@@ -117,7 +109,7 @@ fn run_radar(args: &RadarArgs, quiet: bool) -> anyhow::Result<()> {
             Format::Oxford => RadarLayout::Oxford,
         },
         output: args.output.output.clone(),
-        recording: args.output.recording_options()?,
+        recording: args.output.radar_recording_options(&args.radar_view)?,
     };
     let done = simulate_radar(&simulation, &IndicatifProgress::new(quiet))?;
     if !quiet {

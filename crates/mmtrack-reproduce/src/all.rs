@@ -283,14 +283,13 @@ pub fn run_all(options: &AllOptions, progress: &dyn Progress) -> anyhow::Result<
 /// "N of M paper claims met" and the table of every claim: experiment,
 /// claim, the paper's side, the rule, what was measured, the verdict.
 fn claims_section(claims: &[(&'static str, Verdict)], command: &str, tier: Tier) -> String {
-    let targets: Vec<&Verdict> = claims.iter().map(|(_, v)| v).filter(|v| !v.claim.informational).collect();
-    let met = targets.iter().filter(|v| v.met).count();
-    let variants = claims.len() - targets.len();
+    let (met, targets) = crate::model::claims_met(claims.iter().map(|(_, v)| v));
+    let variants = claims.len() - targets;
     let mut out = format!(
         "**{met} of {} paper claims met**{} (`{command}`; {variants} variants, diagnostics and speed targets of ours \
          reported beside them, not counted). Each claim is judged against the paper by its rule; a missed claim stays \
          in the table.\n\n",
-        targets.len(),
+        targets,
         if tier.is_smoke() { " in the smoke runs (fewer runs than the papers: indicative only)" } else { "" }
     );
     out.push_str("| experiment | claim | paper | rule | measured | verdict |\n|---|---|---|---|---|---|\n");

@@ -325,17 +325,96 @@ pub struct Outcome {
     pub readme: ReadmeBlock,
 }
 
+/// The target claims met among `verdicts` and the target claims in all
+/// (informational ones do not count).
+#[must_use]
+pub fn claims_met<'a>(verdicts: impl IntoIterator<Item = &'a Verdict>) -> (usize, usize) {
+    let targets = verdicts.into_iter().filter(|v| !v.claim.informational);
+    targets.fold((0, 0), |(met, total), v| (met + usize::from(v.met), total + 1))
+}
+
 impl Outcome {
-    /// Every target claim met (informational ones do not count).
+    /// The target claims met and the target claims in all (informational
+    /// ones do not count).
+    #[must_use]
+    pub fn claims_met(&self) -> (usize, usize) {
+        claims_met(&self.verdicts)
+    }
+
+    /// Every target claim met.
     #[must_use]
     pub fn targets_met(&self) -> bool {
-        self.verdicts.iter().all(|v| v.met || v.claim.informational)
+        let (met, total) = self.claims_met();
+        met == total
+    }
+
+    /// The line a front end prints on stderr when a target claim was
+    /// missed (the CLI then exits 1; an error exits 1 too, with its own
+    /// `error:` line), or `None` when every target was met.
+    #[must_use]
+    pub fn missed_line(&self, output_dir: &Path) -> Option<String> {
+        let (met, total) = self.claims_met();
+        (met < total).then(|| {
+            format!(
+                "reproduce {}: {} missed (exit 1; the run itself succeeded); see {}",
+                self.experiment,
+                mmtrack_core::words::counted_as((total - met) as u64, "paper claim", "paper claims"),
+                output_dir.join("reproduce.md").display()
+            )
+        })
+    }
+
+    /// What a front end prints after a run written to `output_dir`: how many
+    /// of the paper's claims were met, one row per claim, and where the full
+    /// report (`reproduce.md`) and the outputs are.
+    #[must_use]
+    pub fn summary(&self, output_dir: &Path) -> String {
+        let (met, total) = self.claims_met();
+        format!(
+            "reproduce {}: {met} of {total} paper claims met\n\n| claim | paper | measured | verdict |\n|---|---|---|---|\n{}\n\
+             report: {}\noutputs: {}\n",
+            self.experiment,
+            verdict_rows(&self.verdicts),
+            output_dir.join("reproduce.md").display(),
+            output_dir.display()
+        )
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Before: `mmtrack reproduce <experiment>` printed the whole report.
+    #[test]
+    fn the_summary_counts_the_target_claims_and_a_miss_has_its_line() {
+        let claim = |what: &str| Claim::new(what, "m", Some(1.0), "1 m", Rule::AtMost { bound: 1.0 });
+        let verdicts = vec![
+            Verdict::judged(claim("a"), Some(0.5), "0.5 m"),
+            Verdict::judged(claim("b"), Some(2.0), "2.0 m"),
+            Verdict::judged(claim("c").informational(), Some(2.0), "2.0 m"),
+        ];
+        let readme = ReadmeBlock { name: "x", body: String::new() };
+        let outcome = Outcome {
+            experiment: "x",
+            metrics: vec![],
+            verdicts,
+            files: vec![],
+            report: "| long |\n".repeat(200),
+            readme,
+        };
+        assert_eq!(outcome.claims_met(), (1, 2));
+        assert!(!outcome.targets_met());
+        let text = outcome.summary(Path::new("out/x"));
+        assert!(text.starts_with("reproduce x: 1 of 2 paper claims met\n"), "{text}");
+        assert!(text.contains("| b | 1 m | 2.0 m | **missed** |") && !text.contains("| long |"), "{text}");
+        assert!(text.contains("report: out/x/reproduce.md\noutputs: out/x\n"), "{text}");
+        // Before: a missed target with `mmtrack reproduce -q` exited 1 without a word.
+        let line = outcome.missed_line(Path::new("out/x")).unwrap();
+        assert!(line.contains(": 1 paper claim missed") && line.contains("out/x/reproduce.md"), "{line}");
+        let all_met = Outcome { verdicts: vec![outcome.verdicts[0].clone(), outcome.verdicts[2].clone()], ..outcome };
+        assert_eq!(all_met.missed_line(Path::new("out/x")), None);
+    }
 
     #[test]
     fn rules_judge_the_measured_value_and_nothing_measured_is_a_miss() {

@@ -14,7 +14,7 @@ use mmtrack_ingest::oxford::{self, OxfordFolder, OxfordOptions};
 use mmtrack_ingest::ros2::{self, Ros2Topics};
 use mmtrack_ingest::sweep::SweepTiming;
 
-use super::OutputArgs;
+use super::{OutputArgs, RadarViewArgs};
 use crate::progress;
 
 /// Which azimuth of a sweep an image stamp marks.
@@ -57,12 +57,14 @@ pub(super) fn positive_metres(flag: &str, value: f64) -> anyhow::Result<()> {
 pub(super) fn boreas_folder(
     input: &Path,
     output: &OutputArgs,
+    radar_view: &RadarViewArgs,
     options: &BoreasOptions,
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
+    let recording = output.radar_recording_options(radar_view)?;
     let folder = BoreasFolder::open(input)?;
     let bar = progress::bar(folder.scans.len() as u64, "ingest boreas", "scans", quiet);
-    let report = ingest_boreas(&folder, &output.output, options, &output.recording_options()?, &mut |done, _| {
+    let report = ingest_boreas(&folder, &output.output, options, &recording, &mut |done, _| {
         bar.set_position(done);
     });
     bar.finish_and_clear();
@@ -86,12 +88,14 @@ pub(super) fn boreas_folder(
 pub(super) fn mulran_folder(
     input: &Path,
     output: &OutputArgs,
+    radar_view: &RadarViewArgs,
     options: &MulranOptions,
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
+    let recording = output.radar_recording_options(radar_view)?;
     let folder = MulranFolder::open(input)?;
     let bar = progress::bar(folder.scans.len() as u64, "ingest mulran", "scans", quiet);
-    let report = ingest_mulran(&folder, &output.output, options, &output.recording_options()?, &mut |done, _| {
+    let report = ingest_mulran(&folder, &output.output, options, &recording, &mut |done, _| {
         bar.set_position(done);
     });
     bar.finish_and_clear();
@@ -114,15 +118,16 @@ pub(super) fn mulran_folder(
 pub fn oxford_folder(
     input: &Path,
     output: &OutputArgs,
+    radar_view: &RadarViewArgs,
     options: &OxfordOptions,
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
+    let recording = output.radar_recording_options(radar_view)?;
     let folder = OxfordFolder::open(input)?;
     let bar = progress::bar(folder.scans.len() as u64, "ingest oxford", "scans", quiet);
-    let report =
-        oxford::ingest_oxford(&folder, &output.output, options, &output.recording_options()?, &mut |done, _| {
-            bar.set_position(done);
-        })?;
+    let report = oxford::ingest_oxford(&folder, &output.output, options, &recording, &mut |done, _| {
+        bar.set_position(done);
+    })?;
     bar.finish_and_clear();
     if !quiet {
         println!(
@@ -181,11 +186,13 @@ fn unlisted_warning(root: &Path, unlisted: &[std::path::PathBuf]) -> Option<Stri
 pub(super) fn ros2_bag(
     input: &Path,
     output: &OutputArgs,
+    radar_view: &RadarViewArgs,
     topics: &Ros2Topics,
     quiet: bool,
 ) -> anyhow::Result<ExitCode> {
+    let recording = output.radar_recording_options(radar_view)?;
     let bar = progress::bytes_bar(std::fs::metadata(input).map_or(0, |m| m.len()), "ingest ros2", quiet);
-    let report = ros2::ingest_ros2(input, &output.output, topics, &output.recording_options()?, &mut |done, total| {
+    let report = ros2::ingest_ros2(input, &output.output, topics, &recording, &mut |done, total| {
         bar.set_length(total);
         bar.set_position(done);
     });

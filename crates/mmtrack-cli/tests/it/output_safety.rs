@@ -81,7 +81,7 @@ fn bad_flag_values_found_after_parsing_exit_2() {
     let cases: [&[&str]; 5] = [
         &["ingest", "oxford", "nowhere", "-o", "o.mcap", "--threads", "1000000"],
         &["ingest", "oxford", "nowhere", "-o", "o.mcap", "--range-resolution-m", "0"],
-        &["ingest", "poses", "traj.tum", "--format", "tum", "-o", "o.mcap", "--radar-cartesian-m-per-px", "0"],
+        &["ingest", "oxford", "nowhere", "-o", "o.mcap", "--radar-cartesian-m-per-px", "0"],
         &["ingest", "beams", "nowhere", "--format", "deepsense", "-o", "out", "--sweep-period-s", "0"],
         &["export", "--format", "kitti", ".", "-o", "k", "--recording", "x.mcap"],
     ];
