@@ -66,6 +66,16 @@ pub struct DetectionConfig {
     /// misfit as a residue the search picks up. Detections whose
     /// re-estimated amplitude falls below the threshold are dropped.
     pub refine_overlapping: bool,
+    /// Ours, not the paper's: after the search, re-estimate every
+    /// detection's delay and amplitude on the CIR as measured (neither
+    /// zeroed below the threshold nor windowed) with all other detections
+    /// subtracted, by coordinate sweeps over the detections (SAGE-like). The
+    /// search and its decisions (which paths, how many) stay the paper's; the
+    /// estimates become the maximum-likelihood ones of eqs. (7)-(8) on the
+    /// full band, whose delay noise the Kaiser window and the zeroing raise
+    /// (one path at -116 dB over a -140 dB floor: 0.035 ns windowed and
+    /// zeroed, 0.020 ns unwindowed and unzeroed, the Cramer-Rao level).
+    pub refit_unwindowed: bool,
 }
 
 impl Default for DetectionConfig {
@@ -78,6 +88,7 @@ impl Default for DetectionConfig {
             blocked_width_s: None,
             max_mpcs: 200,
             refine_overlapping: false,
+            refit_unwindowed: false,
         }
     }
 }

@@ -134,6 +134,9 @@ pub struct Detector {
     pulse_energy: f64,
     /// Half the blocked delay range, seconds.
     blocked_half_width_s: f64,
+    /// The unwindowed correlation's tables, with
+    /// [`DetectionConfig::refit_unwindowed`].
+    unwindowed: Option<UnwindowedFit>,
     fft: Arc<dyn Fft<f64>>,
     ifft: Arc<dyn Fft<f64>>,
 }
@@ -171,6 +174,7 @@ impl Detector {
         let ifft = planner.plan_fft_inverse(band.taps());
         let kernel_rows = KernelRows::new(&band, &mut planner, &kernel);
         let interpolator = PeakInterpolator::new(&band, &kernel_rows);
+        let unwindowed = config.refit_unwindowed.then(|| UnwindowedFit::new(&band, &mut planner, pulse.spectrum()));
         let mut detector = Self {
             config,
             band,
@@ -182,6 +186,7 @@ impl Detector {
             kernel_peak,
             pulse_energy,
             blocked_half_width_s: 0.0,
+            unwindowed,
             fft,
             ifft,
         };
@@ -266,7 +271,10 @@ impl Detector {
         }
         channel_gain /= u;
         self.ifft.process_with_scratch(&mut spectrum, &mut scratch);
-        let detections = self.search_and_subtract(snapshot, spectrum, threshold);
+        let mut detections = self.search_and_subtract(snapshot, spectrum, threshold);
+        if let Some(fit) = &self.unwindowed {
+            self.refit_unwindowed(fit, snapshot, &mut detections, threshold.sqrt(), &mut scratch);
+        }
         let detected_gain: f64 = detections.iter().map(|d| d.amplitude.norm_sqr()).sum::<f64>() * self.pulse_energy;
         Ok(SnapshotDetections {
             detections,
@@ -445,6 +453,96 @@ impl Detector {
                 break;
             }
         }
+    }
+
+    /// [`DetectionConfig::refit_unwindowed`]: re-estimates every detection on
+    /// the matched-filter output of the CIR as measured, `c = p^H h` without
+    /// zeroing or window, with all other detections subtracted (eq. (9) with
+    /// the unwindowed pulse): sweeps over the detections, strongest first,
+    /// each added back, its peak found again near its delay (eqs. (7)-(8))
+    /// and subtracted anew, until no delay moves more than
+    /// [`REFINE_TOLERANCE_TAPS`] (at most [`REFINE_MAX_SWEEPS`]).
+    fn refit_unwindowed(
+        &self,
+        fit: &UnwindowedFit,
+        snapshot: &CirSnapshot,
+        detections: &mut [MpcDetection],
+        threshold_amplitude: f64,
+        scratch: &mut [Complex64],
+    ) {
+        if detections.is_empty() {
+            return;
+        }
+        let spacing_s = self.band.tap_spacing_s();
+        let u = self.band.taps() as f64;
+        let mut correlation = snapshot.taps.clone();
+        self.fft.process_with_scratch(&mut correlation, scratch);
+        for (h, p) in correlation.iter_mut().zip(&self.template) {
+            *h = p.conj() * *h / u;
+        }
+        self.ifft.process_with_scratch(&mut correlation, scratch);
+        let mut paths: Vec<(f64, Complex64)> =
+            detections.iter().map(|d| ((d.delay_s - snapshot.delay_offset_s) / spacing_s, d.amplitude)).collect();
+        let found_taps: Vec<f64> = paths.iter().map(|p| p.0).collect();
+        for &(x, a) in &paths {
+            let reach = fit.kernel_rows.reach_taps(a.norm() / threshold_amplitude);
+            fit.kernel_rows.subtract(&mut correlation, x, a, reach);
+        }
+        let taps = self.band.taps() as i64;
+        let mut around = Neighbourhood::default();
+        for _ in 0..REFINE_MAX_SWEEPS {
+            let mut moved_taps: f64 = 0.0;
+            for (path, &found) in paths.iter_mut().zip(&found_taps) {
+                let (x, a) = *path;
+                let reach = fit.kernel_rows.reach_taps(a.norm() / threshold_amplitude);
+                fit.kernel_rows.subtract(&mut correlation, x, -a, reach);
+                let coarse = (x.round() as i64).rem_euclid(taps) as usize;
+                around.fill(&fit.interpolator, &correlation, coarse);
+                let peak = fit.interpolator.refine(&around);
+                let mut refined = (x.round() + peak.delta_taps, peak.value / fit.kernel_peak);
+                if (refined.0 - found).abs() > MAX_REFIT_MOVE_TAPS {
+                    // Another peak, not this detection's: keep the estimate.
+                    refined = (x, a);
+                }
+                let reach = fit.kernel_rows.reach_taps(refined.1.norm() / threshold_amplitude).max(reach);
+                fit.kernel_rows.subtract(&mut correlation, refined.0, refined.1, reach);
+                moved_taps = moved_taps.max((refined.0 - x).abs());
+                *path = refined;
+            }
+            if moved_taps < REFINE_TOLERANCE_TAPS {
+                break;
+            }
+        }
+        for (d, (x, a)) in detections.iter_mut().zip(paths) {
+            d.delay_s = snapshot.delay_offset_s + x * spacing_s;
+            d.amplitude = a;
+        }
+    }
+}
+
+/// Farthest [`DetectionConfig::refit_unwindowed`] moves a detection from
+/// where the search found it, taps: the search's estimate is within a few
+/// hundredths of a tap of the path at the paper's operating point, so a
+/// peak half a tap away is a neighbour's or the residue of a mismatched
+/// pulse, not a better estimate of this path.
+const MAX_REFIT_MOVE_TAPS: f64 = 0.5;
+
+/// The tables of the unwindowed matched filter (kernel `|P|^2`), for
+/// [`DetectionConfig::refit_unwindowed`].
+struct UnwindowedFit {
+    kernel_rows: KernelRows,
+    interpolator: PeakInterpolator,
+    /// `(1/U) sum |P|^2`: the correlation of a unit path at its own delay.
+    kernel_peak: f64,
+}
+
+impl UnwindowedFit {
+    fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, pulse: &[Complex64]) -> Self {
+        let kernel: Vec<Complex64> = pulse.iter().map(|p| Complex64::new(p.norm_sqr(), 0.0)).collect();
+        let kernel_peak = kernel.iter().map(|k| k.re).sum::<f64>() / band.taps() as f64;
+        let kernel_rows = KernelRows::new(band, planner, &kernel);
+        let interpolator = PeakInterpolator::new(band, &kernel_rows);
+        Self { kernel_rows, interpolator, kernel_peak }
     }
 }
 

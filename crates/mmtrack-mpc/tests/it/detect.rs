@@ -103,15 +103,15 @@ fn blocked_width_of_the_kaiser_windowed_flat_pulse() {
     assert!((width_ns - 2.50).abs() < 0.02, "{width_ns}");
 }
 
-#[test]
-fn paper_operating_point_delay_error_below_three_hundredths_of_a_nanosecond() {
-    // Two equal-power MPCs at -116 dB, noise floor -140 dB (Mahler et al. 2017,
-    // Sec. IV-A): "up to a delay distance of around 2.5 ns, the mean delay
-    // estimation error is below 0.03 ns", i.e. averaged over the approach from
-    // wide separations down to 2.5 ns. Here: separations 20 ns down to 2.5 ns.
+/// Mean delay error over two equal-power MPCs at -116 dB, noise floor
+/// -140 dB (Mahler et al. 2017, Sec. IV-A): "up to a delay distance of around
+/// 2.5 ns, the mean delay estimation error is below 0.03 ns", i.e. averaged
+/// over the approach from wide separations down to 2.5 ns. Here:
+/// separations 20 ns down to 2.5 ns, 10 trials each, seed 7.
+fn paper_operating_point_mean_delay_error_ns(config: DetectionConfig) -> f64 {
     let band = band(256);
     let pulse = SounderPulse::flat(&band);
-    let detector = Detector::new(DetectionConfig::default(), TAP_S, &pulse).unwrap();
+    let detector = Detector::new(config, TAP_S, &pulse).unwrap();
     let mut rng = rng(7);
     let (mut total_error_s, mut total_count) = (0.0, 0);
     for step in 0..=35 {
@@ -141,13 +141,34 @@ fn paper_operating_point_delay_error_below_three_hundredths_of_a_nanosecond() {
             );
         }
     }
-    let mean_error_ns = total_error_s / f64::from(total_count) * 1e9;
+    total_error_s / f64::from(total_count) * 1e9
+}
+
+#[test]
+fn paper_operating_point_delay_error_below_three_hundredths_of_a_nanosecond() {
+    let mean_error_ns = paper_operating_point_mean_delay_error_ns(DetectionConfig::default());
     let verdict = if mean_error_ns < 0.03 { "met" } else { "missed" };
     println!("separations 20..2.5 ns: mean delay error {mean_error_ns:.4} ns (paper: below 0.03 ns): {verdict}");
     // Regression bound, not the paper's target: docs/results/multipath.md reports the
     // measured value (0.035 ns at this seed) against the paper's 0.03 ns and
     // why (zeroing below the threshold costs accuracy; see detect.rs docs).
     assert!(mean_error_ns < 0.04, "{mean_error_ns} ns");
+}
+
+/// `refit_unwindowed` (ours): the same detections re-estimated on the CIR
+/// without the window and the zeroing reach the unwindowed maximum-likelihood
+/// error (0.020 ns mean absolute here, module docs of `detect`), which the
+/// paper's windowed, zeroed estimate misses by about 1.7x.
+#[test]
+fn refit_unwindowed_reaches_the_unwindowed_maximum_likelihood_error() {
+    let paper = paper_operating_point_mean_delay_error_ns(DetectionConfig::default());
+    let refit = paper_operating_point_mean_delay_error_ns(DetectionConfig {
+        refit_unwindowed: true,
+        ..DetectionConfig::default()
+    });
+    println!("mean delay error at -116 dB: paper's detection {paper:.4} ns, refit unwindowed {refit:.4} ns");
+    assert!(refit < 0.022, "refit {refit} ns (unwindowed maximum likelihood: 0.020 ns)");
+    assert!(paper > 0.03, "paper's detection {paper} ns: the comparison needs the windowed estimate's error");
 }
 
 #[test]

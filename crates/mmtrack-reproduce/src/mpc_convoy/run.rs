@@ -31,8 +31,9 @@ pub struct Variant {
     /// Its short-term configuration (the paper's but for [`LS_OURS`]).
     pub short_term: ShortTermConfig,
     /// Whether it runs on the detections of the refined search
-    /// ([`mmtrack_mpc::DetectionConfig::refine_overlapping`], ours) instead
-    /// of the paper's search and subtract.
+    /// ([`mmtrack_mpc::DetectionConfig::refine_overlapping`] and
+    /// [`mmtrack_mpc::DetectionConfig::refit_unwindowed`], ours) instead of
+    /// the paper's search and subtract.
     pub refined_detection: bool,
 }
 
@@ -54,9 +55,13 @@ pub const CHAIN_OURS: &str = "chain-slope+gated+gap";
 /// [`CHAIN_OURS`] on the detections of a search that re-estimates
 /// overlapping paths jointly
 /// ([`mmtrack_mpc::DetectionConfig::refine_overlapping`], not the paper's
-/// steps 3-6): the traced cause of the long-term tracks on no true path
-/// (the LOS and the wall bounce 1.1 ns behind it fitted one pulse at a
-/// time leave a residue before the LOS).
+/// steps 3-6: the traced cause of the long-term tracks on no true path, the
+/// LOS and the wall bounce 1.1 ns behind it fitted one pulse at a time
+/// leave a residue before the LOS) and then re-estimates every detection on
+/// the unwindowed, unzeroed CIR
+/// ([`mmtrack_mpc::DetectionConfig::refit_unwindowed`]: the traced cause of
+/// the cars' broken short-term tracks, the delay noise the Kaiser window and
+/// the zeroing add).
 pub const REFINED_CHAIN: &str = "refined+chain-slope+gated+gap";
 
 /// The seven trackers: the paper's long-term tracker, ours, each of our two
@@ -123,8 +128,8 @@ pub fn variants() -> Vec<Variant> {
         Variant {
             name: REFINED_CHAIN,
             what: "chain-slope+gated+gap on the detections of a search that re-estimates each new detection and \
-                   those within 3 taps of it jointly, dropping any that falls below the threshold (ours, not the \
-                   paper's steps 3-6)",
+                   those within 3 taps of it jointly, dropping any that falls below the threshold, then every \
+                   detection on the CIR without window or zeroing (ours, not the paper's steps 1-6)",
             config: chain,
             short_term: ShortTermConfig::default(),
             refined_detection: true,
@@ -206,6 +211,28 @@ pub struct Measured {
     /// Why the births on true paths happened, per (truth, variant) pair
     /// of [`Measured::rows`] (same order).
     pub diagnoses: Vec<Diagnosis>,
+    /// The scatter-free tunnel with other seeds ([`OTHER_SEEDS`]): the
+    /// variants of [`SEED_VARIANTS`] against its truth.
+    pub other_seeds: Vec<SeedRow>,
+}
+
+/// Seeds of the scatter-free tunnel run beside the scenario's: other draws
+/// of the traffic (Poisson arrivals, speeds), path phases and noise, so that
+/// the birth-rate verdict is not one draw's.
+pub const OTHER_SEEDS: [u64; 4] = [1, 2, 3, 4];
+
+/// The variants run on [`OTHER_SEEDS`]: the paper's, ours and the best row.
+pub const SEED_VARIANTS: [&str; 3] = [LITERAL, OURS, REFINED_CHAIN];
+
+/// One variant on the scatter-free tunnel with another seed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SeedRow {
+    /// The seed.
+    pub seed: u64,
+    /// The long-term tracker's name ([`Variant::name`]).
+    pub variant: &'static str,
+    /// Everything `analyze` reports for it.
+    pub summary: MpcSummary,
 }
 
 impl Measured {
@@ -261,6 +288,7 @@ impl Run {
         // the same full-lifetime tracks.
         let mut config = MpcConfig::default();
         config.detection.refine_overlapping = refined;
+        config.detection.refit_unwindowed = refined;
         let pipeline = MpcPipeline::new(config, pulse, tap_spacing_s, carrier_hz)?;
         let trackers: Vec<LongTermTracker> =
             variants.iter().map(|v| LongTermTracker::new(v.config.clone(), carrier_hz, 0)).collect::<Result<_, _>>()?;
@@ -426,11 +454,7 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     ] {
         // One simulation, one scene per detector: the paper's search, then
         // the refined one.
-        let groups: Vec<(bool, Vec<Variant>)> = [false, true]
-            .into_iter()
-            .map(|refined| (refined, variants().into_iter().filter(|v| v.refined_detection == refined).collect()))
-            .filter(|(_, group): &(bool, Vec<Variant>)| !group.is_empty())
-            .collect();
+        let groups = detector_groups(|_| true);
         progress
             .note(&format!("simulating and tracking {sets} sets of {what} (the paper's search and the refined one)"));
         let scenes: Vec<(Scene, Vec<Variant>)> = run_scenes(scenario, seed, &groups, progress)?
@@ -455,5 +479,27 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
             }
         }
     }
-    Ok(Measured { sets, seed, rows, diagnoses })
+    let mut other_seeds = Vec::new();
+    for other in OTHER_SEEDS {
+        progress.note(&format!("simulating and tracking {sets} sets of the tunnel without diffuse scatterers, seed {other}"));
+        let groups = detector_groups(|v| SEED_VARIANTS.contains(&v.name));
+        for (scene, (_, group)) in run_scenes(&no_diffuse, other, &groups, progress)?.iter().zip(&groups) {
+            for (v, variant) in group.iter().enumerate() {
+                progress.check_cancelled()?;
+                let (summary, _) = score(scene, scene.truth.clone(), v);
+                other_seeds.push(SeedRow { seed: other, variant: variant.name, summary });
+            }
+        }
+    }
+    Ok(Measured { sets, seed, rows, diagnoses, other_seeds })
+}
+
+/// The variants `keep` selects, grouped by detector: the paper's search,
+/// then the refined one (groups without a variant left out).
+fn detector_groups(keep: impl Fn(&Variant) -> bool) -> Vec<(bool, Vec<Variant>)> {
+    [false, true]
+        .into_iter()
+        .map(|refined| (refined, variants().into_iter().filter(|v| v.refined_detection == refined && keep(v)).collect()))
+        .filter(|(_, group): &(bool, Vec<Variant>)| !group.is_empty())
+        .collect()
 }
