@@ -19,6 +19,9 @@ use crate::plot_common::{err, padded_range};
 pub enum ArtificialTracker {
     /// The paper's short-term tracker (Sec. III-B).
     Proposed,
+    /// The same tracker on the same detections re-estimated on the CIR
+    /// without window or zeroing (`refit_unwindowed`, ours, not the paper's).
+    ProposedRefit,
     /// The GM-PHD baseline with the paper's Table I parameters.
     GmPhd,
     /// The GM-PHD baseline with its measurement noise matched to the
@@ -29,13 +32,14 @@ pub enum ArtificialTracker {
 
 impl ArtificialTracker {
     /// Every tracker, in table order.
-    pub const ALL: [Self; 3] = [Self::Proposed, Self::GmPhd, Self::GmPhdMatched];
+    pub const ALL: [Self; 4] = [Self::Proposed, Self::ProposedRefit, Self::GmPhd, Self::GmPhdMatched];
 
     /// The name in CSV files and tables.
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
             Self::Proposed => "proposed",
+            Self::ProposedRefit => "proposed-refit",
             Self::GmPhd => "gm-phd",
             Self::GmPhdMatched => "gm-phd-matched",
         }
@@ -46,6 +50,7 @@ impl ArtificialTracker {
     pub fn label(self) -> &'static str {
         match self {
             Self::Proposed => "proposed",
+            Self::ProposedRefit => "proposed, detections refitted (ours)",
             Self::GmPhd => "GM-PHD (Table I)",
             Self::GmPhdMatched => "GM-PHD (sigma matched)",
         }
@@ -54,6 +59,7 @@ impl ArtificialTracker {
     fn color(self) -> RGBColor {
         match self {
             Self::Proposed => RGBColor(200, 30, 30),
+            Self::ProposedRefit => RGBColor(150, 60, 170),
             Self::GmPhd => RGBColor(30, 70, 200),
             Self::GmPhdMatched => RGBColor(20, 140, 60),
         }
