@@ -99,6 +99,13 @@ pub fn layered_style(index: usize) -> SeriesStyle {
 }
 
 impl SeriesStyle {
+    /// An unbroken line of `color`, `width_px` wide (truth, thresholds, and
+    /// series whose colour carries their meaning).
+    #[must_use]
+    pub fn solid(color: RGBColor, width_px: u32) -> Self {
+        Self { color, dash: Dash::Solid, width_px }
+    }
+
     /// The plotters stroke.
     #[must_use]
     pub fn stroke(&self) -> ShapeStyle {

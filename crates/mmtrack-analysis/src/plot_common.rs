@@ -75,27 +75,6 @@ where
     axes(chart, x_desc, y_desc).draw().map_err(err)
 }
 
-/// Draws `points` joined by a line in `style` and enters it in the legend as
-/// `label`, keyed by a short line of the same style.
-pub(crate) fn draw_labelled_line<'a, DB, X, Y>(
-    chart: &mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
-    points: impl IntoIterator<Item = (f64, f64)>,
-    style: ShapeStyle,
-    label: impl Into<String>,
-) -> anyhow::Result<()>
-where
-    DB: DrawingBackend + 'a,
-    X: Ranged<ValueType = f64>,
-    Y: Ranged<ValueType = f64>,
-{
-    chart
-        .draw_series(LineSeries::new(points, style))
-        .map_err(err)?
-        .label(label)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-    Ok(())
-}
-
 /// Decimals that tell ticks over `range` apart: plotters places about ten
 /// ticks at steps of 1, 2 or 5 x 10^k, so a tenth of the span, rounded down
 /// to its power of ten, sets the last digit shown (0 to 6 decimals).

@@ -35,10 +35,10 @@ fn xy_svg(frame: &str, truth: &[Se2], estimates: &[(String, Vec<Se2>)]) -> anyho
             .build_cartesian_2d((cx - half)..(cx + half), (cy - half)..(cy + half))
             .map_err(err)?;
         crate::plot_common::draw_axes(&mut chart, format!("x (m), {frame}"), format!("y (m), {frame}"))?;
-        crate::plot_common::draw_labelled_line(
+        crate::palette::draw_series_line(
             &mut chart,
             truth.iter().map(|p| (p.x_m, p.y_m)),
-            BLACK.stroke_width(2),
+            crate::palette::SeriesStyle::solid(BLACK, 2),
             "ground truth",
         )?;
         for (k, (label, poses)) in estimates.iter().enumerate() {

@@ -55,8 +55,8 @@ pub fn rms_curves_svg(title: &str, curves: &[RmsCurve], threshold_deg: f64) -> a
                 .map(|(k, v)| (k as f64, v.clamp(y_lo, y_hi)));
             crate::palette::draw_series_line(&mut chart, points, crate::palette::series_style(k), curve.label.clone())?;
         }
-        let threshold = BLACK.stroke_width(1);
-        crate::plot_common::draw_labelled_line(
+        let threshold = crate::palette::SeriesStyle::solid(BLACK, 1);
+        crate::palette::draw_series_line(
             &mut chart,
             [(0.0, threshold_deg), ((blocks - 1) as f64, threshold_deg)],
             threshold,
@@ -133,8 +133,8 @@ pub fn rms_against_distance_svg(title: &str, curves: &[DistanceCurve], threshold
                 PathElement::new(vec![(x, y), (end, y)], style)
             });
         }
-        let thin = BLACK.stroke_width(1);
-        crate::plot_common::draw_labelled_line(
+        let thin = crate::palette::SeriesStyle::solid(BLACK, 1);
+        crate::palette::draw_series_line(
             &mut chart,
             [(x.start, threshold_deg), (x.end, threshold_deg)],
             thin,

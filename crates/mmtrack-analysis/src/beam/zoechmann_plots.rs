@@ -80,8 +80,8 @@ fn draw_trace(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, trace:
         .build_cartesian_2d(x, y)
         .map_err(err)?;
     crate::plot_common::draw_axes(&mut chart, "x along the receiver's heading (m)", "y (m)")?;
-    let truth = BLACK.stroke_width(2);
-    crate::plot_common::draw_labelled_line(&mut chart, trace.truth_m.iter().map(|p| (p[0], p[1])), truth, "true path")?;
+    let truth = crate::palette::SeriesStyle::solid(BLACK, 2);
+    crate::palette::draw_series_line(&mut chart, trace.truth_m.iter().map(|p| (p[0], p[1])), truth, "true path")?;
     chart
         .draw_series(inside.iter().map(|&p| Cross::new(p, 3, RED.stroke_width(1))))
         .map_err(err)?
@@ -217,8 +217,8 @@ fn draw_nlos_map(
     for (i, path) in paths.iter().enumerate() {
         let color = PATH_COLORS[i % PATH_COLORS.len()];
         let rows: Vec<&ZoechmannPathLabelRow> = labels.iter().filter(|l| l.path == *path).collect();
-        let truth = color.stroke_width(2);
-        crate::plot_common::draw_labelled_line(
+        let truth = crate::palette::SeriesStyle::solid(color, 2);
+        crate::palette::draw_series_line(
             &mut chart,
             rows.iter().map(|l| (l.true_x_m, l.true_y_m)),
             truth,
@@ -281,10 +281,10 @@ fn draw_nlos_errors(
         .draw()
         .map_err(err)?;
     for (i, path) in paths.iter().enumerate() {
-        let style = PATH_COLORS[i % PATH_COLORS.len()].stroke_width(2);
+        let style = crate::palette::SeriesStyle::solid(PATH_COLORS[i % PATH_COLORS.len()], 2);
         let points =
             errors.iter().filter(|e| e.path == *path).filter(shown).map(|e| (e.t_ns as f64 * 1e-9, e.position_rmse_m));
-        crate::plot_common::draw_labelled_line(&mut chart, points, style, format!("{path}: RMS position error"))?;
+        crate::palette::draw_series_line(&mut chart, points, style, format!("{path}: RMS position error"))?;
     }
     crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::UpperRight)?;
     Ok(())

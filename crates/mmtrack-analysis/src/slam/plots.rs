@@ -61,16 +61,16 @@ pub fn map_svg(title: &str, figure: &MapFigure) -> anyhow::Result<String> {
         crate::plot_common::draw_axes(&mut chart, "x (m)", "y (m)")?;
         let track = |points: &[[f64; 2]]| points.iter().map(|p| (p[0], p[1])).collect::<Vec<_>>();
         let grey = RGBColor(120, 120, 120);
-        crate::plot_common::draw_labelled_line(
+        crate::palette::draw_series_line(
             &mut chart,
             track(&figure.true_track_m),
-            grey.stroke_width(3),
+            crate::palette::SeriesStyle::solid(grey, 3),
             "true track",
         )?;
-        crate::plot_common::draw_labelled_line(
+        crate::palette::draw_series_line(
             &mut chart,
             track(&figure.estimated_track_m),
-            BLUE.stroke_width(1),
+            crate::palette::SeriesStyle::solid(BLUE, 1),
             "estimated track",
         )?;
         let markers: [Markers<'_>; 5] = [
