@@ -127,7 +127,12 @@ fn cdf_chart(
     crate::plot_common::draw_axes(&mut chart, x_desc, "CDF")?;
     for (label, points, color) in series {
         let color = *color;
-        crate::palette::draw_series_line(&mut chart, points.iter().copied(), crate::palette::SeriesStyle::solid(color, 2), *label)?;
+        crate::palette::draw_series_line(
+            &mut chart,
+            points.iter().copied(),
+            crate::palette::SeriesStyle::solid(color, 2),
+            *label,
+        )?;
     }
     crate::plot_common::draw_legend(&mut chart, SeriesLabelPosition::LowerRight)?;
     Ok(())

@@ -101,7 +101,9 @@ pub fn section(out: &mut String, results: &[MpcResult]) {
          Births: long-term tracks starting in a set (not the first); deaths: ending in a set (not the last); rates \
          per metre use the cumulative distance of both vehicles (`ground_truth_tx` + `ground_truth_rx`) when present, \
          else the one trajectory named under distance, else they are per second. Losses: channel gain after \
-         thresholding and windowing minus the captured gain, mean over sets in dB. Power std: sample standard \
+         thresholding and windowing minus the captured gain, mean over sets in dB; a negative loss means the MPCs' own \
+         energies sum to more than the channel gain, as when resolved paths closer than the windowed pulse interfere \
+         destructively (their cross term is in the channel gain only). Power std: sample standard \
          deviation of a track's detection powers over its set. chi <= 0.1 ns: share of the linked long-term power in \
          the tightest confidence class (paper: 72 %); unrelated: share of long-term power in entries related to no \
          adjacent set (paper: 5 %).\n\n",

@@ -67,7 +67,7 @@ pub struct RadarViewArgs {
 /// Chunk compression choices.
 #[derive(Clone, Copy, ValueEnum)]
 pub enum CompressionArg {
-    /// No compression (fastest; carried PNGs are compressed already).
+    /// No compression (fastest; radar scans gain little from zstd or lz4: they are carried as PNG, compressed already).
     None,
     /// zstd (see --zstd-level).
     Zstd,

@@ -123,7 +123,9 @@ fn tracker_verdicts(sweep: &Sweep, tracker: ArtificialTracker, whose: &str, info
         .max_by(|a, b| a.mean_delay_error_ns.total_cmp(&b.mean_delay_error_ns))
         .map(|b| (format!("{}-{} ns", b.separation_ns.start, b.separation_ns.end), b.mean_delay_error_ns));
     let error = Claim::new(
-        format!("mean delay error below {TARGET_ERROR_NS} ns at {TARGET_ERROR_POWER_DB} dB, separations 20..2.5 ns ({whose})"),
+        format!(
+            "mean delay error below {TARGET_ERROR_NS} ns at {TARGET_ERROR_POWER_DB} dB, separations 20..2.5 ns ({whose})"
+        ),
         "ns",
         Some(TARGET_ERROR_NS),
         format!("below {TARGET_ERROR_NS} ns"),

@@ -180,7 +180,10 @@ fn seeds_table(m: &Measured) -> String {
     out.push('\n');
     let main = (m.seed, SEED_VARIANTS.map(|v| m.row(Truth::NoDiffuse, v).map(|r| &r.summary)));
     let others = OTHER_SEEDS.map(|seed| {
-        (seed, SEED_VARIANTS.map(|v| m.other_seeds.iter().find(|r| r.seed == seed && r.variant == v).map(|r| &r.summary)))
+        (
+            seed,
+            SEED_VARIANTS.map(|v| m.other_seeds.iter().find(|r| r.seed == seed && r.variant == v).map(|r| &r.summary)),
+        )
     });
     for (seed, summaries) in std::iter::once(main).chain(others) {
         let Some(first) = summaries.iter().flatten().next() else { continue };

@@ -481,7 +481,9 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     }
     let mut other_seeds = Vec::new();
     for other in OTHER_SEEDS {
-        progress.note(&format!("simulating and tracking {sets} sets of the tunnel without diffuse scatterers, seed {other}"));
+        progress.note(&format!(
+            "simulating and tracking {sets} sets of the tunnel without diffuse scatterers, seed {other}"
+        ));
         let groups = detector_groups(|v| SEED_VARIANTS.contains(&v.name));
         for (scene, (_, group)) in run_scenes(&no_diffuse, other, &groups, progress)?.iter().zip(&groups) {
             for (v, variant) in group.iter().enumerate() {
@@ -499,7 +501,9 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
 fn detector_groups(keep: impl Fn(&Variant) -> bool) -> Vec<(bool, Vec<Variant>)> {
     [false, true]
         .into_iter()
-        .map(|refined| (refined, variants().into_iter().filter(|v| v.refined_detection == refined && keep(v)).collect()))
+        .map(|refined| {
+            (refined, variants().into_iter().filter(|v| v.refined_detection == refined && keep(v)).collect())
+        })
         .filter(|(_, group): &(bool, Vec<Variant>)| !group.is_empty())
         .collect()
 }
