@@ -128,20 +128,21 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
             )
         })
     };
-    let config = |tables: serde_json::Value| -> anyhow::Result<RunInfo> {
-        Ok(RunInfo {
-            config_json: serde_json::json!({
-                "command": "analyze",
-                "tables": tables,
-                "segment_lengths_m": options.drift.segment_lengths_m,
-                "step": format!("{:?}", options.drift.step),
-                "first_path_range_db": range_db,
-                "mmtrack_version": env!("CARGO_PKG_VERSION"),
-            })
-            .to_string(),
-            time_base: time_base()?,
-            frame: None,
-        })
+    // The options that shaped the results: the drift's for trajectories,
+    // the first path's for MPC tables.
+    let config = |tables: serde_json::Value, results: &[&RunResults]| -> anyhow::Result<RunInfo> {
+        let mut json = serde_json::json!({ "command": "analyze", "tables": tables });
+        if results.iter().any(|r| !r.trajectory.is_empty())
+            && let (Some(fields), serde_json::Value::Object(drift)) =
+                (json.as_object_mut(), options.drift.config_json())
+        {
+            fields.extend(drift);
+        }
+        if results.iter().any(|r| !r.mpc.is_empty()) {
+            json["first_path_range_db"] = serde_json::json!(range_db);
+        }
+        json["mmtrack_version"] = serde_json::json!(env!("CARGO_PKG_VERSION"));
+        Ok(RunInfo { config_json: json.to_string(), time_base: time_base()?, frame: None })
     };
     // One run: its results straight into the output, as always.
     if let [only] = runs.as_slice()
@@ -149,7 +150,7 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
         && only.tables == tables[0]
     {
         let results = analyze_run(&only.tables, &options.drift, &options.mpc)?;
-        let run = config(serde_json::json!(only.tables.display().to_string()))?;
+        let run = config(serde_json::json!(only.tables.display().to_string()), &[&results])?;
         let written = write_all_results(output, &results, &options.drift, &run, options.overwrite)?;
         return Ok(Analyzed::Run { results: Box::new(results), written });
     }
@@ -161,7 +162,8 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
     }
     let inputs: serde_json::Map<String, serde_json::Value> =
         runs.iter().map(|r| (r.id.clone(), serde_json::json!(r.tables.display().to_string()))).collect();
-    let run = config(serde_json::Value::Object(inputs))?;
+    let all: Vec<&RunResults> = analyzed.iter().map(|(_, r)| r).collect();
+    let run = config(serde_json::Value::Object(inputs), &all)?;
     let written = write_campaign(output, &analyzed, &options.drift, &run, options.overwrite)?;
     Ok(Analyzed::Campaign { runs: analyzed, written })
 }

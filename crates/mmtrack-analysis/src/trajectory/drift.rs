@@ -54,6 +54,18 @@ impl Default for DriftOptions {
 }
 
 impl DriftOptions {
+    /// The options as the provenance of result tables records them:
+    /// `{"segment_lengths_m": [...], "first_frame_step": {"frames": n}}` (or
+    /// `{"metres": x}`).
+    #[must_use]
+    pub fn config_json(&self) -> serde_json::Value {
+        let step = match self.step {
+            FirstFrameStep::Frames(n) => serde_json::json!({ "frames": n }),
+            FirstFrameStep::Metres(m) => serde_json::json!({ "metres": m }),
+        };
+        serde_json::json!({ "segment_lengths_m": self.segment_lengths_m, "first_frame_step": step })
+    }
+
     fn check(&self) -> Result<(), TrajectoryError> {
         let bad = |detail: String| Err(TrajectoryError::InvalidOption(detail));
         if self.segment_lengths_m.is_empty() {

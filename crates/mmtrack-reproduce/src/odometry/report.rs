@@ -143,20 +143,18 @@ pub fn write_outputs(
         odometry::write_outputs(&out, &sequence, &run, &r.config, r.preset, Path::new(&config.source))?;
         analysis.push(r.result);
     }
-    let info = RunInfo {
-        config_json: serde_json::json!({
-            "command": "reproduce odometry",
-            "scenario": config.source,
-            "trajectory": config.trajectory.display().to_string(),
-            "max_distance_m": scenario.max_distance_m,
-            "seed": scenario.seed,
-            "segment_lengths_m": drift.segment_lengths_m,
-            "mmtrack_version": env!("CARGO_PKG_VERSION"),
-        })
-        .to_string(),
-        time_base: time_base.into(),
-        frame: None,
-    };
+    let mut config_json = serde_json::json!({
+        "command": "reproduce odometry",
+        "scenario": config.source,
+        "trajectory": config.trajectory.display().to_string(),
+        "max_distance_m": scenario.max_distance_m,
+        "seed": scenario.seed,
+    });
+    if let (Some(fields), serde_json::Value::Object(options)) = (config_json.as_object_mut(), drift.config_json()) {
+        fields.extend(options);
+    }
+    config_json["mmtrack_version"] = serde_json::json!(env!("CARGO_PKG_VERSION"));
+    let info = RunInfo { config_json: config_json.to_string(), time_base: time_base.into(), frame: None };
     write_results(&staging.path().join("analysis"), &analysis, &[], &drift, &info, Overwrite::Refuse)?;
     std::fs::write(staging.path().join("reproduce.md"), report)?;
     write_metrics(staging.path(), metrics)?;

@@ -51,7 +51,8 @@ fn mpc_artificial_smoke_meets_its_expectations() {
     let options = smoke(&dir);
     let outcome = mpc_artificial::run(&mpc_artificial::Config::default(), &options, &NoProgress).unwrap();
     check(&outcome, &options);
-    assert_eq!(outcome.verdicts.len(), 2, "the two targets of PAPERS.md section 2");
+    assert_eq!(outcome.verdicts.len(), 6, "the three claims of PAPERS.md section 2, and each for the refit");
+    assert_eq!(outcome.verdicts.iter().filter(|v| v.claim.informational).count(), 3, "the refit rows are ours");
 }
 
 #[test]
