@@ -161,6 +161,16 @@ fn residual_share(
     left / all
 }
 
+/// The CIRs of both real samples, labelled: the 252 UWB CIRs and the 16
+/// links of the 60 GHz MIMO channel.
+fn both_real_samples() -> [(&'static str, Vec<CirSnapshot>); 2] {
+    let uwb = realdata("uwb-cirs-2018").map(|dir| {
+        let log = read_decawave_log(&dir.join("1.log"), &DecawaveConfig::default()).unwrap();
+        log.frames.iter().map(|frame| frame.cir.clone()).collect::<Vec<_>>()
+    });
+    [("UWB DW1000", uwb.unwrap()), ("60 GHz MIMO", mimo_60ghz_links().unwrap())]
+}
+
 /// The opt-in joint re-estimation of overlapping paths
 /// (`refine_overlapping`) on both real samples: it fits the channel better
 /// than the paper's one-pulse-at-a-time search (less windowed energy left
@@ -169,12 +179,7 @@ fn residual_share(
 /// 1.28 % -> 1.07 % at 200 (the `max_mpcs` cap) both.
 #[test]
 fn refined_detection_on_real_channels() {
-    let uwb = realdata("uwb-cirs-2018").map(|dir| {
-        let log = read_decawave_log(&dir.join("1.log"), &DecawaveConfig::default()).unwrap();
-        log.frames.iter().map(|frame| frame.cir.clone()).collect::<Vec<_>>()
-    });
-    for (label, cirs) in [("UWB DW1000", uwb), ("60 GHz MIMO", mimo_60ghz_links())] {
-        let cirs = cirs.unwrap();
+    for (label, cirs) in both_real_samples() {
         let band = SounderBand::new(cirs[0].taps.len(), cirs[0].tap_spacing_s).unwrap();
         let mut rows = Vec::new();
         for refine in [false, true] {
@@ -218,12 +223,7 @@ fn refined_detection_on_real_channels() {
 /// not the better estimate.
 #[test]
 fn refit_unwindowed_on_real_channels() {
-    let uwb = realdata("uwb-cirs-2018").map(|dir| {
-        let log = read_decawave_log(&dir.join("1.log"), &DecawaveConfig::default()).unwrap();
-        log.frames.iter().map(|frame| frame.cir.clone()).collect::<Vec<_>>()
-    });
-    for (label, cirs) in [("UWB DW1000", uwb), ("60 GHz MIMO", mimo_60ghz_links())] {
-        let cirs = cirs.unwrap();
+    for (label, cirs) in both_real_samples() {
         let band = SounderBand::new(cirs[0].taps.len(), cirs[0].tap_spacing_s).unwrap();
         let pulse = SounderPulse::flat(&band);
         let search = Detector::new(DetectionConfig::default(), band.tap_spacing_s(), &pulse).unwrap();
