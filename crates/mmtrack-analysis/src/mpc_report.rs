@@ -69,18 +69,22 @@ fn first_path_section(out: &mut String, results: &[MpcResult]) {
         out,
         "First path (table `mpc_first_path`): per snapshot, the earliest detection at most the dynamic range below the \
          snapshot's strongest detection. Where the recording carries the receiver's own first-path estimate (e.g. the \
-         DW1000's leading edge HLP, `mpc_snapshots.first_path_hint_s`), first path minus that estimate, in ns.\n\n\
-         | sequence | dynamic range (dB) | snapshots with a first path | with the receiver's estimate | median difference \
-         | median absolute difference | 90th percentile of the absolute difference |\n|---|---|---|---|---|---|---|\n"
+         DW1000's leading edge HLP, `mpc_snapshots.first_path_hint_s`), first path minus that estimate, in ns. \
+         Detections before the first path are more than the dynamic range below the strongest: noise peaks, or a \
+         weak first path the range leaves out (`--first-path-range-db` reaches further).\n\n\
+         | sequence | dynamic range (dB) | snapshots with a first path | with detections before it | with the \
+         receiver's estimate | median difference | median absolute difference | 90th percentile of the absolute \
+         difference |\n|---|---|---|---|---|---|---|---|\n"
     );
     for r in results {
         let s = &r.summary;
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {} | {} | {} | {} | {} |",
+            "| {} | {:.1} | {} | {} | {} | {} | {} | {} |",
             r.sequence,
             s.first_path_dynamic_range_db,
             s.first_path_snapshots,
+            s.first_path_earlier_snapshots,
             s.first_path_hint_snapshots,
             ns(s.first_path_minus_hint_median_s),
             ns(s.first_path_hint_abs_median_s).trim_start_matches('+'),

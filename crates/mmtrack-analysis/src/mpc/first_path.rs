@@ -45,6 +45,8 @@ pub struct FirstPathSummary {
     pub snapshots: u64,
     /// Of those, snapshots that carry the receiver's estimate.
     pub with_hint: u64,
+    /// Of those, snapshots with detections before the first path.
+    pub with_earlier: u64,
     /// Median of first path minus estimate, seconds (signed).
     pub median_minus_hint_s: Option<f64>,
     /// Median of `|first path - estimate|`, seconds.
@@ -75,6 +77,7 @@ pub fn first_paths(
             set_index,
             snapshot_index,
             detections: found.len() as u64,
+            earlier_detections: first.map_or(0, |f| found.iter().filter(|d| d.delay_s < f.delay_s).count() as u64),
             strongest_delay_s: strongest.map(|d| d.delay_s),
             strongest_power_db: strongest.map(MpcDetection::power_db),
             first_path_delay_s: first.map(|d| d.delay_s),
@@ -102,6 +105,7 @@ pub fn summarise_first_paths(rows: &[FirstPathRow]) -> FirstPathSummary {
     FirstPathSummary {
         snapshots: rows.iter().filter(|r| r.first_path_delay_s.is_some()).count() as u64,
         with_hint: signed.len() as u64,
+        with_earlier: rows.iter().filter(|r| r.first_path_delay_s.is_some() && r.earlier_detections > 0).count() as u64,
         median_minus_hint_s: quantile(&signed, 0.5),
         median_abs_minus_hint_s: quantile(&absolute, 0.5),
         p90_abs_minus_hint_s: quantile(&absolute, 0.9),
@@ -133,6 +137,14 @@ mod tests {
             detection(0, 60.0, -105.0), // later
         ];
         let first = first_path(&found, 20.0).unwrap();
+        let rows = first_paths(&found, None, 20.0);
+        assert_eq!((rows[0].detections, rows[0].earlier_detections), (4, 1), "the noise peak ahead is counted");
+        assert_eq!(summarise_first_paths(&rows).with_earlier, 1);
+        assert_eq!(
+            first_paths(&found, None, 25.0)[0].earlier_detections,
+            0,
+            "a wider range takes it as the first path"
+        );
         assert!((first.delay_s - 38.5e-9).abs() < 1e-15, "{first:?}");
         // A wider range reaches the earlier, weaker one; a narrower one only the strongest.
         assert!((first_path(&found, 25.0).unwrap().delay_s - 12.0e-9).abs() < 1e-15);

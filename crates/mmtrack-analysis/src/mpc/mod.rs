@@ -250,6 +250,7 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> Mpc
     summary.first_path_dynamic_range_db = range_db;
     summary.first_path_snapshots = first.snapshots;
     summary.first_path_hint_snapshots = first.with_hint;
+    summary.first_path_earlier_snapshots = first.with_earlier;
     summary.first_path_minus_hint_median_s = first.median_minus_hint_s;
     summary.first_path_hint_abs_median_s = first.median_abs_minus_hint_s;
     summary.first_path_hint_abs_p90_s = first.p90_abs_minus_hint_s;
@@ -479,6 +480,7 @@ fn summarise(
         first_path_dynamic_range_db: DEFAULT_FIRST_PATH_DYNAMIC_RANGE_DB,
         first_path_snapshots: 0,
         first_path_hint_snapshots: 0,
+        first_path_earlier_snapshots: 0,
         first_path_minus_hint_median_s: None,
         first_path_hint_abs_median_s: None,
         first_path_hint_abs_p90_s: None,

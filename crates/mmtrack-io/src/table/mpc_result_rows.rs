@@ -140,6 +140,8 @@ they are null without one, and the per-second rates always apply. Truth columns 
             "a snapshot's first path is its earliest detection at most this far below its strongest (mpc_first_path): dB re the strongest detection's power";
         first_path_snapshots: u64, "", "snapshots with a first path (at least one detection)";
         first_path_hint_snapshots: u64, "", "of those, snapshots carrying the receiver's own first-path estimate";
+        first_path_earlier_snapshots: u64, "",
+            "of those, snapshots with detections before the first path (mpc_first_path.earlier_detections > 0)";
         first_path_minus_hint_median_s: Option<f64>, "s",
             "median of first path minus the receiver's estimate; null without estimates";
         first_path_hint_abs_median_s: Option<f64>, "s",
@@ -164,6 +166,8 @@ strongest detection, and its distance from the receiver's own first-path estimat
         set_index: u64, "", "sounder set";
         snapshot_index: u32, "", "snapshot within the set";
         detections: u64, "", "detections of the snapshot";
+        earlier_detections: u64, "",
+            "detections before the first path, each more than the dynamic range below the strongest: noise peaks, or a weak first path the range leaves out (raise first_path_dynamic_range_db to reach it)";
         strongest_delay_s: Option<f64>, "s", "delay of the strongest detection";
         strongest_power_db: Option<f64>, "dB", "power of the strongest detection (mpc_detections.power_db); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         first_path_delay_s: Option<f64>, "s", "delay of the first path";
