@@ -131,18 +131,18 @@ pub fn analyze(tables: &[PathBuf], output: &Path, options: &AnalyzeOptions) -> a
     // The options that shaped the results: the drift's for trajectories,
     // the first path's for MPC tables.
     let config = |tables: serde_json::Value, results: &[&RunResults]| -> anyhow::Result<RunInfo> {
-        let mut json = serde_json::json!({ "command": "analyze", "tables": tables });
-        if results.iter().any(|r| !r.trajectory.is_empty())
-            && let (Some(fields), serde_json::Value::Object(drift)) =
-                (json.as_object_mut(), options.drift.config_json())
-        {
-            fields.extend(drift);
+        let mut json = serde_json::Map::new();
+        json.insert("command".into(), serde_json::json!("analyze"));
+        json.insert("tables".into(), tables);
+        if results.iter().any(|r| !r.trajectory.is_empty()) {
+            json.extend(options.drift.config_fields());
         }
         if results.iter().any(|r| !r.mpc.is_empty()) {
-            json["first_path_range_db"] = serde_json::json!(range_db);
+            json.insert("first_path_range_db".into(), serde_json::json!(range_db));
         }
-        json["mmtrack_version"] = serde_json::json!(env!("CARGO_PKG_VERSION"));
-        Ok(RunInfo { config_json: json.to_string(), time_base: time_base()?, frame: None })
+        json.insert("mmtrack_version".into(), serde_json::json!(env!("CARGO_PKG_VERSION")));
+        let config_json = serde_json::Value::Object(json).to_string();
+        Ok(RunInfo { config_json, time_base: time_base()?, frame: None })
     };
     // One run: its results straight into the output, as always.
     if let [only] = runs.as_slice()

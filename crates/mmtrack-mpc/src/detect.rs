@@ -123,20 +123,16 @@ pub struct Detector {
     pulse_w: Vec<Complex64>,
     /// The sounder pulse `P`, the matched-filter template.
     template: Vec<Complex64>,
-    /// `kappa(m - delta)`, the correlation of the template with one windowed
-    /// unit path (spectrum `conj(P) W = z |P|^2`), tabulated.
-    kernel_rows: KernelRows,
-    /// Sub-tap refinement of correlation peaks.
-    interpolator: PeakInterpolator,
-    /// Correlation of a unit path at its own delay, `(1/U) sum z |P|^2`.
-    kernel_peak: f64,
+    /// The windowed matched filter's tables: kernel `conj(P) W = z |P|^2`,
+    /// the correlation of the template with one windowed unit path.
+    windowed: Fit,
     /// Windowed pulse energy `w^H w = (1/U) sum |W|^2`.
     pulse_energy: f64,
     /// Half the blocked delay range, seconds.
     blocked_half_width_s: f64,
     /// The unwindowed correlation's tables, with
     /// [`DetectionConfig::refit_unwindowed`].
-    unwindowed: Option<UnwindowedFit>,
+    unwindowed: Option<Fit>,
     fft: Arc<dyn Fft<f64>>,
     ifft: Arc<dyn Fft<f64>>,
 }
@@ -172,18 +168,18 @@ impl Detector {
         let mut planner = FftPlanner::new();
         let fft = planner.plan_fft_forward(band.taps());
         let ifft = planner.plan_fft_inverse(band.taps());
-        let kernel_rows = KernelRows::new(&band, &mut planner, &kernel);
-        let interpolator = PeakInterpolator::new(&band, &kernel_rows);
-        let unwindowed = config.refit_unwindowed.then(|| UnwindowedFit::new(&band, &mut planner, pulse.spectrum()));
+        let windowed = Fit::new(&band, &mut planner, &kernel);
+        let unwindowed = config.refit_unwindowed.then(|| {
+            let kernel: Vec<Complex64> = pulse.spectrum().iter().map(|p| Complex64::new(p.norm_sqr(), 0.0)).collect();
+            Fit::new(&band, &mut planner, &kernel)
+        });
         let mut detector = Self {
             config,
             band,
             window,
             pulse_w,
             template: pulse.spectrum().to_vec(),
-            kernel_rows,
-            interpolator,
-            kernel_peak,
+            windowed,
             pulse_energy,
             blocked_half_width_s: 0.0,
             unwindowed,
@@ -358,9 +354,9 @@ impl Detector {
         let mut paths: Vec<(f64, Complex64)> = Vec::new();
         while detections.len() < self.config.max_mpcs {
             let Some(coarse) = residual.strongest() else { break };
-            around.fill(&self.interpolator, residual.correlation(), coarse);
-            let peak = self.interpolator.refine(&around);
-            let amplitude = peak.value / self.kernel_peak;
+            around.fill(&self.windowed.interpolator, residual.correlation(), coarse);
+            let peak = self.windowed.interpolator.refine(&around);
+            let amplitude = peak.value / self.windowed.kernel_peak;
             if amplitude.norm_sqr() < threshold {
                 break;
             }
@@ -372,8 +368,8 @@ impl Detector {
             let found_again = detected_taps.any_within(delay_taps, half_block_taps);
             // Eq. (9) on the correlation: c[n] -= alpha kappa(n - tau); a
             // re-detection is subtracted too, as residue of the earlier path.
-            let reach = self.kernel_rows.reach_taps(amplitude.norm() / threshold_amplitude);
-            let changed = self.kernel_rows.subtract(residual.correlation_mut(), delay_taps, amplitude, reach);
+            let reach = self.windowed.kernel_rows.reach_taps(amplitude.norm() / threshold_amplitude);
+            let changed = self.windowed.kernel_rows.subtract(residual.correlation_mut(), delay_taps, amplitude, reach);
             // A re-detection blocks only its coarse tap (so the search moves
             // on), not a range of its own.
             let blocked = if found_again {
@@ -430,24 +426,16 @@ impl Detector {
         if group.len() < 2 {
             return;
         }
-        let taps = self.band.taps() as i64;
         for _ in 0..REFINE_MAX_SWEEPS {
             let mut moved_taps: f64 = 0.0;
             for &j in &group {
-                let (x, a) = paths[j];
-                let reach = self.kernel_rows.reach_taps(a.norm() / threshold_amplitude);
-                let added = self.kernel_rows.subtract(residual.correlation_mut(), x, -a, reach);
-                let coarse = (x.round() as i64).rem_euclid(taps) as usize;
-                around.fill(&self.interpolator, residual.correlation(), coarse);
-                let peak = self.interpolator.refine(around);
-                let refined_x = x.round() + peak.delta_taps;
-                let refined_a = peak.value / self.kernel_peak;
-                let reach = self.kernel_rows.reach_taps(refined_a.norm() / threshold_amplitude).max(reach);
-                let removed = self.kernel_rows.subtract(residual.correlation_mut(), refined_x, refined_a, reach);
+                let (refined, added, removed) =
+                    self.windowed
+                        .refit_path(residual.correlation_mut(), around, paths[j], threshold_amplitude, |_| true);
                 residual.rescan(added.0, added.1);
                 residual.rescan(removed.0, removed.1);
-                moved_taps = moved_taps.max((refined_x - x).abs());
-                paths[j] = (refined_x, refined_a);
+                moved_taps = moved_taps.max((refined.0 - paths[j].0).abs());
+                paths[j] = refined;
             }
             if moved_taps < REFINE_TOLERANCE_TAPS {
                 break;
@@ -464,7 +452,7 @@ impl Detector {
     /// [`REFINE_TOLERANCE_TAPS`] (at most [`REFINE_MAX_SWEEPS`]).
     fn refit_unwindowed(
         &self,
-        fit: &UnwindowedFit,
+        fit: &Fit,
         snapshot: &CirSnapshot,
         detections: &mut [MpcDetection],
         threshold_amplitude: f64,
@@ -488,25 +476,15 @@ impl Detector {
             let reach = fit.kernel_rows.reach_taps(a.norm() / threshold_amplitude);
             fit.kernel_rows.subtract(&mut correlation, x, a, reach);
         }
-        let taps = self.band.taps() as i64;
         let mut around = Neighbourhood::default();
         for _ in 0..REFINE_MAX_SWEEPS {
             let mut moved_taps: f64 = 0.0;
             for (path, &found) in paths.iter_mut().zip(&found_taps) {
-                let (x, a) = *path;
-                let reach = fit.kernel_rows.reach_taps(a.norm() / threshold_amplitude);
-                fit.kernel_rows.subtract(&mut correlation, x, -a, reach);
-                let coarse = (x.round() as i64).rem_euclid(taps) as usize;
-                around.fill(&fit.interpolator, &correlation, coarse);
-                let peak = fit.interpolator.refine(&around);
-                let mut refined = (x.round() + peak.delta_taps, peak.value / fit.kernel_peak);
-                if (refined.0 - found).abs() > MAX_REFIT_MOVE_TAPS {
-                    // Another peak, not this detection's: keep the estimate.
-                    refined = (x, a);
-                }
-                let reach = fit.kernel_rows.reach_taps(refined.1.norm() / threshold_amplitude).max(reach);
-                fit.kernel_rows.subtract(&mut correlation, refined.0, refined.1, reach);
-                moved_taps = moved_taps.max((refined.0 - x).abs());
+                // A peak farther from where the search found the path is
+                // another's: the estimate is kept.
+                let near = |x: f64| (x - found).abs() <= MAX_REFIT_MOVE_TAPS;
+                let (refined, _, _) = fit.refit_path(&mut correlation, &mut around, *path, threshold_amplitude, near);
+                moved_taps = moved_taps.max((refined.0 - path.0).abs());
                 *path = refined;
             }
             if moved_taps < REFINE_TOLERANCE_TAPS {
@@ -527,22 +505,55 @@ impl Detector {
 /// pulse, not a better estimate of this path.
 const MAX_REFIT_MOVE_TAPS: f64 = 0.5;
 
-/// The tables of the unwindowed matched filter (kernel `|P|^2`), for
-/// [`DetectionConfig::refit_unwindowed`].
-struct UnwindowedFit {
+/// One matched filter's tables: the windowed one of the search, or the
+/// unwindowed one of [`DetectionConfig::refit_unwindowed`] (kernel `|P|^2`).
+struct Fit {
+    /// `kappa(m - delta)`, the correlation of the template with one unit
+    /// path through the filter, tabulated.
     kernel_rows: KernelRows,
+    /// Sub-tap refinement of correlation peaks.
     interpolator: PeakInterpolator,
-    /// `(1/U) sum |P|^2`: the correlation of a unit path at its own delay.
+    /// Correlation of a unit path at its own delay, `(1/U) sum kernel`.
     kernel_peak: f64,
+    /// Taps of the CIR.
+    taps: i64,
 }
 
-impl UnwindowedFit {
-    fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, pulse: &[Complex64]) -> Self {
-        let kernel: Vec<Complex64> = pulse.iter().map(|p| Complex64::new(p.norm_sqr(), 0.0)).collect();
+impl Fit {
+    /// The tables of the filter whose unit-path correlation has spectrum `kernel`.
+    fn new(band: &SounderBand, planner: &mut FftPlanner<f64>, kernel: &[Complex64]) -> Self {
         let kernel_peak = kernel.iter().map(|k| k.re).sum::<f64>() / band.taps() as f64;
-        let kernel_rows = KernelRows::new(band, planner, &kernel);
+        let kernel_rows = KernelRows::new(band, planner, kernel);
         let interpolator = PeakInterpolator::new(band, &kernel_rows);
-        Self { kernel_rows, interpolator, kernel_peak }
+        Self { kernel_rows, interpolator, kernel_peak, taps: band.taps() as i64 }
+    }
+
+    /// One coordinate step of a joint fit: path `(x, a)` (delay in taps,
+    /// amplitude) is added back to `correlation`, its peak found again near
+    /// its delay (eqs. (7)-(8)) and subtracted anew (eq. (9)); an estimate
+    /// `accept` refuses (by its delay) leaves the path as it was. Returns the
+    /// new estimate and the tap ranges (first, count) changed by adding back
+    /// and by subtracting.
+    fn refit_path(
+        &self,
+        correlation: &mut [Complex64],
+        around: &mut Neighbourhood,
+        (x, a): (f64, Complex64),
+        threshold_amplitude: f64,
+        accept: impl Fn(f64) -> bool,
+    ) -> ((f64, Complex64), (usize, usize), (usize, usize)) {
+        let reach = self.kernel_rows.reach_taps(a.norm() / threshold_amplitude);
+        let added = self.kernel_rows.subtract(correlation, x, -a, reach);
+        let coarse = (x.round() as i64).rem_euclid(self.taps) as usize;
+        around.fill(&self.interpolator, correlation, coarse);
+        let peak = self.interpolator.refine(around);
+        let mut refined = (x.round() + peak.delta_taps, peak.value / self.kernel_peak);
+        if !accept(refined.0) {
+            refined = (x, a);
+        }
+        let reach = self.kernel_rows.reach_taps(refined.1.norm() / threshold_amplitude).max(reach);
+        let removed = self.kernel_rows.subtract(correlation, refined.0, refined.1, reach);
+        (refined, added, removed)
     }
 }
 

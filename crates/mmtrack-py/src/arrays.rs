@@ -318,7 +318,7 @@ pub fn trajectory_metrics(
     // The option check of `analyze` (segment lengths, step).
     mmtrack_analysis::trajectory::kitti_drift(&[], &[], &options.drift).context("--segment-lengths-m / --step-*")?;
     let result = analyze_trajectory(sequence, estimate, ground_truth, &options.drift)?;
-    let info = run_info("mmtrack.trajectory_metrics", options.drift.config_json());
+    let info = run_info("mmtrack.trajectory_metrics", serde_json::Value::Object(options.drift.config_fields()));
     Ok([
         table_bytes(std::slice::from_ref(&result.metrics), &info)?,
         table_bytes(&result.drift_rows(), &info)?,

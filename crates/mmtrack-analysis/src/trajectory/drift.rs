@@ -54,16 +54,19 @@ impl Default for DriftOptions {
 }
 
 impl DriftOptions {
-    /// The options as the provenance of result tables records them:
-    /// `{"segment_lengths_m": [...], "first_frame_step": {"frames": n}}` (or
-    /// `{"metres": x}`).
+    /// The options as the provenance of result tables records them, fields
+    /// of its JSON object: `"segment_lengths_m": [...]` and
+    /// `"first_frame_step": {"frames": n}` (or `{"metres": x}`).
     #[must_use]
-    pub fn config_json(&self) -> serde_json::Value {
+    pub fn config_fields(&self) -> serde_json::Map<String, serde_json::Value> {
         let step = match self.step {
             FirstFrameStep::Frames(n) => serde_json::json!({ "frames": n }),
             FirstFrameStep::Metres(m) => serde_json::json!({ "metres": m }),
         };
-        serde_json::json!({ "segment_lengths_m": self.segment_lengths_m, "first_frame_step": step })
+        let mut fields = serde_json::Map::new();
+        fields.insert("segment_lengths_m".into(), serde_json::json!(self.segment_lengths_m));
+        fields.insert("first_frame_step".into(), step);
+        fields
     }
 
     fn check(&self) -> Result<(), TrajectoryError> {

@@ -150,8 +150,8 @@ pub fn write_outputs(
         "max_distance_m": scenario.max_distance_m,
         "seed": scenario.seed,
     });
-    if let (Some(fields), serde_json::Value::Object(options)) = (config_json.as_object_mut(), drift.config_json()) {
-        fields.extend(options);
+    if let Some(fields) = config_json.as_object_mut() {
+        fields.extend(drift.config_fields());
     }
     config_json["mmtrack_version"] = serde_json::json!(env!("CARGO_PKG_VERSION"));
     let info = RunInfo { config_json: config_json.to_string(), time_base: time_base.into(), frame: None };
