@@ -175,14 +175,14 @@ pub fn power_loss_svg(result: &MpcResult) -> anyhow::Result<String> {
     let t = |t_ns: i64| (t_ns - t0) as f64 * 1e-9;
     type Getter = fn(&mmtrack_io::table::SetMetrics) -> Option<f64>;
     let gains: [(&str, Getter, RGBColor); 4] = [
-        ("channel", |s| Some(s.channel_gain_db), BLACK),
-        ("detected", |s| Some(s.detected_gain_db), BLUE),
-        ("tracked (short-term)", |s| Some(s.tracked_gain_db), RED),
+        ("channel", |s| s.channel_gain_db, BLACK),
+        ("detected", |s| s.detected_gain_db, BLUE),
+        ("tracked (short-term)", |s| s.tracked_gain_db, RED),
         ("tracked (GM-PHD)", |s| s.gmphd_tracked_gain_db, GREEN),
     ];
     let losses: [(&str, Getter, RGBColor); 3] = [
-        ("detection loss", |s| Some(s.detection_loss_db), BLUE),
-        ("tracking loss (short-term)", |s| Some(s.tracking_loss_db), RED),
+        ("detection loss", |s| s.detection_loss_db, BLUE),
+        ("tracking loss (short-term)", |s| s.tracking_loss_db, RED),
         ("tracking loss (GM-PHD)", |s| s.gmphd_tracking_loss_db, GREEN),
     ];
     let mut svg = String::new();

@@ -125,18 +125,24 @@ pub struct MpcSetStats {
     pub short_term_tracks: u32,
     /// Short-term tracks that span the whole set.
     pub full_lifetime_tracks: u32,
-    /// Mean noise floor of the set's snapshots, dB.
-    pub noise_floor_db: f64,
-    /// Mean channel gain after thresholding and windowing, dB.
-    pub channel_gain_db: f64,
-    /// Mean gain captured by the detections, dB.
-    pub detected_gain_db: f64,
-    /// Mean gain captured by the short-term tracks, dB.
-    pub tracked_gain_db: f64,
-    /// Mean gain captured by the full-lifetime tracks, dB.
-    pub full_lifetime_gain_db: f64,
+    /// Mean noise floor of the set's snapshots, dB; `None` when every
+    /// snapshot was skipped.
+    pub noise_floor_db: Option<f64>,
+    /// Mean channel gain after thresholding and windowing, dB; `None` when
+    /// every snapshot was skipped or nothing was left above the threshold.
+    pub channel_gain_db: Option<f64>,
+    /// Mean gain captured by the detections, dB; `None` without detections
+    /// (or measured snapshots).
+    pub detected_gain_db: Option<f64>,
+    /// Mean gain captured by the short-term tracks, dB; `None` without
+    /// tracks (e.g. a recording of one snapshot per set).
+    pub tracked_gain_db: Option<f64>,
+    /// Mean gain captured by the full-lifetime tracks, dB; `None` without
+    /// them.
+    pub full_lifetime_gain_db: Option<f64>,
     /// Mean gain captured by the GM-PHD baseline's tracks, dB (the same
-    /// definition as `tracked_gain_db`); `None` when GM-PHD did not run.
+    /// definition as `tracked_gain_db`); `None` when GM-PHD did not run or
+    /// found no track.
     pub gmphd_tracked_gain_db: Option<f64>,
 }
 

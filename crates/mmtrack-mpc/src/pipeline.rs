@@ -26,8 +26,8 @@
 //! 6. statistics ([`MpcSetStats`]).
 //!
 //! Gains in the statistics are means over the set's measured (not skipped)
-//! snapshots of linear gains, converted to dB (`-inf` when every snapshot was
-//! skipped or nothing was captured). The detected, tracked and full-lifetime
+//! snapshots of linear gains, converted to dB (`None`, a null in the tables,
+//! when every snapshot was skipped or nothing was captured: not `-inf`). The detected, tracked and full-lifetime
 //! gains (and the GM-PHD baseline's tracked gain, when it runs) are
 //! `sum |alpha|^2 (w^H w)` over the respective detections (`w^H w`
 //! = [`Detector::pulse_energy`]), the scale of the detector's
@@ -322,7 +322,7 @@ impl MpcPipeline {
             detected_gain_db: mean_db(detected, n),
             tracked_gain_db: mean_db(captured(tracks), n),
             full_lifetime_gain_db: mean_db(captured(full_lifetime), n),
-            gmphd_tracked_gain_db: gmphd_tracks.map(|tracks| mean_db(captured(tracks), n)),
+            gmphd_tracked_gain_db: gmphd_tracks.and_then(|tracks| mean_db(captured(tracks), n)),
         }
     }
 }
@@ -331,9 +331,10 @@ fn from_db(db: f64) -> f64 {
     10f64.powf(db / 10.0)
 }
 
-/// `10 log10(sum / n)`; `-inf` for `n = 0`.
-fn mean_db(sum: f64, n: usize) -> f64 {
-    if n == 0 { f64::NEG_INFINITY } else { 10.0 * (sum / n as f64).log10() }
+/// `10 log10(sum / n)`; `None` for `n = 0` or nothing summed (`sum <= 0`,
+/// whose level would be `-inf`).
+fn mean_db(sum: f64, n: usize) -> Option<f64> {
+    (n > 0 && sum > 0.0).then(|| 10.0 * (sum / n as f64).log10())
 }
 
 /// A count as `u32`, saturating (a set of 4 billion snapshots or detections

@@ -162,9 +162,9 @@ mod tests {
             snapshot_index: 0,
             detections: 0,
             skipped: false,
-            noise_floor_db: -130.0,
-            channel_gain_db: -100.0,
-            detected_gain_db: -100.0,
+            noise_floor_db: Some(-130.0),
+            channel_gain_db: Some(-100.0),
+            detected_gain_db: Some(-100.0),
             first_path_hint_s: hint_ns.map(|h| h * 1e-9),
         }
     }

@@ -164,6 +164,12 @@ fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
     (n > 0).then(|| sum / n as f64)
 }
 
+/// The loss `channel - captured` in dB (Mahler et al. Figs. 8-9); `None`
+/// when either gain is (nothing measured, or nothing captured).
+fn loss_db(channel_gain_db: Option<f64>, captured_gain_db: Option<f64>) -> Option<f64> {
+    Some(channel_gain_db? - captured_gain_db?)
+}
+
 /// Sample standard deviation with `n - 1` (0 for a single value).
 fn std_dev(values: &[f64]) -> f64 {
     if values.len() < 2 {
@@ -209,7 +215,16 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> Mpc
         let distance_m = previous.and_then(|p| input.distance.distance_m(p.t_ns, s.t_ns));
         let dt_s = previous.map(|p| (s.t_ns - p.t_ns) as f64 * 1e-9);
         let per = |n: Option<u64>, d: Option<f64>| n.zip(d).and_then(|(n, d)| ratio(n, d));
-        let gmphd = s.gmphd_tracked_gain_db;
+        // Tables written before the gains were nullable hold -inf for
+        // "nothing captured": read as null, like the current ones.
+        let [channel, detected, tracked, full_lifetime, gmphd] = [
+            s.channel_gain_db,
+            s.detected_gain_db,
+            s.tracked_gain_db,
+            s.full_lifetime_gain_db,
+            s.gmphd_tracked_gain_db,
+        ]
+        .map(|db| db.filter(|db| db.is_finite()));
         let (true_births, true_deaths) = truth_scores
             .as_ref()
             .and_then(|t| t.transitions.get(&s.set_index))
@@ -227,14 +242,14 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> Mpc
             death_rate_per_m: per(deaths, distance_m),
             birth_rate_per_s: per(births, dt_s),
             death_rate_per_s: per(deaths, dt_s),
-            channel_gain_db: s.channel_gain_db,
-            detected_gain_db: s.detected_gain_db,
-            tracked_gain_db: s.tracked_gain_db,
-            full_lifetime_gain_db: s.full_lifetime_gain_db,
+            channel_gain_db: channel,
+            detected_gain_db: detected,
+            tracked_gain_db: tracked,
+            full_lifetime_gain_db: full_lifetime,
             gmphd_tracked_gain_db: gmphd,
-            detection_loss_db: s.channel_gain_db - s.detected_gain_db,
-            tracking_loss_db: s.channel_gain_db - s.tracked_gain_db,
-            gmphd_tracking_loss_db: gmphd.map(|g| s.channel_gain_db - g),
+            detection_loss_db: loss_db(channel, detected),
+            tracking_loss_db: loss_db(channel, tracked),
+            gmphd_tracking_loss_db: loss_db(channel, gmphd),
             true_births,
             true_deaths,
         });
@@ -451,9 +466,11 @@ fn summarise(
         death_rate_per_m: per_m(deaths),
         birth_rate_per_s: births.and_then(|n| ratio(n, duration_s)),
         death_rate_per_s: deaths.and_then(|n| ratio(n, duration_s)),
-        mean_detection_loss_db: mean(per_set.iter().map(|s| s.detection_loss_db)),
-        mean_tracking_loss_db: mean(per_set.iter().map(|s| s.tracking_loss_db)),
-        mean_full_lifetime_loss_db: mean(per_set.iter().map(|s| s.channel_gain_db - s.full_lifetime_gain_db)),
+        mean_detection_loss_db: mean(per_set.iter().filter_map(|s| s.detection_loss_db)),
+        mean_tracking_loss_db: mean(per_set.iter().filter_map(|s| s.tracking_loss_db)),
+        mean_full_lifetime_loss_db: mean(
+            per_set.iter().filter_map(|s| loss_db(s.channel_gain_db, s.full_lifetime_gain_db)),
+        ),
         mean_gmphd_tracking_loss_db: mean(per_set.iter().filter_map(|s| s.gmphd_tracking_loss_db)),
         full_lifetime_std_below_1db: share_below(
             power_std.iter().filter(|p| p.full_lifetime).map(|p| p.power_std_db),

@@ -13,11 +13,11 @@ fn set(i: u64) -> MpcSetStats {
         detections: 10,
         short_term_tracks: 3,
         full_lifetime_tracks: 2,
-        noise_floor_db: -140.0,
-        channel_gain_db: -80.0,
-        detected_gain_db: -82.0,
-        tracked_gain_db: -83.0,
-        full_lifetime_gain_db: -84.0,
+        noise_floor_db: Some(-140.0),
+        channel_gain_db: Some(-80.0),
+        detected_gain_db: Some(-82.0),
+        tracked_gain_db: Some(-83.0),
+        full_lifetime_gain_db: Some(-84.0),
         gmphd_tracked_gain_db: None,
     }
 }
@@ -225,7 +225,7 @@ fn purity_precision_and_recall() {
     }
     let track = MpcTrack { track_id: 0, doppler_hz: None, detections: detections.clone() };
     let mut sets = vec![set(0)];
-    sets[0].noise_floor_db = -200.0;
+    sets[0].noise_floor_db = Some(-200.0);
     let scores = truth::score(&truth, &detections, &[track], &[], &sets);
     assert_eq!(scores.precision, Some(1.0));
     assert_eq!(scores.recall, Some(0.5));

@@ -192,8 +192,10 @@ pub fn score(
     // Which true MPCs were found: (snapshot, path) pairs taken by a detection.
     let found: BTreeSet<(u64, u32, u64)> =
         detections.iter().zip(&matched).filter_map(|(d, m)| m.map(|p| (d.set_index, d.snapshot_index, p))).collect();
+    // A set without a floor (every snapshot skipped) has no threshold: all
+    // its true paths count as above it.
     let threshold_db: BTreeMap<u64, f64> =
-        sets.iter().map(|s| (s.set_index, s.noise_floor_db + FLOOR_MARGIN_DB)).collect();
+        sets.iter().filter_map(|s| Some((s.set_index, s.noise_floor_db? + FLOOR_MARGIN_DB))).collect();
     let above =
         |t: &MpcTruth| threshold_db.get(&t.set_index).is_none_or(|&th| t.power_db() >= th || t.power_db().is_nan());
     let (mut strong, mut strong_found) = (0u64, 0u64);

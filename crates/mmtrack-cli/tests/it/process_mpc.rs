@@ -247,6 +247,15 @@ fn uwb_first_path_from_the_cli_lies_on_the_chips_leading_edge() {
     assert!(printed.contains("no short-term tracks: sets hold at most 1 snapshot(s)"), "{printed}");
     assert!(report.contains("`uwb`: no short-term tracks, so tracking and full-lifetime losses"), "{report}");
     assert!(report.contains("(first 30 of 252 sets)"), "the delay plot's subset is named: {report}");
+    // Without tracks the tracked gains and losses are nulls, not -inf / +inf
+    // (which pandas and DuckDB would average into infinities); the detection
+    // loss is measured in every set.
+    let (_, sets) = only::<mmtrack_core::MpcSetStats>(&dir.path().join("tables"));
+    assert!(sets.iter().all(|s| s.tracked_gain_db.is_none() && s.full_lifetime_gain_db.is_none()), "{:?}", sets[0]);
+    assert!(sets.iter().all(|s| s.detected_gain_db.is_some_and(f64::is_finite)), "{:?}", sets[0]);
+    let (_, metrics) = only::<mmtrack_io::table::SetMetrics>(&results);
+    assert!(metrics.iter().all(|m| m.tracking_loss_db.is_none()), "{:?}", metrics[0]);
+    assert!(metrics.iter().all(|m| m.detection_loss_db.is_some_and(f64::is_finite)), "{:?}", metrics[0]);
 }
 
 /// Every entry under `dir` (relative), with a file's bytes (`None` for a

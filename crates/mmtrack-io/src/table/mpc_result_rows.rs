@@ -26,14 +26,14 @@ Transition columns are null for the first set.",
         death_rate_per_m: Option<f64>, "1/m", "deaths / distance_m";
         birth_rate_per_s: Option<f64>, "1/s", "births / time since the previous set";
         death_rate_per_s: Option<f64>, "1/s", "deaths / time since the previous set";
-        channel_gain_db: f64, "dB", "channel gain after thresholding and windowing (mpc_sets); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        detected_gain_db: f64, "dB", "gain captured by the detections; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        tracked_gain_db: f64, "dB", "gain captured by the short-term tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        channel_gain_db: Option<f64>, "dB", "channel gain after thresholding and windowing (mpc_sets); null when nothing was measured; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detected_gain_db: Option<f64>, "dB", "gain captured by the detections; null without detections; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        tracked_gain_db: Option<f64>, "dB", "gain captured by the short-term tracks; null without tracks (e.g. one snapshot per set); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        full_lifetime_gain_db: Option<f64>, "dB", "gain captured by the full-lifetime tracks; null without them; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         gmphd_tracked_gain_db: Option<f64>, "dB", "gain captured by the GM-PHD tracks; null without them; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        detection_loss_db: f64, "dB", "channel_gain_db - detected_gain_db: dB re the channel gain";
-        tracking_loss_db: f64, "dB", "channel_gain_db - tracked_gain_db: dB re the channel gain";
-        gmphd_tracking_loss_db: Option<f64>, "dB", "channel_gain_db - gmphd_tracked_gain_db: dB re the channel gain";
+        detection_loss_db: Option<f64>, "dB", "channel_gain_db - detected_gain_db: dB re the channel gain; null when either is";
+        tracking_loss_db: Option<f64>, "dB", "channel_gain_db - tracked_gain_db: dB re the channel gain; null when either is";
+        gmphd_tracking_loss_db: Option<f64>, "dB", "channel_gain_db - gmphd_tracked_gain_db: dB re the channel gain; null when either is";
         true_births: Option<u64>, "", "true paths above the floor appearing since the previous set; null without truth";
         true_deaths: Option<u64>, "", "true paths above the floor gone since the previous set; null without truth";
     }

@@ -46,7 +46,7 @@ crate::define_table! {
     /// `mpc_sets`: per-set statistics of detection and tracking.
     pub const MPC_SETS = "mpc_sets",
         "One sounder set per row, in set order: counts of detections and tracks and the channel gains \
-(Mahler et al. 2017, Figs. 8-9); gains are means over the set's snapshots of sum |a|^2 in dB, -inf when nothing \
+(Mahler et al. 2017, Figs. 8-9); gains are means over the set's snapshots of sum |a|^2 in dB, null when nothing \
 was captured.",
         frame: TableFrame::NotApplicable;
     MpcSetStats {
@@ -57,13 +57,13 @@ was captured.",
         detections: u32, "", "detections over the set";
         short_term_tracks: u32, "", "short-term tracks of the set";
         full_lifetime_tracks: u32, "", "short-term tracks spanning the whole set";
-        noise_floor_db: f64, "dB", "mean noise floor (mean tap power) of the set's snapshots; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        channel_gain_db: f64, "dB", "channel gain (sum of |h|^2 over the taps) after thresholding and windowing; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        detected_gain_db: f64, "dB", "gain captured by the detections (sum of |a|^2 times the pulse energy); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        tracked_gain_db: f64, "dB", "gain captured by the short-term tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        full_lifetime_gain_db: f64, "dB", "gain captured by the full-lifetime tracks; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        noise_floor_db: Option<f64>, "dB", "mean noise floor (mean tap power) of the set's snapshots; null when every snapshot was skipped; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        channel_gain_db: Option<f64>, "dB", "channel gain (sum of |h|^2 over the taps) after thresholding and windowing; null when every snapshot was skipped or nothing was above the threshold; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detected_gain_db: Option<f64>, "dB", "gain captured by the detections (sum of |a|^2 times the pulse energy); null without detections; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        tracked_gain_db: Option<f64>, "dB", "gain captured by the short-term tracks; null without tracks (e.g. one snapshot per set); dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        full_lifetime_gain_db: Option<f64>, "dB", "gain captured by the full-lifetime tracks; null without them; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         gmphd_tracked_gain_db: Option<f64>, "dB",
-            "gain captured by the GM-PHD baseline's tracks (same definition); null when it did not run; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+            "gain captured by the GM-PHD baseline's tracks (same definition); null when it did not run or found no track; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
     }
 }
 
@@ -81,9 +81,9 @@ Sec. III-A) and the receiver's own first-path estimate carried in the recording,
         snapshot_index: u32, "", "snapshot within the set";
         detections: u32, "", "detected MPCs (rows of mpc_detections of this snapshot)";
         skipped: bool, "", "true when detection skipped the snapshot (all taps zero)";
-        noise_floor_db: f64, "dB", "estimated noise floor (mean tap power); -inf when skipped; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        channel_gain_db: f64, "dB", "channel gain (sum of |h|^2 over the taps) after thresholding and windowing; -inf when skipped; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
-        detected_gain_db: f64, "dB", "gain captured by the detections; -inf when none; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        noise_floor_db: Option<f64>, "dB", "estimated noise floor (mean tap power); null when skipped; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        channel_gain_db: Option<f64>, "dB", "channel gain (sum of |h|^2 over the taps) after thresholding and windowing; null when skipped or nothing was above the threshold; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
+        detected_gain_db: Option<f64>, "dB", "gain captured by the detections; null without detections; dB re 1 CIR tap unit squared: |a|^2 with a in the units of the recording's CIR taps, uncalibrated (not dBm)";
         first_path_hint_s: Option<f64>, "s",
             "the receiver's own first-path estimate on the delay axis (e.g. DW1000 HLP); null when not given";
     }

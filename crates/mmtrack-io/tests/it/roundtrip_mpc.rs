@@ -49,11 +49,12 @@ fn set_stats() -> Vec<MpcSetStats> {
             detections: 40 + i as u32,
             short_term_tracks: 7,
             full_lifetime_tracks: 5,
-            noise_floor_db: -140.0 + AWKWARD[i as usize],
-            channel_gain_db: -80.25,
-            detected_gain_db: -82.0,
-            tracked_gain_db: if i == 2 { f64::NEG_INFINITY } else { -82.5 },
-            full_lifetime_gain_db: AWKWARD[(i as usize + 3) % 6],
+            noise_floor_db: Some(-140.0 + AWKWARD[i as usize]),
+            channel_gain_db: Some(-80.25),
+            detected_gain_db: Some(-82.0),
+            // A set without tracks has no tracked gain (null, not -inf).
+            tracked_gain_db: (i != 2).then_some(-82.5),
+            full_lifetime_gain_db: Some(AWKWARD[(i as usize + 3) % 6]),
             gmphd_tracked_gain_db: (i % 2 == 0).then(|| AWKWARD[(i as usize + 4) % 6]),
         })
         .collect()
@@ -88,7 +89,11 @@ fn mpc_tables_round_trip_bit_exactly() {
     let stats = set_stats();
     let back = round_trip(&stats);
     assert_eq!(back, stats);
-    assert_eq!(bits(back.iter().map(|s| s.full_lifetime_gain_db)), bits(stats.iter().map(|s| s.full_lifetime_gain_db)));
+    assert_eq!(
+        bits(back.iter().filter_map(|s| s.full_lifetime_gain_db)),
+        bits(stats.iter().filter_map(|s| s.full_lifetime_gain_db))
+    );
+    assert_eq!(back[2].tracked_gain_db, None);
 
     let truth = truth();
     let back = round_trip(&truth);
@@ -125,7 +130,7 @@ fn mpc_tables_carry_units_and_keep_nulls() {
     };
     assert_eq!(unit(&MPC_LONG_TERM, "chi_class_s"), ("s", true));
     assert_eq!(unit(&MPC_LONG_TERM, "mean_power_db"), ("dB", false));
-    assert_eq!(unit(&MPC_SETS, "channel_gain_db"), ("dB", false));
+    assert_eq!(unit(&MPC_SETS, "channel_gain_db"), ("dB", true));
     assert_eq!(unit(&MPC_TRUTH, "doppler_hz"), ("Hz", false));
     let dir = tempfile::tempdir().unwrap();
     let run = samples::run_info("{}");

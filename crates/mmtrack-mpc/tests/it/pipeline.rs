@@ -106,9 +106,11 @@ fn two_mpc_channel_gives_two_full_lifetime_tracks_per_set_linked_across_sets() {
         // Full-lifetime gain: two paths of -116 dB on the pulse's energy
         // scale; 0.5 dB covers the amplitude error at 24 dB SNR.
         let expected_db = 10.0 * (2.0 * 10f64.powf(-11.6) * energy).log10();
-        assert!((out.stats.full_lifetime_gain_db - expected_db).abs() < 0.5, "{:?}", out.stats);
-        assert!(out.stats.tracked_gain_db >= out.stats.full_lifetime_gain_db);
-        assert!(out.stats.detected_gain_db >= out.stats.tracked_gain_db);
+        let gain = |db: Option<f64>| db.unwrap_or_else(|| panic!("a gain is missing: {:?}", out.stats));
+        let full_lifetime_db = gain(out.stats.full_lifetime_gain_db);
+        assert!((full_lifetime_db - expected_db).abs() < 0.5, "{:?}", out.stats);
+        assert!(gain(out.stats.tracked_gain_db) >= full_lifetime_db);
+        assert!(gain(out.stats.detected_gain_db) >= gain(out.stats.tracked_gain_db));
         assert_eq!(out.stats.skipped_snapshots, 0);
         assert_eq!(out.stats.gmphd_tracked_gain_db, None, "GM-PHD did not run");
     }
@@ -130,7 +132,7 @@ fn gmphd_tracked_gain_is_on_the_scale_of_the_other_gains() {
         // amplitude spread at 24 dB SNR; seen 2.0 dB). Without the pulse
         // energy factor GM-PHD's gain would sit 10 log10(w^H w) (-4.4 dB)
         // from this, outside the range.
-        let below_db = out.stats.tracked_gain_db - gmphd_db;
+        let below_db = out.stats.tracked_gain_db.unwrap() - gmphd_db;
         eprintln!("set {}: GM-PHD {below_db:.2} dB below the proposed tracker", out.stats.set_index);
         assert!((-0.5..=3.0).contains(&below_db), "{below_db} dB; energy factor {energy_db} dB: {:?}", out.stats);
         assert!(energy_db.abs() > 2.5, "the test tells the two scales apart: {energy_db} dB");
@@ -248,7 +250,9 @@ fn all_zero_snapshots_are_counted_as_skipped() {
     // few for a new one): no full-lifetime track, no long-term entry.
     assert_eq!(out.stats.full_lifetime_tracks, 0);
     assert!(out.long_term_entries.is_empty());
-    assert!(out.stats.channel_gain_db.is_finite());
+    assert!(out.stats.channel_gain_db.is_some_and(f64::is_finite));
+    // Nothing full-lifetime was captured: a null gain, not -inf.
+    assert_eq!(out.stats.full_lifetime_gain_db, None);
 }
 
 #[test]
@@ -303,8 +307,9 @@ fn detected_gain_differs_from_channel_gain_by_the_overlap_of_resolved_paths() {
         // zeroing removes nothing of weight and the identity is exact (0.01 dB
         // leaves room for FFT round-off many orders over).
         let stats = &out.stats;
-        assert!((stats.channel_gain_db - 10.0 * coherent.log10()).abs() < 0.01, "{stats:?}");
-        excess_db.push(stats.detected_gain_db - stats.channel_gain_db);
+        let (channel_db, detected_db) = (stats.channel_gain_db.unwrap(), stats.detected_gain_db.unwrap());
+        assert!((channel_db - 10.0 * coherent.log10()).abs() < 0.01, "{stats:?}");
+        excess_db.push(detected_db - channel_db);
     }
     // Measured: -0.48 dB in phase, +0.90 dB in antiphase; the sign is the
     // point, the bounds are half of that.

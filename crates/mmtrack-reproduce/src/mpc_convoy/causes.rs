@@ -349,7 +349,7 @@ pub fn diagnose(t: &Tables<'_>) -> Diagnosis {
         unmatched.entry((d.set_index, d.snapshot_index)).or_default().push(d.delay_s);
     }
     let threshold_db: BTreeMap<u64, f64> =
-        t.sets.iter().map(|s| (s.set_index, s.noise_floor_db + FLOOR_MARGIN_DB)).collect();
+        t.sets.iter().filter_map(|s| Some((s.set_index, s.noise_floor_db? + FLOOR_MARGIN_DB))).collect();
     // Per (set, path): powers per snapshot (resolvable truth).
     let mut powers: BTreeMap<(u64, u64), BTreeMap<u32, f64>> = BTreeMap::new();
     let mut by_snapshot: BTreeMap<(u64, u32), Vec<&MpcTruth>> = BTreeMap::new();
@@ -681,11 +681,11 @@ mod tests {
             detections: 0,
             short_term_tracks: 0,
             full_lifetime_tracks: 0,
-            noise_floor_db: FLOOR_DB,
-            channel_gain_db: -100.0,
-            detected_gain_db: -100.0,
-            tracked_gain_db: -100.0,
-            full_lifetime_gain_db: -100.0,
+            noise_floor_db: Some(FLOOR_DB),
+            channel_gain_db: Some(-100.0),
+            detected_gain_db: Some(-100.0),
+            tracked_gain_db: Some(-100.0),
+            full_lifetime_gain_db: Some(-100.0),
             gmphd_tracked_gain_db: None,
         }
     }
