@@ -211,24 +211,27 @@ pub struct Measured {
     /// Why the births on true paths happened, per (truth, variant) pair
     /// of [`Measured::rows`] (same order).
     pub diagnoses: Vec<Diagnosis>,
-    /// The scatter-free tunnel with other seeds ([`OTHER_SEEDS`]): the
-    /// variants of [`SEED_VARIANTS`] against its truth.
+    /// The tunnel with other seeds ([`OTHER_SEEDS`]), with the diffuse
+    /// scatterers in the truth and without them: the variants of
+    /// [`SEED_VARIANTS`] against each truth.
     pub other_seeds: Vec<SeedRow>,
 }
 
-/// Seeds of the scatter-free tunnel run beside the scenario's: other draws
-/// of the traffic (Poisson arrivals, speeds), path phases and noise, so that
-/// the birth-rate verdict is not one draw's.
+/// Seeds of the tunnel run beside the scenario's (both fair truths): other
+/// draws of the traffic (Poisson arrivals, speeds), the diffuse scatterers,
+/// path phases and noise, so that no birth-rate verdict is one draw's.
 pub const OTHER_SEEDS: [u64; 4] = [1, 2, 3, 4];
 
 /// The variants run on [`OTHER_SEEDS`]: the paper's, ours and the best row.
 pub const SEED_VARIANTS: [&str; 3] = [LITERAL, OURS, REFINED_CHAIN];
 
-/// One variant on the scatter-free tunnel with another seed.
+/// One variant on the tunnel with another seed, against one fair truth.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SeedRow {
     /// The seed.
     pub seed: u64,
+    /// [`Truth::WithDiffuse`] or [`Truth::NoDiffuse`].
+    pub truth: Truth,
     /// The long-term tracker's name ([`Variant::name`]).
     pub variant: &'static str,
     /// Everything `analyze` reports for it.
@@ -481,15 +484,18 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     }
     let mut other_seeds = Vec::new();
     for other in OTHER_SEEDS {
-        progress.note(&format!(
-            "simulating and tracking {sets} sets of the tunnel without diffuse scatterers, seed {other}"
-        ));
-        let groups = detector_groups(|v| SEED_VARIANTS.contains(&v.name));
-        for (scene, (_, group)) in run_scenes(&no_diffuse, other, &groups, progress)?.iter().zip(&groups) {
-            for (v, variant) in group.iter().enumerate() {
-                progress.check_cancelled()?;
-                let (summary, _) = score(scene, scene.truth.clone(), v);
-                other_seeds.push(SeedRow { seed: other, variant: variant.name, summary });
+        for (scenario, truth, what) in [
+            (&with_diffuse, Truth::WithDiffuse, "the tunnel (diffuse scatterers in the truth)"),
+            (&no_diffuse, Truth::NoDiffuse, "the tunnel without diffuse scatterers"),
+        ] {
+            progress.note(&format!("simulating and tracking {sets} sets of {what}, seed {other}"));
+            let groups = detector_groups(|v| SEED_VARIANTS.contains(&v.name));
+            for (scene, (_, group)) in run_scenes(scenario, other, &groups, progress)?.iter().zip(&groups) {
+                for (v, variant) in group.iter().enumerate() {
+                    progress.check_cancelled()?;
+                    let (summary, _) = score(scene, scene.truth.clone(), v);
+                    other_seeds.push(SeedRow { seed: other, truth, variant: variant.name, summary });
+                }
             }
         }
     }
