@@ -99,17 +99,24 @@ use crate::{MpcError, SounderPulse};
 pub struct SnapshotDetections {
     /// Detected MPCs, strongest first.
     pub detections: Vec<MpcDetection>,
-    /// Estimated noise floor, dB (mean tap power).
-    pub noise_floor_db: f64,
+    /// Estimated noise floor, dB (mean tap power); `None` when skipped.
+    pub noise_floor_db: Option<f64>,
     /// Channel gain after thresholding and windowing, `sum_n |h_w[n]|^2`, dB
-    /// (the "original channel gain after Kaiser windowing" of Fig. 8).
-    pub channel_gain_db: f64,
+    /// (the "original channel gain after Kaiser windowing" of Fig. 8);
+    /// `None` when skipped or nothing is left above the threshold.
+    pub channel_gain_db: Option<f64>,
     /// Gain captured by the detections, `sum_l |alpha_l|^2 (w^H w)`, dB: on the
     /// same scale as the channel gain, so their difference is the detection's
-    /// power loss (Fig. 9).
-    pub detected_gain_db: f64,
+    /// power loss (Fig. 9); `None` without detections.
+    pub detected_gain_db: Option<f64>,
     /// Why the snapshot was skipped (all-zero CIR), if it was.
     pub skipped: Option<&'static str>,
+}
+
+/// `10 log10(power)`; `None` for no power (`power <= 0`, whose level would
+/// be `-inf`: a null in the tables, not an infinity).
+pub(crate) fn power_db(power: f64) -> Option<f64> {
+    (power > 0.0).then(|| 10.0 * power.log10())
 }
 
 /// Detects MPCs in snapshots of one sounder (fixed band and pulse).
@@ -235,9 +242,9 @@ impl Detector {
         if peak_power == 0.0 {
             return Ok(SnapshotDetections {
                 detections: Vec::new(),
-                noise_floor_db: f64::NEG_INFINITY,
-                channel_gain_db: f64::NEG_INFINITY,
-                detected_gain_db: f64::NEG_INFINITY,
+                noise_floor_db: None,
+                channel_gain_db: None,
+                detected_gain_db: None,
                 skipped: Some("all taps are zero"),
             });
         }
@@ -274,9 +281,9 @@ impl Detector {
         let detected_gain: f64 = detections.iter().map(|d| d.amplitude.norm_sqr()).sum::<f64>() * self.pulse_energy;
         Ok(SnapshotDetections {
             detections,
-            noise_floor_db: 10.0 * floor.log10(),
-            channel_gain_db: 10.0 * channel_gain.log10(),
-            detected_gain_db: 10.0 * detected_gain.log10(),
+            noise_floor_db: power_db(floor),
+            channel_gain_db: power_db(channel_gain),
+            detected_gain_db: power_db(detected_gain),
             skipped: None,
         })
     }

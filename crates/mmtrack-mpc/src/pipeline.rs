@@ -27,8 +27,8 @@
 //!
 //! Gains in the statistics are means over the set's measured (not skipped)
 //! snapshots of linear gains, converted to dB (`None`, a null in the tables,
-//! when every snapshot was skipped or nothing was captured: not `-inf`). The detected, tracked and full-lifetime
-//! gains (and the GM-PHD baseline's tracked gain, when it runs) are
+//! when every snapshot was skipped or nothing was captured: not `-inf`). The
+//! detected, tracked and full-lifetime gains (and the GM-PHD baseline's tracked gain, when it runs) are
 //! `sum |alpha|^2 (w^H w)` over the respective detections (`w^H w`
 //! = [`Detector::pulse_energy`]), the scale of the detector's
 //! `detected_gain_db`, so each compares directly with the channel gain.
@@ -42,6 +42,7 @@
 use mmtrack_core::{CirSnapshot, MpcLongTermEntry, MpcSetStats, MpcTrack};
 use rayon::prelude::*;
 
+use crate::detect::power_db;
 use crate::short_term::is_full_lifetime;
 use crate::{
     Detector, GmPhdConfig, GmPhdSnapshot, LongTermTracker, MpcConfig, MpcError, SnapshotDetections, SounderPulse,
@@ -327,14 +328,14 @@ impl MpcPipeline {
     }
 }
 
-fn from_db(db: f64) -> f64 {
-    10f64.powf(db / 10.0)
+/// The linear power of a level in dB; 0 for none.
+fn from_db(db: Option<f64>) -> f64 {
+    db.map_or(0.0, |db| 10f64.powf(db / 10.0))
 }
 
-/// `10 log10(sum / n)`; `None` for `n = 0` or nothing summed (`sum <= 0`,
-/// whose level would be `-inf`).
+/// `10 log10(sum / n)` ([`power_db`]); `None` for `n = 0` or nothing summed.
 fn mean_db(sum: f64, n: usize) -> Option<f64> {
-    (n > 0 && sum > 0.0).then(|| 10.0 * (sum / n as f64).log10())
+    if n == 0 { None } else { power_db(sum / n as f64) }
 }
 
 /// A count as `u32`, saturating (a set of 4 billion snapshots or detections

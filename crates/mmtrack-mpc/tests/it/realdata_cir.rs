@@ -110,7 +110,7 @@ fn mimo_60ghz_mpcs_per_link() {
             found.detections.iter().filter(|d| d.power_db() > strongest.power_db() - 30.0).count(),
             strongest.delay_s * 1e9,
             strongest.power_db(),
-            found.noise_floor_db
+            found.noise_floor_db.unwrap_or(f64::NAN)
         );
         strongest_delays_ns.push(strongest.delay_s * 1e9);
     }

@@ -165,10 +165,9 @@ fn snapshot_stats(cir: &CirSnapshot, found: &SnapshotDetections) -> MpcSnapshotS
         snapshot_index: cir.snapshot_index,
         detections: u32::try_from(found.detections.len()).unwrap_or(u32::MAX),
         skipped: found.skipped.is_some(),
-        // The detector's -inf (nothing measured or captured) is a null.
-        noise_floor_db: Some(found.noise_floor_db).filter(|db| db.is_finite()),
-        channel_gain_db: Some(found.channel_gain_db).filter(|db| db.is_finite()),
-        detected_gain_db: Some(found.detected_gain_db).filter(|db| db.is_finite()),
+        noise_floor_db: found.noise_floor_db,
+        channel_gain_db: found.channel_gain_db,
+        detected_gain_db: found.detected_gain_db,
         first_path_hint_s: cir.first_path_hint_s,
     }
 }
