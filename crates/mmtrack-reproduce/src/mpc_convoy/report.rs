@@ -101,12 +101,7 @@ pub fn verdicts(m: &Measured) -> Vec<Verdict> {
         let claim = if informational { claim.informational() } else { claim };
         out.push(Verdict::judged(claim, birth_ratio(&row.summary), rate_note(&row.summary)));
     }
-    for (truth, variant) in [
-        (Truth::WithDiffuse, OURS),
-        (Truth::NoDiffuse, OURS),
-        (Truth::WithDiffuse, REFINED_CHAIN),
-        (Truth::NoDiffuse, REFINED_CHAIN),
-    ] {
+    for (variant, truth) in [OURS, REFINED_CHAIN].into_iter().flat_map(|v| Truth::FAIR.map(|t| (v, t))) {
         let ratios = seed_ratios(m, variant, truth);
         // The worst seed is the one farthest from the true rate either way
         // (the rule is a band, 0.5-2x): log-symmetric, so 0.4x is farther
@@ -133,10 +128,8 @@ pub fn verdicts(m: &Measured) -> Vec<Verdict> {
         out.push(Verdict::judged(claim, Some(worst), format!("{worst:.2} x at seed {worst_seed} (per seed: {all})")));
     }
     let births_on_paths = |truth, variant| m.row(truth, variant).and_then(|r| r.summary.births_on_true_paths);
-    let pairs: Vec<(Truth, Option<u64>, Option<u64>)> = [Truth::WithDiffuse, Truth::NoDiffuse]
-        .into_iter()
-        .map(|t| (t, births_on_paths(t, OURS), births_on_paths(t, LITERAL)))
-        .collect();
+    let pairs: Vec<(Truth, Option<u64>, Option<u64>)> =
+        Truth::FAIR.into_iter().map(|t| (t, births_on_paths(t, OURS), births_on_paths(t, LITERAL))).collect();
     let met = pairs.iter().all(|(_, ours, literal)| matches!((ours, literal), (Some(o), Some(l)) if o < l));
     let note = pairs
         .iter()
@@ -177,7 +170,7 @@ fn seed_ratios(m: &Measured, variant: &str, truth: Truth) -> Vec<(u64, f64)> {
 /// Both fair truths per seed: true births, and each variant of
 /// [`SEED_VARIANTS`] against them.
 fn seeds_table(m: &Measured) -> String {
-    [Truth::WithDiffuse, Truth::NoDiffuse].into_iter().map(|truth| seeds_table_of(m, truth)).collect()
+    Truth::FAIR.into_iter().map(|truth| seeds_table_of(m, truth)).collect()
 }
 
 /// [`seeds_table`] for one truth.
@@ -572,7 +565,7 @@ fn cost_table(m: &Measured) -> String {
          tracks on no true path | births / deaths per m | estimated / true births | precision | recall | recall \
          above floor + 6 dB |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
-    for truth in [Truth::WithDiffuse, Truth::NoDiffuse] {
+    for truth in Truth::FAIR {
         for variant in [OURS, LS_OURS] {
             let Some(Row { summary: s, .. }) = m.row(truth, variant) else { continue };
             let _ = writeln!(

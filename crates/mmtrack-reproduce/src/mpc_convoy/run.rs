@@ -153,6 +153,8 @@ pub enum Truth {
 impl Truth {
     /// Every truth definition, in report order.
     pub const ALL: [Self; 3] = [Self::SpecularOnly, Self::WithDiffuse, Self::NoDiffuse];
+    /// The two fair truths of issue 25, in report order.
+    pub const FAIR: [Self; 2] = [Self::WithDiffuse, Self::NoDiffuse];
 
     /// Short name for metric keys.
     #[must_use]
@@ -484,11 +486,8 @@ pub fn measure(convoy: &ConvoyConfig, seed: u64, sets: usize, progress: &dyn Pro
     }
     let mut other_seeds = Vec::new();
     for other in OTHER_SEEDS {
-        for (scenario, truth, what) in [
-            (&with_diffuse, Truth::WithDiffuse, "the tunnel (diffuse scatterers in the truth)"),
-            (&no_diffuse, Truth::NoDiffuse, "the tunnel without diffuse scatterers"),
-        ] {
-            progress.note(&format!("simulating and tracking {sets} sets of {what}, seed {other}"));
+        for (scenario, truth) in [&with_diffuse, &no_diffuse].into_iter().zip(Truth::FAIR) {
+            progress.note(&format!("simulating and tracking {sets} sets, seed {other}: {}", truth.describe()));
             let groups = detector_groups(|v| SEED_VARIANTS.contains(&v.name));
             for (scene, (_, group)) in run_scenes(scenario, other, &groups, progress)?.iter().zip(&groups) {
                 for (v, variant) in group.iter().enumerate() {
