@@ -556,7 +556,7 @@ impl Particles {
         tag: u64,
         draw: impl Fn(&mut Pcg64) -> ([f64; STATE_DIM], f64) + Send + Sync + 'static,
     ) -> Self {
-        let chunks = team.map(n.div_ceil(chunk_size), move |c| {
+        let chunks = team.map_blocks(n.div_ceil(chunk_size), move |c| {
             let mut chunk = Chunk::with_len(chunk_size.min(n - c * chunk_size));
             let mut rng = keyed_stream(STREAM_KEY, seed, &[tag, c as u64]);
             for i in 0..chunk.len() {
@@ -590,7 +590,7 @@ impl Particles {
     pub(crate) fn predict(&mut self, team: &Team, dt_s: f64, noise: [f64; 3], seed: u64, epoch: u64) {
         let chunks = self.chunks.clone();
         let exp_at_zero = self.known.exp_sums(0.0).is_some();
-        let sums = team.map(chunks.len(), move |c| {
+        let sums = team.map_blocks(chunks.len(), move |c| {
             let mut chunk = write(&chunks[c]);
             let mut rng = keyed_stream(STREAM_KEY, seed, &[epoch, 0x7072_6564, c as u64]);
             for i in 0..chunk.len() {
@@ -618,7 +618,7 @@ impl Particles {
     pub(crate) fn log_likelihood(&mut self, team: &Team, paths: &Arc<[PreparedPath]>, prefetch: &[f64]) {
         let (chunks, paths, z_m) = (self.chunks.clone(), paths.clone(), self.z_m);
         let deltas = prefetch.to_vec();
-        let maxima = team.map(chunks.len(), move |c| {
+        let maxima = team.map_blocks(chunks.len(), move |c| {
             let mut chunk = write(&chunks[c]);
             for i in 0..chunk.len() {
                 chunk.ll[i] =
@@ -636,7 +636,7 @@ impl Particles {
             return m;
         }
         let chunks = self.chunks.clone();
-        let maxima = team.map(chunks.len(), move |c| read(&chunks[c]).max_at(&[delta]));
+        let maxima = team.map_blocks(chunks.len(), move |c| read(&chunks[c]).max_at(&[delta]));
         let m = max_over(&maxima, 1)[0];
         self.known.set_max(&[delta], &[m]);
         m
@@ -672,7 +672,7 @@ impl Particles {
         }
         let (chunks, deltas, trigonometry) = (self.chunks.clone(), prefetch.clone(), self.known.trigonometry);
         let (maxima, sums): (Vec<_>, Vec<_>) = team
-            .map(chunks.len(), move |c| {
+            .map_blocks(chunks.len(), move |c| {
                 let mut chunk = write(&chunks[c]);
                 let chunk = &mut *chunk;
                 for ((e, w), l) in chunk.exp.iter_mut().zip(&chunk.logw).zip(&chunk.ll) {
@@ -698,7 +698,7 @@ impl Particles {
         // `exp(logw - 0)` and the headings' trigonometry come in the same pass.
         let (chunks, trigonometry) = (self.chunks.clone(), !self.known.trigonometry);
         let (maxima, sums): (Vec<_>, Vec<_>) = team
-            .map(chunks.len(), move |c| {
+            .map_blocks(chunks.len(), move |c| {
                 let mut chunk = write(&chunks[c]);
                 let chunk = &mut *chunk;
                 if trigonometry {
@@ -735,7 +735,7 @@ impl Particles {
         let max = self.max_at(team, 0.0);
         let (exponentials, trigonometry) = (self.known.exp_sums(0.0).is_none(), !self.known.trigonometry);
         let chunks = self.chunks.clone();
-        let sums = team.map(chunks.len(), move |c| {
+        let sums = team.map_blocks(chunks.len(), move |c| {
             let mut chunk = write(&chunks[c]);
             let chunk = &mut *chunk;
             if exponentials {
@@ -799,7 +799,8 @@ impl Particles {
         });
         reference[2] = heading;
         let chunks = self.chunks.clone();
-        let per_chunk = team.map(chunks.len(), move |c| chunk_moments(&mut write(&chunks[c]), scale, &reference));
+        let per_chunk =
+            team.map_blocks(chunks.len(), move |c| chunk_moments(&mut write(&chunks[c]), scale, &reference));
         let w = in_chunk_order(&per_chunk, |p| p.weight);
         let m: [f64; STATE_DIM] = std::array::from_fn(|a| in_chunk_order(&per_chunk, |p| p.first[a]));
         let mut mean = reference;
@@ -850,7 +851,7 @@ impl Particles {
         let maxima_at: Vec<f64> = std::iter::once(0.0).chain(deltas.iter().copied()).collect();
         let prefetch = maxima_at.clone();
         let picks = Arc::new(picks);
-        let per_chunk = team.map(new.len(), move |c| {
+        let per_chunk = team.map_blocks(new.len(), move |c| {
             let mut chunk = write(&new[c]);
             let mut rng = keyed_stream(STREAM_KEY, seed, &[words[0], words[1], 0x6a69_7474, c as u64]);
             let mut from: Option<(usize, RwLockReadGuard<'_, Chunk>)> = None;
