@@ -13,7 +13,7 @@ use mmtrack_core::{
 use mmtrack_io::table::{
     BEAM_SWEEPS_TRACKED, BeamSweepTracked, DriftPerLength, GEOMETRIC_PER_EPOCH, GROUND_TRUTH, GeometricEpochRow,
     GroundTruthPose, GroundTruthRxPose, GroundTruthTxPose, MPC_DETECTIONS, MPC_LONG_TERM, MPC_SETS, MPC_TRACKS,
-    MpcSnapshotStats, ODOMETRY, RelativePoseErrorRow, SLAM_UE, SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow,
+    MpcSnapshotStats, ODOMETRY, POSES, RelativePoseErrorRow, SLAM_UE, SPEBT_PER_SLOT, SPEBT_SUMMARY, SpebtSlotRow,
     SpebtSummaryRow, TableRow, TableTimeBase, TrajectoryMetrics, read_table, read_table_dir, table_path,
 };
 
@@ -110,8 +110,8 @@ pub struct Plan {
     pub skipped: Vec<(String, String)>,
 }
 
-/// Picks the metrics that apply: `odometry` + `ground_truth` of the same
-/// sequence -> trajectory metrics; `mpc_sets` (with the other tables of
+/// Picks the metrics that apply: `odometry` or `poses` + `ground_truth` of
+/// the same sequence -> trajectory metrics; `mpc_sets` (with the other tables of
 /// `process mpc`) -> MPC statistics; `beam_sweeps_tracked` -> beam-sweep
 /// accounting.
 #[must_use]
@@ -161,24 +161,49 @@ pub fn plan(inventory: &Inventory) -> Plan {
         }
     }
     let truth = inventory.sequences(GROUND_TRUTH.name);
-    for seq in inventory.sequences(ODOMETRY.name) {
-        if truth.contains(seq) {
-            plan.trajectory.push(seq.clone());
-        } else {
-            plan.skipped.push((
-                seq.clone(),
-                format!(
-                    "has an {} table but no {} table: trajectory metrics need both",
-                    ODOMETRY.name, GROUND_TRUTH.name
-                ),
-            ));
+    for (seq, tables) in estimates_of(inventory) {
+        match tables[..] {
+            [_] if truth.contains(&seq) => plan.trajectory.push(seq),
+            [table] => plan.skipped.push((
+                seq,
+                format!("has the {table} table but no {} table: trajectory metrics need both", GROUND_TRUTH.name),
+            )),
+            _ => plan.skipped.push((seq, two_estimates(&tables))),
         }
     }
-    for seq in truth.iter().filter(|s| !inventory.sequences(ODOMETRY.name).contains(s)) {
-        plan.skipped
-            .push((seq.clone(), format!("has {} but no estimate ({} table)", GROUND_TRUTH.name, ODOMETRY.name)));
+    let estimated: Vec<String> = estimates_of(inventory).into_keys().collect();
+    for seq in truth.iter().filter(|s| !estimated.contains(s)) {
+        plan.skipped.push((
+            seq.clone(),
+            format!("has {} but no estimate ({} or {} table)", GROUND_TRUTH.name, ODOMETRY.name, POSES.name),
+        ));
     }
     plan
+}
+
+/// The tables an estimated trajectory comes in: our radar odometry
+/// (`process odometry`) or a recording's own estimate (`process poses`).
+const ESTIMATE_TABLES: [&str; 2] = [ODOMETRY.name, POSES.name];
+
+/// Each sequence with an estimate, with the estimate tables it has (one, or
+/// both when it has two estimates).
+fn estimates_of(inventory: &Inventory) -> BTreeMap<String, Vec<&'static str>> {
+    let mut out: BTreeMap<String, Vec<&'static str>> = BTreeMap::new();
+    for table in ESTIMATE_TABLES {
+        for seq in inventory.sequences(table) {
+            out.entry(seq.clone()).or_default().push(table);
+        }
+    }
+    out
+}
+
+/// Why a sequence with both estimate tables is not scored.
+fn two_estimates(tables: &[&str]) -> String {
+    format!(
+        "has two estimates ({} tables): which one to score is ambiguous; write them as separate runs (`--run-id`) \
+         to compare them side by side",
+        tables.join(" and ")
+    )
 }
 
 /// Everything computed for one sequence.
@@ -281,36 +306,56 @@ pub fn analyze_trajectory(
 /// An estimate and (when present) its ground truth, as read from tables.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrajectoryInput {
-    /// The `odometry` table as poses.
+    /// The table the estimate came from (`odometry` or `poses`).
+    pub estimate_table: &'static str,
+    /// The estimate as poses.
     pub estimate: Vec<StampedPose>,
     /// The `ground_truth` table, when the sequence has one.
     pub ground_truth: Option<Vec<StampedPose>>,
 }
 
-/// Reads the `odometry` and `ground_truth` tables of every sequence under
-/// `root` (errors name the file). Sequences without an estimate are absent.
+/// Reads the estimate (`odometry` or `poses`) and `ground_truth` tables of
+/// every sequence under `root` (errors name the file). Sequences without an
+/// estimate are absent.
+///
+/// # Errors
+/// A table that cannot be read, implausible poses, or a sequence with both
+/// estimate tables.
 pub fn read_trajectories(root: &Path) -> anyhow::Result<BTreeMap<String, TrajectoryInput>> {
     let inv = inventory(root)?;
+    let estimated = estimates_of(&inv);
     let mut out = BTreeMap::new();
-    if inv.sequences(ODOMETRY.name).is_empty() {
+    if estimated.is_empty() {
         return Ok(out);
     }
-    let estimates = read_table_dir::<OdometryEstimate>(root)?;
+    if let Some((seq, tables)) = estimated.iter().find(|(_, t)| t.len() > 1) {
+        anyhow::bail!("{}: sequence {seq} {}", root.display(), two_estimates(tables));
+    }
+    let mut estimates: BTreeMap<String, (&'static str, Vec<StampedPose>)> = BTreeMap::new();
+    if !inv.sequences(ODOMETRY.name).is_empty() {
+        for (sequence, rows) in read_table_dir::<OdometryEstimate>(root)? {
+            let poses = rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle });
+            estimates.insert(sequence, (ODOMETRY.name, poses.collect()));
+        }
+    }
+    if !inv.sequences(POSES.name).is_empty() {
+        for (sequence, rows) in read_table_dir::<StampedPose>(root)? {
+            estimates.insert(sequence, (POSES.name, rows));
+        }
+    }
     let mut truths = if inv.sequences(GROUND_TRUTH.name).is_empty() {
         BTreeMap::new()
     } else {
         read_table_dir::<GroundTruthPose>(root)?
     };
-    for (sequence, rows) in estimates {
-        let estimate: Vec<StampedPose> =
-            rows.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
-        check_plausible_poses(&table_path(root, ODOMETRY.name, &sequence)?, &estimate)?;
+    for (sequence, (estimate_table, estimate)) in estimates {
+        check_plausible_poses(&table_path(root, estimate_table, &sequence)?, &estimate)?;
         let ground_truth: Option<Vec<StampedPose>> =
             truths.remove(&sequence).map(|g| g.into_iter().map(|p| p.0).collect());
         if let Some(truth) = &ground_truth {
             check_plausible_poses(&table_path(root, GROUND_TRUTH.name, &sequence)?, truth)?;
         }
-        out.insert(sequence, TrajectoryInput { estimate, ground_truth });
+        out.insert(sequence, TrajectoryInput { estimate_table, estimate, ground_truth });
     }
     Ok(out)
 }
@@ -336,13 +381,13 @@ pub fn analyze_all(root: &Path, plan: &Plan, options: &DriftOptions) -> anyhow::
     let inputs = read_trajectories(root)?;
     let mut results = Vec::new();
     for sequence in &plan.trajectory {
-        let input = inputs.get(sequence).with_context(|| format!("sequence {sequence}: odometry table vanished"))?;
+        let input = inputs.get(sequence).with_context(|| format!("sequence {sequence}: estimate table vanished"))?;
         let truth = input.ground_truth.as_deref().unwrap_or_default();
         let result = analyze_trajectory(sequence, &input.estimate, truth, options).with_context(|| {
             let file = |t: &str| root.join(t).join(format!("sequence={sequence}")).join("part-0.parquet");
             format!(
                 "sequence {sequence} (estimate {}, ground truth {})",
-                file(ODOMETRY.name).display(),
+                file(input.estimate_table).display(),
                 file(GROUND_TRUTH.name).display()
             )
         })?;
@@ -533,11 +578,12 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
     {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         anyhow::bail!(
-            "{}: nothing to analyze: looked for tables {} and {} of the same sequence (trajectory metrics), {} with \
+            "{}: nothing to analyze: looked for tables {} (or {}) and {} of the same sequence (trajectory metrics), {} with \
              {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT), {} (geometric tracker) and \
              slam_ue with slam_map and slam_true_sources (SLAM); found {}{reasons}{}",
             root.display(),
             ODOMETRY.name,
+            POSES.name,
             GROUND_TRUTH.name,
             MPC_SETS.name,
             MPC_DETECTIONS.name,

@@ -56,7 +56,7 @@ pub struct ExportArgs {
     /// The recording the tables came from (`--format mcap` only): copied, with the estimate added.
     #[arg(long, value_name = "RECORDING.mcap", required_if_eq("format", "mcap"))]
     recording: Option<PathBuf>,
-    /// Export only this sequence (default: every sequence with an odometry table).
+    /// Export only this sequence (default: every sequence with an estimate: an odometry or poses table).
     #[arg(long, value_name = "ID")]
     sequence: Option<String>,
     /// Replace existing files.
@@ -77,14 +77,14 @@ pub fn run(args: &ExportArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     }
     let mut inputs = read_trajectories(&args.tables)?;
     if inputs.is_empty() {
-        bail!("{}: no odometry table to export (found {})", args.tables.display(), inventory(&args.tables)?.describe());
+        bail!("{}: no estimate to export (found {})", args.tables.display(), inventory(&args.tables)?.describe());
     }
     if let Some(wanted) = &args.sequence {
         let available: Vec<String> = inputs.keys().cloned().collect();
         inputs.retain(|s, _| s == wanted);
         if inputs.is_empty() {
             bail!(
-                "sequence {wanted}: no odometry table in {} (sequences: {})",
+                "sequence {wanted}: no odometry or poses table in {} (sequences: {})",
                 args.tables.display(),
                 available.join(", ")
             );

@@ -7,10 +7,9 @@ use std::process::ExitCode;
 use anyhow::bail;
 use clap::{Args, Subcommand};
 use mmtrack_core::words::{counted, counted_as};
-use mmtrack_core::{OdometryTiming, StampedPose, path_length_m};
 use mmtrack_io::table::TableWriteSummary;
 use mmtrack_odometry::OdometryConfig;
-use mmtrack_process::{mpc, odometry, slam};
+use mmtrack_process::{mpc, odometry, poses, slam};
 
 use crate::output_args::OutputArgs;
 use crate::progress::IndicatifProgress;
@@ -35,6 +34,14 @@ enum Pipeline {
     /// devkit / pyboreas.
     #[command(verbatim_doc_comment)]
     Odometry(OdometryArgs),
+    /// The recording's own estimate (/estimate/pose) and ground truth as tables, to score another odometry.
+    ///
+    /// Writes `poses/sequence=<id>/part-0.parquet` (the estimate: /odom of a ROS 2 bag
+    /// from `mmtrack ingest ros2`, a CSV from `mmtrack ingest poses --estimate`) and,
+    /// when the recording has it, `ground_truth/...`. `mmtrack analyze <out>` scores it
+    /// as our radar odometry (drift per length, RPE, ATE); `--run-id` compares runs.
+    #[command(verbatim_doc_comment)]
+    Poses(PosesArgs),
     /// Multipath-component detection and tracking (Mahler et al. 2017) on the recording's CIR snapshots.
     ///
     /// Writes, under the output directory, per sequence partition:
@@ -123,6 +130,17 @@ pub struct OdometryArgs {
 }
 
 #[derive(Args)]
+pub struct PosesArgs {
+    /// Recording with poses on /estimate/pose.
+    pub recording: PathBuf,
+    /// Output table directory (created if missing).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub output_args: OutputArgs,
+}
+
+#[derive(Args)]
 pub struct MpcArgs {
     /// Recording with CIR snapshots on /channel/cir (from `mmtrack ingest cir` or `mmtrack simulate sounder`); not
     /// needed with `--print-config`.
@@ -203,6 +221,15 @@ pub fn run_pipeline(args: &ProcessArgs, quiet: bool) -> anyhow::Result<Vec<PathB
     let written = |w: Vec<TableWriteSummary>| w.into_iter().map(|w| w.path).collect();
     Ok(match &args.pipeline {
         Pipeline::Odometry(odometry_args) => written(run_odometry(odometry_args, quiet)?),
+        Pipeline::Poses(a) => {
+            let progress = IndicatifProgress::new(quiet);
+            let done = poses::process_poses(&a.recording, &a.output, &a.output_args.options(), &progress)?;
+            if !quiet {
+                println!("{}", done.poses.summary());
+                print_written(&done.written);
+            }
+            written(done.written)
+        }
         Pipeline::Mpc(mpc_args) => written(run_mpc(mpc_args, quiet)?),
         Pipeline::Beam(beam_args) => crate::process_beam::run(beam_args, quiet)?,
         Pipeline::Slam(slam_args) => written(run_slam(slam_args, quiet)?),
@@ -232,27 +259,11 @@ fn run_odometry(args: &OdometryArgs, quiet: bool) -> anyhow::Result<Vec<TableWri
 }
 
 pub(crate) fn print_odometry(run: &odometry::OdometryRun, preset: &str, written: &[TableWriteSummary]) {
-    let n = run.estimates.len();
-    let low = run.estimates.iter().filter(|e| e.low_confidence).count();
-    let path: Vec<StampedPose> =
-        run.estimates.iter().map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle }).collect();
-    let mean = |f: fn(&OdometryTiming) -> f64| run.timings.iter().map(f).sum::<f64>() / n as f64 * 1e3;
-    println!(
-        "odometry ({preset}): {n} scans, {low} low-confidence, estimated path {:.1} m{}",
-        path_length_m(&path),
-        if run.ground_truth.is_empty() {
-            String::new()
-        } else {
-            format!(" (ground truth {:.1} m)", path_length_m(&run.ground_truth))
-        }
-    );
-    println!(
-        "  {:.1} scans/s end to end; per scan: filter {:.2} ms, surface points {:.2} ms, registration {:.2} ms",
-        n as f64 / run.elapsed_s,
-        mean(|t| t.filter_s),
-        mean(|t| t.surface_s),
-        mean(|t| t.register_s)
-    );
+    run.summary(preset).iter().for_each(|line| println!("{line}"));
+    print_written(written);
+}
+
+fn print_written(written: &[TableWriteSummary]) {
     for w in written {
         println!("  wrote {} ({} rows)", w.path.display(), w.rows);
     }
@@ -350,9 +361,7 @@ fn run_slam(args: &SlamArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummar
             done.config.particles,
             ue.len()
         );
-        for w in &done.written {
-            println!("  wrote {} ({} rows)", w.path.display(), w.rows);
-        }
+        print_written(&done.written);
     }
     Ok(done.written)
 }

@@ -8,6 +8,8 @@
 //!
 //! - [`odometry`]: radar odometry (Fast-CFEAR / CFEAR) → `odometry`,
 //!   `odometry_timing`, `ground_truth`;
+//! - [`poses`]: a recording's own estimate and ground truth → `poses`,
+//!   `ground_truth` (an external odometry scored like ours);
 //! - [`mpc`]: CLEAN detection, short- and long-term MPC tracking and the
 //!   GM-PHD baseline (Mahler et al. 2017) → `mpc_*`;
 //! - [`beam`]: the beam-sweep trackers, SPEBT (Liu et al. 2024) and
@@ -34,6 +36,7 @@ pub mod manifest;
 pub mod mpc;
 pub mod odometry;
 pub mod output;
+pub mod poses;
 pub mod provenance;
 pub mod simulate;
 pub mod slam;

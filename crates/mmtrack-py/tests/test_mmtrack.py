@@ -109,6 +109,13 @@ def test_ingest_ros2_writes_what_the_cli_writes(tmp_path: Path) -> None:
     done = mmtrack.ingest("ros2", bag, tmp_path / "py.mcap", pose_topic="/amcl_pose")
     assert done["poses"] > 0 and done["radar_scans"] == 0
     assert (tmp_path / "py.mcap").read_bytes() == (tmp_path / "cli.mcap").read_bytes()
+    # The bag's poses as a table (`process poses`), the CLI's rows.
+    cli("process", "poses", tmp_path / "cli.mcap", "-o", tmp_path / "cli-tables", "-q")
+    written = mmtrack.process("poses", tmp_path / "py.mcap", tmp_path / "py-tables")
+    assert written["estimate_poses"] == done["poses"] and written["ground_truth_poses"] == 0
+    ours = mmtrack.read_table(tmp_path / "py-tables", "poses").collect()
+    assert ours.equals(mmtrack.read_table(tmp_path / "cli-tables", "poses").collect())
+    assert ours.height == done["poses"]
     # A radar topic needs its range resolution (the images do not carry it).
     with pytest.raises(mmtrack.MmtrackError, match="give --radar-range-resolution-m"):
         mmtrack.ingest("ros2", bag, tmp_path / "radar.mcap", radar_topic="/radar")

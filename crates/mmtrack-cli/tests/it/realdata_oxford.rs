@@ -190,3 +190,61 @@ fn oxford_report_trajectory_plot_is_in_the_frame_of_the_tables() {
         x_ticks("trajectory.svg")
     );
 }
+
+/// Someone else's odometry scores as ours: our CFEAR run on the real Oxford
+/// scans, put into a copy of the recording as `/estimate/pose` (`export
+/// --format mcap`, as a ROS 2 bag's /odom would be by `ingest ros2`), read
+/// back by `process poses` and analyzed beside the original run, gives the
+/// same poses and the same trajectory metrics, value for value.
+#[test]
+fn an_estimate_in_the_recording_scores_exactly_as_the_odometry_it_came_from() {
+    use mmtrack_io::table::{TrajectoryMetrics, read_table};
+    let Some(realdata) = super::common::realdata("oxford_external_estimate") else { return };
+    let input = realdata.join("oxford-radar-tiny");
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let run = |args: &[&str]| {
+        let out = mmtrack(d, args);
+        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+        text(&out).0
+    };
+    run(&["ingest", "oxford", input.to_str().unwrap(), "-o", "tiny.mcap", "-q"]);
+    // Without an estimate the recording is refused, naming the topic.
+    let out = mmtrack(d, &["process", "poses", "tiny.mcap", "-o", "runs", "--run-id", "none"]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out).1.contains("tiny.mcap: the recording has no estimated poses (topic /estimate/pose"),
+        "{}",
+        text(&out).1
+    );
+    assert!(!d.join("runs/run=none").exists());
+
+    run(&["process", "odometry", "tiny.mcap", "-o", "runs", "--run-id", "ours", "-q"]);
+    run(&["export", "--format", "mcap", "runs/run=ours", "--recording", "tiny.mcap", "-o", "est.mcap", "-q"]);
+    let stdout = run(&["process", "poses", "est.mcap", "-o", "runs", "--run-id", "external"]);
+    assert!(stdout.contains("poses: estimate 11 (2.5 s, 19.2 m), ground truth 11 (2.5 s, 19.4 m)"), "{stdout}");
+    let part =
+        |run: &str, table: &str| d.join(format!("runs/run={run}/{table}/sequence=oxford-radar-tiny/part-0.parquet"));
+    let ours: Vec<mmtrack_core::OdometryEstimate> = read_table(&part("ours", "odometry")).unwrap();
+    let external: Vec<StampedPose> = read_table(&part("external", "poses")).unwrap();
+    assert_eq!(external.len(), 11);
+    for (e, o) in external.iter().zip(&ours) {
+        assert_eq!((e.t_ns, e.parent_from_child), (o.t_ns, o.world_from_vehicle));
+    }
+
+    run(&["analyze", "runs", "-o", "an", "--segment-lengths-m", "5,10", "--step-frames", "1", "-q"]);
+    let metrics = |run: &str| -> Vec<TrajectoryMetrics> {
+        read_table(&d.join(format!("an/run={run}/tables/trajectory_metrics/sequence=oxford-radar-tiny/part-0.parquet")))
+            .unwrap()
+    };
+    let (a, b) = (metrics("ours"), metrics("external"));
+    assert_eq!(a.len(), 1);
+    assert!(a[0].kitti_translational_pct.is_some_and(f64::is_finite), "{a:?}");
+    assert_eq!(a, b);
+
+    // Both estimates in one sequence of one run: which to score is ambiguous, so analyze says so.
+    run(&["process", "poses", "est.mcap", "-o", "runs/run=ours", "--force", "-q"]);
+    let out = mmtrack(d, &["analyze", "runs/run=ours", "-o", "an2"]);
+    assert!(!out.status.success());
+    assert!(text(&out).1.contains("has two estimates (odometry and poses tables)"), "{}", text(&out).1);
+}

@@ -40,6 +40,19 @@ fn ros2_bag_odom_becomes_poses() {
     );
     assert!(text(&out).0.contains("135 poses"), "{}", text(&out).1);
 
+    // /odom as a table for pandas / DuckDB (`process poses`); with no ground
+    // truth in the recording, analyze says what it lacks.
+    let out = mmtrack(dir.path(), &["process", "poses", "bag.mcap", "-o", "tables"]);
+    assert!(text(&out).0.contains("poses: estimate 2639 (96.7 s, 34.3 m), ground truth 0 (none)"), "{}", text(&out).1);
+    let table = dir.path().join("tables/poses/sequence=nav2_turtlebot/part-0.parquet");
+    let rows: Vec<mmtrack_core::StampedPose> = mmtrack_io::table::read_table(&table).unwrap();
+    assert_eq!(rows, poses);
+    assert!(!dir.path().join("tables/ground_truth").exists());
+    let out = mmtrack(dir.path(), &["analyze", "tables", "-o", "analysis"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = text(&out).1;
+    assert!(stderr.contains("sequence nav2_turtlebot has the poses table but no ground_truth table"), "{stderr}");
+
     // A topic the bag lacks is one clear error listing what it has.
     let out = mmtrack(dir.path(), &["ingest", "ros2", bag.to_str().unwrap(), "-o", "x.mcap", "--gnss-topic", "/fix"]);
     let (_, stderr) = text(&out);

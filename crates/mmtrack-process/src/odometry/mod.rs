@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use anyhow::{Context, bail};
 use mmtrack_core::progress::Progress;
-use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose};
+use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, StampedPose, path_length_m};
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::recording::TimeBase;
 use mmtrack_io::table::{Frame, GroundTruthPose, RunInfo, TableWriteSummary};
@@ -107,6 +107,40 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, progress: &dyn Pro
         recording_extra,
         elapsed_s: started.elapsed().as_secs_f64(),
     })
+}
+
+impl OdometryRun {
+    /// Two lines for a terminal: scans, low-confidence ones and path
+    /// lengths; throughput and the mean time of each stage.
+    #[must_use]
+    pub fn summary(&self, preset: &str) -> [String; 2] {
+        let n = self.estimates.len();
+        let low = self.estimates.iter().filter(|e| e.low_confidence).count();
+        let path: Vec<StampedPose> = self
+            .estimates
+            .iter()
+            .map(|e| StampedPose { t_ns: e.t_ns, parent_from_child: e.world_from_vehicle })
+            .collect();
+        let mean_ms = |f: fn(&OdometryTiming) -> f64| self.timings.iter().map(f).sum::<f64>() / n.max(1) as f64 * 1e3;
+        let truth = if self.ground_truth.is_empty() {
+            String::new()
+        } else {
+            format!(" (ground truth {:.1} m)", path_length_m(&self.ground_truth))
+        };
+        [
+            format!(
+                "odometry ({preset}): {n} scans, {low} low-confidence, estimated path {:.1} m{truth}",
+                path_length_m(&path)
+            ),
+            format!(
+                "  {:.1} scans/s end to end; per scan: filter {:.2} ms, surface points {:.2} ms, registration {:.2} ms",
+                n as f64 / self.elapsed_s,
+                mean_ms(|t| t.filter_s),
+                mean_ms(|t| t.surface_s),
+                mean_ms(|t| t.register_s)
+            ),
+        ]
+    }
 }
 
 fn process_scan(

@@ -47,6 +47,11 @@ PROCESS_OPTIONS: dict[str, dict[str, Any]] = {
         "run_id": None,
         "threads": 0,
     },
+    "poses": {
+        "sequence": None,
+        "force": False,
+        "run_id": None,
+    },
     "mpc": {
         "config": None,
         "pulse": None,
@@ -181,8 +186,9 @@ def ingest(
 def process(pipeline: str, recording: Union[PathLike, Sequence[PathLike]], output: PathLike, **options: Any) -> Any:
     """``mmtrack process <pipeline> <recording> -o <output>``: a pipeline's tables.
 
-    ``pipeline``: odometry, mpc, beam (``recording`` may be a list of
-    recordings or folders) or slam; ``options`` are its flags
+    ``pipeline``: odometry, poses (the recording's own estimate and ground
+    truth, to score another odometry), mpc, beam (``recording`` may be a list
+    of recordings or folders) or slam; ``options`` are its flags
     (:data:`PROCESS_OPTIONS`). Returns the tables written (path, rows) and
     the pipeline's counts.
     """
@@ -209,6 +215,8 @@ def process(pipeline: str, recording: Union[PathLike, Sequence[PathLike]], outpu
         return _native.process_odometry(
             rec, out, o["preset"], _path(o["config"]), o["sequence"], o["force"], o["run_id"], o["threads"]
         )
+    if pipeline == "poses":
+        return _native.process_poses(rec, out, o["sequence"], o["force"], o["run_id"])
     if pipeline == "mpc":
         return _native.process_mpc(
             rec,

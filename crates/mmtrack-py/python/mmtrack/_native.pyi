@@ -81,6 +81,9 @@ def process_odometry(
     run_id: Optional[str],
     threads: int,
 ) -> dict[str, Any]: ...
+def process_poses(
+    recording: str, output: str, sequence: Optional[str], force: bool, run_id: Optional[str]
+) -> dict[str, Any]: ...
 def effective_config(pipeline: str, preset: str, config: Optional[str], gmphd: bool) -> str: ...
 def process_mpc(
     recording: str,

@@ -36,6 +36,32 @@ pub(super) fn process_odometry<'py>(
     )
 }
 
+/// `mmtrack process poses`.
+#[pyfunction]
+#[pyo3(signature = (recording, output, sequence, force, run_id))]
+pub(super) fn process_poses<'py>(
+    py: Python<'py>,
+    recording: PathBuf,
+    output: PathBuf,
+    sequence: Option<String>,
+    force: bool,
+    run_id: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let options = output_options(sequence, force, run_id);
+    let done = interruptible(py, 1, |progress| {
+        mmtrack_process::poses::process_poses(&recording, &output, &options, progress)
+    })?;
+    dict(
+        py,
+        &[
+            ("sequence", any(py, &done.sequence)?),
+            ("estimate_poses", any(py, done.poses.estimate.len())?),
+            ("ground_truth_poses", any(py, done.poses.ground_truth.len())?),
+            ("tables", written_tables(py, &done.written)?.into_any()),
+        ],
+    )
+}
+
 /// `mmtrack process odometry --print-config` / `process mpc --print-config`:
 /// the effective configuration as TOML.
 #[pyfunction]
