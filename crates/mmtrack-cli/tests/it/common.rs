@@ -27,6 +27,14 @@ pub fn mmtrack(cwd: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mmtrack")).args(args).current_dir(cwd).output().unwrap()
 }
 
+/// Runs `mmtrack` with `args` in `cwd`, asserting it succeeds (the
+/// failure names the arguments and shows stderr); returns stdout.
+pub fn mmtrack_ok(cwd: &Path, args: &[&str]) -> String {
+    let out = mmtrack(cwd, args);
+    assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+    text(&out).0
+}
+
 /// Stdout and stderr as text.
 pub fn text(output: &Output) -> (String, String) {
     (String::from_utf8_lossy(&output.stdout).into_owned(), String::from_utf8_lossy(&output.stderr).into_owned())

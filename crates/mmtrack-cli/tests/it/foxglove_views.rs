@@ -159,11 +159,7 @@ fn foxglove_messages_decode_frames_chain_and_estimates_are_added_to_a_copy() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("s.toml"), RADAR).unwrap();
-    let run = |args: &[&str]| {
-        let out = mmtrack(d, args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
-        text(&out).0
-    };
+    let run = |args: &[&str]| super::common::mmtrack_ok(d, args);
     run(&["simulate", "radar", "--scenario", "s.toml", "-o", "sim.mcap", "-q"]);
     run(&["process", "odometry", "sim.mcap", "-o", "tables", "--preset", "fast-cfear", "-q"]);
     let before = std::fs::read(d.join("sim.mcap")).unwrap();

@@ -48,8 +48,7 @@ fn duckdb_join_of_odometry_and_ground_truth_gives_analyze_position_rmse() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let run = |args: &[&str]| {
-        let out = mmtrack(d, args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+        super::common::mmtrack_ok(d, args);
     };
     run(&["ingest", "oxford", input.to_str().unwrap(), "-o", "rec.mcap", "-q"]);
     run(&["process", "odometry", "rec.mcap", "-o", "tables", "--preset", "fast-cfear", "-q"]);

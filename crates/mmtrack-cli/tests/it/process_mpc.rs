@@ -211,9 +211,7 @@ fn uwb_first_path_from_the_cli_lies_on_the_chips_leading_edge() {
     ];
     let mut printed = String::new();
     for args in steps {
-        let out = mmtrack(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
-        printed += &text(&out).0;
+        printed += &super::common::mmtrack_ok(dir.path(), args);
     }
     let results = dir.path().join("analysis/tables");
     let (_, rows) = only::<mmtrack_io::table::FirstPathRow>(&results);

@@ -148,8 +148,7 @@ fn oxford_report_trajectory_plot_is_in_the_frame_of_the_tables() {
         &["process", "odometry", "tiny.mcap", "-o", "tables", "--quiet"],
         &["analyze", "tables", "-o", "an", "--segment-lengths-m", "2,4,8", "--step-frames", "1", "--quiet"],
     ] {
-        let out = mmtrack(dir.path(), args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+        super::common::mmtrack_ok(dir.path(), args);
     }
     let part = |table: &str| dir.path().join(format!("tables/{table}/sequence=oxford-radar-tiny/part-0.parquet"));
     let truth: Vec<f64> = read_table::<GroundTruthPose>(&part("ground_truth"))
@@ -203,11 +202,7 @@ fn an_estimate_in_the_recording_scores_exactly_as_the_odometry_it_came_from() {
     let input = realdata.join("oxford-radar-tiny");
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let run = |args: &[&str]| {
-        let out = mmtrack(d, args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
-        text(&out).0
-    };
+    let run = |args: &[&str]| super::common::mmtrack_ok(d, args);
     run(&["ingest", "oxford", input.to_str().unwrap(), "-o", "tiny.mcap", "-q"]);
     // Without an estimate the recording is refused, naming the topic.
     let out = mmtrack(d, &["process", "poses", "tiny.mcap", "-o", "runs", "--run-id", "none"]);

@@ -30,8 +30,7 @@ fn run_with_1_and_2_threads(dir: &Path, args: &[&str]) {
         std::fs::create_dir_all(&cwd).unwrap();
         let mut args = args.to_vec();
         args.extend(["--threads", threads]);
-        let out = mmtrack(&cwd, &args);
-        assert!(out.status.success(), "{args:?}: {}", text(&out).1);
+        super::common::mmtrack_ok(&cwd, &args);
     }
 }
 
