@@ -40,8 +40,8 @@ pub fn compare_plots(runs: &[(RunTables, RunResults)]) -> anyhow::Result<(Vec<Co
     }
     text.push_str(
         "## Runs overlaid\n\nPer sequence, every run's curve in one plot (run colours as in the legends; the \
-         ground truth in black, in the tables' frame, as each run's `odometry` and `ground_truth` tables hold \
-         them).\n\n",
+         ground truth in black, in the tables' frame, as each run's estimate (`odometry` or `poses`) and \
+         `ground_truth` tables hold them).\n\n",
     );
     for sequence in trajectory_sequences {
         let of_runs: Vec<(&str, &TrajectoryResult)> = runs

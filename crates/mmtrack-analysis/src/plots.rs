@@ -59,7 +59,7 @@ fn xy_svg(frame: &str, truth: &[Se2], estimates: &[(String, Vec<Se2>)]) -> anyho
 }
 
 /// x-y view of the estimate and the ground truth as their tables hold them
-/// (the frame of the `odometry` and `ground_truth` tables; no re-anchoring),
+/// (the frame of the estimate and `ground_truth` tables; no re-anchoring),
 /// equal axes, a dot at the first associated ground-truth pose.
 pub fn trajectory_svg(result: &TrajectoryResult) -> anyhow::Result<String> {
     let a = &result.association;

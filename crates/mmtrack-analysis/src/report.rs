@@ -126,7 +126,9 @@ fn trajectory_row(name: &str, m: &mmtrack_io::table::TrajectoryMetrics, end_poin
 fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &DriftOptions) -> anyhow::Result<()> {
     let _ = write!(
         out,
-        "## Trajectory (table `odometry` against `ground_truth`)\n\n\
+        "## Trajectory (estimate against `ground_truth`)\n\n\
+         The estimate is the sequence's `odometry` table (our radar odometry, `process odometry`) or its `poses` \
+         table (the recording's own estimate, `process poses`). \
          Both trajectories are associated by time (ground truth interpolated); the metrics compare them from \
          their first associated pose on (both re-expressed relative to it). Per sequence, the first plot shows \
          them as the tables hold them, the second relative to each first pose. \
@@ -194,7 +196,7 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
         let s = &r.sequence;
         let _ = writeln!(
             out,
-            "![trajectory in the tables' frame (as `odometry` and `ground_truth` hold it)](plots/{s}/trajectory.svg)\n\
+            "![trajectory in the tables' frame (as the estimate and `ground_truth` hold it)](plots/{s}/trajectory.svg)\n\
              ![trajectory relative to each first pose (the frame of KITTI drift and RPE)](plots/{s}/trajectory_relative.svg)\n\
              ![errors vs distance](plots/{s}/errors_vs_distance.svg)\n\
              ![drift per length](plots/{s}/drift_per_length.svg)\n"
