@@ -376,6 +376,9 @@ enum Kind {
         /// Record the poses as ground truth instead of as an estimate.
         #[arg(long)]
         poses_are_ground_truth: bool,
+        /// A second pose topic recorded as ground truth (e.g. /amcl_pose beside /odom), to score the estimate.
+        #[arg(long)]
+        ground_truth_topic: Option<String>,
         /// NavSatFix topic, if any.
         #[arg(long)]
         gnss_topic: Option<String>,
@@ -531,6 +534,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             radar_view,
             pose_topic,
             poses_are_ground_truth,
+            ground_truth_topic,
             gnss_topic,
             radar_topic,
             radar_range_resolution_m,
@@ -539,6 +543,7 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
             let topics = Ros2Topics::from_flags(
                 &pose_topic,
                 poses_are_ground_truth,
+                ground_truth_topic,
                 gnss_topic,
                 radar_topic,
                 radar_range_resolution_m,

@@ -136,6 +136,9 @@ pub struct Ros2Topics {
     pub pose_topic: Option<String>,
     /// Whether the poses are ground truth or an estimate.
     pub pose_stream: PoseStream,
+    /// A second pose topic recorded as ground truth (e.g. `/amcl_pose`
+    /// beside `/odom`), so one recording holds an estimate and its reference.
+    pub ground_truth_topic: Option<String>,
     /// `sensor_msgs/msg/NavSatFix` topic.
     pub gnss_topic: Option<String>,
     /// Polar radar image topic.
@@ -145,15 +148,17 @@ pub struct Ros2Topics {
 impl Ros2Topics {
     /// The topics `mmtrack ingest ros2`'s flags choose (the Python keywords
     /// are the same words): `--pose-topic` (`none` for no poses),
-    /// `--poses-are-ground-truth`, `--gnss-topic`, `--radar-topic` with
-    /// `--radar-range-resolution-m` and the sweep timing.
+    /// `--poses-are-ground-truth`, `--ground-truth-topic`, `--gnss-topic`,
+    /// `--radar-topic` with `--radar-range-resolution-m` and the sweep timing.
     ///
     /// # Errors
-    /// A radar topic without its range resolution, or a resolution that is
-    /// not a positive number of metres.
+    /// A radar topic without its range resolution, a resolution that is not
+    /// a positive number of metres, or a ground-truth topic that is the pose
+    /// topic or comes with `--poses-are-ground-truth`.
     pub fn from_flags(
         pose_topic: &str,
         poses_are_ground_truth: bool,
+        ground_truth_topic: Option<String>,
         gnss_topic: Option<String>,
         radar_topic: Option<String>,
         radar_range_resolution_m: Option<f64>,
@@ -173,9 +178,22 @@ impl Ros2Topics {
             }
             (None, _) => None,
         };
+        if let Some(topic) = &ground_truth_topic {
+            if topic == pose_topic {
+                return Err(format!(
+                    "--ground-truth-topic {topic} is also --pose-topic: give the estimate's topic there"
+                ));
+            }
+            if poses_are_ground_truth {
+                return Err(format!(
+                    "--ground-truth-topic {topic} with --poses-are-ground-truth: one ground truth per recording"
+                ));
+            }
+        }
         Ok(Self {
             pose_topic: (pose_topic != "none").then(|| pose_topic.to_string()),
             pose_stream: if poses_are_ground_truth { PoseStream::GroundTruth } else { PoseStream::Estimate },
+            ground_truth_topic,
             gnss_topic,
             radar,
         })
@@ -185,6 +203,7 @@ impl Ros2Topics {
     fn roles(&self) -> impl Iterator<Item = (&'static str, &str, &'static [&'static str])> {
         [
             self.pose_topic.as_deref().map(|t| ("pose", t, &POSE_TYPES[..])),
+            self.ground_truth_topic.as_deref().map(|t| ("ground-truth", t, &POSE_TYPES[..])),
             self.gnss_topic.as_deref().map(|t| ("GNSS", t, &GNSS_TYPES[..])),
             self.radar.as_ref().map(|r| ("radar", r.topic.as_str(), &RADAR_TYPES[..])),
         ]
@@ -207,15 +226,23 @@ impl Ros2Topics {
 
 impl Default for Ros2Topics {
     fn default() -> Self {
-        Self { pose_topic: Some("/odom".into()), pose_stream: PoseStream::Estimate, gnss_topic: None, radar: None }
+        Self {
+            pose_topic: Some("/odom".into()),
+            pose_stream: PoseStream::Estimate,
+            ground_truth_topic: None,
+            gnss_topic: None,
+            radar: None,
+        }
     }
 }
 
 /// What a bag ingest did.
 #[derive(Debug, Clone)]
 pub struct Ros2Report {
-    /// Poses written.
+    /// Poses written from the pose topic.
     pub poses: u64,
+    /// Poses written from the ground-truth topic.
+    pub ground_truth_poses: u64,
     /// GNSS fixes written.
     pub gnss_fixes: u64,
     /// NavSatFix messages without a fix (skipped).
@@ -226,16 +253,33 @@ pub struct Ros2Report {
     pub output: WriteSummary,
 }
 
+impl Ros2Report {
+    /// One line for a terminal: what was written where.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        format!(
+            "{}: {} poses, {} ground-truth poses, {} GNSS fixes ({} NavSatFix without a fix skipped), {} radar scans",
+            self.output.path.display(),
+            self.poses,
+            self.ground_truth_poses,
+            self.gnss_fixes,
+            self.no_fix,
+            self.radar_scans
+        )
+    }
+}
+
 /// Writes the chosen topics' messages, checking that each topic's header
 /// stamps increase.
 struct Sink<'a> {
     topics: &'a Ros2Topics,
     writer: RecordingWriter,
     poses: u64,
+    ground_truth_poses: u64,
     gnss_fixes: u64,
     no_fix: u64,
     radar_scans: u64,
-    last_ns: [i64; 3],
+    last_ns: [i64; 4],
 }
 
 impl Sink<'_> {
@@ -250,18 +294,25 @@ impl Sink<'_> {
     /// Handles one message; `Ok(Err(..))` is a bad message (the caller names it).
     fn handle(&mut self, topic: &str, schema: &str, data: &[u8]) -> Result<Result<(), String>, IngestError> {
         let topics = self.topics;
-        if topics.pose_topic.as_deref() == Some(topic) {
+        let pose_role = if topics.pose_topic.as_deref() == Some(topic) {
+            Some((0, topics.pose_stream))
+        } else if topics.ground_truth_topic.as_deref() == Some(topic) {
+            Some((3, PoseStream::GroundTruth))
+        } else {
+            None
+        };
+        if let Some((slot, stream)) = pose_role {
             let decoded = match schema {
                 "nav_msgs/msg/Odometry" => decode_odometry(data),
                 "geometry_msgs/msg/PoseWithCovarianceStamped" => decode_pose_with_covariance_stamped(data),
                 other => Err(format!("type {other}; expected {}", POSE_TYPES.join(" or "))),
             };
-            let decoded = match decoded.and_then(|d| self.increasing(0, d.pose.t_ns).map(|()| d)) {
+            let decoded = match decoded.and_then(|d| self.increasing(slot, d.pose.t_ns).map(|()| d)) {
                 Ok(d) => d,
                 Err(e) => return Ok(Err(e)),
             };
-            self.writer.write_pose(topics.pose_stream, &decoded.pose, &decoded.frame_id)?;
-            self.poses += 1;
+            self.writer.write_pose(stream, &decoded.pose, &decoded.frame_id)?;
+            if slot == 0 { self.poses += 1 } else { self.ground_truth_poses += 1 }
         } else if topics.gnss_topic.as_deref() == Some(topic) {
             match decode_nav_sat_fix(data) {
                 Ok(Some(fix)) => {
@@ -315,6 +366,7 @@ fn metadata(bag: &Path, sequence_id: String, topics: &Ros2Topics, first_stamp_ns
     let mut extra = BTreeMap::from([
         ("time.note".to_string(), time_note),
         ("ros2.pose_topic".to_string(), topics.pose_topic.clone().unwrap_or_default()),
+        ("ros2.ground_truth_topic".to_string(), topics.ground_truth_topic.clone().unwrap_or_default()),
         ("ros2.gnss_topic".to_string(), topics.gnss_topic.clone().unwrap_or_default()),
     ]);
     if let Some(radar) = &topics.radar {
@@ -350,15 +402,25 @@ pub fn ingest_ros2(
 ) -> Result<Ros2Report, IngestError> {
     let sequence_id = crate::scan_folder::sequence_id_of_file(bag, "bag")?;
     let bag_bytes = std::fs::metadata(bag).map(|m| m.len()).unwrap_or(0);
-    let wanted: Vec<&str> = [topics.pose_topic.as_deref(), topics.gnss_topic.as_deref()]
-        .into_iter()
-        .flatten()
-        .chain(topics.radar.as_ref().map(|r| r.topic.as_str()))
-        .collect();
+    let wanted: Vec<&str> =
+        [topics.pose_topic.as_deref(), topics.ground_truth_topic.as_deref(), topics.gnss_topic.as_deref()]
+            .into_iter()
+            .flatten()
+            .chain(topics.radar.as_ref().map(|r| r.topic.as_str()))
+            .collect();
     let first_stamp = first_stamp_ns(bag, &wanted)?;
     let mut reader = RawReader::open(bag)?;
     let writer = RecordingWriter::create(out, &metadata(bag, sequence_id, topics, first_stamp), recording)?;
-    let mut sink = Sink { topics, writer, poses: 0, gnss_fixes: 0, no_fix: 0, radar_scans: 0, last_ns: [i64::MIN; 3] };
+    let mut sink = Sink {
+        topics,
+        writer,
+        poses: 0,
+        ground_truth_poses: 0,
+        gnss_fixes: 0,
+        no_fix: 0,
+        radar_scans: 0,
+        last_ns: [i64::MIN; 4],
+    };
     // Messages seen per topic: a message is named by its 0-based index among
     // its topic's messages in file order, and its log time. Not by the MCAP
     // sequence number: rosbag2 writers leave it 0.
@@ -394,8 +456,8 @@ pub fn ingest_ros2(
             ),
         });
     }
-    let Sink { poses, gnss_fixes, no_fix, radar_scans, writer, .. } = sink;
-    Ok(Ros2Report { poses, gnss_fixes, no_fix, radar_scans, output: writer.finish()? })
+    let Sink { poses, ground_truth_poses, gnss_fixes, no_fix, radar_scans, writer, .. } = sink;
+    Ok(Ros2Report { poses, ground_truth_poses, gnss_fixes, no_fix, radar_scans, output: writer.finish()? })
 }
 
 #[cfg(test)]

@@ -209,6 +209,7 @@ pub(crate) mod tests {
         bag(&input, &messages);
         let topics = Ros2Topics {
             pose_topic: None,
+            ground_truth_topic: None,
             radar: Some(RadarTopic {
                 topic: "/Navtech/Polar".into(),
                 range_resolution_m: 0.0596,

@@ -199,14 +199,7 @@ pub(super) fn ros2_bag(
     bar.finish_and_clear();
     let report = report?;
     if !quiet {
-        println!(
-            "{}: {} poses, {} GNSS fixes ({} NavSatFix without a fix skipped), {} radar scans",
-            report.output.path.display(),
-            report.poses,
-            report.gnss_fixes,
-            report.no_fix,
-            report.radar_scans
-        );
+        println!("{}", report.summary());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -53,6 +53,30 @@ fn ros2_bag_odom_becomes_poses() {
     let stderr = text(&out).1;
     assert!(stderr.contains("sequence nav2_turtlebot has the poses table but no ground_truth table"), "{stderr}");
 
+    // /amcl_pose as the reference in the same recording: /odom is then scored against it.
+    let bag_arg = bag.to_str().unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "ros2", bag_arg, "-o", "gt.mcap", "--ground-truth-topic", "/amcl_pose"]);
+    assert!(text(&out).0.contains("2639 poses, 135 ground-truth poses"), "{}", text(&out).1);
+    let out = mmtrack(dir.path(), &["process", "poses", "gt.mcap", "-o", "scored", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let out = mmtrack(dir.path(), &["analyze", "scored", "-o", "scored-an", "--segment-lengths-m", "1,2,4,8", "-q"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let metrics: Vec<mmtrack_io::table::TrajectoryMetrics> = mmtrack_io::table::read_table(
+        &dir.path().join("scored-an/tables/trajectory_metrics/sequence=nav2_turtlebot/part-0.parquet"),
+    )
+    .unwrap();
+    // /odom's poses outside /amcl_pose's time span are not scored; the rest are.
+    assert_eq!((metrics[0].estimate_poses, metrics[0].associated_poses), (2639, 2578));
+    assert!(metrics[0].ate_rmse_m > 0.0 && metrics[0].ate_rmse_m < 2.0, "{:?}", metrics[0]);
+    for (args, message) in [
+        (&["--ground-truth-topic", "/odom"][..], "--ground-truth-topic /odom is also --pose-topic"),
+        (&["--ground-truth-topic", "/amcl_pose", "--poses-are-ground-truth"][..], "one ground truth per recording"),
+    ] {
+        let out = mmtrack(dir.path(), &[&["ingest", "ros2", bag_arg, "-o", "bad.mcap"][..], args].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(text(&out).1.contains(message), "{}", text(&out).1);
+    }
+
     // A topic the bag lacks is one clear error listing what it has.
     let out = mmtrack(dir.path(), &["ingest", "ros2", bag.to_str().unwrap(), "-o", "x.mcap", "--gnss-topic", "/fix"]);
     let (_, stderr) = text(&out);

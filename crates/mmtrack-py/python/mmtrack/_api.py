@@ -29,6 +29,7 @@ INGEST_OPTIONS: dict[str, dict[str, Any]] = {
     "ros2": {
         "pose_topic": "/odom",
         "poses_are_ground_truth": False,
+        "ground_truth_topic": None,
         "gnss_topic": None,
         "radar_topic": None,
         "radar_range_resolution_m": None,
@@ -172,6 +173,7 @@ def ingest(
             flags,
             o["pose_topic"],
             o["poses_are_ground_truth"],
+            o["ground_truth_topic"],
             o["gnss_topic"],
             o["radar_topic"],
             o["radar_range_resolution_m"],

@@ -57,6 +57,7 @@ def ingest_ros2(
     flags: dict[str, Any],
     pose_topic: str,
     poses_are_ground_truth: bool,
+    ground_truth_topic: Optional[str],
     gnss_topic: Optional[str],
     radar_topic: Optional[str],
     radar_range_resolution_m: Optional[float],

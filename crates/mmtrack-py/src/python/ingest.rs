@@ -218,8 +218,8 @@ pub(super) fn ingest_poses<'py>(
 /// `mmtrack ingest ros2`.
 #[pyfunction]
 #[pyo3(signature = (
-    input, output, flags, pose_topic, poses_are_ground_truth, gnss_topic, radar_topic, radar_range_resolution_m,
-    stamp_at, scan_period_s
+    input, output, flags, pose_topic, poses_are_ground_truth, ground_truth_topic, gnss_topic, radar_topic,
+    radar_range_resolution_m, stamp_at, scan_period_s
 ))]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn ingest_ros2<'py>(
@@ -229,6 +229,7 @@ pub(super) fn ingest_ros2<'py>(
     flags: &Bound<'py, PyDict>,
     pose_topic: String,
     poses_are_ground_truth: bool,
+    ground_truth_topic: Option<String>,
     gnss_topic: Option<String>,
     radar_topic: Option<String>,
     radar_range_resolution_m: Option<f64>,
@@ -242,6 +243,7 @@ pub(super) fn ingest_ros2<'py>(
         let topics = Ros2Topics::from_flags(
             &pose_topic,
             poses_are_ground_truth,
+            ground_truth_topic,
             gnss_topic,
             radar_topic,
             radar_range_resolution_m,
@@ -255,6 +257,7 @@ pub(super) fn ingest_ros2<'py>(
         &report.output,
         &[
             ("poses", report.poses),
+            ("ground_truth_poses", report.ground_truth_poses),
             ("gnss_fixes", report.gnss_fixes),
             ("no_fix", report.no_fix),
             ("radar_scans", report.radar_scans),
