@@ -6,6 +6,26 @@ use mmtrack_io::{RecordingEvent, RecordingReader};
 
 use super::common::{mmtrack, text};
 
+/// Absolute trajectory error of `<tables>/poses` against
+/// `<tables>/ground_truth` (sequence nav2_turtlebot): prints the poses
+/// scored, the RMSE and the largest error, metres.
+const ATE_PY: &str = r#"
+import sys
+import numpy as np
+import pyarrow.parquet as pq
+part = lambda t: f"{sys.argv[1]}/{t}/sequence=nav2_turtlebot/part-0.parquet"
+e = pq.read_table(part("poses")).to_pydict()
+g = pq.read_table(part("ground_truth")).to_pydict()
+t, gt = np.array(e["t_ns"]), np.array(g["t_ns"])
+inside = (t >= gt[0]) & (t <= gt[-1])
+p = np.c_[np.array(e["x_m"])[inside], np.array(e["y_m"])[inside]]
+q = np.c_[np.interp(t[inside], gt, g["x_m"]), np.interp(t[inside], gt, g["y_m"])]
+u, _, vt = np.linalg.svd((p - p.mean(0)).T @ (q - q.mean(0)))
+r = vt.T @ np.diag([1.0, np.sign(np.linalg.det(vt.T @ u.T))]) @ u.T
+err = np.linalg.norm((p - p.mean(0)) @ r.T + q.mean(0) - q, axis=1)
+print(len(p), np.sqrt(np.mean(err**2)), err.max())
+"#;
+
 #[test]
 fn ros2_bag_odom_becomes_poses() {
     let Some(realdata) = super::common::realdata("ros2_bag") else { return };
@@ -67,7 +87,19 @@ fn ros2_bag_odom_becomes_poses() {
     .unwrap();
     // /odom's poses outside /amcl_pose's time span are not scored; the rest are.
     assert_eq!((metrics[0].estimate_poses, metrics[0].associated_poses), (2639, 2578));
-    assert!(metrics[0].ate_rmse_m > 0.0 && metrics[0].ate_rmse_m < 2.0, "{:?}", metrics[0]);
+    // The ATE, computed independently from the two tables with numpy: the
+    // ground truth interpolated at the estimate's times inside its span, the
+    // least-squares rotation and translation (Kabsch), the position RMSE.
+    let python = super::common::venv_python().expect("Python 3 with pip access to PyPI (numpy, pyarrow) is needed");
+    let script = dir.path().join("ate.py");
+    std::fs::write(&script, ATE_PY).unwrap();
+    let out = std::process::Command::new(python).arg(&script).arg(dir.path().join("scored")).output().unwrap();
+    assert!(out.status.success(), "{}", text(&out).1);
+    let numpy: Vec<f64> = text(&out).0.split_whitespace().map(|v| v.parse().unwrap()).collect();
+    assert_eq!(numpy[0] as u64, metrics[0].associated_poses);
+    assert!((numpy[1] - metrics[0].ate_rmse_m).abs() < 1e-9, "numpy {numpy:?} vs {:?}", metrics[0]);
+    assert!((numpy[2] - metrics[0].ate_max_m).abs() < 1e-9, "numpy {numpy:?} vs {:?}", metrics[0]);
+    assert!(metrics[0].ate_rmse_m > 0.1, "/odom drifts from /amcl_pose: {:?}", metrics[0]);
     for (args, message) in [
         (&["--ground-truth-topic", "/odom"][..], "--ground-truth-topic /odom is also --pose-topic"),
         (&["--ground-truth-topic", "/amcl_pose", "--poses-are-ground-truth"][..], "one ground truth per recording"),
