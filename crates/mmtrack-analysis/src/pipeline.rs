@@ -161,18 +161,18 @@ pub fn plan(inventory: &Inventory) -> Plan {
         }
     }
     let truth = inventory.sequences(GROUND_TRUTH.name);
-    for (seq, tables) in estimates_of(inventory) {
+    let estimated = estimates_of(inventory);
+    for (seq, tables) in &estimated {
         match tables[..] {
-            [_] if truth.contains(&seq) => plan.trajectory.push(seq),
+            [_] if truth.contains(seq) => plan.trajectory.push(seq.clone()),
             [table] => plan.skipped.push((
-                seq,
+                seq.clone(),
                 format!("has the {table} table but no {} table: trajectory metrics need both", GROUND_TRUTH.name),
             )),
-            _ => plan.skipped.push((seq, two_estimates(&tables))),
+            _ => plan.skipped.push((seq.clone(), two_estimates(tables))),
         }
     }
-    let estimated: Vec<String> = estimates_of(inventory).into_keys().collect();
-    for seq in truth.iter().filter(|s| !estimated.contains(s)) {
+    for seq in truth.iter().filter(|s| !estimated.contains_key(*s)) {
         plan.skipped.push((
             seq.clone(),
             format!("has {} but no estimate ({} or {} table)", GROUND_TRUTH.name, ODOMETRY.name, POSES.name),
@@ -578,8 +578,8 @@ pub fn analyze_run(root: &Path, options: &DriftOptions, mpc_options: &MpcOptions
     {
         let reasons: String = plan.skipped.iter().map(|(s, r)| format!("; sequence {s} {r}")).collect();
         anyhow::bail!(
-            "{}: nothing to analyze: looked for tables {} (or {}) and {} of the same sequence (trajectory metrics), {} with \
-             {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT), {} (geometric tracker) and \
+            "{}: nothing to analyze: looked for tables {} (or {}) and {} of the same sequence (trajectory metrics), \
+             {} with {}, {}, {} (MPC statistics), {} (beam sweeps), {} with {} (SPEBT), {} (geometric tracker) and \
              slam_ue with slam_map and slam_true_sources (SLAM); found {}{reasons}{}",
             root.display(),
             ODOMETRY.name,
