@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use foxglove::schemas::{CompressedImage, RawImage};
 use mcap::records::Record;
-use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
+use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
 use mmtrack_core::slam::{PathOrigin, SlamEpoch, SourceType, UeState};
 use mmtrack_core::{
     AzimuthSample, BeamSweep, CirSnapshot, Complex64, GnssFix, GnssFixQuality, MpcTruth, PolarScan, PolarScanHeader,
@@ -55,12 +55,22 @@ pub struct RawMessage {
     pub data: bytes::Bytes,
 }
 
+/// The longest MCAP record, and decompressed chunk, a reader accepts: far
+/// above what we (a radar scan is 1.5 MB, a chunk 4 MiB) or a ROS 2 bag
+/// write, far below what a corrupt length field can ask for, so a damaged
+/// file is an error instead of an allocation of its garbage length.
+pub const RECORD_LENGTH_LIMIT_BYTES: usize = 256 << 20;
+
 /// Streams the messages of any MCAP file (ours, ROS 2 bags, ...) in file
-/// order with bounded memory, without decoding them.
+/// order with bounded memory, without decoding them. Every chunk's CRC is
+/// checked before any of its messages is returned, and the data section's
+/// at its end, so a damaged file is refused rather than read as other
+/// values.
 pub struct RawReader {
     path: PathBuf,
     file: File,
     bytes_read: u64,
+    messages_read: u64,
     reader: LinearReader,
     schemas: HashMap<u16, (String, String, Arc<[u8]>)>,
     channels: HashMap<u16, Arc<ChannelInfo>>,
@@ -75,7 +85,13 @@ impl RawReader {
             path: path.to_path_buf(),
             file,
             bytes_read: 0,
-            reader: LinearReader::new(),
+            messages_read: 0,
+            reader: LinearReader::new_with_options(
+                LinearReaderOptions::default()
+                    .with_prevalidate_chunk_crcs(true)
+                    .with_validate_data_section_crc(true)
+                    .with_record_length_limit(RECORD_LENGTH_LIMIT_BYTES),
+            ),
             schemas: HashMap::new(),
             channels: HashMap::new(),
             metadata: BTreeMap::new(),
@@ -107,7 +123,7 @@ impl RawReader {
     /// The next message, or `None` at a clean end of file.
     pub fn next_message(&mut self) -> Result<Option<RawMessage>> {
         while let Some(event) = self.reader.next_event() {
-            match event.map_err(|e| IoError::CorruptRecording { path: self.path.clone(), detail: e.to_string() })? {
+            match event.map_err(|e| corrupt_at(&self.path, &e, self.messages_read, self.bytes_read))? {
                 LinearReadEvent::ReadRequest(need) => {
                     let read = self.file.read(self.reader.insert(need)).map_err(os_err(&self.path))?;
                     self.reader.notify_read(read);
@@ -148,6 +164,7 @@ impl RawReader {
                                     header.sequence, header.channel_id
                                 )));
                             };
+                            self.messages_read += 1;
                             return Ok(Some(RawMessage {
                                 channel,
                                 sequence: header.sequence,
@@ -161,6 +178,20 @@ impl RawReader {
             }
         }
         Ok(None)
+    }
+}
+
+/// A reader error, with where in the file it was met.
+fn corrupt_at(path: &Path, error: &mcap::McapError, messages_read: u64, bytes_read: u64) -> IoError {
+    let limit = match error {
+        mcap::McapError::RecordTooLarge { .. } | mcap::McapError::ChunkTooLarge(_) => {
+            format!(" (the limit is {} MiB)", RECORD_LENGTH_LIMIT_BYTES >> 20)
+        }
+        _ => String::new(),
+    };
+    IoError::CorruptRecording {
+        path: path.to_path_buf(),
+        detail: format!("{error}{limit}, after message {messages_read} (within the first {bytes_read} bytes)"),
     }
 }
 
