@@ -102,10 +102,33 @@ fn nmea_rmc_only_epochs_and_a_backward_step_are_reported_not_lost() {
     assert!(
         stdout.contains("1652 GNSS fixes")
             && stdout.contains(
-                "1 epoch out of time order (first at line 2892: fix at 021555.700000000 UTC is 0.300000000 s before"
+                "1 epoch out of time order (first at line 2892: fix at 2020-02-07 021555.700000000 UTC is \
+                 0.300000000 s before"
             ),
         "{stdout}"
     );
+
+    // The first RMC dated 2068 (checksum valid): every later epoch is before
+    // it. Refused, naming the misdated fix, instead of a one-fix recording.
+    let first_rmc = std::cell::Cell::new(true);
+    let misdated = edit_sentences(&nmea, |p| {
+        if p.contains("RMC,") && first_rmc.replace(false) {
+            Some(p.replace(",070220,", ",070268,"))
+        } else {
+            Some(p.to_string())
+        }
+    });
+    std::fs::write(dir.path().join("misdated.nmea"), misdated).unwrap();
+    let out = mmtrack(dir.path(), &["ingest", "nmea", "misdated.nmea", "-o", "misdated.mcap"]);
+    let (_, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("misdated.nmea")
+            && stderr.contains("1652 epochs are before an earlier fix and only 1 would be kept")
+            && stderr.contains("2068-02-07"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("misdated.mcap").exists());
 }
 
 #[test]

@@ -127,11 +127,13 @@ fn nearest_ns(reference_ns: i64, time_of_day_ns: i64) -> i64 {
         .unwrap_or(midnight + time_of_day_ns)
 }
 
-/// `hhmmss.sssssssss` of a time in nanoseconds, for messages.
+/// `YYYY-MM-DD hhmmss.sssssssss` of a time in nanoseconds, for messages
+/// (the date too: a wrong date in one RMC is a step of whole days).
 fn clock(t_ns: i64) -> String {
     let ns = t_ns.rem_euclid(NS_PER_DAY);
+    let (year, month, day) = mmtrack_core::calendar::civil_from_days(t_ns.div_euclid(NS_PER_DAY));
     let s = ns / 1_000_000_000;
-    format!("{:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, ns % 1_000_000_000)
+    format!("{year:04}-{month:02}-{day:02} {:02}{:02}{:02}.{:09}", s / 3600, s / 60 % 60, s % 60, ns % 1_000_000_000)
 }
 
 /// How altitudes are put on their datum, which is known only once every

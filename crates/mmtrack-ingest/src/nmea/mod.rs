@@ -333,6 +333,27 @@ impl Parser {
     }
 }
 
+/// Refuses a log in which more epochs go back in time than are kept: one
+/// epoch stepped back is skipped (a receiver's clock correction), but when
+/// most are "before the previous fix", the fix they are measured against
+/// is the wrong one (e.g. one RMC with a wrong date), and keeping it would
+/// drop the drive.
+fn refuse_mostly_out_of_order(path: &Path, log: &NmeaLog) -> Result<(), IngestError> {
+    match &log.first_out_of_order {
+        Some(first) if log.out_of_order_epochs > log.fix_count => Err(IngestError::bad_line(
+            path,
+            first.line,
+            "time",
+            format!(
+                "{} epochs are before an earlier fix and only {} would be kept (the first: {}); \
+                 the fix they are before is likely misdated",
+                log.out_of_order_epochs, log.fix_count, first.reason
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Opens and parses a log file (streamed: see [`parse_nmea`]).
 pub fn read_nmea(path: &Path) -> Result<NmeaLog, IngestError> {
     let file = std::fs::File::open(path).map_err(os_err(path))?;
@@ -393,6 +414,7 @@ pub fn ingest_nmea(
             log.epochs_without_fix
         ),
     })?;
+    refuse_mostly_out_of_order(input, log)?;
     let altitude_datum = match log.altitude_datum {
         "" => "none (no fix gives an altitude)",
         datum => datum,

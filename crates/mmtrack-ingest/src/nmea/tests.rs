@@ -263,6 +263,31 @@ fn an_epoch_earlier_than_the_previous_fix_is_skipped_and_counted() {
 }
 
 #[test]
+fn a_misdated_first_fix_is_an_error_not_a_one_fix_drive() {
+    // The first RMC dated 2068 instead of 2020 (checksum valid): every later
+    // epoch is "before the previous fix". Before, ingest kept the one
+    // misdated fix, skipped the other 1652 of the real log and exited 0.
+    let misdated = format!("{}\n{}\n", rmc("GN", "021417.00", "A", "070268"), gga("GN", "021417.00", "5"));
+    let text = misdated + &["021418.00", "021419.00", "021420.00"].iter().map(|t| epoch("GN", t)).collect::<String>();
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("drive.nmea"), dir.path().join("drive.mcap"));
+    std::fs::write(&input, &text).unwrap();
+    let err = ingest_nmea(&input, &out, None, &mmtrack_io::RecordingOptions::default()).unwrap_err().to_string();
+    assert!(
+        err.contains("drive.nmea")
+            && err.contains("3 epochs are before an earlier fix and only 1 would be kept")
+            && err.contains("2068-02-07 021417.000000000 UTC, line 1"),
+        "{err}"
+    );
+    assert!(!out.exists());
+    // One epoch stepped back among many is still skipped, not refused.
+    let text = ["021417.00", "021418.00", "021416.00", "021419.00"].iter().map(|t| epoch("GN", t)).collect::<String>();
+    std::fs::write(&input, &text).unwrap();
+    let report = ingest_nmea(&input, &out, None, &mmtrack_io::RecordingOptions::default()).unwrap();
+    assert_eq!((report.log.fix_count, report.log.out_of_order_epochs), (3, 1));
+}
+
+#[test]
 fn an_rmc_without_a_usable_gga_is_a_fix_without_altitude() {
     let t0_ns = T0_S * 1_000_000_000;
     // RMC alone: position, date and the mode indicator's quality; no height
