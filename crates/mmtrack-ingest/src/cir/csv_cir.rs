@@ -5,7 +5,7 @@
 //! it needs no grouping or sorting, and a missing tap cannot go unnoticed.
 //!
 //! The first non-comment line is the header. Columns, in this order:
-//! - optional `t_ns` (integer ns since the UNIX epoch), `set_index`,
+//! - optional `t_ns` (integer ns since the UNIX epoch, increasing on each link), `set_index`,
 //!   `snapshot_index`, `tx_antenna`, `rx_antenna` (non-negative integers; each
 //!   may be left out: antennas default to 0, the indices follow from the row
 //!   number and the sidecar's `snapshots_per_set`, and times from the sidecar's
@@ -62,7 +62,8 @@ pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Re
         }
         let int = |name: &str| -> Result<Option<i64>, IngestError> {
             let Some(k) = index_cols.iter().position(|c| *c == name) else { return Ok(None) };
-            let ok = fields[k].parse::<i64>().ok().filter(|v| name == "t_ns" || *v >= 0);
+            // Times too: a recording's times are ns since its time base, never negative.
+            let ok = fields[k].parse::<i64>().ok().filter(|v| *v >= 0);
             ok.map(Some).ok_or_else(|| bad(line, name, format!("`{}`, expected an integer >= 0", fields[k])))
         };
         let ordinal = match (int("set_index")?, int("snapshot_index")?) {
@@ -119,7 +120,7 @@ pub(crate) fn parse_cir_csv(path: &Path, text: &str, sidecar: &CirSidecar) -> Re
 /// The line, set and time of the last snapshot of each link (tx, rx antenna).
 type LastOnLink = std::collections::BTreeMap<(u32, u32), (usize, u64, i64)>;
 
-/// Refuses a snapshot whose set comes before, or whose time lies before,
+/// Refuses a snapshot whose set comes before, or whose time is not after,
 /// the previous snapshot of its link (what `process mpc` requires: each
 /// link's snapshots in set and time order), naming the field and the line
 /// of that previous snapshot.
@@ -136,12 +137,13 @@ fn check_link_order(last: &mut LastOnLink, line: usize, snapshot: &CirSnapshot) 
                 ),
             ));
         }
-        if snapshot.t_ns < t_ns {
+        if snapshot.t_ns <= t_ns {
+            let relation = if snapshot.t_ns == t_ns { "the same time as" } else { "before" };
             return Err((
                 "t_ns",
                 format!(
-                    "{} ns before the {t_ns} ns of line {previous_line} on {on}: expected each link's snapshots in time \
-                     order",
+                    "{} ns, {relation} the {t_ns} ns of line {previous_line} on {on}: expected each link's snapshots \
+                     in increasing time",
                     snapshot.t_ns
                 ),
             ));
@@ -260,9 +262,15 @@ mod tests {
         let e = parse(&format!("{header}30,5,0,0,1,0\n20,6,0,0,1,0\n")).unwrap_err().to_string();
         assert_eq!(
             e,
-            "c.csv: line 3: t_ns: 20 ns before the 30 ns of line 2 on link tx0:rx0: expected each link's snapshots \
-             in time order"
+            "c.csv: line 3: t_ns: 20 ns, before the 30 ns of line 2 on link tx0:rx0: expected each link's snapshots \
+             in increasing time"
         );
+        // The same time twice on a link (`process mpc` would refuse the recording) and a negative time
+        // (the recording would, naming itself rather than this line).
+        let e = parse(&format!("{header}30,5,0,0,1,0\n30,6,0,0,1,0\n")).unwrap_err().to_string();
+        assert!(e.starts_with("c.csv: line 3: t_ns: 30 ns, the same time as the 30 ns of line 2"), "{e}");
+        let e = parse(&format!("{header}-5,5,0,0,1,0\n")).unwrap_err().to_string();
+        assert_eq!(e, "c.csv: line 2: t_ns: `-5`, expected an integer >= 0");
         // Two links interleaved, each in order; the same time on two antennas.
         let ok = parse(&format!("{header}10,1,0,0,1,0\n10,1,0,1,1,0\n20,2,0,0,1,0\n20,2,0,1,1,0\n")).unwrap();
         assert_eq!(ok.len(), 4);

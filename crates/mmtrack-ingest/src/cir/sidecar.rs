@@ -230,7 +230,11 @@ impl CirSidecar {
                 }
             }
             "delay_offset_s" => self.delay_offset_s = number(value, f64::NEG_INFINITY, true)?,
-            "t0_ns" => self.t0_ns = Some(value.as_integer().ok_or_else(|| format!("{value}, expected an integer"))?),
+            "t0_ns" => {
+                let t0_ns = value.as_integer().filter(|t| *t >= 0);
+                self.t0_ns =
+                    Some(t0_ns.ok_or_else(|| format!("{value}, expected an integer >= 0 (ns since the time base)"))?);
+            }
             "snapshot_period_s" => self.snapshot_period_s = Some(number(value, 0.0, false)?),
             "set_period_s" => self.set_period_s = Some(number(value, 0.0, false)?),
             "snapshots_per_set" => self.snapshots_per_set = count(value)?,
@@ -387,6 +391,9 @@ mod tests {
         let late = parse("snapshot_period_s = 1.0\nt0_ns = 9223372036000000000").unwrap();
         let err = late.snapshot_time(1, 2).unwrap_err().to_string();
         assert!(err.starts_with("s.toml: key `t0_ns`: snapshot 1 (1000000000 ns after t0_ns"), "{err}");
+        // A negative start is named here (the recording would refuse it, naming itself).
+        let err = parse("t0_ns = -1").unwrap_err().to_string();
+        assert!(err.contains("t0_ns") && err.contains("expected an integer >= 0"), "{err}");
     }
 
     #[test]
