@@ -18,13 +18,19 @@ pub fn empty_because(result: &MpcResult, file: &str) -> Option<String> {
     let sets = mmtrack_core::words::counted(result.per_set.len() as u64, "set");
     match file {
         "mpc_delay_tracks.svg" if result.detections.is_empty() => Some("no detections".into()),
-        "mpc_count.svg" if result.counts.is_empty() => {
+        // Without tracks the summary's counts and rates are null ("n/a" in the
+        // report): a plot of zeros would contradict it (the UWB log, one
+        // snapshot per set, drew "252 sets with 0 MPCs").
+        "mpc_count.svg" if result.counts.is_empty() || result.summary.mean_mpcs_per_set.is_none() => {
             Some("the MPCs of a set are its long-term tracks; this sequence has none".into())
         }
         "mpc_birth_death.svg"
             if result.per_set.iter().all(|s| s.birth_rate_per_s.is_none() && s.birth_rate_per_m.is_none()) =>
         {
             Some(format!("birth and death rates are taken between consecutive sets; this sequence has {sets}"))
+        }
+        "mpc_birth_death.svg" if result.summary.births.is_none() => {
+            Some("births and deaths are of long-term tracks; this sequence has none".into())
         }
         "mpc_power_loss.svg" if result.per_set.len() < 2 => {
             Some(format!("gain and loss are drawn against time over sets; this sequence has {sets}"))

@@ -254,18 +254,21 @@ fn write_into(
         write_table(&tables, seq, &r.rpe_rows(), &run.at(seq), Overwrite::Refuse)?;
         let plot_dir = dir.join("plots").join(seq);
         mmtrack_io::create_output_dirs(&plot_dir).with_context(|| plot_dir.display().to_string())?;
-        let plots = [
+        let mut plots = vec![
             ("trajectory.svg", plots::trajectory_svg(r)),
             ("trajectory_relative.svg", plots::trajectory_relative_svg(r)),
             ("errors_vs_distance.svg", plots::errors_vs_distance_svg(r)),
-            ("drift_per_length.svg", plots::drift_per_length_svg(r)),
         ];
+        // Without a KITTI segment there is nothing to draw; the report says why.
+        if !r.drift.per_length.is_empty() {
+            plots.push(("drift_per_length.svg", plots::drift_per_length_svg(r)));
+        }
+        files += 3 + plots.len();
         for (file, svg) in plots {
             let path = plot_dir.join(file);
             let svg = svg.with_context(|| format!("sequence {seq}: {file}"))?;
             std::fs::write(&path, svg).with_context(|| path.display().to_string())?;
         }
-        files += 7;
     }
     let report_path = dir.join("report.md");
     std::fs::write(&report_path, report::markdown(results, skipped, options)?)

@@ -198,9 +198,12 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
             out,
             "![trajectory in the tables' frame (as the estimate and `ground_truth` hold it)](plots/{s}/trajectory.svg)\n\
              ![trajectory relative to each first pose (the frame of KITTI drift and RPE)](plots/{s}/trajectory_relative.svg)\n\
-             ![errors vs distance](plots/{s}/errors_vs_distance.svg)\n\
-             ![drift per length](plots/{s}/drift_per_length.svg)\n"
+             ![errors vs distance](plots/{s}/errors_vs_distance.svg)"
         );
+        if !r.drift.per_length.is_empty() {
+            let _ = writeln!(out, "![drift per length](plots/{s}/drift_per_length.svg)");
+        }
+        out.push('\n');
     }
     Ok(())
 }

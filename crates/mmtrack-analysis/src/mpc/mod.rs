@@ -257,10 +257,14 @@ pub fn analyze_mpc(sequence: &str, input: MpcInput, options: &MpcOptions) -> Mpc
 
     let power_std = track_power_std(&input.tracks, &sets);
     let chi = chi_shares(&input.long_term);
-    let counts = count_distribution(per_set.iter().map(|s| s.long_term_mpcs));
     let range_db = options.first_path_dynamic_range_db;
     let first_path = first_path::first_paths(&input.detections, input.snapshots.as_deref(), range_db);
     let mut summary = summarise(&input, &per_set, &power_std, &chi, &spans, truth_scores.as_ref());
+    // Null counts (nothing tracked) have no distribution either.
+    let counts = match summary.mean_mpcs_per_set {
+        Some(_) => count_distribution(per_set.iter().map(|s| s.long_term_mpcs)),
+        None => Vec::new(),
+    };
     let first = first_path::summarise_first_paths(&first_path);
     summary.first_path_dynamic_range_db = range_db;
     summary.first_path_snapshots = first.snapshots;

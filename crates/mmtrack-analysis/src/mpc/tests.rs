@@ -116,6 +116,11 @@ fn counts_are_null_when_nothing_was_tracked() {
     assert!(r.notes.iter().any(|n| n.contains("births, deaths")), "{:?}", r.notes);
     let line = crate::mpc_report::one_line(&r);
     assert!(line.contains("n/a MPCs per set, births n/a / deaths n/a"), "{line}");
+    // Nor is there a distribution of counts or a plot of zeros beside the "n/a".
+    assert!(r.counts.is_empty());
+    for file in ["mpc_count.svg", "mpc_birth_death.svg"] {
+        assert!(crate::mpc_plots::empty_because(&r, file).is_some(), "{file}");
+    }
 }
 
 /// Before: a single-snapshot source (the real BUT 60 GHz sample: one set
@@ -138,7 +143,7 @@ fn plots_without_data_are_not_drawn_and_the_report_says_why() {
         .map(|(file, _)| *file)
         .filter(|file| crate::mpc_plots::empty_because(&r, file).is_some())
         .collect();
-    assert_eq!(empty, ["mpc_birth_death.svg", "mpc_power_loss.svg", "mpc_power_std.svg"]);
+    assert_eq!(empty, ["mpc_count.svg", "mpc_birth_death.svg", "mpc_power_loss.svg", "mpc_power_std.svg"]);
     let mut report = String::new();
     crate::mpc_report::section(&mut report, std::slice::from_ref(&r));
     assert!(report.contains("](plots/one/mpc_delay_tracks.svg)"), "{report}");

@@ -270,6 +270,11 @@ fn short_drive_reports_no_kitti_segment_instead_of_nan() {
         read_table(&table_path(&dir.path().join("res/tables"), "trajectory_metrics", "s1").unwrap()).unwrap();
     assert_eq!((metrics[0].kitti_segments, metrics[0].kitti_translational_pct), (0, None));
     assert!(metrics[0].ate_rmse_m.is_finite());
+    // No drift-per-length figure of a sentence without axes: the report says why in its place.
+    assert!(dir.path().join("res/plots/s1/trajectory.svg").exists());
+    assert!(!dir.path().join("res/plots/s1/drift_per_length.svg").exists());
+    let report = std::fs::read_to_string(dir.path().join("res/report.md")).unwrap();
+    assert!(!report.contains("drift_per_length.svg") && report.contains("No KITTI segment"), "{report}");
 }
 
 #[test]
