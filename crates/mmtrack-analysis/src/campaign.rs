@@ -414,8 +414,19 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
         order.extend(compared.keys.iter().map(|k| PlSmallStr::from(*k)));
         order.push("run".into());
         let wide = query(frame.clone().select(select).sort(order, SortMultipleOptions::default()), compared)?;
+        let first_pooled = rows.len();
         long_rows(&wide, compared, None, &mut rows)?;
+        // The pooled rows only of runs with several sequences: with one they
+        // would repeat its row, and a query summing the table without a
+        // `sequence` filter would count it three times.
+        let mut sequences_of_run: std::collections::BTreeMap<String, std::collections::BTreeSet<String>> =
+            std::collections::BTreeMap::new();
+        for r in &rows[first_pooled..] {
+            sequences_of_run.entry(r.row.run.clone()).or_default().insert(r.sequence.clone());
+        }
+        let several = |run: &str| sequences_of_run.get(run).is_some_and(|s| s.len() > 1);
         if compared.spec.name == mmtrack_io::table::TRAJECTORY_METRICS.name {
+            let pooled_from = rows.len();
             let mut pooled = query(
                 frame.clone().group_by([col("run")]).agg(pooled_trajectory_exprs()).sort(["run"], Default::default()),
                 compared,
@@ -440,6 +451,8 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
                 compared,
             )?;
             long_rows(&means, compared, Some("mean"), &mut rows)?;
+            let pooled_rows = rows.split_off(pooled_from);
+            rows.extend(pooled_rows.into_iter().filter(|r| several(&r.row.run)));
         }
     }
     let metric_rank = |row: &ComparedRow| {
@@ -712,7 +725,9 @@ pub(crate) mod tests {
             assert_eq!((found[0].source_table.as_str(), found[0].key.as_str()), ("trajectory_metrics", ""));
             found[0].value
         };
-        assert_eq!(rows.len(), (3 + 2 + 2) * TRAJECTORY_COMPARED.len());
+        // Pooled rows (`all`, `mean`) only for run a: b has one sequence, which they would repeat.
+        assert_eq!(rows.len(), (3 + 1 + 1) * TRAJECTORY_COMPARED.len());
+        assert!(rows.iter().all(|r| r.row.run == "a" || r.sequence == "s1"), "{rows:?}");
         assert!(rows.iter().all(|r| r.row.run != "c"));
         assert_eq!(value("a", "s1", "ate_rmse_m"), Some(1.0));
         assert_eq!(value("a", "s2", "kitti_translational_pct"), Some(5.0));
@@ -722,10 +737,8 @@ pub(crate) mod tests {
         let pooled = pooled_trajectory_metrics(&[&a1, &a2]).unwrap().unwrap();
         assert_eq!(value("a", "all", "ate_rmse_m"), Some(pooled.ate_rmse_m));
         assert_eq!(value("a", "all", "kitti_translational_pct"), Some(2.0));
-        assert_eq!(value("b", "all", "kitti_translational_pct"), None);
         assert_eq!(value("a", "mean", "ate_rmse_m"), Some(1.5));
         assert_eq!(value("a", "mean", "kitti_translational_pct"), Some(3.0));
-        assert_eq!(value("b", "mean", "kitti_translational_pct"), None);
         let unit = rows.iter().find(|r| r.row.metric == "ate_rmse_m").map(|r| r.row.unit.as_str());
         assert_eq!(unit, Some("m"));
         // Sequences first, then `all`, then `mean`; metrics in report order; runs last.
