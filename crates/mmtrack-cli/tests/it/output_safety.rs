@@ -78,8 +78,10 @@ fn an_output_that_is_the_input_is_refused_before_any_work() {
 fn bad_flag_values_found_after_parsing_exit_2() {
     let dir = tempfile::tempdir().unwrap();
     trajectory(dir.path());
-    let cases: [&[&str]; 5] = [
+    let cases: [&[&str]; 7] = [
         &["ingest", "oxford", "nowhere", "-o", "o.mcap", "--threads", "1000000"],
+        &["simulate", "slam", "-o", "s.mcap", "--epochs", "1000000000"],
+        &["process", "mpc", "nowhere.mcap", "-o", "t", "--link", "abc"],
         &["ingest", "oxford", "nowhere", "-o", "o.mcap", "--range-resolution-m", "0"],
         &["ingest", "oxford", "nowhere", "-o", "o.mcap", "--radar-cartesian-m-per-px", "0"],
         &["ingest", "beams", "nowhere", "--format", "deepsense", "-o", "out", "--sweep-period-s", "0"],

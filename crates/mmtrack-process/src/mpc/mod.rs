@@ -66,13 +66,16 @@ pub struct MpcOptions {
 /// `TX:RX` antenna indices (`--link`).
 ///
 /// # Errors
-/// Anything else, quoting the text.
+/// Anything else, quoting the text (a usage error: exit status 2).
 pub fn parse_link(text: &str) -> anyhow::Result<(u32, u32)> {
     let parse = || -> Option<(u32, u32)> {
         let (tx, rx) = text.split_once(':')?;
         Some((tx.trim().parse().ok()?, rx.trim().parse().ok()?))
     };
-    parse().with_context(|| format!("--link '{text}': expected TX:RX antenna indices, e.g. 0:1"))
+    parse().ok_or_else(|| {
+        let message = format!("--link '{text}': expected TX:RX antenna indices, e.g. 0:1");
+        mmtrack_core::error::UsageError::new(message).into()
+    })
 }
 
 /// The default configuration with the TOML file's fields on top, table by
