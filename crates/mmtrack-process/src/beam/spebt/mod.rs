@@ -276,16 +276,17 @@ fn experiment(options: &SpebtOptions) -> anyhow::Result<(SpebtExperiment, String
         source = crate::provenance::canonical(path);
     }
     if let Some(sigma_r_m) = options.sigma_r_m {
-        if !(sigma_r_m.is_finite() && sigma_r_m >= 0.0) {
-            let message = format!("--sigma-r-m {sigma_r_m}: need a finite value >= 0");
+        // A position error beyond a kilometre is no pose estimate; squared, 1e300 overflowed the filter.
+        if !(0.0..=1000.0).contains(&sigma_r_m) {
+            let message = format!("--sigma-r-m {sigma_r_m}: need a value in [0, 1000] m");
             return Err(mmtrack_core::error::UsageError(message).into());
         }
         experiment.scenario.position_sigma_m = sigma_r_m;
         experiment.tracker.position_sigma_m = sigma_r_m;
     }
     if let Some(sigma_theta_deg) = options.sigma_theta_deg {
-        if !(sigma_theta_deg.is_finite() && sigma_theta_deg >= 0.0) {
-            let message = format!("--sigma-theta-deg {sigma_theta_deg}: need a finite value >= 0");
+        if !(0.0..=180.0).contains(&sigma_theta_deg) {
+            let message = format!("--sigma-theta-deg {sigma_theta_deg}: need a value in [0, 180] deg");
             return Err(mmtrack_core::error::UsageError(message).into());
         }
         experiment.scenario.yaw_sigma_deg = sigma_theta_deg;
