@@ -252,6 +252,41 @@ fn floats(path: &Path, matrix: NpyMatrix, columns: Option<usize>, what: &str) ->
     }
 }
 
+/// The farthest a car may be from the roadside unit: a 60 GHz link spans
+/// tens to hundreds of metres (DeepSense's sites: under 100 m); 10 km is far
+/// beyond any link and far below a position of (0, 0), the value GPS logs
+/// write for "no fix", thousands of kilometres from any site.
+pub const MAX_LINK_DISTANCE_M: f64 = 10_000.0;
+
+/// Refuses a sweep whose car is farther than [`MAX_LINK_DISTANCE_M`] from
+/// the roadside unit (before, (0, 0) positions were ingested and the beam
+/// map fit failed later without naming a file or row).
+fn check_link_distance(vehicle_file: &Path, array: &[[f64; 2]], vehicle: &[[f64; 2]]) -> Result<(), IngestError> {
+    for (row, (a, v)) in array.iter().zip(vehicle).enumerate() {
+        let origin = crate::nmea::EnuOrigin { latitude_deg: a[0], longitude_deg: a[1], altitude_m: 0.0 };
+        let [east_m, north_m, _] = crate::nmea::geodetic_to_enu_m(&origin, v[0], v[1], 0.0);
+        let distance_m = east_m.hypot(north_m);
+        if !(distance_m <= MAX_LINK_DISTANCE_M) {
+            return Err(bad(
+                vehicle_file,
+                format!("row {row}"),
+                "latitude, longitude",
+                format!(
+                    "({}, {}) is {:.0} km from the roadside unit at ({}, {}); a link spans at most {} km (a position \
+                     of (0, 0) is a GPS log's \"no fix\")",
+                    v[0],
+                    v[1],
+                    distance_m / 1000.0,
+                    a[0],
+                    a[1],
+                    MAX_LINK_DISTANCE_M / 1000.0
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Latitude/longitude pairs of a `N x 2` position array, checked.
 fn positions(path: &Path, what: &str) -> Result<(usize, Vec<[f64; 2]>), IngestError> {
     let matrix = read_npy_matrix(path)?;
@@ -368,6 +403,7 @@ pub fn read_scenario(files: &ScenarioFiles, positions_wanted: VehiclePositions) 
             ));
         }
     }
+    check_link_distance(&vehicle_file, &array_lat_lon_deg, &vehicle_lat_lon_deg)?;
     Ok(ScenarioArrays {
         files: files.clone(),
         rows,
