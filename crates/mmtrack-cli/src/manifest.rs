@@ -189,6 +189,7 @@ fn run_one(manifest: &Manifest, task: &Task, output: &str, args: &ManifestArgs) 
     let tables = Path::new(output);
     let key = task.command_line(output, false);
     let previous = marker::read(tables, &key)?;
+    let previous_written = marker::written_at(tables, &key);
     let mut force = args.force;
     if args.skip_existing {
         match marker::resume(previous.as_ref()) {
@@ -218,7 +219,7 @@ fn run_one(manifest: &Manifest, task: &Task, output: &str, args: &ManifestArgs) 
             // A failed task removed its own partial outputs: what was there
             // before is still there, and so is its record.
             let _ = match &previous {
-                Some(record) => marker::write(tables, record),
+                Some(record) => marker::restore(tables, record, previous_written),
                 None => marker::remove(tables, &key),
             };
             Err(e)

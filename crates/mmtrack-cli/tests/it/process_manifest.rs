@@ -298,6 +298,13 @@ fn steps_run_in_the_order_of_their_needs() {
     assert!(d.join("rec/demo.mcap").is_file());
     assert!(d.join("t/odometry/sequence=oxford-demo/part-0.parquet").is_file());
     assert!(d.join("analysis/tables/trajectory_metrics/sequence=oxford-demo/part-0.parquet").is_file());
+    // A re-run without --skip-existing fails (the outputs exist) and must not
+    // make the complete tasks look stale: before, their records were put back
+    // with a new time, and the resume below redid the 3 tasks after the ingest.
+    let refused = mmtrack(d, &["process", "manifest", "steps.toml", "-o", "t"]);
+    assert_eq!(refused.status.code(), Some(1));
+    let idle = ok(d, &["process", "manifest", "steps.toml", "-o", "t", "--skip-existing"]);
+    assert!(idle.contains("4 of 4 tasks done (0 ran, 4 skipped as complete)"), "{idle}");
     // Resumed after one output went missing: the odometry runs again, and
     // so does the analysis that reads it; the ingest and MPC are skipped.
     let before =

@@ -112,6 +112,23 @@ pub fn write(tables: &Path, record: &Record) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Puts back a record as it was before a task that then failed: its
+/// contents and its time ([`written_at`]), which decides whether the tasks
+/// that need it are stale. Rewriting it with a new time made
+/// `--skip-existing` redo every task after a failed re-run of a complete one.
+///
+/// # Errors
+/// The record cannot be written or its time set, naming it.
+pub fn restore(tables: &Path, record: &Record, written: Option<std::time::SystemTime>) -> anyhow::Result<()> {
+    write(tables, record)?;
+    if let Some(time) = written {
+        let target = path(tables, &record.command);
+        let context = || format!("{}: cannot set the task record's time", target.display());
+        std::fs::File::options().write(true).open(&target).and_then(|f| f.set_modified(time)).with_context(context)?;
+    }
+    Ok(())
+}
+
 /// Removes the record of `command` (nothing when there is none).
 ///
 /// # Errors
