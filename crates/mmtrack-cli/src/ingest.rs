@@ -474,42 +474,8 @@ pub fn run(args: IngestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
                 add_to.as_deref(),
                 &output.recording_options()?,
             )?;
-            let log = &report.log;
             if !quiet {
-                let without_altitude = log.fixes_without_altitude;
-                let partial = if without_altitude > 0 {
-                    format!(" ({} from RMC alone, {without_altitude} without altitude)", log.rmc_only_fixes)
-                } else {
-                    String::new()
-                };
-                let out_of_order = match &log.first_out_of_order {
-                    Some(first) => format!(
-                        ", {} epoch{} out of time order (first at line {}: {})",
-                        log.out_of_order_epochs,
-                        if log.out_of_order_epochs == 1 { "" } else { "s" },
-                        first.line,
-                        first.reason
-                    ),
-                    None => String::new(),
-                };
-                let leap_seconds = match log.first_leap_second_line {
-                    Some(line) => format!(
-                        ", {} leap-second epoch{} (23:59:60 UTC has no UNIX time of its own; first at line {line})",
-                        log.leap_second_epochs,
-                        if log.leap_second_epochs == 1 { "" } else { "s" },
-                    ),
-                    None => String::new(),
-                };
-                println!(
-                    "{}: {} GNSS fixes{partial}; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs without a fix{out_of_order}{leap_seconds}; {} other sentences ignored",
-                    report.output.path.display(),
-                    log.fix_count,
-                    log.bad_checksum_lines,
-                    log.first_bad_checksum_line.map(|l| format!(" (first at line {l})")).unwrap_or_default(),
-                    log.unparsable_lines,
-                    log.epochs_without_fix,
-                    log.ignored_sentences
-                );
+                println!("{}", report.summary());
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -577,20 +543,7 @@ fn cir_file(
     bar.finish_and_clear();
     let report = report?;
     if !quiet {
-        let (fewest, most) = report.taps;
-        let taps = if fewest == most { format!("{most}") } else { format!("{fewest}-{most}") };
-        let (times, tx, rx) = report.times_tx_rx;
-        let times = if times == 1 { "1 time".to_string() } else { format!("{times} times") };
-        println!(
-            "{}: {} CIR snapshots ({times} x {tx} TX x {rx} RX antennas) of {taps} taps, {:.4} ns apart; {} with \
-             a first-path hint; {} skipped; domain {}",
-            report.output.path.display(),
-            report.snapshots,
-            report.tap_spacing_s * 1e9,
-            report.with_first_path_hint,
-            mmtrack_core::words::counted(report.skipped as u64, "reception"),
-            report.metadata.get("cir.domain").and_then(|d| d.split(':').next()).unwrap_or("cir"),
-        );
+        println!("{}", report.summary());
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -105,6 +105,7 @@ pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let file = args.manifest.display();
+    check_tasks(&manifest, &output, &file.to_string())?;
     if let Some(n) = args.task {
         let Some(task) = manifest.tasks.get(n) else {
             bail!("{file}: --task {n}: the manifest has tasks 0 to {}", manifest.tasks.len() - 1);
@@ -157,6 +158,50 @@ pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
         println!("{} of {} tasks done{resumed}; tables under {output}", ran + skipped, manifest.tasks.len());
     }
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+/// Before any task runs: every task's words parse as the command they name
+/// (a typo in a later level was found only after the earlier levels ran),
+/// and no two tasks write the same output: the same `-o` of ingest or
+/// analyze tasks, or the same pipeline on the same recordings (or folders)
+/// into the same run, whose partitions one would replace (with `--force`,
+/// which one was kept depended on which finished last).
+fn check_tasks(manifest: &Manifest, output: &str, file: &str) -> anyhow::Result<()> {
+    use clap::CommandFactory;
+    let cli = crate::Cli::command();
+    let mut writers: std::collections::BTreeMap<Vec<String>, &Task> = std::collections::BTreeMap::new();
+    for task in &manifest.tasks {
+        let words = task.command_line(output, false);
+        let argv = std::iter::once("mmtrack").chain(words.iter().map(String::as_str));
+        let matches = cli.clone().try_get_matches_from(argv).map_err(|e| {
+            let message = e.to_string();
+            anyhow::anyhow!("{file}: {}: key `args`: {}", task.label(), message.lines().next().unwrap_or("").trim())
+        })?;
+        let (mut command, mut at, mut key) = (&cli, &matches, Vec::new());
+        while let Some((name, sub)) = at.subcommand() {
+            key.push(name.to_string());
+            command = command.find_subcommand(name).context("a parsed subcommand")?;
+            at = sub;
+        }
+        if task.step == manifest::Step::Process {
+            for arg in command.get_positionals().chain(command.get_arguments().filter(|a| a.get_id() == "run_id")) {
+                let values = at.get_raw(arg.get_id().as_str()).into_iter().flatten();
+                key.extend(values.map(|v| format!("{}={}", arg.get_id(), v.to_string_lossy())));
+            }
+        } else {
+            key.extend(task.own_output(output));
+        }
+        if let Some(first) = writers.insert(key, task) {
+            bail!(
+                "{file}: {}: writes what {} writes (the same {}); give each its own {}",
+                task.label(),
+                first.label(),
+                if task.step == manifest::Step::Process { "pipeline, recordings and run" } else { "-o" },
+                if task.step == manifest::Step::Process { "--run-id" } else { "-o" }
+            );
+        }
+    }
+    Ok(())
 }
 
 /// A command line as a shell would take it.

@@ -323,6 +323,47 @@ fn steps_run_in_the_order_of_their_needs() {
     let typo = mmtrack(d, &["process", "manifest", "typo.toml", "-o", "t"]);
     assert_eq!(typo.status.code(), Some(1));
     assert!(text(&typo).1.contains("typo.toml: task 1: unknown key `need`"), "{}", text(&typo).1);
+    // Found before anything runs: a flag the command does not have (in the
+    // last level), and two tasks writing the same partitions (the same
+    // pipeline on the same recording into the same run: before, both ran and
+    // with --force the one that finished last was kept).
+    let cases = [
+        (
+            STEPS.replace("\"-o\", \"analysis\"", "\"-o\", \"analysis\", \"--frob\""),
+            "task 3: key `args`: error: unexpected argument '--frob'",
+        ),
+        (
+            STEPS.replace(
+                "\"--threads\", \"2\"]",
+                "\"--threads\", \"2\"]\n[[task]]\nargs = [\"mpc\", \"demo/sounder.mcap\"]",
+            ),
+            "task 3: writes what task 2 (mpc) writes (the same pipeline, recordings and run); give each its own --run-id",
+        ),
+        (
+            STEPS.replace(
+                "\"fast-cfear\"]",
+                "\"fast-cfear\"]\n[[task]]\nargs = [\"odometry\", \"rec/demo.mcap\", \"--preset\", \"cfear\"]",
+            ),
+            "task 2: writes what task 1 (odometry-demo) writes",
+        ),
+    ];
+    for (manifest, expected) in cases {
+        std::fs::write(d.join("bad.toml"), manifest).unwrap();
+        let out = mmtrack(d, &["process", "manifest", "bad.toml", "-o", "fresh", "--force"]);
+        let (_, stderr) = text(&out);
+        assert_eq!(out.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(&format!("bad.toml: {expected}")), "{stderr}");
+        assert!(!d.join("fresh").exists(), "nothing ran");
+    }
+    // Into two runs, the same pipeline on the same recording is fine.
+    let two_runs = STEPS.replace(
+        "\"fast-cfear\"]",
+        "\"fast-cfear\"]\n[[task]]\nargs = [\"odometry\", \"rec/demo.mcap\", \"--preset\", \"cfear\", \"--run-id\", \"b\"]",
+    );
+    std::fs::write(d.join("two.toml"), two_runs).unwrap();
+    assert_eq!(ok(d, &["process", "manifest", "two.toml", "--print-levels"]), "0,2,3\n1\n4\n");
+    let printed = mmtrack(d, &["process", "manifest", "two.toml", "-o", "t2", "--task", "2"]);
+    assert!(printed.status.success(), "{}", text(&printed).1);
 }
 
 /// A Boreas and a MulRan dataset folder of two sequences each beside a

@@ -266,7 +266,7 @@ fn check_link_distance(vehicle_file: &Path, array: &[[f64; 2]], vehicle: &[[f64;
         let origin = crate::nmea::EnuOrigin { latitude_deg: a[0], longitude_deg: a[1], altitude_m: 0.0 };
         let [east_m, north_m, _] = crate::nmea::geodetic_to_enu_m(&origin, v[0], v[1], 0.0);
         let distance_m = east_m.hypot(north_m);
-        if !(distance_m <= MAX_LINK_DISTANCE_M) {
+        if distance_m.is_nan() || distance_m > MAX_LINK_DISTANCE_M {
             return Err(bad(
                 vehicle_file,
                 format!("row {row}"),

@@ -258,6 +258,28 @@ pub struct CirIngestReport {
     pub metadata: BTreeMap<String, String>,
 }
 
+impl CirIngestReport {
+    /// The one-line summary the CLI prints: what the snapshots are, their
+    /// taps and spacing, first-path hints, skipped receptions and domain.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let (fewest, most) = self.taps;
+        let taps = if fewest == most { format!("{most}") } else { format!("{fewest}-{most}") };
+        let (times, tx, rx) = self.times_tx_rx;
+        let times = if times == 1 { "1 time".to_string() } else { format!("{times} times") };
+        format!(
+            "{}: {} CIR snapshots ({times} x {tx} TX x {rx} RX antennas) of {taps} taps, {:.4} ns apart; {} with \
+             a first-path hint; {} skipped; domain {}",
+            self.output.path.display(),
+            self.snapshots,
+            self.tap_spacing_s * 1e9,
+            self.with_first_path_hint,
+            mmtrack_core::words::counted(self.skipped as u64, "reception"),
+            self.metadata.get("cir.domain").and_then(|d| d.split(':').next()).unwrap_or("cir"),
+        )
+    }
+}
+
 /// Distinct times, TX antennas and RX antennas of `snapshots`.
 fn times_tx_rx(snapshots: &[mmtrack_core::CirSnapshot]) -> (usize, usize, usize) {
     use std::collections::BTreeSet;

@@ -369,6 +369,50 @@ pub struct NmeaReport {
     pub output: mmtrack_io::recording::WriteSummary,
 }
 
+impl NmeaReport {
+    /// The one-line summary the CLI prints: fixes, and every kind of line
+    /// or epoch skipped, with the first of each.
+    #[must_use]
+    pub fn summary(&self) -> String {
+        let log = &self.log;
+        let without_altitude = log.fixes_without_altitude;
+        let partial = if without_altitude > 0 {
+            format!(" ({} from RMC alone, {without_altitude} without altitude)", log.rmc_only_fixes)
+        } else {
+            String::new()
+        };
+        let out_of_order = match &log.first_out_of_order {
+            Some(first) => format!(
+                ", {} epoch{} out of time order (first at line {}: {})",
+                log.out_of_order_epochs,
+                if log.out_of_order_epochs == 1 { "" } else { "s" },
+                first.line,
+                first.reason
+            ),
+            None => String::new(),
+        };
+        let leap_seconds = match log.first_leap_second_line {
+            Some(line) => format!(
+                ", {} leap-second epoch{} (23:59:60 UTC has no UNIX time of its own; first at line {line})",
+                log.leap_second_epochs,
+                if log.leap_second_epochs == 1 { "" } else { "s" },
+            ),
+            None => String::new(),
+        };
+        format!(
+            "{}: {} GNSS fixes{partial}; skipped {} lines with bad checksums{}, {} unparsable lines, {} epochs \
+             without a fix{out_of_order}{leap_seconds}; {} other sentences ignored",
+            self.output.path.display(),
+            log.fix_count,
+            log.bad_checksum_lines,
+            log.first_bad_checksum_line.map(|l| format!(" (first at line {l})")).unwrap_or_default(),
+            log.unparsable_lines,
+            log.epochs_without_fix,
+            log.ignored_sentences
+        )
+    }
+}
+
 /// Writes the fixes of an NMEA log into `out` (new, or a copy of `extend` plus
 /// the fixes). The metadata records the altitude datum (`none (no fix gives
 /// an altitude)` when no fix has one) and the origin of the local ENU frame
