@@ -120,7 +120,7 @@ fn a_recording_without_cir_snapshots_is_named_in_the_error() {
     assert!(!dir.path().join("tables").join("mpc_sets").exists(), "nothing written");
 
     let bad_link = mmtrack(dir.path(), &["process", "mpc", "poses.mcap", "-o", "tables", "--link", "x"]);
-    assert_eq!(bad_link.status.code(), Some(1));
+    assert_eq!(bad_link.status.code(), Some(2), "a bad flag value is a usage error");
     assert!(text(&bad_link).1.contains("--link 'x'"));
 }
 
