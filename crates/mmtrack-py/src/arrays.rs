@@ -103,18 +103,33 @@ pub fn detect_mpc(
 ) -> anyhow::Result<Vec<u8>> {
     let n = cir.t_ns.len();
     ensure!(cir.taps_per_snapshot > 0, "cir: no taps");
+    let rows = cir.taps.len() / cir.taps_per_snapshot;
     ensure!(
-        cir.taps.len() == n * cir.taps_per_snapshot,
-        "cir: {} taps for {n} snapshots of {} taps",
+        cir.taps.len() % cir.taps_per_snapshot == 0,
+        "cir: {} taps are not snapshots of {} taps",
         cir.taps.len(),
         cir.taps_per_snapshot
     );
     ensure!(
-        cir.set_index.len() == n && cir.snapshot_index.len() == n,
-        "t_ns, set_index and snapshot_index: one per snapshot ({n}, {}, {})",
+        rows == n && cir.set_index.len() == n && cir.snapshot_index.len() == n,
+        "t_ns, set_index and snapshot_index: one per snapshot of cir ({rows}), got {n}, {} and {}",
         cir.set_index.len(),
         cir.snapshot_index.len()
     );
+    // The labels name the snapshot of each detection: two rows with the same
+    // ones could not be told apart (the detections of both read as the last's).
+    let mut seen = std::collections::HashMap::with_capacity(n);
+    for i in 0..n {
+        let label = (cir.t_ns[i], cir.set_index[i], cir.snapshot_index[i]);
+        if let Some(first) = seen.insert(label, i) {
+            bail!(
+                "t_ns, set_index, snapshot_index: rows {first} and {i} are both ({}, {}, {}); each row is one snapshot",
+                label.0,
+                label.1,
+                label.2
+            );
+        }
+    }
     let mpc_config = mmtrack_process::mpc::effective_config(config)?;
     let pulse = match pulse {
         Some(b2b) => SounderPulse::from_back_to_back_cir(b2b).context("pulse: back-to-back CIR")?,

@@ -505,6 +505,17 @@ def test_every_error_is_an_mmtrack_error(tmp_path: Path) -> None:
     with pytest.raises(mmtrack.MmtrackError) as raised:
         mmtrack.process("odometry", tmp_path / "x.mcap", tmp_path / "t")
     assert type(raised.value) is mmtrack.MmtrackError
+    # Labels name each row's snapshot: repeated ones could not be told apart
+    # (before, every detection read as the last row's), and a short t_ns is
+    # named as such (before: "cir: 192 taps for 1 snapshots of 64 taps").
+    cir3 = np.ones((3, 64), dtype=complex)
+    with pytest.raises(mmtrack.MmtrackError, match=r"rows 0 and 1 are both \(5, 0, 0\)"):
+        mmtrack.detect_mpc(cir3, tap_spacing_s=1e-9, t_ns=[5, 5, 5], set_index=[0, 0, 0], snapshot_index=[0, 0, 0])
+    with pytest.raises(mmtrack.MmtrackError, match=r"one per snapshot of cir \(3\), got 1"):
+        mmtrack.detect_mpc(cir3, tap_spacing_s=1e-9, t_ns=[1])
+    # No recording is an error, as the CLI's (it reported success, writing nothing).
+    with pytest.raises(mmtrack.MmtrackError, match="no recordings"):
+        mmtrack.process("beam", [], tmp_path / "nothing")
     # `config` is a path (str or pathlib.Path), as documented.
     with pytest.raises(mmtrack.MmtrackError, match="none.toml"):
         mmtrack.detect_mpc(np.ones((1, 8), dtype=complex), tap_spacing_s=1e-9, config=tmp_path / "none.toml")

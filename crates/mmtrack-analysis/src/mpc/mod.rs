@@ -311,7 +311,7 @@ fn empty_metric_notes(sets: &[MpcSetStats], detections: &[MpcDetection], tracks:
             "no short-term tracks, so {what}: its sets hold at most {most} snapshot(s) each, and a short-term track \
              follows one path over at least {MIN_SHORT_TERM_TRACK_SNAPSHOTS} snapshots of one set \
              (`short_term.min_track_length`, Mahler et al. Sec. III-B). Sources that record one CIR per set (e.g. \
-             DecaWave logs) give detections and first paths only."
+             DecaWave logs) give detections and first paths only"
         )]
     } else {
         vec![format!(

@@ -63,7 +63,11 @@ fn simulator_settings_beyond_the_limits_are_refused_by_key() {
     refused(d, &slam("clutter.toml"), &["clutter_per_epoch", "10000"]);
     std::fs::write(d.join("sps.toml"), "random_scattering_points = 100000000\n").unwrap();
     refused(d, &slam("sps.toml"), &["random_scattering_points", "100000"]);
-    refused(d, &["simulate", "slam", "--epochs", "1000000000", "-o", "e.mcap", "-q"], &["epochs", "1000000"]);
+    refused(
+        d,
+        &["simulate", "slam", "--epochs", "1000000000", "-o", "e.mcap", "-q"],
+        &["--epochs 1000000000", "1000000"],
+    );
 
     // simulate sounder: snapshots held in memory.
     let artificial = std::fs::read_to_string(super::common::root().join("data/sounder/artificial.toml")).unwrap();
@@ -98,6 +102,8 @@ fn pipeline_flags_and_keys_beyond_the_limits_are_refused() {
     }
     // A flag's value is a usage error (exit 2), as clap's own checks; exit 1 before.
     refused(d, &["process", "slam", "w.mcap", "-o", "p", "--particles", "1", "-q"], &["--particles 1", "between 2"]);
+    // The same flag of reproduce kim (exit 1 before, blaming the embedded experiment file).
+    refused(d, &["reproduce", "kim", "--quick", "--particles", "0", "-o", "k", "-q"], &["--particles 0", "between 2"]);
 
     let out = mmtrack(d, &["simulate", "radar", "--scenario", "r.toml", "-o", "r.mcap", "-q"]);
     assert!(!out.status.success());
@@ -120,12 +126,13 @@ fn pipeline_flags_and_keys_beyond_the_limits_are_refused() {
         &["process", "beam", "r.mcap", "--tracker", "spebt", "--runs", "100000000", "-o", "b", "-q"],
         &["--runs", "1000000"],
     );
-    for (flag, value) in [("--sigma-r-m", "NaN"), ("--sigma-theta-deg", "inf")] {
-        refused(
-            d,
-            &["process", "beam", "r.mcap", "--tracker", "spebt", flag, value, "-o", "b", "-q"],
-            &[flag, "finite value >= 0"],
-        );
+    // Not finite, or finite but overflowing the filter once squared (1e300 failed at block 0 before).
+    for (flag, value, range) in [
+        ("--sigma-r-m", "NaN", "[0, 1000] m"),
+        ("--sigma-theta-deg", "inf", "[0, 180] deg"),
+        ("--sigma-theta-deg", "1e300", "[0, 180] deg"),
+    ] {
+        refused(d, &["process", "beam", "r.mcap", "--tracker", "spebt", flag, value, "-o", "b", "-q"], &[flag, range]);
     }
 }
 

@@ -77,6 +77,13 @@ fn spebt_tracks_on_the_odometry_table_and_on_the_pose_error_model() {
     assert_eq!(slots.len(), 24);
     assert!(slots.iter().enumerate().all(|(k, s)| s.slot == k as u64 && s.run0_aoa_rad.is_finite()));
     assert!(slots.windows(2).all(|w| w[1].t_ns > w[0].t_ns));
+    // Two recordings of one sequence: refused before any work (before, with
+    // --force the second replaced the first's partitions, exit 0).
+    std::fs::copy(d.join("drive.mcap"), d.join("again.mcap")).unwrap();
+    let twice = ["process", "beam", "drive.mcap", "again.mcap", "--tracker", "spebt", "-o", "twice", "--force"];
+    let (ok, _, stderr) = run(d, &twice);
+    assert!(!ok && stderr.contains("again.mcap: both are sequence drive; give each sequence once"), "{stderr}");
+    assert!(!d.join("twice").exists());
     // Again without --force: refused.
     let (ok, _, stderr) = run(d, &[&spebt[..], &["--odometry", "tables", "-o", "out"]].concat());
     assert!(!ok && stderr.contains("--force"), "{stderr}");

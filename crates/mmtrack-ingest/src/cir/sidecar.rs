@@ -229,7 +229,16 @@ impl CirSidecar {
                     _ => return Err(format!("{value}, expected \"cir\" or \"cfr\"")),
                 }
             }
-            "delay_offset_s" => self.delay_offset_s = number(value, f64::NEG_INFINITY, true)?,
+            "delay_offset_s" => {
+                // One second is 300 000 km of propagation: beyond it the value is a unit slip (ns as s).
+                let offset_s = number(value, f64::NEG_INFINITY, true)?;
+                if offset_s.abs() > 1.0 {
+                    return Err(format!(
+                        "{offset_s} s, expected a delay of at most 1 s in magnitude (seconds, not ns)"
+                    ));
+                }
+                self.delay_offset_s = offset_s;
+            }
             "t0_ns" => {
                 let t0_ns = value.as_integer().filter(|t| *t >= 0);
                 self.t0_ns =
@@ -391,6 +400,10 @@ mod tests {
         let late = parse("snapshot_period_s = 1.0\nt0_ns = 9223372036000000000").unwrap();
         let err = late.snapshot_time(1, 2).unwrap_err().to_string();
         assert!(err.starts_with("s.toml: key `t0_ns`: snapshot 1 (1000000000 ns after t0_ns"), "{err}");
+        // A delay offset in ns typed as s is named (1e300 was accepted).
+        let err = parse("delay_offset_s = 1e300").unwrap_err().to_string();
+        assert!(err.contains("delay_offset_s") && err.contains("at most 1 s"), "{err}");
+        assert_eq!(parse("delay_offset_s = -2e-7").unwrap().delay_offset_s, -2e-7);
         // A negative start is named here (the recording would refuse it, naming itself).
         let err = parse("t0_ns = -1").unwrap_err().to_string();
         assert!(err.contains("t0_ns") && err.contains("expected an integer >= 0"), "{err}");

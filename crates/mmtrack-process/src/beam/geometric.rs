@@ -181,6 +181,7 @@ pub fn process_geometric(
         Schedule::FullScan => BeamSchedule { full_scan_epochs: usize::MAX, ..BeamSchedule::paper(scenario.beams) },
     };
     let inputs = recordings.iter().map(|p| read(p).map(|r| (p, r))).collect::<anyhow::Result<Vec<_>>>()?;
+    super::refuse_repeated_sequences(inputs.iter().map(|(p, r)| (r.sequence_id.as_str(), p.as_path())))?;
     for (_, r) in &inputs {
         out.refuse_existing(&[GEOMETRIC_PER_EPOCH.name], &r.sequence_id)?;
     }

@@ -16,6 +16,24 @@ use geometric::{GeometricOptions, GeometricOutput};
 use spebt::{SpebtOptions, SpebtOutput};
 use sweep::{Reacquire, SweepOutput, SweepTrackerKind};
 
+/// Refuses two recordings of one sequence among a run's inputs: both would
+/// write the same partitions, and with `--force` the second replaced the
+/// first (SPEBT and geometric did; the sweep trackers refused it).
+///
+/// # Errors
+/// Naming both recordings and the sequence.
+pub(crate) fn refuse_repeated_sequences<'a>(
+    recordings: impl IntoIterator<Item = (&'a str, &'a Path)>,
+) -> anyhow::Result<()> {
+    let mut by_sequence = std::collections::BTreeMap::new();
+    for (sequence, path) in recordings {
+        if let Some(other) = by_sequence.insert(sequence, path) {
+            bail!("{} and {}: both are sequence {sequence}; give each sequence once", other.display(), path.display());
+        }
+    }
+    Ok(())
+}
+
 /// A tracker of `process beam --tracker`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum BeamTracker {
@@ -108,6 +126,10 @@ pub fn process_beam(output: &Path, request: &BeamRequest, progress: &dyn Progres
             BeamTracker::NAMES.join(", ")
         ))
         .into());
+    }
+    if request.recordings.is_empty() {
+        let message = "no recordings: name at least one recording or folder (nothing was done)".to_string();
+        return Err(mmtrack_core::error::UsageError(message).into());
     }
     let files = sweep::expand(&request.recordings)?;
     if kinds.contains(&BeamTracker::Geometric) {

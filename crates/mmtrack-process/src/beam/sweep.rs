@@ -480,18 +480,10 @@ pub fn process_sweeps(
     kinds.sort();
     kinds.dedup();
     let recordings = files.iter().map(|f| read_beam_recording(f)).collect::<anyhow::Result<Vec<_>>>()?;
-    let mut by_sequence: BTreeMap<&str, &Path> = BTreeMap::new();
     let time_bases: BTreeMap<&str, TimeBase> =
         recordings.iter().map(|r| (r.sequence_id.as_str(), r.time_base)).collect();
+    super::refuse_repeated_sequences(recordings.iter().map(|r| (r.sequence_id.as_str(), r.path.as_path())))?;
     for r in &recordings {
-        if let Some(other) = by_sequence.insert(&r.sequence_id, &r.path) {
-            bail!(
-                "{} and {}: both are sequence {}; give each sequence once",
-                other.display(),
-                r.path.display(),
-                r.sequence_id
-            );
-        }
         out.refuse_existing(&[BEAM_SWEEPS_TRACKED.name], &r.sequence_id)?;
     }
     let mut sites: BTreeMap<&str, Vec<&BeamRecording>> = BTreeMap::new();

@@ -349,6 +349,7 @@ pub fn process_spebt(
     }
     let config = tracker_config(&experiment);
     let recordings = recordings.iter().map(|p| read_truth(p)).collect::<anyhow::Result<Vec<_>>>()?;
+    super::refuse_repeated_sequences(recordings.iter().map(|r| (r.sequence_id.as_str(), r.path.as_path())))?;
     for r in &recordings {
         out.refuse_existing(&[SPEBT_SUMMARY.name, SPEBT_PER_SLOT.name], &r.sequence_id)?;
     }
