@@ -161,8 +161,8 @@ def test_tables_are_lazy_frames_with_units_time_base_and_frame(demo: dict[str, P
     assert info.frame == "ground_truth" and info.frame_meaning
     assert mmtrack.table_info(demo["tables"], "odometry_timing").frame == "not_applicable"
     assert info.run_config["command"] == "process odometry"
-    # The recording's time base (the demo's simulated drive starts at a UNIX time).
-    assert info.time_base == "unix_epoch"
+    # The recording's time base: the demo's drive is simulated (the simulator's clock, not UNIX dates).
+    assert info.time_base == "scenario_start"
     pandas = pytest.importorskip("pandas")
     assert isinstance(frame.to_pandas(), pandas.DataFrame)
     assert "trajectory_metrics" in mmtrack.table_names()
@@ -513,6 +513,13 @@ def test_every_error_is_an_mmtrack_error(tmp_path: Path) -> None:
         mmtrack.detect_mpc(cir3, tap_spacing_s=1e-9, t_ns=[5, 5, 5], set_index=[0, 0, 0], snapshot_index=[0, 0, 0])
     with pytest.raises(mmtrack.MmtrackError, match=r"one per snapshot of cir \(3\), got 1"):
         mmtrack.detect_mpc(cir3, tap_spacing_s=1e-9, t_ns=[1])
+    # A sweep period as ingest beams checks it (NaN gave "sweep time -9223372036854775808 ns"), and a
+    # short t_ns named as such (the power array was blamed).
+    power = np.ones((10, 64))
+    with pytest.raises(mmtrack.MmtrackError, match="sweep_period_s nan: expected a positive number"):
+        mmtrack.track_beams(power, sweep_period_s=float("nan"))
+    with pytest.raises(mmtrack.MmtrackError, match=r"t_ns: one time per sweep of power \(10\)"):
+        mmtrack.track_beams(power, t_ns=[1, 2])
     # No recording is an error, as the CLI's (it reported success, writing nothing).
     with pytest.raises(mmtrack.MmtrackError, match="no recordings"):
         mmtrack.process("beam", [], tmp_path / "nothing")

@@ -60,6 +60,41 @@ pub struct OxfordFolder {
     pub gps: Option<PathBuf>,
     /// `gps/ins.csv`, when present.
     pub ins: Option<PathBuf>,
+    /// What the times count from: UNIX time (the dataset's), unless the
+    /// folder was simulated ([`SIMULATION_MARKER`]).
+    pub time_base: TimeBase,
+}
+
+/// The file `mmtrack simulate radar --format oxford` writes beside the
+/// dataset's files: the folder's time base (`scenario_start` for the
+/// simulator's clock), so that ingesting it does not label simulated times
+/// as UNIX dates. The Oxford SDK ignores it; real folders do not have it.
+pub const SIMULATION_MARKER: &str = "mmtrack-simulation.toml";
+
+/// The text of [`SIMULATION_MARKER`] for a folder of `time_base`.
+#[must_use]
+pub fn simulation_marker_text(time_base: TimeBase) -> String {
+    format!(
+        "# Written by `mmtrack simulate radar --format oxford`: the scans of this folder are simulated.\n\
+         # `mmtrack ingest oxford` records this time base (what the times count from).\n\
+         time_base = \"{}\"\n",
+        time_base.as_str()
+    )
+}
+
+/// The time base a [`SIMULATION_MARKER`] at `path` states.
+fn read_simulation_marker(path: &Path) -> Result<TimeBase, IngestError> {
+    let bad = |detail: String| IngestError::BadLayout { path: path.to_path_buf(), detail };
+    let text = mmtrack_io::paths::read_config_text(path)?;
+    let table: toml::Table = toml::from_str(&text).map_err(|e| bad(e.message().to_string()))?;
+    if let Some(key) = table.keys().find(|k| *k != "time_base") {
+        return Err(bad(format!("unknown key `{key}` (the simulator writes time_base only)")));
+    }
+    match table.get("time_base").and_then(toml::Value::as_str) {
+        Some("scenario_start") => Ok(TimeBase::ScenarioStart),
+        Some("unix_epoch") => Ok(TimeBase::UnixEpoch),
+        other => Err(bad(format!("key `time_base`: {other:?}, expected \"scenario_start\" or \"unix_epoch\""))),
+    }
 }
 
 fn parse_stamp(path: &Path, line: usize, raw: &str) -> Result<i64, IngestError> {
@@ -127,6 +162,10 @@ impl OxfordFolder {
             ground_truth: optional_file(&gt)?,
             gps: optional_file(&gps)?,
             ins: optional_file(&ins)?,
+            time_base: match optional_file(&root.join(SIMULATION_MARKER))? {
+                Some(marker) => read_simulation_marker(&marker)?,
+                None => TimeBase::UnixEpoch,
+            },
         })
     }
 
@@ -268,7 +307,7 @@ pub fn ingest_oxford(
     let metadata = RecordingMetadata {
         sequence_id,
         source: format!("oxford:{}", mmtrack_io::paths::canonical(&folder.root)),
-        time_base: TimeBase::UnixEpoch,
+        time_base: folder.time_base,
         extra,
     };
     let mut writer = RecordingWriter::create(out, &metadata, recording)?;

@@ -97,6 +97,7 @@ pub fn parse_scenario(text: &str) -> anyhow::Result<Scenario> {
 pub fn write_oxford_streaming(
     scenario: &Scenario,
     simulator: RadarSimulator<'_>,
+    time_base: TimeBase,
     dir: &Path,
     overwrite: Overwrite,
     progress: &dyn Progress,
@@ -129,6 +130,9 @@ pub fn write_oxford_streaming(
     oxford::write_oxford_folder(staging.path(), &[], &truth, &layout)?;
     let path = staging.path().join("radar.timestamps");
     std::fs::write(&path, timestamps).with_context(|| path.display().to_string())?;
+    // So that `ingest oxford` records the simulator's time base, not UNIX dates.
+    let path = staging.path().join(oxford::SIMULATION_MARKER);
+    std::fs::write(&path, oxford::simulation_marker_text(time_base)).with_context(|| path.display().to_string())?;
     // The old folder (checked above to hold only our own files) moves aside
     // into a staging name first, so `dir` is never missing while a finished
     // output exists, and is removed after the new one is in place.
@@ -153,12 +157,12 @@ pub fn write_oxford_streaming(
 
 /// Whether `relative` (a path inside an Oxford output folder) is something
 /// [`write_oxford_streaming`] writes: `radar/` with `<t_us>.png` scans,
-/// `radar.timestamps`, `gt/` with `radar_odometry.csv`.
+/// `radar.timestamps`, `gt/` with `radar_odometry.csv`, the simulation marker.
 fn is_oxford_output_entry(relative: &Path, is_dir: bool) -> bool {
     let parts: Vec<&str> = relative.iter().filter_map(|c| c.to_str()).collect();
     match parts.as_slice() {
         ["radar" | "gt"] => is_dir,
-        ["radar.timestamps"] => !is_dir,
+        ["radar.timestamps"] | [oxford::SIMULATION_MARKER] => !is_dir,
         ["radar", scan] => {
             !is_dir && scan.strip_suffix(".png").is_some_and(|t| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()))
         }
@@ -247,7 +251,13 @@ pub fn simulate_radar(args: &RadarSimulation, progress: &dyn Progress) -> anyhow
     progress.start("simulate radar", total as u64, "scans");
     match args.layout {
         RadarLayout::Oxford => {
-            write_oxford_streaming(&scenario, simulator, &args.output, args.recording.overwrite, progress)?;
+            // As a recording's: a real drive's UNIX times with --trajectory, else the scenario's clock.
+            let time_base = if args.trajectory.is_some() {
+                TimeBase::unix_or(trajectory.start_t_ns(), TimeBase::ScenarioStart)
+            } else {
+                TimeBase::ScenarioStart
+            };
+            write_oxford_streaming(&scenario, simulator, time_base, &args.output, args.recording.overwrite, progress)?;
         }
         RadarLayout::Recording => write_recording(args, &scenario, simulator, progress)?,
     }

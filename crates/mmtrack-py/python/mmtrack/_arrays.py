@@ -8,6 +8,7 @@ units), as a polars DataFrame.
 from __future__ import annotations
 
 import io
+import math
 import os
 from dataclasses import dataclass
 from typing import Any, Optional, Sequence, Union
@@ -133,9 +134,15 @@ def track_beams(
         raise _native.MmtrackError(f"power: expected shape (sweeps, beams), got {p.shape}")
     n, beams = p.shape
     if t_ns is None:
-        t = np.round(np.arange(n) * sweep_period_s * 1e9).astype(np.int64)
+        period = float(sweep_period_s)
+        # As ingest beams --sweep-period-s (NaN became a time of -2^63 ns before).
+        if not (math.isfinite(period) and 0.0 < period < 3600.0):
+            raise _native.MmtrackError(f"sweep_period_s {period}: expected a positive number of seconds below 3600")
+        t = np.round(np.arange(n) * period * 1e9).astype(np.int64)
     else:
         t = np.asarray(t_ns, dtype=np.int64)
+        if t.shape != (n,):
+            raise _native.MmtrackError(f"t_ns: one time per sweep of power ({n}), got shape {t.shape}")
     names = [tracker] if isinstance(tracker, str) else list(tracker)
     passes = None if pass_index is None else _le(np.asarray(pass_index).ravel(), "i8")
     if car_east_north_m is not None and car_lat_lon_deg is not None:

@@ -324,6 +324,7 @@ fn simulated_recording(scans: usize, dir: &Path) -> anyhow::Result<PathBuf> {
     mmtrack_process::simulate::radar::write_oxford_streaming(
         &scenario,
         simulator,
+        mmtrack_io::recording::TimeBase::ScenarioStart,
         &folder,
         mmtrack_io::Overwrite::Replace,
         &NoProgress,

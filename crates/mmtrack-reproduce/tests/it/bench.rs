@@ -27,6 +27,7 @@ fn simulated_oxford_folder(dir: &Path, scans: usize) {
     mmtrack_process::simulate::radar::write_oxford_streaming(
         &scenario,
         simulator,
+        mmtrack_io::recording::TimeBase::ScenarioStart,
         dir,
         mmtrack_io::Overwrite::Refuse,
         &NoProgress,
