@@ -484,6 +484,17 @@ def test_tables_reads_a_multi_run_analyze_per_run_tables(demo: dict[str, Path], 
     assert_frames_close(metrics.filter(pl.col("run") == "a"), alone.select(metrics.columns))
     assert list(mmtrack.tables(done["tables"])) == ["run_comparison"]
     assert mmtrack.table_info(out, "trajectory_metrics").files[0].endswith("part-0.parquet")
+    # Tables directly under a directory beside its run=<ID> folders (a run
+    # without --run-id next to one with it): before, tables() refused the
+    # whole directory ("in more than one layout") while analyze read it. Now
+    # the direct ones are a run named after the directory, as analyze names it.
+    mixed = tmp_path / "mixed"
+    mmtrack.process("odometry", demo["recording"], mixed)
+    mmtrack.process("odometry", demo["recording"], mixed, run_id="x")
+    odometry = mmtrack.tables(mixed)["odometry"].collect()
+    assert sorted(set(odometry["run"].to_list())) == ["mixed", "x"]
+    direct = mmtrack.read_table(mixed, "odometry").filter(pl.col("run") == "mixed").collect()
+    assert_frames_close(direct.drop("run"), odometry.filter(pl.col("run") == "x").select(direct.drop("run").columns))
 
 
 def test_every_error_is_an_mmtrack_error(tmp_path: Path) -> None:

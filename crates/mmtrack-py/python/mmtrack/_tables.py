@@ -115,19 +115,16 @@ _LAYOUTS = (
 )
 
 
-def _layout(root: Path, name: str) -> tuple[str, dict[str, Any], list[Path]]:
-    """The one layout of table `name` under `root`: glob pattern, Hive schema, files."""
+def _layouts(root: Path, name: str) -> list[tuple[str, dict[str, Any], list[Path]]]:
+    """The layouts table `name` has under `root`: glob pattern, Hive schema, files."""
     found = [(pattern, hive, sorted(root.glob(pattern.format(name=name)))) for pattern, hive in _LAYOUTS]
     found = [f for f in found if f[2]]
-    if len(found) > 1:
-        where = " and ".join(str(root / pattern.format(name=name)) for pattern, _, _ in found)
-        raise _native.MmtrackError(f"{root}: table {name} in more than one layout ({where}); read one of them")
     if not found:
         raise _native.MmtrackError(
             f"{root}: no table {name} (expected {name}/sequence=<id>/part-0.parquet, or that under run=<ID>/ "
             f"or run=<ID>/tables/)"
         )
-    return found[0]
+    return found
 
 
 def _check_parquet_footer(file: Path) -> None:
@@ -147,7 +144,7 @@ def _check_parquet_footer(file: Path) -> None:
 
 
 def _files(root: Path, name: str) -> list[Path]:
-    return _layout(root, name)[2]
+    return [file for _, _, files in _layouts(root, name) for file in files]
 
 
 def read_table(root: PathLike, name: str) -> pl.LazyFrame:
@@ -159,20 +156,32 @@ def read_table(root: PathLike, name: str) -> pl.LazyFrame:
     per-run result tables are under ``<root>/run=<ID>/tables/<name>/...``
     (its comparison tables: ``read_table(<root>/tables, "run_comparison")``).
     The Hive columns ``sequence`` (and ``run`` for ``run=<ID>`` folders) are
-    strings. Row order is file order (runs, then sequences, sorted) and row
+    strings; tables directly under ``root`` beside ``run=<ID>`` folders are a
+    run named after ``root`` (as ``mmtrack analyze`` takes them). Row order is file order (runs, then sequences, sorted) and row
     order within each file; sort explicitly after joins. ``.collect()`` for a
     DataFrame, ``.collect().to_pandas()`` for pandas.
     """
     base = Path(os.fspath(root))
-    pattern, hive, files = _layout(base, name)
-    for file in files:
-        _check_parquet_footer(file)
+    layouts = _layouts(base, name)
     # polars takes every `key=value` folder of the path as a Hive column, also
     # those of `root` itself (e.g. `<analysis>/run=a/tables`): strings too.
-    hive = {**{part.split("=", 1)[0]: pl.String for part in base.parts if "=" in part}, **hive}
-    return pl.scan_parquet(
-        f"{base}/{pattern.format(name=name)}", hive_partitioning=True, hive_schema=hive, try_parse_hive_dates=False
-    )
+    own = {part.split("=", 1)[0]: pl.String for part in base.parts if "=" in part}
+    frames = []
+    for pattern, hive, files in layouts:
+        for file in files:
+            _check_parquet_footer(file)
+        frame = pl.scan_parquet(
+            f"{base}/{pattern.format(name=name)}",
+            hive_partitioning=True,
+            hive_schema={**own, **hive},
+            try_parse_hive_dates=False,
+        )
+        if len(layouts) > 1 and "run" not in hive and "run" not in own:
+            # Tables directly under `root` beside run=<ID> folders: a run named
+            # after the directory, as `mmtrack analyze` takes them.
+            frame = frame.with_columns(pl.lit(base.name, dtype=pl.String).alias("run"))
+        frames.append(frame)
+    return frames[0] if len(frames) == 1 else pl.concat(frames, how="diagonal_relaxed")
 
 
 def tables(root: PathLike) -> dict[str, pl.LazyFrame]:
