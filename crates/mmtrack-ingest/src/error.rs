@@ -46,7 +46,7 @@ pub enum IngestError {
     BadSidecar {
         /// The sidecar file.
         path: PathBuf,
-        /// The key at fault (`(syntax)` for a TOML syntax error).
+        /// The key at fault.
         key: String,
         /// What is wrong and what was expected.
         detail: String,

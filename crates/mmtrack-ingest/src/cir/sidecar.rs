@@ -180,7 +180,11 @@ impl CirSidecar {
     pub fn parse(path: &Path, text: &str) -> Result<Self, IngestError> {
         let bad =
             |key: &str, detail: String| IngestError::BadSidecar { path: path.to_path_buf(), key: key.into(), detail };
-        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| bad("(syntax)", e.to_string()))?;
+        // A syntax error as one line naming its line (its multi-line snippet printed as literal `\n`s).
+        let table: toml::Table = text.parse().map_err(|e: toml::de::Error| {
+            let line = e.span().map_or(1, |span| text[..span.start.min(text.len())].matches('\n').count() + 1);
+            IngestError::bad_line(path, line, "TOML syntax", e.message().trim().to_string())
+        })?;
         let mut out = Self { path: path.to_path_buf(), ..Self::empty() };
         for (key, value) in &table {
             if !KNOWN_KEYS.contains(&key.as_str()) {
@@ -424,7 +428,7 @@ mod tests {
             ("carrier_hz = nan", "key `carrier_hz`: NaN"),
             ("tap_spacing_s = \"1ns\"", "expected a number"),
             ("snapshot_period_s = 0.002\nsnapshots_per_set = 6\nset_period_s = 0.01", "key `set_period_s`"),
-            ("carrier_hz = ", "key `(syntax)`"),
+            ("carrier_hz = ", "s.toml: line 1: TOML syntax: "),
         ] {
             let err = parse(text).unwrap_err();
             assert!(err.contains(needle), "{text}: {err}");

@@ -134,7 +134,22 @@ impl OxfordFolder {
                 let t_ns = parse_stamp(&timestamps, index + 1, parts.next().unwrap_or(""))?;
                 let path = radar_dir.join(format!("{}.png", t_ns / 1000));
                 listed.insert(path.clone());
-                if parts.next() == Some("0") {
+                // The SDK's valid flag: 1 valid, 0 not; anything else (a
+                // missing flag, a 7, a third field) is not this file's format.
+                let valid = match (parts.next(), parts.next()) {
+                    (Some("1"), None) => true,
+                    (Some("0"), None) => false,
+                    (flag, extra) => {
+                        let found = [flag, extra].into_iter().flatten().collect::<Vec<_>>().join(" ");
+                        return Err(IngestError::bad_line(
+                            &timestamps,
+                            index + 1,
+                            "valid flag",
+                            format!("`{found}`, expected 0 or 1 after the timestamp (`<t_us> <flag>`)"),
+                        ));
+                    }
+                };
+                if !valid {
                     skipped_invalid += 1;
                     continue;
                 }

@@ -109,3 +109,31 @@ fn a_listed_png_that_is_a_directory_and_a_missing_folder_say_what_they_are() {
     let err = open_err(&dir.path().join("radar.timestamps"));
     assert!(err.contains("radar.timestamps: is not a folder"), "{err}");
 }
+
+/// Before: any valid flag but `0` (a 7, none, a third field) counted as
+/// valid. The SDK writes `<t_us> 1` or `<t_us> 0`; anything else is named.
+#[test]
+fn a_valid_flag_other_than_0_or_1_is_named_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    scan_folder(dir.path(), 2);
+    let timestamps = dir.path().join("radar.timestamps");
+    let first = T0_US;
+    let second = T0_US + 250_000;
+    for (text, found) in [
+        (format!("{first} 1\n{second} 7\n"), "`7`"),
+        (format!("{first} 1\n{second}\n"), "``"),
+        (format!("{first} 1\n{second} 1 2\n"), "`1 2`"),
+    ] {
+        std::fs::write(&timestamps, text).unwrap();
+        let err = open_err(dir.path());
+        assert!(
+            err.contains("radar.timestamps: line 2: valid flag: ")
+                && err.contains(found)
+                && err.contains("expected 0 or 1"),
+            "{err}"
+        );
+    }
+    std::fs::write(&timestamps, format!("{first} 1\n{second} 0\n")).unwrap();
+    let folder = OxfordFolder::open(dir.path()).unwrap();
+    assert_eq!((folder.scans.len(), folder.skipped_invalid), (1, 1));
+}
