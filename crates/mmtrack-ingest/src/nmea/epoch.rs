@@ -236,6 +236,19 @@ impl Assembler {
     /// out-of-order epoch, which are counted instead).
     fn emit(&mut self, t_ns: i64, candidate: Candidate, horizontal_sigma_m: Option<f64>, line: usize) -> bool {
         if let Some((last_t_ns, last_line)) = self.last_fix {
+            let step_ns = t_ns.abs_diff(last_t_ns);
+            if step_ns > super::MAX_DATE_STEP_NS as u64 && self.log.first_date_step.is_none() {
+                let reason = format!(
+                    "fix at {} UTC is {} days {} the previous fix ({} UTC, line {last_line}): one of them is likely \
+                     misdated (at most {} days between consecutive fixes)",
+                    clock(t_ns),
+                    step_ns / 86_400_000_000_000,
+                    if t_ns > last_t_ns { "after" } else { "before" },
+                    clock(last_t_ns),
+                    super::MAX_DATE_STEP_NS / 86_400_000_000_000
+                );
+                self.log.first_date_step = Some(SkippedLine { line, reason });
+            }
             if t_ns == last_t_ns {
                 self.log.duplicate_epochs += 1;
                 return false;

@@ -165,6 +165,9 @@ pub struct NmeaLog {
     pub first_leap_second_line: Option<usize>,
     /// The first epoch skipped for its time, and by how much it went back.
     pub first_out_of_order: Option<SkippedLine>,
+    /// The first step between consecutive fixes (either way) longer than
+    /// [`MAX_DATE_STEP_NS`]: a misdated RMC, which `ingest_nmea` refuses.
+    pub first_date_step: Option<SkippedLine>,
     /// `ellipsoid` or `mean sea level`; empty when no fix has an altitude.
     pub altitude_datum: &'static str,
 }
@@ -333,12 +336,21 @@ impl Parser {
     }
 }
 
+/// The longest step between consecutive fixes of one log that is taken as
+/// real: a logger off for a month is not a drive; a step of years is one
+/// RMC's wrong date (a first fix dated 1998 made a 22-year recording whose
+/// times were then labelled relative, not UNIX).
+pub const MAX_DATE_STEP_NS: i64 = 30 * 86_400 * 1_000_000_000;
+
 /// Refuses a log in which more epochs go back in time than are kept: one
 /// epoch stepped back is skipped (a receiver's clock correction), but when
 /// most are "before the previous fix", the fix they are measured against
 /// is the wrong one (e.g. one RMC with a wrong date), and keeping it would
 /// drop the drive.
 fn refuse_mostly_out_of_order(path: &Path, log: &NmeaLog) -> Result<(), IngestError> {
+    if let Some(step) = &log.first_date_step {
+        return Err(IngestError::bad_line(path, step.line, "date", step.reason.clone()));
+    }
     match &log.first_out_of_order {
         Some(first) if log.out_of_order_epochs > log.fix_count => Err(IngestError::bad_line(
             path,

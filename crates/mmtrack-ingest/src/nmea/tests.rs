@@ -274,12 +274,30 @@ fn a_misdated_first_fix_is_an_error_not_a_one_fix_drive() {
     std::fs::write(&input, &text).unwrap();
     let err = ingest_nmea(&input, &out, None, &mmtrack_io::RecordingOptions::default()).unwrap_err().to_string();
     assert!(
-        err.contains("drive.nmea")
-            && err.contains("3 epochs are before an earlier fix and only 1 would be kept")
-            && err.contains("2068-02-07 021417.000000000 UTC, line 1"),
+        err.contains("drive.nmea: line 3: date: fix at 2020-02-07 021418.000000000 UTC is 17531 days before")
+            && err.contains("2068-02-07 021417.000000000 UTC, line 1): one of them is likely misdated"),
         "{err}"
     );
     assert!(!out.exists());
+    // Misdated into the past (the drive became 22 years long, its times then
+    // labelled relative), the last fix misdated, a two-fix log: the same.
+    let past = format!("{}\n{}\n", rmc("GN", "021417.00", "A", "070298"), gga("GN", "021417.00", "5"));
+    let last = format!("{}\n{}\n", rmc("GN", "021421.00", "A", "070268"), gga("GN", "021421.00", "5"));
+    let good = |times: &[&str]| times.iter().map(|t| epoch("GN", t)).collect::<String>();
+    for (text, days) in [
+        (past + &good(&["021418.00", "021419.00"]), "days after the previous fix (1998-02-07"),
+        (good(&["021418.00", "021419.00"]) + &last, "days after the previous fix (2020-02-07 021419"),
+        (
+            format!("{}\n{}\n", rmc("GN", "021417.00", "A", "070268"), gga("GN", "021417.00", "5"))
+                + &good(&["021418.00"]),
+            "days before",
+        ),
+    ] {
+        std::fs::write(&input, &text).unwrap();
+        let err = ingest_nmea(&input, &out, None, &mmtrack_io::RecordingOptions::default()).unwrap_err().to_string();
+        assert!(err.contains(days) && err.contains("likely misdated"), "{err}");
+        assert!(!out.exists());
+    }
     // One epoch stepped back among many is still skipped, not refused.
     let text = ["021417.00", "021418.00", "021416.00", "021419.00"].iter().map(|t| epoch("GN", t)).collect::<String>();
     std::fs::write(&input, &text).unwrap();
