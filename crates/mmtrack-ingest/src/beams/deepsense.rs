@@ -296,6 +296,11 @@ fn positions(path: &Path, what: &str) -> Result<(usize, Vec<[f64; 2]>), IngestEr
     for (row, &[lat, lon]) in pairs.iter().enumerate() {
         check_plausible(path, || format!("row {row}"), "latitude (column 0)", &LATITUDE_DEG, lat)?;
         check_plausible(path, || format!("row {row}"), "longitude (column 1)", &LONGITUDE_DEG, lon)?;
+        // Named in its own file (the link-distance check below could not tell which unit is wrong).
+        if lat == 0.0 && lon == 0.0 {
+            let detail = format!("(0, 0), a GPS log's \"no fix\", not a position ({what})");
+            return Err(bad(path, format!("row {row}"), "latitude, longitude", detail));
+        }
     }
     Ok((rows, pairs))
 }

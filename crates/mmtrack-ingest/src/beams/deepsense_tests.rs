@@ -194,10 +194,15 @@ fn non_consecutive_passes_and_bad_positions_name_the_row() {
     assert!(text.contains("scenario1_unit2_loc_1-3.npy: row 1: longitude (column 1): inf"), "{text}");
     let text = error_text(&[1, 1, 2], |a| a.unit[0] = 91.0);
     assert!(text.contains("scenario1_unit1_loc_1-3.npy: row 0: latitude (column 0): 91"), "{text}");
-    // A car at (0, 0), a GPS log's "no fix": valid degrees, but 12 000 km from the unit.
+    // A car or a roadside unit at (0, 0), a GPS log's "no fix": valid degrees, named in its own file.
     let text = error_text(&[1, 1, 2], |a| a.car[2..4].copy_from_slice(&[0.0, 0.0]));
+    assert!(text.contains("scenario1_unit2_loc_1-3.npy: row 1: latitude, longitude: (0, 0), a GPS log's"), "{text}");
+    let text = error_text(&[1, 1, 2], |a| a.unit[0..2].copy_from_slice(&[0.0, 0.0]));
+    assert!(text.contains("scenario1_unit1_loc_1-3.npy: row 0: latitude, longitude: (0, 0)"), "{text}");
+    // A car far from the unit (here about 1100 km).
+    let text = error_text(&[1, 1, 2], |a| a.car[2] += 10.0);
     assert!(
-        text.contains("scenario1_unit2_loc_1-3.npy: row 1: latitude, longitude: (0, 0) is ")
+        text.contains("scenario1_unit2_loc_1-3.npy: row 1: latitude, longitude: (43.4201, ")
             && text.contains("km from the roadside unit at (33.42, -111.93); a link spans at most 10 km"),
         "{text}"
     );
