@@ -160,12 +160,9 @@ pub fn run(args: &ManifestArgs, quiet: bool) -> anyhow::Result<ExitCode> {
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-/// Before any task runs: every task's words parse as the command they name
-/// (a typo in a later level was found only after the earlier levels ran),
-/// and no two tasks write the same output: the same `-o` of ingest or
-/// analyze tasks, or the same pipeline on the same recordings (or folders)
-/// into the same run, whose partitions one would replace (with `--force`,
-/// which one was kept depended on which finished last).
+/// Before any task runs: every task's words parse (a typo in a late level was found after the others ran),
+/// and no two tasks write the same output (the same `-o`, or the same pipeline on the same recordings into
+/// the same run: with `--force` the one that finished last was kept).
 fn check_tasks(manifest: &Manifest, output: &str, file: &str) -> anyhow::Result<()> {
     use clap::CommandFactory;
     let cli = crate::Cli::command();
@@ -183,21 +180,28 @@ fn check_tasks(manifest: &Manifest, output: &str, file: &str) -> anyhow::Result<
             command = command.find_subcommand(name).context("a parsed subcommand")?;
             at = sub;
         }
+        let path = |p: &std::ffi::OsStr| manifest::path_key(Path::new(p));
         if task.step == manifest::Step::Process {
-            for arg in command.get_positionals().chain(command.get_arguments().filter(|a| a.get_id() == "run_id")) {
-                let values = at.get_raw(arg.get_id().as_str()).into_iter().flatten();
-                key.extend(values.map(|v| format!("{}={}", arg.get_id(), v.to_string_lossy())));
+            let raw = |id: &str| at.try_get_raw(id).ok().flatten().into_iter().flatten();
+            // `--sequence` names the partitions instead of the recordings' ids.
+            match raw("sequence").next() {
+                Some(sequence) => key.push(format!("sequence={}", sequence.to_string_lossy())),
+                None => command.get_positionals().for_each(|a| key.extend(raw(a.get_id().as_str()).map(path))),
             }
+            key.extend(raw("run_id").map(|v| format!("run={}", v.to_string_lossy())));
         } else {
-            key.extend(task.own_output(output));
+            key.extend(task.own_output(output).map(|o| path(o.as_ref())));
         }
+        let (same, own) = if task.step == manifest::Step::Process {
+            ("pipeline, recordings and run", "--run-id")
+        } else {
+            ("-o", "-o")
+        };
         if let Some(first) = writers.insert(key, task) {
             bail!(
-                "{file}: {}: writes what {} writes (the same {}); give each its own {}",
+                "{file}: {}: writes what {} writes (the same {same}); give each its own {own}",
                 task.label(),
-                first.label(),
-                if task.step == manifest::Step::Process { "pipeline, recordings and run" } else { "-o" },
-                if task.step == manifest::Step::Process { "--run-id" } else { "-o" }
+                first.label()
             );
         }
     }

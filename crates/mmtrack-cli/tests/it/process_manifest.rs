@@ -339,6 +339,15 @@ fn steps_run_in_the_order_of_their_needs() {
             ),
             "task 3: writes what task 2 (mpc) writes (the same pipeline, recordings and run); give each its own --run-id",
         ),
+        // Other spellings of the same recording or output are the same.
+        (
+            STEPS.replace("\"--threads\", \"2\"]", "\"--threads\", \"2\"]\n[[task]]\nargs = [\"mpc\", \"./demo//sounder.mcap\"]"),
+            "task 3: writes what task 2 (mpc) writes",
+        ),
+        (
+            STEPS.replace("\"fast-cfear\"]", "\"fast-cfear\"]\n[[task]]\nstep = \"ingest\"\nargs = [\"oxford\", \"x\", \"-o\", \"./rec//demo.mcap\"]"),
+            "task 2: writes what task 0 (ingest-demo) writes (the same -o); give each its own -o",
+        ),
         (
             STEPS.replace(
                 "\"fast-cfear\"]",

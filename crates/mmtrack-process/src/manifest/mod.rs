@@ -407,6 +407,15 @@ fn find_cycle(tasks: &[Task]) -> Option<Vec<usize>> {
     None
 }
 
+/// One spelling of a path for comparing tasks' inputs and outputs: absolute
+/// and without `.` or repeated separators (`./a.mcap`, `a.mcap`, its absolute
+/// path and `rec//a.mcap` are one; links and `..` are not resolved).
+#[must_use]
+pub fn path_key(path: &Path) -> String {
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    absolute.components().collect::<std::path::PathBuf>().display().to_string()
+}
+
 /// Shell-quotes `word` when it needs it.
 #[must_use]
 pub fn shell_word(word: &str) -> String {
