@@ -105,7 +105,7 @@ pub fn detect_mpc(
     ensure!(cir.taps_per_snapshot > 0, "cir: no taps");
     let rows = cir.taps.len() / cir.taps_per_snapshot;
     ensure!(
-        cir.taps.len() % cir.taps_per_snapshot == 0,
+        cir.taps.len().is_multiple_of(cir.taps_per_snapshot),
         "cir: {} taps are not snapshots of {} taps",
         cir.taps.len(),
         cir.taps_per_snapshot
