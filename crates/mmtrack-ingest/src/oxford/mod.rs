@@ -93,7 +93,10 @@ fn read_simulation_marker(path: &Path) -> Result<TimeBase, IngestError> {
     match table.get("time_base").and_then(toml::Value::as_str) {
         Some("scenario_start") => Ok(TimeBase::ScenarioStart),
         Some("unix_epoch") => Ok(TimeBase::UnixEpoch),
-        other => Err(bad(format!("key `time_base`: {other:?}, expected \"scenario_start\" or \"unix_epoch\""))),
+        other => {
+            let found = other.map_or_else(|| "missing".to_string(), |v| format!("\"{v}\""));
+            Err(bad(format!("key `time_base`: {found}, expected \"scenario_start\" or \"unix_epoch\"")))
+        }
     }
 }
 
