@@ -238,7 +238,7 @@ impl CirSidecar {
                 let offset_s = number(value, f64::NEG_INFINITY, true)?;
                 if offset_s.abs() > 1.0 {
                     return Err(format!(
-                        "{offset_s} s, expected a delay of at most 1 s in magnitude (seconds, not ns)"
+                        "{offset_s:e} s, expected a delay of at most 1 s in magnitude (seconds, not ns)"
                     ));
                 }
                 self.delay_offset_s = offset_s;
