@@ -274,6 +274,21 @@ pub fn read_manifest(path: &Path) -> anyhow::Result<Manifest> {
         if let Some(key) = keys.keys().find(|k| !TASK_KEYS.contains(&k.as_str())) {
             bail!("{file}: task {i}: unknown key `{key}` (expected one of {})", TASK_KEYS.join(", "));
         }
+        // Each key's type named (serde's message named none: "invalid type: string, expected a sequence").
+        for (key, value) in keys {
+            let strings = value.as_array().is_some_and(|a| a.iter().all(toml::Value::is_str));
+            let (ok, expected) = match key.as_str() {
+                "name" => (value.is_str(), "a string"),
+                "step" => (
+                    matches!(value.as_str(), Some("ingest" | "process" | "analyze")),
+                    "\"ingest\", \"process\" or \"analyze\"",
+                ),
+                _ => (strings, "an array of strings"),
+            };
+            if !ok {
+                bail!("{file}: task {i}: key `{key}`: {value}, expected {expected}");
+            }
+        }
         let task: RawTask = entry
             .clone()
             .try_into()
@@ -328,7 +343,14 @@ pub fn read_manifest(path: &Path) -> anyhow::Result<Manifest> {
         }
     }
     if let Some(cycle) = find_cycle(&tasks) {
-        let path: Vec<String> = cycle.iter().map(|&i| tasks[i].label()).collect();
+        // At most the first 8 tasks of a long cycle (one of 100 000 printed a 2.3 MB line).
+        let mut path: Vec<String> = cycle.iter().take(8).map(|&i| tasks[i].label()).collect();
+        if cycle.len() > 9 {
+            path.push(format!("... ({} tasks in all)", cycle.len() - 1));
+        }
+        if cycle.len() > 8 {
+            path.push(tasks[cycle[0]].label());
+        }
         bail!("{file}: {}: key `needs`: a cycle: {}", tasks[cycle[0]].label(), path.join(" -> "));
     }
     Ok(Manifest { tasks })

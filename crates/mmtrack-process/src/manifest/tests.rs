@@ -74,7 +74,10 @@ fn bad_manifests_are_refused_naming_file_task_and_key() {
             "m.toml: task 0: unknown key `argz` (expected one of name, step, needs, args)",
         ),
         (&format!("{ok}[[task]]\nnedds = [\"a\"]\nargs = [\"mpc\"]\n"), "m.toml: task 1: unknown key `nedds`"),
-        ("[[task]]\nstep = \"export\"\nargs = [\"x\"]\n", "m.toml: task 0: unknown variant `export`"),
+        (
+            "[[task]]\nstep = \"export\"\nargs = [\"x\"]\n",
+            "m.toml: task 0: key `step`: \"export\", expected \"ingest\", \"process\" or \"analyze\"",
+        ),
         (
             "[[task]]\nargs = [\"mpc\", \"x.mcap\", \"-o\", \"y\"]\n",
             "m.toml: task 0: key `args`: leave -o/--output out",
@@ -106,6 +109,13 @@ fn bad_manifests_are_refused_naming_file_task_and_key() {
              [[task]]\nname = \"c\"\nneeds = [\"b\"]\nargs = [\"mpc\"]\n",
             "m.toml: task 0 (a): key `needs`: a cycle: task 0 (a) -> task 2 (c) -> task 1 (b) -> task 0 (a)",
         ),
+        // A key of the wrong type is named (serde's message named none).
+        (
+            "[[task]]\nargs = \"odometry x\"\n",
+            "m.toml: task 0: key `args`: \"odometry x\", expected an array of strings",
+        ),
+        ("[[task]]\nstep = \"simulate\"\nargs = [\"x\"]\n", "task 0: key `step`: \"simulate\", expected \"ingest\""),
+        ("[[task]]\nname = 3\nargs = [\"x\"]\n", "task 0: key `name`: 3, expected a string"),
     ] {
         let err = refusal(text);
         assert!(err.contains(message), "{text}\n{err}");
@@ -114,6 +124,12 @@ fn bad_manifests_are_refused_naming_file_task_and_key() {
     assert!(refusal(&many).contains("m.toml: key `task`: 100001 tasks; expected at most 100000"));
     let long = format!("[[task]]\nargs = [{}]\n", vec!["\"x\""; MAX_WORDS + 1].join(","));
     assert!(refusal(&long).contains("task 0: key `args`: 1001 words; expected at most 1000"));
+    // A cycle through 1000 tasks is named in one short line (100 000 printed 2.3 MB).
+    let ring: String = (0..1000)
+        .map(|i| format!("[[task]]\nname = \"t{i}\"\nneeds = [\"t{}\"]\nargs = [\"mpc\"]\n", (i + 1) % 1000))
+        .collect();
+    let err = refusal(&ring);
+    assert!(err.contains("-> ... (1000 tasks in all) -> task 0 (t0)") && err.len() < 400, "{err}");
 }
 
 #[test]
