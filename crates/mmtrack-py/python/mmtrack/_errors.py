@@ -40,6 +40,15 @@ def raises_mmtrack_errors(function: F) -> F:
         except TypeError as error:
             raise MmtrackTypeError(f"{function.__name__}: {error}") from error
         except (ValueError, OverflowError) as error:
-            raise MmtrackValueError(f"{function.__name__}: {error}") from error
+            # An integer the native call cannot take names no argument
+            # ("can't convert negative int to unsigned"): name the keywords
+            # that hold a negative or oversized integer.
+            suspects = [
+                f"{name}={value}"
+                for name, value in kwargs.items()
+                if isinstance(value, int) and not isinstance(value, bool) and not 0 <= value < 2**63
+            ]
+            hint = f" ({', '.join(suspects)}: expected a non-negative integer)" if suspects else ""
+            raise MmtrackValueError(f"{function.__name__}: {error}{hint}") from error
 
     return call  # type: ignore[return-value]
