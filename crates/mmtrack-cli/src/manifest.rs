@@ -171,8 +171,13 @@ fn check_tasks(manifest: &Manifest, output: &str, file: &str) -> anyhow::Result<
         let words = task.command_line(output, false);
         let argv = std::iter::once("mmtrack").chain(words.iter().map(String::as_str));
         let matches = cli.clone().try_get_matches_from(argv).map_err(|e| {
-            let message = e.to_string();
-            anyhow::anyhow!("{file}: {}: key `args`: {}", task.label(), message.lines().next().unwrap_or("").trim())
+            use clap::error::ErrorKind::{DisplayHelp, DisplayHelpOnMissingArgumentOrSubcommand, DisplayVersion};
+            let message = match e.kind() {
+                DisplayHelp | DisplayVersion => "--help and --version print text; a task runs a command".to_string(),
+                DisplayHelpOnMissingArgumentOrSubcommand => "names no subcommand (e.g. odometry)".to_string(),
+                _ => e.to_string().lines().next().unwrap_or("").trim().to_string(),
+            };
+            anyhow::anyhow!("{file}: {}: key `args`: {message}", task.label())
         })?;
         let (mut command, mut at, mut key) = (&cli, &matches, Vec::new());
         while let Some((name, sub)) = at.subcommand() {

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 
 use anyhow::bail;
 use clap::{Args, Subcommand};
-use mmtrack_core::words::{counted, counted_as};
+use mmtrack_core::words::counted_as;
 use mmtrack_io::table::TableWriteSummary;
 use mmtrack_odometry::OdometryConfig;
 use mmtrack_process::{mpc, odometry, poses, slam};
@@ -299,28 +299,7 @@ fn run_mpc(args: &MpcArgs, quiet: bool) -> anyhow::Result<Vec<TableWriteSummary>
         return Ok(done.written);
     }
     for link in &done.links {
-        let capped = match link.snapshots_at_max_mpcs {
-            0 => String::new(),
-            n => format!(" ({n} snapshots at max_mpcs)"),
-        };
-        println!(
-            "mpc {} (link tx{}:rx{}): {}, {}{capped}, {}, {}",
-            link.partition,
-            link.link.0,
-            link.link.1,
-            counted(link.sets as u64, "set"),
-            counted(link.detections as u64, "detection"),
-            counted(link.tracks as u64, "short-term track"),
-            counted_as(link.long_term as u64, "long-term entry", "long-term entries")
-        );
-        let (most, needed) = (link.most_snapshots_per_set, config.short_term.min_track_length);
-        if link.tracks == 0 && link.detections > 0 && (most as usize) < needed {
-            println!(
-                "  no short-term tracks: sets hold at most {most} snapshot(s) and a track follows one path over at \
-                 least short_term.min_track_length = {needed} snapshots of one set (Mahler et al. Sec. III-B); \
-                 this source gives detections and first paths only"
-            );
-        }
+        link.summary(config.short_term.min_track_length).iter().for_each(|line| println!("{line}"));
     }
     for w in &done.written {
         let (one, many) = mpc::record_noun(&w.path);

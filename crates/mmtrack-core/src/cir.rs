@@ -70,6 +70,16 @@ impl CirSnapshot {
             ensure_finite("tap real part", tap.re)?;
             ensure_finite("tap imaginary part", tap.im)?;
         }
+        // Finite taps whose power overflows (|tap| of 1e308) made every power
+        // and the noise floor infinite: zero detections, no error.
+        if !self.taps.iter().map(|t| t.norm_sqr()).sum::<f64>().is_finite() {
+            let largest = self.taps.iter().map(|t| t.norm()).fold(0.0, f64::max);
+            return Err(CoreError::OutOfRange {
+                field: "taps",
+                value: largest,
+                expected: "taps whose total power is finite (magnitudes below about 1e150)",
+            });
+        }
         Ok(())
     }
 
@@ -117,5 +127,9 @@ mod tests {
         let mut s = snapshot();
         s.first_path_hint_s = Some(f64::INFINITY);
         assert!(matches!(s.validate(), Err(CoreError::NotFinite { field: "first_path_hint_s", .. })));
+        // Finite taps whose power overflows (detection found nothing, silently).
+        let mut s = snapshot();
+        s.taps[1].re = 1e308;
+        assert!(matches!(s.validate(), Err(CoreError::OutOfRange { field: "taps", .. })));
     }
 }

@@ -339,6 +339,8 @@ fn steps_run_in_the_order_of_their_needs() {
             ),
             "task 3: writes what task 2 (mpc) writes (the same pipeline, recordings and run); give each its own --run-id",
         ),
+        // --help in a task: its text was the error (the help's first line).
+        (STEPS.replace("\"--threads\", \"2\"]", "\"--help\"]"), "task 2 (mpc): key `args`: --help and --version print text"),
         // Other spellings of the same recording or output are the same.
         (
             STEPS.replace("\"--threads\", \"2\"]", "\"--threads\", \"2\"]\n[[task]]\nargs = [\"mpc\", \"./demo//sounder.mcap\"]"),

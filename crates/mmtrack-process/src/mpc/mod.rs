@@ -402,6 +402,38 @@ pub struct LinkSummary {
     pub snapshots_at_max_mpcs: usize,
 }
 
+impl LinkSummary {
+    /// The lines the CLI prints for the link: its counts, and why there are
+    /// no short-term tracks when its sets are too short for one.
+    #[must_use]
+    pub fn summary(&self, min_track_length: usize) -> Vec<String> {
+        use mmtrack_core::words::{counted, counted_as};
+        let capped = match self.snapshots_at_max_mpcs {
+            0 => String::new(),
+            n => format!(" ({n} snapshots at max_mpcs)"),
+        };
+        let mut lines = vec![format!(
+            "mpc {} (link tx{}:rx{}): {}, {}{capped}, {}, {}",
+            self.partition,
+            self.link.0,
+            self.link.1,
+            counted(self.sets as u64, "set"),
+            counted(self.detections as u64, "detection"),
+            counted(self.tracks as u64, "short-term track"),
+            counted_as(self.long_term as u64, "long-term entry", "long-term entries")
+        )];
+        let most = self.most_snapshots_per_set;
+        if self.tracks == 0 && self.detections > 0 && (most as usize) < min_track_length {
+            lines.push(format!(
+                "  no short-term tracks: sets hold at most {most} snapshot(s) and a track follows one path over at \
+                 least short_term.min_track_length = {min_track_length} snapshots of one set (Mahler et al. Sec. \
+                 III-B); this source gives detections and first paths only"
+            ));
+        }
+        lines
+    }
+}
+
 /// Per snapshot (set, snapshot index) with detections: how many there are
 /// and how many of those reached `max_mpcs`.
 fn snapshots_at_cap(detections: &[mmtrack_core::MpcDetection], max_mpcs: usize) -> (usize, usize) {

@@ -214,6 +214,14 @@ fn values_of_file(file: &Path, partitions: &[(String, String)], selection: &Sele
     }
     let counting = selection.aggregate == Some(Aggregate::Count);
     if !counting && !columns.iter().any(|c| c == &selection.column) {
+        // A partition key is text (the sequence or run of the path), not a number to check.
+        if partition_keys.contains(&selection.column) {
+            bail!(
+                "{name}: `{}` is a partition (text from the path), not a numeric column (columns: {})",
+                selection.column,
+                columns.join(", ")
+            );
+        }
         bail!("{name}: no column `{}` (columns: {})", selection.column, columns.join(", "));
     }
     let mut values = Vec::new();

@@ -93,6 +93,11 @@ fn metrics_select_rows_by_partition_and_column_and_reduce_them() {
         ),
         (sel(vec![("mode", Wanted::Text("a".into()))], "cost", None), "no column or partition `mode`"),
         (sel(vec![], "preset", Some(Aggregate::Mean)), "row 0: preset: a Utf8 column is not a number"),
+        // The partition column: text from the path (it read "no column `sequence`").
+        (
+            sel(vec![], "sequence", Some(Aggregate::Mean)),
+            "`sequence` is a partition (text from the path), not a numeric column",
+        ),
     ] {
         let err = one(s).unwrap_err();
         assert!(err.contains(message), "{err}");

@@ -129,6 +129,14 @@ impl SpebtScenario {
         ensure_finite("bs_y_m", self.bs_y_m)?;
         ensure_non_negative("position_sigma_m", self.position_sigma_m)?;
         ensure_non_negative("yaw_sigma_deg", self.yaw_sigma_deg)?;
+        // As the --sigma-r-m / --sigma-theta-deg flags: beyond these no pose
+        // estimate is meant, and squared they overflow the filter (1e300).
+        if self.position_sigma_m > 1000.0 {
+            return Err(invalid("position_sigma_m", self.position_sigma_m, "at most 1000 m"));
+        }
+        if self.yaw_sigma_deg > 180.0 {
+            return Err(invalid("yaw_sigma_deg", self.yaw_sigma_deg, "at most 180 deg"));
+        }
         if !(self.max_step_ratio.is_finite() && self.max_step_ratio > 1.0) {
             return Err(invalid("max_step_ratio", self.max_step_ratio, "a finite ratio above 1"));
         }
@@ -428,6 +436,16 @@ mod tests {
         // Deterministic per (seed, run), different across runs.
         assert_eq!(link.realise(5, 3), link.realise(5, 3));
         assert_ne!(link.realise(5, 3).noise[1], link.realise(5, 4).noise[1]);
+    }
+
+    #[test]
+    fn pose_error_sigmas_beyond_a_pose_estimate_are_named() {
+        // 1e300 passed `validate` and overflowed the filter's covariance once squared.
+        for (sigma_m, sigma_deg, field) in [(1e300, 1.0, "position_sigma_m"), (1.0, 1e300, "yaw_sigma_deg")] {
+            let scenario = SpebtScenario { position_sigma_m: sigma_m, yaw_sigma_deg: sigma_deg, ..Default::default() };
+            let err = scenario.validate().unwrap_err().to_string();
+            assert!(err.contains(field) && err.contains("at most"), "{err}");
+        }
     }
 
     #[test]
