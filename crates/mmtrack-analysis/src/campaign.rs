@@ -414,14 +414,14 @@ pub fn compare_runs(out: &Path) -> anyhow::Result<Vec<ComparedRow>> {
         order.extend(compared.keys.iter().map(|k| PlSmallStr::from(*k)));
         order.push("run".into());
         let wide = query(frame.clone().select(select).sort(order, SortMultipleOptions::default()), compared)?;
-        let first_pooled = rows.len();
+        let first_of_table = rows.len();
         long_rows(&wide, compared, None, &mut rows)?;
         // The pooled rows only of runs with several sequences: with one they
         // would repeat its row, and a query summing the table without a
         // `sequence` filter would count it three times.
         let mut sequences_of_run: std::collections::BTreeMap<String, std::collections::BTreeSet<String>> =
             std::collections::BTreeMap::new();
-        for r in &rows[first_pooled..] {
+        for r in &rows[first_of_table..] {
             sequences_of_run.entry(r.row.run.clone()).or_default().insert(r.sequence.clone());
         }
         let several = |run: &str| sequences_of_run.get(run).is_some_and(|s| s.len() > 1);

@@ -18,10 +18,10 @@ pub fn empty_because(result: &MpcResult, file: &str) -> Option<String> {
     let sets = mmtrack_core::words::counted(result.per_set.len() as u64, "set");
     match file {
         "mpc_delay_tracks.svg" if result.detections.is_empty() => Some("no detections".into()),
-        // Without tracks the summary's counts and rates are null ("n/a" in the
-        // report): a plot of zeros would contradict it (the UWB log, one
-        // snapshot per set, drew "252 sets with 0 MPCs").
-        "mpc_count.svg" if result.counts.is_empty() || result.summary.mean_mpcs_per_set.is_none() => {
+        // Without tracks the summary's counts are null ("n/a" in the report)
+        // and so is their distribution: a plot of zeros would contradict it
+        // (the UWB log, one snapshot per set, drew "252 sets with 0 MPCs").
+        "mpc_count.svg" if result.counts.is_empty() => {
             Some("the MPCs of a set are its long-term tracks; this sequence has none".into())
         }
         "mpc_birth_death.svg"

@@ -34,6 +34,19 @@ impl Limit {
     pub fn allows_count(&self, value: u64) -> bool {
         (value as f64) <= self.max
     }
+
+    /// The count `value` of command-line flag `flag`, at least `min` and
+    /// within the bound, or a usage error (exit status 2) naming the flag.
+    ///
+    /// # Errors
+    /// `value` below `min` or beyond the bound.
+    pub fn check_flag(&self, flag: &str, value: u64, min: u64) -> Result<(), crate::error::UsageError> {
+        if value >= min && self.allows_count(value) {
+            Ok(())
+        } else {
+            Err(crate::error::UsageError::new(format!("{flag} {value}: expected {}", self.expected)))
+        }
+    }
 }
 
 /// Worker threads (`--threads`): starting a pool costs about quadratically in

@@ -254,13 +254,13 @@ fn floats(path: &Path, matrix: NpyMatrix, columns: Option<usize>, what: &str) ->
 
 /// The farthest a car may be from the roadside unit: a 60 GHz link spans
 /// tens to hundreds of metres (DeepSense's sites: under 100 m); 10 km is far
-/// beyond any link and far below a position of (0, 0), the value GPS logs
-/// write for "no fix", thousands of kilometres from any site.
+/// beyond any link. (A position of (0, 0), a GPS log's "no fix", is refused
+/// before, in its own file.)
 pub const MAX_LINK_DISTANCE_M: f64 = 10_000.0;
 
 /// Refuses a sweep whose car is farther than [`MAX_LINK_DISTANCE_M`] from
-/// the roadside unit (before, (0, 0) positions were ingested and the beam
-/// map fit failed later without naming a file or row).
+/// the roadside unit (before, such positions were ingested and the beam map
+/// fit failed later without naming a file or row).
 fn check_link_distance(vehicle_file: &Path, array: &[[f64; 2]], vehicle: &[[f64; 2]]) -> Result<(), IngestError> {
     for (row, (a, v)) in array.iter().zip(vehicle).enumerate() {
         let origin = crate::nmea::EnuOrigin { latitude_deg: a[0], longitude_deg: a[1], altitude_m: 0.0 };
@@ -272,8 +272,7 @@ fn check_link_distance(vehicle_file: &Path, array: &[[f64; 2]], vehicle: &[[f64;
                 format!("row {row}"),
                 "latitude, longitude",
                 format!(
-                    "({}, {}) is {:.0} km from the roadside unit at ({}, {}); a link spans at most {} km (a position \
-                     of (0, 0) is a GPS log's \"no fix\")",
+                    "({}, {}) is {:.0} km from the roadside unit at ({}, {}); a link spans at most {} km",
                     v[0],
                     v[1],
                     distance_m / 1000.0,

@@ -242,10 +242,10 @@ impl Assembler {
                     "fix at {} UTC is {} days {} the previous fix ({} UTC, line {last_line}): one of them is likely \
                      misdated (at most {} days between consecutive fixes)",
                     clock(t_ns),
-                    step_ns / 86_400_000_000_000,
+                    step_ns / NS_PER_DAY as u64,
                     if t_ns > last_t_ns { "after" } else { "before" },
                     clock(last_t_ns),
-                    super::MAX_DATE_STEP_NS / 86_400_000_000_000
+                    super::MAX_DATE_STEP_NS / NS_PER_DAY
                 );
                 self.log.first_date_step = Some(SkippedLine { line, reason });
             }

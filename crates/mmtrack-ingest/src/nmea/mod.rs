@@ -340,14 +340,14 @@ impl Parser {
 /// real: a logger off for a month is not a drive; a step of years is one
 /// RMC's wrong date (a first fix dated 1998 made a 22-year recording whose
 /// times were then labelled relative, not UNIX).
-pub const MAX_DATE_STEP_NS: i64 = 30 * 86_400 * 1_000_000_000;
+pub const MAX_DATE_STEP_NS: i64 = 30 * sentence::NS_PER_DAY;
 
-/// Refuses a log in which more epochs go back in time than are kept: one
-/// epoch stepped back is skipped (a receiver's clock correction), but when
-/// most are "before the previous fix", the fix they are measured against
-/// is the wrong one (e.g. one RMC with a wrong date), and keeping it would
-/// drop the drive.
-fn refuse_mostly_out_of_order(path: &Path, log: &NmeaLog) -> Result<(), IngestError> {
+/// Refuses a log with a misdated fix: a step over [`MAX_DATE_STEP_NS`]
+/// between consecutive fixes, or more epochs going back in time than are
+/// kept (one epoch stepped back is skipped, a receiver's clock correction;
+/// when most are "before the previous fix", the fix they are measured
+/// against is the wrong one, and keeping it would drop the drive).
+fn refuse_misdated_fixes(path: &Path, log: &NmeaLog) -> Result<(), IngestError> {
     if let Some(step) = &log.first_date_step {
         return Err(IngestError::bad_line(path, step.line, "date", step.reason.clone()));
     }
@@ -470,7 +470,7 @@ pub fn ingest_nmea(
             log.epochs_without_fix
         ),
     })?;
-    refuse_mostly_out_of_order(input, log)?;
+    refuse_misdated_fixes(input, log)?;
     let altitude_datum = match log.altitude_datum {
         "" => "none (no fix gives an altitude)",
         datum => datum,

@@ -116,11 +116,7 @@ pub fn simulate_slam(args: &SlamSimulation) -> anyhow::Result<SlamSimulated> {
         None => SlamScenario::default(),
     };
     if let Some(n) = args.epochs {
-        let limit = mmtrack_core::limits::SLAM_EPOCHS;
-        if n == 0 || !limit.allows_count(n) {
-            let message = format!("--epochs {n}: expected {}", limit.expected);
-            return Err(mmtrack_core::error::UsageError::new(message).into());
-        }
+        mmtrack_core::limits::SLAM_EPOCHS.check_flag("--epochs", n, 1)?;
         scenario.epochs = usize::try_from(n).context("--epochs")?;
     }
     let run = scenario.realise(args.seed, 0).with_context(|| {

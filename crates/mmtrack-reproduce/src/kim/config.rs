@@ -168,12 +168,8 @@ impl Config {
     pub fn filter_for(&self, particles: Option<usize>, tier: Tier) -> anyhow::Result<SlamConfig> {
         let mut filter = self.filter.clone();
         if let Some(p) = particles {
-            let limit = mmtrack_core::limits::PARTICLES;
-            if p < 2 || !limit.allows_count(p as u64) {
-                // The flag's fault, not the experiment file's (exit 2, as `process slam --particles`).
-                let message = format!("--particles {p}: expected {}", limit.expected);
-                return Err(mmtrack_core::error::UsageError::new(message).into());
-            }
+            // The flag's fault, not the experiment file's (exit 2, as `process slam --particles`).
+            mmtrack_core::limits::PARTICLES.check_flag("--particles", p as u64, 2)?;
             filter.particles = p;
         } else if tier.is_smoke() {
             filter.particles = self.quick_particles;
