@@ -42,7 +42,9 @@ pub struct OdometryConfig {
     pub keyframe_min_distance_m: f64,
     /// ... or this much rotation, degrees.
     pub keyframe_min_rotation_deg: f64,
-    /// Undo the motion during the sweep using the constant-velocity estimate.
+    /// Undo the motion during the sweep: each scan's bins are placed at the
+    /// middle of its sweep with the previous step's velocity (once per scan,
+    /// as the CFEAR authors' code does).
     pub motion_compensation: bool,
     /// Fewest correspondences for a trusted estimate; fewer flags it low-confidence.
     pub min_correspondences: usize,

@@ -1,7 +1,7 @@
 //! Stage 1: the k-strongest conservative filter, and placing the kept bins in
 //! the vehicle frame with optional per-azimuth motion compensation.
 
-use mmtrack_core::{PolarScan, Se2};
+use mmtrack_core::{PolarScan, PolarScanHeader, Se2};
 
 /// A point kept by the filter, in the vehicle frame at the scan's stamp.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -198,24 +198,48 @@ fn strongest_by_counting(
     }
 }
 
-/// Places the kept bins in the vehicle frame at the scan stamp. With
-/// `velocity = Some(v)` each point is moved from the pose at its azimuth's time
-/// to the pose at the stamp, assuming the constant body velocity `v` during the
-/// sweep (motion compensation, CFEAR Sec. III-B): `p = stamp_from_azimuth * p_a`
-/// with `stamp_from_azimuth = exp(v dt)`. With `None` the sweep is taken as
+/// Motion compensation of one sweep: the constant body velocity assumed
+/// during it and the instant the points are placed at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SweepMotion {
+    /// The vehicle's velocity during the sweep.
+    pub velocity: BodyVelocity,
+    /// The instant the points are placed at, seconds after the scan stamp
+    /// (the middle of the sweep: [`sweep_middle_ns`]).
+    pub reference_dt_s: f64,
+}
+
+/// The middle of the sweep, nanoseconds after the scan stamp: halfway
+/// between the first and the last valid azimuth's time (0 without one).
+/// Oxford stamps a scan with its first azimuth's time, about 125 ms before
+/// the middle of its 250 ms sweep.
+#[must_use]
+pub fn sweep_middle_ns(header: &PolarScanHeader) -> i64 {
+    let mut times = header.azimuths.iter().filter(|a| a.valid).map(|a| a.t_ns - header.t_ns);
+    let Some(first) = times.next() else { return 0 };
+    let (earliest, latest) = times.fold((first, first), |(lo, hi), t| (lo.min(t), hi.max(t)));
+    earliest + (latest - earliest) / 2
+}
+
+/// Places the kept bins in the vehicle frame. With `motion = Some(m)` each
+/// point is moved from the pose at its azimuth's time to the pose at
+/// `m.reference_dt_s`, assuming the constant body velocity `m.velocity`
+/// during the sweep (motion compensation, CFEAR Sec. III-B):
+/// `p = reference_from_azimuth * p_a` with `reference_from_azimuth =
+/// exp(v (dt - reference_dt))`. With `None` the sweep is taken as
 /// instantaneous, as Fast-CFEAR does.
 ///
 /// # References
 /// Adolfsson et al., CFEAR, T-RO 2023, Sec. III-B (motion compensation).
 ///
 /// The points of one azimuth share its time offset (the filter emits them
-/// together), so the transform `exp(v dt)` and its sine and cosine are
-/// computed once per run of equal `dt_s`, not once per point: the same
-/// arithmetic on the same operands, hence the same coordinates, at about a
-/// k-th of the trigonometry (k = 40 points per azimuth for CFEAR).
+/// together), so the transform and its sine and cosine are computed once per
+/// run of equal `dt_s`, not once per point: the same arithmetic on the same
+/// operands, hence the same coordinates, at about a k-th of the
+/// trigonometry (k = 40 points per azimuth for CFEAR).
 #[must_use]
-pub fn place(points: &[PolarPoint], velocity: Option<BodyVelocity>) -> Vec<FilteredPoint> {
-    let Some(v) = velocity else {
+pub fn place(points: &[PolarPoint], motion: Option<SweepMotion>) -> Vec<FilteredPoint> {
+    let Some(SweepMotion { velocity: v, reference_dt_s }) = motion else {
         return points
             .iter()
             .map(|p| FilteredPoint { xy_m: [p.range_m * p.direction[0], p.range_m * p.direction[1]], power: p.power })
@@ -229,7 +253,7 @@ pub fn place(points: &[PolarPoint], velocity: Option<BodyVelocity>) -> Vec<Filte
             let (s, c, x_m, y_m) = match cached {
                 Some((dt_s, s, c, x_m, y_m)) if dt_s.to_bits() == p.dt_s.to_bits() => (s, c, x_m, y_m),
                 _ => {
-                    let motion = v.motion_over(p.dt_s);
+                    let motion = v.motion_over(p.dt_s - reference_dt_s);
                     let (s, c) = motion.yaw_rad.sin_cos();
                     cached = Some((p.dt_s, s, c, motion.x_m, motion.y_m));
                     (s, c, motion.x_m, motion.y_m)
@@ -351,5 +375,39 @@ mod tests {
         let back = BodyVelocity::from_motion(v.motion_over(0.25), 0.25);
         assert!((back.vx_mps - 8.0).abs() < 1e-12 && (back.vy_mps + 0.3).abs() < 1e-12);
         assert!((back.yaw_rate_radps - 0.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_middle_of_the_sweep_is_halfway_between_the_first_and_last_valid_azimuth() {
+        let mut s = scan(&vec![vec![0u8; 4]; 5]);
+        s.header.t_ns = 100;
+        for (a, azimuth) in s.header.azimuths.iter_mut().enumerate() {
+            azimuth.t_ns = 100 + 1000 * a as i64;
+        }
+        assert_eq!(sweep_middle_ns(&s.header), 2000);
+        // Invalid rows at either end do not count; an odd span rounds down
+        // (1000 + 2001 / 2).
+        s.header.azimuths[0].valid = false;
+        s.header.azimuths[4].valid = false;
+        s.header.azimuths[3].t_ns = 3101;
+        assert_eq!(sweep_middle_ns(&s.header), 2000);
+        s.header.azimuths[3].t_ns = 3300;
+        assert_eq!(sweep_middle_ns(&s.header), 2100);
+        s.header.azimuths.iter_mut().for_each(|a| a.valid = false);
+        assert_eq!(sweep_middle_ns(&s.header), 0);
+    }
+
+    #[test]
+    fn placing_at_the_reference_instant_leaves_its_azimuth_where_it_was_seen() {
+        let mut s = scan(&[vec![0, 0, 90, 0], vec![0, 0, 0, 80]]);
+        s.header.azimuths[1].t_ns = 250_000_000;
+        let kept = k_strongest(&s, 1, 60, 0.0, 100.0);
+        let velocity = BodyVelocity { vx_mps: 8.0, vy_mps: 0.0, yaw_rate_radps: 0.2 };
+        let at_second = place(&kept, Some(SweepMotion { velocity, reference_dt_s: 0.25 }));
+        let instantaneous = place(&kept, None);
+        assert_eq!(at_second[1], instantaneous[1]);
+        // The first azimuth, 0.25 s earlier, is moved back by the motion over 0.25 s.
+        let back = velocity.motion_over(-0.25).transform_point(instantaneous[0].xy_m);
+        assert!((at_second[0].xy_m[0] - back[0]).abs() < 1e-12 && (at_second[0].xy_m[1] - back[1]).abs() < 1e-12);
     }
 }

@@ -27,7 +27,11 @@
 //! search (same minimum, exact 3x3 steps); (d) the downsampled point of a cell
 //! is its centroid, as the paper says (the code takes the point nearest the
 //! cell centre); (e) `fast-cfear` registers each scan to the previous one, as
-//! the paper says (the code keeps a keyframe until 1.5 m or 1.5 deg of motion).
+//! the paper says (the code keeps a keyframe until 1.5 m or 1.5 deg of motion);
+//! (f) motion compensation places each sweep once, at its middle, with the
+//! previous step's velocity, as the code does, but the first scan is placed
+//! again once the second gives a velocity (the code keeps it as placed
+//! without one).
 //!
 //! This crate is pure computation: no files, no printing. It sits in the
 //! `process` step: recording -> scans -> [`RadarOdometry`] -> odometry table.

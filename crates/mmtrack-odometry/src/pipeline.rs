@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use mmtrack_core::{OdometryEstimate, OdometryTiming, PolarScan, Se2};
 
-use crate::filter::{BodyVelocity, PolarPoint, k_strongest, place};
+use crate::filter::{BodyVelocity, PolarPoint, SweepMotion, k_strongest, place, sweep_middle_ns};
 use crate::register::{Reference, associate, solve};
 use crate::surface::{SurfaceParams, SurfacePoint, surface_points};
 use crate::{OdometryConfig, OdometryError};
@@ -23,10 +23,13 @@ struct Keyframe {
     reference: Reference,
 }
 
-/// The previous scan's estimate.
+/// The previous scan: its stamp, and its pose in the pipeline's frame at the
+/// instant its points were placed at (the stamp, or with motion
+/// compensation the middle of its sweep).
 #[derive(Debug, Clone, Copy)]
 struct Previous {
-    t_ns: i64,
+    stamp_ns: i64,
+    placed_t_ns: i64,
     world_from_vehicle: Se2,
 }
 
@@ -43,12 +46,25 @@ pub struct ScanOdometry {
 /// order. Memory is bounded by the keyframe submap, whatever the sequence length.
 ///
 /// The world frame is the first scan's pose. Each scan: (1) k-strongest filter
-/// (motion-compensated with the current velocity when configured), (2)-(3)
-/// oriented surface points, (4) registration to the submap starting from the
-/// constant-velocity prediction, re-associating `association_rounds` times.
-/// When registration cannot be trusted (too few correspondences, a degenerate
-/// scene, a non-finite result) the pose follows the prediction and the estimate
-/// is flagged `low_confidence`: never a NaN pose.
+/// (with motion compensation: placed at the middle of the sweep with the
+/// previous step's velocity), (2)-(3) oriented surface points, (4)
+/// registration to the submap starting from the constant-velocity
+/// prediction, re-associating `association_rounds` times. When registration
+/// cannot be trusted (too few correspondences, a degenerate scene, a
+/// non-finite result) the pose follows the prediction and the estimate is
+/// flagged `low_confidence`: never a NaN pose.
+///
+/// Motion compensation as the CFEAR authors' code does it (`Compensate` in
+/// their `utils.cpp`, called once per scan before the surface points): each
+/// point is moved to the middle of its sweep with the velocity of the step
+/// before, once. Placed at the middle, a velocity error `e` only skews the
+/// sweep (`e (t - t_mid)` has zero mean); placed at the scan's stamp (Oxford:
+/// the first azimuth) it would also shift the whole sweep by `e T / 2`, and
+/// with the next velocity taken from the resulting estimate the step errors
+/// obey `d_k = -(d_{k-1} - d_{k-2}) / 2`, whose root -1 makes the steps
+/// oscillate without decaying. The poses inside the pipeline are at the
+/// middle of each sweep; the estimate is moved back to the stamp with the
+/// estimated velocity.
 #[derive(Debug, Clone)]
 pub struct RadarOdometry {
     config: OdometryConfig,
@@ -56,9 +72,16 @@ pub struct RadarOdometry {
     keyframes: VecDeque<Keyframe>,
     previous: Option<Previous>,
     velocity: BodyVelocity,
-    /// With motion compensation: the first scan's kept bins, until the second
-    /// scan gives a velocity to place them with (the first scan's own velocity
-    /// is unknown when it arrives).
+    /// With motion compensation: the first scan's middle of the sweep after
+    /// its stamp, seconds, until the second scan gives the velocity that
+    /// places the world origin (the first scan's pose at its stamp) in the
+    /// pipeline's frame (the first scan's pose at the middle of its sweep).
+    first_middle_s: f64,
+    /// With motion compensation: the world frame from the pipeline's frame,
+    /// known from the second scan on.
+    world_from_pipeline: Option<Se2>,
+    /// With motion compensation: the first scan's kept bins, until the
+    /// second scan gives the velocity to place them with.
     first_kept: Option<Vec<PolarPoint>>,
 }
 
@@ -78,6 +101,8 @@ impl RadarOdometry {
             keyframes: VecDeque::new(),
             previous: None,
             velocity: BodyVelocity::default(),
+            first_middle_s: 0.0,
+            world_from_pipeline: None,
             first_kept: None,
         })
     }
@@ -93,11 +118,24 @@ impl RadarOdometry {
         check_scan(scan)?;
         let t_ns = scan.header.t_ns;
         if let Some(previous) = self.previous
-            && t_ns <= previous.t_ns
+            && t_ns <= previous.stamp_ns
         {
-            return Err(OdometryError::NonMonotonicTime { previous_t_ns: previous.t_ns, t_ns });
+            return Err(OdometryError::NonMonotonicTime { previous_t_ns: previous.stamp_ns, t_ns });
         }
         let config = &self.config;
+        let compensate = config.motion_compensation;
+        // The instant the points are placed at, and the pose is estimated at.
+        let middle_ns = if compensate { sweep_middle_ns(&scan.header) } else { 0 };
+        let placed_t_ns = t_ns + middle_ns;
+        if let Some(previous) = self.previous
+            && placed_t_ns <= previous.placed_t_ns
+        {
+            let detail = format!(
+                "the middle of its sweep (t_ns {placed_t_ns}) is not after the previous scan's (t_ns {})",
+                previous.placed_t_ns
+            );
+            return Err(OdometryError::BadScan { t_ns, detail });
+        }
         let mut clock = StageClock::start();
         let kept = k_strongest(scan, config.k_strongest, config.min_power, config.min_range_m, config.max_range_m);
         clock.lap_filter();
@@ -112,86 +150,86 @@ impl RadarOdometry {
             cost_m2: 0.0,
             low_confidence: false,
         };
-        let surface = match self.previous {
+        let middle_s = middle_ns as f64 * 1e-9;
+        let motion = compensate.then_some(SweepMotion { velocity: self.velocity, reference_dt_s: middle_s });
+        let mut surface = surface_points(&place(&kept, motion), &self.surface);
+        clock.lap_surface();
+        let pose = match self.previous {
             None => {
-                let surface = surface_points(&place(&kept, None), &self.surface);
-                clock.lap_surface();
-                if self.config.motion_compensation {
+                self.first_middle_s = middle_s;
+                if compensate {
                     self.first_kept = Some(kept);
                 }
-                surface
+                Se2::IDENTITY
             }
             Some(previous) => {
-                let dt_s = (t_ns - previous.t_ns) as f64 * 1e-9;
+                let dt_s = (placed_t_ns - previous.placed_t_ns) as f64 * 1e-9;
                 let predicted = previous.world_from_vehicle * self.velocity.motion_over(dt_s);
-                let (surface, first_reference) = self.register(&kept, previous, predicted, &mut estimate, &mut clock);
-                if let (Some(reference), Some(first)) = (first_reference, self.keyframes.front_mut()) {
-                    first.reference = reference;
+                let mut pose = self.register(&surface, predicted, &mut estimate);
+                self.velocity = BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s);
+                if let Some(first) = self.first_kept.take() {
+                    // The second scan: both sweeps were placed without motion
+                    // (none was known); place both again with the velocity
+                    // between them (constant over both sweeps) and register again.
+                    surface = self.place_first_two_again(&first, &kept, middle_s);
+                    clock.lap_surface();
+                    pose = self.register(&surface, pose, &mut estimate);
+                    self.velocity = BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s);
                 }
-                self.first_kept = None;
-                let motion = previous.world_from_vehicle.inverse() * estimate.world_from_vehicle;
-                self.velocity = BodyVelocity::from_motion(motion, dt_s);
-                surface
+                pose
             }
+        };
+        estimate.world_from_vehicle = if compensate {
+            // From the second scan on, the first scan's stamp pose is known
+            // in the pipeline's frame: it is the world origin.
+            let first_middle_s = self.first_middle_s;
+            let velocity = self.velocity;
+            let world_from_pipeline = match self.previous {
+                None => Se2::IDENTITY,
+                Some(_) => {
+                    *self.world_from_pipeline.get_or_insert_with(|| velocity.motion_over(-first_middle_s).inverse())
+                }
+            };
+            world_from_pipeline * pose * self.velocity.motion_over(-middle_s)
+        } else {
+            pose
         };
         estimate.surface_points = surface.len() as u32;
         estimate.low_confidence |= surface.len() < self.config.min_correspondences;
-        self.update_keyframes(&surface, estimate.world_from_vehicle);
-        self.previous = Some(Previous { t_ns, world_from_vehicle: estimate.world_from_vehicle });
+        self.update_keyframes(&surface, pose);
+        self.previous = Some(Previous { stamp_ns: t_ns, placed_t_ns, world_from_vehicle: pose });
         clock.lap_register();
         Ok(ScanOdometry { estimate, timing: clock.timing(t_ns) })
     }
 
-    /// Registers the scan against the submap from `predicted`, re-associating
-    /// `association_rounds` times; with motion compensation, each round places
-    /// the points with the velocity implied by the current estimate (so the
-    /// compensation and the estimate agree, instead of feeding one scan's error
-    /// into the next scan's compensation). Fills the estimate, falling back to
-    /// the prediction when the result is doubtful, and returns the scan's
-    /// surface points as placed for the final estimate. On the second scan with
-    /// motion compensation, the first scan is placed with the same velocity in
-    /// every round (constant velocity over both sweeps); its re-placed
-    /// reference is returned too.
-    fn register(
-        &self,
-        kept: &[PolarPoint],
-        previous: Previous,
-        predicted: Se2,
-        estimate: &mut OdometryEstimate,
-        clock: &mut StageClock,
-    ) -> (Vec<SurfacePoint>, Option<Reference>) {
+    /// The second scan's surface points, placed with the current velocity,
+    /// after the first scan's keyframe is placed again with it too.
+    fn place_first_two_again(
+        &mut self,
+        first: &[PolarPoint],
+        second: &[PolarPoint],
+        middle_s: f64,
+    ) -> Vec<SurfacePoint> {
+        let velocity = self.velocity;
+        let first_motion = SweepMotion { velocity, reference_dt_s: self.first_middle_s };
+        let first_surface = surface_points(&place(first, Some(first_motion)), &self.surface);
+        if let Some(keyframe) = self.keyframes.front_mut() {
+            keyframe.reference = Reference::new(&first_surface, keyframe.world_from_vehicle, self.config.grid_m);
+        }
+        surface_points(&place(second, Some(SweepMotion { velocity, reference_dt_s: middle_s })), &self.surface)
+    }
+
+    /// Registers the scan's surface points against the submap from
+    /// `predicted`, re-associating `association_rounds` times at the new
+    /// estimate. Fills the estimate's diagnostics and returns the pose,
+    /// falling back to the prediction when the result is doubtful.
+    fn register(&self, surface: &[SurfacePoint], predicted: Se2, estimate: &mut OdometryEstimate) -> Se2 {
         let config = &self.config;
-        let dt_s = (estimate.t_ns - previous.t_ns) as f64 * 1e-9;
-        let velocity_at = |pose: Se2| {
-            config
-                .motion_compensation
-                .then(|| BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s))
-        };
-        let first_reference_at = |pose: Se2| {
-            self.first_kept.as_ref().map(|first| {
-                let first_surface = surface_points(&place(first, velocity_at(pose)), &self.surface);
-                Reference::new(&first_surface, previous.world_from_vehicle, config.grid_m)
-            })
-        };
-        let mut first_reference = first_reference_at(predicted);
-        let mut surface = surface_points(&place(kept, velocity_at(predicted)), &self.surface);
-        clock.lap_surface();
-        let sweep_s = kept.iter().map(|p| p.dt_s.abs()).fold(0.0, f64::max);
-        let mut placed_for = predicted;
+        let references: Vec<&Reference> = self.keyframes.iter().map(|k| &k.reference).collect();
         let mut pose = predicted;
         let mut trusted = true;
         for _ in 0..config.association_rounds {
-            if config.motion_compensation && !same_placement(velocity_at(placed_for), velocity_at(pose), sweep_s) {
-                surface = surface_points(&place(kept, velocity_at(pose)), &self.surface);
-                first_reference = first_reference_at(pose);
-                placed_for = pose;
-                clock.lap_surface();
-            }
-            let references: Vec<&Reference> = match &first_reference {
-                Some(first) => vec![first],
-                None => self.keyframes.iter().map(|k| &k.reference).collect(),
-            };
-            let correspondences = associate(&surface, &references, pose, config.grid_m, config.max_normal_angle_rad());
+            let correspondences = associate(surface, &references, pose, config.grid_m, config.max_normal_angle_rad());
             estimate.correspondences = correspondences.len() as u32;
             if correspondences.len() < config.min_correspondences {
                 trusted = false;
@@ -201,22 +239,13 @@ impl RadarOdometry {
             estimate.iterations += solution.iterations;
             estimate.cost_m2 = solution.cost_m2;
             pose = solution.world_from_scan;
-            clock.lap_register();
             trusted = pose.is_finite() && solution.translation_observability >= MIN_TRANSLATION_OBSERVABILITY;
             if !trusted {
                 break;
             }
         }
         estimate.low_confidence |= !trusted;
-        estimate.world_from_vehicle = if trusted { pose } else { predicted };
-        if config.motion_compensation
-            && !same_placement(velocity_at(placed_for), velocity_at(estimate.world_from_vehicle), sweep_s)
-        {
-            surface = surface_points(&place(kept, velocity_at(estimate.world_from_vehicle)), &self.surface);
-            first_reference = first_reference_at(estimate.world_from_vehicle);
-            clock.lap_surface();
-        }
-        (surface, first_reference)
+        if trusted { pose } else { predicted }
     }
 
     /// Adds the scan as a keyframe when it moved far enough from the last one.
@@ -237,21 +266,6 @@ impl RadarOdometry {
                 self.keyframes.pop_front();
             }
         }
-    }
-}
-
-/// True when two compensation velocities place every point of a sweep of
-/// `sweep_s` within 1 mm and 1e-5 rad of each other: re-placing the points
-/// would not change the surface points measurably, so it is skipped.
-fn same_placement(a: Option<BodyVelocity>, b: Option<BodyVelocity>, sweep_s: f64) -> bool {
-    match (a, b) {
-        (Some(a), Some(b)) => {
-            let translation_m = (a.vx_mps - b.vx_mps).hypot(a.vy_mps - b.vy_mps) * sweep_s;
-            let rotation_rad = (a.yaw_rate_radps - b.yaw_rate_radps).abs() * sweep_s;
-            translation_m < 1e-3 && rotation_rad < 1e-5
-        }
-        (None, None) => true,
-        _ => false,
     }
 }
 

@@ -253,7 +253,7 @@ mod tests {
 
     #[test]
     fn on_real_scans_the_pruned_search_gives_the_full_searchs_surface_points_bit_for_bit() {
-        use crate::filter::{BodyVelocity, k_strongest, place};
+        use crate::filter::{BodyVelocity, SweepMotion, k_strongest, place};
         let Some(scans) = crate::real_scans::oxford() else { return };
         let bits = |points: &[SurfacePoint]| -> Vec<(u32, [u64; 4])> {
             points
@@ -262,7 +262,7 @@ mod tests {
                 .collect()
         };
         // Both presets; the sweep as instantaneous and motion-compensated
-        // (a turning drive, as cfear places it in its association rounds).
+        // (a turning drive placed at the middle of its sweep, as cfear places it).
         let turning = BodyVelocity { vx_mps: 8.3, vy_mps: -0.2, yaw_rate_radps: 0.21 };
         let mut compared = 0;
         for config in [crate::OdometryConfig::fast_cfear(), crate::OdometryConfig::cfear()] {
@@ -270,12 +270,12 @@ mod tests {
             for scan in &scans {
                 let kept =
                     k_strongest(scan, config.k_strongest, config.min_power, config.min_range_m, config.max_range_m);
-                for velocity in [None, Some(turning)] {
-                    let filtered = place(&kept, velocity);
+                for motion in [None, Some(SweepMotion { velocity: turning, reference_dt_s: 0.125 })] {
+                    let filtered = place(&kept, motion);
                     let pruned = surface_points(&filtered, &params);
                     let full = surface_points_full_3x3(&filtered, &params);
                     assert!(pruned.len() > 50, "{} surface points: too few to test anything", pruned.len());
-                    assert_eq!(bits(&pruned), bits(&full), "k = {}, {velocity:?}", config.k_strongest);
+                    assert_eq!(bits(&pruned), bits(&full), "k = {}, {motion:?}", config.k_strongest);
                     compared += pruned.len();
                 }
             }

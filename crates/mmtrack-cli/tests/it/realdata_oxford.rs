@@ -217,7 +217,7 @@ fn an_estimate_in_the_recording_scores_exactly_as_the_odometry_it_came_from() {
     run(&["process", "odometry", "tiny.mcap", "-o", "runs", "--run-id", "ours", "-q"]);
     run(&["export", "--format", "mcap", "runs/run=ours", "--recording", "tiny.mcap", "-o", "est.mcap", "-q"]);
     let stdout = run(&["process", "poses", "est.mcap", "-o", "runs", "--run-id", "external"]);
-    assert!(stdout.contains("poses: estimate 11 (2.5 s, 19.2 m), ground truth 11 (2.5 s, 19.4 m)"), "{stdout}");
+    assert!(stdout.contains("poses: estimate 11 (2.5 s, 19.3 m), ground truth 11 (2.5 s, 19.4 m)"), "{stdout}");
     let part =
         |run: &str, table: &str| d.join(format!("runs/run={run}/{table}/sequence=oxford-radar-tiny/part-0.parquet"));
     let ours: Vec<mmtrack_core::OdometryEstimate> = read_table(&part("ours", "odometry")).unwrap();
