@@ -165,7 +165,7 @@ impl RadarOdometry {
             Some(previous) => {
                 let dt_s = (placed_t_ns - previous.placed_t_ns) as f64 * 1e-9;
                 let predicted = previous.world_from_vehicle * self.velocity.motion_over(dt_s);
-                let mut pose = self.register(&surface, predicted, &mut estimate);
+                let (mut pose, mut trusted) = self.register(&surface, predicted, &mut estimate);
                 self.velocity = BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s);
                 if let Some(first) = self.first_kept.take() {
                     // The second scan: both sweeps were placed without motion
@@ -173,9 +173,10 @@ impl RadarOdometry {
                     // between them (constant over both sweeps) and register again.
                     surface = self.place_first_two_again(&first, &kept, middle_s);
                     clock.lap_surface();
-                    pose = self.register(&surface, pose, &mut estimate);
+                    (pose, trusted) = self.register(&surface, pose, &mut estimate);
                     self.velocity = BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s);
                 }
+                estimate.low_confidence |= !trusted;
                 pose
             }
         };
@@ -221,9 +222,9 @@ impl RadarOdometry {
 
     /// Registers the scan's surface points against the submap from
     /// `predicted`, re-associating `association_rounds` times at the new
-    /// estimate. Fills the estimate's diagnostics and returns the pose,
-    /// falling back to the prediction when the result is doubtful.
-    fn register(&self, surface: &[SurfacePoint], predicted: Se2, estimate: &mut OdometryEstimate) -> Se2 {
+    /// estimate. Fills the estimate's diagnostics and returns the pose and
+    /// whether it can be trusted (if not, the pose is the prediction).
+    fn register(&self, surface: &[SurfacePoint], predicted: Se2, estimate: &mut OdometryEstimate) -> (Se2, bool) {
         let config = &self.config;
         let references: Vec<&Reference> = self.keyframes.iter().map(|k| &k.reference).collect();
         let mut pose = predicted;
@@ -244,8 +245,7 @@ impl RadarOdometry {
                 break;
             }
         }
-        estimate.low_confidence |= !trusted;
-        if trusted { pose } else { predicted }
+        if trusted { (pose, true) } else { (predicted, false) }
     }
 
     /// Adds the scan as a keyframe when it moved far enough from the last one.
