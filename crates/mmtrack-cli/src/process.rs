@@ -41,7 +41,13 @@ enum Pipeline {
     /// when the recording has it, `ground_truth/...`. `mmtrack analyze <out>` scores it
     /// as our radar odometry (drift per length, RPE, ATE); `--run-id` compares runs.
     #[command(verbatim_doc_comment)]
-    Poses(PosesArgs),
+    Poses(RecordingArgs),
+    /// The recording's radar scans, CIR snapshots, GNSS fixes and ground truth as tables, for pandas / polars / DuckDB.
+    ///
+    /// Writes those it has, one row per message as recorded (memory stays bounded): `radar_scans`,
+    /// `cir_snapshots`, `gnss_fixes`, `ground_truth` (`<table>/sequence=<id>/part-0.parquet`; schemas/).
+    #[command(verbatim_doc_comment)]
+    Raw(RecordingArgs),
     /// Multipath-component detection and tracking (Mahler et al. 2017) on the recording's CIR snapshots.
     ///
     /// Writes, under the output directory, per sequence partition:
@@ -130,8 +136,8 @@ pub struct OdometryArgs {
 }
 
 #[derive(Args)]
-pub struct PosesArgs {
-    /// Recording with poses on /estimate/pose.
+pub struct RecordingArgs {
+    /// Recording (from `mmtrack ingest` or `mmtrack simulate`).
     pub recording: PathBuf,
     /// Output table directory (created if missing).
     #[arg(short, long)]
@@ -226,6 +232,15 @@ pub fn run_pipeline(args: &ProcessArgs, quiet: bool) -> anyhow::Result<Vec<PathB
             let done = poses::process_poses(&a.recording, &a.output, &a.output_args.options(), &progress)?;
             if !quiet {
                 println!("{}", done.poses.summary());
+                print_written(&done.written);
+            }
+            written(done.written)
+        }
+        Pipeline::Raw(a) => {
+            let progress = IndicatifProgress::new(quiet);
+            let done = mmtrack_process::raw::process_raw(&a.recording, &a.output, &a.output_args.options(), &progress)?;
+            if !quiet {
+                println!("{}", done.summary());
                 print_written(&done.written);
             }
             written(done.written)

@@ -38,6 +38,7 @@ pub mod odometry;
 pub mod output;
 pub mod poses;
 pub mod provenance;
+pub mod raw;
 pub mod simulate;
 pub mod slam;
 pub mod threads;

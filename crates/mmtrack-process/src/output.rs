@@ -35,7 +35,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
-use mmtrack_io::table::{RunInfo, StagedTable, TableRow, TableWriteSummary, publish_tables, stage_table, table_path};
+use mmtrack_io::table::{
+    RunInfo, StagedTable, TableRow, TableSpec, TableWriteSummary, TableWriter, publish_tables, stage_table, table_path,
+};
 
 /// Where a pipeline writes, as the front end gave it: the output directory,
 /// an optional run id and whether existing tables may be replaced.
@@ -170,7 +172,34 @@ impl RunTables {
     /// An existing table (without `--force`), a bad partition name, or a
     /// table that cannot be written.
     pub fn write<T: TableRow>(&mut self, sequence: &str, rows: &[T], run: &RunInfo) -> anyhow::Result<()> {
-        let target = table_path(&self.dir.path, T::SPEC.name, sequence)?;
+        self.note_created_dirs(T::SPEC.name, sequence)?;
+        self.staged.push(stage_table(&self.dir.path, sequence, rows, run, self.dir.overwrite)?);
+        Ok(())
+    }
+
+    /// A writer of the `sequence` partition of `spec`'s table, for rows
+    /// that come in many calls; hand it back with [`RunTables::add`].
+    ///
+    /// # Errors
+    /// As [`RunTables::write`].
+    pub fn writer(&mut self, spec: &'static TableSpec, sequence: &str, run: &RunInfo) -> anyhow::Result<TableWriter> {
+        self.note_created_dirs(spec.name, sequence)?;
+        Ok(TableWriter::create(&self.dir.path, spec, sequence, run, self.dir.overwrite)?)
+    }
+
+    /// Adds a table completed by a [`RunTables::writer`] to the run.
+    ///
+    /// # Errors
+    /// The file cannot be completed.
+    pub fn add(&mut self, writer: TableWriter) -> anyhow::Result<()> {
+        self.staged.push(writer.stage()?);
+        Ok(())
+    }
+
+    /// Remembers the directories the table's partition will create, so an
+    /// unpublished run removes them.
+    fn note_created_dirs(&mut self, table: &str, sequence: &str) -> anyhow::Result<()> {
+        let target = table_path(&self.dir.path, table, sequence)?;
         let mut missing: Vec<PathBuf> = target
             .ancestors()
             .skip(1)
@@ -179,7 +208,6 @@ impl RunTables {
             .collect();
         missing.reverse();
         self.created_dirs.extend(missing);
-        self.staged.push(stage_table(&self.dir.path, sequence, rows, run, self.dir.overwrite)?);
         Ok(())
     }
 

@@ -121,6 +121,23 @@ def test_ingest_ros2_writes_what_the_cli_writes(tmp_path: Path) -> None:
         mmtrack.ingest("ros2", bag, tmp_path / "radar.mcap", radar_topic="/radar")
 
 
+def test_process_raw_gives_the_cli_s_tables_of_the_recording_s_measurements(tmp_path: Path) -> None:
+    ingested = mmtrack.ingest("oxford", DEMO_FOLDER, tmp_path / "demo.mcap", bins="auto")
+    cli("process", "raw", tmp_path / "demo.mcap", "-o", tmp_path / "cli-raw", "-q")
+    done = mmtrack.process("raw", tmp_path / "demo.mcap", tmp_path / "py-raw")
+    assert done["radar_scans"] == ingested["scans"] > 0
+    assert done["cir_snapshots"] == 0 and done["ground_truth_poses"] > 0
+    for table in ("radar_scans", "ground_truth"):
+        ours = mmtrack.read_table(tmp_path / "py-raw", table).collect()
+        assert ours.equals(mmtrack.read_table(tmp_path / "cli-raw", table).collect()), table
+    scans = mmtrack.read_table(tmp_path / "py-raw", "radar_scans").collect()
+    assert scans.height == done["radar_scans"]
+    first = scans.row(0, named=True)
+    assert len(first["power"]) == len(first["azimuth_rad"]) * first["bins_per_azimuth"]
+    with pytest.raises(mmtrack.MmtrackError, match="radar_scans/sequence=oxford-demo/part-0.parquet: exists; use --force"):
+        mmtrack.process("raw", tmp_path / "demo.mcap", tmp_path / "py-raw")
+
+
 def test_ingest_poses_writes_what_the_cli_writes(tmp_path: Path) -> None:
     tum = tmp_path / "gt.tum"
     tum.write_text("".join(f"{1.7e9 + 0.25 * k:.2f} {2.0 * k} {0.1 * k} 0 0 0 0 1\n" for k in range(12)))

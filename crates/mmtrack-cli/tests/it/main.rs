@@ -26,6 +26,7 @@ mod process_beam_spebt;
 mod process_manifest;
 mod process_mpc;
 mod process_odometry;
+mod process_raw;
 mod python_package;
 mod realdata_beams;
 mod realdata_nmea;

@@ -180,7 +180,12 @@ pub fn table_bytes<T: TableRow>(rows: &[T], run: &RunInfo) -> Result<Vec<u8>> {
     writer.into_inner().map_err(|e| table_write_err(path, e))
 }
 
+/// Encoded bytes a [`TableWriter`] buffers before it writes them to the
+/// file as a row group.
+pub const ROW_GROUP_BYTES: usize = 64 << 20;
+
 /// Writes one partition of one table; nothing appears until [`TableWriter::finish`].
+/// Rows may come in any number of calls; memory stays near [`ROW_GROUP_BYTES`].
 pub struct TableWriter {
     spec: &'static TableSpec,
     schema: Arc<arrow_schema::Schema>,
@@ -219,6 +224,12 @@ impl TableWriter {
         let batch =
             RecordBatch::try_new(self.schema.clone(), T::to_columns(rows)).map_err(|e| table_write_err(&path, e))?;
         self.writer.write(&batch).map_err(|e| table_write_err(&path, e))?;
+        // Bounded memory for tables written in many calls (radar scans of a
+        // whole drive): the buffered row group goes to the file once it
+        // holds ROW_GROUP_BYTES.
+        if self.writer.in_progress_size() >= ROW_GROUP_BYTES {
+            self.writer.flush().map_err(|e| table_write_err(&path, e))?;
+        }
         self.rows += rows.len() as u64;
         Ok(())
     }

@@ -24,7 +24,7 @@ crate::define_table! {
 
 crate::define_table! {
     /// `gnss_fixes`: GNSS positions.
-    pub const GNSS_FIXES = "gnss_fixes", "One WGS-84 GNSS fix per row.",
+    pub const GNSS_FIXES = "gnss_fixes", "One WGS-84 GNSS fix per row (`mmtrack process raw`: the recording's /gnss/fix).",
         frame: TableFrame::Fixed {
             id: "wgs84",
             meaning: "WGS-84 geodetic latitude and longitude in degrees (the GNSS convention), altitude as the receiver gives it (the recording names its datum)",
@@ -49,7 +49,7 @@ crate::define_table! {
 crate::define_table! {
     /// `radar_scans`: polar radar scans, one per row.
     pub const RADAR_SCANS = "radar_scans",
-        "One polar radar scan per row; power is row-major azimuth x bin, one byte per bin.",
+        "One polar radar scan per row (`mmtrack process raw`); power is row-major azimuth x bin, one byte per bin.",
         frame: TableFrame::Fixed {
             id: "radar_sensor",
             meaning: "azimuth_rad in the radar sensor's own frame, clockwise from its forward axis seen from above, as the sensor reports it",
@@ -86,7 +86,7 @@ crate::define_table! {
 crate::define_table! {
     /// `cir_snapshots`: channel impulse responses, one per row.
     pub const CIR_SNAPSHOTS = "cir_snapshots",
-        "One channel impulse response per row; tap k is at delay delay_offset_s + k * tap_spacing_s.",
+        "One channel impulse response per row (`mmtrack process raw`); tap k is at delay delay_offset_s + k * tap_spacing_s.",
         frame: TableFrame::NotApplicable;
     CirSnapshot {
         t_ns: i64, "ns", "measurement time";

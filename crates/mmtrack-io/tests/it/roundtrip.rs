@@ -326,3 +326,53 @@ proptest! {
         prop_assert_eq!(back.iter().map(pose_bits).collect::<Vec<_>>(), poses.iter().map(pose_bits).collect::<Vec<_>>());
     }
 }
+
+/// A table written in many calls (radar scans of a whole drive) goes to the
+/// file a row group at a time, about every `ROW_GROUP_BYTES`, instead of
+/// buffering every row until the end; it reads back whole, in order.
+#[test]
+fn a_table_written_in_many_calls_is_flushed_in_row_groups_and_reads_back_whole() {
+    use mmtrack_core::{AzimuthSample, PolarScanHeader};
+    use mmtrack_io::table::{RADAR_SCANS, ROW_GROUP_BYTES, RunInfo, TableWriter};
+    let (azimuths, bins) = (400, 3768);
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut scan = |k: i64| {
+        let power = (0..azimuths * bins)
+            .map(|_| {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 56) as u8
+            })
+            .collect();
+        let azimuths = (0..azimuths)
+            .map(|a| AzimuthSample { t_ns: k * 250_000_000 + a as i64, azimuth_rad: a as f64 * 0.0157, valid: true })
+            .collect();
+        let header = PolarScanHeader {
+            t_ns: k * 250_000_000,
+            range_resolution_m: 0.0438,
+            range_offset_m: 0.0,
+            bins_per_azimuth: bins,
+            azimuths,
+        };
+        PolarScan::new(header, power).unwrap()
+    };
+    let scans_per_group = ROW_GROUP_BYTES / (azimuths * bins) + 1;
+    let dir = tempfile::tempdir().unwrap();
+    let run = RunInfo::new("{}", mmtrack_io::recording::TimeBase::Relative);
+    let mut writer = TableWriter::create(dir.path(), &RADAR_SCANS, "s", &run, Overwrite::Refuse).unwrap();
+    let mut written = Vec::new();
+    for k in 0..(scans_per_group + 3) as i64 {
+        let s = scan(k);
+        writer.write(std::slice::from_ref(&s)).unwrap();
+        written.push(s);
+    }
+    let summary = writer.finish().unwrap();
+    let file = std::fs::File::open(&summary.path).unwrap();
+    let row_groups = parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder::try_new(file)
+        .unwrap()
+        .metadata()
+        .num_row_groups();
+    assert_eq!(row_groups, 2, "{} scans of {} bytes", written.len(), azimuths * bins);
+    assert_eq!(read_table::<PolarScan>(&summary.path).unwrap(), written);
+}

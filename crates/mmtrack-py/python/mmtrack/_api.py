@@ -53,6 +53,11 @@ PROCESS_OPTIONS: dict[str, dict[str, Any]] = {
         "force": False,
         "run_id": None,
     },
+    "raw": {
+        "sequence": None,
+        "force": False,
+        "run_id": None,
+    },
     "mpc": {
         "config": None,
         "pulse": None,
@@ -189,7 +194,8 @@ def process(pipeline: str, recording: Union[PathLike, Sequence[PathLike]], outpu
     """``mmtrack process <pipeline> <recording> -o <output>``: a pipeline's tables.
 
     ``pipeline``: odometry, poses (the recording's own estimate and ground
-    truth, to score another odometry), mpc, beam (``recording`` may be a list
+    truth, to score another odometry), raw (its radar scans, CIR snapshots,
+    GNSS fixes and ground truth as tables), mpc, beam (``recording`` may be a list
     of recordings or folders) or slam; ``options`` are its flags
     (:data:`PROCESS_OPTIONS`). Returns the tables written (path, rows) and
     the pipeline's counts.
@@ -219,6 +225,8 @@ def process(pipeline: str, recording: Union[PathLike, Sequence[PathLike]], outpu
         )
     if pipeline == "poses":
         return _native.process_poses(rec, out, o["sequence"], o["force"], o["run_id"])
+    if pipeline == "raw":
+        return _native.process_raw(rec, out, o["sequence"], o["force"], o["run_id"])
     if pipeline == "mpc":
         return _native.process_mpc(
             rec,

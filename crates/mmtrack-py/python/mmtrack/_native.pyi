@@ -85,6 +85,9 @@ def process_odometry(
 def process_poses(
     recording: str, output: str, sequence: Optional[str], force: bool, run_id: Optional[str]
 ) -> dict[str, Any]: ...
+def process_raw(
+    recording: str, output: str, sequence: Optional[str], force: bool, run_id: Optional[str]
+) -> dict[str, Any]: ...
 def effective_config(pipeline: str, preset: str, config: Optional[str], gmphd: bool) -> str: ...
 def process_mpc(
     recording: str,

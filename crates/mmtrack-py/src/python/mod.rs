@@ -196,6 +196,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ingest::ingest_beams, m)?)?;
     m.add_function(wrap_pyfunction!(process::process_odometry, m)?)?;
     m.add_function(wrap_pyfunction!(process::process_poses, m)?)?;
+    m.add_function(wrap_pyfunction!(process::process_raw, m)?)?;
     m.add_function(wrap_pyfunction!(process::effective_config, m)?)?;
     m.add_function(wrap_pyfunction!(process::process_mpc, m)?)?;
     m.add_function(wrap_pyfunction!(process::process_beam, m)?)?;

@@ -62,6 +62,34 @@ pub(super) fn process_poses<'py>(
     )
 }
 
+/// `mmtrack process raw`.
+#[pyfunction]
+#[pyo3(signature = (recording, output, sequence, force, run_id))]
+pub(super) fn process_raw<'py>(
+    py: Python<'py>,
+    recording: PathBuf,
+    output: PathBuf,
+    sequence: Option<String>,
+    force: bool,
+    run_id: Option<String>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let options = output_options(sequence, force, run_id);
+    let done =
+        interruptible(py, 0, |progress| mmtrack_process::raw::process_raw(&recording, &output, &options, progress))?;
+    let c = done.counts;
+    dict(
+        py,
+        &[
+            ("sequence", any(py, &done.sequence)?),
+            ("radar_scans", any(py, c.radar_scans)?),
+            ("cir_snapshots", any(py, c.cir_snapshots)?),
+            ("gnss_fixes", any(py, c.gnss_fixes)?),
+            ("ground_truth_poses", any(py, c.ground_truth)?),
+            ("tables", written_tables(py, &done.written)?.into_any()),
+        ],
+    )
+}
+
 /// `mmtrack process odometry --print-config` / `process mpc --print-config`:
 /// the effective configuration as TOML.
 #[pyfunction]
