@@ -534,6 +534,25 @@ const REPLACED_SUFFIX: &str = ".replaced";
 enum PartialKind {
     File,
     Directory,
+    /// A directory this process created for outputs it has not published:
+    /// removed on an interruption when it is empty once the partials are.
+    CreatedDirectory,
+}
+
+/// Registers `dir`, a directory this process just created for outputs not
+/// yet published, so that an interruption ([`remove_partial_outputs`])
+/// removes it if it is empty by then (the partial files in it go first).
+/// Dropping the result takes it out of the registry (the outputs were
+/// published, or the writer removed the directory itself).
+pub fn register_created_dir(dir: &Path) -> CreatedDirRegistration {
+    live_partials().insert(dir.to_path_buf(), PartialKind::CreatedDirectory);
+    CreatedDirRegistration { _registration: Registration(dir.to_path_buf()) }
+}
+
+/// Keeps a directory in the registry of [`register_created_dir`] until dropped.
+#[derive(Debug)]
+pub struct CreatedDirRegistration {
+    _registration: Registration,
 }
 
 /// The partial outputs this process is writing.
@@ -577,6 +596,7 @@ pub fn remove_partial_outputs() -> PartialOutputsRemoved {
         let result = match kind {
             PartialKind::File => std::fs::remove_file(path),
             PartialKind::Directory => remove_directory_being_written(path),
+            PartialKind::CreatedDirectory => continue,
         };
         match result {
             Ok(()) => removed += 1,
@@ -584,6 +604,12 @@ pub fn remove_partial_outputs() -> PartialOutputsRemoved {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
             Err(e) => failed.push((path.clone(), e)),
         }
+    }
+    // Then the directories created for them, innermost first (path order
+    // puts a directory before what is inside it); only empty ones go, so
+    // nothing another writer put there is touched.
+    for (path, _) in registry.iter().rev().filter(|(_, kind)| **kind == PartialKind::CreatedDirectory) {
+        let _ = std::fs::remove_dir(path);
     }
     PartialOutputsRemoved { removed, failed, _registry: registry }
 }

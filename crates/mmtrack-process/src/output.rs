@@ -35,6 +35,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
+use mmtrack_io::atomic::{CreatedDirRegistration, register_created_dir};
 use mmtrack_io::table::{
     RunInfo, StagedTable, TableRow, TableSpec, TableWriteSummary, TableWriter, publish_tables, stage_table, table_path,
 };
@@ -155,12 +156,15 @@ pub struct RunTables {
     /// Directories this run created, outermost first: removed when still
     /// empty if the run does not publish.
     created_dirs: Vec<PathBuf>,
+    /// The same directories in the registry of partial outputs, so that an
+    /// interruption (Ctrl-C) removes them too when empty.
+    registered_dirs: Vec<CreatedDirRegistration>,
 }
 
 impl RunDir {
     /// Starts the set of tables of one run here.
     pub fn tables(&self) -> RunTables {
-        RunTables { dir: self.clone(), staged: Vec::new(), created_dirs: Vec::new() }
+        RunTables { dir: self.clone(), staged: Vec::new(), created_dirs: Vec::new(), registered_dirs: Vec::new() }
     }
 }
 
@@ -207,6 +211,7 @@ impl RunTables {
             .map(Path::to_path_buf)
             .collect();
         missing.reverse();
+        self.registered_dirs.extend(missing.iter().map(|dir| register_created_dir(dir)));
         self.created_dirs.extend(missing);
         Ok(())
     }
@@ -219,6 +224,7 @@ impl RunTables {
     pub fn publish(mut self) -> anyhow::Result<Vec<TableWriteSummary>> {
         let written = publish_tables(std::mem::take(&mut self.staged), self.dir.overwrite)?;
         self.created_dirs.clear();
+        self.registered_dirs.clear();
         Ok(written)
     }
 }

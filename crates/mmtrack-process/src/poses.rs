@@ -55,6 +55,16 @@ impl RecordingPoses {
     }
 }
 
+/// The frame of a recording's ground truth as its tables state it (the
+/// recording's `extra` metadata names its origin).
+pub(crate) fn ground_truth_frame(recording_extra: &BTreeMap<String, String>) -> Frame {
+    Frame::of_recording(
+        "ground_truth",
+        "the world frame of the recording's ground truth (/ground_truth/pose)",
+        recording_extra,
+    )
+}
+
 /// Adds `pose` (of `topic`) to `poses`, refusing a time that
 /// does not increase: the trajectory metrics interpolate between poses.
 fn push_in_order(poses: &mut Vec<StampedPose>, pose: StampedPose, topic: &str) -> anyhow::Result<()> {
@@ -152,11 +162,7 @@ pub fn process_poses(
         "the world frame of the recording's estimate (/estimate/pose) as its source gives it; `mmtrack analyze` \
          anchors it to the ground truth before comparing",
     );
-    let truth_frame = Frame::of_recording(
-        "ground_truth",
-        "the world frame of the recording's ground truth (/ground_truth/pose)",
-        &poses.recording_extra,
-    );
+    let truth_frame = ground_truth_frame(&poses.recording_extra);
     let info = RunInfo {
         config_json: serde_json::json!({
             "command": "process poses",

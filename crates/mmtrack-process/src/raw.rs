@@ -14,7 +14,7 @@ use anyhow::{Context, bail};
 use mmtrack_core::progress::Progress;
 use mmtrack_core::{CirSnapshot, GnssFix, PolarScan};
 use mmtrack_io::recording::PoseStream;
-use mmtrack_io::table::{Frame, GroundTruthPose, RunInfo, TableRow, TableWriteSummary, TableWriter};
+use mmtrack_io::table::{GroundTruthPose, RunInfo, TableRow, TableWriteSummary, TableWriter};
 use mmtrack_io::{RecordingEvent, RecordingMetadata, RecordingReader};
 
 use crate::events::for_each_event;
@@ -185,11 +185,7 @@ pub fn process_raw(
         tables.write(&sequence, &fixes, &run)?;
     }
     if !truth.is_empty() {
-        let frame = Frame::of_recording(
-            "ground_truth",
-            "the world frame of the recording's ground truth (/ground_truth/pose)",
-            &extra,
-        );
+        let frame = crate::poses::ground_truth_frame(&extra);
         tables.write(&sequence, &truth, &RunInfo { frame: Some(frame), ..run.clone() })?;
     }
     let written = tables.publish()?;

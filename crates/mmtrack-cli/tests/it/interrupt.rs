@@ -293,3 +293,49 @@ fn analyze_force_interrupted_while_removing_the_old_results_leaves_nothing() {
     // 16 of 16 here; the bound only makes sure the window was hit at all.
     assert!(signalled_while_removing >= 2, "only {signalled_while_removing} runs hit the removal");
 }
+
+/// `process raw` writes its scan table as it reads (not at the end, as the
+/// other pipelines do), so an interruption finds the table directories it
+/// created: they go with the partial file, and a directory that was there
+/// before stays (QA of session 27: `t/radar_scans/sequence=.../` was left).
+#[test]
+fn process_raw_interrupted_leaves_no_partial_and_none_of_the_directories_it_created() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let drive = LONG_DRIVE.replace("duration_s = 400.0", "duration_s = 30.0");
+    std::fs::write(d.join("drive.toml"), drive).unwrap();
+    super::common::mmtrack_ok(d, &["simulate", "radar", "--scenario", "drive.toml", "-o", "drive.mcap", "-q"]);
+    std::fs::create_dir_all(d.join("kept/mine")).unwrap();
+    for (out, kept) in [("new", false), ("kept", true)] {
+        let child = Command::new(env!("CARGO_BIN_EXE_mmtrack"))
+            .args(["process", "raw", "drive.mcap", "-o", out])
+            .current_dir(d)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut run = Running(child);
+        let table = d.join(out).join("radar_scans/sequence=drive");
+        for _ in 0..1200 {
+            if table.is_dir()
+                && partials(&table).iter().any(|n| std::fs::metadata(table.join(n)).is_ok_and(|m| m.len() > 1 << 20))
+            {
+                break;
+            }
+            assert!(run.0.try_wait().unwrap().is_none(), "process raw ended before it was interrupted");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        send("INT", &run);
+        let (status, stderr) = finish(run);
+        assert_eq!(status.code(), Some(130), "{status:?} {stderr}");
+        if kept {
+            let left: Vec<String> = std::fs::read_dir(d.join(out))
+                .unwrap()
+                .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+                .collect();
+            assert_eq!(left, ["mine"], "only what was there before stays");
+        } else {
+            assert!(!d.join(out).exists(), "{:?}", files(&d.join(out)));
+        }
+    }
+}
