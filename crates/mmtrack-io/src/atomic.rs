@@ -546,13 +546,21 @@ enum PartialKind {
 /// published, or the writer removed the directory itself).
 pub fn register_created_dir(dir: &Path) -> CreatedDirRegistration {
     live_partials().insert(dir.to_path_buf(), PartialKind::CreatedDirectory);
-    CreatedDirRegistration { _registration: Registration(dir.to_path_buf()) }
+    CreatedDirRegistration { registration: Registration(dir.to_path_buf()) }
 }
 
 /// Keeps a directory in the registry of [`register_created_dir`] until dropped.
 #[derive(Debug)]
 pub struct CreatedDirRegistration {
-    _registration: Registration,
+    registration: Registration,
+}
+
+impl CreatedDirRegistration {
+    /// The directory.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.registration.0
+    }
 }
 
 /// The partial outputs this process is writing.

@@ -3,7 +3,8 @@
 
 use mmtrack_core::{PolarScan, PolarScanHeader, Se2};
 
-/// A point kept by the filter, in the vehicle frame at the scan's stamp.
+/// A point kept by the filter, in the vehicle frame at the instant it is
+/// placed at ([`place`]: the scan's stamp, or the middle of the sweep).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FilteredPoint {
     /// Position, metres (x forward, y left).

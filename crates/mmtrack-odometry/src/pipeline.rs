@@ -72,17 +72,14 @@ pub struct RadarOdometry {
     keyframes: VecDeque<Keyframe>,
     previous: Option<Previous>,
     velocity: BodyVelocity,
-    /// With motion compensation: the first scan's middle of the sweep after
-    /// its stamp, seconds, until the second scan gives the velocity that
-    /// places the world origin (the first scan's pose at its stamp) in the
-    /// pipeline's frame (the first scan's pose at the middle of its sweep).
-    first_middle_s: f64,
-    /// With motion compensation: the world frame from the pipeline's frame,
-    /// known from the second scan on.
+    /// With motion compensation: the world frame (the first scan's pose at
+    /// its stamp) from the pipeline's frame (the first scan's pose at the
+    /// middle of its sweep), known from the second scan on.
     world_from_pipeline: Option<Se2>,
-    /// With motion compensation: the first scan's kept bins, until the
-    /// second scan gives the velocity to place them with.
-    first_kept: Option<Vec<PolarPoint>>,
+    /// With motion compensation: the first scan's kept bins and the middle
+    /// of its sweep after its stamp (seconds), until the second scan gives
+    /// the velocity to place them with.
+    first_kept: Option<(Vec<PolarPoint>, f64)>,
 }
 
 impl RadarOdometry {
@@ -101,7 +98,6 @@ impl RadarOdometry {
             keyframes: VecDeque::new(),
             previous: None,
             velocity: BodyVelocity::default(),
-            first_middle_s: 0.0,
             world_from_pipeline: None,
             first_kept: None,
         })
@@ -156,9 +152,8 @@ impl RadarOdometry {
         clock.lap_surface();
         let pose = match self.previous {
             None => {
-                self.first_middle_s = middle_s;
                 if compensate {
-                    self.first_kept = Some(kept);
+                    self.first_kept = Some((kept, middle_s));
                 }
                 Se2::IDENTITY
             }
@@ -167,31 +162,23 @@ impl RadarOdometry {
                 let predicted = previous.world_from_vehicle * self.velocity.motion_over(dt_s);
                 let (mut pose, mut trusted) = self.register(&surface, predicted, &mut estimate);
                 self.velocity = BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s);
-                if let Some(first) = self.first_kept.take() {
+                if let Some((first, first_middle_s)) = self.first_kept.take() {
                     // The second scan: both sweeps were placed without motion
                     // (none was known); place both again with the velocity
                     // between them (constant over both sweeps) and register again.
-                    surface = self.place_first_two_again(&first, &kept, middle_s);
+                    surface = self.place_first_two_again(&first, first_middle_s, &kept, middle_s);
                     clock.lap_surface();
                     (pose, trusted) = self.register(&surface, pose, &mut estimate);
                     self.velocity = BodyVelocity::from_motion(previous.world_from_vehicle.inverse() * pose, dt_s);
+                    // The first scan's stamp pose in the pipeline's frame is now known.
+                    self.world_from_pipeline = Some(self.velocity.motion_over(-first_middle_s).inverse());
                 }
                 estimate.low_confidence |= !trusted;
                 pose
             }
         };
         estimate.world_from_vehicle = if compensate {
-            // From the second scan on, the first scan's stamp pose is known
-            // in the pipeline's frame: it is the world origin.
-            let first_middle_s = self.first_middle_s;
-            let velocity = self.velocity;
-            let world_from_pipeline = match self.previous {
-                None => Se2::IDENTITY,
-                Some(_) => {
-                    *self.world_from_pipeline.get_or_insert_with(|| velocity.motion_over(-first_middle_s).inverse())
-                }
-            };
-            world_from_pipeline * pose * self.velocity.motion_over(-middle_s)
+            self.world_from_pipeline.unwrap_or(Se2::IDENTITY) * pose * self.velocity.motion_over(-middle_s)
         } else {
             pose
         };
@@ -208,11 +195,12 @@ impl RadarOdometry {
     fn place_first_two_again(
         &mut self,
         first: &[PolarPoint],
+        first_middle_s: f64,
         second: &[PolarPoint],
         middle_s: f64,
     ) -> Vec<SurfacePoint> {
         let velocity = self.velocity;
-        let first_motion = SweepMotion { velocity, reference_dt_s: self.first_middle_s };
+        let first_motion = SweepMotion { velocity, reference_dt_s: first_middle_s };
         let first_surface = surface_points(&place(first, Some(first_motion)), &self.surface);
         if let Some(keyframe) = self.keyframes.front_mut() {
             keyframe.reference = Reference::new(&first_surface, keyframe.world_from_vehicle, self.config.grid_m);

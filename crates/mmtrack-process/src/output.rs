@@ -65,11 +65,7 @@ impl OutputOptions {
     /// reports the problem itself and checks again after its work.
     #[must_use]
     pub fn sequence_hint(&self, recording: &Path) -> Option<String> {
-        self.sequence.clone().or_else(|| {
-            let mut reader = mmtrack_io::RecordingReader::open(recording).ok()?;
-            let _ = reader.next_item();
-            reader.metadata().and_then(mmtrack_io::recording::RecordingMetadata::from_map).map(|m| m.sequence_id)
-        })
+        self.sequence.clone().or_else(|| recording_metadata(recording).ok().flatten().map(|m| m.sequence_id))
     }
 
     /// The run directory under `output` with the overwrite policy of
@@ -81,6 +77,19 @@ impl OutputOptions {
         let overwrite = if self.force { Overwrite::Replace } else { Overwrite::Refuse };
         Ok(RunDir { path: run_dir(output, self.run_id.as_deref())?, overwrite })
     }
+}
+
+/// The recording's metadata (writers put it first), read up to the first
+/// message; `None` when it has none.
+///
+/// # Errors
+/// The file cannot be opened, or a record before the first message is bad.
+pub fn recording_metadata(recording: &Path) -> anyhow::Result<Option<mmtrack_io::RecordingMetadata>> {
+    let mut reader = mmtrack_io::RecordingReader::open(recording)?;
+    if let Some(Err(e)) = reader.next_item() {
+        return Err(e.into());
+    }
+    Ok(reader.metadata().and_then(mmtrack_io::RecordingMetadata::from_map))
 }
 
 /// The directory the tables go to: `output` itself without a run id, else
@@ -154,17 +163,15 @@ pub struct RunTables {
     dir: RunDir,
     staged: Vec<StagedTable>,
     /// Directories this run created, outermost first: removed when still
-    /// empty if the run does not publish.
-    created_dirs: Vec<PathBuf>,
-    /// The same directories in the registry of partial outputs, so that an
-    /// interruption (Ctrl-C) removes them too when empty.
-    registered_dirs: Vec<CreatedDirRegistration>,
+    /// empty if the run does not publish; in the registry of partial
+    /// outputs meanwhile, so that an interruption (Ctrl-C) removes them too.
+    created_dirs: Vec<CreatedDirRegistration>,
 }
 
 impl RunDir {
     /// Starts the set of tables of one run here.
     pub fn tables(&self) -> RunTables {
-        RunTables { dir: self.clone(), staged: Vec::new(), created_dirs: Vec::new(), registered_dirs: Vec::new() }
+        RunTables { dir: self.clone(), staged: Vec::new(), created_dirs: Vec::new() }
     }
 }
 
@@ -211,8 +218,7 @@ impl RunTables {
             .map(Path::to_path_buf)
             .collect();
         missing.reverse();
-        self.registered_dirs.extend(missing.iter().map(|dir| register_created_dir(dir)));
-        self.created_dirs.extend(missing);
+        self.created_dirs.extend(missing.iter().map(|dir| register_created_dir(dir)));
         Ok(())
     }
 
@@ -224,7 +230,6 @@ impl RunTables {
     pub fn publish(mut self) -> anyhow::Result<Vec<TableWriteSummary>> {
         let written = publish_tables(std::mem::take(&mut self.staged), self.dir.overwrite)?;
         self.created_dirs.clear();
-        self.registered_dirs.clear();
         Ok(written)
     }
 }
@@ -236,7 +241,7 @@ impl Drop for RunTables {
         // ones, so nothing another writer put there goes.
         self.staged.clear();
         for dir in self.created_dirs.iter().rev() {
-            let _ = std::fs::remove_dir(dir);
+            let _ = std::fs::remove_dir(dir.path());
         }
     }
 }

@@ -15,10 +15,10 @@ use mmtrack_core::progress::Progress;
 use mmtrack_core::{CirSnapshot, GnssFix, PolarScan};
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::table::{GroundTruthPose, RunInfo, TableRow, TableWriteSummary, TableWriter};
-use mmtrack_io::{RecordingEvent, RecordingMetadata, RecordingReader};
+use mmtrack_io::{RecordingEvent, RecordingMetadata};
 
 use crate::events::for_each_event;
-use crate::output::{OutputOptions, RunTables, run_id_of};
+use crate::output::{OutputOptions, RunTables, recording_metadata, run_id_of};
 
 /// Every table `process raw` may write.
 pub const TABLES: [&str; 4] = ["radar_scans", "cir_snapshots", "gnss_fixes", "ground_truth"];
@@ -70,12 +70,11 @@ struct Batched<T> {
     rows: Vec<T>,
     per_batch: usize,
     writer: Option<TableWriter>,
-    written: u64,
 }
 
 impl<T: TableRow> Batched<T> {
     fn new(per_batch: usize) -> Self {
-        Self { rows: Vec::new(), per_batch, writer: None, written: 0 }
+        Self { rows: Vec::new(), per_batch, writer: None }
     }
 
     fn push(&mut self, row: T, tables: &mut RunTables, sequence: &str, run: &RunInfo) -> anyhow::Result<()> {
@@ -90,24 +89,23 @@ impl<T: TableRow> Batched<T> {
         if self.rows.is_empty() {
             return Ok(());
         }
-        if self.writer.is_none() {
-            self.writer = Some(tables.writer(T::SPEC, sequence, run)?);
-        }
-        if let Some(writer) = self.writer.as_mut() {
-            writer.write(&self.rows)?;
-        }
-        self.written += self.rows.len() as u64;
+        let writer = match &mut self.writer {
+            Some(writer) => writer,
+            None => self.writer.insert(tables.writer(T::SPEC, sequence, run)?),
+        };
+        writer.write(&self.rows)?;
         self.rows.clear();
         Ok(())
     }
 
-    /// Writes what is left and hands the table to the run (nothing when no row came).
+    /// Writes what is left and hands the table to the run (nothing when no
+    /// row came); returns the rows written.
     fn finish(mut self, tables: &mut RunTables, sequence: &str, run: &RunInfo) -> anyhow::Result<u64> {
         self.flush(tables, sequence, run)?;
-        if let Some(writer) = self.writer {
-            tables.add(writer)?;
-        }
-        Ok(self.written)
+        let Some(writer) = self.writer else { return Ok(0) };
+        let rows = writer.rows();
+        tables.add(writer)?;
+        Ok(rows)
     }
 }
 
@@ -126,14 +124,7 @@ pub fn process_raw(
     progress: &dyn Progress,
 ) -> anyhow::Result<RawOutput> {
     let out = options.resolve(output)?;
-    let metadata = {
-        let mut reader = RecordingReader::open(recording)?;
-        if let Some(Err(e)) = reader.next_item() {
-            return Err(e.into());
-        }
-        reader.metadata().and_then(RecordingMetadata::from_map)
-    };
-    let Some(RecordingMetadata { sequence_id, time_base, extra, .. }) = metadata else {
+    let Some(RecordingMetadata { sequence_id, time_base, extra, .. }) = recording_metadata(recording)? else {
         bail!("{}: no mmtrack recording metadata (sequence id); nothing written", recording.display());
     };
     let sequence = options.sequence_or(&sequence_id);

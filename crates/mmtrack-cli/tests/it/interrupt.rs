@@ -316,15 +316,18 @@ fn process_raw_interrupted_leaves_no_partial_and_none_of_the_directories_it_crea
             .unwrap();
         let mut run = Running(child);
         let table = d.join(out).join("radar_scans/sequence=drive");
-        for _ in 0..1200 {
-            if table.is_dir()
+        let growing = || {
+            table.is_dir()
                 && partials(&table).iter().any(|n| std::fs::metadata(table.join(n)).is_ok_and(|m| m.len() > 1 << 20))
-            {
+        };
+        for _ in 0..1200 {
+            if growing() {
                 break;
             }
             assert!(run.0.try_wait().unwrap().is_none(), "process raw ended before it was interrupted");
             std::thread::sleep(Duration::from_millis(20));
         }
+        assert!(growing(), "no growing partial table appeared in {}", table.display());
         send("INT", &run);
         let (status, stderr) = finish(run);
         assert_eq!(status.code(), Some(130), "{status:?} {stderr}");

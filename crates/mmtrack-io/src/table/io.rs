@@ -234,6 +234,12 @@ impl TableWriter {
         Ok(())
     }
 
+    /// Rows written so far.
+    #[must_use]
+    pub fn rows(&self) -> u64 {
+        self.rows
+    }
+
     /// Completes the file and moves it into place.
     pub fn finish(self) -> Result<TableWriteSummary> {
         let overwrite = self.overwrite;
