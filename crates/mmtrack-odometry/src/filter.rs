@@ -160,18 +160,25 @@ fn strongest_by_counting(
     candidates: &mut Vec<(u8, usize)>,
     strongest: &mut Vec<(u8, usize)>,
 ) {
-    candidates.clear();
+    // Each bin of a block with a candidate is written to the next free slot,
+    // which only advances for a candidate: no branch on the bin's power, whose
+    // outcome is as good as random along a row. There are never more
+    // candidates than bins, so the slots before each write are enough.
+    if candidates.len() < bins.len() {
+        candidates.resize(bins.len(), (0, 0));
+    }
+    let mut found = 0;
     for (block_index, block) in bins.chunks(SKIP_BLOCK_BINS).enumerate() {
         if block.iter().fold(0u8, |m, &p| m.max(p)) < min_power {
             continue;
         }
-        let block_start = first_bin + block_index * SKIP_BLOCK_BINS;
+        let block_start = block_index * SKIP_BLOCK_BINS;
         for (offset, &power) in block.iter().enumerate() {
-            if power >= min_power {
-                candidates.push((power, block_start + offset));
-            }
+            candidates[found] = (power, first_bin + block_start + offset);
+            found += usize::from(power >= min_power);
         }
     }
+    let candidates = &candidates[..found];
     strongest.clear();
     let kept = k.min(candidates.len());
     if kept == 0 {
@@ -180,7 +187,7 @@ fn strongest_by_counting(
     // next[p]: the place of the next candidate of power p, counted from
     // the strongest (the candidates stronger than p come first).
     let mut next = [0usize; 256];
-    for &(power, _) in candidates.iter() {
+    for &(power, _) in candidates {
         next[usize::from(power)] += 1;
     }
     let mut stronger = 0;
@@ -190,7 +197,7 @@ fn strongest_by_counting(
         stronger += count;
     }
     strongest.resize(kept, (0, 0));
-    for &(power, bin) in candidates.iter() {
+    for &(power, bin) in candidates {
         let place = &mut next[usize::from(power)];
         if *place < kept {
             strongest[*place] = (power, bin);

@@ -11,6 +11,9 @@
 #[derive(Debug, Clone)]
 pub struct GridIndex {
     cell_m: f64,
+    /// `1 / cell_m`: a point's cell is `floor(x * cells_per_m)`, one
+    /// multiplication instead of a division per coordinate (see [`cell_of`]).
+    cells_per_m: f64,
     /// Cell of the lower-left corner of the bounding box.
     origin: (i64, i64),
     /// Cells along x and y.
@@ -27,6 +30,9 @@ pub struct GridIndex {
 /// finer than `cell_m`: queries stay correct, only a little less selective).
 const MAX_CELLS: i64 = 1 << 20;
 
+/// Interleaved counters per cell in [`GridIndex::new`]'s counting sort.
+const COUNT_LANES: usize = 4;
+
 impl GridIndex {
     /// Buckets `points` into square cells of side `cell_m` (> 0). Points
     /// with a non-finite coordinate are left out (no finite point is within
@@ -41,15 +47,24 @@ impl GridIndex {
             }
         }
         if finite.is_empty() {
-            return Self { cell_m, origin: (0, 0), size: (0, 0), start: vec![0], order: Vec::new(), xy_m: Vec::new() };
+            return Self {
+                cell_m,
+                cells_per_m: cell_m.recip(),
+                origin: (0, 0),
+                size: (0, 0),
+                start: vec![0],
+                order: Vec::new(),
+                xy_m: Vec::new(),
+            };
         }
         let mut cell_m = cell_m;
         let mut keys: Vec<(i64, i64)> = Vec::with_capacity(finite.len());
         loop {
             keys.clear();
+            let cells_per_m = cell_m.recip();
             let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
             for (_, p) in &finite {
-                let (x, y) = cell_of(*p, cell_m);
+                let (x, y) = cell_of(*p, cells_per_m);
                 lo = (lo.0.min(x), lo.1.min(y));
                 hi = (hi.0.max(x), hi.1.max(y));
                 keys.push((x, y));
@@ -62,12 +77,25 @@ impl GridIndex {
             let cells = (size.0 * size.1) as usize;
             // Flat cell of every point, computed once for both passes below.
             let flat: Vec<u32> = keys.iter().map(|&(x, y)| ((x - lo.0) * size.1 + (y - lo.1)) as u32).collect();
-            let mut start = vec![0u32; cells + 1];
-            for &c in &flat {
-                start[c as usize + 1] += 1;
+            // Points come in runs within one cell (a ray's bins), so one
+            // counter per cell would make each increment wait for the last
+            // one's store; four interleaved counters per cell do not.
+            let mut counts = vec![[0u32; COUNT_LANES]; cells];
+            let mut lanes = flat.chunks_exact(COUNT_LANES);
+            for run in lanes.by_ref() {
+                for (lane, &c) in run.iter().enumerate() {
+                    counts[c as usize][lane] += 1;
+                }
             }
-            for c in 0..cells {
-                start[c + 1] += start[c];
+            for &c in lanes.remainder() {
+                counts[c as usize][0] += 1;
+            }
+            let mut start = Vec::with_capacity(cells + 1);
+            let mut before = 0u32;
+            start.push(before);
+            for count in &counts {
+                before += count.iter().sum::<u32>();
+                start.push(before);
             }
             let mut next = start.clone();
             let mut order = vec![0u32; flat.len()];
@@ -78,7 +106,7 @@ impl GridIndex {
                 xy_m[*slot as usize] = p;
                 *slot += 1;
             }
-            return Self { cell_m, origin: lo, size, start, order, xy_m };
+            return Self { cell_m, cells_per_m, origin: lo, size, start, order, xy_m };
         }
     }
 
@@ -102,7 +130,7 @@ impl GridIndex {
     /// points within `cell_m` of `p`; callers check the distance.
     #[cfg(test)]
     pub fn candidates(&self, p: [f64; 2]) -> impl Iterator<Item = usize> + '_ {
-        let (cx, cy) = cell_of(p, self.cell_m);
+        let (cx, cy) = cell_of(p, self.cells_per_m);
         (-1..=1)
             .flat_map(move |dy| (-1..=1).flat_map(move |dx| self.cell((cx + dx, cy + dy)).iter().map(|&i| i as usize)))
     }
@@ -116,7 +144,7 @@ impl GridIndex {
     /// replaces cost about as much as the distance tests).
     #[inline]
     pub fn for_each_candidate(&self, p: [f64; 2], mut visit: impl FnMut(usize, [f64; 2])) {
-        let (cx, cy) = cell_of(p, self.cell_m);
+        let (cx, cy) = cell_of(p, self.cells_per_m);
         for dy in -1..=1 {
             for dx in -1..=1 {
                 let range = self.cell_range((cx + dx, cy + dy));
@@ -138,7 +166,7 @@ impl GridIndex {
     /// in a skipped cell.
     #[inline]
     pub fn for_each_cell_near(&self, p: [f64; 2], radius_m: f64, mut visit: impl FnMut(&[[f64; 2]])) {
-        let (cx, cy) = cell_of(p, self.cell_m);
+        let (cx, cy) = cell_of(p, self.cells_per_m);
         // Distances from `p` to the lower and upper sides of its own cell.
         let lower = [p[0] - cx as f64 * self.cell_m, p[1] - cy as f64 * self.cell_m];
         let upper = [(cx + 1) as f64 * self.cell_m - p[0], (cy + 1) as f64 * self.cell_m - p[1]];
@@ -184,11 +212,16 @@ impl GridIndex {
     }
 }
 
-/// The cell holding `p`.
+/// The cell holding `p` in a grid of `cells_per_m` cells per metre (the
+/// reciprocal of the cell side). Multiplying by the reciprocal can put a
+/// point within a rounding error of a cell boundary in the neighbouring
+/// cell, as dividing can; the index and its queries use this one function,
+/// and a query's reach into neighbouring cells has a margin for it
+/// ([`GridIndex::for_each_cell_near`]).
 #[must_use]
 #[inline]
-pub fn cell_of(p: [f64; 2], cell_m: f64) -> (i64, i64) {
-    (floor_to_i64(p[0] / cell_m), floor_to_i64(p[1] / cell_m))
+pub fn cell_of(p: [f64; 2], cells_per_m: f64) -> (i64, i64) {
+    (floor_to_i64(p[0] * cells_per_m), floor_to_i64(p[1] * cells_per_m))
 }
 
 /// `x.floor() as i64` (saturating, NaN to 0) without the call to libm's

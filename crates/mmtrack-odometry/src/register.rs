@@ -36,18 +36,37 @@ impl Reference {
     /// `world_from_scan`, indexed for queries within `radius_m`.
     #[must_use]
     pub fn new(points: &[SurfacePoint], world_from_scan: Se2, radius_m: f64) -> Self {
-        let points: Vec<SurfacePoint> = points.iter().map(|p| transform(p, world_from_scan)).collect();
+        let world_from_scan = Transform::new(world_from_scan);
+        let points: Vec<SurfacePoint> = points.iter().map(|p| world_from_scan.surface_point(p)).collect();
         let index = GridIndex::new(points.iter().map(|p| p.mean_m), radius_m);
         Self { points, index }
     }
 }
 
-fn transform(p: &SurfacePoint, a_from_b: Se2) -> SurfacePoint {
-    let (s, c) = a_from_b.yaw_rad.sin_cos();
-    SurfacePoint {
-        mean_m: a_from_b.transform_point(p.mean_m),
-        normal: [c * p.normal[0] - s * p.normal[1], s * p.normal[0] + c * p.normal[1]],
-        neighbours: p.neighbours,
+/// An SE(2) transform with its yaw's sine and cosine computed once, for
+/// placing many points: the arithmetic of [`Se2::transform_point`] per point.
+#[derive(Debug, Clone, Copy)]
+struct Transform {
+    sin: f64,
+    cos: f64,
+    x_m: f64,
+    y_m: f64,
+}
+
+impl Transform {
+    fn new(a_from_b: Se2) -> Self {
+        let (sin, cos) = a_from_b.yaw_rad.sin_cos();
+        Self { sin, cos, x_m: a_from_b.x_m, y_m: a_from_b.y_m }
+    }
+
+    fn surface_point(&self, p: &SurfacePoint) -> SurfacePoint {
+        let (s, c) = (self.sin, self.cos);
+        let [x, y] = p.mean_m;
+        SurfacePoint {
+            mean_m: [c * x - s * y + self.x_m, s * x + c * y + self.y_m],
+            normal: [c * p.normal[0] - s * p.normal[1], s * p.normal[0] + c * p.normal[1]],
+            neighbours: p.neighbours,
+        }
     }
 }
 
@@ -80,8 +99,9 @@ pub fn associate(
     let min_cos = max_angle_rad.cos();
     let radius_sq = radius_m * radius_m;
     let mut out = Vec::with_capacity(source.len() * references.len());
+    let world_from_scan = Transform::new(world_from_scan);
     for s in source {
-        let placed = transform(s, world_from_scan);
+        let placed = world_from_scan.surface_point(s);
         for &reference in references {
             let mut best: Option<(f64, usize)> = None;
             reference.index.for_each_candidate(placed.mean_m, |j, _| {
@@ -223,7 +243,8 @@ mod tests {
         let world = room();
         let truth = Se2::new(1.7, -0.4, 0.05);
         // The scan sees the room from `truth`: source = truth^-1 * world.
-        let source: Vec<SurfacePoint> = world.iter().map(|p| transform(p, truth.inverse())).collect();
+        let source: Vec<SurfacePoint> =
+            world.iter().map(|p| Transform::new(truth.inverse()).surface_point(p)).collect();
         let reference = Reference::new(&world, Se2::IDENTITY, 3.5);
         let mut pose = Se2::new(1.2, 0.0, 0.0);
         for _ in 0..3 {
