@@ -37,7 +37,8 @@ use anyhow::{Context, bail};
 use mmtrack_io::Overwrite;
 use mmtrack_io::atomic::{CreatedDirRegistration, register_created_dir};
 use mmtrack_io::table::{
-    RunInfo, StagedTable, TableRow, TableSpec, TableWriteSummary, TableWriter, publish_tables, stage_table, table_path,
+    RunInfo, StagedTable, TableRow, TableSpec, TableWriteSummary, TableWriter, check_partition_name, publish_tables,
+    stage_table, table_path,
 };
 
 /// Where a pipeline writes, as the front end gave it: the output directory,
@@ -72,8 +73,14 @@ impl OutputOptions {
     /// [`Self::force`].
     ///
     /// # Errors
-    /// A bad run id ([`run_dir`]). Call it before any work.
+    /// A bad run id ([`run_dir`]) or sequence id (naming `--sequence`). Call
+    /// it before any work.
     pub fn resolve(&self, output: &Path) -> anyhow::Result<RunDir> {
+        if let Some(sequence) = &self.sequence
+            && let Err(detail) = check_partition_name(sequence)
+        {
+            bail!("--sequence: {detail}; it names the partitions sequence=<ID> of the tables; nothing was written");
+        }
         let overwrite = if self.force { Overwrite::Replace } else { Overwrite::Refuse };
         Ok(RunDir { path: run_dir(output, self.run_id.as_deref())?, overwrite })
     }
@@ -296,6 +303,24 @@ mod tests {
         }
         assert_eq!(run_id_of(&output.join("run=a")).as_deref(), Some("a"));
         assert_eq!(run_id_of(output), None);
+    }
+
+    #[test]
+    fn a_bad_sequence_id_is_refused_naming_the_flag_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let output = dir.path().join("out");
+        let with = |id: &str| OutputOptions { sequence: Some(id.to_string()), run_id: None, force: false };
+        let long = "a".repeat(300);
+        for bad in ["a b", "../up", "", "__HIVE_DEFAULT_PARTITION__", long.as_str()] {
+            let err = with(bad).resolve(&output).unwrap_err().to_string();
+            assert!(err.starts_with("--sequence: ") && err.ends_with("nothing was written"), "{bad}: {err}");
+        }
+        assert!(with(&long).resolve(&output).unwrap_err().to_string().contains("300 bytes is too long"));
+        let longest = "a".repeat(mmtrack_io::table::MAX_PARTITION_NAME_BYTES);
+        let run = with(&longest).resolve(&output).unwrap();
+        // The longest accepted id makes a folder the file system takes.
+        std::fs::create_dir_all(run.path.join("t").join(format!("sequence={longest}"))).unwrap();
+        assert!(!output.join("t").join(format!("sequence={longest}a")).exists());
     }
 
     #[test]

@@ -87,7 +87,8 @@ impl RunInfo {
 
 /// Checks that `sequence_id` can name a table partition (the folder
 /// `sequence=<id>`): not empty, not `.` or `..`, and only ASCII letters,
-/// digits, `-`, `_` and `.` (no path separator, space or `=`). The error is
+/// digits, `-`, `_` and `.` (no path separator, space or `=`), at most
+/// [`MAX_PARTITION_NAME_BYTES`] long. The error is
 /// what is wrong, for the caller to place. Ingest checks the id it writes
 /// into a recording with this, so a recording that `process` would refuse
 /// is refused when it is made. [`HIVE_NULL_PARTITION`] is refused too: Hive
@@ -96,6 +97,13 @@ pub fn check_partition_name(sequence_id: &str) -> std::result::Result<(), String
     if sequence_id == HIVE_NULL_PARTITION {
         return Err(format!(
             "'{HIVE_NULL_PARTITION}' is not a valid partition name (Hive readers take it for a missing value)"
+        ));
+    }
+    if sequence_id.len() > MAX_PARTITION_NAME_BYTES {
+        return Err(format!(
+            "a partition name of {} bytes is too long (at most {MAX_PARTITION_NAME_BYTES}: the folder \
+             sequence=<id> is one file name, at most 255 bytes)",
+            sequence_id.len()
         ));
     }
     let safe = !sequence_id.is_empty()
@@ -111,6 +119,10 @@ pub fn check_partition_name(sequence_id: &str) -> std::result::Result<(), String
         ))
     }
 }
+
+/// Longest partition name: `sequence=` and the name make one file name,
+/// and file systems allow at most 255 bytes for one.
+pub const MAX_PARTITION_NAME_BYTES: usize = 255 - "sequence=".len();
 
 /// The partition value Hive readers read as null.
 pub const HIVE_NULL_PARTITION: &str = "__HIVE_DEFAULT_PARTITION__";

@@ -56,9 +56,9 @@ pub use geometric_rows::{
     ZoechmannNlosErrorRow, ZoechmannNmseRow, ZoechmannPathLabelRow, ZoechmannSummaryRow,
 };
 pub use io::{
-    ROW_GROUP_BYTES, RunInfo, StagedTable, TableFileSummary, TableWriteSummary, TableWriter, check_partition_name,
-    inspect_table_dir, inspect_table_file, publish_tables, read_table, read_table_dir, stage_table, table_bytes,
-    table_path, write_table,
+    MAX_PARTITION_NAME_BYTES, ROW_GROUP_BYTES, RunInfo, StagedTable, TableFileSummary, TableWriteSummary, TableWriter,
+    check_partition_name, inspect_table_dir, inspect_table_file, publish_tables, read_table, read_table_dir,
+    stage_table, table_bytes, table_path, write_table,
 };
 pub use mpc_result_rows::{
     ChiClassShare, CountBin, FirstPathRow, MPC_CHI_CLASSES, MPC_COUNT_DISTRIBUTION, MPC_FIRST_PATH, MPC_SET_METRICS,
