@@ -67,7 +67,7 @@ pub(crate) fn ground_truth_frame(recording_extra: &BTreeMap<String, String>) -> 
 
 /// Adds `pose` (of `topic`) to `poses`, refusing a time that
 /// does not increase: the trajectory metrics interpolate between poses.
-fn push_in_order(poses: &mut Vec<StampedPose>, pose: StampedPose, topic: &str) -> anyhow::Result<()> {
+pub(crate) fn push_in_order(poses: &mut Vec<StampedPose>, pose: StampedPose, topic: &str) -> anyhow::Result<()> {
     if let Some(last) = poses.last()
         && pose.t_ns <= last.t_ns
     {
@@ -101,10 +101,10 @@ pub fn read_poses(recording: &Path, progress: &dyn Progress) -> anyhow::Result<R
         progress.check_cancelled()?;
         match item.with_context(|| recording.display().to_string())? {
             RecordingItem::Event(RecordingEvent::Pose { stream: PoseStream::Estimate, pose }) => {
-                push_in_order(&mut estimate, pose, "/estimate/pose")
+                push_in_order(&mut estimate, pose, PoseStream::Estimate.topic())
             }
             RecordingItem::Event(RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose }) => {
-                push_in_order(&mut ground_truth, pose, "/ground_truth/pose")
+                push_in_order(&mut ground_truth, pose, PoseStream::GroundTruth.topic())
             }
             _ => Ok(()),
         }

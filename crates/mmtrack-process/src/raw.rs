@@ -12,7 +12,7 @@ use std::path::Path;
 
 use anyhow::{Context, bail};
 use mmtrack_core::progress::Progress;
-use mmtrack_core::{CirSnapshot, GnssFix, PolarScan};
+use mmtrack_core::{CirSnapshot, GnssFix, PolarScan, StampedPose};
 use mmtrack_io::recording::PoseStream;
 use mmtrack_io::table::{GroundTruthPose, RunInfo, TableRow, TableWriteSummary, TableWriter};
 use mmtrack_io::{RecordingEvent, RecordingMetadata};
@@ -143,7 +143,7 @@ pub fn process_raw(
     let mut scans: Batched<PolarScan> = Batched::new(SCANS_PER_BATCH);
     let mut cirs: Batched<CirSnapshot> = Batched::new(CIRS_PER_BATCH);
     let mut fixes: Vec<GnssFix> = Vec::new();
-    let mut truth: Vec<GroundTruthPose> = Vec::new();
+    let mut truth: Vec<StampedPose> = Vec::new();
     let total_bytes = std::fs::metadata(recording).map(|m| m.len()).unwrap_or(0);
     progress.start("raw", total_bytes, "bytes");
     for_each_event(recording, |event, bytes_read| {
@@ -153,7 +153,9 @@ pub fn process_raw(
             RecordingEvent::RadarScan(scan) => scans.push(scan, &mut tables, &sequence, &run)?,
             RecordingEvent::Cir(cir) => cirs.push(cir, &mut tables, &sequence, &run)?,
             RecordingEvent::Gnss(fix) => fixes.push(fix),
-            RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => truth.push(GroundTruthPose(pose)),
+            RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => {
+                crate::poses::push_in_order(&mut truth, pose, PoseStream::GroundTruth.topic())?
+            }
             _ => {}
         }
         Ok(())
@@ -177,6 +179,7 @@ pub fn process_raw(
     }
     if !truth.is_empty() {
         let frame = crate::poses::ground_truth_frame(&extra);
+        let truth: Vec<GroundTruthPose> = truth.into_iter().map(GroundTruthPose).collect();
         tables.write(&sequence, &truth, &RunInfo { frame: Some(frame), ..run.clone() })?;
     }
     let written = tables.publish()?;

@@ -85,7 +85,9 @@ pub fn run_odometry(recording: &Path, config: OdometryConfig, progress: &dyn Pro
                 estimates.push(result.estimate);
                 timings.push(result.timing);
             }
-            RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => ground_truth.push(pose),
+            RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => {
+                crate::poses::push_in_order(&mut ground_truth, pose, PoseStream::GroundTruth.topic())?
+            }
             _ => {}
         }
         Ok(())

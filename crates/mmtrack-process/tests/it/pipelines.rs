@@ -205,3 +205,43 @@ fn sweep_trackers_run_on_real_deepsense_passes() {
     let beams = |k: SweepTrackerKind| done.summaries.iter().find(|s| s.1 == k).map(|s| s.2.mean_beams_per_sweep);
     assert!(beams(SweepTrackerKind::Window) < beams(SweepTrackerKind::LastFullSweep));
 }
+
+#[test]
+fn ground_truth_that_goes_back_in_time_is_refused_by_every_pipeline_that_writes_it() {
+    use mmtrack_core::{Se2, StampedPose};
+    use mmtrack_io::recording::{PoseStream, TimeBase};
+    use mmtrack_io::{RecordingMetadata, RecordingWriter};
+    let dir = tempfile::tempdir().unwrap();
+    let recording = dir.path().join("backwards.mcap");
+    let metadata = RecordingMetadata {
+        sequence_id: "backwards".into(),
+        source: "test".into(),
+        time_base: TimeBase::Relative,
+        extra: Default::default(),
+    };
+    let mut writer = RecordingWriter::create(&recording, &metadata, &RecordingOptions::default()).unwrap();
+    // The estimate is in order, the ground truth's third pose goes back.
+    for (estimate_t_ns, truth_t_ns) in [(1_000, 1_000), (2_000, 2_000), (2_500, 1_500), (3_000, 3_000)] {
+        let pose = |t_ns: i64| StampedPose { t_ns, parent_from_child: Se2::new(t_ns as f64 * 1e-3, 0.0, 0.0) };
+        writer.write_pose(PoseStream::Estimate, &pose(estimate_t_ns), "world").unwrap();
+        writer.write_pose(PoseStream::GroundTruth, &pose(truth_t_ns), "world").unwrap();
+    }
+    writer.finish().unwrap();
+    let tables = dir.path().join("tables");
+    let options = OutputOptions::default();
+    let config = odometry::effective_config("cfear", None).unwrap();
+    let refusals = [
+        mmtrack_process::raw::process_raw(&recording, &tables, &options, &NoProgress).err(),
+        odometry::process_odometry(&recording, &tables, "cfear", &config, &options, &NoProgress).err(),
+        mmtrack_process::poses::process_poses(&recording, &tables, &options, &NoProgress).err(),
+    ];
+    for err in refusals {
+        let err = err.map(|e| format!("{e:#}")).unwrap_or_default();
+        assert!(err.contains("backwards.mcap"), "names the file: {err}");
+        assert!(
+            err.contains("/ground_truth/pose: pose 2 has t_ns 1500 at or before the previous pose's 2000"),
+            "{err}"
+        );
+    }
+    assert!(!tables.exists(), "nothing written");
+}
