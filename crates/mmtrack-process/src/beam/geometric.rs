@@ -2,7 +2,7 @@
 //! recording's two vehicles (`mmtrack process beam --tracker geometric`).
 //!
 //! The recording must hold the ground truth of a transmitter and a receiver
-//! vehicle (`/ground_truth_tx/pose` and `/ground_truth_rx/pose`, as `mmtrack
+//! vehicle (`/ground_truth/tx` and `/ground_truth/rx`, as `mmtrack
 //! simulate sounder` writes them). Both are interpolated (linearly; yaw on
 //! the shortest arc) every [`GeometricOptions::epoch_ms`] within their common time span; the
 //! transmitter's position in the receiver's frame gives the true range and
@@ -117,7 +117,8 @@ fn read(path: &Path) -> anyhow::Result<TwoVehicles> {
     let (sequence_id, time_base) = RecordingMetadata::from_map(&metadata)
         .map(|m| (m.sequence_id, m.time_base))
         .with_context(|| format!("{}: no mmtrack recording metadata (sequence id)", path.display()))?;
-    for (name, poses) in [("transmitter (/ground_truth_tx/pose)", &tx), ("receiver (/ground_truth_rx/pose)", &rx)] {
+    let names = [PoseStream::GroundTruthTx, PoseStream::GroundTruthRx].map(|s| s.topic());
+    for (name, poses) in [(format!("transmitter ({})", names[0]), &tx), (format!("receiver ({})", names[1]), &rx)] {
         if poses.len() < 2 {
             bail!(
                 "{}: {} poses of the {name}; --tracker geometric needs both vehicles' ground truth (e.g. from `mmtrack \

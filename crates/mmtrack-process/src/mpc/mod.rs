@@ -318,8 +318,10 @@ fn read_and_process(
                 link.pending.push(snapshot);
             }
             RecordingEvent::MpcTruth(truth) => run.truth.push(truth),
-            RecordingEvent::Pose { stream: PoseStream::GroundTruthTx, pose } => run.tx.push(pose),
-            RecordingEvent::Pose { stream: PoseStream::GroundTruthRx, pose } => run.rx.push(pose),
+            RecordingEvent::Pose { stream: stream @ (PoseStream::GroundTruthTx | PoseStream::GroundTruthRx), pose } => {
+                let poses = if stream == PoseStream::GroundTruthTx { &mut run.tx } else { &mut run.rx };
+                crate::poses::push_in_order(poses, pose, stream.topic()).with_context(|| path.display().to_string())?;
+            }
             _ => {}
         }
     }

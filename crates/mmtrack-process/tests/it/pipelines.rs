@@ -244,4 +244,22 @@ fn ground_truth_that_goes_back_in_time_is_refused_by_every_pipeline_that_writes_
         );
     }
     assert!(!tables.exists(), "nothing written");
+
+    // A sounder's transmitter and receiver truth: process mpc writes them as tables.
+    let recording = dir.path().join("backwards-tx.mcap");
+    let mut writer = RecordingWriter::create(&recording, &metadata, &RecordingOptions::default()).unwrap();
+    // The receiver's poses are in order, the transmitter's third goes back.
+    for (rx_t_ns, tx_t_ns) in [(1_000, 1_000), (2_000, 2_000), (3_000, 1_500)] {
+        let pose = |t_ns: i64| StampedPose { t_ns, parent_from_child: Se2::IDENTITY };
+        writer.write_pose(PoseStream::GroundTruthRx, &pose(rx_t_ns), "world").unwrap();
+        writer.write_pose(PoseStream::GroundTruthTx, &pose(tx_t_ns), "world").unwrap();
+    }
+    writer.finish().unwrap();
+    let config = mpc::effective_config(None).unwrap();
+    let err = mpc::process_mpc(&recording, &tables, &config, &mpc::MpcOptions::default(), &NoProgress)
+        .err()
+        .map(|e| format!("{e:#}"))
+        .unwrap_or_default();
+    assert!(err.contains("backwards-tx.mcap") && err.contains("/ground_truth/tx: pose 2 has t_ns 1500"), "{err}");
+    assert!(!tables.exists(), "nothing written");
 }
