@@ -194,7 +194,9 @@ pub fn checked_sequence_id(root: &Path, given: Option<&str>) -> Result<String, I
     };
     mmtrack_io::table::check_partition_name(&id).map_err(|detail| IngestError::BadLayout {
         path: root.to_path_buf(),
-        detail: format!("sequence id (from {from}): {detail}; pass --sequence-id with a name that is"),
+        detail: format!(
+            "sequence id (from {from}): {detail}; pass --sequence-id with a valid name (nothing was written)"
+        ),
     })?;
     Ok(id)
 }
@@ -347,7 +349,7 @@ mod tests {
         let err = checked_sequence_id(&root, None).unwrap_err().to_string();
         assert!(
             err.contains("my drive: sequence id (from the folder name): 'my drive' is not a valid partition name")
-                && err.ends_with("pass --sequence-id with a name that is"),
+                && err.ends_with("pass --sequence-id with a valid name (nothing was written)"),
             "{err}"
         );
         for bad in ["", "a=b", "../../evil", ".."] {

@@ -301,7 +301,14 @@ impl RecordingReader {
             let topic = m.channel.topic.as_str();
             if topic == RADAR_META_TOPIC {
                 let meta: proto::RadarScanMeta = self.decode(&m)?;
-                self.pending_meta = Some((m.sequence, meta));
+                // A writer puts each scan's image right after its metadata.
+                if let Some((sequence, previous)) = self.pending_meta.replace((m.sequence, meta)) {
+                    return Err(self.scan_without_image(
+                        sequence,
+                        previous.t_ns,
+                        "the next scan's metadata came first",
+                    ));
+                }
             } else if topic == RADAR_IMAGE_TOPIC {
                 return self.join_scan(m).map(|s| Some(RecordingItem::Scan(s)));
             } else if let Some(stream) = PoseStream::from_topic(topic) {
@@ -363,7 +370,21 @@ impl RecordingReader {
                 }))));
             }
         }
+        if let Some((sequence, meta)) = self.pending_meta.take() {
+            return Err(self.scan_without_image(sequence, meta.t_ns, "the file ends first"));
+        }
         Ok(None)
+    }
+
+    /// A scan's metadata whose image never came: the error names the
+    /// metadata message and its scan time.
+    fn scan_without_image(&self, sequence: u32, t_ns: i64, why: &str) -> IoError {
+        IoError::BadMessage {
+            path: self.raw.path.clone(),
+            topic: RADAR_META_TOPIC.to_string(),
+            sequence,
+            detail: format!("the radar scan at t_ns {t_ns} has no {RADAR_IMAGE_TOPIC} message: {why}"),
+        }
     }
 
     fn decode_fix(&self, m: &RawMessage) -> Result<GnssFix> {

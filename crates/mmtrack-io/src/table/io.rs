@@ -114,7 +114,7 @@ pub fn check_partition_name(sequence_id: &str) -> std::result::Result<(), String
         Ok(())
     } else {
         Err(format!(
-            "'{}' is not a valid partition name (use letters, digits, '-', '_', '.')",
+            "'{}' is not a valid partition name (use ASCII letters, digits, '-', '_', '.'; not '.' or '..' alone)",
             sequence_id.escape_debug()
         ))
     }

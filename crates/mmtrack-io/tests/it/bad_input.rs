@@ -263,3 +263,46 @@ fn the_hive_null_partition_is_not_a_sequence_id() {
         mmtrack_io::table::check_partition_name(fine).unwrap();
     }
 }
+
+/// `path`'s messages, without the `/radar/image` messages whose index among
+/// them is in `dropped`, written to `out` (metadata records are not copied).
+fn copy_without_images(path: &std::path::Path, out: &std::path::Path, dropped: &[usize]) {
+    let bytes = std::fs::read(path).unwrap();
+    let mut writer = mcap::Writer::new(std::io::BufWriter::new(std::fs::File::create(out).unwrap())).unwrap();
+    let mut images = 0;
+    for message in mcap::MessageStream::new(&bytes).unwrap() {
+        let message = message.unwrap();
+        if message.channel.topic == "/radar/image" {
+            images += 1;
+            if dropped.contains(&(images - 1)) {
+                continue;
+            }
+        }
+        writer.write(&message).unwrap();
+    }
+    writer.finish().unwrap();
+    assert!(images > 2, "{images} images");
+}
+
+#[test]
+fn radar_metadata_without_its_image_is_an_error_naming_the_scan() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = recording(dir.path());
+    let scans = read_all(&path).unwrap().len() / 2;
+    let last = scans - 1;
+    let t_ns = |i: usize| samples::poses()[i].t_ns;
+    for (dropped, why) in [(0, "the next scan's metadata came first"), (last, "the file ends first")] {
+        let bad = dir.path().join(format!("without-{dropped}.mcap"));
+        copy_without_images(&path, &bad, &[dropped]);
+        let err = read_all(&bad).unwrap_err().to_string();
+        assert!(err.contains(&format!("without-{dropped}.mcap")) && err.contains("/radar/scan_meta"), "{err}");
+        assert!(
+            err.contains(&format!("the radar scan at t_ns {} has no /radar/image message: {why}", t_ns(dropped))),
+            "{err}"
+        );
+    }
+    // The copy itself reads as the original does.
+    let copy = dir.path().join("copy.mcap");
+    copy_without_images(&path, &copy, &[]);
+    assert_eq!(read_all(&copy).unwrap().len(), read_all(&path).unwrap().len());
+}
