@@ -211,6 +211,9 @@ fn two_estimates(tables: &[&str]) -> String {
 pub struct TrajectoryResult {
     /// Sequence id.
     pub sequence: String,
+    /// The table the estimate came from (`odometry` or `poses`) when read
+    /// from tables ([`analyze_all`]); `None` for poses given directly.
+    pub estimate_table: Option<&'static str>,
     /// Estimate and ground truth at the same times, both from the identity.
     pub association: Association,
     /// KITTI drift.
@@ -300,7 +303,7 @@ pub fn analyze_trajectory(
         rpe_translation_rmse_m: rms(rpe.iter().map(|e| e.translation_error_m)).unwrap_or(0.0),
         rpe_yaw_rmse_rad: rms(rpe.iter().map(|e| e.yaw_error_rad)).unwrap_or(0.0),
     };
-    Ok(TrajectoryResult { sequence: sequence.to_string(), association, drift, rpe, metrics })
+    Ok(TrajectoryResult { sequence: sequence.to_string(), estimate_table: None, association, drift, rpe, metrics })
 }
 
 /// An estimate and (when present) its ground truth, as read from tables.
@@ -391,7 +394,7 @@ pub fn analyze_all(root: &Path, plan: &Plan, options: &DriftOptions) -> anyhow::
                 file(GROUND_TRUTH.name).display()
             )
         })?;
-        results.push(result);
+        results.push(TrajectoryResult { estimate_table: Some(input.estimate_table), ..result });
     }
     Ok(results)
 }

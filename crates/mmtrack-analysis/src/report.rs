@@ -101,12 +101,17 @@ pub fn not_analyzed(skipped: &[(String, String)]) -> String {
 
 /// One row of the trajectory table; the compared columns formatted as the
 /// compare report formats them ([`Metric::cell`]).
-fn trajectory_row(name: &str, m: &mmtrack_io::table::TrajectoryMetrics, end_point_m: Option<f64>) -> String {
+fn trajectory_row(
+    name: &str,
+    estimate_table: &str,
+    m: &mmtrack_io::table::TrajectoryMetrics,
+    end_point_m: Option<f64>,
+) -> String {
     let [kitti_t, kitti_r, ate, ate_max, x, y, _position, yaw, rpe_t, rpe_yaw, end_point] =
         TRAJECTORY_COMPARED.map(|metric| (metric, value_of(m, metric.column, end_point_m)));
     let cell = |(metric, value): (Metric, Option<f64>)| metric.cell(value);
     format!(
-        "| {name} | {} | {} | {:.1} | {} | {} | {} | {} | ({}, {}) | {} | {} | {} | {} |",
+        "| {name} | {estimate_table} | {} | {} | {:.1} | {} | {} | {} | {} | ({}, {}) | {} | {} | {} | {} |",
         m.associated_poses,
         m.dropped_poses,
         m.path_length_m,
@@ -127,8 +132,8 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
     let _ = write!(
         out,
         "## Trajectory (estimate against `ground_truth`)\n\n\
-         The estimate is the sequence's `odometry` table (our radar odometry, `process odometry`) or its `poses` \
-         table (the recording's own estimate, `process poses`). \
+         The estimate (column `estimate`) is the sequence's `odometry` table (our radar odometry, `process \
+         odometry`) or its `poses` table (the recording's own estimate, `process poses`). \
          Both trajectories are associated by time (ground truth interpolated); the metrics compare them from \
          their first associated pose on (both re-expressed relative to it). Per sequence, the first plot shows \
          them as the tables hold them, the second relative to each first pose. \
@@ -142,22 +147,25 @@ fn trajectory_section(out: &mut String, results: &[TrajectoryResult], options: &
         step(options)
     );
     out.push_str(
-        "| sequence | poses | dropped | path (m) | KITTI t (%) | KITTI r (deg/100 m) | ATE (m) | \
+        "| sequence | estimate | poses | dropped | path (m) | KITTI t (%) | KITTI r (deg/100 m) | ATE (m) | \
          ATE max (m) | RMSE (x, y) (m) | yaw RMSE (deg) | RPE t (m) | RPE yaw (deg) | end-point error (m) |\n\
-         |---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         |---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     let pooled = if results.len() > 1 {
         crate::campaign::pooled_trajectory_metrics(&results.iter().map(|r| &r.metrics).collect::<Vec<_>>())?
     } else {
         None
     };
-    // The pooled row has no end point.
+    // The pooled row has no end point, and its estimate is every sequence's.
     let rows = results
         .iter()
-        .map(|r| (r.sequence.as_str(), &r.metrics, Some(r.metrics.final_position_error_m)))
-        .chain(pooled.as_ref().map(|p| ("all (pooled)", p, None)));
-    for (name, m, end_point_m) in rows {
-        let _ = writeln!(out, "{}", trajectory_row(name, m, end_point_m));
+        .map(|r| {
+            let table = r.estimate_table.map_or_else(|| "-".to_string(), |t| format!("`{t}`"));
+            (r.sequence.as_str(), table, &r.metrics, Some(r.metrics.final_position_error_m))
+        })
+        .chain(pooled.as_ref().map(|p| ("all (pooled)", "-".to_string(), p, None)));
+    for (name, table, m, end_point_m) in rows {
+        let _ = writeln!(out, "{}", trajectory_row(name, &table, m, end_point_m));
     }
     out.push('\n');
     let without: Vec<&str> =
@@ -221,10 +229,10 @@ mod tests {
         for metric in super::TRAJECTORY_COMPARED {
             assert!(super::value_of(&m, metric.column, Some(5.0)).is_some(), "{}", metric.column);
         }
-        let text = super::trajectory_row("s", &m, Some(5.0));
+        let text = super::trajectory_row("s", "`odometry`", &m, Some(5.0));
         // yaw 0.01 rad = 0.573 deg; RPE yaw 0.001 rad = 0.0573 deg; end point 5 m.
         assert!(text.ends_with("| 0.573 | 0.1000 | 0.0573 | 5.000 |"), "{text}");
-        assert!(super::trajectory_row("all", &m, None).ends_with("| 0.0573 | - |"));
+        assert!(super::trajectory_row("all", "-", &m, None).ends_with("| 0.0573 | - |"));
     }
 
     #[test]

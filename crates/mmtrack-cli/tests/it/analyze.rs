@@ -100,7 +100,7 @@ fn analyze_agrees_with_an_independent_devkit_on_exported_kitti_files() {
         assert!(svg.starts_with("<svg") && svg.contains("polyline"), "{plot}");
     }
     let report = std::fs::read_to_string(dir.path().join("analysis/report.md")).unwrap();
-    assert!(report.contains("| drive-a |") && report.contains("plots/drive-a/trajectory.svg"), "{report}");
+    assert!(report.contains("| drive-a | `odometry` |") && report.contains("plots/drive-a/trajectory.svg"), "{report}");
 
     let tables = dir.path().join("analysis/tables");
     let metrics: Vec<TrajectoryMetrics> =
