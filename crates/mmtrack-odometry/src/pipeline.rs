@@ -257,7 +257,7 @@ impl RadarOdometry {
     /// and every later prediction inherits that velocity. So when fewer than
     /// half of the scan's surface points found a correspondence (on the real
     /// Oxford sample's second scan 0.72 / 0.74 did for `cfear` /
-    /// `fast-cfear`; with every other scan, 4.5 m apart, 0.40 / 0.38), the
+    /// `fast-cfear`; with every other scan, 4.7 m apart, 0.40 / 0.38), the
     /// registration also starts from [`FROM_REST_STARTS_IN_RADII`] ahead or
     /// behind, and the trusted start with the most correspondences wins (rest
     /// on a tie); the estimate's diagnostics are the winner's. Ours, not the

@@ -72,8 +72,8 @@ pub(crate) fn push_in_order(poses: &mut Vec<StampedPose>, pose: StampedPose, top
         && pose.t_ns <= last.t_ns
     {
         bail!(
-            "{topic}: pose {} has t_ns {} at or before the previous pose's {}: poses must be in strictly increasing \
-             time",
+            "{topic}: pose {} (counted from 0) has t_ns {} at or before the previous pose's {}: poses must be in \
+             strictly increasing time",
             poses.len(),
             pose.t_ns,
             last.t_ns
@@ -199,9 +199,9 @@ mod tests {
         push_in_order(&mut poses, pose(20), "/estimate/pose").unwrap();
         for t_ns in [20, 5] {
             let e = push_in_order(&mut poses, pose(t_ns), "/estimate/pose").unwrap_err().to_string();
-            assert!(
-                e.starts_with(&format!("/estimate/pose: pose 2 has t_ns {t_ns} at or before the previous pose's 20"))
-            );
+            assert!(e.starts_with(&format!(
+                "/estimate/pose: pose 2 (counted from 0) has t_ns {t_ns} at or before the previous pose's 20"
+            )));
         }
         assert_eq!(poses.len(), 2);
     }

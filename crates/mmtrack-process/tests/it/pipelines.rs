@@ -239,7 +239,9 @@ fn ground_truth_that_goes_back_in_time_is_refused_by_every_pipeline_that_writes_
         let err = err.map(|e| format!("{e:#}")).unwrap_or_default();
         assert!(err.contains("backwards.mcap"), "names the file: {err}");
         assert!(
-            err.contains("/ground_truth/pose: pose 2 has t_ns 1500 at or before the previous pose's 2000"),
+            err.contains(
+                "/ground_truth/pose: pose 2 (counted from 0) has t_ns 1500 at or before the previous pose's 2000"
+            ),
             "{err}"
         );
     }
@@ -260,6 +262,9 @@ fn ground_truth_that_goes_back_in_time_is_refused_by_every_pipeline_that_writes_
         .err()
         .map(|e| format!("{e:#}"))
         .unwrap_or_default();
-    assert!(err.contains("backwards-tx.mcap") && err.contains("/ground_truth/tx: pose 2 has t_ns 1500"), "{err}");
+    assert!(
+        err.contains("backwards-tx.mcap") && err.contains("/ground_truth/tx: pose 2 (counted from 0) has t_ns 1500"),
+        "{err}"
+    );
     assert!(!tables.exists(), "nothing written");
 }
