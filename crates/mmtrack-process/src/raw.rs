@@ -154,13 +154,13 @@ pub fn process_raw(
             RecordingEvent::Cir(cir) => cirs.push(cir, &mut tables, &sequence, &run)?,
             RecordingEvent::Gnss(fix) => fixes.push(fix),
             RecordingEvent::Pose { stream: PoseStream::GroundTruth, pose } => {
-                crate::poses::push_in_order(&mut truth, pose, PoseStream::GroundTruth.topic())?
+                crate::poses::push_in_order(&mut truth, pose, PoseStream::GroundTruth.topic())
+                    .with_context(|| recording.display().to_string())?
             }
             _ => {}
         }
         Ok(())
-    })
-    .with_context(|| format!("{}: reading the recording", recording.display()))?;
+    })?;
     progress.finish();
     let counts = RawCounts {
         radar_scans: scans.finish(&mut tables, &sequence, &run)?,
